@@ -1,0 +1,63 @@
+"""pfm-stability: will a potential-field controller oscillate, and where?
+
+Koren & Borenstein 1991 ("Potential Field Methods and Their Inherent
+Limitations for Mobile Robot Navigation", ICRA) reduce a VFF-controlled robot
+near a wall or in a corridor to a third-order loop (their eq 15–20). This
+package derives that loop symbolically, decides its stability with five models
+of increasing fidelity (DESIGN §4), and checks the predictions against a
+simulation of the VFF algorithm on a histogram grid.
+
+The public names below are imported lazily (PEP 562) so that the command line
+starts fast; ``from pfm_stability import analyze_wall`` works as usual.
+"""
+
+from __future__ import annotations
+
+import importlib
+
+__version__ = "0.1.0"
+
+_EXPORTS = {
+    "Robot": "parameters",
+    "Controller": "parameters",
+    "Wall": "parameters",
+    "Corridor": "parameters",
+    "Preset": "parameters",
+    "CARMEL": "parameters",
+    "get_preset": "parameters",
+    "PowerLaw": "force_law",
+    "ForceLaw": "force_law",
+    "wall_gain": "force_law",
+    "corridor_gain": "force_law",
+    "Loop": "models",
+    "Boundary": "models",
+    "MODEL_NAMES": "models",
+    "make_model": "models",
+    "make_models": "models",
+    "Continuous": "models",
+    "KBFirstOrder": "models",
+    "Pade": "models",
+    "ExactDelay": "models",
+    "Sampled": "models",
+    "DelayLoop": "delay",
+    "analyze_wall": "criteria",
+    "analyze_corridor": "criteria",
+    "kb_critical_L": "criteria",
+    "kb_critical_f_wall": "criteria",
+    "build_report": "report",
+    "routh_array": "routh",
+    "schur_cohn_stable": "routh",
+}
+
+__all__ = sorted(_EXPORTS) + ["__version__"]
+
+
+def __getattr__(name):
+    if name in _EXPORTS:
+        module = importlib.import_module(f".{_EXPORTS[name]}", __name__)
+        return getattr(module, name)
+    raise AttributeError(f"module 'pfm_stability' has no attribute {name!r}")
+
+
+def __dir__():
+    return __all__

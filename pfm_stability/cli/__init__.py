@@ -1,0 +1,80 @@
+"""The ``pfm-stability`` command line.
+
+Subcommands live in their own modules (``report``, ``derive``, ``simulate``,
+``validate``, ``plot``); each exposes ``add_parser(subparsers)`` and
+``run(args) -> int``. Module imports here are light (no numpy, scipy, sympy or
+matplotlib) so that start-up stays fast; the heavy libraries are imported by
+the subcommand that needs them.
+
+Every user error — a bad value, an unknown option, an impossible scenario —
+ends with exit status 2 and one line on stderr::
+
+    pfm-stability: error: V must be a finite number in (0, inf) m/s; got -1.0
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+
+__all__ = ["main", "build_parser", "UsageError"]
+
+SUBCOMMANDS = ("report", "derive", "simulate", "validate", "plot")
+
+
+class UsageError(Exception):
+    """A user error found while parsing; printed as one line, exit status 2."""
+
+
+class _Parser(argparse.ArgumentParser):
+    """ArgumentParser whose errors are a single line and an exception, not an exit."""
+
+    def error(self, message):
+        raise UsageError(message)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The full parser with every available subcommand."""
+    parser = _Parser(
+        prog="pfm-stability",
+        description="Will a potential-field (VFF) controller oscillate near walls and in corridors? "
+        "Koren & Borenstein 1991 analysis with exact-delay and sampled-data models, and a simulator that checks it.",
+    )
+    from .. import __version__
+
+    parser.add_argument("--version", action="version", version=f"pfm-stability {__version__}")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
+    sub.required = True
+    for name in SUBCOMMANDS:
+        try:
+            module = importlib.import_module(f".{name}", __name__)
+        except ModuleNotFoundError as exc:  # a subcommand not built in this version
+            if exc.name != f"{__name__}.{name}":
+                raise
+            continue
+        module.add_parser(sub)
+    return parser
+
+
+def _fail(message: str) -> int:
+    print(f"pfm-stability: error: {message}", file=sys.stderr)
+    return 2
+
+
+def main(argv=None) -> int:
+    """Run the CLI; returns the exit status (0 ok, 2 user error)."""
+    parser = build_parser()
+    try:
+        args = parser.parse_args(argv)
+        return int(args.run(args) or 0)
+    except UsageError as exc:
+        return _fail(str(exc))
+    except ValueError as exc:
+        return _fail(str(exc))
+    except BrokenPipeError:
+        return 0
+
+
+def entry_point() -> None:  # pragma: no cover - thin wrapper
+    sys.exit(main())

@@ -1,0 +1,59 @@
+"""``pfm-stability report``: every model's verdict for a wall and/or a corridor."""
+
+from __future__ import annotations
+
+import argparse
+
+from .options import add_parameter_options, number, resolve_parameters
+
+MODEL_CHOICES = ("continuous", "kb_first_order", "pade", "exact_delay", "sampled")
+
+
+def add_parser(sub) -> None:
+    p = sub.add_parser(
+        "report",
+        help="stability report for a wall (--alpha) and/or a corridor (--L)",
+        description="Stability of the VFF robot-environment loop (Koren & Borenstein 1991) for every model.",
+    )
+    add_parameter_options(p)
+    p.add_argument("--alpha", type=number("alpha", 0.0, 90.0, unit="deg"), help="wall: target angle from the wall normal, deg, in (0, 90)")
+    p.add_argument("--L", type=number("L", 0.0, unit="m"), help="corridor half-width, m (> W/2)")
+    p.add_argument("--model", action="append", choices=MODEL_CHOICES, help="model to include (repeatable; default: all)")
+    p.add_argument("--pade-order", type=_pade_order, default=3, help="order m of the pade model (1..12, default 3)")
+    p.add_argument("--format", choices=("text", "json", "markdown"), default="text")
+    p.set_defaults(run=run)
+
+
+def _pade_order(text: str) -> int:
+    from ..checks import check_integer
+
+    try:
+        return check_integer("pade_order", int(text), 1, 12)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"pade_order must be an integer in [1, 12]; got {text!r}") from None
+
+
+def run(args) -> int:
+    import json
+    import math
+
+    from ..report import build_report
+    from ..render import render_markdown, render_text
+
+    params = resolve_parameters(args)
+    report = build_report(
+        params.robot,
+        params.controller,
+        alpha=math.radians(args.alpha) if args.alpha is not None else None,
+        L=args.L,
+        models=tuple(dict.fromkeys(args.model)) if args.model else MODEL_CHOICES,
+        pade_order=args.pade_order,
+        sources={**params.sources, "alpha_deg": "user", "L": "user", "pade_order": "user" if args.pade_order != 3 else "default"},
+    )
+    if args.format == "json":
+        print(json.dumps(report.to_dict(), indent=2))
+    elif args.format == "markdown":
+        print(render_markdown(report), end="")
+    else:
+        print(render_text(report), end="")
+    return 0

@@ -1,0 +1,327 @@
+"""Wall and corridor stability criteria for every loop model.
+
+Koren & Borenstein 1991 (KB) state stability as NV(τ + T) < 1 (eq 20) and turn
+it into conditions on the environment: eq (21)/(24) for a wall, eq (25) for a
+corridor. Every model of `pfm_stability.models` gives its own critical NV*, and
+since N depends on the force law, α, f and L but not on V, the same algebra
+gives each model's critical values with 1/NV* in place of KB's (τ + T):
+
+* wall (power law): N = (n/W) f^(−1/n) cos^((n+1)/n) α / sin α, so
+  f* = cos α [nV/(W·NV*·tan α)]^n (eq 24 generalized), V* = NV*/N, and α*
+  solves N(α)V = NV*;
+* corridor (power law): N = 2nfWⁿ/L^(n+1), so
+  L* = (2nWⁿVf/NV*)^(1/(n+1)) (eq 25 generalized), f* = L^(n+1)NV*/(2nWⁿV).
+
+For any other force law the same conditions are solved numerically (Brent's
+method on a bracket found by geometric expansion).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+from .force_law import ForceLaw, PowerLaw, corridor_gain, wall_gain
+from .models import Loop, LoopModel, verdict_label
+from .parameters import Controller, Corridor, Robot, Wall, check_corridor_fits
+
+__all__ = [
+    "ModelVerdict",
+    "WallAnalysis",
+    "CorridorAnalysis",
+    "analyze_wall",
+    "analyze_corridor",
+    "critical_alpha",
+    "critical_f_wall",
+    "critical_f_corridor",
+    "critical_L",
+    "kb_critical_f_wall",
+    "kb_critical_L",
+    "loop_of",
+]
+
+
+@dataclass(frozen=True)
+class ModelVerdict:
+    """One model's answer for one scenario.
+
+    Attributes
+    ----------
+    model : str
+        Model name (DESIGN §4).
+    NV : float
+        Operating NV, 1/s.
+    NV_critical : float
+        NV*, 1/s (``inf``: stable for every NV).
+    omega_critical : float or None
+        Oscillation frequency at the boundary, rad/s.
+    margin : float
+        NV*/NV − 1: > 0 stable, < 0 unstable (relative gain margin).
+    verdict : str
+        "stable", "unstable" or "undecided" (|margin| <= 1e-9).
+    critical : dict
+        Critical value of each parameter with the others fixed
+        (SI units; angles in rad, plus ``alpha_critical_deg``).
+    rightmost_root : complex
+        Dominant root σ + jω (1/s, rad/s) at the operating point.
+    """
+
+    model: str
+    NV: float
+    NV_critical: float
+    omega_critical: float | None
+    margin: float
+    verdict: str
+    critical: dict = field(default_factory=dict)
+    rightmost_root: complex = 0j
+
+    @property
+    def stable(self) -> bool:
+        """True only when the verdict is "stable"."""
+        return self.verdict == "stable"
+
+
+@dataclass(frozen=True)
+class WallAnalysis:
+    """Travel along a wall: equilibrium, gain and every model's verdict.
+
+    Attributes
+    ----------
+    alpha : float
+        Target angle, rad.
+    d0 : float
+        Equilibrium distance, m (KB eq 23).
+    N : float
+        Environment gain, 1/m (KB eq 11).
+    NV : float
+        1/s.
+    models : dict[str, ModelVerdict]
+    """
+
+    alpha: float
+    d0: float
+    N: float
+    NV: float
+    models: dict
+
+
+@dataclass(frozen=True)
+class CorridorAnalysis:
+    """Travel down a corridor: gain and every model's verdict.
+
+    Attributes
+    ----------
+    L : float
+        Half-width, m.
+    N : float
+        Environment gain, 1/m (N = 2nfWⁿ/L^(n+1) for KB's law).
+    NV : float
+        1/s.
+    models : dict[str, ModelVerdict]
+    """
+
+    L: float
+    N: float
+    NV: float
+    models: dict
+
+
+def loop_of(robot: Robot, controller: Controller) -> Loop:
+    """The (τ, T, k) every model needs."""
+    return Loop(robot.tau, controller.T, robot.k)
+
+
+def _law(robot: Robot, controller: Controller, law: ForceLaw | None) -> ForceLaw:
+    return law if law is not None else PowerLaw(controller.f, controller.n, robot.W)
+
+
+# --------------------------------------------------------------- root finding
+def _solve_monotone(func, x0: float, *, positive: bool = True) -> float:
+    """Root of a monotone function, bracketed by geometric expansion from x0.
+
+    For ``positive`` the search stays in (0, inf); the bracket grows by a
+    factor 2 each way for up to 200 steps. Returns the bracket end
+    (0 or inf) if no sign change is found.
+    """
+    from scipy.optimize import brentq
+
+    f0 = func(x0)
+    if f0 == 0:
+        return x0
+    lo = hi = x0
+    for _ in range(200):
+        lo, hi = lo / 2, hi * 2
+        flo, fhi = func(lo), func(hi)
+        if flo * f0 <= 0:
+            return brentq(func, lo, lo * 2, xtol=1e-300, rtol=1e-13)
+        if fhi * f0 <= 0:
+            return brentq(func, hi / 2, hi, xtol=1e-300, rtol=1e-13)
+    return 0.0 if abs(flo) < abs(fhi) else math.inf
+
+
+# ------------------------------------------------------------- closed forms
+def kb_critical_f_wall(alpha, V, tau_plus_T, n, W):
+    """KB eq (24): f* = cos α [nV(τ+T)/(W tan α)]^n (α in rad, V in m/s, τ+T in s, W in m)."""
+    return math.cos(alpha) * (n * V * tau_plus_T / (W * math.tan(alpha))) ** n
+
+
+def kb_critical_L(n, W, V, tau_plus_T, f):
+    """KB eq (25) with the W* misprint corrected: L* = (2nWⁿV(τ+T)f)^(1/(n+1)), m.
+
+    Plain arithmetic, so it accepts sympy symbols: the tests compare it with the
+    derivation exactly.
+    """
+    return (2 * n * W**n * V * tau_plus_T * f) ** (1 / (n + 1))
+
+
+def critical_alpha(law: ForceLaw, V: float, NV_critical: float) -> float:
+    """α*, rad: N(α)·V = NV* (stable for α > α* when N decreases with α).
+
+    0 when NV* is infinite; π/2 when NV* = 0.
+    """
+    if math.isinf(NV_critical):
+        return 0.0
+    if NV_critical <= 0:
+        return math.pi / 2
+    target = NV_critical / V
+
+    # t = ln tan α maps (0, π/2) onto the real line; N(α) − target is decreasing in t
+    def excess(t):
+        alpha = math.atan(math.exp(t))
+        if alpha >= math.pi / 2:
+            return -target
+        return wall_gain(law, alpha)[1] - target
+
+    from scipy.optimize import brentq
+
+    lo, hi = -1.0, 1.0
+    for _ in range(200):
+        if excess(lo) > 0:
+            break
+        lo *= 2
+    for _ in range(200):
+        if excess(hi) < 0:
+            break
+        hi *= 2
+    return math.atan(math.exp(brentq(excess, lo, hi, xtol=1e-14, rtol=1e-14)))
+
+
+def critical_f_wall(law: ForceLaw, alpha: float, V: float, NV_critical: float) -> float:
+    """f*: the force-law strength above which the wall is stable (KB eq 24)."""
+    if math.isinf(NV_critical):
+        return 0.0
+    if NV_critical <= 0:
+        return math.inf
+    if isinstance(law, PowerLaw):
+        return kb_critical_f_wall(alpha, V, 1.0 / NV_critical, law.n, law.W)
+    return _solve_monotone(lambda c: math.log(wall_gain(law.with_scale(c), alpha)[1] * V / NV_critical), law.scale)
+
+
+def critical_L(law: ForceLaw, V: float, NV_critical: float) -> float:
+    """L*, m: corridor half-width above which the middle is stable (KB eq 25)."""
+    if math.isinf(NV_critical):
+        return 0.0
+    if NV_critical <= 0:
+        return math.inf
+    if isinstance(law, PowerLaw):
+        return kb_critical_L(law.n, law.W, V, 1.0 / NV_critical, law.f)
+    return _solve_monotone(lambda L: math.log(corridor_gain(law, L) * V / NV_critical), 1.0)
+
+
+def critical_f_corridor(law: ForceLaw, L: float, V: float, NV_critical: float) -> float:
+    """f*: force-law strength below which the corridor middle is stable (N ∝ f)."""
+    if math.isinf(NV_critical):
+        return math.inf
+    return law.scale * NV_critical / (corridor_gain(law, L) * V)
+
+
+# ------------------------------------------------------------------ analyses
+def _verdict(model: LoopModel, loop: Loop, NV: float, boundary, critical: dict) -> ModelVerdict:
+    if NV == 0:
+        return ModelVerdict(model.name, NV, boundary.NV_critical, boundary.omega_critical, math.inf, "stable", critical, 0j)
+    stable = model.is_stable(NV, loop)
+    critical = dict(critical)
+    critical["T_critical"] = model.critical_delay(NV, loop)
+    if model.name == "kb_first_order":
+        critical["tau_plus_T_critical"] = 1.0 / NV
+    return ModelVerdict(
+        model=model.name,
+        NV=NV,
+        NV_critical=boundary.NV_critical,
+        omega_critical=boundary.omega_critical,
+        margin=boundary.NV_critical / NV - 1.0,
+        verdict=verdict_label(NV, boundary, stable),
+        critical=critical,
+        rightmost_root=model.rightmost_root(NV, loop),
+    )
+
+
+def analyze_wall(robot: Robot, controller: Controller, wall: Wall, models, law: ForceLaw | None = None) -> WallAnalysis:
+    """Stability along a wall for each model (KB §5.3, eq 20–24).
+
+    Parameters
+    ----------
+    robot, controller : Robot, Controller
+    wall : Wall
+        Target angle α.
+    models : iterable of LoopModel
+    law : ForceLaw, optional
+        Lateral repulsion law; KB's power law f(W/d)^n by default.
+
+    Returns
+    -------
+    WallAnalysis
+        Critical values per model: ``alpha_critical`` (rad), ``alpha_critical_deg``,
+        ``f_critical``, ``V_critical`` (m/s), ``T_critical`` (s).
+    """
+    law = _law(robot, controller, law)
+    loop = loop_of(robot, controller)
+    d0, N = wall_gain(law, wall.alpha)
+    NV = N * robot.V
+    out = {}
+    for model in models:
+        boundary = model.boundary(loop)
+        alpha_star = critical_alpha(law, robot.V, boundary.NV_critical)
+        critical = {
+            "alpha_critical": alpha_star,
+            "alpha_critical_deg": math.degrees(alpha_star),
+            "f_critical": critical_f_wall(law, wall.alpha, robot.V, boundary.NV_critical),
+            "V_critical": boundary.NV_critical / N if N > 0 else math.inf,
+        }
+        out[model.name] = _verdict(model, loop, NV, boundary, critical)
+    return WallAnalysis(wall.alpha, d0, N, NV, out)
+
+
+def analyze_corridor(robot: Robot, controller: Controller, corridor: Corridor, models, law: ForceLaw | None = None) -> CorridorAnalysis:
+    """Stability in the middle of a corridor for each model (KB §5.4, eq 25).
+
+    Parameters
+    ----------
+    robot, controller : Robot, Controller
+    corridor : Corridor
+        Half-width L (must exceed W/2).
+    models : iterable of LoopModel
+    law : ForceLaw, optional
+        KB's power law by default.
+
+    Returns
+    -------
+    CorridorAnalysis
+        Critical values per model: ``L_critical`` (m), ``V_critical`` (m/s),
+        ``f_critical``, ``T_critical`` (s).
+    """
+    check_corridor_fits(corridor, robot)
+    law = _law(robot, controller, law)
+    loop = loop_of(robot, controller)
+    N = corridor_gain(law, corridor.L)
+    NV = N * robot.V
+    out = {}
+    for model in models:
+        boundary = model.boundary(loop)
+        critical = {
+            "L_critical": critical_L(law, robot.V, boundary.NV_critical),
+            "V_critical": boundary.NV_critical / N if N > 0 else math.inf,
+            "f_critical": critical_f_corridor(law, corridor.L, robot.V, boundary.NV_critical),
+        }
+        out[model.name] = _verdict(model, loop, NV, boundary, critical)
+    return CorridorAnalysis(corridor.L, N, NV, out)

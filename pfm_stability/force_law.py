@@ -1,0 +1,156 @@
+"""Lateral repulsion laws F_r(d) and the environment gain N they produce.
+
+Forces are in units of the attractive force constant F_a (KB's F_ct), so a law
+is the dimensionless ratio F_r(d)/F_a. KB's lumped law (Koren & Borenstein 1991
+eq 8 with eq 13) is the power law F_r/F_a = f·(W/d)^n. Any decreasing law works
+(DESIGN §3, "General force law"):
+
+* wall (KB eq 22–23): the equilibrium distance solves F_r(d0) = F_a cos α, and
+  the linearization (eq 10–11, δ = 0) gives N = −F_r′(d0)/(F_a sin α);
+* corridor, target straight ahead: N = −2F_r′(L)/F_a (both walls push).
+
+Everything downstream depends on the product NV only.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .checks import check_number
+
+__all__ = ["ForceLaw", "PowerLaw", "wall_equilibrium", "wall_gain", "corridor_gain"]
+
+
+class ForceLaw:
+    """A decreasing lateral repulsion law F_r(d)/F_a, d in m.
+
+    Subclasses implement `force`, `slope` and `with_scale`; `distance_for`
+    has a numerical default (Brent's method on the monotone law).
+
+    Attributes
+    ----------
+    scale : float
+        The law's strength parameter (KB's f for the power law; the cell
+        force ratio for a grid law); `with_scale` returns the same law with
+        another strength, the force being proportional to it.
+    """
+
+    scale: float = 1.0
+    name: str = "force law"
+
+    def force(self, d):
+        """F_r(d)/F_a (dimensionless)."""
+        raise NotImplementedError  # pragma: no cover - interface
+
+    def slope(self, d):
+        """d(F_r/F_a)/dd, 1/m (negative)."""
+        raise NotImplementedError  # pragma: no cover - interface
+
+    def with_scale(self, scale: float) -> "ForceLaw":
+        """The same law with strength `scale` (force ∝ scale)."""
+        raise NotImplementedError  # pragma: no cover - interface
+
+    def domain(self) -> tuple[float, float]:
+        """(d_min, d_max), m: where the law is defined and decreasing."""
+        return (1e-9, math.inf)
+
+    def distance_for(self, force: float) -> float:
+        """d with F_r(d)/F_a = `force` (m); ``inf`` if the law never gets that weak."""
+        from scipy.optimize import brentq
+
+        lo, hi = self.domain()
+        if self.force(lo) <= force:
+            return lo
+        if math.isinf(hi):
+            hi = max(lo * 2, 1.0)
+            while self.force(hi) > force:
+                hi *= 2
+                if hi > 1e12:
+                    return math.inf
+        elif self.force(hi) > force:
+            return math.inf
+        return brentq(lambda d: self.force(d) - force, lo, hi, xtol=1e-14, rtol=1e-14)
+
+    def local_exponent(self, d):
+        """Local exponent −d·F′/F (n for the power law)."""
+        d = np.asarray(d, dtype=float)
+        return -d * self.slope(d) / self.force(d)
+
+    def equivalent_f(self, d, n: float, W: float):
+        """KB's lumped f that gives this law's force at d: F_r(d)·(d/W)^n (KB §4 f_av)."""
+        d = np.asarray(d, dtype=float)
+        return self.force(d) * (d / W) ** n
+
+
+@dataclass(frozen=True)
+class PowerLaw(ForceLaw):
+    """KB's lumped law F_r/F_a = f·(W/d)^n (Koren & Borenstein 1991 eq 8, 13).
+
+    Parameters
+    ----------
+    f : float
+        Force-constant ratio F_cr/F_ct, > 0 (eq 13).
+    n : float
+        Exponent, > 0 (eq 1, 8).
+    W : float
+        Robot width, m, > 0 (eq 1).
+    """
+
+    f: float
+    n: float
+    W: float
+    name = "power law (KB eq 8)"
+
+    def __post_init__(self):
+        object.__setattr__(self, "f", check_number("f", self.f, 0.0))
+        object.__setattr__(self, "n", check_number("n", self.n, 0.0))
+        object.__setattr__(self, "W", check_number("W", self.W, 0.0, unit="m"))
+
+    @property
+    def scale(self) -> float:
+        return self.f
+
+    def force(self, d):
+        return self.f * (self.W / np.asarray(d, dtype=float)) ** self.n
+
+    def slope(self, d):
+        d = np.asarray(d, dtype=float)
+        return -self.n * self.f * self.W**self.n / d ** (self.n + 1)
+
+    def with_scale(self, scale: float) -> "PowerLaw":
+        return PowerLaw(scale, self.n, self.W)
+
+    def distance_for(self, force: float) -> float:
+        """KB eq (23): d0 = W (f/F)^(1/n)."""
+        return self.W * (self.f / force) ** (1.0 / self.n)
+
+
+def wall_equilibrium(law: ForceLaw, alpha: float) -> float:
+    """Equilibrium distance to the wall d0, m (KB eq 22–23: F_r(d0) = F_a cos α).
+
+    Parameters
+    ----------
+    law : ForceLaw
+    alpha : float
+        Target angle from the wall normal, rad, in (0, π/2).
+    """
+    return law.distance_for(math.cos(alpha))
+
+
+def wall_gain(law: ForceLaw, alpha: float) -> tuple[float, float]:
+    """(d0 in m, N in 1/m) for travel along a wall (KB eq 11 with δ = 0, eq 23).
+
+    N = −F_r′(d0)/(F_a sin α); 0 when no equilibrium exists (d0 = inf).
+    """
+    d0 = wall_equilibrium(law, alpha)
+    if math.isinf(d0):
+        return d0, 0.0
+    return d0, float(-law.slope(d0) / math.sin(alpha))
+
+
+def corridor_gain(law: ForceLaw, L: float) -> float:
+    """N = −2F_r′(L)/F_a, 1/m, in the middle of a corridor of half-width L (KB §5.4)."""
+    return float(-2.0 * law.slope(L))

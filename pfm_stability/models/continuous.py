@@ -1,0 +1,32 @@
+"""`continuous`: no delay, KB eq (17): τs³ + s² + ks + kNV = 0.
+
+Routh on (17) gives stable ⇔ τNV < 1, so NV* = 1/τ (∞ for τ = 0, where the
+loop s² + ks + kNV is stable for every gain); the boundary oscillation is at
+ω* = √(k/τ). Both closed forms are checked against the derivation and against
+the generic crossing computation in the tests.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .base import AffineGainModel, Loop
+
+__all__ = ["Continuous"]
+
+
+class Continuous(AffineGainModel):
+    """Koren & Borenstein 1991 eq (17): the delay-free robot–environment loop."""
+
+    name = "continuous"
+    equation = "tau s^3 + s^2 + k s + k N V = 0  (KB eq 17)"
+
+    def polynomials(self, loop: Loop):
+        """D = τs³ + s² + ks, E = 1 (descending powers of s)."""
+        return loop.plant, np.array([1.0])
+
+    def critical_delay(self, NV: float, loop: Loop) -> float:
+        """T does not enter (17): ``inf`` if τNV < 1, else 0 (s)."""
+        return math.inf if self.is_stable(NV, loop) else 0.0

@@ -1,0 +1,226 @@
+"""Robot, controller and scenario parameters, and the CARMEL preset.
+
+All quantities are SI (m, s, rad); the CLI converts degrees at its edge.
+Symbols follow Koren & Borenstein 1991 ("KB"): V, tau (τ, eq 6), k (eq 5),
+W (eq 1), f (eq 13), n (eq 1, 8), T (eq 18), alpha (α, eq 9), L (eq 25).
+
+Every dataclass validates itself on construction and raises :class:`ValueError`
+with a one-line message naming the parameter and its allowed range.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, replace
+
+from .checks import check_choice, check_integer, check_number
+
+__all__ = [
+    "Robot",
+    "Controller",
+    "Wall",
+    "Corridor",
+    "Preset",
+    "CARMEL",
+    "PRESETS",
+    "get_preset",
+    "HOLDS",
+    "check_corridor_fits",
+]
+
+HOLDS = ("command", "reference")
+"""Sampled-loop structures of DESIGN §4: what the sampled computer holds."""
+
+_MAX_EXPONENT = 10.0
+
+
+@dataclass(frozen=True)
+class Robot:
+    """A synchro-drive robot with a first-order steering-rate lag (KB eq 6).
+
+    Parameters
+    ----------
+    V : float
+        Travel speed, m/s, > 0.
+    tau : float
+        Steering-motor time constant τ, s, >= 0 (KB eq 6; 0 = ideal motor).
+    k : float
+        Steering gain, 1/s, > 0 (KB eq 5: u = k(δ − θ)).
+    W : float
+        Robot width, m, > 0 (KB eq 1).
+    max_steering_rate : float
+        Largest steering rate |ω|, rad/s, > 0 (CARMEL: 120°/s). Used by the
+        simulator only; the linear analysis assumes no saturation.
+    """
+
+    V: float
+    tau: float
+    k: float
+    W: float
+    max_steering_rate: float = math.radians(120.0)
+
+    def __post_init__(self):
+        object.__setattr__(self, "V", check_number("V", self.V, 0.0, unit="m/s"))
+        object.__setattr__(self, "tau", check_number("tau", self.tau, 0.0, low_open=False, unit="s"))
+        object.__setattr__(self, "k", check_number("k", self.k, 0.0, unit="1/s"))
+        object.__setattr__(self, "W", check_number("W", self.W, 0.0, unit="m"))
+        object.__setattr__(
+            self,
+            "max_steering_rate",
+            check_number("max_steering_rate", self.max_steering_rate, 0.0, unit="rad/s"),
+        )
+
+    def replace(self, **changes) -> "Robot":
+        """Return a copy with some fields changed (validated again)."""
+        return replace(self, **changes)
+
+
+@dataclass(frozen=True)
+class Controller:
+    """The VFF potential-field controller and how it samples.
+
+    Parameters
+    ----------
+    f : float
+        Repulsive/attractive force-constant ratio, > 0 (KB eq 13).
+    n : float
+        Repulsion exponent, in (0, 10] (KB eq 1, 8).
+    T : float
+        Sampling period, s, >= 0 (KB eq 18; 0 = continuous controller).
+    hold : {"command", "reference"}
+        What the sampled computer holds between samples (DESIGN §4):
+        ``"command"`` holds u = k(δ_k − θ_k); ``"reference"`` holds δ_k and the
+        steering servo closes k(δ − θ) continuously.
+    compute_delay : {0, 1}
+        Samples between measuring at t_k and applying the result.
+    """
+
+    f: float
+    n: float
+    T: float
+    hold: str = "command"
+    compute_delay: int = 0
+
+    def __post_init__(self):
+        object.__setattr__(self, "f", check_number("f", self.f, 0.0))
+        object.__setattr__(self, "n", check_number("n", self.n, 0.0, _MAX_EXPONENT, high_open=False))
+        object.__setattr__(self, "T", check_number("T", self.T, 0.0, low_open=False, unit="s"))
+        check_choice("hold", self.hold, HOLDS)
+        object.__setattr__(self, "compute_delay", check_integer("compute_delay", self.compute_delay, 0, 1))
+
+    def replace(self, **changes) -> "Controller":
+        """Return a copy with some fields changed (validated again)."""
+        return replace(self, **changes)
+
+
+@dataclass(frozen=True)
+class Wall:
+    """Travel along a long wall with the target at angle α (KB Fig 2, eq 9).
+
+    Parameters
+    ----------
+    alpha : float
+        Angle between the wall normal (towards the wall) and the target
+        direction, rad, in (0, π/2); π/2 = target straight ahead along the wall.
+    """
+
+    alpha: float
+
+    def __post_init__(self):
+        object.__setattr__(self, "alpha", check_number("alpha", self.alpha, 0.0, math.pi / 2, unit="rad"))
+
+    @classmethod
+    def from_degrees(cls, alpha_deg: float) -> "Wall":
+        """Build from α in degrees, with the range stated in degrees on error."""
+        alpha_deg = check_number("alpha", alpha_deg, 0.0, 90.0, unit="deg")
+        return cls(math.radians(alpha_deg))
+
+
+@dataclass(frozen=True)
+class Corridor:
+    """Travel down the middle of a corridor, target straight ahead (KB §5.4).
+
+    Parameters
+    ----------
+    L : float
+        Half-width: robot centre line to each wall, m, > W/2 (KB eq 25).
+    """
+
+    L: float
+
+    def __post_init__(self):
+        object.__setattr__(self, "L", check_number("L", self.L, 0.0, unit="m"))
+
+
+def check_corridor_fits(corridor: Corridor, robot: Robot) -> None:
+    """Raise ValueError unless the robot fits: L > W/2.
+
+    Raises
+    ------
+    ValueError
+        ``"L must be a finite number in (W/2, inf) m = (0.4, inf) m; got 0.3"``.
+    """
+    if not corridor.L > robot.W / 2:
+        raise ValueError(
+            f"L must be a finite number in (W/2, inf) m = ({robot.W / 2:g}, inf) m; got {corridor.L!r}"
+        )
+
+
+@dataclass(frozen=True)
+class Preset:
+    """A named robot + controller with the provenance of every value.
+
+    Attributes
+    ----------
+    name : str
+        Preset name used by the CLI (``--preset``).
+    robot : Robot
+    controller : Controller
+    assumed : dict[str, str]
+        Parameters the source does not give, with why the value was chosen.
+    source : str
+        Where the other values come from.
+    cell_size : float
+        Histogram-grid cell size, m (KB §2: 0.1 m).
+    window_cells : int
+        Active-window side w_s, cells (KB §2: 33).
+    """
+
+    name: str
+    robot: Robot
+    controller: Controller
+    assumed: dict = field(default_factory=dict)
+    source: str = ""
+    cell_size: float = 0.1
+    window_cells: int = 33
+
+
+CARMEL = Preset(
+    name="carmel",
+    robot=Robot(V=0.8, tau=0.3, k=2.0, W=0.8, max_steering_rate=math.radians(120.0)),
+    controller=Controller(f=0.8, n=2.0, T=0.065, hold="command", compute_delay=1),
+    assumed={
+        "k": "KB do not give the steering gain; 2 1/s gives the steering loop "
+        "tau*s^2 + s + k a damping ratio of 0.65 with tau = 0.3 s",
+        "hold": "KB do not say how CARMEL sampled; the VFF computer sends steering-rate "
+        "commands to the Z-80 low-level controller, so the whole command is held",
+        "compute_delay": "KB do not say; one VFF cycle (T = 65 ms on the 386) is the time to "
+        "compute a command, so a command computed from the data of t_k is applied at t_k+1",
+    },
+    source="Koren & Borenstein 1991, §4 and §5.4: V = 0.8 m/s, tau = 0.3 s, T = 0.065 s, "
+    "f_av = 0.8, n = 2, W = 0.8 m (sensor ring diameter), 120 deg/s, 0.1 m cells, 33-cell window",
+)
+
+PRESETS = {CARMEL.name: CARMEL}
+
+
+def get_preset(name: str) -> Preset:
+    """Return the preset called `name` (``"carmel"``).
+
+    Raises
+    ------
+    ValueError
+        If no preset has that name.
+    """
+    check_choice("preset", name, tuple(PRESETS))
+    return PRESETS[name]

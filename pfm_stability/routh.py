@@ -1,0 +1,254 @@
+"""Routh–Hurwitz and Schur–Cohn (Jury) tests for polynomials of any degree.
+
+`routh_array` builds the Routh array of a real polynomial, numerically (floats)
+or symbolically (sympy expressions), and handles the two special cases:
+
+* a zero in the first column of an otherwise non-zero row: replaced by a small
+  ε > 0 (numerically ``eps_scale`` times the row's size; symbolically a positive
+  sympy symbol ``epsilon`` whose limit ε → 0+ is taken when signs are counted);
+* a row of zeros (roots symmetric about the origin, e.g. a pair on the imaginary
+  axis): replaced by the coefficients of the derivative of the auxiliary
+  polynomial formed from the row above.
+
+The number of sign changes in the first column equals the number of roots with
+positive real part (Routh 1877; Gantmacher, *Matrix Theory* II, ch. XV). A row of
+zeros marks roots symmetric about the origin, so the verdict is then at best
+marginal: `RouthResult.marginal` is set.
+
+`schur_cohn_stable` is the discrete-time counterpart used by the ``sampled``
+model: all roots strictly inside the unit circle, by the Schur–Cohn step-down
+recursion (Jury's table in reflection-coefficient form; Åström & Wittenmark,
+*Computer-Controlled Systems*, 3rd ed., §3.3).
+
+KB (Koren & Borenstein 1991) apply Routh to their eq (19) to obtain eq (20).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = ["RouthResult", "routh_array", "routh_count", "routh_stable", "schur_cohn_stable", "strip_leading_zeros"]
+
+
+@dataclass(frozen=True)
+class RouthResult:
+    """Routh array and what it says.
+
+    Attributes
+    ----------
+    table : list[list]
+        The rows s^n … s^0 (floats or sympy expressions).
+    first_column : list
+        First entry of every row (after ε and auxiliary-polynomial substitution).
+    sign_changes : int
+        Sign changes in the first column = roots with Re > 0 (numeric case).
+    marginal : bool
+        A row of zeros or an ε substitution occurred: roots on or symmetric
+        about the imaginary axis may exist, so "stable" needs care.
+    """
+
+    table: list
+    first_column: list
+    sign_changes: int
+    marginal: bool
+
+    @property
+    def stable(self) -> bool:
+        """True when every root has a negative real part."""
+        return self.sign_changes == 0 and not self.marginal
+
+
+def strip_leading_zeros(coefficients) -> np.ndarray:
+    """Drop leading (highest-power) exact zeros of a descending coefficient array."""
+    c = np.atleast_1d(np.asarray(coefficients, dtype=float))
+    nonzero = np.flatnonzero(c)
+    if nonzero.size == 0:
+        raise ValueError("polynomial must have a non-zero coefficient; got all zeros")
+    return c[nonzero[0]:]
+
+
+def routh_array(coefficients, eps_scale: float = 1e-9) -> RouthResult:
+    """Routh array of a polynomial given in descending powers.
+
+    Parameters
+    ----------
+    coefficients : sequence of float or sympy expressions
+        a_n, …, a_0 of a_n s^n + … + a_0 (a_n ≠ 0). If any entry is a sympy
+        expression the array is built symbolically.
+    eps_scale : float
+        Numerical case: a zero in the first column is replaced by
+        ``eps_scale`` × (largest magnitude in that row, or 1).
+
+    Returns
+    -------
+    RouthResult
+        For symbolic input, `sign_changes` is computed only when every
+        first-column entry has a decidable sign (else -1).
+    """
+    symbolic = any(_is_sympy(c) for c in coefficients)
+    if symbolic:
+        return _routh_symbolic(list(coefficients))
+    c = strip_leading_zeros(coefficients)
+    if not np.all(np.isfinite(c)):
+        raise ValueError(f"polynomial coefficients must be finite; got {list(coefficients)!r}")
+    return _routh_numeric(c, eps_scale)
+
+
+def _first_two_rows(c):
+    n = len(c) - 1
+    width = n // 2 + 1
+    row0 = [c[i] for i in range(0, n + 1, 2)]
+    row1 = [c[i] for i in range(1, n + 1, 2)]
+    zero = 0 * c[0]
+    row0 += [zero] * (width - len(row0))
+    row1 += [zero] * (width - len(row1))
+    return row0, row1, width
+
+
+def _next_row(upper, lower):
+    # r_j = (lower0 * upper_{j+1} - upper0 * lower_{j+1}) / lower0
+    width = len(upper)
+    zero = 0 * upper[0]
+    row = []
+    for j in range(width):
+        a = upper[j + 1] if j + 1 < width else zero
+        b = lower[j + 1] if j + 1 < width else zero
+        row.append((lower[0] * a - upper[0] * b) / lower[0])
+    return row
+
+
+def _auxiliary_derivative(upper, power):
+    # auxiliary polynomial A(s) = sum upper[j] s^(power-2j); rows take dA/ds
+    return [upper[j] * (power - 2 * j) for j in range(len(upper))]
+
+
+def _next_row_numeric(upper, lower):
+    """Next Routh row; entries lost to cancellation (below round-off) become exactly 0."""
+    width = len(upper)
+    row = []
+    for j in range(width):
+        a = upper[j + 1] if j + 1 < width else 0.0
+        b = lower[j + 1] if j + 1 < width else 0.0
+        value = (lower[0] * a - upper[0] * b) / lower[0]
+        size = (abs(lower[0] * a) + abs(upper[0] * b)) / abs(lower[0])
+        row.append(0.0 if abs(value) <= _CANCELLATION * size else value)
+    return row
+
+
+_CANCELLATION = 1e3 * np.finfo(float).eps
+
+
+def _routh_numeric(c: np.ndarray, eps_scale: float) -> RouthResult:
+    n = len(c) - 1
+    if n == 0:
+        return RouthResult([[float(c[0])]], [float(c[0])], 0, False)
+    row0, row1, _ = _first_two_rows([float(x) for x in c])
+    table = [row0, row1]
+    marginal = False
+    for power in range(n - 1, 0, -1):
+        upper, lower = table[-2], table[-1]
+        if all(x == 0.0 for x in lower):
+            marginal = True
+            lower = _auxiliary_derivative(upper, power + 1)
+            table[-1] = lower
+        if lower[0] == 0.0:
+            marginal = True
+            lower = [eps_scale * max(max(abs(x) for x in lower), 1.0)] + list(lower[1:])
+            table[-1] = lower
+        table.append(_next_row_numeric(upper, lower))
+    if table[-1][0] == 0.0:
+        marginal = True
+    first = [row[0] for row in table]
+    signs = [np.sign(x) for x in first if x != 0.0]
+    changes = sum(1 for a, b in zip(signs, signs[1:]) if a != b)
+    return RouthResult(table, first, changes, marginal)
+
+
+def _is_sympy(x) -> bool:
+    return type(x).__module__.startswith("sympy")
+
+
+def _routh_symbolic(c) -> RouthResult:
+    import sympy as sp
+
+    c = [sp.sympify(x) for x in c]
+    while c and c[0] == 0:
+        c.pop(0)
+    n = len(c) - 1
+    epsilon = sp.Symbol("epsilon", positive=True)
+    if n == 0:
+        return RouthResult([[c[0]]], [c[0]], 0, False)
+    row0, row1, _ = _first_two_rows(c)
+    table = [row0, row1]
+    marginal = False
+    for power in range(n - 1, 0, -1):
+        upper, lower = table[-2], table[-1]
+        if all(sp.simplify(x) == 0 for x in lower):
+            marginal = True
+            lower = _auxiliary_derivative(upper, power + 1)
+            table[-1] = lower
+        if sp.simplify(lower[0]) == 0:
+            marginal = True
+            lower = [epsilon] + list(lower[1:])
+            table[-1] = lower
+        table.append([sp.simplify(x) for x in _next_row(upper, lower)])
+    first = [sp.simplify(row[0]) for row in table]
+    limits = [sp.limit(x, epsilon, 0, "+") if x.has(epsilon) else x for x in first]
+    signs = []
+    for x in limits:
+        if x.is_positive:
+            signs.append(1)
+        elif x.is_negative:
+            signs.append(-1)
+        elif x.is_zero:
+            continue
+        else:
+            return RouthResult(table, first, -1, marginal)
+    changes = sum(1 for a, b in zip(signs, signs[1:]) if a != b)
+    return RouthResult(table, first, changes, marginal)
+
+
+def routh_count(coefficients) -> int:
+    """Number of roots with positive real part by Routh's sign changes.
+
+    Parameters
+    ----------
+    coefficients : sequence of float
+        Descending powers, leading coefficient non-zero.
+    """
+    return routh_array(coefficients).sign_changes
+
+
+def routh_stable(coefficients) -> bool:
+    """True when every root of the polynomial has a negative real part (Routh).
+
+    A zero row or zero first-column entry (a root on, or symmetric about, the
+    imaginary axis) counts as not stable.
+    """
+    return routh_array(coefficients).stable
+
+
+def schur_cohn_stable(coefficients, margin: float = 0.0) -> bool:
+    """True when every root lies strictly inside the unit circle (Schur–Cohn).
+
+    Step-down recursion on the reflection coefficients of the monic polynomial
+    z^n + a_1 z^(n−1) + … + a_n: stable ⇔ every reflection coefficient
+    κ_i satisfies |κ_i| < 1 (Jury's table in lattice form).
+
+    Parameters
+    ----------
+    coefficients : sequence of float
+        Descending powers of z, leading coefficient non-zero.
+    margin : float
+        Require |κ_i| < 1 − margin (0 by default).
+    """
+    a = strip_leading_zeros(coefficients)
+    a = a / a[0]
+    while len(a) > 1:
+        kappa = a[-1]
+        if not abs(kappa) < 1.0 - margin:
+            return False
+        a = (a - kappa * a[::-1])[:-1] / (1.0 - kappa * kappa)
+    return True
