@@ -1,0 +1,462 @@
+"""Batch engine: many robots advance together, one sampling period per step (DESIGN §4–5).
+
+Every member is a `Scenario`; members may differ in everything (robot,
+controller, environment, target, T). The state of all members lives in
+arrays of shape (B,), and one engine step is one sampling period of each
+member (member m is at t = k·T_m after k steps).
+
+One step, for every member still running (DESIGN §4, the `sampled` model):
+
+1. **Events** at t_k (`pfm_stability.sim.events`): collision, target
+   reached, trapped. A member with an event stops.
+2. **Sense** at t_k: repulsion from the active window's occupied cells
+   (grid, KB eq 1–2) or the analytic walls' law; attraction (eq 3);
+   δ_k = direction of R (eq 4).
+3. **Compute** the held value: ``hold="command"``: u_k = sat(k·wrap(δ_k − θ_k))
+   (eq 5, saturated at the steering-rate limit); ``hold="reference"``:
+   δ̃_k = θ_k + wrap(δ_k − θ_k). With ``compute_delay = 1`` the value
+   applied over [t_k, t_k+1) is the one computed at t_k−1 (at k = 0, the
+   value computed at t_0: the robot starts as if it had been running).
+4. **Advance** over [t_k, t_k+1) exactly (`pfm_stability.sim.robot`):
+   held command → constant-input solution of eq (6); held reference → servo
+   solution of eq (7). Saturation: a held command is clipped to
+   ±ω_max, and since ω moves monotonically from ω_k towards u, |ω| <= ω_max
+   stays exact. A servo whose command k(δ̃ − θ(t)) would exceed ±ω_max at the
+   start, a quadrature node or the end of the period is instead advanced in
+   `SUBSTEPS` equal sub-intervals, each either saturated (constant ±ω_max)
+   or linear (servo), decided at its start — exact whenever the servo is not
+   saturated, first-order in the sub-interval where it switches.
+   Positions: Gauss–Legendre quadrature of V sin θ, V cos θ.
+
+Everything is numpy on (B,) or (B, K) arrays; the grid's window sums use
+the precompiled occupied-cell lists of `pfm_stability.sim.window`.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+
+from ..force_law import PowerLaw
+from .environment import segment_clearance, wall_coordinates
+from .events import Event
+from .metrics import oscillation_metrics
+from .results import BatchResult, RunResult, Trajectory
+from .robot import NODES, advance_position, constant_input, gauss_legendre, propagate, servo
+from .vff import cell_repulsion, direction_of, steering_command, vff_speed, wrap_angle
+from .window import compile_window_table, stack_tables
+
+__all__ = ["run_batch", "SUBSTEPS", "RECORD_MODES"]
+
+SUBSTEPS = 8
+"""Sub-intervals per period for a saturated steering servo (``hold="reference"``)."""
+
+RECORD_MODES = ("trajectory", "offset")
+
+
+def _array(scenarios, getter, dtype=float):
+    return np.array([getter(s) for s in scenarios], dtype=dtype)
+
+
+class _Batch:
+    """Member arrays and the compiled environments of a batch."""
+
+    def __init__(self, scenarios):
+        self.scenarios = scenarios
+        B = self.size = len(scenarios)
+        robot = lambda name: _array(scenarios, lambda s: getattr(s.robot, name))
+        ctrl = lambda name: _array(scenarios, lambda s: getattr(s.controller, name))
+        self.V, self.tau, self.k, self.W = robot("V"), robot("tau"), robot("k"), robot("W")
+        self.max_rate = robot("max_steering_rate")
+        self.n, self.T, self.f = ctrl("n"), ctrl("T"), ctrl("f")
+        self.reference = _array(scenarios, lambda s: s.controller.hold == "reference", bool)
+        self.delayed = _array(scenarios, lambda s: s.controller.compute_delay == 1, bool)
+        self.speed_law = _array(scenarios, lambda s: s.speed_law, bool)
+        self.any_speed_law = bool(self.speed_law.any())
+        self.steps = np.ceil(_array(scenarios, lambda s: s.duration) / self.T - 1e-9).astype(np.int64)
+        self.order = (self.tau > 0).astype(int) + 2 + self.delayed.astype(int)
+        self._compile_targets()
+        self._compile_measure()
+        self._compile_grids()
+        self._compile_walls()
+        fractions, self.weights = gauss_legendre(NODES)
+        self.command_idx = np.flatnonzero(~self.reference)
+        self.reference_idx = np.flatnonzero(self.reference)
+        self.command_coef = constant_input(self.tau[self.command_idx], self.T[self.command_idx], fractions)
+        r = self.reference_idx
+        self.servo_coef = servo(self.tau[r], self.k[r], self.T[r], fractions)
+        self.servo_sub = servo(self.tau[r], self.k[r], self.T[r] / SUBSTEPS, fractions)
+        self.saturated_sub = constant_input(self.tau[r], self.T[r] / SUBSTEPS, fractions)
+        self.all_command = self.command_idx.size == B
+        self.uniform_n2 = bool(np.all(self.n == 2.0))
+
+    # ----------------------------------------------------------- compilation
+    def _compile_targets(self):
+        s = self.scenarios
+        self.point = _array(s, lambda m: m.target.is_point, bool)
+        self.tx = _array(s, lambda m: m.target.x if m.target.is_point else 0.0)
+        self.ty = _array(s, lambda m: m.target.y if m.target.is_point else 0.0)
+        angle = _array(s, lambda m: 0.0 if m.target.is_point else m.target.angle)
+        self.dx, self.dy = np.sin(angle), np.cos(angle)
+        self.radius = _array(s, lambda m: m.target.radius)
+        self.finish = _array(s, lambda m: math.inf if m.target.is_point or m.target.finish is None else m.target.finish)
+        self.any_point = bool(self.point.any())
+        self.trap_time = _array(s, lambda m: m.trap_time)
+        self.trap_distance = _array(s, lambda m: m.trap_distance)
+
+    def _compile_measure(self):
+        s = self.scenarios
+        self.mox = _array(s, lambda m: m.measure.origin[0])
+        self.moy = _array(s, lambda m: m.measure.origin[1])
+        self.lat = np.array([m.measure.lateral_unit for m in s], dtype=float).reshape(-1, 2)
+        self.along = np.array([m.measure.along_unit for m in s], dtype=float).reshape(-1, 2)
+        self.along_from = _array(s, lambda m: m.measure.along_from)
+
+    def _compile_grids(self):
+        s = self.scenarios
+        self.is_grid = _array(s, lambda m: m.env == "grid", bool)
+        self.grid_idx = np.flatnonzero(self.is_grid)
+        self.ratio = _array(s, lambda m: m.cell_ratio if m.env == "grid" else 0.0)
+        if self.grid_idx.size == 0:
+            self.table = None
+            return
+        keys = {}
+        for i in self.grid_idx:
+            keys.setdefault((id(s[i].environment), s[i].window_cells), []).append(i)
+        tables, member_grid = [], np.zeros(self.size, dtype=np.int64)
+        for g, (key, members) in enumerate(keys.items()):
+            grid = s[members[0]].environment
+            widths, steps = self.W[members], self.V[members] * self.T[members]
+            tables.append(compile_window_table(grid, s[members[0]].window_cells, widths.min(), widths.max(), steps.max()))
+            member_grid[members] = g
+        self.table = stack_tables(tables)
+        geo = [self.table.grids[g] for g in member_grid[self.grid_idx]]
+        take = lambda name, dtype=float: np.array([getattr(q, name) for q in geo], dtype=dtype)
+        self.g_offset, self.g_nx, self.g_ny, self.g_pad = (take(n, np.int64) for n in ("cell_offset", "nx_padded", "ny_padded", "pad"))
+        self.g_xmin, self.g_ymin, self.g_c = take("x_min"), take("y_min"), take("cell_size")
+        self.g_scale = self.ratio[self.grid_idx] * self.W[self.grid_idx] ** self.n[self.grid_idx]
+
+    def _compile_walls(self):
+        s = self.scenarios
+        self.wall_idx = np.flatnonzero(~self.is_grid)
+        if self.wall_idx.size == 0:
+            return
+        envs = [s[i].environment.arrays() for i in self.wall_idx]
+        width = max(1, max(e["p0x"].size for e in envs))
+        self.walls = {}
+        for key in envs[0]:
+            a = np.zeros((len(envs), width))
+            for row, e in enumerate(envs):
+                a[row, : e[key].size] = e[key]
+            self.walls[key] = a
+        valid = np.zeros((len(envs), width), dtype=bool)
+        for row, e in enumerate(envs):
+            valid[row, : e["p0x"].size] = True
+        self.walls["valid"] = valid
+        self.walls["length"] = np.where(valid, self.walls["length"], 0.0)
+        self.walls["ux"] = np.where(valid, self.walls["ux"], 1.0)
+        # lateral laws: None = KB's power law with the member's (f, n, W), vectorized
+        laws = [s[i].law for i in self.wall_idx]
+        self.law_groups = {}
+        for row, law in enumerate(laws):
+            if law is not None and not isinstance(law, PowerLaw):
+                self.law_groups.setdefault(_law_key(law), (law, []))[1].append(row)
+        custom = np.zeros(len(laws), dtype=bool)
+        pf, pn, pW = self.f[self.wall_idx].copy(), self.n[self.wall_idx].copy(), self.W[self.wall_idx].copy()
+        for row, law in enumerate(laws):
+            if isinstance(law, PowerLaw):
+                pf[row], pn[row], pW[row] = law.f, law.n, law.W
+            elif law is not None:
+                custom[row] = True
+        self.power = (pf[:, None], pn[:, None], pW[:, None], ~custom)
+
+    # --------------------------------------------------------------- forces
+    def grid_rows(self, x, y, active):
+        """Window-table row of each grid member's cell: 0 for inactive members, −1 where it is colliding."""
+        gi = self.grid_idx
+        i = np.floor((x[gi] - self.g_xmin) / self.g_c).astype(np.int64) + self.g_pad
+        j = np.floor((y[gi] - self.g_ymin) / self.g_c).astype(np.int64) + self.g_pad
+        inside = (i >= 0) & (i < self.g_nx) & (j >= 0) & (j < self.g_ny) & active[gi]
+        rows = self.table.row_of_cell[np.where(inside, self.g_offset + i * self.g_ny + j, 0)]
+        return np.where(inside, rows, 0)
+
+    def sensing_rows(self, rows, running):
+        """Rows for the window sums of the running members (0 for the others)."""
+        rows = np.where(running[self.grid_idx], rows, 0)
+        if np.any(rows < 0):  # unreachable cells imply a collision, which stopped the member
+            raise RuntimeError(f"member {self.grid_idx[np.flatnonzero(rows < 0)[0]]} senses from a cell where it collides")
+        return rows
+
+    def grid_repulsion(self, x, y, rows):
+        """(fx, fy)/F_ct of the grid members (KB eq 1–2)."""
+        gi, t = self.grid_idx, self.table
+        n = 2.0 if self.uniform_n2 else self.n[gi][:, None]
+        fx, fy = cell_repulsion(x[gi][:, None], y[gi][:, None], t.wx[rows], t.wy[rows], t.wcv[rows], n)
+        return self.g_scale * fx, self.g_scale * fy
+
+    def wall_repulsion(self, x, y):
+        """(fx, fy)/F_ct of the analytic members: Σ law(d)·normal over walls within their extent."""
+        wi, w = self.wall_idx, self.walls
+        s, d = wall_coordinates(w, x[wi][:, None], y[wi][:, None])
+        acting = w["valid"] & (s >= 0) & (s <= w["length"]) & (d > 0)
+        d_eval = np.where(acting, d, 1.0)
+        pf, pn, pW, power_rows = self.power
+        magnitude = np.zeros_like(d)
+        magnitude[power_rows] = (pf * (pW / d_eval) ** pn)[power_rows]
+        for law, rows in self.law_groups.values():
+            magnitude[rows] = law.force(d_eval[rows])
+        magnitude = np.where(acting, magnitude, 0.0)
+        return np.sum(magnitude * w["nx"], axis=1), np.sum(magnitude * w["ny"], axis=1)
+
+    def gaps(self, x, y, rows):
+        """Clearance minus W/2 per member (m); +inf where no obstacle is near."""
+        gap = np.full(self.size, math.inf)
+        if self.grid_idx.size:
+            for m in self.grid_idx[rows < 0]:  # in a cell where it cannot fit: exact clearance by brute force
+                gap[m] = float(self.scenarios[m].clearance([x[m]], [y[m]])[0])
+            near = rows > 0
+            near[near] = self.table.near_count[rows[near]] > 0
+            if np.any(near):
+                g = self.grid_idx[near]
+                cells = self.table.near[rows[near]]
+                half = (self.g_c[near] / 2)[:, None]
+                gx = np.maximum(np.abs(x[g][:, None] - self.table.ox[cells]) - half, 0.0)
+                gy = np.maximum(np.abs(y[g][:, None] - self.table.oy[cells]) - half, 0.0)
+                gap[g] = np.sqrt(np.min(gx * gx + gy * gy, axis=1)) - self.W[g] / 2
+        if self.wall_idx.size:
+            wi = self.wall_idx
+            gap[wi] = segment_clearance(self.walls, x[wi][:, None], y[wi][:, None]) - self.W[wi] / 2
+        return gap
+
+    def attraction(self, x, y):
+        """Unit vector towards the target (KB eq 3)."""
+        if not self.any_point:
+            return self.dx, self.dy
+        rx, ry = self.tx - x, self.ty - y
+        dist = np.hypot(rx, ry)
+        safe = np.where(dist > 0, dist, 1.0)
+        return np.where(self.point, rx / safe, self.dx), np.where(self.point, ry / safe, self.dy)
+
+    def target_distance(self, x, y):
+        """Distance to point targets, m (0 for direction targets)."""
+        if not self.any_point:
+            return np.zeros(self.size)
+        return np.where(self.point, np.hypot(self.tx - x, self.ty - y), 0.0)
+
+    def progress(self, x, y, x0, y0, distance):
+        """Progress towards the target, m: −distance (point) or advance along the direction."""
+        return np.where(self.point, -distance, (x - x0) * self.dx + (y - y0) * self.dy)
+
+
+def _law_key(law):
+    """Equal laws (frozen dataclasses) share one evaluation; others are grouped by identity."""
+    try:
+        hash(law)
+        return law
+    except TypeError:
+        return id(law)
+
+
+class _Recorder:
+    """Per-sample storage: lateral offset along the measure axis, optionally the full state."""
+
+    def __init__(self, batch: _Batch, trajectory: bool):
+        shape = (batch.size, int(batch.steps.max()) + 1)
+        self.batch = batch
+        self.offset = np.zeros(shape)
+        self.along = np.zeros(shape)
+        self.full = trajectory
+        if trajectory:
+            self.x, self.y, self.theta = np.zeros(shape), np.zeros(shape), np.zeros(shape)
+
+    def record(self, k, x, y, theta):
+        b = self.batch
+        rx, ry = x - b.mox, y - b.moy
+        self.offset[:, k] = rx * b.lat[:, 0] + ry * b.lat[:, 1]
+        self.along[:, k] = rx * b.along[:, 0] + ry * b.along[:, 1]
+        if self.full:
+            self.x[:, k], self.y[:, k], self.theta[:, k] = x, y, theta
+
+
+def _start_state(scenarios):
+    x, y, theta = (np.array([getattr(s.start, a) for s in scenarios], dtype=float) for a in ("x", "y", "theta"))
+    for i, s in enumerate(scenarios):
+        if s.start_jitter > 0:
+            shift = np.random.default_rng(s.seed).normal(0.0, s.start_jitter)
+            x[i] += shift * math.cos(theta[i])
+            y[i] -= shift * math.sin(theta[i])
+    return x, y, theta
+
+
+def _advance_command(b, coef, theta, omega, u, V, x, y):
+    theta_nodes, theta_end, omega_end = propagate(coef, theta, omega, u)
+    x, y = advance_position(x, y, V, coef.h, theta_nodes, b.weights)
+    return x, y, theta_end, omega_end
+
+
+def _advance_reference(b, theta, omega, ref, V, x, y):
+    """Servo members over one period; saturated ones in SUBSTEPS sub-intervals."""
+    r = b.reference_idx
+    k, wmax = b.k[r], b.max_rate[r]
+    theta_nodes, theta_end, omega_end = propagate(b.servo_coef, theta, omega, ref)
+    x_new, y_new = advance_position(x, y, V, b.servo_coef.h, theta_nodes, b.weights)
+    servo_u = k[:, None] * (ref[:, None] - np.concatenate([theta[:, None], theta_nodes, theta_end[:, None]], axis=1))
+    sat = np.any(np.abs(servo_u) > wmax[:, None], axis=1)
+    if np.any(sat):
+        s = np.flatnonzero(sat)
+        th, om, xs, ys = theta[s], omega[s], x[s], y[s]
+        lin, cst = b.servo_sub.take(s), b.saturated_sub.take(s)
+        for _ in range(SUBSTEPS):
+            u = k[s] * (ref[s] - th)
+            clipped = np.abs(u) > wmax[s]
+            n1, e1, o1 = propagate(lin, th, om, ref[s])
+            n2, e2, o2 = propagate(cst, th, om, np.clip(u, -wmax[s], wmax[s]))
+            nodes = np.where(clipped[:, None], n2, n1)
+            xs, ys = advance_position(xs, ys, V[s], lin.h, nodes, b.weights)
+            th, om = np.where(clipped, e2, e1), np.where(clipped, o2, o1)
+        x_new[s], y_new[s], theta_end[s], omega_end[s] = xs, ys, th, om
+    return x_new, y_new, theta_end, omega_end
+
+
+def run_batch(scenarios, *, record: str = "trajectory", metrics: bool = True) -> BatchResult:
+    """Simulate every scenario of `scenarios` together.
+
+    Parameters
+    ----------
+    scenarios : sequence of Scenario
+    record : {"trajectory", "offset"}
+        Keep every sample's (x, y, θ), or only the lateral offset needed by
+        the metrics (less memory for large batches).
+    metrics : bool
+        Compute the oscillation metrics of each member (DESIGN §6); if
+        False, each run's ``metrics`` is None (for timing and sweeps of events).
+
+    Returns
+    -------
+    BatchResult
+    """
+    from ..checks import check_choice
+
+    check_choice("record", record, RECORD_MODES)
+    scenarios = list(scenarios)
+    if not scenarios:
+        raise ValueError("scenarios must hold at least one Scenario")
+    b = _Batch(scenarios)
+    B = b.size
+    x, y, theta = _start_state(scenarios)
+    x0, y0 = x.copy(), y.copy()
+    omega = np.zeros(B)
+    alive = np.ones(B, dtype=bool)
+    pending = np.zeros(B)
+    pending_V = b.V.copy()
+    best = b.progress(x, y, x0, y0, b.target_distance(x, y))
+    best_t = np.zeros(B)
+    last_gap = np.full(B, math.inf)
+    min_gap = np.full(B, math.inf)
+    done_steps = np.zeros(B, dtype=np.int64)
+    events = [None] * B
+    rec = _Recorder(b, record == "trajectory")
+    rec.record(0, x, y, theta)
+    started = time.perf_counter()
+    k = 0
+    max_steps = int(b.steps.max())
+    while True:
+        due = alive & (k <= b.steps)
+        done_steps[due] = k
+        rows = b.grid_rows(x, y, due) if b.grid_idx.size else None
+        _check_events(b, k, x, y, x0, y0, rows, due, alive, events, best, best_t, last_gap)
+        np.minimum(min_gap, last_gap, out=min_gap)
+        running = due & alive & (k < b.steps)
+        if k == max_steps or not running.any():
+            break
+        if rows is not None:
+            rows = b.sensing_rows(rows, running)
+        # sense (KB eq 1–4)
+        fx, fy = np.zeros(B), np.zeros(B)
+        if rows is not None:
+            fx[b.grid_idx], fy[b.grid_idx] = b.grid_repulsion(x, y, rows)
+        if b.wall_idx.size:
+            fx[b.wall_idx], fy[b.wall_idx] = b.wall_repulsion(x, y)
+        ax, ay = b.attraction(x, y)
+        delta = direction_of(fx + ax, fy + ay)
+        # compute the held value (eq 5) and the speed
+        value = np.where(b.reference, theta + wrap_angle(delta - theta), steering_command(delta, theta, b.k, b.max_rate))
+        speed = np.where(b.speed_law, vff_speed(b.V, fx, fy, theta), b.V) if b.any_speed_law else b.V
+        if k == 0:
+            pending, pending_V = value, speed
+        applied = np.where(b.delayed, pending, value)
+        applied_V = np.where(b.delayed, pending_V, speed)
+        pending, pending_V = value, speed
+        # advance over [t_k, t_k+1)
+        if b.all_command:
+            x_new, y_new, th_new, om_new = _advance_command(b, b.command_coef, theta, omega, applied, applied_V, x, y)
+        else:
+            x_new, y_new, th_new, om_new = x.copy(), y.copy(), theta.copy(), omega.copy()
+            c, r = b.command_idx, b.reference_idx
+            if c.size:
+                x_new[c], y_new[c], th_new[c], om_new[c] = _advance_command(b, b.command_coef, theta[c], omega[c], applied[c], applied_V[c], x[c], y[c])
+            if r.size:
+                x_new[r], y_new[r], th_new[r], om_new[r] = _advance_reference(b, theta[r], omega[r], applied[r], applied_V[r], x[r], y[r])
+        x, y = np.where(running, x_new, x), np.where(running, y_new, y)
+        theta, omega = np.where(running, th_new, theta), np.where(running, om_new, omega)
+        k += 1
+        rec.record(k, x, y, theta)
+        if k % 64 == 0:
+            _check_finite(x, y, theta, omega, k, b)
+    seconds = time.perf_counter() - started
+    _check_finite(x, y, theta, omega, k, b)
+    runs = tuple(_member_result(b, rec, m, int(done_steps[m]), events[m], metrics, float(min_gap[m])) for m in range(B))
+    return BatchResult(runs, int(done_steps.sum()), seconds)
+
+
+def _check_events(b, k, x, y, x0, y0, rows, due, alive, events, best, best_t, last_gap):
+    """Collision, target reached, trapped at t_k for the members due a check (in that priority)."""
+    t = k * b.T
+    gap = b.gaps(x, y, rows) if rows is not None or b.wall_idx.size else np.full(b.size, math.inf)
+    hit = due & (gap <= 0)
+    distance = b.target_distance(x, y)
+    prog = b.progress(x, y, x0, y0, distance)
+    reached = due & ~hit & np.where(b.point, distance <= b.radius, prog >= b.finish)
+    improved = prog >= best + b.trap_distance
+    best[improved] = prog[improved]
+    best_t[improved] = t[improved]
+    trapped = due & ~hit & ~reached & (t - best_t > b.trap_time)
+    for m in np.flatnonzero(hit | reached | trapped):
+        if hit[m]:
+            g0 = last_gap[m]
+            frac = g0 / (g0 - gap[m]) if math.isfinite(g0) and g0 > 0 and k > 0 else 1.0
+            events[m] = Event("collision", float((k - 1 + frac) * b.T[m]) if k > 0 else 0.0, float(x[m]), float(y[m]))
+        else:
+            events[m] = Event("target_reached" if reached[m] else "trapped", float(t[m]), float(x[m]), float(y[m]))
+        alive[m] = False
+    last_gap[:] = np.where(due, gap, last_gap)
+
+
+def _check_finite(x, y, theta, omega, k, b):
+    bad = ~(np.isfinite(x) & np.isfinite(y) & np.isfinite(theta) & np.isfinite(omega))
+    if np.any(bad):
+        m = int(np.flatnonzero(bad)[0])
+        raise FloatingPointError(f"member {m} ({b.scenarios[m].name}) reached a non-finite state at step {k}")
+
+
+def _member_result(b, rec, m, steps, event, want_metrics, min_gap) -> RunResult:
+    n = steps + 1
+    T = float(b.T[m])
+    t = np.arange(n) * T
+    window = rec.along[m, :n] >= b.along_from[m]
+    if np.any(window):
+        window[np.argmax(window):] = True  # from the first sample past the start of the window
+    offset_t, offset = t[window], rec.offset[m, :n][window]
+    collision = event.t if event is not None and event.type == "collision" else None
+    if want_metrics:
+        metrics = oscillation_metrics(offset_t, offset, T, order=int(b.order[m]), collision_time=collision)
+    else:
+        metrics = None
+    trajectory = None
+    if rec.full:
+        trajectory = Trajectory(t, rec.x[m, :n].copy(), rec.y[m, :n].copy(), rec.theta[m, :n].copy())
+    events = (event,) if event is not None else ()
+    clearance = min_gap if math.isfinite(min_gap) else None
+    return RunResult(b.scenarios[m], events, metrics, steps * T, steps, offset_t, offset.copy(), clearance, trajectory)

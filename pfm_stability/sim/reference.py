@@ -1,0 +1,207 @@
+"""A plain per-robot Python loop of the same model: the benchmark baseline and an independent check.
+
+`simulate_reference` runs one `Scenario` step by step with Python floats and
+the `math` module: the active window is cut out of the histogram grid and its
+occupied cells are summed in a Python loop (KB eq 1–2), the analytic walls
+likewise; the steering solutions (KB eq 6–7) are the same closed forms as in
+`pfm_stability.sim.robot`, written out per robot. It shares no stepping code
+with the batch engine, so the tests compare the two trajectories
+(`tests/test_sim_engine.py`), and `benchmarks/bench_simulator.py` times both.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..force_law import PowerLaw
+from .engine import SUBSTEPS
+from .events import Event
+from .grid import HistogramGrid
+from .results import Trajectory
+from .robot import NODES, gauss_legendre
+from .scenario import Scenario
+
+__all__ = ["simulate_reference"]
+
+
+def _wrap(a: float) -> float:
+    return (a + math.pi) % (2 * math.pi) - math.pi
+
+
+def _constant_input(tau, t):
+    """(a, decay) of θ = θ₀ + aω₀ + (t − a)u, ω = decay·ω₀ + (1 − decay)u."""
+    if tau > 0:
+        return -tau * math.expm1(-t / tau), math.exp(-t / tau)
+    return 0.0, 0.0
+
+
+def _servo_matrix(tau, k, t):
+    """exp(A t) for (e, ω), A = [[0, 1], [−k/τ, −1/τ]] (τ = 0: e decays as e^(−kt))."""
+    if tau > 0:
+        from scipy.linalg import expm
+
+        E = expm(np.array([[0.0, 1.0], [-k / tau, -1.0 / tau]]) * t)
+        return tuple(float(v) for v in E.ravel())
+    d = math.exp(-k * t)
+    return (d, 0.0, -k * d, 0.0)
+
+
+class _Steering:
+    """Per-robot closed-form steering over one hold interval."""
+
+    def __init__(self, tau, k, h, servo: bool):
+        self.tau, self.k, self.h = tau, k, h
+        fractions, self.weights = gauss_legendre(NODES)
+        self.times = [h * f for f in fractions] + [h]
+        self.const = [_constant_input(tau, t) for t in self.times]
+        self.servo = [_servo_matrix(tau, k, t) for t in self.times] if servo else None
+
+    def constant(self, theta, omega, u):
+        nodes = [theta + a * omega + (t - a) * u for (a, _), t in zip(self.const, self.times)]
+        decay = self.const[-1][1]
+        return nodes[:-1], nodes[-1], decay * omega + (1 - decay) * u
+
+    def reference(self, theta, omega, ref):
+        e = theta - ref
+        nodes = [ref + P * e + Q * omega for P, Q, _, _ in self.servo]
+        _, _, R, S = self.servo[-1]
+        return nodes[:-1], nodes[-1], R * e + S * omega
+
+    def move(self, x, y, V, nodes):
+        for w, th in zip(self.weights, nodes):
+            x += V * self.h * w * math.sin(th)
+            y += V * self.h * w * math.cos(th)
+        return x, y
+
+
+def _grid_sense(s: Scenario, x, y):
+    """(fx, fy, clearance − W/2) from the occupied cells of the window around (x, y)."""
+    g: HistogramGrid = s.environment
+    c, h = g.cell_size, s.window_cells // 2
+    i, j = (int(v) for v in g.cell_index(x, y))
+    nx, ny = g.shape
+    i0, i1, j0, j1 = max(i - h, 0), min(i + h + 1, nx), max(j - h, 0), min(j + h + 1, ny)
+    fx = fy = 0.0
+    gap = math.inf
+    if i0 < i1 and j0 < j1:
+        ii, jj = np.nonzero(g.cv[i0:i1, j0:j1])
+        n, W = s.controller.n, s.robot.W
+        for a, b in zip(ii.tolist(), jj.tolist()):
+            cx, cy = g.x_min + (i0 + a + 0.5) * c, g.y_min + (j0 + b + 0.5) * c
+            dx, dy = x - cx, y - cy
+            d = math.hypot(dx, dy)
+            weight = s.cell_ratio * float(g.cv[i0 + a, j0 + b]) * W**n / d ** (n + 1)
+            fx += weight * dx
+            fy += weight * dy
+            gx, gy = max(abs(dx) - c / 2, 0.0), max(abs(dy) - c / 2, 0.0)
+            gap = min(gap, math.hypot(gx, gy))
+    return fx, fy, gap - s.robot.W / 2
+
+
+def _wall_sense(s: Scenario, x, y):
+    law = s.effective_law()
+    fx = fy = 0.0
+    gap = math.inf
+    for w in s.environment.walls:
+        (ux, uy), (nx, ny) = w.unit, w.normal
+        sx, sy = x - w.p0[0], y - w.p0[1]
+        along, d = sx * ux + sy * uy, sx * nx + sy * ny
+        if 0 <= along <= w.length and d > 0:
+            if isinstance(law, PowerLaw):
+                F = law.f * (law.W / d) ** law.n
+            else:
+                F = float(law.force(d))
+            fx += F * nx
+            fy += F * ny
+        outside = max(-along, along - w.length, 0.0)
+        gap = min(gap, math.hypot(outside, d))
+    return fx, fy, gap - s.robot.W / 2
+
+
+def simulate_reference(s: Scenario):
+    """Run one scenario in a per-robot Python loop.
+
+    Returns
+    -------
+    (Trajectory, Event or None)
+    """
+    r, c = s.robot, s.controller
+    T, k, wmax = c.T, r.k, r.max_steering_rate
+    sense = _grid_sense if s.env == "grid" else _wall_sense
+    servo = c.hold == "reference"
+    full = _Steering(r.tau, k, T, servo)
+    sub = _Steering(r.tau, k, T / SUBSTEPS, servo) if servo else None
+    x, y, theta = s.start.x, s.start.y, s.start.theta
+    if s.start_jitter > 0:
+        shift = float(np.random.default_rng(s.seed).normal(0.0, s.start_jitter))
+        x, y = x + shift * math.cos(theta), y - shift * math.sin(theta)
+    x0, y0 = x, y
+    omega = 0.0
+    tgt = s.target
+    steps = math.ceil(s.duration / T - 1e-9)
+    xs, ys, ths = [x], [y], [theta]
+    pending = None
+    best, best_t, last_gap = None, 0.0, math.inf
+    event = None
+    for step in range(steps + 1):
+        t = step * T
+        fx, fy, gap = sense(s, x, y)
+        distance = math.hypot(tgt.x - x, tgt.y - y) if tgt.is_point else 0.0
+        progress = -distance if tgt.is_point else (x - x0) * math.sin(tgt.angle) + (y - y0) * math.cos(tgt.angle)
+        if best is None:
+            best = progress
+        if progress >= best + s.trap_distance:
+            best, best_t = progress, t
+        if gap <= 0:
+            frac = last_gap / (last_gap - gap) if math.isfinite(last_gap) and last_gap > 0 and step > 0 else 1.0
+            event = Event("collision", (step - 1 + frac) * T if step > 0 else 0.0, x, y)
+        elif (distance <= tgt.radius) if tgt.is_point else (tgt.finish is not None and progress >= tgt.finish):
+            event = Event("target_reached", t, x, y)
+        elif t - best_t > s.trap_time:
+            event = Event("trapped", t, x, y)
+        last_gap = gap
+        if event is not None or step == steps:
+            break
+        if tgt.is_point:
+            ax, ay = (tgt.x - x) / distance, (tgt.y - y) / distance
+        else:
+            ax, ay = math.sin(tgt.angle), math.cos(tgt.angle)
+        delta = math.atan2(fx + ax, fy + ay)
+        if c.hold == "command":
+            value = min(max(k * _wrap(delta - theta), -wmax), wmax)
+        else:
+            value = theta + _wrap(delta - theta)
+        if s.speed_law:
+            norm = math.hypot(fx, fy)
+            cos_phi = (fx * math.sin(theta) + fy * math.cos(theta)) / norm if norm > 0 else 0.0
+            speed = r.V * (1 - abs(cos_phi))
+        else:
+            speed = r.V
+        if pending is None:
+            pending = (value, speed)
+        applied, V = pending if c.compute_delay == 1 else (value, speed)
+        pending = (value, speed)
+        if c.hold == "command":
+            nodes, theta_end, omega_end = full.constant(theta, omega, applied)
+            x, y = full.move(x, y, V, nodes)
+        else:
+            nodes, theta_end, omega_end = full.reference(theta, omega, applied)
+            checks = [theta] + nodes + [theta_end]
+            if all(abs(k * (applied - th)) <= wmax for th in checks):
+                x, y = full.move(x, y, V, nodes)
+            else:
+                theta_end, omega_end = theta, omega
+                for _ in range(SUBSTEPS):
+                    u = k * (applied - theta_end)
+                    if abs(u) > wmax:
+                        nodes, th2, om2 = sub.constant(theta_end, omega_end, min(max(u, -wmax), wmax))
+                    else:
+                        nodes, th2, om2 = sub.reference(theta_end, omega_end, applied)
+                    x, y = sub.move(x, y, V, nodes)
+                    theta_end, omega_end = th2, om2
+        theta, omega = theta_end, omega_end
+        xs.append(x), ys.append(y), ths.append(theta)
+    n = len(xs)
+    return Trajectory(np.arange(n) * T, np.array(xs), np.array(ys), np.array(ths)), event

@@ -1,0 +1,300 @@
+"""What one simulated run is: robot, controller, environment, start, target, measurement.
+
+A `Scenario` is one member of a batch. Every field is validated on
+construction and an impossible run raises :class:`ValueError` with one line
+naming the parameter (T <= 0, an even window, a robot that does not fit the
+window, a start pose touching an obstacle, a target inside an obstacle, …).
+Presets (``kb-fig3``, ``corridor``, …) live in `pfm_stability.sim.presets`.
+
+Directions are radians from +Y towards +X (DESIGN §2: X lateral, Y along the
+corridor), so heading θ moves the robot by (V sin θ, V cos θ).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..checks import check_number
+from ..effective_force import GridWallLaw, calibrate_cell_ratio, check_window_cells, working_range
+from ..force_law import ForceLaw, PowerLaw
+from ..parameters import Controller, Robot
+from .environment import AnalyticEnvironment
+from .grid import HistogramGrid
+
+__all__ = ["Pose", "Target", "MeasureAxis", "Scenario"]
+
+
+@dataclass(frozen=True)
+class Pose:
+    """Position (m) and heading θ (rad, from +Y towards +X)."""
+
+    x: float
+    y: float
+    theta: float = 0.0
+
+    def __post_init__(self):
+        object.__setattr__(self, "x", check_number("start x", self.x, unit="m"))
+        object.__setattr__(self, "y", check_number("start y", self.y, unit="m"))
+        object.__setattr__(self, "theta", check_number("start heading", self.theta, unit="rad"))
+
+
+@dataclass(frozen=True)
+class Target:
+    """A point target, or a direction "at infinity" (KB eq 3; DESIGN §5).
+
+    Use `Target.point` or `Target.direction`. A direction keeps α constant
+    along a wall, as KB's analysis assumes (α̇ ≈ 0).
+
+    Attributes
+    ----------
+    x, y : float or None
+        Point target, m.
+    angle : float or None
+        Direction target, rad from +Y towards +X.
+    radius : float
+        Point target: reached when the robot centre is this close, m.
+    finish : float or None
+        Direction target: reached when the robot has advanced this far along
+        the direction from its start, m (None: never).
+    """
+
+    x: float | None = None
+    y: float | None = None
+    angle: float | None = None
+    radius: float = 0.2
+    finish: float | None = None
+
+    @classmethod
+    def point(cls, x: float, y: float, radius: float = 0.2) -> "Target":
+        """A target at (x, y), m, reached within `radius` m."""
+        return cls(
+            x=check_number("target x", x, unit="m"),
+            y=check_number("target y", y, unit="m"),
+            radius=check_number("target radius", radius, 0.0, unit="m"),
+        )
+
+    @classmethod
+    def direction(cls, angle: float, finish: float | None = None) -> "Target":
+        """A target at infinity in direction `angle` (rad from +Y towards +X)."""
+        finish = None if finish is None else check_number("finish", finish, 0.0, unit="m")
+        return cls(angle=check_number("target angle", angle, unit="rad"), finish=finish)
+
+    @property
+    def is_point(self) -> bool:
+        return self.angle is None
+
+    def to_dict(self) -> dict:
+        if self.is_point:
+            return {"kind": "point", "x": self.x, "y": self.y, "radius": self.radius}
+        return {"kind": "direction", "angle_deg": math.degrees(self.angle), "finish": self.finish}
+
+
+@dataclass(frozen=True)
+class MeasureAxis:
+    """Where and along which line the oscillation metrics are measured (DESIGN §6).
+
+    The lateral offset is the coordinate of the robot centre to the right of
+    the line through `origin` in direction `angle`; samples count once the
+    robot has advanced `along_from` m along it (e.g. past a disturbance).
+
+    Attributes
+    ----------
+    origin : (float, float)
+        m.
+    angle : float
+        Direction of travel along the line, rad from +Y towards +X.
+    along_from : float
+        m.
+    """
+
+    origin: tuple = (0.0, 0.0)
+    angle: float = 0.0
+    along_from: float = -math.inf
+
+    @property
+    def along_unit(self) -> tuple[float, float]:
+        return (math.sin(self.angle), math.cos(self.angle))
+
+    @property
+    def lateral_unit(self) -> tuple[float, float]:
+        return (math.cos(self.angle), -math.sin(self.angle))
+
+    def to_dict(self) -> dict:
+        return {
+            "origin": list(self.origin),
+            "angle_deg": math.degrees(self.angle),
+            "along_from": None if math.isinf(self.along_from) else self.along_from,
+        }
+
+
+@dataclass(frozen=True)
+class Scenario:
+    """One simulated run.
+
+    Parameters
+    ----------
+    name : str
+    robot : Robot
+        V, τ, k, W, max steering rate (KB eq 5–6; §4).
+    controller : Controller
+        f, n, T, hold, compute_delay (T must be > 0: the simulator samples).
+        In the grid, f is KB's f_av used to calibrate `cell_ratio` when that
+        is not given.
+    environment : HistogramGrid or AnalyticEnvironment
+    start : Pose
+    target : Target
+    duration : float
+        Simulated time, s.
+    cell_ratio : float, optional
+        Grid: ρ = F_cr/F_ct; default `calibrate_cell_ratio(controller.f, …)`.
+    law : ForceLaw, optional
+        Analytic: the walls' lateral law; default KB's `PowerLaw(f, n, W)`.
+    window_cells : int
+        Grid: active window side w_s (odd, >= 3; KB: 33).
+    measure : MeasureAxis
+    speed_law : bool
+        Use the VFF speed law V = V(1 − |cos φ|) instead of constant speed.
+    trap_time, trap_distance : float
+        Trapped: less than `trap_distance` m of progress towards the target
+        within `trap_time` s.
+    analysis : dict or None
+        The linear analysis that applies inside the measurement window:
+        ``{"kind": "corridor", "L": m}`` or ``{"kind": "wall", "alpha": rad}``
+        (used by `pfm_stability.sim.predict`); None when none applies.
+    seed : int or None
+        Seed of the random start jitter (with `start_jitter`).
+    start_jitter : float
+        Standard deviation of a random lateral start offset, m (0: none).
+    notes : dict
+        Documented choices (geometry, calibration), reported with the inputs.
+    """
+
+    name: str
+    robot: Robot
+    controller: Controller
+    environment: object
+    start: Pose
+    target: Target
+    duration: float
+    cell_ratio: float | None = None
+    law: ForceLaw | None = None
+    window_cells: int = 33
+    measure: MeasureAxis = field(default_factory=MeasureAxis)
+    speed_law: bool = False
+    trap_time: float = 10.0
+    trap_distance: float = 0.5
+    analysis: dict | None = None
+    seed: int | None = None
+    start_jitter: float = 0.0
+    notes: dict = field(default_factory=dict)
+
+    def __post_init__(self):
+        check_number("T", self.controller.T, 0.0, unit="s")
+        object.__setattr__(self, "duration", check_number("duration", self.duration, 0.0, 1e6, unit="s"))
+        object.__setattr__(self, "trap_time", check_number("trap_time", self.trap_time, 0.0, unit="s"))
+        object.__setattr__(self, "trap_distance", check_number("trap_distance", self.trap_distance, 0.0, unit="m"))
+        object.__setattr__(self, "start_jitter", check_number("start_jitter", self.start_jitter, 0.0, low_open=False, unit="m"))
+        if self.seed is not None and (isinstance(self.seed, bool) or not isinstance(self.seed, (int, np.integer)) or self.seed < 0):
+            raise ValueError(f"seed must be a non-negative integer; got {self.seed!r}")
+        if isinstance(self.environment, HistogramGrid):
+            object.__setattr__(self, "window_cells", check_window_cells(self.window_cells))
+            working_range(self.robot.W, self.environment.cell_size, self.window_cells)
+            if self.cell_ratio is None:
+                object.__setattr__(self, "cell_ratio", self.calibrated_ratio())
+            object.__setattr__(self, "cell_ratio", check_number("cell_ratio", self.cell_ratio, 0.0))
+            if self.law is not None:
+                raise ValueError("law applies to env=analytic only; the grid's law is its cells")
+        elif isinstance(self.environment, AnalyticEnvironment):
+            if self.cell_ratio is not None:
+                raise ValueError("cell_ratio applies to env=grid only")
+        else:
+            raise ValueError(f"environment must be a HistogramGrid or an AnalyticEnvironment; got {type(self.environment).__name__}")
+        self._check_start_and_target()
+
+    # -------------------------------------------------------------- derived
+    @property
+    def env(self) -> str:
+        """"grid" or "analytic"."""
+        return "grid" if isinstance(self.environment, HistogramGrid) else "analytic"
+
+    def calibrated_ratio(self) -> float:
+        """ρ giving the grid's f_av = controller.f over the working range (KB §4)."""
+        g = self.environment
+        return calibrate_cell_ratio(self.controller.f, self.controller.n, self.robot.W, g.cell_size, self.window_cells, g.cv_max)
+
+    def effective_law(self) -> ForceLaw:
+        """The lateral law the analysis should use for this run.
+
+        Grid: `GridWallLaw` of a straight wall with this run's ρ, n, W, cells
+        and window (exact for straight walls along the grid axes). Analytic:
+        `law`, or KB's power law.
+        """
+        if self.env == "grid":
+            g = self.environment
+            return GridWallLaw(self.cell_ratio, self.controller.n, self.robot.W, g.cell_size, self.window_cells, g.cv_max)
+        return self.law if self.law is not None else PowerLaw(self.controller.f, self.controller.n, self.robot.W)
+
+    def clearance(self, x, y) -> np.ndarray:
+        """Distance from robot centres to the nearest obstacle, m (minus W/2: < 0 = collision)."""
+        return self.environment.clearance(x, y) - self.robot.W / 2
+
+    def _check_start_and_target(self) -> None:
+        gap = float(self.clearance([self.start.x], [self.start.y])[0])
+        if not gap > 0:
+            raise ValueError(
+                f"start must leave the robot (W = {self.robot.W:g} m) clear of obstacles; "
+                f"it overlaps them by {-gap:.3g} m at ({self.start.x:g}, {self.start.y:g}) m"
+            )
+        t = self.target
+        if t.is_point:
+            inside = self.clearance([t.x], [t.y])[0] + self.robot.W / 2 <= 0
+            if self.env == "grid":
+                inside = inside or bool(self.environment.occupied_at([t.x], [t.y])[0])
+            else:
+                inside = inside or _behind_a_wall(self.environment, t.x, t.y)
+            if inside:
+                raise ValueError(f"target must not lie inside an obstacle; got ({t.x:g}, {t.y:g}) m")
+
+    def inputs(self) -> dict:
+        """Everything that defines the run, for reports (SI units, angles in degrees)."""
+        r, c = self.robot, self.controller
+        out = {
+            "scenario": self.name,
+            "env": self.env,
+            "V": r.V,
+            "tau": r.tau,
+            "k": r.k,
+            "W": r.W,
+            "max_steering_rate_deg": math.degrees(r.max_steering_rate),
+            "f": c.f,
+            "n": c.n,
+            "T": c.T,
+            "hold": c.hold,
+            "compute_delay": c.compute_delay,
+            "duration": self.duration,
+            "start": {"x": self.start.x, "y": self.start.y, "heading_deg": math.degrees(self.start.theta)},
+            "target": self.target.to_dict(),
+            "speed_law": self.speed_law,
+            "measure": self.measure.to_dict(),
+            "seed": self.seed,
+            "start_jitter": self.start_jitter,
+        }
+        if self.env == "grid":
+            g = self.environment
+            out.update(cell_ratio=self.cell_ratio, cell_size=g.cell_size, window_cells=self.window_cells, cv=g.cv_max)
+        else:
+            out["law"] = self.effective_law().name
+        out["notes"] = dict(self.notes)
+        return out
+
+
+def _behind_a_wall(env: AnalyticEnvironment, x: float, y: float) -> bool:
+    """True if (x, y) lies on the blocked side of a wall, within its extent."""
+    from .environment import wall_coordinates
+
+    walls = env.arrays()
+    s, d = wall_coordinates(walls, x, y)
+    return bool(np.any((s >= 0) & (s <= walls["length"]) & (d < 0)))

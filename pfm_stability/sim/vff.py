@@ -1,0 +1,131 @@
+"""The virtual force field controller (Koren & Borenstein 1991 §2, eq 1–5).
+
+Forces are in units of the target force constant F_ct, so the attraction
+(eq 3) is a unit vector and the repulsion of an active cell (eq 1) is
+
+    F_ij/F_ct = ρ · C_ij · Wⁿ/dⁿ · (p − c_ij)/d,     ρ = F_cr/F_ct,
+
+pointing **from the cell towards the robot** (repulsion). KB's eq (1) as
+printed has the unit vector (x_i − x_0, y_i − y_0)/d, from the robot to the
+cell; their text ("each active cell exerts a virtual repulsive force") and
+eq (9) need the repulsive sign, which is what is implemented here.
+
+Angles follow DESIGN §2 and the `sampled` model: X lateral, Y forward, a
+direction is measured from +Y towards +X, so a heading θ moves the robot by
+(V sin θ, V cos θ) (KB eq 14) and δ = atan2(R_x, R_y) is the direction of the
+resultant R (eq 4). The steering-rate command is u = k·wrap(δ − θ) (eq 5),
+wrap giving the shortest rotational difference in [−π, π).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+__all__ = [
+    "wrap_angle",
+    "direction_of",
+    "cell_repulsion",
+    "window_repulsion",
+    "steering_command",
+    "vff_speed",
+]
+
+
+def wrap_angle(a):
+    """Shortest rotational equivalent of `a` (rad), in [−π, π)."""
+    return np.mod(np.asarray(a, dtype=float) + math.pi, 2 * math.pi) - math.pi
+
+
+def direction_of(fx, fy):
+    """Direction (rad, from +Y towards +X) of the vector (fx, fy); 0 for the zero vector."""
+    return np.arctan2(fx, fy)
+
+
+def cell_repulsion(px, py, ox, oy, ocv, n):
+    """Σ_cells C·(p − c)/|p − c|^(n+1) over the last axis (KB eq 1–2 without ρWⁿ), 1/m^n.
+
+    Parameters
+    ----------
+    px, py : ndarray, shape (B, 1) or broadcastable
+        Robot centres, m.
+    ox, oy, ocv : ndarray, shape (B, K)
+        Cell centres (m) and certainty values of each robot's active cells
+        (padding cells have C = 0 and lie far away).
+    n : float or ndarray, shape (B, 1)
+        Exponent of eq (1); n = 2 (KB's choice) uses a faster path.
+
+    Returns
+    -------
+    (fx, fy) : ndarray, shape (B,)
+    """
+    dx = px - ox
+    dy = py - oy
+    d2 = dx * dx
+    d2 += dy * dy
+    if np.isscalar(n) and n == 2.0:
+        weight = np.sqrt(d2)
+        weight *= d2
+        np.divide(ocv, weight, out=weight)
+    else:
+        weight = d2 ** (-(np.asarray(n) + 1.0) / 2.0)
+        weight *= ocv
+    return np.einsum("bk,bk->b", weight, dx), np.einsum("bk,bk->b", weight, dy)
+
+
+def window_repulsion(grid, px, py, *, ratio, n, W, window_cells=33):
+    """Repulsion F_r/F_ct of a grid's active window at points (KB eq 1–2).
+
+    A convenience for single evaluations (force-law checks, plots): compiles
+    the grid's window table (`pfm_stability.sim.window`) and sums the
+    occupied cells of each point's window.
+
+    Parameters
+    ----------
+    grid : HistogramGrid
+    px, py : array_like
+        Robot centres, m.
+    ratio : float
+        Cell force ratio ρ = F_cr/F_ct.
+    n : float
+        Exponent.
+    W : float
+        Robot width, m.
+    window_cells : int
+        Window side w_s (odd).
+
+    Returns
+    -------
+    (fx, fy) : ndarray
+        Components of the repulsion, in units of F_ct.
+    """
+    from .window import compile_window_table
+
+    table = compile_window_table(grid, window_cells)
+    px = np.atleast_1d(np.asarray(px, dtype=float))
+    py = np.atleast_1d(np.asarray(py, dtype=float))
+    g = table.grids[0]
+    i = np.floor((px - g.x_min) / g.cell_size).astype(np.int64) + g.pad
+    j = np.floor((py - g.y_min) / g.cell_size).astype(np.int64) + g.pad
+    inside = (i >= 0) & (i < g.nx_padded) & (j >= 0) & (j < g.ny_padded)
+    row = np.where(inside, table.row_of_cell[np.where(inside, i * g.ny_padded + j, 0)], 0)
+    fx, fy = cell_repulsion(px[:, None], py[:, None], table.wx[row], table.wy[row], table.wcv[row], n)
+    scale = ratio * W**n
+    return scale * fx, scale * fy
+
+
+def steering_command(delta, theta, k, max_rate):
+    """u = k·wrap(δ − θ) (KB eq 5), clipped to ±max_rate (rad/s)."""
+    return np.clip(k * wrap_angle(delta - theta), -max_rate, max_rate)
+
+
+def vff_speed(V_max, fx, fy, theta):
+    """The VFF speed law V = V_max(1 − |cos φ|), m/s.
+
+    φ is the angle between the repulsive resultant (fx, fy) and the travel
+    direction θ; with no repulsion the robot travels at V_max.
+    """
+    norm = np.hypot(fx, fy)
+    cos_phi = np.where(norm > 0, (fx * np.sin(theta) + fy * np.cos(theta)) / np.where(norm > 0, norm, 1.0), 0.0)
+    return V_max * (1.0 - np.abs(cos_phi))
