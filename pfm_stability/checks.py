@@ -14,10 +14,11 @@ from __future__ import annotations
 import math
 import numbers
 
-__all__ = ["check_number", "check_choice", "check_integer"]
+__all__ = ["check_number", "check_choice", "check_integer", "describe_range"]
 
 
-def _describe_range(low: float, high: float, low_open: bool, high_open: bool) -> str:
+def describe_range(low: float, high: float, low_open: bool, high_open: bool) -> str:
+    """Interval notation, e.g. ``(0, 100]``."""
     left = "(" if low_open else "["
     right = ")" if high_open else "]"
     return f"{left}{_fmt(low)}, {_fmt(high)}{right}"
@@ -28,7 +29,7 @@ def _fmt(x: float) -> str:
         return "inf"
     if x == -math.inf:
         return "-inf"
-    return f"{x:g}"
+    return f"{x:.12g}"
 
 
 def check_number(
@@ -67,7 +68,7 @@ def check_number(
     ValueError
         ``"<name> must be a finite number in <range> <unit>; got <value>"``.
     """
-    allowed = _describe_range(low, high, low_open, high_open)
+    allowed = describe_range(low, high, low_open, high_open)
     message = f"{name} must be a finite number in {allowed}{' ' + unit if unit else ''}; got {value!r}"
     if isinstance(value, bool) or not isinstance(value, numbers.Real):
         raise ValueError(message)

@@ -12,8 +12,8 @@ gives each model's critical values with 1/NV* in place of KB's (τ + T):
 * corridor (power law): N = 2nfWⁿ/L^(n+1), so
   L* = (2nWⁿVf/NV*)^(1/(n+1)) (eq 25 generalized), f* = L^(n+1)NV*/(2nWⁿV).
 
-For any other force law the same conditions are solved numerically (Brent's
-method on a bracket found by geometric expansion).
+For any other force law the same conditions are solved numerically
+(bisection on a bracket found by geometric expansion, module `solve`).
 """
 
 from __future__ import annotations
@@ -21,9 +21,12 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
+import numpy as np
+
 from .force_law import ForceLaw, PowerLaw, corridor_gain, wall_gain
 from .models import Loop, LoopModel, verdict_label
 from .parameters import Controller, Corridor, Robot, Wall, check_corridor_fits
+from .solve import bisect_root, expand_bracket
 
 __all__ = [
     "ModelVerdict",
@@ -136,33 +139,36 @@ def _law(robot: Robot, controller: Controller, law: ForceLaw | None) -> ForceLaw
 
 
 # --------------------------------------------------------------- root finding
-def _solve_monotone(func, x0: float, *, positive: bool = True) -> float:
-    """Root of a monotone function, bracketed by geometric expansion from x0.
+def _solve_decreasing(func, x0: float) -> float:
+    """Root in (0, inf) of a decreasing function, bracketed geometrically from x0.
 
-    For ``positive`` the search stays in (0, inf); the bracket grows by a
-    factor 2 each way for up to 200 steps. Returns the bracket end
-    (0 or inf) if no sign change is found.
+    The search goes up when func(x0) > 0 and down otherwise; if no sign change
+    is found within a factor 2^±200 the answer is that end (``inf`` or 0):
+    no finite value of the parameter reaches the boundary.
     """
-    from scipy.optimize import brentq
-
-    f0 = func(x0)
-    if f0 == 0:
+    value = func(x0)
+    if value == 0:
         return x0
-    lo = hi = x0
-    for _ in range(200):
-        lo, hi = lo / 2, hi * 2
-        flo, fhi = func(lo), func(hi)
-        if flo * f0 <= 0:
-            return brentq(func, lo, lo * 2, xtol=1e-300, rtol=1e-13)
-        if fhi * f0 <= 0:
-            return brentq(func, hi / 2, hi, xtol=1e-300, rtol=1e-13)
-    return 0.0 if abs(flo) < abs(fhi) else math.inf
+    upward = value > 0
+    bracket = expand_bracket(func, x0, upward=upward)
+    if bracket is None:
+        return math.inf if upward else 0.0
+    return bisect_root(func, *bracket)
+
+
+def _log_ratio(N: float, V: float, NV_critical: float) -> float:
+    """log(NV/NV*): > 0 unstable; −inf when N = 0 (no equilibrium: no loop gain)."""
+    return math.log(N * V / NV_critical) if N > 0 else -math.inf
 
 
 # ------------------------------------------------------------- closed forms
 def kb_critical_f_wall(alpha, V, tau_plus_T, n, W):
-    """KB eq (24): f* = cos α [nV(τ+T)/(W tan α)]^n (α in rad, V in m/s, τ+T in s, W in m)."""
-    return math.cos(alpha) * (n * V * tau_plus_T / (W * math.tan(alpha))) ** n
+    """KB eq (24): f* = cos α [nV(τ+T)/(W tan α)]^n (α in rad, V in m/s, τ+T in s, W in m).
+
+    ``inf`` when the value overflows (α → 0).
+    """
+    with np.errstate(over="ignore"):
+        return float(np.cos(alpha) * (n * V * tau_plus_T / (W * np.tan(alpha))) ** n)
 
 
 def kb_critical_L(n, W, V, tau_plus_T, f):
@@ -185,25 +191,15 @@ def critical_alpha(law: ForceLaw, V: float, NV_critical: float) -> float:
         return math.pi / 2
     target = NV_critical / V
 
-    # t = ln tan α maps (0, π/2) onto the real line; N(α) − target is decreasing in t
-    def excess(t):
-        alpha = math.atan(math.exp(t))
-        if alpha >= math.pi / 2:
-            return -target
+    def excess(alpha):
         return wall_gain(law, alpha)[1] - target
 
-    from scipy.optimize import brentq
-
-    lo, hi = -1.0, 1.0
-    for _ in range(200):
-        if excess(lo) > 0:
-            break
-        lo *= 2
-    for _ in range(200):
-        if excess(hi) < 0:
-            break
-        hi *= 2
-    return math.atan(math.exp(brentq(excess, lo, hi, xtol=1e-14, rtol=1e-14)))
+    lo, hi = 1e-12, math.pi / 2 - 1e-12
+    if excess(lo) <= 0:
+        return 0.0
+    if excess(hi) >= 0:
+        return math.pi / 2
+    return bisect_root(excess, lo, hi, rtol=1e-14)
 
 
 def critical_f_wall(law: ForceLaw, alpha: float, V: float, NV_critical: float) -> float:
@@ -214,7 +210,8 @@ def critical_f_wall(law: ForceLaw, alpha: float, V: float, NV_critical: float) -
         return math.inf
     if isinstance(law, PowerLaw):
         return kb_critical_f_wall(alpha, V, 1.0 / NV_critical, law.n, law.W)
-    return _solve_monotone(lambda c: math.log(wall_gain(law.with_scale(c), alpha)[1] * V / NV_critical), law.scale)
+    # N falls as the law gets stronger (the equilibrium moves out to flatter force)
+    return _solve_decreasing(lambda c: _log_ratio(wall_gain(law.with_scale(c), alpha)[1], V, NV_critical), law.scale)
 
 
 def critical_L(law: ForceLaw, V: float, NV_critical: float) -> float:
@@ -225,14 +222,15 @@ def critical_L(law: ForceLaw, V: float, NV_critical: float) -> float:
         return math.inf
     if isinstance(law, PowerLaw):
         return kb_critical_L(law.n, law.W, V, 1.0 / NV_critical, law.f)
-    return _solve_monotone(lambda L: math.log(corridor_gain(law, L) * V / NV_critical), 1.0)
+    return _solve_decreasing(lambda L: _log_ratio(corridor_gain(law, L), V, NV_critical), 1.0)
 
 
 def critical_f_corridor(law: ForceLaw, L: float, V: float, NV_critical: float) -> float:
     """f*: force-law strength below which the corridor middle is stable (N ∝ f)."""
-    if math.isinf(NV_critical):
+    gain = corridor_gain(law, L) * V
+    if math.isinf(NV_critical) or gain == 0:
         return math.inf
-    return law.scale * NV_critical / (corridor_gain(law, L) * V)
+    return law.scale * NV_critical / gain
 
 
 # ------------------------------------------------------------------ analyses

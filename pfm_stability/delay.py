@@ -23,7 +23,7 @@ Methods
 * **Gain crossings** (T fixed, K grows). s = jω is a root for a real K > 0 iff
   arg a(jω) + ωT ≡ π (mod 2π); the phase is unwrapped through the roots of a
   (continuous in ω) and every level (2m + 1)π is bracketed on a grid and refined
-  by Brent's method; K_m = |a(jω_m)|. When a(s) has no roots with Re > 0 the
+  by bisection; K_m = |a(jω_m)|. When a(s) has no roots with Re > 0 the
   phase is monotone and the crossings found are provably all of them.
 * **Rightmost roots** by pseudospectral collocation of the infinitesimal
   generator (Breda, Maset & Vermiglio, "Pseudospectral differencing methods for
@@ -42,6 +42,7 @@ import numpy as np
 from .checks import check_number
 from .crossings import Crossing, StabilityInterval, stable_interval
 from .routh import routh_array, strip_leading_zeros
+from .solve import bisect_root
 
 __all__ = ["DelayLoop", "DelayCrossing"]
 
@@ -65,6 +66,17 @@ class DelayCrossing:
     delay: float
     frequency: float
     direction: int
+
+
+def _newton_polish(p, dp, x: float, steps: int = 3) -> float:
+    """A few Newton steps on a real polynomial: np.roots loses relative accuracy
+    on small roots of badly scaled polynomials (e.g. τ → 0 in |a(jω)|² − K²)."""
+    for _ in range(steps):
+        slope = np.polyval(dp, x)
+        if slope == 0:
+            break
+        x = x - np.polyval(p, x) / slope
+    return float(x)
 
 
 def _polyval_derivative(p, s):
@@ -128,7 +140,7 @@ class DelayLoop:
         for y in roots:
             if abs(y.imag) > 1e-9 * max(1.0, abs(y)) or y.real <= 0:
                 continue
-            y = y.real
+            y = _newton_polish(F, dF, y.real)
             w = math.sqrt(y)
             slope = np.polyval(dF, y)
             scale = max(abs(np.polyval(np.abs(dF), y)), 1e-300)
@@ -233,8 +245,6 @@ class DelayLoop:
         list of Crossing
             (gain K_m = |a(jω_m)|, frequency ω_m in rad/s), sorted by gain.
         """
-        from scipy.optimize import brentq
-
         w_max = self._frequency_bound(K_max) * (1 + 1e-9)
         if w_max <= 0:
             return []
@@ -247,7 +257,7 @@ class DelayLoop:
             lo, hi = sorted((levels[i], levels[i + 1]))
             for level in np.arange(lo + 1, hi + 1):
                 target = math.pi + _TWO_PI * level
-                w = brentq(lambda x: self._phase(x) - target, grid[i], grid[i + 1], xtol=1e-15 * grid[i + 1], rtol=4 * np.finfo(float).eps)
+                w = bisect_root(lambda x: float(self._phase(x)) - target, grid[i], grid[i + 1], rtol=1e-15)
                 gain = abs(np.polyval(self.a, 1j * w))
                 if 0 < gain <= K_max * (1 + 1e-12):
                     out.append(Crossing(float(gain), float(w)))

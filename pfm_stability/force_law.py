@@ -20,6 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .checks import check_number
+from .solve import bisect_root, expand_bracket
 
 __all__ = ["ForceLaw", "PowerLaw", "wall_equilibrium", "wall_gain", "corridor_gain"]
 
@@ -28,7 +29,7 @@ class ForceLaw:
     """A decreasing lateral repulsion law F_r(d)/F_a, d in m.
 
     Subclasses implement `force`, `slope` and `with_scale`; `distance_for`
-    has a numerical default (Brent's method on the monotone law).
+    has a numerical default (bisection on the monotone law).
 
     Attributes
     ----------
@@ -58,21 +59,21 @@ class ForceLaw:
         return (1e-9, math.inf)
 
     def distance_for(self, force: float) -> float:
-        """d with F_r(d)/F_a = `force` (m); ``inf`` if the law never gets that weak."""
-        from scipy.optimize import brentq
+        """d with F_r(d)/F_a = `force` (m); ``inf`` if the law never gets that weak.
 
+        Bisection on the monotone law over its `domain` (module `solve`).
+        """
         lo, hi = self.domain()
         if self.force(lo) <= force:
             return lo
         if math.isinf(hi):
-            hi = max(lo * 2, 1.0)
-            while self.force(hi) > force:
-                hi *= 2
-                if hi > 1e12:
-                    return math.inf
+            bracket = expand_bracket(lambda d: self.force(d) - force, max(lo, 1e-3))
+            if bracket is None:
+                return math.inf
+            lo, hi = max(lo, bracket[0]), bracket[1]
         elif self.force(hi) > force:
             return math.inf
-        return brentq(lambda d: self.force(d) - force, lo, hi, xtol=1e-14, rtol=1e-14)
+        return bisect_root(lambda d: float(self.force(d)) - force, lo, hi, rtol=1e-14)
 
     def local_exponent(self, d):
         """Local exponent −d·F′/F (n for the power law)."""

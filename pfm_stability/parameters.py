@@ -16,6 +16,9 @@ from dataclasses import dataclass, field, replace
 from .checks import check_choice, check_integer, check_number
 
 __all__ = [
+    "Range",
+    "RANGES",
+    "check_parameter",
     "Robot",
     "Controller",
     "Wall",
@@ -31,7 +34,60 @@ __all__ = [
 HOLDS = ("command", "reference")
 """Sampled-loop structures of DESIGN §4: what the sampled computer holds."""
 
-_MAX_EXPONENT = 10.0
+
+
+@dataclass(frozen=True)
+class Range:
+    """Allowed values of one parameter (bounds, openness, unit)."""
+
+    low: float
+    high: float
+    low_open: bool = True
+    high_open: bool = False
+    unit: str = ""
+
+    def describe(self) -> str:
+        """E.g. ``(0, 100] m/s``."""
+        from .checks import describe_range
+
+        return describe_range(self.low, self.high, self.low_open, self.high_open) + (f" {self.unit}" if self.unit else "")
+
+
+_ALPHA_MARGIN_DEG = 1e-6
+# α within 1e-6° of 0 or 90° makes N (∝ 1/sin α, or the equilibrium distance
+# ∝ (cos α)^(−1/n)) overflow what the root finders can represent; the answer
+# there is the limit already reached at 1e-6° (unstable at 0, stable at 90°).
+
+RANGES = {
+    "V": Range(0.0, 100.0, unit="m/s"),
+    "tau": Range(0.0, 100.0, low_open=False, unit="s"),
+    "T": Range(0.0, 100.0, low_open=False, unit="s"),
+    "k": Range(0.0, 1e4, unit="1/s"),
+    "W": Range(0.0, 100.0, unit="m"),
+    "f": Range(0.0, 1e6),
+    "n": Range(0.0, 10.0),
+    "alpha": Range(_ALPHA_MARGIN_DEG * math.pi / 180, math.pi / 2 - _ALPHA_MARGIN_DEG * math.pi / 180, low_open=False, unit="rad"),
+    "alpha_deg": Range(_ALPHA_MARGIN_DEG, 90.0 - _ALPHA_MARGIN_DEG, low_open=False, unit="deg"),
+    "L": Range(0.0, 1e4, unit="m"),
+    "max_steering_rate": Range(0.0, math.inf, high_open=True, unit="rad/s"),
+}
+"""The one place where parameter ranges live (library, vectorized code and CLI).
+
+Lower bounds are physical (V > 0, τ >= 0 …); upper bounds are generous caps
+(100 m/s, 100 s, 10⁴ 1/s …) that keep every computation inside floating point.
+"""
+
+
+def check_parameter(name: str, value) -> float:
+    """`value` as a float if it lies in ``RANGES[name]``, else ValueError.
+
+    The message names the parameter as the user knows it (``alpha_deg`` is
+    reported as ``alpha``), the range with its unit, and the value.
+    """
+    r = RANGES[name]
+    shown = "alpha" if name == "alpha_deg" else name
+    return check_number(shown, value, r.low, r.high, low_open=r.low_open, high_open=r.high_open, unit=r.unit)
+
 
 
 @dataclass(frozen=True)
@@ -41,13 +97,13 @@ class Robot:
     Parameters
     ----------
     V : float
-        Travel speed, m/s, > 0.
+        Travel speed, m/s, in (0, 100].
     tau : float
-        Steering-motor time constant τ, s, >= 0 (KB eq 6; 0 = ideal motor).
+        Steering-motor time constant τ, s, in [0, 100] (KB eq 6; 0 = ideal motor).
     k : float
-        Steering gain, 1/s, > 0 (KB eq 5: u = k(δ − θ)).
+        Steering gain, 1/s, in (0, 10⁴] (KB eq 5: u = k(δ − θ)).
     W : float
-        Robot width, m, > 0 (KB eq 1).
+        Robot width, m, in (0, 100] (KB eq 1).
     max_steering_rate : float
         Largest steering rate |ω|, rad/s, > 0 (CARMEL: 120°/s). Used by the
         simulator only; the linear analysis assumes no saturation.
@@ -60,15 +116,8 @@ class Robot:
     max_steering_rate: float = math.radians(120.0)
 
     def __post_init__(self):
-        object.__setattr__(self, "V", check_number("V", self.V, 0.0, unit="m/s"))
-        object.__setattr__(self, "tau", check_number("tau", self.tau, 0.0, low_open=False, unit="s"))
-        object.__setattr__(self, "k", check_number("k", self.k, 0.0, unit="1/s"))
-        object.__setattr__(self, "W", check_number("W", self.W, 0.0, unit="m"))
-        object.__setattr__(
-            self,
-            "max_steering_rate",
-            check_number("max_steering_rate", self.max_steering_rate, 0.0, unit="rad/s"),
-        )
+        for name in ("V", "tau", "k", "W", "max_steering_rate"):
+            object.__setattr__(self, name, check_parameter(name, getattr(self, name)))
 
     def replace(self, **changes) -> "Robot":
         """Return a copy with some fields changed (validated again)."""
@@ -82,11 +131,11 @@ class Controller:
     Parameters
     ----------
     f : float
-        Repulsive/attractive force-constant ratio, > 0 (KB eq 13).
+        Repulsive/attractive force-constant ratio, in (0, 10⁶] (KB eq 13).
     n : float
         Repulsion exponent, in (0, 10] (KB eq 1, 8).
     T : float
-        Sampling period, s, >= 0 (KB eq 18; 0 = continuous controller).
+        Sampling period, s, in [0, 100] (KB eq 18; 0 = continuous controller).
     hold : {"command", "reference"}
         What the sampled computer holds between samples (DESIGN §4):
         ``"command"`` holds u = k(δ_k − θ_k); ``"reference"`` holds δ_k and the
@@ -102,9 +151,8 @@ class Controller:
     compute_delay: int = 0
 
     def __post_init__(self):
-        object.__setattr__(self, "f", check_number("f", self.f, 0.0))
-        object.__setattr__(self, "n", check_number("n", self.n, 0.0, _MAX_EXPONENT, high_open=False))
-        object.__setattr__(self, "T", check_number("T", self.T, 0.0, low_open=False, unit="s"))
+        for name in ("f", "n", "T"):
+            object.__setattr__(self, name, check_parameter(name, getattr(self, name)))
         check_choice("hold", self.hold, HOLDS)
         object.__setattr__(self, "compute_delay", check_integer("compute_delay", self.compute_delay, 0, 1))
 
@@ -121,19 +169,21 @@ class Wall:
     ----------
     alpha : float
         Angle between the wall normal (towards the wall) and the target
-        direction, rad, in (0, π/2); π/2 = target straight ahead along the wall.
+        direction, rad, in [1e-6°, 90° − 1e-6°]; π/2 = target straight ahead
+        along the wall.
     """
 
     alpha: float
 
     def __post_init__(self):
-        object.__setattr__(self, "alpha", check_number("alpha", self.alpha, 0.0, math.pi / 2, unit="rad"))
+        object.__setattr__(self, "alpha", check_parameter("alpha", self.alpha))
 
     @classmethod
     def from_degrees(cls, alpha_deg: float) -> "Wall":
         """Build from α in degrees, with the range stated in degrees on error."""
-        alpha_deg = check_number("alpha", alpha_deg, 0.0, 90.0, unit="deg")
-        return cls(math.radians(alpha_deg))
+        alpha_deg = check_parameter("alpha_deg", alpha_deg)
+        r = RANGES["alpha"]
+        return cls(min(max(math.radians(alpha_deg), r.low), r.high))  # round-off at the ends
 
 
 @dataclass(frozen=True)
@@ -143,13 +193,13 @@ class Corridor:
     Parameters
     ----------
     L : float
-        Half-width: robot centre line to each wall, m, > W/2 (KB eq 25).
+        Half-width: robot centre line to each wall, m, in (W/2, 10⁴] (KB eq 25).
     """
 
     L: float
 
     def __post_init__(self):
-        object.__setattr__(self, "L", check_number("L", self.L, 0.0, unit="m"))
+        object.__setattr__(self, "L", check_parameter("L", self.L))
 
 
 def check_corridor_fits(corridor: Corridor, robot: Robot) -> None:
@@ -161,9 +211,8 @@ def check_corridor_fits(corridor: Corridor, robot: Robot) -> None:
         ``"L must be a finite number in (W/2, inf) m = (0.4, inf) m; got 0.3"``.
     """
     if not corridor.L > robot.W / 2:
-        raise ValueError(
-            f"L must be a finite number in (W/2, inf) m = ({robot.W / 2:g}, inf) m; got {corridor.L!r}"
-        )
+        high = RANGES["L"].high
+        raise ValueError(f"L must be a finite number in (W/2, {high:g}] m = ({robot.W / 2:g}, {high:g}] m; got {corridor.L!r}")
 
 
 @dataclass(frozen=True)

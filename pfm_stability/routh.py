@@ -3,9 +3,12 @@
 `routh_array` builds the Routh array of a real polynomial, numerically (floats)
 or symbolically (sympy expressions), and handles the two special cases:
 
-* a zero in the first column of an otherwise non-zero row: replaced by a small
-  ε > 0 (numerically ``eps_scale`` times the row's size; symbolically a positive
-  sympy symbol ``epsilon`` whose limit ε → 0+ is taken when signs are counted);
+* a zero in the first column of an otherwise non-zero row: replaced by a
+  positive symbol ε, the signs taken in the limit ε → 0+. A float array cannot
+  keep 1/ε and ε² apart once zero pivots chain, and a pivot below 1e-9 of its
+  rows amplifies round-off into the signs below it, so in both cases the float
+  coefficients are converted exactly to rationals and the symbolic array
+  decides;
 * a row of zeros (roots symmetric about the origin, e.g. a pair on the imaginary
   axis): replaced by the coefficients of the derivative of the auxiliary
   polynomial formed from the row above.
@@ -43,21 +46,27 @@ class RouthResult:
     first_column : list
         First entry of every row (after ε and auxiliary-polynomial substitution).
     sign_changes : int
-        Sign changes in the first column = roots with Re > 0 (numeric case).
+        Sign changes in the first column = roots with Re > 0 (exact unless
+        `marginal`).
     marginal : bool
-        A row of zeros or an ε substitution occurred: roots on or symmetric
-        about the imaginary axis may exist, so "stable" needs care.
+        A row of zeros (roots symmetric about the origin, possibly on the
+        imaginary axis) or a zero last entry (a root at s = 0).
+    epsilon_used : bool
+        A zero first-column entry occurred (resolved by ε → 0+); the count is still exact when no root lies on the
+        imaginary axis, but the polynomial is not Hurwitz (a Hurwitz
+        polynomial has no zero in the first column).
     """
 
     table: list
     first_column: list
     sign_changes: int
     marginal: bool
+    epsilon_used: bool = False
 
     @property
     def stable(self) -> bool:
         """True when every root has a negative real part."""
-        return self.sign_changes == 0 and not self.marginal
+        return self.sign_changes == 0 and not self.marginal and not self.epsilon_used
 
 
 def strip_leading_zeros(coefficients) -> np.ndarray:
@@ -69,7 +78,7 @@ def strip_leading_zeros(coefficients) -> np.ndarray:
     return c[nonzero[0]:]
 
 
-def routh_array(coefficients, eps_scale: float = 1e-9) -> RouthResult:
+def routh_array(coefficients) -> RouthResult:
     """Routh array of a polynomial given in descending powers.
 
     Parameters
@@ -77,9 +86,6 @@ def routh_array(coefficients, eps_scale: float = 1e-9) -> RouthResult:
     coefficients : sequence of float or sympy expressions
         a_n, …, a_0 of a_n s^n + … + a_0 (a_n ≠ 0). If any entry is a sympy
         expression the array is built symbolically.
-    eps_scale : float
-        Numerical case: a zero in the first column is replaced by
-        ``eps_scale`` × (largest magnitude in that row, or 1).
 
     Returns
     -------
@@ -93,7 +99,7 @@ def routh_array(coefficients, eps_scale: float = 1e-9) -> RouthResult:
     c = strip_leading_zeros(coefficients)
     if not np.all(np.isfinite(c)):
         raise ValueError(f"polynomial coefficients must be finite; got {list(coefficients)!r}")
-    return _routh_numeric(c, eps_scale)
+    return _routh_numeric(c)
 
 
 def _first_two_rows(c):
@@ -138,12 +144,32 @@ def _next_row_numeric(upper, lower):
 
 
 _CANCELLATION = 1e3 * np.finfo(float).eps
+_SMALL_PIVOT = 1e-9
 
 
-def _routh_numeric(c: np.ndarray, eps_scale: float) -> RouthResult:
-    n = len(c) - 1
-    if n == 0:
+def _routh_numeric(c: np.ndarray) -> RouthResult:
+    """Numeric Routh array; a zero or near-zero pivot hands over to exact arithmetic.
+
+    A finite ε cannot stand in for ε → 0+ in floating point once several
+    zero pivots chain (entries like 1/ε and ε² must be kept apart), and a
+    pivot below 1e-9 of its rows amplifies round-off into the signs below it;
+    in either case the float coefficients are converted exactly to rationals
+    and the symbolic array (with ε → 0+ where a pivot is exactly zero) decides
+    (Gantmacher, ch. XV §6).
+    """
+    if len(c) == 1:
         return RouthResult([[float(c[0])]], [float(c[0])], 0, False)
+    result = _routh_table(c)
+    if result is None:
+        import sympy as sp
+
+        return _routh_symbolic([sp.Rational(float(x)) for x in c])
+    return result
+
+
+def _routh_table(c: np.ndarray) -> RouthResult | None:
+    """The float array, or None at the first zero pivot."""
+    n = len(c) - 1
     row0, row1, _ = _first_two_rows([float(x) for x in c])
     table = [row0, row1]
     marginal = False
@@ -153,10 +179,8 @@ def _routh_numeric(c: np.ndarray, eps_scale: float) -> RouthResult:
             marginal = True
             lower = _auxiliary_derivative(upper, power + 1)
             table[-1] = lower
-        if lower[0] == 0.0:
-            marginal = True
-            lower = [eps_scale * max(max(abs(x) for x in lower), 1.0)] + list(lower[1:])
-            table[-1] = lower
+        if abs(lower[0]) <= _SMALL_PIVOT * max(abs(x) for x in upper + lower):
+            return None  # a zero or a near-zero pivot: floats lose the signs below it
         table.append(_next_row_numeric(upper, lower))
     if table[-1][0] == 0.0:
         marginal = True
@@ -182,7 +206,7 @@ def _routh_symbolic(c) -> RouthResult:
         return RouthResult([[c[0]]], [c[0]], 0, False)
     row0, row1, _ = _first_two_rows(c)
     table = [row0, row1]
-    marginal = False
+    marginal = epsilon_used = False
     for power in range(n - 1, 0, -1):
         upper, lower = table[-2], table[-1]
         if all(sp.simplify(x) == 0 for x in lower):
@@ -190,24 +214,25 @@ def _routh_symbolic(c) -> RouthResult:
             lower = _auxiliary_derivative(upper, power + 1)
             table[-1] = lower
         if sp.simplify(lower[0]) == 0:
-            marginal = True
+            epsilon_used = True
             lower = [epsilon] + list(lower[1:])
             table[-1] = lower
         table.append([sp.simplify(x) for x in _next_row(upper, lower)])
     first = [sp.simplify(row[0]) for row in table]
-    limits = [sp.limit(x, epsilon, 0, "+") if x.has(epsilon) else x for x in first]
+    # sign of each entry as ε → 0+ (ε itself counts as positive)
+    limits = [sp.limit(sp.sign(x), epsilon, 0, "+") if x.has(epsilon) else x for x in first]
     signs = []
     for x in limits:
-        if x.is_positive:
+        if x.is_extended_positive:
             signs.append(1)
-        elif x.is_negative:
+        elif x.is_extended_negative:
             signs.append(-1)
         elif x.is_zero:
             continue
         else:
-            return RouthResult(table, first, -1, marginal)
+            return RouthResult(table, first, -1, marginal, epsilon_used)
     changes = sum(1 for a, b in zip(signs, signs[1:]) if a != b)
-    return RouthResult(table, first, changes, marginal)
+    return RouthResult(table, first, changes, marginal, epsilon_used)
 
 
 def routh_count(coefficients) -> int:

@@ -7,23 +7,23 @@ where every value came from so reports can mark the assumed ones.
 from __future__ import annotations
 
 import argparse
-import math
 from dataclasses import dataclass, fields
 
 from ..checks import check_number
-from ..parameters import HOLDS, PRESETS, Controller, Preset, Robot, get_preset
+from ..parameters import HOLDS, PRESETS, RANGES, Controller, Preset, Robot, check_parameter, get_preset
 
 __all__ = ["number", "add_parameter_options", "resolve_parameters", "ResolvedParameters"]
 
 
-def number(name: str, low: float = -math.inf, high: float = math.inf, *, low_open=True, high_open=True, unit="", scale=1.0):
-    """An argparse ``type=`` that parses a float and checks its range.
+def number(name: str, *bounds, **options):
+    """An argparse ``type=`` that parses a float and checks it against ``RANGES[name]``.
 
-    The message on failure is the library's (`checks.check_number`), so the
-    CLI and the library name the parameter and its range the same way.
-    ``scale`` converts the checked value (e.g. degrees → radians is left to
-    the caller; 1 by default).
+    The message on failure is the library's (`parameters.check_parameter`),
+    so the CLI and the library name the parameter and its range the same way.
+    A parameter without an entry in ``RANGES`` gives its bounds here, as
+    `checks.check_number` takes them (``low, high, low_open=…, unit=…``).
     """
+    check = (lambda value: check_number(name, value, *bounds, **options)) if bounds or options else (lambda value: check_parameter(name, value))
 
     def parse(text: str) -> float:
         try:
@@ -31,7 +31,7 @@ def number(name: str, low: float = -math.inf, high: float = math.inf, *, low_ope
         except ValueError:
             value = text
         try:
-            return check_number(name, value, low, high, low_open=low_open, high_open=high_open, unit=unit) * scale
+            return check(value)
         except ValueError as exc:
             raise argparse.ArgumentTypeError(str(exc)) from None
 
@@ -43,13 +43,17 @@ def add_parameter_options(parser: argparse.ArgumentParser) -> None:
     """--preset, --V, --tau, --T, --k, --f, --n, --W, --hold, --compute-delay."""
     group = parser.add_argument_group("robot and controller (override the preset)")
     group.add_argument("--preset", choices=sorted(PRESETS), default="carmel", help="parameter preset (default: carmel)")
-    group.add_argument("--V", type=number("V", 0.0, unit="m/s"), help="speed, m/s (> 0)")
-    group.add_argument("--tau", type=number("tau", 0.0, low_open=False, unit="s"), help="steering time constant, s (>= 0)")
-    group.add_argument("--T", type=number("T", 0.0, low_open=False, unit="s"), help="sampling period, s (>= 0)")
-    group.add_argument("--k", type=number("k", 0.0, unit="1/s"), help="steering gain, 1/s (> 0)")
-    group.add_argument("--f", type=number("f", 0.0), help="force-constant ratio F_cr/F_ct (> 0)")
-    group.add_argument("--n", type=number("n", 0.0, 10.0, high_open=False), help="repulsion exponent (0 < n <= 10)")
-    group.add_argument("--W", type=number("W", 0.0, unit="m"), help="robot width, m (> 0)")
+    helps = {
+        "V": "speed",
+        "tau": "steering time constant",
+        "T": "sampling period",
+        "k": "steering gain",
+        "f": "force-constant ratio F_cr/F_ct",
+        "n": "repulsion exponent",
+        "W": "robot width",
+    }
+    for name, text in helps.items():
+        group.add_argument(f"--{name}", type=number(name), help=f"{text}, {RANGES[name].describe()}")
     group.add_argument("--hold", choices=HOLDS, help="sampled structure: what is held between samples")
     group.add_argument("--compute-delay", type=_compute_delay, help="samples from measurement to actuation (0 or 1)")
 

@@ -16,8 +16,8 @@ def add_parser(sub) -> None:
         description="Stability of the VFF robot-environment loop (Koren & Borenstein 1991) for every model.",
     )
     add_parameter_options(p)
-    p.add_argument("--alpha", type=number("alpha", 0.0, 90.0, unit="deg"), help="wall: target angle from the wall normal, deg, in (0, 90)")
-    p.add_argument("--L", type=number("L", 0.0, unit="m"), help="corridor half-width, m (> W/2)")
+    p.add_argument("--alpha", type=number("alpha_deg"), help="wall: target angle from the wall normal, deg, in (0, 90)")
+    p.add_argument("--L", type=number("L"), help="corridor half-width, m, in (W/2, 1e4]")
     p.add_argument("--model", action="append", choices=MODEL_CHOICES, help="model to include (repeatable; default: all)")
     p.add_argument("--pade-order", type=_pade_order, default=3, help="order m of the pade model (1..12, default 3)")
     p.add_argument("--format", choices=("text", "json", "markdown"), default="text")

@@ -17,11 +17,14 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 
 from ..checks import check_number
+from ..parameters import RANGES, check_parameter
 from ..crossings import first_stable_interval, verdict_at
+from ..solve import bisect_root
 
 __all__ = ["Loop", "Boundary", "LoopModel", "AffineGainModel", "verdict_label", "UNDECIDED_RTOL"]
 
@@ -48,9 +51,8 @@ class Loop:
     k: float
 
     def __post_init__(self):
-        object.__setattr__(self, "tau", check_number("tau", self.tau, 0.0, low_open=False, unit="s"))
-        object.__setattr__(self, "T", check_number("T", self.T, 0.0, low_open=False, unit="s"))
-        object.__setattr__(self, "k", check_number("k", self.k, 0.0, unit="1/s"))
+        for name in ("tau", "T", "k"):
+            object.__setattr__(self, name, check_parameter(name, getattr(self, name)))
 
     @property
     def plant(self) -> np.ndarray:
@@ -99,13 +101,26 @@ def verdict_label(NV: float, boundary: Boundary, stable: bool, rtol: float = UND
     return "stable" if stable else "unstable"
 
 
+@lru_cache(maxsize=8192)
+def _cached_boundary(model: "LoopModel", loop: Loop) -> Boundary:
+    return model.compute_boundary(loop)
+
+
 class LoopModel:
-    """Base class: a named loop model. Subclasses implement the three queries."""
+    """Base class: a named loop model. Subclasses implement the queries.
+
+    Models are immutable and hashable, so `boundary` is cached per
+    (model, loop): a report asks for the same boundary many times.
+    """
 
     name: str = ""
     equation: str = ""
 
-    def boundary(self, loop: Loop) -> Boundary:  # pragma: no cover - interface
+    def boundary(self, loop: Loop) -> Boundary:
+        """NV* and the boundary frequency for (τ, T, k) (cached)."""
+        return _cached_boundary(self, loop)
+
+    def compute_boundary(self, loop: Loop) -> Boundary:  # pragma: no cover - interface
         raise NotImplementedError
 
     def is_stable(self, NV: float, loop: Loop) -> bool:  # pragma: no cover - interface
@@ -118,12 +133,10 @@ class LoopModel:
         """Largest sampling period / delay T that keeps NV stable (τ, k fixed), s.
 
         The first T at which NV*(T) falls to NV: a doubling search from
-        T = 10⁻³(τ + 1/k) brackets it and Brent's method refines it to 1e-12
+        T = 10⁻³(τ + 1/k) brackets it and bisection refines it to 1e-10
         relative. 0 if NV is unstable already at T = 0; ``inf`` if NV*(T)
-        stays above NV up to T = 2⁴⁰·10⁻³(τ + 1/k).
+        stays above NV up to the largest allowed T (100 s).
         """
-        from scipy.optimize import brentq
-
         NV = _check_NV(NV)
 
         def excess(T):
@@ -131,15 +144,25 @@ class LoopModel:
 
         if excess(0.0) <= 0:
             return 0.0
-        lo, hi = 0.0, 1e-3 * (loop.tau + 1.0 / loop.k)
-        for _ in range(40):
+        start = 1e-3 * (loop.tau + 1.0 / loop.k)
+        if excess(start) <= 0:
+            return bisect_root(excess, 0.0, start, rtol=1e-10)
+        lo, T_max = start, RANGES["T"].high
+        while lo < T_max:
+            hi = min(2 * lo, T_max)
             if excess(hi) <= 0:
-                return brentq(excess, lo, hi, xtol=1e-15, rtol=1e-12)
-            lo, hi = hi, 2 * hi
+                return bisect_root(excess, lo, hi, rtol=1e-10)
+            lo = hi
         return math.inf
 
     def __repr__(self) -> str:
         return f"{type(self).__name__}()"
+
+    def __eq__(self, other) -> bool:
+        return type(self) is type(other) and vars(self) == vars(other)
+
+    def __hash__(self) -> int:
+        return hash((type(self).__name__, tuple(sorted(vars(self).items()))))
 
 
 def _check_NV(NV) -> float:
@@ -171,7 +194,7 @@ class AffineGainModel(LoopModel):
             return None
         return raw / loop.T if self.domain == "z" else raw
 
-    def boundary(self, loop: Loop) -> Boundary:
+    def compute_boundary(self, loop: Loop) -> Boundary:
         d, e = self.polynomials(loop)
         interval = first_stable_interval(d, e, self.domain)
         return Boundary(self.name, interval.gain / loop.k, self._frequency(interval.frequency, loop), interval.gain)

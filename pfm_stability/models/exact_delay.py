@@ -5,9 +5,13 @@ finds the crossings of the imaginary axis (Cooke & van den Driessche 1986;
 Walton & Marshall 1987), counts the roots in Re s > 0 exactly, and finds the
 rightmost roots by pseudospectral collocation (Breda, Maset & Vermiglio 2005)
 polished by Newton. For a(s) = τs³ + s² + ks the phase arg a(jω) + ωT is
-strictly increasing and |a(jω)| is strictly increasing, so there is one
-crossing frequency per gain and every crossing is destabilizing: K* is the
-first gain crossing and NV* = K*/k, which depends on k (unlike KB's eq 20).
+strictly increasing (arg a(jω) = π − atan((k − τω²)/ω)), so each level
+(2m + 1)π gives one gain crossing K_m = |a(jω_m)|. |a(jω)| itself is monotone
+only for kτ <= 2 + √3; above that the steering loop τs² + s + k resonates,
+|a(jω)|² = τ²ω⁶ + (1 − 2kτ)ω⁴ + k²ω² dips, and a later crossing can have the
+smallest gain. K* is therefore the end of the stable interval found by
+checking the crossing count between consecutive crossing gains, and
+NV* = K*/k — which depends on k, unlike KB's eq (20).
 T = 0 reduces to `continuous` (eq 17).
 """
 
@@ -30,7 +34,7 @@ class ExactDelay(LoopModel):
         """The quasi-polynomial a(s) + K e^(−sT) with a(s) = τs³ + s² + ks."""
         return DelayLoop(loop.plant, loop.T)
 
-    def boundary(self, loop: Loop) -> Boundary:
+    def compute_boundary(self, loop: Loop) -> Boundary:
         interval = self.quasi_polynomial(loop).critical_gain()
         return Boundary(self.name, interval.gain / loop.k, interval.frequency, interval.gain)
 

@@ -27,6 +27,8 @@ T = 0 is the continuous loop of KB eq (17) (`continuous`).
 
 from __future__ import annotations
 
+from functools import lru_cache
+
 import numpy as np
 
 from ..checks import check_choice, check_integer
@@ -91,6 +93,15 @@ def discretize(A, B, T: float):
     return E[:n, :n], E[:n, n:]
 
 
+@lru_cache(maxsize=4096)
+def _discrete_plant(loop: Loop, hold: str):
+    A, B, F0, F1 = continuous_plant(loop, hold)
+    Phi, Gamma = discretize(A, B, loop.T)
+    for array in (Phi, Gamma, F0, F1):
+        array.setflags(write=False)
+    return Phi, Gamma, F0, F1
+
+
 def closed_loop_matrix(loop: Loop, K: float, hold: str, compute_delay: int) -> np.ndarray:
     """Φ_cl of the sampled loop for gain K = kNV (1/s²).
 
@@ -109,8 +120,7 @@ def closed_loop_matrix(loop: Loop, K: float, hold: str, compute_delay: int) -> n
         State transition matrix over one period; with compute_delay = 1 the
         last state is the command waiting to be applied.
     """
-    A, B, F0, F1 = continuous_plant(loop, hold)
-    Phi, Gamma = discretize(A, B, loop.T)
+    Phi, Gamma, F0, F1 = _discrete_plant(loop, hold)
     F = (F0 + K * F1)[None, :]
     if compute_delay == 0:
         return Phi - Gamma @ F
@@ -154,11 +164,11 @@ class Sampled(AffineGainModel):
         e[np.abs(e) <= 100 * np.finfo(float).eps * np.max(np.abs(d))] = 0.0
         return d, e
 
-    def boundary(self, loop: Loop) -> Boundary:
+    def compute_boundary(self, loop: Loop) -> Boundary:
         if loop.T == 0:
             b = Continuous().boundary(loop)
             return Boundary(self.name, b.NV_critical, b.omega_critical, b.K_critical)
-        return super().boundary(loop)
+        return super().compute_boundary(loop)
 
     def eigenvalues(self, NV: float, loop: Loop) -> np.ndarray:
         """Closed-loop eigenvalues z (T > 0)."""
