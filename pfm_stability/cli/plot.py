@@ -1,0 +1,56 @@
+"""``pfm-stability plot KIND --out FILE.png``: pictures of the analysis.
+
+Kinds: ``rlocus`` (root locus of the Padé loop with the critical crossings of
+every model), ``gain-vs-k`` (NV* against the steering gain k for all models),
+``force-law`` (the grid's effective force law against KB's lumped law).
+"""
+
+from __future__ import annotations
+
+from .options import add_parameter_options, resolve_parameters
+
+KINDS = ("rlocus", "gain-vs-k", "force-law")
+
+
+def add_parser(sub) -> None:
+    p = sub.add_parser("plot", help="save a plot as PNG (root locus, NV* vs k, grid force law)", description=__doc__.splitlines()[0])
+    p.add_argument("kind", choices=KINDS, help="what to draw")
+    p.add_argument("--out", required=True, help="output PNG file")
+    p.add_argument("--pade-order", type=int, choices=range(1, 13), default=3, metavar="M", help="Padé order m (1..12, default 3)")
+    add_parameter_options(p)
+    p.set_defaults(run=run)
+
+
+def _draw(kind, params, pade_order):
+    from ..criteria import loop_of
+
+    robot, controller = params.robot, params.controller
+    if kind == "rlocus":
+        from ..plots.rlocus import plot_root_locus
+
+        return plot_root_locus(loop_of(robot, controller), pade_order=pade_order, hold=controller.hold, compute_delay=controller.compute_delay)
+    if kind == "gain-vs-k":
+        from ..plots.rlocus import plot_critical_gain_vs_k
+
+        return plot_critical_gain_vs_k(robot.tau, controller.T, pade_order=pade_order)
+    from ..effective_force import GridWallLaw, calibrate_cell_ratio
+    from ..plots.force import plot_force_summary
+
+    ratio = calibrate_cell_ratio(controller.f, controller.n, robot.W, params.preset.cell_size, params.preset.window_cells)
+    return plot_force_summary(GridWallLaw(ratio, controller.n, robot.W, params.preset.cell_size, params.preset.window_cells))
+
+
+def run(args) -> int:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    params = resolve_parameters(args)
+    if args.kind == "rlocus" and params.controller.T == 0:
+        raise ValueError("T must be a finite number in (0, 100] s for a root locus of the delay loop; got 0.0")
+    fig = _draw(args.kind, params, args.pade_order)
+    try:
+        fig.savefig(args.out, dpi=130)
+    except OSError as exc:
+        raise ValueError(f"out must be a writable PNG path; got {args.out!r} ({exc.strerror})") from None
+    print(f"wrote {args.out}")
+    return 0
