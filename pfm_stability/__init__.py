@@ -47,6 +47,10 @@ _EXPORTS = {
     "build_report": "report",
     "routh_array": "routh",
     "schur_cohn_stable": "routh",
+    "exact_delay_verdicts": "vectorized",
+    "GridWallLaw": "effective_force",
+    "simulate": "sim",
+    "simulate_batch": "sim",
 }
 
 __all__ = sorted(_EXPORTS) + ["__version__"]

@@ -5,8 +5,9 @@ or symbolically (sympy expressions), and handles the two special cases:
 
 * a zero in the first column of an otherwise non-zero row: replaced by a
   positive symbol ε, the signs taken in the limit ε → 0+. A float array cannot
-  keep 1/ε and ε² apart once zero pivots chain, and a pivot below 1e-9 of its
-  rows amplifies round-off into the signs below it, so in both cases the float
+  keep 1/ε and ε² apart once zero pivots chain, and a pivot that is mostly
+  cancellation (below 1e-9 of the terms it came from) has no reliable sign, so
+  in both cases the float
   coefficients are converted exactly to rationals and the symbolic array
   decides;
 * a row of zeros (roots symmetric about the origin, e.g. a pair on the imaginary
@@ -131,16 +132,20 @@ def _auxiliary_derivative(upper, power):
 
 
 def _next_row_numeric(upper, lower):
-    """Next Routh row; entries lost to cancellation (below round-off) become exactly 0."""
+    """Next Routh row and, per entry, the size of the terms that produced it.
+
+    Entries lost to cancellation (below round-off of those terms) become exactly 0.
+    """
     width = len(upper)
-    row = []
+    row, sizes = [], []
     for j in range(width):
         a = upper[j + 1] if j + 1 < width else 0.0
         b = lower[j + 1] if j + 1 < width else 0.0
         value = (lower[0] * a - upper[0] * b) / lower[0]
         size = (abs(lower[0] * a) + abs(upper[0] * b)) / abs(lower[0])
         row.append(0.0 if abs(value) <= _CANCELLATION * size else value)
-    return row
+        sizes.append(size)
+    return row, sizes
 
 
 _CANCELLATION = 1e3 * np.finfo(float).eps
@@ -152,14 +157,17 @@ def _routh_numeric(c: np.ndarray) -> RouthResult:
 
     A finite ε cannot stand in for ε → 0+ in floating point once several
     zero pivots chain (entries like 1/ε and ε² must be kept apart), and a
-    pivot below 1e-9 of its rows amplifies round-off into the signs below it;
-    in either case the float coefficients are converted exactly to rationals
+    pivot that is mostly cancellation (below 1e-9 of the terms it came from)
+    has an unreliable sign (and coefficients spanning more than 1e100 would
+    overflow the products); in each case the float coefficients are converted exactly to rationals
     and the symbolic array (with ε → 0+ where a pivot is exactly zero) decides
     (Gantmacher, ch. XV §6).
     """
     if len(c) == 1:
         return RouthResult([[float(c[0])]], [float(c[0])], 0, False)
-    result = _routh_table(c)
+    nonzero = np.abs(c[c != 0])
+    # products of entries must stay inside the float range (~1e±308)
+    result = _routh_table(c) if nonzero.max() <= 1e100 * nonzero.min() else None
     if result is None:
         import sympy as sp
 
@@ -168,10 +176,13 @@ def _routh_numeric(c: np.ndarray) -> RouthResult:
 
 
 def _routh_table(c: np.ndarray) -> RouthResult | None:
-    """The float array, or None at the first zero pivot."""
+    """The float array, or None where floats cannot be trusted with the signs:
+    a zero pivot, a pivot that is mostly cancellation (below 1e-9 of the terms
+    it was computed from), or an overflow."""
     n = len(c) - 1
     row0, row1, _ = _first_two_rows([float(x) for x in c])
     table = [row0, row1]
+    sizes = [abs(x) for x in row1]
     marginal = False
     for power in range(n - 1, 0, -1):
         upper, lower = table[-2], table[-1]
@@ -179,9 +190,13 @@ def _routh_table(c: np.ndarray) -> RouthResult | None:
             marginal = True
             lower = _auxiliary_derivative(upper, power + 1)
             table[-1] = lower
-        if abs(lower[0]) <= _SMALL_PIVOT * max(abs(x) for x in upper + lower):
-            return None  # a zero or a near-zero pivot: floats lose the signs below it
-        table.append(_next_row_numeric(upper, lower))
+            sizes = [abs(x) for x in lower]
+        if abs(lower[0]) <= _SMALL_PIVOT * sizes[0]:
+            return None
+        row, sizes = _next_row_numeric(upper, lower)
+        if not all(np.isfinite(row)):
+            return None
+        table.append(row)
     if table[-1][0] == 0.0:
         marginal = True
     first = [row[0] for row in table]

@@ -8,8 +8,9 @@ sympy is imported only when the command runs, so the CLI starts fast.
 
 from __future__ import annotations
 
-import argparse
 import textwrap
+
+from .options import PADE_ORDER
 
 FORMATS = ("text", "latex")
 LAWS = ("power", "general")  # = pfm_stability.derivation.LAWS (not imported: it imports sympy)
@@ -29,17 +30,8 @@ def add_parser(sub) -> None:
         default="power",
         help="force law: KB's power law F_r = f F_a W^n/d^n (default) or a general F_r(d)",
     )
-    p.add_argument("--pade-order", type=_pade_order, default=2, help="order m of the Pade form of (18) shown (1..12, default 2)")
+    p.add_argument("--pade-order", type=PADE_ORDER, default=2, help="order m of the Pade form of (18) shown (1..12, default 2)")
     p.set_defaults(run=run)
-
-
-def _pade_order(text: str) -> int:
-    from ..checks import check_integer
-
-    try:
-        return check_integer("pade_order", int(text), 1, 12)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"pade_order must be an integer in [1, 12]; got {text!r}") from None
 
 
 def run(args) -> int:

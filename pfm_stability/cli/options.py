@@ -9,10 +9,10 @@ from __future__ import annotations
 import argparse
 from dataclasses import dataclass, fields
 
-from ..checks import check_number
+from ..checks import check_integer, check_number
 from ..parameters import HOLDS, PRESETS, RANGES, Controller, Preset, Robot, check_parameter, get_preset
 
-__all__ = ["number", "add_parameter_options", "resolve_parameters", "ResolvedParameters"]
+__all__ = ["number", "integer", "add_parameter_options", "resolve_parameters", "ResolvedParameters"]
 
 
 def number(name: str, *bounds, **options):
@@ -39,6 +39,23 @@ def number(name: str, *bounds, **options):
     return parse
 
 
+def integer(name: str, low: int, high: int):
+    """An argparse ``type=`` for an integer in [low, high], with the library's message."""
+
+    def parse(text: str) -> int:
+        try:
+            return check_integer(name, int(text), low, high)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{name} must be an integer in [{low}, {high}]; got {text!r}") from None
+
+    parse.__name__ = name
+    return parse
+
+
+PADE_ORDER = integer("pade_order", 1, 12)
+"""``--pade-order`` values: Padé order m of the ``pade`` model."""
+
+
 def add_parameter_options(parser: argparse.ArgumentParser) -> None:
     """--preset, --V, --tau, --T, --k, --f, --n, --W, --hold, --compute-delay."""
     group = parser.add_argument_group("robot and controller (override the preset)")
@@ -55,13 +72,7 @@ def add_parameter_options(parser: argparse.ArgumentParser) -> None:
     for name, text in helps.items():
         group.add_argument(f"--{name}", type=number(name), help=f"{text}, {RANGES[name].describe()}")
     group.add_argument("--hold", choices=HOLDS, help="sampled structure: what is held between samples")
-    group.add_argument("--compute-delay", type=_compute_delay, help="samples from measurement to actuation (0 or 1)")
-
-
-def _compute_delay(text: str) -> int:
-    if text.strip() in ("0", "1"):
-        return int(text)
-    raise argparse.ArgumentTypeError(f"compute_delay must be an integer in [0, 1]; got {text!r}")
+    group.add_argument("--compute-delay", type=integer("compute_delay", 0, 1), help="samples from measurement to actuation (0 or 1)")
 
 
 _ROBOT_FIELDS = ("V", "tau", "k", "W")

@@ -7,7 +7,7 @@ every model), ``gain-vs-k`` (NV* against the steering gain k for all models),
 
 from __future__ import annotations
 
-from .options import add_parameter_options, resolve_parameters
+from .options import PADE_ORDER, add_parameter_options, resolve_parameters
 
 KINDS = ("rlocus", "gain-vs-k", "force-law")
 
@@ -16,7 +16,7 @@ def add_parser(sub) -> None:
     p = sub.add_parser("plot", help="save a plot as PNG (root locus, NV* vs k, grid force law)", description=__doc__.splitlines()[0])
     p.add_argument("kind", choices=KINDS, help="what to draw")
     p.add_argument("--out", required=True, help="output PNG file")
-    p.add_argument("--pade-order", type=int, choices=range(1, 13), default=3, metavar="M", help="Padé order m (1..12, default 3)")
+    p.add_argument("--pade-order", type=PADE_ORDER, default=3, metavar="M", help="Padé order m (1..12, default 3)")
     add_parameter_options(p)
     p.set_defaults(run=run)
 

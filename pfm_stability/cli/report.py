@@ -2,9 +2,7 @@
 
 from __future__ import annotations
 
-import argparse
-
-from .options import add_parameter_options, number, resolve_parameters
+from .options import PADE_ORDER, add_parameter_options, number, resolve_parameters
 
 MODEL_CHOICES = ("continuous", "kb_first_order", "pade", "exact_delay", "sampled")
 
@@ -19,18 +17,9 @@ def add_parser(sub) -> None:
     p.add_argument("--alpha", type=number("alpha_deg"), help="wall: target angle from the wall normal, deg, in (0, 90)")
     p.add_argument("--L", type=number("L"), help="corridor half-width, m, in (W/2, 1e4]")
     p.add_argument("--model", action="append", choices=MODEL_CHOICES, help="model to include (repeatable; default: all)")
-    p.add_argument("--pade-order", type=_pade_order, default=3, help="order m of the pade model (1..12, default 3)")
+    p.add_argument("--pade-order", type=PADE_ORDER, default=3, help="order m of the pade model (1..12, default 3)")
     p.add_argument("--format", choices=("text", "json", "markdown"), default="text")
     p.set_defaults(run=run)
-
-
-def _pade_order(text: str) -> int:
-    from ..checks import check_integer
-
-    try:
-        return check_integer("pade_order", int(text), 1, 12)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"pade_order must be an integer in [1, 12]; got {text!r}") from None
 
 
 def run(args) -> int:

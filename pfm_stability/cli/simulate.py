@@ -13,24 +13,10 @@ criterion, for corridor and wall geometries; null otherwise), ``inputs``
 
 from __future__ import annotations
 
-import argparse
 
-from .options import add_parameter_options, number, resolve_parameters
+from .options import add_parameter_options, integer, number, resolve_parameters
 
 SCENARIO_CHOICES = ("straight", "corridor", "wall", "kb-fig3", "kb-fig5", "kb-fig6-wide", "kb-fig6-narrow")
-
-
-def _integer(name: str, low: int, high: int):
-    def parse(text: str) -> int:
-        from ..checks import check_integer
-
-        try:
-            return check_integer(name, int(text), low, high)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"{name} must be an integer in [{low}, {high}]; got {text!r}") from None
-
-    parse.__name__ = name
-    return parse
 
 
 def add_parser(sub) -> None:
@@ -44,16 +30,16 @@ def add_parser(sub) -> None:
     p.add_argument("--env", choices=("grid", "analytic"), default="grid", help="histogram grid (default) or analytic walls")
     add_parameter_options(p)
     g = p.add_argument_group("scenario")
-    g.add_argument("--L", type=number("L", 0.0, unit="m"), help="corridor: half-width, m")
-    g.add_argument("--alpha", type=number("alpha", 0.0, 90.0, unit="deg"), help="wall: target angle from the wall normal, deg, in (0, 90)")
+    g.add_argument("--L", type=number("L"), help="corridor: half-width, m, in (W/2, 1e4]")
+    g.add_argument("--alpha", type=number("alpha_deg"), help="wall: target angle from the wall normal, deg, in (0, 90)")
     g.add_argument("--offset", type=number("offset", unit="m"), help="corridor/wall: start offset from equilibrium, m")
     g.add_argument("--duration", type=number("duration", 0.0, 1e6, unit="s"), help="simulated time, s")
     g.add_argument("--cell-ratio", type=number("cell_ratio", 0.0), help="grid: F_cr/F_ct per cell (default: calibrated to f_av = f)")
     g.add_argument("--law", choices=("power", "grid"), help="analytic: KB's lumped power law (default) or the grid's effective law")
-    g.add_argument("--window-cells", type=_integer("window_cells", -10**6, 10**6), default=33, help="grid: active window side, odd >= 3 (33)")
+    g.add_argument("--window-cells", type=integer("window_cells", -10**6, 10**6), default=33, help="grid: active window side, odd >= 3 (33)")
     g.add_argument("--cell-size", type=number("cell_size", 0.0, unit="m"), default=0.1, help="grid: cell size, m (0.1)")
     g.add_argument("--speed-law", action="store_true", help="use the VFF speed law V(1 - |cos phi|)")
-    g.add_argument("--seed", type=_integer("seed", 0, 2**63 - 1), help="seed of the random start jitter")
+    g.add_argument("--seed", type=integer("seed", 0, 2**63 - 1), help="seed of the random start jitter")
     g.add_argument("--jitter", type=number("start_jitter", 0.0, low_open=False, unit="m"), default=0.0, help="std of a random lateral start offset, m")
     out = p.add_argument_group("output")
     out.add_argument("--plot", metavar="PNG", help="write a trajectory plot drawn like KB's figures")

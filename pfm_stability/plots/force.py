@@ -15,17 +15,9 @@ import numpy as np
 
 from ..effective_force import GridWallLaw, f_average, working_range
 from ..force_law import PowerLaw
+from .common import figure_and_axes
 
 __all__ = ["plot_force_laws", "plot_equivalent_f", "plot_force_summary"]
-
-
-def _axes(ax, size=(5.5, 4.2)):
-    import matplotlib.pyplot as plt
-
-    if ax is not None:
-        return ax.figure, ax
-    fig, ax = plt.subplots(figsize=size, layout="constrained")
-    return fig, ax
 
 
 def _distances(law: GridWallLaw, d):
@@ -58,7 +50,7 @@ def plot_force_laws(law: GridWallLaw, lumped: PowerLaw | None = None, ax=None, d
     -------
     matplotlib.figure.Figure
     """
-    fig, ax = _axes(ax)
+    fig, ax = figure_and_axes(ax)
     d = _distances(law, d)
     lumped = lumped if lumped is not None else law.lumped()
     _shade_range(ax, law)
@@ -89,7 +81,7 @@ def plot_equivalent_f(law: GridWallLaw, ax=None, d=None):
     -------
     matplotlib.figure.Figure
     """
-    fig, ax = _axes(ax)
+    fig, ax = figure_and_axes(ax)
     lo, hi = working_range(law.W, law.cell_size, law.window_cells)
     d = _distances(law, d)
     d = d[d <= law.reach]

@@ -13,6 +13,8 @@ import math
 
 import numpy as np
 
+from .common import figure_and_axes
+
 __all__ = ["plot_trajectory"]
 
 _PAD = 1.2
@@ -20,14 +22,8 @@ _PAD = 1.2
 
 
 def _figure_axes(ax, width, height):
-    import matplotlib.pyplot as plt
-
-    if ax is not None:
-        return ax.figure, ax
     scale = 7.5 / max(height, width)
-    size = (max(4.6, width * scale + 1.6), max(3.8, height * scale + 1.2))
-    fig, ax = plt.subplots(figsize=size, layout="constrained")
-    return fig, ax
+    return figure_and_axes(ax, (max(4.6, width * scale + 1.6), max(3.8, height * scale + 1.2)))
 
 
 def _draw_grid(ax, grid, bounds):
