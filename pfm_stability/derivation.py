@@ -184,6 +184,7 @@ class Step:
     explanation: str
 
     def to_dict(self) -> dict:
+        """The fields as a JSON-ready dict (SI units)."""
         return {"equation": self.equation, "title": self.title, "expr": sp.sstr(self.expr), "explanation": self.explanation}
 
 

@@ -68,6 +68,7 @@ class KBError:
         return f"KB's criterion is {abs(self.relative) * 100:.1f} % {self.direction} against {against}"
 
     def to_dict(self) -> dict:
+        """The fields as a JSON-ready dict (SI units)."""
         return {
             "relative": _json_number(self.relative),
             "direction": self.direction,
@@ -102,6 +103,7 @@ class StabilityReport:
     remedies: dict = field(default_factory=dict)
 
     def to_dict(self) -> dict:
+        """The fields as a JSON-ready dict (SI units)."""
         out = {"inputs": self.inputs, "models": self.model_options}
         if self.wall is not None:
             out.setdefault("environment", {})["wall"] = {

@@ -82,6 +82,7 @@ class Boundary:
     K_critical: float
 
     def to_dict(self) -> dict:
+        """The fields as a JSON-ready dict (SI units)."""
         return {
             "model": self.model,
             "NV_critical": _finite_or_none(self.NV_critical),
@@ -121,12 +122,15 @@ class LoopModel:
         return _cached_boundary(self, loop)
 
     def compute_boundary(self, loop: Loop) -> Boundary:  # pragma: no cover - interface
+        """NV* and ω* for (τ, T, k), uncached (`boundary` caches it)."""
         raise NotImplementedError
 
     def is_stable(self, NV: float, loop: Loop) -> bool:  # pragma: no cover - interface
+        """Verdict for NV (1/s) by a route independent of `boundary`."""
         raise NotImplementedError
 
     def rightmost_root(self, NV: float, loop: Loop) -> complex:  # pragma: no cover - interface
+        """Dominant root σ + jω (1/s, rad/s); sampled models map z by ln(z)/T."""
         raise NotImplementedError
 
     def critical_delay(self, NV: float, loop: Loop) -> float:
@@ -179,6 +183,7 @@ class AffineGainModel(LoopModel):
     domain = "s"
 
     def polynomials(self, loop: Loop):  # pragma: no cover - interface
+        """(D, E), descending coefficients: the characteristic polynomial is D + kNV·E."""
         raise NotImplementedError
 
     def characteristic(self, NV: float, loop: Loop) -> np.ndarray:

@@ -5,3 +5,5 @@ regions), ``trajectory`` (simulated runs drawn like KB's figures), ``force``
 (grid effective force law against KB's lumped law), ``validation`` (predicted vs
 simulated boundaries).
 """
+
+__all__: list[str] = []

@@ -48,6 +48,7 @@ class BoundaryEstimate:
     runs: int
 
     def to_dict(self) -> dict:
+        """The fields as a JSON-ready dict (SI units)."""
         return dict(self.__dict__)
 
 

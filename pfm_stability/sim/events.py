@@ -42,4 +42,5 @@ class Event:
     y: float
 
     def to_dict(self) -> dict:
+        """The fields as a JSON-ready dict (SI units)."""
         return {"type": self.type, "t": self.t, "x": self.x, "y": self.y}

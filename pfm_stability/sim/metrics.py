@@ -116,6 +116,7 @@ class OscillationMetrics:
     reason: str | None = None
 
     def to_dict(self) -> dict:
+        """The fields as a JSON-ready dict (SI units)."""
         out = asdict(self)
         out["window"] = list(self.window) if self.window is not None else None
         return out

@@ -56,6 +56,7 @@ class ModelPrediction:
     critical: float
 
     def to_dict(self) -> dict:
+        """The fields as a JSON-ready dict (SI units)."""
         fin = lambda v: v if math.isfinite(v) else None
         return {
             "model": self.model,
@@ -93,6 +94,7 @@ class Prediction:
     kb: ModelPrediction
 
     def to_dict(self) -> dict:
+        """The fields as a JSON-ready dict (SI units)."""
         return {
             "kind": self.kind,
             "value": self.value,

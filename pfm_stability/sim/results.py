@@ -43,6 +43,7 @@ class Trajectory:
         return np.interp(times, self.t, self.x), np.interp(times, self.t, self.y)
 
     def to_dict(self) -> dict:
+        """The fields as a JSON-ready dict (SI units)."""
         return {key: getattr(self, key).tolist() for key in ("t", "x", "y", "theta")}
 
 
@@ -90,6 +91,7 @@ class RunResult:
         return self.event("collision") is not None
 
     def to_dict(self, trajectory: bool = False) -> dict:
+        """Events, metrics and inputs as a JSON-ready dict (SI units); the sampled trajectory too if asked."""
         out = {
             "events": [e.to_dict() for e in self.events],
             "metrics": self.metrics.to_dict() if self.metrics is not None else None,
@@ -169,4 +171,5 @@ class BatchResult:
         return self.robot_steps / self.seconds if self.seconds > 0 else float("inf")
 
     def to_dict(self) -> dict:
+        """The fields as a JSON-ready dict (SI units)."""
         return {"members": [r.to_dict() for r in self.runs], "robot_steps": self.robot_steps, "seconds": self.seconds}

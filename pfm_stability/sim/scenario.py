@@ -87,6 +87,7 @@ class Target:
         return self.angle is None
 
     def to_dict(self) -> dict:
+        """The fields as a JSON-ready dict (SI units)."""
         if self.is_point:
             return {"kind": "point", "x": self.x, "y": self.y, "radius": self.radius}
         return {"kind": "direction", "angle_deg": math.degrees(self.angle), "finish": self.finish}
@@ -123,6 +124,7 @@ class MeasureAxis:
         return (math.cos(self.angle), -math.sin(self.angle))
 
     def to_dict(self) -> dict:
+        """The fields as a JSON-ready dict (SI units)."""
         return {
             "origin": list(self.origin),
             "angle_deg": math.degrees(self.angle),
