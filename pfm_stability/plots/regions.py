@@ -1,0 +1,439 @@
+"""Stability-region plots: where the robot is safe near a wall and in a corridor (issue 6).
+
+Each panel shades the `exact_delay` verdicts of a dense grid (green stable,
+red unstable; `pfm_stability.regions`, vectorized crossing count of KB eq 18)
+and draws every model's boundary curve in its DESIGN §4 style
+(`plots.common.MODEL_STYLE`), with the operating points of KB's CARMEL runs
+marked (Koren & Borenstein 1991 Figs 5 and 6). Computation lives in
+`pfm_stability.regions`; these functions only draw.
+
+* `plot_wall_f_region`: (V, f) plane at one α; stable above f*(V) (KB eq 24).
+* `plot_wall_alpha_critical`: α*(V); stable above (KB eq 21, 23).
+* `plot_corridor_region`: (L, V) plane; stable below V*(L) (KB eq 25).
+* `plot_corridor_L_critical`: L*(V); stable above (KB eq 25).
+* `plot_wall_regions`, `plot_corridor_regions`: the panels above side by side
+  with one legend (the figures of ``analyses/``).
+* `plot_simulated_boundary`: simulated boundary points (`regions.simulated_boundary`)
+  on top of any of these.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..force_law import ForceLaw, PowerLaw
+from ..parameters import Controller, Robot
+from ..regions import (
+    corridor_L_curves,
+    corridor_region,
+    corridor_V_curves,
+    default_models,
+    wall_alpha_curves,
+    wall_alpha_region,
+    wall_f_curves,
+    wall_f_region,
+)
+from .common import MODEL_STYLE, figure_and_axes, model_label
+
+__all__ = [
+    "MARK_LABEL",
+    "STABLE_COLOR",
+    "UNSTABLE_COLOR",
+    "plot_wall_f_region",
+    "plot_wall_alpha_critical",
+    "plot_corridor_region",
+    "plot_corridor_L_critical",
+    "plot_wall_regions",
+    "plot_corridor_regions",
+    "plot_simulated_boundary",
+    "region_legend",
+]
+
+STABLE_COLOR = "#dcefd6"
+UNSTABLE_COLOR = "#f7d9d6"
+MARK_LABEL = "CARMEL operating point (KB §4–5)"
+_MARK = dict(marker="*", ms=15, mfc="gold", mec="k", mew=1.0, ls="none", zorder=6)
+_NOFIT = dict(facecolor="0.85", edgecolor="0.55", hatch="///", lw=0)
+
+V_LABEL = "speed V (m/s)"
+F_LABEL = "force ratio f = F_cr/F_ct (dimensionless, KB eq 13)"
+ALPHA_LABEL = "target angle α (deg); curves: critical α*(V)"
+L_LABEL = "corridor half-width L (m)"
+L_STAR_LABEL = "corridor half-width L (m); curves: critical L*(V)"
+
+
+# ------------------------------------------------------------------ pieces
+def _shade(ax, region, y_scale=1.0):
+    """Shade the exact_delay verdicts (green stable, red unstable)."""
+    from matplotlib.colors import ListedColormap
+
+    ax.pcolormesh(
+        region.x, region.y * y_scale, region.stable.astype(float), shading="nearest",
+        cmap=ListedColormap([UNSTABLE_COLOR, STABLE_COLOR]), vmin=0, vmax=1, rasterized=True, zorder=0,
+    )
+
+
+def _curve_label(curve) -> str:
+    return f"{model_label(curve.model)}: NV* = {curve.NV_critical:.3g} 1/s"
+
+
+def _draw_curves(ax, curves, *, swap=False, y_scale=1.0):
+    for c in curves:
+        x, y = np.asarray(c.x, dtype=float), np.asarray(c.y, dtype=float) * y_scale
+        y = np.where(np.isfinite(y), y, np.nan)
+        if swap:
+            x, y = y, x
+        ax.plot(x, y, label=_curve_label(c), zorder=3, **MODEL_STYLE[c.model.name])
+
+
+def _mark(ax, x, y, text, *, label=None, offset=(7, 5)):
+    ax.plot([x], [y], label=label, **_MARK)
+    if text:
+        ax.annotate(text, (x, y), xytext=offset, textcoords="offset points", fontsize=8,
+                    bbox=dict(boxstyle="round,pad=0.2", fc="white", ec="none", alpha=0.8), zorder=7)
+
+
+def region_legend(ax=None, *, fig=None, ncol=1, loc="best", fontsize=8, **kwargs):
+    """Legend with the model curves, the CARMEL mark and the shading proxies.
+
+    Draws into `fig` (a figure legend) when given, else into `ax`.
+    """
+    from matplotlib.patches import Patch
+
+    source = ax if ax is not None else fig.axes[0]
+    handles, labels = source.get_legend_handles_labels()
+    seen = {}
+    for h, l in zip(handles, labels):
+        seen.setdefault(l, h)
+    handles, labels = list(seen.values()), list(seen)
+    handles += [Patch(fc=STABLE_COLOR, ec="0.6"), Patch(fc=UNSTABLE_COLOR, ec="0.6")]
+    labels += ["stable (exact_delay verdicts, dense grid)", "unstable (exact_delay verdicts)"]
+    if fig is not None:
+        return fig.legend(handles, labels, ncol=ncol, loc=loc, fontsize=fontsize, frameon=False, **kwargs)
+    return ax.legend(handles, labels, ncol=ncol, loc=loc, fontsize=fontsize, framealpha=0.9, **kwargs)
+
+
+def _loop_text(robot: Robot, controller: Controller, law: ForceLaw | None = None) -> str:
+    law_text = f"f = {controller.f:g}, n = {controller.n:g}" if law is None or isinstance(law, PowerLaw) else f"{law.name}"
+    return f"τ = {robot.tau:g} s, T = {controller.T:g} s, k = {robot.k:g} 1/s, W = {robot.W:g} m, {law_text}"
+
+
+def _style_axes(ax, xlabel, ylabel, title):
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    ax.set_title(title, fontsize=9)
+    ax.grid(True, which="major", lw=0.4, alpha=0.5)
+
+
+def _no_fit_band(ax, W, *, vertical=True):
+    """Hatch L <= W/2, where the robot does not fit the corridor."""
+    if vertical:
+        lo = ax.get_xlim()[0]
+        ax.axvspan(lo, W / 2, label=f"robot does not fit (L ≤ W/2 = {W / 2:g} m)", zorder=1, **_NOFIT)
+    else:
+        lo = ax.get_ylim()[0]
+        ax.axhspan(lo, W / 2, label=f"robot does not fit (L ≤ W/2 = {W / 2:g} m)", zorder=1, **_NOFIT)
+
+
+# ------------------------------------------------------------------ wall
+def plot_wall_f_region(
+    robot: Robot,
+    controller: Controller,
+    alpha: float,
+    *,
+    V=None,
+    f=None,
+    models=None,
+    ax=None,
+    legend: bool = True,
+    mark: bool = True,
+    resolution: int = 300,
+):
+    """Stable and unstable regions along a wall in the (V, f) plane at one target angle α.
+
+    Shading: `exact_delay` verdicts (`regions.wall_f_region`); curves: f*(V)
+    of every model (`regions.wall_f_curves`, KB eq 24 with the model's NV*);
+    stable above the curves. KB's power law.
+
+    Parameters
+    ----------
+    robot, controller : Robot, Controller
+        The robot (τ, k, W) and controller (n, T, hold, compute delay); the
+        operating point (V, f) is marked when `mark`.
+    alpha : float
+        Target angle from the wall normal, rad (KB eq 9).
+    V : array_like, optional
+        Speeds, m/s (default 300 points in [0.02, 2] m/s).
+    f : array_like, optional
+        Force ratios (default 300 log-spaced points in [0.01, 100]).
+    models : list of LoopModel, optional
+        Default `regions.default_models(controller)`.
+    ax : matplotlib Axes, optional
+    legend : bool
+    mark : bool
+        Mark (robot.V, controller.f).
+    resolution : int
+        Grid points per axis of the shading.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    fig, ax = figure_and_axes(ax, (6.4, 4.8))
+    V = np.linspace(0.02, 2.0, resolution) if V is None else np.asarray(V, dtype=float)
+    f = np.geomspace(0.01, 100.0, resolution) if f is None else np.asarray(f, dtype=float)
+    models = default_models(controller) if models is None else models
+    _shade(ax, wall_f_region(robot, controller, alpha, V, f))
+    _draw_curves(ax, wall_f_curves(robot, controller, alpha, V, models))
+    if mark:
+        _mark(ax, robot.V, controller.f, f"CARMEL: V = {robot.V:g} m/s, f = {controller.f:g}", label=MARK_LABEL)
+    ax.set_yscale("log")
+    ax.set_xlim(V[0], V[-1])
+    ax.set_ylim(f[0], f[-1])
+    _style_axes(ax, V_LABEL, F_LABEL, f"Wall, α = {math.degrees(alpha):.3g}°: stable above f*(V) (KB eq 24)\n{_loop_text(robot, controller)}")
+    ax.text(0.03, 0.96, "stable", transform=ax.transAxes, va="top", fontsize=10, color="#2a6a1f", weight="bold")
+    ax.text(0.97, 0.04, "oscillates", transform=ax.transAxes, ha="right", fontsize=10, color="#9b2b22", weight="bold")
+    if legend:
+        region_legend(ax, loc="lower right", fontsize=7, bbox_to_anchor=(1.0, 0.08))
+    return fig
+
+
+def plot_wall_alpha_critical(
+    robot: Robot,
+    controller: Controller,
+    *,
+    V=None,
+    models=None,
+    law: ForceLaw | None = None,
+    marks=((20.0, "KB Fig 5: α = 20°"), (50.0, "before the corner: α = 50°")),
+    ax=None,
+    legend: bool = True,
+    shade: bool = True,
+    resolution: int = 300,
+):
+    """Critical target angle α*(V) along a wall: stable above every model's curve (KB eq 21, 23).
+
+    Parameters
+    ----------
+    robot, controller : Robot, Controller
+    V : array_like, optional
+        Speeds, m/s (default [0.02, 2]).
+    models : list of LoopModel, optional
+    law : ForceLaw, optional
+        Default KB's power law with the controller's f; e.g. the grid's
+        effective law to compare with the grid simulator.
+    marks : sequence of (alpha_deg, text)
+        Operating points (robot.V, α) to mark (default KB Fig 5's corner run).
+    ax : matplotlib Axes, optional
+    legend, shade : bool
+    resolution : int
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    fig, ax = figure_and_axes(ax, (6.4, 4.8))
+    V = np.linspace(0.02, 2.0, resolution) if V is None else np.asarray(V, dtype=float)
+    models = default_models(controller) if models is None else models
+    if shade:
+        alpha = np.radians(np.linspace(0.2, 89.8, resolution))
+        _shade(ax, wall_alpha_region(robot, controller, V, alpha, law=law), y_scale=180 / math.pi)
+    _draw_curves(ax, wall_alpha_curves(robot, controller, V, models, law=law), y_scale=180 / math.pi)
+    for i, (a, text) in enumerate(marks or ()):
+        _mark(ax, robot.V, a, text, label=MARK_LABEL if i == 0 else None)
+    ax.set_xlim(V[0], V[-1])
+    ax.set_ylim(0, 90)
+    ax.set_yticks(range(0, 91, 15))
+    _style_axes(ax, V_LABEL, ALPHA_LABEL, f"Wall: stable above α*(V) (KB eq 21 with eq 23)\n{_loop_text(robot, controller, law)}")
+    ax.text(0.03, 0.96, "stable", transform=ax.transAxes, va="top", fontsize=10, color="#2a6a1f", weight="bold")
+    ax.text(0.97, 0.04, "oscillates", transform=ax.transAxes, ha="right", fontsize=10, color="#9b2b22", weight="bold")
+    if legend:
+        region_legend(ax, loc="upper left", fontsize=7, bbox_to_anchor=(0.0, 0.9)) if shade else ax.legend(fontsize=7)
+    return fig
+
+
+# ------------------------------------------------------------------ corridor
+def plot_corridor_region(
+    robot: Robot,
+    controller: Controller,
+    *,
+    L=None,
+    V=None,
+    models=None,
+    law: ForceLaw | None = None,
+    marks=((0.9, "KB Fig 6a\n(wide)"), (0.6, "KB Fig 6b\n(narrow)")),
+    ax=None,
+    legend: bool = True,
+    shade: bool = True,
+    resolution: int = 300,
+):
+    """Stable and unstable regions in the middle of a corridor, (L, V) plane: stable below V*(L).
+
+    Shading: `exact_delay` verdicts (`regions.corridor_region`); curves:
+    V*(L) = NV*/N(L) of every model (`regions.corridor_V_curves`; KB eq 25).
+
+    Parameters
+    ----------
+    robot, controller : Robot, Controller
+    L : array_like, optional
+        Half-widths, m (default (W/2, 2] m).
+    V : array_like, optional
+        Speeds, m/s (default [0.02, 2]).
+    models : list of LoopModel, optional
+    law : ForceLaw, optional
+        Default KB's power law.
+    marks : sequence of (L, text)
+        Operating points (L, robot.V) to mark (default KB Fig 6's corridors
+        after the step, L = 0.9 m and 0.6 m).
+    ax : matplotlib Axes, optional
+    legend, shade : bool
+    resolution : int
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    fig, ax = figure_and_axes(ax, (6.4, 4.8))
+    lo = robot.W / 2
+    L = np.linspace(lo * 1.0005, 2.0, resolution) if L is None else np.asarray(L, dtype=float)
+    V = np.linspace(0.02, 2.0, resolution) if V is None else np.asarray(V, dtype=float)
+    models = default_models(controller) if models is None else models
+    if shade:
+        _shade(ax, corridor_region(robot, controller, L, V, law=law))
+    _draw_curves(ax, corridor_V_curves(robot, controller, L, models, law=law))
+    for i, (Lm, text) in enumerate(marks or ()):
+        _mark(ax, Lm, robot.V, text, label=MARK_LABEL if i == 0 else None)
+    ax.set_xlim(min(L[0], lo) - 0.1, L[-1])
+    ax.set_ylim(V[0], V[-1])
+    _no_fit_band(ax, robot.W, vertical=True)
+    _style_axes(ax, L_LABEL, V_LABEL, f"Corridor: stable below V*(L) = NV*/N(L) (KB eq 25)\n{_loop_text(robot, controller, law)}")
+    ax.text(0.97, 0.04, "stable", transform=ax.transAxes, ha="right", fontsize=10, color="#2a6a1f", weight="bold")
+    ax.text(0.25, 0.96, "oscillates", transform=ax.transAxes, va="top", fontsize=10, color="#9b2b22", weight="bold")
+    if legend:
+        region_legend(ax, loc="upper right", fontsize=7) if shade else ax.legend(fontsize=7, loc="upper left")
+    return fig
+
+
+def plot_corridor_L_critical(
+    robot: Robot,
+    controller: Controller,
+    *,
+    V=None,
+    models=None,
+    law: ForceLaw | None = None,
+    marks=((0.9, "KB Fig 6a\n(wide)"), (0.6, "KB Fig 6b\n(narrow)")),
+    ax=None,
+    legend: bool = True,
+    shade: bool = True,
+    resolution: int = 300,
+):
+    """Critical corridor half-width L*(V): stable above every model's curve (KB eq 25).
+
+    Parameters
+    ----------
+    robot, controller : Robot, Controller
+    V : array_like, optional
+        Speeds, m/s (default [0.02, 2]).
+    models : list of LoopModel, optional
+    law : ForceLaw, optional
+    marks : sequence of (L, text)
+        Operating points (robot.V, L).
+    ax : matplotlib Axes, optional
+    legend, shade : bool
+    resolution : int
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    fig, ax = figure_and_axes(ax, (6.4, 4.8))
+    V = np.linspace(0.02, 2.0, resolution) if V is None else np.asarray(V, dtype=float)
+    models = default_models(controller) if models is None else models
+    curves = corridor_L_curves(robot, controller, V, models, law=law)
+    top = max(1.6, 1.15 * max(float(np.nanmax(np.where(np.isfinite(c.y), c.y, np.nan))) for c in curves))
+    if shade:
+        L = np.linspace(robot.W / 2 * 1.0005, top, resolution)
+        region = corridor_region(robot, controller, L, V, law=law)
+        # the region grid is (V rows, L columns): transpose to (L rows, V columns)
+        from dataclasses import replace
+
+        _shade(ax, replace(region, x=region.y, y=region.x, stable=region.stable.T))
+    _draw_curves(ax, curves)
+    for i, (Lm, text) in enumerate(marks or ()):
+        _mark(ax, robot.V, Lm, text, label=MARK_LABEL if i == 0 else None)
+    ax.set_xlim(V[0], V[-1])
+    ax.set_ylim(0.0, top)
+    _no_fit_band(ax, robot.W, vertical=False)
+    _style_axes(ax, V_LABEL, L_STAR_LABEL, f"Corridor: stable above L*(V) (KB eq 25)\n{_loop_text(robot, controller, law)}")
+    ax.text(0.03, 0.96, "stable", transform=ax.transAxes, va="top", fontsize=10, color="#2a6a1f", weight="bold")
+    ax.text(0.97, 0.3, "oscillates", transform=ax.transAxes, ha="right", fontsize=10, color="#9b2b22", weight="bold")
+    if legend:
+        region_legend(ax, loc="upper left", fontsize=7, bbox_to_anchor=(0.0, 0.9)) if shade else ax.legend(fontsize=7)
+    return fig
+
+
+# ------------------------------------------------------------------ summaries
+def plot_wall_regions(robot: Robot, controller: Controller, alphas_deg=(20.0, 45.0, 70.0), *, models=None, resolution: int = 300):
+    """(V, f) regions at each α and α*(V), in a 2 × 2 grid with one legend (KB §5.3).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    import matplotlib.pyplot as plt
+
+    panels = len(alphas_deg) + 1
+    cols = 2
+    rows = math.ceil(panels / cols)
+    fig, axes = plt.subplots(rows, cols, figsize=(11.5, 4.3 * rows + 1.3), layout="constrained")
+    axes = np.ravel(axes)
+    for ax, a in zip(axes, alphas_deg):
+        plot_wall_f_region(robot, controller, math.radians(a), models=models, ax=ax, legend=False, resolution=resolution)
+    plot_wall_alpha_critical(robot, controller, models=models, ax=axes[len(alphas_deg)], legend=False, resolution=resolution)
+    for ax in axes[panels:]:
+        ax.set_visible(False)
+    region_legend(fig=fig, ncol=3, loc="outside lower center")
+    fig.suptitle("Where CARMEL is safe along a wall: every model's boundary over exact_delay verdicts (Koren & Borenstein 1991 §5.3)", fontsize=11)
+    return fig
+
+
+def plot_corridor_regions(robot: Robot, controller: Controller, *, models=None, resolution: int = 300):
+    """(L, V) regions and L*(V) side by side with one legend (KB §5.4).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    import matplotlib.pyplot as plt
+
+    fig, (a, b) = plt.subplots(1, 2, figsize=(11.5, 5.6), layout="constrained")
+    plot_corridor_region(robot, controller, models=models, ax=a, legend=False, resolution=resolution)
+    plot_corridor_L_critical(robot, controller, models=models, ax=b, legend=False, resolution=resolution)
+    region_legend(fig=fig, ncol=3, loc="outside lower center")
+    fig.suptitle("Where CARMEL is safe in a corridor: every model's boundary over exact_delay verdicts (Koren & Borenstein 1991 §5.4)", fontsize=11)
+    return fig
+
+
+# ------------------------------------------------------------------ simulation
+def plot_simulated_boundary(sim, ax=None, *, label: str | None = None, color="k", marker="o", **style):
+    """Simulated boundary points (`regions.SimulatedBoundary`) with their bisection brackets.
+
+    x = the values of ``sim.over``, y = the bisected ``sim.parameter``
+    (angles drawn in degrees), so the points sit on `plot_corridor_region`
+    (over L, bisected V) or `plot_wall_alpha_critical` (over V, bisected α).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    fig, ax = figure_and_axes(ax)
+    sx = 180 / math.pi if sim.over == "alpha" else 1.0
+    sy = 180 / math.pi if sim.parameter == "alpha" else 1.0
+    x = sim.values * sx
+    y = sim.critical * sy
+    err = np.vstack([y - sim.lo * sy, sim.hi * sy - y])
+    label = label if label is not None else f"simulated boundary ({sim.env}, {sim.scenario}; bisection on {sim.parameter})"
+    ax.errorbar(x, y, yerr=err, ls="none", marker=marker, ms=7, mfc="white", mec=color, mew=1.8, ecolor=color, capsize=3, label=label, zorder=8, **style)
+    return fig
