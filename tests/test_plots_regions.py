@@ -5,11 +5,11 @@ returns its figure, draws into a given ``ax``, never calls ``plt.show()``,
 labels its axes with units, names every model as in DESIGN §4 in the legend
 with the shared `MODEL_STYLE` colour, and marks the CARMEL operating point at
 its coordinates. Small grids keep the plot tests under a few seconds; the
-notebooks of ``analyses/`` are executed here too (about 40 s, marked slow).
+notebooks of ``analyses/`` are executed by nbmake (``--nbmake`` in the pytest
+configuration, ``analyses`` in ``testpaths``), so a notebook failure fails CI.
 """
 
 import math
-from pathlib import Path
 
 import matplotlib
 
@@ -169,25 +169,3 @@ def test_kb_error_map_plot_marks_exact_value():
     assert "kτ" in ax.get_xlabel() and "T/τ" in ax.get_ylabel()
     fig = plot_kb_error_maps([m, kb_error_map(m.k_tau, m.T_over_tau, ExactDelay())], mark=(0.6, 0.2))
     assert fig.legends
-
-
-# ------------------------------------------------------------------ notebooks
-NOTEBOOKS = sorted((Path(__file__).resolve().parents[1] / "analyses").glob("*.ipynb"))
-
-
-@pytest.mark.slow
-@pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda p: p.name)
-def test_notebook_executes(path, request):
-    """Issue 6 item 4: every notebook of analyses/ runs top to bottom (kernel python3, cwd analyses/).
-
-    CI runs plain ``pytest``, which collects tests/ only; this test executes the
-    notebooks there so that a notebook failure fails CI. Under ``pytest --nbmake``
-    nbmake executes them itself, so this test skips instead of running them twice.
-    """
-    if request.config.getoption("nbmake", default=False):
-        pytest.skip("executed by nbmake")
-    nbformat = pytest.importorskip("nbformat")
-    nbclient = pytest.importorskip("nbclient")
-    notebook = nbformat.read(path, as_version=4)
-    assert notebook.metadata["kernelspec"]["name"] == "python3"
-    nbclient.NotebookClient(notebook, timeout=300, kernel_name="python3", resources={"metadata": {"path": str(path.parent)}}).execute()

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-__all__ = ["figure_and_axes", "MODEL_STYLE", "model_label"]
+__all__ = ["figure_and_axes", "MODEL_STYLE", "model_label", "model_style"]
 
 MODEL_STYLE = {
     "continuous": dict(color="#7f7f7f", ls=":", lw=1.8),
@@ -22,6 +22,17 @@ def model_label(model) -> str:
     if name == "sampled":
         return f"sampled ({model.hold}, cd={model.compute_delay})"
     return name
+
+
+def model_style(model) -> dict:
+    """Line style of `model`: `MODEL_STYLE`, the four sampled structures told
+    apart (command solid, reference dashed; compute delay 1 thinner)."""
+    style = dict(MODEL_STYLE[model.name])
+    if model.name == "sampled":
+        style["ls"] = "-" if model.hold == "command" else "--"
+        style["lw"] = 2.4 if model.compute_delay == 0 else 1.4
+        style["alpha"] = 1.0 if model.compute_delay == 0 else 0.7
+    return style
 
 
 def figure_and_axes(ax=None, size=(6.0, 4.5)):

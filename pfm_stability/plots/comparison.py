@@ -23,10 +23,9 @@ import numpy as np
 
 from ..models import Loop
 from ..regions import GainCurve, KBErrorMap, critical_gain_vs_delay, kb_relative_error
-from .common import MODEL_STYLE, figure_and_axes, model_label
+from .common import figure_and_axes, model_label, model_style
 
 __all__ = [
-    "model_style",
     "plot_critical_gain_vs_delay",
     "plot_kb_error_map",
     "plot_kb_error_maps",
@@ -35,16 +34,6 @@ __all__ = [
 
 _RATIO_LIMIT = 2.0
 """Colour scale of the error maps: log2(NV*_KB/NV*) clipped to ±2 (KB off by 4×)."""
-
-
-def model_style(model) -> dict:
-    """Line style of `model`: `MODEL_STYLE`, with the sampled structures told apart as in `plots.rlocus`."""
-    style = dict(MODEL_STYLE[model.name])
-    if model.name == "sampled":
-        style["ls"] = "-" if model.hold == "command" else "--"
-        style["lw"] = 2.4 if model.compute_delay == 0 else 1.4
-        style["alpha"] = 1.0 if model.compute_delay == 0 else 0.7
-    return style
 
 
 def plot_critical_gain_vs_delay(tau: float, k: float, T_over_tau=None, *, curves: list[GainCurve] | None = None, mark: float | None = None, mark_label: str = "CARMEL", ax=None):

@@ -15,7 +15,7 @@ import math
 import numpy as np
 
 from ..models import ExactDelay, KBFirstOrder, Loop, Pade, Sampled, make_models
-from .common import MODEL_STYLE, figure_and_axes, model_label
+from .common import MODEL_STYLE, figure_and_axes, model_label, model_style
 
 __all__ = ["root_locus_data", "plot_root_locus", "critical_gain_vs_k", "plot_critical_gain_vs_k"]
 
@@ -108,11 +108,7 @@ def plot_critical_gain_vs_k(tau: float, T: float, ks=None, *, pade_order: int = 
     ks = np.geomspace(0.2, 30, 60) if ks is None else np.asarray(ks, dtype=float)
     curves, models = critical_gain_vs_k(tau, T, ks, pade_order=pade_order)
     for model, (label, values) in zip(models, curves.items()):
-        style = dict(MODEL_STYLE[model.name])
-        if model.name == "sampled":
-            style["ls"] = "-" if model.hold == "command" else "--"
-            style["lw"] = 2.4 if model.compute_delay == 0 else 1.4
-            style["alpha"] = 1.0 if model.compute_delay == 0 else 0.7
+        style = model_style(model)
         shown = np.where(np.isfinite(values) & (values > 0), values, np.nan)
         ax.plot(ks, shown, label=label, **style)
     ax.set_xscale("log")
