@@ -47,6 +47,7 @@ from .checks import check_number
 from .force_law import ForceLaw, PowerLaw
 from .models import Continuous, ExactDelay, KBFirstOrder, Loop, LoopModel, Pade, Sampled, make_model
 from .parameters import Controller, Robot, check_parameter
+from .serialize import json_array, json_number
 from .vectorized import delay_verdicts_from_gain, exact_delay_verdicts
 
 __all__ = [
@@ -77,15 +78,6 @@ SAMPLED_STRUCTURES = (("command", 0), ("command", 1), ("reference", 0), ("refere
 
 
 # ------------------------------------------------------------------ results
-def _list(a):
-    a = np.asarray(a, dtype=float)
-    return [None if not math.isfinite(v) else v for v in a.ravel().tolist()] if a.ndim <= 1 else [_list(r) for r in a]
-
-
-def _finite_or_none(x):
-    return x if x is not None and math.isfinite(x) else None
-
-
 def model_options(model: LoopModel) -> dict:
     """The options that configure `model` (``{"order": 3}``, ``{"hold": …, "compute_delay": …}`` or ``{}``)."""
     if isinstance(model, Pade):
@@ -140,14 +132,14 @@ class BoundaryCurve:
         return {
             "model": self.model.name,
             "options": model_options(self.model),
-            "NV_critical": _finite_or_none(self.NV_critical),
+            "NV_critical": json_number(self.NV_critical),
             "omega_critical": self.omega_critical,
             "x_name": self.x_name,
             "x_unit": self.x_unit,
             "y_name": self.y_name,
             "y_unit": self.y_unit,
-            "x": _list(self.x),
-            "y": _list(self.y),
+            "x": json_array(self.x),
+            "y": json_array(self.y),
             "stable_side": self.stable_side,
         }
 
@@ -194,10 +186,10 @@ class RegionGrid:
             "x_unit": self.x_unit,
             "y_name": self.y_name,
             "y_unit": self.y_unit,
-            "x": _list(self.x),
-            "y": _list(self.y),
+            "x": json_array(self.x),
+            "y": json_array(self.y),
             "stable": self.stable.tolist(),
-            "NV": _list(self.NV),
+            "NV": json_array(self.NV),
         }
 
 
@@ -236,8 +228,8 @@ class GainCurve:
             "options": model_options(self.model),
             "x_name": self.x_name,
             "x_unit": self.x_unit,
-            "x": _list(self.x),
-            "NV_critical": _list(self.NV_critical),
+            "x": json_array(self.x),
+            "NV_critical": json_array(self.NV_critical),
             "tau": self.tau,
             "T": self.T,
             "k": self.k,
@@ -298,11 +290,11 @@ class KBErrorMap:
         return {
             "reference": self.reference.name,
             "options": model_options(self.reference),
-            "k_tau": _list(self.k_tau),
-            "T_over_tau": _list(self.T_over_tau),
-            "NV_tau_kb": _list(self.NV_tau_kb),
-            "NV_tau_reference": _list(self.NV_tau_reference),
-            "relative_error": _list(self.relative_error),
+            "k_tau": json_array(self.k_tau),
+            "T_over_tau": json_array(self.T_over_tau),
+            "NV_tau_kb": json_array(self.NV_tau_kb),
+            "NV_tau_reference": json_array(self.NV_tau_reference),
+            "relative_error": json_array(self.relative_error),
         }
 
 
@@ -349,10 +341,10 @@ class SimulatedBoundary:
             "env": self.env,
             "parameter": self.parameter,
             "over": self.over,
-            "values": _list(self.values),
-            "critical": _list(self.critical),
-            "lo": _list(self.lo),
-            "hi": _list(self.hi),
+            "values": json_array(self.values),
+            "critical": json_array(self.critical),
+            "lo": json_array(self.lo),
+            "hi": json_array(self.hi),
             "stable_above": self.stable_above.tolist(),
             "runs": self.runs,
             "options": {k: (v if isinstance(v, (int, float, str, bool)) or v is None else repr(v)) for k, v in self.options.items()},

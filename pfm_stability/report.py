@@ -16,6 +16,7 @@ from dataclasses import dataclass, field
 from .criteria import CorridorAnalysis, WallAnalysis, analyze_corridor, analyze_wall, loop_of
 from .models import MODEL_NAMES, KBFirstOrder, Sampled, make_models
 from .parameters import Controller, Corridor, Robot, Wall
+from .serialize import json_number
 
 __all__ = ["StabilityReport", "KBError", "build_report", "remedies", "kb_error"]
 
@@ -70,10 +71,10 @@ class KBError:
     def to_dict(self) -> dict:
         """The fields as a JSON-ready dict (SI units)."""
         return {
-            "relative": _json_number(self.relative),
+            "relative": json_number(self.relative),
             "direction": self.direction,
-            "NV_critical_kb_first_order": _json_number(self.NV_kb),
-            "NV_critical_sampled": _json_number(self.NV_sampled),
+            "NV_critical_kb_first_order": json_number(self.NV_kb),
+            "NV_critical_sampled": json_number(self.NV_sampled),
             "hold": self.hold,
             "compute_delay": self.compute_delay,
             "text": self.sentence(),
@@ -108,7 +109,7 @@ class StabilityReport:
         if self.wall is not None:
             out.setdefault("environment", {})["wall"] = {
                 "alpha_deg": math.degrees(self.wall.alpha),
-                "d0": _json_number(self.wall.d0),
+                "d0": json_number(self.wall.d0),
                 "N": self.wall.N,
                 "NV": self.wall.NV,
             }
@@ -121,25 +122,18 @@ class StabilityReport:
         return out
 
 
-def _json_number(x):
-    if x is None:
-        return None
-    x = float(x)
-    return x if math.isfinite(x) else None
-
-
 def _verdict_dict(v, remedy) -> dict:
     root = v.rightmost_root
     out = {
         "stable": v.stable,
         "verdict": v.verdict,
         "NV": v.NV,
-        "NV_critical": _json_number(v.NV_critical),
-        "margin": _json_number(v.margin),
-        "omega_critical": _json_number(v.omega_critical),
+        "NV_critical": json_number(v.NV_critical),
+        "margin": json_number(v.margin),
+        "omega_critical": json_number(v.omega_critical),
         "rightmost_root": {"sigma": float(root.real), "omega": float(abs(root.imag))},
     }
-    out.update({key: _json_number(value) for key, value in v.critical.items()})
+    out.update({key: json_number(value) for key, value in v.critical.items()})
     out["to_stabilize"] = remedy or {}
     return out
 

@@ -24,6 +24,7 @@ import numpy as np
 from ..checks import check_number
 from ..parameters import RANGES, check_parameter
 from ..crossings import first_stable_interval, verdict_at
+from ..serialize import json_number
 from ..solve import bisect_root
 
 __all__ = ["Loop", "Boundary", "LoopModel", "AffineGainModel", "verdict_label", "UNDECIDED_RTOL"]
@@ -85,14 +86,10 @@ class Boundary:
         """The fields as a JSON-ready dict (SI units)."""
         return {
             "model": self.model,
-            "NV_critical": _finite_or_none(self.NV_critical),
+            "NV_critical": json_number(self.NV_critical),
             "omega_critical": self.omega_critical,
-            "K_critical": _finite_or_none(self.K_critical),
+            "K_critical": json_number(self.K_critical),
         }
-
-
-def _finite_or_none(x):
-    return x if x is not None and math.isfinite(x) else None
 
 
 def verdict_label(NV: float, boundary: Boundary, stable: bool, rtol: float = UNDECIDED_RTOL) -> str:
