@@ -1,0 +1,94 @@
+"""Helpers shared by the experiment scripts: output folder, JSON, figures, command line.
+
+Every experiment script has ``run(out, quick=False) -> dict`` (writes its PNG
+and JSON into `out` and returns the JSON content, including ``rows`` for the
+results table of ``experiments/README.md``) and ``main(argv=None)``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+
+__all__ = ["output_dir", "write_json", "save_figure", "parse_args", "row", "jsonable"]
+
+HERE = Path(__file__).resolve().parent
+DEFAULT_OUT = HERE / "results"
+
+
+def output_dir(out) -> Path:
+    """The output folder as a Path, created if missing."""
+    path = Path(out)
+    path.mkdir(parents=True, exist_ok=True)
+    return path
+
+
+def jsonable(value):
+    """Plain JSON: numpy scalars → Python, non-finite floats → None, tuples → lists."""
+    import numpy as np
+
+    if isinstance(value, dict):
+        return {str(k): jsonable(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [jsonable(v) for v in value]
+    if isinstance(value, np.generic):
+        value = value.item()
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    return value
+
+
+def write_json(path: Path, data: dict) -> Path:
+    path.write_text(json.dumps(jsonable(data), indent=2, allow_nan=False) + "\n")
+    return path
+
+
+def save_figure(fig, path: Path, dpi: int = 110) -> Path:
+    import matplotlib.pyplot as plt
+
+    fig.savefig(path, dpi=dpi)
+    plt.close(fig)
+    return path
+
+
+def parse_args(description: str, argv=None):
+    parser = argparse.ArgumentParser(description=description)
+    parser.add_argument("--out", default=str(DEFAULT_OUT), help="output folder (default: experiments/results)")
+    parser.add_argument("--quick", action="store_true", help="reduced run for CI smoke tests")
+    return parser.parse_args(argv)
+
+
+def row(experiment: str, quantity: str, kb: str, predicted: str, simulated: str, note: str = "") -> dict:
+    """One line of the README results table."""
+    return {"experiment": experiment, "quantity": quantity, "kb": kb, "predicted": predicted, "simulated": simulated, "note": note}
+
+
+def share_limits(axes, runs) -> None:
+    """Give trajectory panels one scale, and draw every grid cell inside the common limits.
+
+    `plot_trajectory` draws only the cells near its own path; with a shared
+    scale the walls would seem to stop where a short run ended.
+    """
+    from matplotlib.collections import PatchCollection
+    from matplotlib.patches import Rectangle
+
+    limits = [ax.get_xlim() + ax.get_ylim() for ax in axes]
+    x0, x1 = min(l[0] for l in limits), max(l[1] for l in limits)
+    y0, y1 = min(l[2] for l in limits), max(l[3] for l in limits)
+    for ax, run in zip(axes, runs):
+        ax.set_xlim(x0, x1)
+        ax.set_ylim(y0, y1)
+        if run.scenario.env != "grid":
+            continue
+        grid = run.scenario.environment
+        ox, oy, _ = grid.occupied()
+        c = grid.cell_size
+        keep = (ox > x0 - c) & (ox < x1 + c) & (oy > y0 - c) & (oy < y1 + c)
+        cells = [Rectangle((x - c / 2, y - c / 2), c, c) for x, y in zip(ox[keep], oy[keep])]
+        ax.add_collection(PatchCollection(cells, facecolor="0.15", edgecolor="none"))
