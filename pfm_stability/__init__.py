@@ -51,6 +51,8 @@ _EXPORTS = {
     "GridWallLaw": "effective_force",
     "simulate": "sim",
     "simulate_batch": "sim",
+    "validate_boundary": "validation",
+    "verdict_sweep": "validation",
 }
 
 __all__ = sorted(_EXPORTS) + ["__version__"]

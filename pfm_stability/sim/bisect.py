@@ -3,10 +3,13 @@
 Each round simulates `members` values of one parameter spread evenly over the
 current bracket in a single batch (`simulate_batch`), finds where the verdict
 changes, and shrinks the bracket to the two neighbouring values, so one round
-divides the bracket by members − 1. The verdict is each run's
-`OscillationMetrics.stable` (σ < 0 in the linear regime, where σ comes from
-the linear-prediction fit and is exact). The parameter must change the
-verdict once inside [lo, hi] (e.g. L: unstable below L*, stable above).
+divides the bracket by members − 1. The verdict is linear stability, what
+the models predict: σ < 0 (σ from the linear-prediction fit, exact in the
+linear regime) and no collision; where σ is undefined, the run's
+`OscillationMetrics.stable`. (`stable` alone would also call a slowly decaying
+run with a limit-cycle-like envelope "not stable", biasing grid boundaries.)
+The parameter must change the verdict once inside [lo, hi] (e.g. L: unstable
+below L*, stable above).
 """
 
 from __future__ import annotations
@@ -18,7 +21,7 @@ import numpy as np
 from ..checks import check_integer, check_number
 from .api import simulate_batch
 
-__all__ = ["BoundaryEstimate", "boundary_by_bisection"]
+__all__ = ["BoundaryEstimate", "boundary_by_bisection", "linearly_stable", "simulated_verdict"]
 
 
 @dataclass(frozen=True)
@@ -50,6 +53,34 @@ class BoundaryEstimate:
     def to_dict(self) -> dict:
         """The fields as a JSON-ready dict (SI units)."""
         return dict(self.__dict__)
+
+
+def simulated_verdict(run) -> tuple[str, str]:
+    """(verdict, basis) of one simulated run: "stable" or "unstable", and why.
+
+    A collision is unstable; otherwise the sign of the measured growth rate σ
+    (linear stability, what the loop models predict); when σ is undefined (too
+    few turning points and a rejected linear fit) the run's own
+    `OscillationMetrics.stable` decides.
+
+    Returns
+    -------
+    (str, str)
+        Verdict, and its basis: ``"collision"``, ``"growth_rate"`` or ``"metrics"``.
+    """
+    if run.collided:
+        return "unstable", "collision"
+    m = run.metrics
+    if m is None:
+        raise ValueError("run has no metrics: simulate with metrics=True")
+    if m.growth_rate is not None:
+        return ("stable" if m.growth_rate < 0 else "unstable"), "growth_rate"
+    return ("stable" if m.stable else "unstable"), "metrics"
+
+
+def linearly_stable(result) -> np.ndarray:
+    """`simulated_verdict` == "stable" for every member of a `BatchResult` (bool array)."""
+    return np.array([simulated_verdict(run)[0] == "stable" for run in result.runs], dtype=bool)
 
 
 def boundary_by_bisection(
@@ -97,7 +128,7 @@ def boundary_by_bisection(
     while rounds < max_rounds and hi - lo > rtol * abs(lo + hi) / 2:
         values = np.linspace(lo, hi, members)
         result = simulate_batch(scenario, env=env, metrics=True, **{parameter: values}, **fixed)
-        stable = result.stable
+        stable = linearly_stable(result)
         runs += members
         rounds += 1
         if stable[0] == stable[-1]:

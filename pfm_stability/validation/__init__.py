@@ -14,7 +14,8 @@ Modules: `common` (parameters, the simulated verdict, predictions),
 """
 
 from .boundary import BoundaryValidation, OscillationCheck, SimulatedPoint, StabilityMap, validate_boundary
-from .common import PARAMETERS, REFERENCE_SETS, SCENARIOS, predicted_boundaries, simulated_verdict
+from ..sim.bisect import simulated_verdict
+from .common import PARAMETERS, REFERENCE_SETS, SCENARIOS, predicted_boundaries
 from .sweep import SWEEP_RANGES, SweepPoint, SweepResult, verdict_sweep
 
 __all__ = [

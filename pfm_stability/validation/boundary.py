@@ -13,7 +13,7 @@ Bisection (DESIGN §6): each round simulates `members` values spread over the
 bracket in one batch (`simulate_batch`), keeps the two neighbours where the
 verdict changes, and stops when the bracket is narrower than `rtol`
 relative. The verdict is the sign of the measured growth rate σ
-(`common.simulated_verdict`); the reported boundary interpolates σ linearly to
+(`sim.bisect.simulated_verdict`); the reported boundary interpolates σ linearly to
 zero between the final bracket's ends (σ is smooth in the parameter; the
 midpoint when σ is undefined at an end). In the grid a corridor's walls lie
 on cell centres, so L takes only multiples of c/2 (0.05 m): the bracket is
@@ -38,8 +38,9 @@ from ..criteria import loop_of
 from ..effective_force import GridWallLaw
 from ..force_law import corridor_gain, wall_gain
 from ..models import Sampled
-from ..serialize import json_number
 from ..parameters import CARMEL, Controller, Robot
+from ..serialize import json_number
+from ..sim.bisect import simulated_verdict
 from .common import (
     SCENARIOS,
     default_parameter,
@@ -50,7 +51,6 @@ from .common import (
     predicted_boundaries,
     relative_errors,
     scenario_law,
-    simulated_verdict,
     validation_models,
 )
 
@@ -82,7 +82,7 @@ class SimulatedPoint:
     value : float
         Parameter value (reported units: L m, α deg, V m/s, f).
     verdict : str
-        "stable" or "unstable" (`common.simulated_verdict`).
+        "stable" or "unstable" (`sim.bisect.simulated_verdict`).
     basis : str
         "growth_rate", "collision" or "metrics".
     growth_rate : float or None

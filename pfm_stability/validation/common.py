@@ -27,7 +27,6 @@ __all__ = [
     "ParameterSpec",
     "parameter_spec",
     "default_parameter",
-    "simulated_verdict",
     "validation_models",
     "predicted_boundaries",
     "lumped_law",
@@ -100,28 +99,6 @@ def parameter_spec(scenario: str, parameter: str) -> ParameterSpec:
 def default_parameter(scenario: str) -> str:
     """L for a corridor, α for a wall (the environment parameter of KB eq 25 and 24)."""
     return "L" if scenario == "corridor" else "alpha"
-
-
-def simulated_verdict(run) -> tuple[str, str]:
-    """(verdict, basis) of one simulated run: "stable" or "unstable", and why.
-
-    A collision is unstable; otherwise the sign of the measured growth rate σ
-    (module docstring); when σ is undefined (too few turning points and a
-    rejected linear fit) the simulator's own `stable` flag decides.
-
-    Returns
-    -------
-    (str, str)
-        Verdict, and its basis: ``"collision"``, ``"growth_rate"`` or ``"metrics"``.
-    """
-    if run.collided:
-        return "unstable", "collision"
-    m = run.metrics
-    if m is None:
-        raise ValueError("run has no metrics: simulate with metrics=True")
-    if m.growth_rate is not None:
-        return ("stable" if m.growth_rate < 0 else "unstable"), "growth_rate"
-    return ("stable" if m.stable else "unstable"), "metrics"
 
 
 def validation_models(controller: Controller, pade_order: int = 3) -> list:

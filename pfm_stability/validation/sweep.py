@@ -14,7 +14,7 @@ Each member's NV comes from its own scenario (`Scenario.effective_law`,
 `Scenario.analysis`: the grid's law and the L actually drawn in the grid).
 Members within `exclude` (3 %) of the `sampled` model's boundary in NV,
 |NV/NV* − 1| < `exclude`, are excluded: there σ is too small to tell from
-zero. On the rest, the simulated verdict (sign of σ, `common.simulated_verdict`)
+zero. On the rest, the simulated verdict (sign of σ, `sim.bisect.simulated_verdict`)
 is compared with every model's verdict: the agreement with ``sampled`` is
 the validation, the other models' wrong-verdict rates say how misleading
 they are for a sampled robot (KB's ``kb_first_order`` eq 20, the delay
@@ -34,7 +34,8 @@ from ..force_law import corridor_gain, wall_gain
 from ..models import Loop, MODEL_NAMES, make_model
 from ..parameters import CARMEL, Controller, Robot
 from ..serialize import json_number
-from .common import SCENARIOS, parameter_domain, scenario_law, simulated_verdict
+from ..sim.bisect import simulated_verdict
+from .common import SCENARIOS, parameter_domain, scenario_law
 
 __all__ = ["SWEEP_RANGES", "STRUCTURES", "SweepPoint", "SweepResult", "verdict_sweep", "sweep_parameters"]
 
