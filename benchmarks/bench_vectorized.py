@@ -69,7 +69,7 @@ def qpmr_verdict(qpmr, tau, T, k, K) -> bool:
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--points", type=int, default=2_000_000)
-    parser.add_argument("--sample", type=int, default=10_000)
+    parser.add_argument("--sample", type=int, default=10_000, help="points checked against qpmr (0: skip; ~35 ms each)")
     args = parser.parse_args(argv)
 
     data = random_corridors(args.points, seed=1)
@@ -80,6 +80,8 @@ def main(argv=None) -> int:
     rate = args.points / elapsed
     print(f"vectorized exact_delay: {args.points:,} points in {elapsed:.3f} s = {rate:,.0f} points/s (target >= 1,000,000)")
 
+    if args.sample <= 0:
+        return 0 if rate >= 1e6 else 1
     try:
         import qpmr
     except ImportError:

@@ -29,6 +29,9 @@ from ..solve import bisect_root
 
 __all__ = ["Loop", "Boundary", "LoopModel", "AffineGainModel", "verdict_label", "UNDECIDED_RTOL"]
 
+_DELAY_RTOL = 1e-7
+"""Relative bracket width at which `critical_delay` stops (reports show 4 digits)."""
+
 UNDECIDED_RTOL = 1e-9
 """|NV/NV* − 1| below this is reported as "undecided" (on the boundary)."""
 
@@ -134,7 +137,7 @@ class LoopModel:
         """Largest sampling period / delay T that keeps NV stable (τ, k fixed), s.
 
         The first T at which NV*(T) falls to NV: a doubling search from
-        T = 10⁻³(τ + 1/k) brackets it and bisection refines it to 1e-10
+        T = 10⁻³(τ + 1/k) brackets it and bisection refines it to 1e-7
         relative. 0 if NV is unstable already at T = 0; ``inf`` if NV*(T)
         stays above NV up to the largest allowed T (100 s).
         """
@@ -147,12 +150,12 @@ class LoopModel:
             return 0.0
         start = 1e-3 * (loop.tau + 1.0 / loop.k)
         if excess(start) <= 0:
-            return bisect_root(excess, 0.0, start, rtol=1e-10)
+            return bisect_root(excess, 0.0, start, rtol=_DELAY_RTOL)
         lo, T_max = start, RANGES["T"].high
         while lo < T_max:
             hi = min(2 * lo, T_max)
             if excess(hi) <= 0:
-                return bisect_root(excess, lo, hi, rtol=1e-10)
+                return bisect_root(excess, lo, hi, rtol=_DELAY_RTOL)
             lo = hi
         return math.inf
 
