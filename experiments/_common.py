@@ -16,7 +16,7 @@ import matplotlib
 
 matplotlib.use("Agg")
 
-__all__ = ["output_dir", "write_json", "save_figure", "parse_args", "row", "jsonable"]
+__all__ = ["output_dir", "write_json", "save_figure", "parse_args", "row", "jsonable", "run_summary", "script_main"]
 
 HERE = Path(__file__).resolve().parent
 DEFAULT_OUT = HERE / "results"
@@ -92,3 +92,33 @@ def share_limits(axes, runs) -> None:
         keep = (ox > x0 - c) & (ox < x1 + c) & (oy > y0 - c) & (oy < y1 + c)
         cells = [Rectangle((x - c / 2, y - c / 2), c, c) for x, y in zip(ox[keep], oy[keep])]
         ax.add_collection(PatchCollection(cells, facecolor="0.15", edgecolor="none"))
+
+
+def run_summary(run, prediction, key: str) -> dict:
+    """JSON summary of one simulated run beside its prediction (`sim.predict`).
+
+    ``key`` names the varied quantity (``"L"`` in m, ``"alpha_deg"``), whose
+    value is the prediction's.
+    """
+    m = run.metrics
+    e = run.events[0] if run.events else None
+    return {
+        key: prediction.value,
+        "event": e.type if e else None,
+        "t_event": e.t if e else None,
+        "collided": run.collided,
+        "measured": {
+            "growth_rate": m.growth_rate, "angular_frequency": m.angular_frequency, "oscillating": m.oscillating,
+            "stable": m.stable, "method": m.method, "turning_points": m.turning_points, "reason": m.reason,
+        },
+        "predicted": prediction.to_dict(),
+    }
+
+
+def script_main(run, doc: str, argv=None) -> int:
+    """Command line of an experiment script: ``--out DIR [--quick]``; prints the finding."""
+    args = parse_args(doc.splitlines()[0], argv)
+    result = run(args.out, quick=args.quick)
+    print(result["finding"])
+    return 0
+

@@ -36,7 +36,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import numpy as np  # noqa: E402
 
-from _common import output_dir, parse_args, row, save_figure, write_json  # noqa: E402
+from _common import output_dir, row, save_figure, script_main, write_json  # noqa: E402
 
 KB_F_AV = 0.8
 """KB §4: "we determined f_av = 0.8"."""
@@ -127,10 +127,7 @@ def run(out, quick: bool = False) -> dict:
 
 
 def main(argv=None) -> int:
-    args = parse_args(__doc__.splitlines()[0], argv)
-    result = run(args.out, quick=args.quick)
-    print(result["finding"])
-    return 0
+    return script_main(run, __doc__, argv)
 
 
 if __name__ == "__main__":

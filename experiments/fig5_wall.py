@@ -34,7 +34,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import numpy as np  # noqa: E402
 
-from _common import output_dir, parse_args, row, save_figure, share_limits, write_json  # noqa: E402
+from _common import output_dir, row, run_summary, save_figure, script_main, share_limits, write_json  # noqa: E402
 
 KB_ALPHA = 20.0
 """deg: KB's discontinuity."""
@@ -76,22 +76,6 @@ def above_scenario(alpha_deg: float = ABOVE_ALPHA):
     )
 
 
-def _run_summary(run, prediction) -> dict:
-    m = run.metrics
-    e = run.events[0] if run.events else None
-    return {
-        "alpha_deg": prediction.value,
-        "event": e.type if e else None,
-        "t_event": e.t if e else None,
-        "collided": run.collided,
-        "measured": {
-            "growth_rate": m.growth_rate, "angular_frequency": m.angular_frequency, "oscillating": m.oscillating,
-            "stable": m.stable, "method": m.method, "turning_points": m.turning_points, "reason": m.reason,
-        },
-        "predicted": prediction.to_dict(),
-    }
-
-
 def run(out, quick: bool = False) -> dict:
     import matplotlib.pyplot as plt
 
@@ -112,7 +96,7 @@ def run(out, quick: bool = False) -> dict:
         "experiment": "KB 1991 Fig 5: oscillation along a wall below alpha*",
         "kb": {"alpha_deg": KB_ALPHA, "outcome": "oscillatory and unstable motion", "condition": "eq (24) not met"},
         "inputs": {**v.inputs, "quick": quick, "kb_run": kb_scenario.notes, "above_run": high_scenario.notes},
-        "runs": {key: _run_summary(runs[key], predictions[key]) for key in runs},
+        "runs": {key: run_summary(runs[key], predictions[key], "alpha_deg") for key in runs},
         "alpha_critical_deg": {
             "simulated": v.simulated_boundary,
             "bracket": list(v.bracket),
@@ -169,10 +153,7 @@ def run(out, quick: bool = False) -> dict:
 
 
 def main(argv=None) -> int:
-    args = parse_args(__doc__.splitlines()[0], argv)
-    result = run(args.out, quick=args.quick)
-    print(result["finding"])
-    return 0
+    return script_main(run, __doc__, argv)
 
 
 if __name__ == "__main__":

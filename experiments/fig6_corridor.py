@@ -29,23 +29,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from _common import output_dir, parse_args, row, save_figure, share_limits, write_json  # noqa: E402
-
-
-def _run_summary(run, prediction) -> dict:
-    m = run.metrics
-    e = run.events[0] if run.events else None
-    return {
-        "L": prediction.value,
-        "event": e.type if e else None,
-        "t_event": e.t if e else None,
-        "collided": run.collided,
-        "measured": {
-            "growth_rate": m.growth_rate, "angular_frequency": m.angular_frequency, "oscillating": m.oscillating,
-            "stable": m.stable, "method": m.method, "turning_points": m.turning_points, "reason": m.reason,
-        },
-        "predicted": prediction.to_dict(),
-    }
+from _common import output_dir, row, run_summary, save_figure, script_main, share_limits, write_json  # noqa: E402
 
 
 def run(out, quick: bool = False) -> dict:
@@ -68,7 +52,7 @@ def run(out, quick: bool = False) -> dict:
         "experiment": "KB 1991 Fig 6: stable and unstable motion in corridors",
         "kb": {"f_av": 0.8, "n": 2, "T": 0.065, "tau": 0.3, "V": 0.8, "wide": "smoothly adjusts", "narrow": "unstable oscillations, collision"},
         "inputs": {**v.inputs, "quick": quick, "wide_run": scenarios["wide"].notes, "narrow_run": scenarios["narrow"].notes},
-        "runs": {key: _run_summary(runs[key], predictions[key]) for key in runs},
+        "runs": {key: run_summary(runs[key], predictions[key], "L") for key in runs},
         "L_critical_m": {
             "simulated": v.simulated_boundary,
             "bracket": list(v.bracket),
@@ -123,10 +107,7 @@ def run(out, quick: bool = False) -> dict:
 
 
 def main(argv=None) -> int:
-    args = parse_args(__doc__.splitlines()[0], argv)
-    result = run(args.out, quick=args.quick)
-    print(result["finding"])
-    return 0
+    return script_main(run, __doc__, argv)
 
 
 if __name__ == "__main__":
