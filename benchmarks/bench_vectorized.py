@@ -12,7 +12,6 @@ Run:
 from __future__ import annotations
 
 import argparse
-import math
 import sys
 import time
 import warnings
@@ -75,7 +74,7 @@ def main(argv=None) -> int:
     data = random_corridors(args.points, seed=1)
     exact_delay_verdicts(**{key: v[:1000] for key, v in data.items()})  # warm-up
     start = time.perf_counter()
-    result = exact_delay_verdicts(**data)
+    exact_delay_verdicts(**data)
     elapsed = time.perf_counter() - start
     rate = args.points / elapsed
     print(f"vectorized exact_delay: {args.points:,} points in {elapsed:.3f} s = {rate:,.0f} points/s (target >= 1,000,000)")

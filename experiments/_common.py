@@ -16,7 +16,7 @@ import matplotlib
 
 matplotlib.use("Agg")
 
-__all__ = ["output_dir", "write_json", "save_figure", "parse_args", "row", "jsonable", "run_summary", "script_main"]
+__all__ = ["output_dir", "write_json", "save_figure", "parse_args", "row", "jsonable", "run_summary", "script_main", "boundary_row"]
 
 HERE = Path(__file__).resolve().parent
 DEFAULT_OUT = HERE / "results"
@@ -67,6 +67,22 @@ def parse_args(description: str, argv=None):
 def row(experiment: str, quantity: str, kb: str, predicted: str, simulated: str, note: str = "") -> dict:
     """One line of the README results table."""
     return {"experiment": experiment, "quantity": quantity, "kb": kb, "predicted": predicted, "simulated": simulated, "note": note}
+
+
+def boundary_row(experiment: str, quantity: str, kb: str, v, digits: int, simulated: str) -> dict:
+    """Results row of a grid boundary validation `v` (`validate_boundary`): the
+    sampled, kb_first_order (grid law and KB's lumped law) and exact_delay
+    predictions, and their relative errors; values shown with `digits` decimals."""
+    p, lumped = v.predicted_boundary, v.lumped_predicted_boundary
+    e = v.relative_error
+    return row(
+        experiment, quantity, kb,
+        f"sampled {p['sampled']:.{digits}f}; kb_first_order {p['kb_first_order']:.{digits}f} "
+        f"(grid law), {lumped['kb_first_order']:.{digits}f} (lumped f_av = 0.8); exact_delay {p['exact_delay']:.{digits}f}",
+        simulated,
+        f"sampled {100 * e['sampled']:+.2f} %, kb_first_order {100 * e['kb_first_order']:+.1f} % "
+        f"(lumped {100 * v.lumped_relative_error['kb_first_order']:+.1f} %)",
+    )
 
 
 def share_limits(axes, runs) -> None:

@@ -34,7 +34,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import numpy as np  # noqa: E402
 
-from _common import output_dir, row, run_summary, save_figure, script_main, share_limits, write_json  # noqa: E402
+from _common import boundary_row, output_dir, row, run_summary, save_figure, script_main, share_limits, write_json  # noqa: E402
 
 KB_ALPHA = 20.0
 """deg: KB's discontinuity."""
@@ -79,7 +79,6 @@ def above_scenario(alpha_deg: float = ABOVE_ALPHA):
 def run(out, quick: bool = False) -> dict:
     import matplotlib.pyplot as plt
 
-    from pfm_stability.parameters import CARMEL
     from pfm_stability.plots.trajectory import plot_trajectory
     from pfm_stability.plots.validation import plot_validation
     from pfm_stability.sim import make_scenario, predict, simulate
@@ -133,14 +132,8 @@ def run(out, quick: bool = False) -> dict:
     save_figure(fig, out / "fig5.png")
     save_figure(plot_validation(v), out / "fig5_boundary.png")
 
-    lumped = v.lumped_predicted_boundary
     result["rows"] = [
-        row("Fig 5", "alpha* (deg), straight grid wall", "eq (24) violated at 20",
-            f"sampled {v.predicted_boundary['sampled']:.2f}; kb_first_order {v.predicted_boundary['kb_first_order']:.2f} "
-            f"(grid law), {lumped['kb_first_order']:.2f} (lumped f_av = 0.8); exact_delay {v.predicted_boundary['exact_delay']:.2f}",
-            f"{v.simulated_boundary:.2f}",
-            f"sampled {100 * v.relative_error['sampled']:+.2f} %, kb_first_order {100 * v.relative_error['kb_first_order']:+.1f} % "
-            f"(lumped {100 * v.lumped_relative_error['kb_first_order']:+.1f} %)"),
+        boundary_row("Fig 5", "alpha* (deg), straight grid wall", "eq (24) violated at 20", v, 2, f"{v.simulated_boundary:.2f}"),
         row("Fig 5", "run with the discontinuity at alpha = 20 deg", "oscillatory, unstable",
             f"unstable, sigma = {p_kb.growth_rate:+.3f} 1/s",
             (f"oscillates, collides at {kb_run.events[0].t:.1f} s" if kb_run.collided else

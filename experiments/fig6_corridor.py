@@ -29,7 +29,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from _common import output_dir, row, run_summary, save_figure, script_main, share_limits, write_json  # noqa: E402
+from _common import boundary_row, output_dir, row, run_summary, save_figure, script_main, share_limits, write_json  # noqa: E402
 
 
 def run(out, quick: bool = False) -> dict:
@@ -87,14 +87,9 @@ def run(out, quick: bool = False) -> dict:
     save_figure(fig, out / "fig6.png")
     save_figure(plot_validation(v), out / "fig6_boundary.png")
 
-    lumped = v.lumped_predicted_boundary
     result["rows"] = [
-        row("Fig 6", "L* (m), straight grid corridor", "eq (25)",
-            f"sampled {v.predicted_boundary['sampled']:.3f}; kb_first_order {v.predicted_boundary['kb_first_order']:.3f} "
-            f"(grid law), {lumped['kb_first_order']:.3f} (lumped f_av = 0.8); exact_delay {v.predicted_boundary['exact_delay']:.3f}",
-            f"{v.simulated_boundary:.3f} (between {v.bracket[0]:.2f} and {v.bracket[1]:.2f})",
-            f"sampled {100 * v.relative_error['sampled']:+.2f} %, kb_first_order {100 * v.relative_error['kb_first_order']:+.1f} % "
-            f"(lumped {100 * v.lumped_relative_error['kb_first_order']:+.1f} %)"),
+        boundary_row("Fig 6", "L* (m), straight grid corridor", "eq (25)", v, 3,
+                     f"{v.simulated_boundary:.3f} (between {v.bracket[0]:.2f} and {v.bracket[1]:.2f})"),
         row("Fig 6a", "wide corridor, L = 0.9 m after the step", "smoothly adjusts",
             f"stable, sigma = {pw.growth_rate:+.3f} 1/s", f"settles, sigma = {wide.metrics.growth_rate:+.3f} 1/s", ""),
         row("Fig 6b", "narrow corridor, L = 0.6 m after the step", "unstable oscillations, collision",

@@ -124,7 +124,6 @@ def closed_loop_matrix(loop: Loop, K: float, hold: str, compute_delay: int) -> n
     F = (F0 + K * F1)[None, :]
     if compute_delay == 0:
         return Phi - Gamma @ F
-    n = Phi.shape[0]
     top = np.hstack([Phi, Gamma])
     bottom = np.hstack([-F, np.zeros((1, 1))])
     return np.vstack([top, bottom])

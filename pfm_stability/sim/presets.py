@@ -286,7 +286,7 @@ def _staircase_equilibrium(law: GridWallLaw, angle: float, force: float) -> floa
 
 def _fig5(o):
     walls = _fig5_walls()
-    robot, env = o["robot"], o["env"]
+    env = o["env"]
     law = o["law_object"] or o["grid_law"]
     alpha1 = math.radians(50.0)
     turn = math.radians(30.0)
