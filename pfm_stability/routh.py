@@ -4,12 +4,11 @@
 or symbolically (sympy expressions), and handles the two special cases:
 
 * a zero in the first column of an otherwise non-zero row: replaced by a
-  positive symbol ε, the signs taken in the limit ε → 0+. A float array cannot
-  keep 1/ε and ε² apart once zero pivots chain, and a pivot that is mostly
-  cancellation (below 1e-9 of the terms it came from) has no reliable sign, so
-  in both cases the float
-  coefficients are converted exactly to rationals and the symbolic array
-  decides;
+  positive symbol ε, the signs taken in the limit ε → 0+. A float array
+  cannot keep 1/ε and ε² apart once zero pivots chain, so numerically every
+  entry carries a running error bound, and wherever a first-column sign is
+  not certain (a zero, a cancellation, a zero row) the float coefficients are
+  converted exactly to rationals and the symbolic array decides;
 * a row of zeros (roots symmetric about the origin, e.g. a pair on the imaginary
   axis): replaced by the coefficients of the derivative of the auxiliary
   polynomial formed from the row above.
@@ -29,6 +28,7 @@ KB (Koren & Borenstein 1991) apply Routh to their eq (19) to obtain eq (20).
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -131,43 +131,47 @@ def _auxiliary_derivative(upper, power):
     return [upper[j] * (power - 2 * j) for j in range(len(upper))]
 
 
-def _next_row_numeric(upper, lower):
-    """Next Routh row and, per entry, the size of the terms that produced it.
+def _next_row_numeric(upper, lower, upper_err, lower_err):
+    """Next Routh row and a first-order bound on each entry's absolute error.
 
-    Entries lost to cancellation (below round-off of those terms) become exactly 0.
+    r_j = a − u₀·b/l₀ (a = upper[j+1], b = lower[j+1]); the bound adds the
+    propagated errors of a, u₀, b, l₀ and the rounding of the three operations
+    (running error analysis, Higham, *Accuracy and Stability of Numerical
+    Algorithms*, §3.3).
     """
     width = len(upper)
-    row, sizes = [], []
+    l0, u0, e_l0, e_u0 = lower[0], upper[0], lower_err[0], upper_err[0]
+    row, err = [], []
     for j in range(width):
-        a = upper[j + 1] if j + 1 < width else 0.0
-        b = lower[j + 1] if j + 1 < width else 0.0
-        value = (lower[0] * a - upper[0] * b) / lower[0]
-        size = (abs(lower[0] * a) + abs(upper[0] * b)) / abs(lower[0])
-        row.append(0.0 if abs(value) <= _CANCELLATION * size else value)
-        sizes.append(size)
-    return row, sizes
+        a, e_a = (upper[j + 1], upper_err[j + 1]) if j + 1 < width else (0.0, 0.0)
+        b, e_b = (lower[j + 1], lower_err[j + 1]) if j + 1 < width else (0.0, 0.0)
+        term = u0 * b / l0
+        value = a - term
+        bound = e_a + abs(b / l0) * e_u0 + abs(u0 / l0) * e_b + abs(term / l0) * e_l0
+        row.append(value)
+        err.append(bound + 3 * _EPS * (abs(a) + abs(term)))
+    return row, err
 
 
-_CANCELLATION = 1e3 * np.finfo(float).eps
-_SMALL_PIVOT = 1e-9
+_EPS = np.finfo(float).eps
+_SIGN_MARGIN = 1e3
+"""An entry whose magnitude is within this factor of its error bound has no certain sign."""
 
 
 def _routh_numeric(c: np.ndarray) -> RouthResult:
-    """Numeric Routh array; a zero or near-zero pivot hands over to exact arithmetic.
+    """Numeric Routh array; where floats cannot certify a sign, exact arithmetic.
 
-    A finite ε cannot stand in for ε → 0+ in floating point once several
-    zero pivots chain (entries like 1/ε and ε² must be kept apart), and a
-    pivot that is mostly cancellation (below 1e-9 of the terms it came from)
-    has an unreliable sign (and coefficients spanning more than 1e100 would
-    overflow the products); in each case the float coefficients are converted exactly to rationals
-    and the symbolic array (with ε → 0+ where a pivot is exactly zero) decides
-    (Gantmacher, ch. XV §6).
+    Every entry carries a running error bound. A first-column entry within
+    1e3 of its bound — a zero pivot, a pivot lost to cancellation, a zero
+    row — or an overflow hands the float coefficients, converted exactly to
+    rationals, to the symbolic array, which takes ε → 0+ where a pivot is
+    exactly zero (Gantmacher, ch. XV §6). A finite ε cannot stand in for that
+    limit in floating point once zero pivots chain (1/ε and ε² must be kept
+    apart).
     """
     if len(c) == 1:
         return RouthResult([[float(c[0])]], [float(c[0])], 0, False)
-    nonzero = np.abs(c[c != 0])
-    # products of entries must stay inside the float range (~1e±308)
-    result = _routh_table(c) if nonzero.max() <= 1e100 * nonzero.min() else None
+    result = _routh_table(c)
     if result is None:
         import sympy as sp
 
@@ -176,33 +180,26 @@ def _routh_numeric(c: np.ndarray) -> RouthResult:
 
 
 def _routh_table(c: np.ndarray) -> RouthResult | None:
-    """The float array, or None where floats cannot be trusted with the signs:
-    a zero pivot, a pivot that is mostly cancellation (below 1e-9 of the terms
-    it was computed from), or an overflow."""
+    """The float array, or None where a first-column sign is not certain."""
     n = len(c) - 1
     row0, row1, _ = _first_two_rows([float(x) for x in c])
     table = [row0, row1]
-    sizes = [abs(x) for x in row1]
-    marginal = False
-    for power in range(n - 1, 0, -1):
+    errors = [[0.0] * len(row0), [0.0] * len(row1)]  # the coefficients are exact
+    for _ in range(n - 1):
         upper, lower = table[-2], table[-1]
-        if all(x == 0.0 for x in lower):
-            marginal = True
-            lower = _auxiliary_derivative(upper, power + 1)
-            table[-1] = lower
-            sizes = [abs(x) for x in lower]
-        if abs(lower[0]) <= _SMALL_PIVOT * sizes[0]:
-            return None
-        row, sizes = _next_row_numeric(upper, lower)
-        if not all(np.isfinite(row)):
+        if abs(lower[0]) <= _SIGN_MARGIN * errors[-1][0]:
+            return None  # zero, or of unknown sign: zero row and ε cases included
+        row, err = _next_row_numeric(upper, lower, errors[-2], errors[-1])
+        if not all(math.isfinite(x) for x in row + err):
             return None
         table.append(row)
-    if table[-1][0] == 0.0:
-        marginal = True
+        errors.append(err)
     first = [row[0] for row in table]
-    signs = [np.sign(x) for x in first if x != 0.0]
+    if any(abs(x) <= _SIGN_MARGIN * e[0] for x, e in zip(first, errors)):
+        return None
+    signs = [x > 0 for x in first]
     changes = sum(1 for a, b in zip(signs, signs[1:]) if a != b)
-    return RouthResult(table, first, changes, marginal)
+    return RouthResult(table, first, changes, False)
 
 
 def _is_sympy(x) -> bool:

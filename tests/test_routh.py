@@ -52,6 +52,7 @@ def test_routh_count_on_polynomials_built_from_roots(roots):
         ([1, 2, 24, 48, -25, -50], 1, True, False),  # Ogata's zero-row example: roots ±1, ±5j, −2
         ([-4.0, 2.2250738585072014e-308, -1.0, 0.0, 0.0, 3.7e-207, 0.0, 1.0], 3, False, False),  # subnormal pivot → exact arithmetic (found by hypothesis)
         ([-9.0, 1e-13, 1.0, 1e-13, 0.0, 1.0], 3, False, False),  # tiny but genuine pivots (found by hypothesis)
+        ([1.0, 8.996531936802499e-90, 2.0, -1.0, 0.0, 0.0, 0.0, 1.0], 2, False, False),  # 1e-90 pivot, 1/ε-sized rows (found by hypothesis)
     ],
 )
 def test_textbook_special_cases(coefficients, rhp, marginal, epsilon):
