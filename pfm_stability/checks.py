@@ -68,18 +68,19 @@ def check_number(
     ValueError
         ``"<name> must be a finite number in <range> <unit>; got <value>"``.
     """
-    allowed = describe_range(low, high, low_open, high_open)
-    message = f"{name} must be a finite number in {allowed}{' ' + unit if unit else ''}; got {value!r}"
     if isinstance(value, bool) or not isinstance(value, numbers.Real):
-        raise ValueError(message)
+        raise ValueError(_number_message(name, value, low, high, low_open, high_open, unit))
     x = float(value)
-    if not math.isfinite(x):
-        raise ValueError(message)
     below = x <= low if low_open else x < low
     above = x >= high if high_open else x > high
-    if below or above:
-        raise ValueError(message)
+    if below or above or not math.isfinite(x):
+        raise ValueError(_number_message(name, value, low, high, low_open, high_open, unit))
     return x
+
+
+def _number_message(name, value, low, high, low_open, high_open, unit) -> str:
+    allowed = describe_range(low, high, low_open, high_open)
+    return f"{name} must be a finite number in {allowed}{' ' + unit if unit else ''}; got {value!r}"
 
 
 def check_integer(name: str, value, low: int, high: int) -> int:

@@ -24,7 +24,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .force_law import ForceLaw, PowerLaw, corridor_gain, wall_gain
-from .models import Loop, LoopModel, verdict_label
+from .models import Loop, LoopModel, gain_margin, models_for, verdict_label
 from .parameters import Controller, Corridor, Robot, Wall, check_corridor_fits
 from .solve import bisect_root, expand_bracket
 
@@ -235,11 +235,13 @@ def critical_f_corridor(law: ForceLaw, L: float, V: float, NV_critical: float) -
 
 # ------------------------------------------------------------------ analyses
 def _verdict(model: LoopModel, loop: Loop, NV: float, boundary, critical: dict) -> ModelVerdict:
-    if NV == 0:
+    critical = dict(critical)
+    if NV == 0:  # no equilibrium force gradient: nothing to oscillate
+        critical.update(T_critical=math.inf, k_critical=math.inf)
         return ModelVerdict(model.name, NV, boundary.NV_critical, boundary.omega_critical, math.inf, "stable", critical, 0j)
     stable = model.is_stable(NV, loop)
-    critical = dict(critical)
     critical["T_critical"] = model.critical_delay(NV, loop)
+    critical["k_critical"] = model.critical_gain_k(NV, loop)
     if model.name == "kb_first_order":
         critical["tau_plus_T_critical"] = 1.0 / NV
     return ModelVerdict(
@@ -247,14 +249,14 @@ def _verdict(model: LoopModel, loop: Loop, NV: float, boundary, critical: dict) 
         NV=NV,
         NV_critical=boundary.NV_critical,
         omega_critical=boundary.omega_critical,
-        margin=boundary.NV_critical / NV - 1.0,
+        margin=gain_margin(NV, boundary, stable),
         verdict=verdict_label(NV, boundary, stable),
         critical=critical,
         rightmost_root=model.rightmost_root(NV, loop),
     )
 
 
-def analyze_wall(robot: Robot, controller: Controller, wall: Wall, models, law: ForceLaw | None = None) -> WallAnalysis:
+def analyze_wall(robot: Robot, controller: Controller, wall: Wall, models=None, law: ForceLaw | None = None) -> WallAnalysis:
     """Stability along a wall for each model (KB §5.3, eq 20–24).
 
     Parameters
@@ -262,7 +264,10 @@ def analyze_wall(robot: Robot, controller: Controller, wall: Wall, models, law: 
     robot, controller : Robot, Controller
     wall : Wall
         Target angle α.
-    models : iterable of LoopModel
+    models : iterable of LoopModel or str, optional
+        Default: every model, ``sampled`` with the controller's hold and
+        compute delay (the controller is the one source of truth: a
+        ``Sampled`` model that contradicts it raises ValueError).
     law : ForceLaw, optional
         Lateral repulsion law; KB's power law f(W/d)^n by default.
 
@@ -270,14 +275,17 @@ def analyze_wall(robot: Robot, controller: Controller, wall: Wall, models, law: 
     -------
     WallAnalysis
         Critical values per model: ``alpha_critical`` (rad), ``alpha_critical_deg``,
-        ``f_critical``, ``V_critical`` (m/s), ``T_critical`` (s).
+        ``f_critical``, ``V_critical`` (m/s), ``T_critical`` (s), ``k_critical`` (1/s).
+        A model that is unstable at every NV (NV* = 0) gives V* = 0, α* = 90°
+        and f* = inf: no speed, angle or force ratio helps; ``T_critical`` and
+        ``k_critical`` say whether a shorter period or a lower gain does.
     """
     law = _law(robot, controller, law)
     loop = loop_of(robot, controller)
     d0, N = wall_gain(law, wall.alpha)
     NV = N * robot.V
     out = {}
-    for model in models:
+    for model in models_for(controller, models):
         boundary = model.boundary(loop)
         alpha_star = critical_alpha(law, robot.V, boundary.NV_critical)
         critical = {
@@ -290,7 +298,7 @@ def analyze_wall(robot: Robot, controller: Controller, wall: Wall, models, law: 
     return WallAnalysis(wall.alpha, d0, N, NV, out)
 
 
-def analyze_corridor(robot: Robot, controller: Controller, corridor: Corridor, models, law: ForceLaw | None = None) -> CorridorAnalysis:
+def analyze_corridor(robot: Robot, controller: Controller, corridor: Corridor, models=None, law: ForceLaw | None = None) -> CorridorAnalysis:
     """Stability in the middle of a corridor for each model (KB §5.4, eq 25).
 
     Parameters
@@ -298,7 +306,9 @@ def analyze_corridor(robot: Robot, controller: Controller, corridor: Corridor, m
     robot, controller : Robot, Controller
     corridor : Corridor
         Half-width L (must exceed W/2).
-    models : iterable of LoopModel
+    models : iterable of LoopModel or str, optional
+        Default: every model, ``sampled`` with the controller's structure
+        (see `analyze_wall`).
     law : ForceLaw, optional
         KB's power law by default.
 
@@ -306,7 +316,8 @@ def analyze_corridor(robot: Robot, controller: Controller, corridor: Corridor, m
     -------
     CorridorAnalysis
         Critical values per model: ``L_critical`` (m), ``V_critical`` (m/s),
-        ``f_critical``, ``T_critical`` (s).
+        ``f_critical``, ``T_critical`` (s), ``k_critical`` (1/s). NV* = 0 gives
+        V* = 0, L* = inf and f* = 0 ("unstable at any speed").
     """
     check_corridor_fits(corridor, robot)
     law = _law(robot, controller, law)
@@ -314,7 +325,7 @@ def analyze_corridor(robot: Robot, controller: Controller, corridor: Corridor, m
     N = corridor_gain(law, corridor.L)
     NV = N * robot.V
     out = {}
-    for model in models:
+    for model in models_for(controller, models):
         boundary = model.boundary(loop)
         critical = {
             "L_critical": critical_L(law, robot.V, boundary.NV_critical),

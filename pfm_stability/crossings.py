@@ -31,6 +31,7 @@ __all__ = [
     "affine_crossings",
     "first_stable_interval",
     "stable_interval",
+    "stable_set",
     "verdict_at",
 ]
 
@@ -67,11 +68,17 @@ class StabilityInterval:
         ``"z"``); None when K* is 0 or infinite.
     crossings : tuple of Crossing
         Every crossing with K > 0, sorted by gain.
+    intervals : tuple of (float, float)
+        Every stable gain interval (lo, hi), ascending; the first starts at 0
+        when K* > 0. Stability in K need not be one interval: a sampled
+        steering loop with kT near 2 is unstable for small K and stable
+        further up.
     """
 
     gain: float
     frequency: float | None
     crossings: tuple
+    intervals: tuple = ()
 
 
 def _align(d, e):
@@ -191,6 +198,39 @@ def verdict_at(d, e, gain: float, domain: str = "s") -> bool:
     return routh_array(p).stable if domain == "s" else schur_cohn_stable(p)
 
 
+def stable_set(crossings, is_stable) -> tuple:
+    """Every interval of gains K > 0 on which the loop is stable.
+
+    Stability can change only at a crossing gain, so one verdict between
+    consecutive crossing gains (and beyond the last) decides each stretch;
+    adjacent stable stretches (a crossing that merely touches the boundary)
+    are merged.
+
+    Parameters
+    ----------
+    crossings : sequence of Crossing
+        Every boundary crossing with K > 0, sorted by gain.
+    is_stable : callable
+        ``is_stable(K) -> bool`` by an independent test.
+
+    Returns
+    -------
+    tuple of (float, float)
+        Ascending (lo, hi) pairs; hi may be ``inf``.
+    """
+    gains = sorted({c.gain for c in crossings})
+    edges = [0.0] + gains + [math.inf]
+    out = []
+    for lo, hi in zip(edges, edges[1:]):
+        probe = (lo + hi) / 2 if math.isfinite(hi) else (2 * lo if lo > 0 else 1.0)
+        if is_stable(probe):
+            if out and out[-1][1] == lo:
+                out[-1] = (out[-1][0], hi)
+            else:
+                out.append((lo, hi))
+    return tuple(out)
+
+
 def stable_interval(crossings, is_stable) -> StabilityInterval:
     """K*: the end of the interval (0, K*) of stabilizing gains.
 
@@ -201,23 +241,24 @@ def stable_interval(crossings, is_stable) -> StabilityInterval:
         sorted by gain.
     is_stable : callable
         ``is_stable(K) -> bool`` by an independent test (Routh, Schur–Cohn, a
-        crossing count). It is asked at the midpoint of each interval between
-        consecutive crossing gains (and beyond the last one), so a crossing that
-        merely touches the boundary does not end the interval.
+        crossing count). It is asked once between consecutive crossing gains
+        (and beyond the last one), so a crossing that merely touches the
+        boundary does not end the interval.
 
     Returns
     -------
     StabilityInterval
+        K* = 0 when the loop is unstable for every small K > 0.
     """
     crossings = tuple(crossings)
-    gains = [c.gain for c in crossings]
-    if not is_stable(gains[0] / 2 if gains else 1.0):
-        return StabilityInterval(0.0, None, crossings)
-    for i, crossing in enumerate(crossings):
-        beyond = gains[i + 1] if i + 1 < len(gains) else 2 * crossing.gain
-        if not is_stable((crossing.gain + beyond) / 2):
-            return StabilityInterval(crossing.gain, crossing.frequency, crossings)
-    return StabilityInterval(math.inf, None, crossings)
+    intervals = stable_set(crossings, is_stable)
+    if not intervals or intervals[0][0] > 0:
+        return StabilityInterval(0.0, None, crossings, intervals)
+    end = intervals[0][1]
+    if math.isinf(end):
+        return StabilityInterval(math.inf, None, crossings, intervals)
+    frequency = next(c.frequency for c in crossings if c.gain == end)
+    return StabilityInterval(end, frequency, crossings, intervals)
 
 
 def first_stable_interval(d, e, domain: str = "s") -> StabilityInterval:

@@ -40,11 +40,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from .checks import check_number
-from .crossings import Crossing, StabilityInterval, stable_interval
+from .crossings import Crossing, StabilityInterval
 from .routh import routh_array, strip_leading_zeros
-from .solve import bisect_root
+from .solve import bisect_root, newton_increasing
 
-__all__ = ["DelayLoop", "DelayCrossing"]
+__all__ = ["DelayLoop", "DelayCrossing", "delay_verdicts_from_gain", "kb_critical_gain"]
 
 _TWO_PI = 2.0 * math.pi
 
@@ -213,80 +213,65 @@ class DelayLoop:
         omega = np.asarray(omega, dtype=float)
         phase = np.full(omega.shape, float(np.angle(self.a[0])))
         for r in self._a_roots:
-            factor = 1j * omega - r
-            if r.real > 0:
-                phase += np.angle(-factor) + math.pi
-            else:
-                phase += np.angle(factor)
+            phase += np.angle(1j * omega - r)
         return phase
 
     def _phase(self, omega):
         return self._unwrapped_phase(omega) + omega * self.T
 
-    def _frequency_bound(self, K_max: float) -> float:
-        """Largest ω with |a(jω)| <= K_max (0 if none)."""
-        freqs = [w for w, _ in self.crossing_frequencies(K_max)]
-        return max(freqs) if freqs else 0.0
-
-    def gain_crossings(self, K_max: float, grid_points: int = 4096) -> list[Crossing]:
-        """Every crossing of the imaginary axis with 0 < K <= K_max as K grows (T fixed).
-
-        Parameters
-        ----------
-        K_max : float
-            Largest gain of interest.
-        grid_points : int
-            Bracketing grid over (0, ω_max]; exact for a(s) without roots in
-            Re s > 0 (monotone phase), otherwise a pair of crossings closer than
-            the grid step could be missed.
-
-        Returns
-        -------
-        list of Crossing
-            (gain K_m = |a(jω_m)|, frequency ω_m in rad/s), sorted by gain.
-        """
-        w_max = self._frequency_bound(K_max) * (1 + 1e-9)
-        if w_max <= 0:
-            return []
-        scale = w_max
-        grid = np.unique(np.concatenate([np.linspace(0, w_max, grid_points)[1:], np.geomspace(scale * 1e-9, w_max, grid_points)]))
-        psi = self._phase(grid)
-        levels = np.floor((psi - math.pi) / _TWO_PI)
-        out = []
-        for i in np.flatnonzero(levels[1:] != levels[:-1]):
-            lo, hi = sorted((levels[i], levels[i + 1]))
-            for level in np.arange(lo + 1, hi + 1):
-                target = math.pi + _TWO_PI * level
-                w = bisect_root(lambda x: float(self._phase(x)) - target, grid[i], grid[i + 1], rtol=1e-15)
-                gain = abs(np.polyval(self.a, 1j * w))
-                if 0 < gain <= K_max * (1 + 1e-12):
-                    out.append(Crossing(float(gain), float(w)))
-        return sorted(out, key=lambda c: c.gain)
-
     def critical_gain(self) -> StabilityInterval:
         """K*: stable for 0 < K < K* (T fixed), and the boundary frequency ω*.
 
-        The gain crossings are searched up to a bound that doubles until the
-        stable interval ends inside it (or 60 doublings: then K* = inf).
+        When a(s) has no root in Re s > 0 its phase arg a(jω) + ωT increases
+        strictly, so a root is on the axis at gain K exactly when the phase is
+        (2m + 1)π for some m = 0, 1, … (one frequency ω_m each) and
+        K = K_m = |a(jω_m)|; each such crossing moves a root pair to the right
+        as K grows (Re(ds/dK) has the sign of the phase slope). Hence
+        K* = min_m K_m, and only one level per stretch on which |a(jω)| is
+        monotone can be the minimum: the first level of an increasing stretch,
+        the last of a decreasing one (stretches split at the critical points
+        of |a(jω)|², a polynomial in ω²). A root of a(s) with Re s > 0 makes
+        the loop unstable for small K: K* = 0.
+
+        Raises
+        ------
+        ValueError
+            If a(s) has a non-zero root on the imaginary axis (the phase jumps).
         """
         if self.T == 0:
             from .crossings import first_stable_interval
 
             return first_stable_interval(self.a, [1.0], "s")
-        K_max = self._first_level_gain()
-        for _ in range(60):
-            interval = stable_interval(self.gain_crossings(K_max), self.is_stable)
-            if interval.gain <= K_max:
-                return interval
-            K_max *= 2
-        return StabilityInterval(math.inf, None, interval.crossings)
+        scale = max(1.0, float(np.max(np.abs(self._a_roots)))) if self._a_roots.size else 1.0
+        if np.any(self._a_roots.real > 1e-12 * scale):
+            return StabilityInterval(0.0, None, (), ())
+        if np.any((np.abs(self._a_roots.real) <= 1e-12 * scale) & (np.abs(self._a_roots) > 1e-12 * scale)):
+            raise ValueError("a(s) must not have non-zero roots on the imaginary axis")
+        levels = set()
+        for w in [0.0] + self._modulus_critical_points():
+            level = self._level_at(w)
+            levels.update({max(level, 0), max(level + 1, 0)} if w > 0 else {0})
+        crossings = sorted((Crossing(float(abs(np.polyval(self.a, 1j * w))), w) for w in (self._level_frequency(m) for m in sorted(levels))), key=lambda c: c.gain)
+        best = crossings[0]
+        return StabilityInterval(best.gain, best.frequency, tuple(crossings), ((0.0, best.gain),))
 
-    def _first_level_gain(self) -> float:
-        """Gain of the lowest-frequency phase crossing, a first search bound."""
-        w = 1.0 / self.T
-        while self._phase(w) < math.pi and w < 1e12 / self.T:
-            w *= 2
-        return max(abs(np.polyval(self.a, 1j * w)), 1e-12)
+    def _modulus_critical_points(self) -> list[float]:
+        """ω > 0 where |a(jω)|² has a critical point (roots of its derivative in y = ω²)."""
+        dF = np.polyder(self._modulus_poly_in_y(0.0))
+        roots = np.roots(np.trim_zeros(dF, "f")) if np.any(dF[:-1]) else np.empty(0)
+        return sorted(math.sqrt(y.real) for y in roots if abs(y.imag) <= 1e-9 * max(1.0, abs(y)) and y.real > 0)
+
+    def _level_at(self, w: float) -> int:
+        """Largest m with phase(ω_m) <= phase(w), i.e. floor((phase − π)/2π)."""
+        return int(math.floor((float(self._phase(w)) - math.pi) / _TWO_PI))
+
+    def _level_frequency(self, m: int) -> float:
+        """ω > 0 where the phase equals (2m + 1)π (it increases strictly)."""
+        target = math.pi + _TWO_PI * m
+        hi = 1.0 / self.T
+        while float(self._phase(hi)) < target:
+            hi *= 2.0
+        return bisect_root(lambda x: float(self._phase(x)) - target, 0.0, hi, rtol=1e-15)
 
     # ---------------------------------------------------------- rightmost roots
     def rightmost_roots(self, K: float, count: int = 6, nodes: int = 40) -> np.ndarray:
@@ -347,3 +332,181 @@ class DelayLoop:
             if abs(step) <= 1e-13 * max(1.0, abs(s)):
                 return complex(s)
         return complex(s) if abs(self.value(s, K)) <= 1e-9 * max(1.0, abs(np.polyval(self.a, s))) else None
+
+
+# ----------------------------------------------------------------------------
+# KB's quasi-polynomial τs³ + s² + ks + K·e^(−sT), vectorized over points
+# ----------------------------------------------------------------------------
+_RESONANCE = 2.0 + math.sqrt(3.0)
+"""kτ above which |a(jω)| of a(s) = τs³ + s² + ks dips (the steering loop resonates)."""
+
+
+def _kb_level_offset(w, tau, T, k):
+    """g(ω) = ωT − atan(k/ω − τω) and g′(ω): the phase of a(jω)e^(jωT) minus π, increasing."""
+    u = k / w - tau * w
+    return w * T - np.arctan(u), T + (k / (w * w) + tau) / (1.0 + u * u)
+
+
+def _kb_level_frequency(tau, T, k, m):
+    """ω_m > 0 with g(ω_m) = 2πm (arrays; T > 0): a root on the axis at gain |a(jω_m)|.
+
+    g ranges over (ωT − π/2, ωT + π/2), which brackets ω_m in a band of width
+    π/T; for m = 0 also ω_0 < √(k/τ) (g > 0 needs k − τω² > 0).
+    """
+    target = 2.0 * math.pi * m
+    lo = np.maximum((target - math.pi / 2) / T, 0.0)
+    hi = (target + math.pi / 2) / T
+    with np.errstate(divide="ignore"):
+        hi = np.where((m == 0) & (tau > 0), np.minimum(hi, np.sqrt(k / np.where(tau > 0, tau, 1.0))), hi)
+
+    def func(w):
+        with np.errstate(divide="ignore", invalid="ignore"):
+            g, slope = _kb_level_offset(w, tau, T, k)
+        return np.where(w > 0, g - target, -1.0), slope
+
+    return newton_increasing(func, lo, hi)
+
+
+def kb_critical_gain(tau, T, k):
+    """K* and ω* of KB eq (18), τs³ + s² + ks + K·e^(−sT), for arrays (τ, T, k).
+
+    The loop is stable exactly for 0 < K < K* (`DelayLoop.critical_gain`: the
+    phase of a(jω) = jω(k − τω² + jω) increases strictly, every gain crossing
+    is destabilizing). K* = min_m |a(jω_m)| over the levels g(ω_m) = 2πm, and
+    only three levels can attain it: m = 0 (|a(jω)| increases up to the first
+    critical point of |a(jω)|²) and, when kτ > 2 + √3, the last level below
+    and the first above the dip's bottom ω_c, where
+    ω_c² = [(2kτ − 1) + √((2kτ − 1)² − 3k²τ²)]/(3τ²). Each level frequency
+    is found by safeguarded Newton on g. No iteration over levels, no search
+    bound: the number of levels below ω_c (up to ~10⁵ for T = 100 s) does
+    not matter.
+
+    T = 0: K* = k/τ, ω* = √(k/τ) (KB eq 17; ``inf`` and NaN for τ = 0).
+
+    Parameters
+    ----------
+    tau, T, k : array_like
+        s, s, 1/s; broadcast together; τ >= 0, T >= 0, k > 0.
+
+    Returns
+    -------
+    K_star, omega_star : ndarray
+        1/s² and rad/s.
+    """
+    tau, T, k = (np.asarray(x, dtype=float) for x in np.broadcast_arrays(tau, T, k))
+    shape = tau.shape
+    tau, T, k = tau.ravel(), T.ravel(), k.ravel()
+    K_star = np.full(tau.shape, np.inf)
+    omega_star = np.full(tau.shape, np.nan)
+    still = (T == 0) & (tau > 0)
+    K_star[still] = k[still] / tau[still]
+    omega_star[still] = np.sqrt(k[still] / tau[still])
+    delayed = T > 0
+    if delayed.any():
+        t, d, g = tau[delayed], T[delayed], k[delayed]
+        kt = g * t
+        resonant = kt > _RESONANCE
+        safe_t = np.where(resonant, t, 1.0)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            y_c = ((2 * kt - 1) + np.sqrt(np.maximum((2 * kt - 1) ** 2 - 3 * kt * kt, 0.0))) / (3 * safe_t * safe_t)
+            g_c = _kb_level_offset(np.sqrt(y_c), safe_t, d, g)[0]
+        m_c = np.where(resonant & (g_c >= 0), np.floor(g_c / (2 * math.pi)), 0.0)
+        best_K = np.full(t.shape, np.inf)
+        best_w = np.full(t.shape, np.nan)
+        for m in (np.zeros_like(m_c), m_c, m_c + resonant):
+            w = _kb_level_frequency(t, d, g, m)
+            K = w * np.sqrt((g - t * w * w) ** 2 + w * w)
+            better = K < best_K
+            best_K = np.where(better, K, best_K)
+            best_w = np.where(better, w, best_w)
+        K_star[delayed], omega_star[delayed] = best_K, best_w
+    return K_star.reshape(shape), omega_star.reshape(shape)
+
+
+def _cubic_positive_roots(tau, k, K):
+    """Positive roots y of F(y) = τ²y³ + (1 − 2kτ)y² + k²y − K² (up to three; NaN where absent).
+
+    No discriminant (it cancels catastrophically when τ is small): the
+    critical points of F (a stable quadratic formula) split (0, ∞) into
+    intervals where F is monotone and of one convexity, so each root is reached
+    by Newton's method from a start that satisfies Fourier's condition
+    F·F″ > 0 — convergence is monotone and needs no safeguard. τ = 0 leaves
+    the quadratic y² + k²y − K² (one positive root, closed form).
+    """
+    roots = np.full(tau.shape + (3,), np.nan)
+    quadratic = tau == 0
+    if quadratic.any():
+        kk, KK = k[quadratic] ** 2, K[quadratic] ** 2
+        roots[quadratic, 0] = 2 * KK / (kk + np.sqrt(kk * kk + 4 * KK))
+    cubic = ~quadratic
+    if cubic.any():
+        roots[cubic] = _newton_cubic_roots(tau[cubic] ** 2, 1 - 2 * k[cubic] * tau[cubic], k[cubic] ** 2, K[cubic] ** 2)
+    return roots
+
+
+def _newton_cubic_roots(a, beta, c, D):
+    """Up to three positive roots of a·y³ + β·y² + c·y − D (a, c, D > 0)."""
+
+    def F(y):
+        return ((a * y + beta) * y + c) * y - D
+
+    inflection = -beta / (3 * a)
+    disc = beta * beta - 3 * a * c
+    critical = (beta < 0) & (disc > 0)
+    c2 = np.where(critical, (-beta + np.sqrt(np.maximum(disc, 0))) / (3 * a), np.inf)
+    c1 = np.where(critical, c / (3 * a * np.where(critical, c2, 1.0)), np.inf)
+    F1 = np.where(critical, F(np.where(critical, c1, 0.0)), np.inf)
+    F2 = np.where(critical, F(np.where(critical, c2, 0.0)), -np.inf)
+    # a point right of every root: with β >= 0 each term alone bounds the root
+    # (within a factor 3 of it); otherwise Fujiwara's bound
+    with np.errstate(divide="ignore"):
+        positive_bound = np.minimum.reduce([D / c, np.sqrt(D / np.where(beta > 0, beta, 0.0)), np.cbrt(D / a)])
+    right = np.where(beta >= 0, positive_bound, 2 * np.maximum.reduce([np.abs(beta) / a, np.sqrt(c / a), np.cbrt(D / (2 * a))]))
+    F_inflection = np.where(inflection > 0, F(np.maximum(inflection, 0.0)), -np.inf)
+    # smallest root: in the concave stretch left of the inflection (start at 0) or in the convex one (start right)
+    left_concave = np.where(critical, F1 > 0, F_inflection >= 0)
+    starts = np.stack(
+        [
+            np.where(left_concave, 0.0, right),
+            np.where(critical & (F1 > 0) & (F2 < 0), inflection, np.nan),
+            np.where(critical & (F1 > 0) & (F2 < 0), right, np.nan),
+        ],
+        axis=-1,
+    )
+    used = np.isfinite(starts)
+    point = np.nonzero(used)[0]
+    y = starts[used]
+    A, B, C, Dd = a[point], beta[point], c[point], D[point]
+    for _ in range(60):
+        value = ((A * y + B) * y + C) * y - Dd
+        slope = (3 * A * y + 2 * B) * y + C
+        with np.errstate(invalid="ignore", divide="ignore"):
+            step = value / slope
+        step[~np.isfinite(step)] = 0.0
+        y -= step
+        # converged when every step is at round-off level (1e-13 relative: near
+        # double roots the iterates jitter by a few ulps and never settle)
+        if not np.any(np.abs(step) > 1e-13 * np.abs(y)):
+            break
+    out = np.full(starts.shape, np.nan)
+    out[used] = y
+    y = out
+    return y
+
+
+def delay_verdicts_from_gain(tau, T, k, K):
+    """Crossing-count verdicts for arrays (τ, T, k, K = kNV); returns (stable, Z, delay margin)."""
+    y = _cubic_positive_roots(tau, k, K)
+    present = np.isfinite(y)
+    y0 = np.where(present, y, 1.0)
+    w = np.sqrt(y0)
+    t3, k3 = tau[:, None], k[:, None]
+    slope = 3 * t3**2 * y0**2 + 2 * (1 - 2 * k3 * t3) * y0 + k3**2
+    direction = np.where(present, np.sign(slope), 0.0)
+    psi = np.arctan((k3 - t3 * y0) / w)
+    first = np.where(psi >= 0, psi, psi + _TWO_PI) / w
+    passed = np.where(present & (T[:, None] > first), np.floor((T[:, None] - first) * w / _TWO_PI) + 1, 0.0)
+    base = np.where(tau * K > k, 2, 0)
+    Z = base + 2 * np.sum(direction * passed, axis=1).astype(np.int64)
+    margin = np.where(base == 0, np.min(np.where(present, first, np.inf), axis=1), 0.0)
+    return Z == 0, Z, margin

@@ -21,8 +21,15 @@ _LABELS = {
     "L": "L (corridor half-width)",
 }
 
-_REMEDY_UNITS = {"V": "m/s", "T": "s", "alpha_deg": "deg", "L": "m", "f": ""}
-_REMEDY_NAMES = {"V": "V", "T": "T", "alpha_deg": "alpha", "L": "L", "f": "f"}
+_REMEDY_UNITS = {"V": "m/s", "T": "s", "k": "1/s", "alpha_deg": "deg", "L": "m", "f": ""}
+_REMEDY_NAMES = {"V": "V", "T": "T", "k": "k", "alpha_deg": "alpha", "L": "L", "f": "f"}
+
+
+def _percent(x) -> str:
+    """A JSON margin as a signed percentage ("-" undefined, "inf" infinite)."""
+    if x is None or isinstance(x, str):
+        return _num(x)
+    return f"{x * 100:+.1f}%"
 
 
 def _num(x, digits=4) -> str:
@@ -47,17 +54,17 @@ def _rows(report):
                 f"Wall, alpha = {_num(env['alpha_deg'])} deg: equilibrium d0 = {_num(env['d0'])} m, "
                 f"N = {_num(env['N'])} 1/m, NV = {_num(env['NV'])} 1/s"
             )
-            header = ["model", "verdict", "margin", "NV* 1/s", "omega* rad/s", "alpha* deg", "f*", "V* m/s", "T* s"]
-            keys = ["alpha_critical_deg", "f_critical", "V_critical", "T_critical"]
+            header = ["model", "verdict", "margin", "NV* 1/s", "omega* rad/s", "alpha* deg", "f*", "V* m/s", "T* s", "k* 1/s"]
+            keys = ["alpha_critical_deg", "f_critical", "V_critical", "T_critical", "k_critical"]
         else:
             title = f"Corridor, L = {_num(env['L'])} m: N = {_num(env['N'])} 1/m, NV = {_num(env['NV'])} 1/s"
-            header = ["model", "verdict", "margin", "NV* 1/s", "omega* rad/s", "L* m", "V* m/s", "f*", "T* s"]
-            keys = ["L_critical", "V_critical", "f_critical", "T_critical"]
+            header = ["model", "verdict", "margin", "NV* 1/s", "omega* rad/s", "L* m", "V* m/s", "f*", "T* s", "k* 1/s"]
+            keys = ["L_critical", "V_critical", "f_critical", "T_critical", "k_critical"]
         rows = []
         for name, v in data[scenario].items():
-            margin = "-" if v["margin"] is None else f"{v['margin'] * 100:+.1f}%"
-            cells = [name, v["verdict"].upper() if v["verdict"] != "stable" else "stable", margin, _num(v["NV_critical"] if v["NV_critical"] is not None else math.inf), _num(v["omega_critical"])]
-            cells += [_num(v[k] if v[k] is not None else math.inf) for k in keys]
+            margin = _percent(v["margin"])
+            cells = [name, v["verdict"].upper() if v["verdict"] != "stable" else "stable", margin, _num(v["NV_critical"]), _num(v["omega_critical"])]
+            cells += [_num(v[k]) for k in keys]
             rows.append(cells)
         fixes = {name: v["to_stabilize"] for name, v in data[scenario].items() if v["to_stabilize"]}
         yield title, header, rows, fixes

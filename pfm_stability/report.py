@@ -14,9 +14,9 @@ import math
 from dataclasses import dataclass, field
 
 from .criteria import CorridorAnalysis, WallAnalysis, analyze_corridor, analyze_wall, loop_of
-from .models import MODEL_NAMES, KBFirstOrder, Sampled, make_models
-from .parameters import Controller, Corridor, Robot, Wall
-from .serialize import json_number
+from .models import MODEL_NAMES, KBFirstOrder, Sampled, models_for
+from .parameters import RANGES, Controller, Corridor, Robot, Wall
+from .serialize import SCHEMA_VERSION, json_number
 
 __all__ = ["StabilityReport", "KBError", "build_report", "remedies", "kb_error"]
 
@@ -35,6 +35,9 @@ UNITS = {
     "pade_order": "",
 }
 
+REMEDY_PARAMETERS = ("V", "T", "k", "alpha_deg", "L", "f")
+"""Parameters a remedy may change (one at a time), in the order they are listed."""
+
 
 @dataclass(frozen=True)
 class KBError:
@@ -44,7 +47,9 @@ class KBError:
     ----------
     relative : float
         NV*_kb / NV*_sampled − 1: > 0 optimistic (KB allows gains the sampled
-        loop cannot take), < 0 conservative.
+        loop cannot take), < 0 conservative; ``inf`` when the sampled loop is
+        unstable at every NV (NV*_sampled = 0); NaN (undefined) when both are
+        infinite.
     NV_kb, NV_sampled : float
         1/s.
     hold : str
@@ -58,27 +63,35 @@ class KBError:
     compute_delay: int
 
     @property
-    def direction(self) -> str:
+    def direction(self) -> str | None:
+        """"optimistic", "conservative", or None when `relative` is undefined or 0."""
+        if math.isnan(self.relative) or self.relative == 0:
+            return None
         return "optimistic" if self.relative > 0 else "conservative"
 
     def sentence(self) -> str:
         """"KB's criterion is X % optimistic/conservative against `sampled` (…)"."""
         against = f"`sampled` (hold={self.hold}, compute_delay={self.compute_delay})"
-        if not math.isfinite(self.relative):
-            return f"KB's criterion cannot be compared with {against}: its NV* is {self.NV_sampled:g} 1/s"
-        return f"KB's criterion is {abs(self.relative) * 100:.1f} % {self.direction} against {against}"
+        if math.isnan(self.relative):
+            return f"KB's criterion cannot be compared with {against}: both are stable at every NV"
+        if math.isinf(self.relative):
+            return (f"KB's criterion is infinitely optimistic against {against}: the sampled loop is unstable at every NV "
+                    f"(NV* = 0) while KB allows NV < {self.NV_kb:.4g} 1/s")
+        return f"KB's criterion is {abs(self.relative) * 100:.1f} % {self.direction or 'off'} against {against}"
 
     def to_dict(self) -> dict:
-        """The fields as a JSON-ready dict (SI units)."""
-        return {
+        """The fields as a JSON-ready dict (SI units); ``direction`` only with a value."""
+        out = {
             "relative": json_number(self.relative),
-            "direction": self.direction,
             "NV_critical_kb_first_order": json_number(self.NV_kb),
             "NV_critical_sampled": json_number(self.NV_sampled),
             "hold": self.hold,
             "compute_delay": self.compute_delay,
             "text": self.sentence(),
         }
+        if self.direction is not None:
+            out["direction"] = self.direction
+        return out
 
 
 @dataclass(frozen=True)
@@ -104,8 +117,8 @@ class StabilityReport:
     remedies: dict = field(default_factory=dict)
 
     def to_dict(self) -> dict:
-        """The fields as a JSON-ready dict (SI units)."""
-        out = {"inputs": self.inputs, "models": self.model_options}
+        """The fields as a JSON-ready dict (SI units; infinities as ``"inf"``, undefined as null)."""
+        out = {"schema_version": SCHEMA_VERSION, "command": "report", "inputs": self.inputs, "models": self.model_options}
         if self.wall is not None:
             out.setdefault("environment", {})["wall"] = {
                 "alpha_deg": math.degrees(self.wall.alpha),
@@ -131,7 +144,7 @@ def _verdict_dict(v, remedy) -> dict:
         "NV_critical": json_number(v.NV_critical),
         "margin": json_number(v.margin),
         "omega_critical": json_number(v.omega_critical),
-        "rightmost_root": {"sigma": float(root.real), "omega": float(abs(root.imag))},
+        "rightmost_root": {"sigma": json_number(root.real), "omega": json_number(abs(root.imag))},
     }
     out.update({key: json_number(value) for key, value in v.critical.items()})
     out["to_stabilize"] = remedy or {}
@@ -151,25 +164,29 @@ def remedies(scenario: str, verdict, robot: Robot, controller: Controller) -> di
     -------
     dict
         Parameter → {"to": critical value (SI, α in deg), "direction": "raise"
-        or "lower", "change_percent": relative change, %}. Empty if stable, or
-        if no change of that parameter alone can help.
+        or "lower", "change_percent": relative change, %}. Each value leaves
+        the loop stable over the whole way from it to 0 (V, T, k) or beyond it
+        (α, L), by the definitions of the critical values. Empty if stable; a
+        parameter is left out when no value of it alone helps (e.g. V, α, L
+        and f when the model is unstable at every NV: then only a shorter T or
+        a lower k can work).
     """
     if verdict.verdict == "stable":
         return {}
     c = verdict.critical
-    current = {"V": robot.V, "f": controller.f, "T": controller.T}
-    wanted = [("V", "lower", c["V_critical"]), ("T", "lower", c["T_critical"])]
+    current = {"V": robot.V, "f": controller.f, "T": controller.T, "k": robot.k}
+    wanted = [("V", "lower", c["V_critical"]), ("T", "lower", c["T_critical"]), ("k", "lower", c["k_critical"])]
     if scenario == "wall":
-        current["alpha_deg"] = None
         wanted += [("alpha_deg", "raise", c["alpha_critical_deg"]), ("f", "raise", c["f_critical"])]
     else:
-        current["L"] = None
         wanted += [("L", "raise", c["L_critical"]), ("f", "lower", c["f_critical"])]
     out = {}
     for name, direction, target in wanted:
         if not math.isfinite(target) or target <= 0 or (name == "alpha_deg" and target >= 90):
             continue
         now = current.get(name)
+        if now is not None and (target >= now if direction == "lower" else target <= now):
+            continue  # not a change in the helpful direction (on the boundary)
         entry = {"to": target, "direction": direction}
         if now:
             entry["change_percent"] = (target / now - 1.0) * 100
@@ -182,7 +199,12 @@ def kb_error(robot: Robot, controller: Controller) -> KBError:
     loop = loop_of(robot, controller)
     kb = KBFirstOrder().boundary(loop).NV_critical
     sampled = Sampled(controller.hold, controller.compute_delay).boundary(loop).NV_critical
-    relative = kb / sampled - 1.0 if sampled > 0 and math.isfinite(sampled) else math.inf
+    if sampled == 0:
+        relative = math.inf
+    elif math.isinf(sampled) and math.isinf(kb):
+        relative = math.nan
+    else:
+        relative = kb / sampled - 1.0
     return KBError(relative, kb, sampled, controller.hold, controller.compute_delay)
 
 
@@ -196,14 +218,17 @@ def build_report(
     pade_order: int = 3,
     sources: dict | None = None,
     law=None,
+    alpha_deg: float | None = None,
 ) -> StabilityReport:
-    """Analyze a wall (α, rad) and/or a corridor (L, m) with the chosen models.
+    """Analyze a wall (α) and/or a corridor (L, m) with the chosen models.
 
     Parameters
     ----------
     robot, controller : Robot, Controller
     alpha : float, optional
-        Wall target angle, rad, in (0, π/2).
+        Wall target angle, rad, in [1e-6°, 90° − 1e-6°].
+    alpha_deg : float, optional
+        The same in degrees (what the CLI passes; checked in degrees).
     L : float, optional
         Corridor half-width, m, > W/2.
     models : sequence of str
@@ -220,11 +245,18 @@ def build_report(
     ValueError
         Neither α nor L given, or any parameter out of range.
     """
-    if alpha is None and L is None:
-        raise ValueError("alpha or L must be given: a wall (--alpha DEG, in (0, 90) deg) and/or a corridor (--L M, in (W/2, inf) m)")
-    wall = Wall(alpha) if alpha is not None else None
+    if alpha is not None and alpha_deg is not None:
+        raise ValueError("give alpha (rad) or alpha_deg, not both")
+    if alpha is None and alpha_deg is None and L is None:
+        raise ValueError(
+            f"alpha or L must be given: a wall (--alpha DEG, in {RANGES['alpha_deg'].describe()}) "
+            f"and/or a corridor (--L M, in (W/2, {RANGES['L'].high:g}] m)"
+        )
+    wall = Wall.from_degrees(alpha_deg) if alpha_deg is not None else (Wall(alpha) if alpha is not None else None)
     corridor = Corridor(L) if L is not None else None
-    model_objs = make_models(tuple(models), pade_order=pade_order, hold=controller.hold, compute_delay=controller.compute_delay)
+    if isinstance(models, str):
+        raise ValueError(f"models must be a sequence of model names; got {models!r}")
+    model_objs = models_for(controller, tuple(dict.fromkeys(models)), pade_order=pade_order)
     sources = sources or {}
     values = {
         "V": robot.V,

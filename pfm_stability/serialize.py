@@ -1,8 +1,15 @@
 """JSON-ready numbers: strict JSON has no inf or NaN.
 
-Every `to_dict` in the package turns a non-finite value into ``None`` ("no
-finite value": e.g. NV* = inf when a loop is stable for every gain) with these
-two helpers.
+Every `to_dict` in the package writes numbers with `json_number`:
+
+* a finite number is itself;
+* +inf and −inf — "no finite value", e.g. NV* = inf when a loop is stable for
+  every gain, or L* = inf when no corridor is wide enough — are the strings
+  ``"inf"`` and ``"-inf"``;
+* an undefined value (NaN, or None: e.g. no boundary frequency when NV* = 0)
+  is ``null``.
+
+`parse_json_number` reads them back.
 """
 
 from __future__ import annotations
@@ -11,15 +18,29 @@ import math
 
 import numpy as np
 
-__all__ = ["json_number", "json_array"]
+__all__ = ["json_number", "json_array", "parse_json_number", "SCHEMA_VERSION"]
+
+SCHEMA_VERSION = "1.0"
+"""Version of the JSON output (`pfm_stability/schema/output.schema.json`)."""
 
 
 def json_number(x):
-    """``float(x)`` if finite, else None (also for None)."""
+    """``float(x)`` if finite, ``"inf"``/``"-inf"`` if infinite, None if undefined (NaN or None)."""
     if x is None:
         return None
     x = float(x)
-    return x if math.isfinite(x) else None
+    if math.isnan(x):
+        return None
+    if math.isinf(x):
+        return "inf" if x > 0 else "-inf"
+    return x
+
+
+def parse_json_number(value) -> float:
+    """The float a `json_number` stands for (None → NaN)."""
+    if value is None:
+        return math.nan
+    return float(value)
 
 
 def json_array(a):

@@ -29,6 +29,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .delay import delay_verdicts_from_gain
 from .parameters import RANGES, check_parameter
 
 __all__ = ["VectorVerdicts", "exact_delay_verdicts", "loop_gain_arrays", "delay_verdicts_from_gain"]
@@ -115,95 +116,6 @@ def loop_gain_arrays(V, tau, T, k, f, n, W, *, alpha=None, L=None):
         N = 2.0 * n * f * W**n / L ** (n + 1.0)
     tau, T, k, NV = np.broadcast_arrays(tau, T, k, N * V)
     return tau, T, k, NV
-
-
-def _cubic_positive_roots(tau, k, K):
-    """Positive roots y of F(y) = τ²y³ + (1 − 2kτ)y² + k²y − K² (up to three; NaN where absent).
-
-    No discriminant (it cancels catastrophically when τ is small): the
-    critical points of F (a stable quadratic formula) split (0, ∞) into
-    intervals where F is monotone and of one convexity, so each root is reached
-    by Newton's method from a start that satisfies Fourier's condition
-    F·F″ > 0 — convergence is monotone and needs no safeguard. τ = 0 leaves
-    the quadratic y² + k²y − K² (one positive root, closed form).
-    """
-    roots = np.full(tau.shape + (3,), np.nan)
-    quadratic = tau == 0
-    if quadratic.any():
-        kk, KK = k[quadratic] ** 2, K[quadratic] ** 2
-        roots[quadratic, 0] = 2 * KK / (kk + np.sqrt(kk * kk + 4 * KK))
-    cubic = ~quadratic
-    if cubic.any():
-        roots[cubic] = _newton_cubic_roots(tau[cubic] ** 2, 1 - 2 * k[cubic] * tau[cubic], k[cubic] ** 2, K[cubic] ** 2)
-    return roots
-
-
-def _newton_cubic_roots(a, beta, c, D):
-    """Up to three positive roots of a·y³ + β·y² + c·y − D (a, c, D > 0)."""
-
-    def F(y):
-        return ((a * y + beta) * y + c) * y - D
-
-    inflection = -beta / (3 * a)
-    disc = beta * beta - 3 * a * c
-    critical = (beta < 0) & (disc > 0)
-    c2 = np.where(critical, (-beta + np.sqrt(np.maximum(disc, 0))) / (3 * a), np.inf)
-    c1 = np.where(critical, c / (3 * a * np.where(critical, c2, 1.0)), np.inf)
-    F1 = np.where(critical, F(np.where(critical, c1, 0.0)), np.inf)
-    F2 = np.where(critical, F(np.where(critical, c2, 0.0)), -np.inf)
-    # a point right of every root: with β >= 0 each term alone bounds the root
-    # (within a factor 3 of it); otherwise Fujiwara's bound
-    with np.errstate(divide="ignore"):
-        positive_bound = np.minimum.reduce([D / c, np.sqrt(D / np.where(beta > 0, beta, 0.0)), np.cbrt(D / a)])
-    right = np.where(beta >= 0, positive_bound, 2 * np.maximum.reduce([np.abs(beta) / a, np.sqrt(c / a), np.cbrt(D / (2 * a))]))
-    F_inflection = np.where(inflection > 0, F(np.maximum(inflection, 0.0)), -np.inf)
-    # smallest root: in the concave stretch left of the inflection (start at 0) or in the convex one (start right)
-    left_concave = np.where(critical, F1 > 0, F_inflection >= 0)
-    starts = np.stack(
-        [
-            np.where(left_concave, 0.0, right),
-            np.where(critical & (F1 > 0) & (F2 < 0), inflection, np.nan),
-            np.where(critical & (F1 > 0) & (F2 < 0), right, np.nan),
-        ],
-        axis=-1,
-    )
-    used = np.isfinite(starts)
-    point = np.nonzero(used)[0]
-    y = starts[used]
-    A, B, C, Dd = a[point], beta[point], c[point], D[point]
-    for _ in range(60):
-        value = ((A * y + B) * y + C) * y - Dd
-        slope = (3 * A * y + 2 * B) * y + C
-        with np.errstate(invalid="ignore", divide="ignore"):
-            step = value / slope
-        step[~np.isfinite(step)] = 0.0
-        y -= step
-        # converged when every step is at round-off level (1e-13 relative: near
-        # double roots the iterates jitter by a few ulps and never settle)
-        if not np.any(np.abs(step) > 1e-13 * np.abs(y)):
-            break
-    out = np.full(starts.shape, np.nan)
-    out[used] = y
-    y = out
-    return y
-
-
-def delay_verdicts_from_gain(tau, T, k, K):
-    """Crossing-count verdicts for arrays (τ, T, k, K = kNV); returns (stable, Z, delay margin)."""
-    y = _cubic_positive_roots(tau, k, K)
-    present = np.isfinite(y)
-    y0 = np.where(present, y, 1.0)
-    w = np.sqrt(y0)
-    t3, k3 = tau[:, None], k[:, None]
-    slope = 3 * t3**2 * y0**2 + 2 * (1 - 2 * k3 * t3) * y0 + k3**2
-    direction = np.where(present, np.sign(slope), 0.0)
-    psi = np.arctan((k3 - t3 * y0) / w)
-    first = np.where(psi >= 0, psi, psi + _TWO_PI) / w
-    passed = np.where(present & (T[:, None] > first), np.floor((T[:, None] - first) * w / _TWO_PI) + 1, 0.0)
-    base = np.where(tau * K > k, 2, 0)
-    Z = base + 2 * np.sum(direction * passed, axis=1).astype(np.int64)
-    margin = np.where(base == 0, np.min(np.where(present, first, np.inf), axis=1), 0.0)
-    return Z == 0, Z, margin
 
 
 def _run_chunks(func, arrays):

@@ -24,7 +24,6 @@ def add_parser(sub) -> None:
 
 def run(args) -> int:
     import json
-    import math
 
     from ..report import build_report
     from ..render import render_markdown, render_text
@@ -33,14 +32,14 @@ def run(args) -> int:
     report = build_report(
         params.robot,
         params.controller,
-        alpha=math.radians(args.alpha) if args.alpha is not None else None,
+        alpha_deg=args.alpha,
         L=args.L,
         models=tuple(dict.fromkeys(args.model)) if args.model else MODEL_CHOICES,
         pade_order=args.pade_order,
         sources={**params.sources, "alpha_deg": "user", "L": "user", "pade_order": "user" if args.pade_order != 3 else "default"},
     )
     if args.format == "json":
-        print(json.dumps(report.to_dict(), indent=2))
+        print(json.dumps(report.to_dict(), indent=2, allow_nan=False))
     elif args.format == "markdown":
         print(render_markdown(report), end="")
     else:

@@ -13,7 +13,7 @@ sampled            det(zI − Φ_cl(kNV)) = 0, ZOH                   eigenvalues
 
 from __future__ import annotations
 
-from .base import Boundary, Loop, LoopModel, verdict_label
+from .base import Boundary, Loop, LoopModel, gain_margin, verdict_label
 from .continuous import Continuous
 from .exact_delay import ExactDelay
 from .kb_first_order import KBFirstOrder
@@ -30,8 +30,10 @@ __all__ = [
     "Pade",
     "ExactDelay",
     "Sampled",
+    "gain_margin",
     "make_model",
     "make_models",
+    "models_for",
     "pade_coefficients",
     "verdict_label",
 ]
@@ -69,6 +71,53 @@ def make_model(name: str, *, pade_order: int = 3, hold: str = "command", compute
     return Sampled(hold, compute_delay)
 
 
-def make_models(names=MODEL_NAMES, **options) -> list[LoopModel]:
-    """`make_model` for each name, in order."""
+def make_models(names=MODEL_NAMES, *, controller=None, **options) -> list[LoopModel]:
+    """`make_model` for each name, in order.
+
+    With `controller`, the ``sampled`` model takes the controller's hold and
+    compute delay (giving ``hold``/``compute_delay`` as well is an error).
+    """
+    if controller is not None:
+        if "hold" in options or "compute_delay" in options:
+            raise ValueError("hold and compute_delay come from the controller; do not give them as well")
+        options = dict(options, hold=controller.hold, compute_delay=controller.compute_delay)
     return [make_model(name, **options) for name in names]
+
+
+def models_for(controller, models=None, *, pade_order: int = 3) -> list[LoopModel]:
+    """The models an analysis of this controller runs, consistent with it.
+
+    Parameters
+    ----------
+    controller : Controller
+        Its ``hold`` and ``compute_delay`` are the one source of truth for the
+        ``sampled`` model.
+    models : iterable of str or LoopModel, optional
+        Names are built for the controller; a ``Sampled`` object must match
+        the controller. Default: every model.
+    pade_order : int
+        Order of a ``pade`` model built by name.
+
+    Raises
+    ------
+    ValueError
+        A ``Sampled`` model whose structure contradicts the controller, or an
+        unknown name.
+    """
+    if models is None:
+        models = MODEL_NAMES
+    if isinstance(models, (str, LoopModel)):
+        raise ValueError(f"models must be a sequence of model names or LoopModel objects; got {models!r}")
+    out = []
+    for model in models:
+        if isinstance(model, str):
+            model = make_model(model, pade_order=pade_order, hold=controller.hold, compute_delay=controller.compute_delay)
+        elif not isinstance(model, LoopModel):
+            raise ValueError(f"models must hold model names or LoopModel objects; got {model!r}")
+        elif isinstance(model, Sampled) and (model.hold, model.compute_delay) != (controller.hold, controller.compute_delay):
+            raise ValueError(
+                f"models: {model!r} contradicts the controller (hold={controller.hold!r}, "
+                f"compute_delay={controller.compute_delay}); the controller decides how the loop is sampled"
+            )
+        out.append(model)
+    return out

@@ -25,9 +25,8 @@ from ..checks import check_number
 from ..parameters import RANGES, check_parameter
 from ..crossings import first_stable_interval, verdict_at
 from ..serialize import json_number
-from ..solve import bisect_root
 
-__all__ = ["Loop", "Boundary", "LoopModel", "AffineGainModel", "verdict_label", "UNDECIDED_RTOL"]
+__all__ = ["Loop", "Boundary", "LoopModel", "AffineGainModel", "verdict_label", "gain_margin", "gain_range", "UNDECIDED_RTOL"]
 
 _DELAY_RTOL = 1e-7
 """Relative bracket width at which `critical_delay` stops (reports show 4 digits)."""
@@ -73,17 +72,34 @@ class Boundary:
     model : str
         Model name (DESIGN §4).
     NV_critical : float
-        NV*, 1/s: stable for 0 < NV < NV* (``inf``: stable for every NV).
+        NV*, 1/s: stable for every 0 < NV < NV* (``inf``: stable for every
+        NV; 0: unstable at every NV close to 0 — "unstable at any speed").
     omega_critical : float or None
-        Angular frequency of the oscillation that starts at NV*, rad/s.
+        Angular frequency of the oscillation that starts at NV*, rad/s (None
+        when NV* is 0 or infinite).
     K_critical : float
         K* = k·NV*, 1/s².
+    stable_set : tuple of (float, float)
+        Every interval of NV (1/s) on which the loop is stable, ascending. The
+        first is (0, NV*) when NV* > 0; a sampled loop can have more, or one
+        that does not start at 0.
     """
 
     model: str
     NV_critical: float
     omega_critical: float | None
     K_critical: float
+    stable_set: tuple = ()
+
+    @classmethod
+    def from_interval(cls, model: str, interval, k: float) -> "Boundary":
+        """From a `crossings.StabilityInterval` in gain K = kNV."""
+        intervals = tuple((lo / k, hi / k) for lo, hi in interval.intervals)
+        return cls(model, interval.gain / k, interval.frequency, interval.gain, intervals)
+
+    def contains(self, NV: float) -> bool:
+        """True when NV lies strictly inside a stable interval."""
+        return any(lo < NV < hi for lo, hi in self.stable_set)
 
     def to_dict(self) -> dict:
         """The fields as a JSON-ready dict (SI units)."""
@@ -92,14 +108,41 @@ class Boundary:
             "NV_critical": json_number(self.NV_critical),
             "omega_critical": self.omega_critical,
             "K_critical": json_number(self.K_critical),
+            "stable_set": [[json_number(lo), json_number(hi)] for lo, hi in self.stable_set],
         }
 
 
+def _edges(boundary: Boundary):
+    """Finite positive edges of the stable set (NV* alone if the set is unknown)."""
+    if boundary.stable_set:
+        return [x for pair in boundary.stable_set for x in pair if 0 < x < math.inf]
+    return [boundary.NV_critical] if 0 < boundary.NV_critical < math.inf else []
+
+
 def verdict_label(NV: float, boundary: Boundary, stable: bool, rtol: float = UNDECIDED_RTOL) -> str:
-    """"stable", "unstable" or "undecided" (within `rtol` of NV*)."""
-    if math.isfinite(boundary.NV_critical) and abs(NV / boundary.NV_critical - 1.0) <= rtol:
+    """"stable", "unstable" or "undecided" (within `rtol` of an edge of the stable set)."""
+    if any(abs(NV / edge - 1.0) <= rtol for edge in _edges(boundary)):
         return "undecided"
     return "stable" if stable else "unstable"
+
+
+def gain_margin(NV: float, boundary: Boundary, stable: bool) -> float:
+    """Relative distance to the nearest boundary below or above, NV_edge/NV − 1.
+
+    Stable: NV_edge is the upper end of the stable interval that holds NV
+    (``inf`` if unbounded), so the margin is how much NV may grow. Unstable:
+    the upper end of the nearest stable interval below NV, so the (negative)
+    margin is how much NV must shrink; −1 when no smaller NV is stable. With
+    the usual stable set (0, NV*) both are NV*/NV − 1.
+    """
+    intervals = boundary.stable_set or (((0.0, boundary.NV_critical),) if boundary.NV_critical > 0 else ())
+    if stable:
+        holding = [hi for lo, hi in intervals if lo <= NV <= hi]
+        edge = holding[0] if holding else boundary.NV_critical
+    else:
+        below = [hi for lo, hi in intervals if hi <= NV * (1 + UNDECIDED_RTOL)]
+        edge = max(below) if below else 0.0
+    return edge / NV - 1.0
 
 
 @lru_cache(maxsize=8192)
@@ -133,31 +176,52 @@ class LoopModel:
         """Dominant root σ + jω (1/s, rad/s); sampled models map z by ln(z)/T."""
         raise NotImplementedError
 
-    def critical_delay(self, NV: float, loop: Loop) -> float:
-        """Largest sampling period / delay T that keeps NV stable (τ, k fixed), s.
+    def growth_rates(self, NV: float, loops) -> np.ndarray:
+        """Real part of the dominant root, 1/s, at NV for each loop of a sequence.
 
-        The first T at which NV*(T) falls to NV: a doubling search from
-        T = 10⁻³(τ + 1/k) brackets it and bisection refines it to 1e-7
-        relative. 0 if NV is unstable already at T = 0; ``inf`` if NV*(T)
-        stays above NV up to the largest allowed T (100 s).
+        Models override this with a vectorized version where they can.
         """
+        return np.array([self.rightmost_root(NV, loop).real for loop in loops])
+
+    def critical_delay(self, NV: float, loop: Loop) -> float:
+        """T*: the smallest sampling period / delay at which NV loses stability (τ, k fixed), s.
+
+        The operating point's delay margin, the same definition in every
+        model: stable for every T in [0, T*). 0 if NV is unstable already at
+        T → 0; ``inf`` if it stays stable up to the largest allowed T
+        (100 s). Found by `solve.first_crossing` on the dominant growth rate
+        over T (a geometric grid with its local maxima refined, then
+        bisection to 1e-7 relative); models with an exact route override it.
+        """
+        from ..solve import first_crossing
+
         NV = _check_NV(NV)
-
-        def excess(T):
-            return self.boundary(Loop(loop.tau, T, loop.k)).NV_critical - NV
-
-        if excess(0.0) <= 0:
+        if self.growth_rates(NV, [Loop(loop.tau, 0.0, loop.k)])[0] >= 0:
             return 0.0
-        start = 1e-3 * (loop.tau + 1.0 / loop.k)
-        if excess(start) <= 0:
-            return bisect_root(excess, 0.0, start, rtol=_DELAY_RTOL)
-        lo, T_max = start, RANGES["T"].high
-        while lo < T_max:
-            hi = min(2 * lo, T_max)
-            if excess(hi) <= 0:
-                return bisect_root(excess, lo, hi, rtol=_DELAY_RTOL)
-            lo = hi
-        return math.inf
+
+        def measure(Ts):
+            return self.growth_rates(NV, [Loop(loop.tau, float(T), loop.k) for T in Ts])
+
+        return first_crossing(measure, _time_scale(loop, NV) * 1e-2, RANGES["T"].high, rtol=_DELAY_RTOL)
+
+    def critical_gain_k(self, NV: float, loop: Loop) -> float:
+        """k*: the smallest steering gain at which NV loses stability (τ, T fixed), 1/s.
+
+        Stable for every k in (0, k*): lowering k below k* is a remedy that
+        works. 0 if no k is small enough; ``inf`` if NV stays stable up to the
+        largest allowed k (10⁴ 1/s). Same search as `critical_delay`, over k.
+        """
+        from ..solve import first_crossing
+
+        NV = _check_NV(NV)
+        lo, hi = gain_range(loop)
+        if self.growth_rates(NV, [Loop(loop.tau, loop.T, lo)])[0] >= 0:
+            return 0.0
+
+        def measure(ks):
+            return self.growth_rates(NV, [Loop(loop.tau, loop.T, float(k)) for k in ks])
+
+        return first_crossing(measure, lo, hi, start=lo, rtol=_DELAY_RTOL)
 
     def __repr__(self) -> str:
         return f"{type(self).__name__}()"
@@ -171,6 +235,17 @@ class LoopModel:
 
 def _check_NV(NV) -> float:
     return check_number("NV", NV, 0.0, unit="1/s")
+
+
+def _time_scale(loop: Loop, NV: float) -> float:
+    """The loop's fastest time scale, s: min(τ, 1/k, 1/NV) (τ counts when > 0)."""
+    scales = [1.0 / loop.k, 1.0 / NV] + ([loop.tau] if loop.tau > 0 else [])
+    return min(scales)
+
+
+def gain_range(loop: Loop) -> tuple[float, float]:
+    """(k_lo, k_hi), 1/s: where `critical_gain_k` searches (k_hi = the largest allowed k)."""
+    return 1e-3 * loop.k, RANGES["k"].high
 
 
 class AffineGainModel(LoopModel):
@@ -202,7 +277,8 @@ class AffineGainModel(LoopModel):
     def compute_boundary(self, loop: Loop) -> Boundary:
         d, e = self.polynomials(loop)
         interval = first_stable_interval(d, e, self.domain)
-        return Boundary(self.name, interval.gain / loop.k, self._frequency(interval.frequency, loop), interval.gain)
+        b = Boundary.from_interval(self.name, interval, loop.k)
+        return Boundary(b.model, b.NV_critical, self._frequency(b.omega_critical, loop), b.K_critical, b.stable_set)
 
     def is_stable(self, NV: float, loop: Loop) -> bool:
         d, e = self.polynomials(loop)
@@ -211,6 +287,33 @@ class AffineGainModel(LoopModel):
     def roots(self, NV: float, loop: Loop) -> np.ndarray:
         """All roots of the characteristic polynomial (s or z)."""
         return np.roots(self.characteristic(NV, loop))
+
+    def batch_polynomials(self, loops):
+        """(D, E) of each loop as two arrays of rows of one length (descending; leading zeros allowed)."""
+        pairs = [self.polynomials(loop) for loop in loops]
+        width = max(max(len(d), len(e)) for d, e in pairs)
+        D = np.array([np.pad(d, (width - len(d), 0)) for d, _ in pairs])
+        E = np.array([np.pad(e, (width - len(e), 0)) for _, e in pairs])
+        return D, E
+
+    def growth_rates(self, NV: float, loops) -> np.ndarray:
+        """max Re s (1/s) at NV for each loop: eigenvalues of the companion matrices, batched by degree."""
+        loops = list(loops)
+        D, E = self.batch_polynomials(loops)
+        P = D + (np.array([loop.k for loop in loops]) * _check_NV(NV))[:, None] * E
+        polys = [row[np.flatnonzero(row)[0]:] for row in P]
+        out = np.empty(len(polys))
+        for degree in {len(p) - 1 for p in polys}:
+            rows = [i for i, p in enumerate(polys) if len(p) - 1 == degree]
+            if degree == 0:
+                out[rows] = -np.inf
+                continue
+            monic = np.array([polys[i][1:] / polys[i][0] for i in rows])
+            companion = np.zeros((len(rows), degree, degree))
+            companion[:, 0, :] = -monic
+            companion[:, np.arange(1, degree), np.arange(degree - 1)] = 1.0
+            out[rows] = np.linalg.eigvals(companion).real.max(axis=1)
+        return out
 
     def rightmost_root(self, NV: float, loop: Loop) -> complex:
         roots = self.roots(NV, loop)

@@ -30,3 +30,7 @@ class Continuous(AffineGainModel):
     def critical_delay(self, NV: float, loop: Loop) -> float:
         """T does not enter (17): ``inf`` if τNV < 1, else 0 (s)."""
         return math.inf if self.is_stable(NV, loop) else 0.0
+
+    def critical_gain_k(self, NV: float, loop: Loop) -> float:
+        """k cancels from Routh's condition τNV < 1: ``inf`` if it holds, else 0 (1/s)."""
+        return math.inf if self.is_stable(NV, loop) else 0.0

@@ -1,26 +1,39 @@
 """`exact_delay`: KB eq (18), τs³ + s² + ks + kNV·e^(−sT) = 0, solved exactly.
 
-The quasi-polynomial has infinitely many roots; module `pfm_stability.delay`
-finds the crossings of the imaginary axis (Cooke & van den Driessche 1986;
-Walton & Marshall 1987), counts the roots in Re s > 0 exactly, and finds the
-rightmost roots by pseudospectral collocation (Breda, Maset & Vermiglio 2005)
-polished by Newton. For a(s) = τs³ + s² + ks the phase arg a(jω) + ωT is
-strictly increasing (arg a(jω) = π − atan((k − τω²)/ω)), so each level
-(2m + 1)π gives one gain crossing K_m = |a(jω_m)|. |a(jω)| itself is monotone
-only for kτ <= 2 + √3; above that the steering loop τs² + s + k resonates,
-|a(jω)|² = τ²ω⁶ + (1 − 2kτ)ω⁴ + k²ω² dips, and a later crossing can have the
-smallest gain. K* is therefore the end of the stable interval found by
-checking the crossing count between consecutive crossing gains, and
-NV* = K*/k — which depends on k, unlike KB's eq (20).
+The quasi-polynomial has infinitely many roots. Module `pfm_stability.delay`
+answers every question without a search bound, by the same array code that
+`pfm_stability.vectorized` runs on millions of points:
+
+* **K*** (`kb_critical_gain`): the phase arg a(jω) + ωT of a(s) = τs³ + s² + ks
+  increases strictly (arg a(jω) = π − atan((k − τω²)/ω)), so each level
+  (2m + 1)π gives one gain crossing K_m = |a(jω_m)|, every one of them
+  destabilizing; the loop is stable exactly for 0 < K < K* = min_m K_m.
+  |a(jω)| is monotone only for kτ <= 2 + √3; above that the steering loop
+  τs² + s + k resonates, |a(jω)|² = τ²ω⁶ + (1 − 2kτ)ω⁴ + k²ω² dips, and a
+  later level can give the smallest gain — NV* = K*/k then depends on k,
+  unlike KB's eq (20).
+* **Verdict and delay margin** (`delay_verdicts_from_gain`): the crossing count
+  of Cooke & van den Driessche (1986), Z(T) = Z(0) + 2·Σ_{T_m < T} sign F′(ω²).
+* **Rightmost roots**: pseudospectral collocation polished by Newton
+  (`DelayLoop.rightmost_roots`).
+
 T = 0 reduces to `continuous` (eq 17).
 """
 
 from __future__ import annotations
 
-from ..delay import DelayLoop
-from .base import Boundary, Loop, LoopModel, _check_NV
+import math
+
+import numpy as np
+
+from ..delay import DelayLoop, delay_verdicts_from_gain, kb_critical_gain
+from .base import Boundary, Loop, LoopModel, _check_NV, gain_range
 
 __all__ = ["ExactDelay"]
+
+
+def _one(x) -> np.ndarray:
+    return np.array([float(x)])
 
 
 class ExactDelay(LoopModel):
@@ -35,12 +48,18 @@ class ExactDelay(LoopModel):
         return DelayLoop(loop.plant, loop.T)
 
     def compute_boundary(self, loop: Loop) -> Boundary:
-        interval = self.quasi_polynomial(loop).critical_gain()
-        return Boundary(self.name, interval.gain / loop.k, interval.frequency, interval.gain)
+        K, w = (float(x[0]) for x in kb_critical_gain(_one(loop.tau), _one(loop.T), _one(loop.k)))
+        omega = w if math.isfinite(K) else None
+        return Boundary(self.name, K / loop.k, omega, K, ((0.0, K / loop.k),))
+
+    def _count(self, NV: float, loop: Loop):
+        K = loop.k * _check_NV(NV)
+        stable, Z, margin = delay_verdicts_from_gain(_one(loop.tau), _one(loop.T), _one(loop.k), _one(K))
+        return bool(stable[0]), int(Z[0]), float(margin[0])
 
     def is_stable(self, NV: float, loop: Loop) -> bool:
         """Crossing count Z(T) = 0 (no root in Re s >= 0)."""
-        return self.quasi_polynomial(loop).is_stable(loop.k * _check_NV(NV))
+        return self._count(NV, loop)[0]
 
     def unstable_root_count(self, NV: float, loop: Loop) -> int | None:
         """Roots with Re s > 0 (None when a root is on the imaginary axis)."""
@@ -52,5 +71,27 @@ class ExactDelay(LoopModel):
         return complex(top[top.imag.argmax()])
 
     def critical_delay(self, NV: float, loop: Loop) -> float:
-        """Delay margin: largest T keeping NV stable (τ, k fixed), s."""
-        return self.quasi_polynomial(loop).delay_margin(loop.k * _check_NV(NV))
+        """Delay margin: the smallest T at which NV loses stability (τ, k fixed), s."""
+        return self._count(NV, loop)[2]
+
+    def critical_gain_k(self, NV: float, loop: Loop) -> float:
+        """Smallest steering gain k at which NV loses stability (τ, T fixed), 1/s.
+
+        Stability is NV < NV*(k); NV*(k) → 1/(τ + T) as k → 0 (the roots
+        shrink and e^(−sT) ≈ 1 − sT becomes exact: KB's eq 20), so k* = 0
+        when NV(τ + T) >= 1. Otherwise the first k with NV*(k) <= NV.
+        """
+        from ..solve import first_crossing
+
+        NV = _check_NV(NV)
+        if loop.T == 0:
+            return super().critical_gain_k(NV, loop)
+        if NV * (loop.tau + loop.T) >= 1.0:
+            return 0.0
+
+        def measure(ks):
+            K_star = kb_critical_gain(loop.tau, loop.T, ks)[0]
+            return np.log(NV * ks / K_star)
+
+        lo, hi = gain_range(loop)
+        return first_crossing(measure, lo, hi, start=lo)

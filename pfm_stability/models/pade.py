@@ -55,13 +55,16 @@ def pade_coefficients(T: float, m: int):
     if T == 0:
         return np.array([1.0]), np.array([1.0])
     # c_j = (2m − j)! m! / ((2m)! j! (m − j)!) ; Q(s) = Σ c_j (sT)^j, P(s) = Q(−s)
-    c = np.array(
-        [math.factorial(2 * m - j) * math.factorial(m) / (math.factorial(2 * m) * math.factorial(j) * math.factorial(m - j)) for j in range(m + 1)]
-    )
+    c = np.array([_pade_term(m, j) for j in range(m + 1)])
     powers = T ** np.arange(m + 1)
     den = (c * powers)[::-1]
     num = (c * powers * (-1.0) ** np.arange(m + 1))[::-1]
     return num / den[0], den / den[0]
+
+
+def _pade_term(m: int, j: int) -> float:
+    """c_j = (2m − j)! m! / ((2m)! j! (m − j)!) (Golub & Van Loan §11.3)."""
+    return math.factorial(2 * m - j) * math.factorial(m) / (math.factorial(2 * m) * math.factorial(j) * math.factorial(m - j))
 
 
 class Pade(AffineGainModel):
@@ -83,6 +86,24 @@ class Pade(AffineGainModel):
         """D = (τs³ + s² + ks)·Q_m, E = P_m (descending powers of s)."""
         num, den = pade_coefficients(loop.T, self.order)
         return np.polymul(loop.plant, den), num
+
+    def batch_polynomials(self, loops):
+        """`polynomials` of many loops at once: rows of D = (τs³ + s² + ks)·Q_m and E = P_m."""
+        tau, T, k = (np.array([getattr(loop, name) for loop in loops]) for name in ("tau", "T", "k"))
+        m = self.order
+        c = np.array([_pade_term(m, j) for j in range(m + 1)])
+        powers = T[:, None] ** np.arange(m + 1)
+        den = (c * powers)[:, ::-1]  # descending; constant term 1
+        num = (c * powers * (-1.0) ** np.arange(m + 1))[:, ::-1]
+        lead = np.where(T > 0, den[:, 0], 1.0)[:, None]
+        den, num = den / lead, num / lead
+        plant = np.stack([tau, np.ones_like(tau), k, np.zeros_like(tau)], axis=1)
+        D = np.zeros((len(loops), m + 4))
+        for i in range(4):
+            D[:, i:i + m + 1] += plant[:, i, None] * den
+        E = np.zeros_like(D)
+        E[:, 3:] = num
+        return D, E
 
     def __repr__(self) -> str:
         return f"Pade(order={self.order})"

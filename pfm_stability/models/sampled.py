@@ -15,29 +15,52 @@ Linearized loop (Koren & Borenstein 1991 eq 6, 7, 10, 14): steering motor
 
 ``compute_delay`` = 1 applies the value computed at t_k over [t_k+1, t_k+2)
 (one more state: the stored command). The plant is discretized with a
-zero-order hold, Φ = e^(AT), Γ = ∫₀ᵀ e^(As) ds·B (the exponential of the
-augmented matrix [[A, B], [0, 0]]·T; python-control's ``sample_system`` is the
-test oracle), and closed with the sampled feedback. Because the feedback is
-affine in K, det(zI − Φ_cl(K)) = D(z) + K·E(z): the unit-circle crossings and
-K* follow from module `crossings`; the verdict for a given K comes from the
-closed-loop eigenvalues, cross-checked by the Schur–Cohn (Jury) test.
+zero-order hold, Φ = e^(AT), Γ = ∫₀ᵀ e^(As) ds·B (python-control's
+``sample_system`` is the test oracle), and closed with the sampled feedback
+v_k = −(F0 + K·F1)·x_k.
+
+Numerics: the δ (delta-operator) form
+-------------------------------------
+As T → 0 the poles z crowd at 1 and a polynomial in z loses every digit
+that matters (its coefficients tend to binomial coefficients). Everything
+here is therefore computed in the δ form z = 1 + T·w (Middleton & Goodwin,
+*Digital Control and Estimation: A Unified Approach*, 1990):
+Φ = I + TΨ and Γ = TG with Ψ = (e^(AT) − I)/T and G = Γ/T taken from the
+exponential of [[A, I], [0, 0]]·T without forming Φ − I. The characteristic
+polynomial becomes, with F = F0 + K·F1 (rank one, so it is affine in K),
+
+    P(w) = (1 + Tw)^c·det(wI − Ψ) + F·adj(wI − Ψ)·G,   c = compute_delay,
+
+whose coefficients stay O(1) as T → 0 and tend to the continuous loop's.
+The unit circle |z| = 1 is mapped to the imaginary axis by the bilinear
+substitution z = (1 + Tμ/2)/(1 − Tμ/2) (Tustin's w-plane), so
+Q(μ) = (1 − Tμ/2)^d·P(μ/(1 − Tμ/2)) is Hurwitz exactly when the sampled
+loop is stable, and the crossing gains are those of `pfm_stability.crossings`
+in the s domain, plus the gain at which the degree of Q drops (a pole
+passing through z = −1, where Ω → ∞). A crossing at Ω maps back to the
+frequency ω = 2·atan(ΩT/2)/T. Verdicts come from the eigenvalues λ of the
+δ-form closed-loop matrix (|1 + Tλ| < 1 ⇔ 2 Re λ + T|λ|² < 0), an
+independent route; the dominant pole is σ = ln|1 + Tλ|/T (log1p),
+ω = arg(1 + Tλ)/T (atan2: π/T for a real negative z).
 
 T = 0 is the continuous loop of KB eq (17) (`continuous`).
 """
 
 from __future__ import annotations
 
+import math
 from functools import lru_cache
 
 import numpy as np
 
 from ..checks import check_choice, check_integer
+from ..crossings import Crossing, affine_crossings, stable_interval
 from ..parameters import HOLDS
 from ..routh import schur_cohn_stable
 from .base import AffineGainModel, Boundary, Loop, _check_NV
 from .continuous import Continuous
 
-__all__ = ["Sampled", "continuous_plant", "discretize", "closed_loop_matrix"]
+__all__ = ["Sampled", "continuous_plant", "discretize", "closed_loop_matrix", "delta_plant"]
 
 
 def continuous_plant(loop: Loop, hold: str):
@@ -78,28 +101,43 @@ def continuous_plant(loop: Loop, hold: str):
     return A, B, F0, F1
 
 
-def discretize(A, B, T: float):
-    """Zero-order-hold discretization: Φ = e^(AT), Γ = ∫₀ᵀ e^(As) ds B.
-
-    Computed as the exponential of [[A, B], [0, 0]]·T (Van Loan 1978).
-    """
+def _exponential_blocks(A, T: float):
+    """(e^(AT), ∫₀ᵀ e^(As) ds) from one exponential of [[A, I], [0, 0]]·T (Van Loan 1978)."""
     from scipy.linalg import expm
 
-    n, m = B.shape
-    M = np.zeros((n + m, n + m))
+    n = A.shape[0]
+    M = np.zeros((2 * n, 2 * n))
     M[:n, :n] = A
-    M[:n, n:] = B
+    M[:n, n:] = np.eye(n)
     E = expm(M * T)
     return E[:n, :n], E[:n, n:]
 
 
+def discretize(A, B, T: float):
+    """Zero-order-hold discretization: Φ = e^(AT), Γ = ∫₀ᵀ e^(As) ds B."""
+    Phi, integral = _exponential_blocks(A, T)
+    return Phi, integral @ B
+
+
 @lru_cache(maxsize=4096)
-def _discrete_plant(loop: Loop, hold: str):
+def delta_plant(loop: Loop, hold: str):
+    """(Ψ, G, F0, F1) with Φ = I + TΨ and Γ = TG, accurate as T → 0.
+
+    Ψ = (e^(AT) − I)/T is formed as (∫₀ᵀ e^(As) ds)·A/T when ‖A‖T <= 1 (no
+    cancellation against I), and from Φ directly otherwise; G = (∫₀ᵀ e^(As) ds)·B/T.
+    T = 0 gives Ψ = A, G = B (the continuous loop).
+    """
     A, B, F0, F1 = continuous_plant(loop, hold)
-    Phi, Gamma = discretize(A, B, loop.T)
-    for array in (Phi, Gamma, F0, F1):
+    if loop.T == 0:
+        Psi, G = A.copy(), B.copy()
+    else:
+        Phi, integral = _exponential_blocks(A, loop.T)
+        small = np.linalg.norm(A, 1) * loop.T <= 1.0
+        Psi = integral @ A / loop.T if small else (Phi - np.eye(A.shape[0])) / loop.T
+        G = integral @ B / loop.T
+    for array in (Psi, G, F0, F1):
         array.setflags(write=False)
-    return Phi, Gamma, F0, F1
+    return Psi, G, F0, F1
 
 
 def closed_loop_matrix(loop: Loop, K: float, hold: str, compute_delay: int) -> np.ndarray:
@@ -120,13 +158,42 @@ def closed_loop_matrix(loop: Loop, K: float, hold: str, compute_delay: int) -> n
         State transition matrix over one period; with compute_delay = 1 the
         last state is the command waiting to be applied.
     """
-    Phi, Gamma, F0, F1 = _discrete_plant(loop, hold)
+    Psi, G, F0, F1 = delta_plant(loop, hold)
+    n = Psi.shape[0]
+    Phi, Gamma = np.eye(n) + loop.T * Psi, loop.T * G
     F = (F0 + K * F1)[None, :]
     if compute_delay == 0:
         return Phi - Gamma @ F
-    top = np.hstack([Phi, Gamma])
-    bottom = np.hstack([-F, np.zeros((1, 1))])
-    return np.vstack([top, bottom])
+    return np.block([[Phi, Gamma], [-F, np.zeros((1, 1))]])
+
+
+def _delta_matrix(loop: Loop, K: float, hold: str, compute_delay: int) -> np.ndarray:
+    """(Φ_cl − I)/T without cancellation: its eigenvalues λ give the poles z = 1 + Tλ."""
+    Psi, G, F0, F1 = delta_plant(loop, hold)
+    F = (F0 + K * F1)[None, :]
+    if compute_delay == 0 or loop.T == 0:
+        return Psi - G @ F
+    return np.block([[Psi, G], [-F / loop.T, np.full((1, 1), -1.0 / loop.T)]])
+
+
+def _bilinear(p_w, degree: int, T: float) -> np.ndarray:
+    """Q(μ) = (1 − Tμ/2)^degree · P(μ/(1 − Tμ/2)) for P(w) given descending (degree >= deg P)."""
+    p = np.asarray(p_w, dtype=float)[::-1]  # ascending: p_i w^i
+    factor = np.array([-T / 2, 1.0])  # 1 − Tμ/2, descending
+    out = np.zeros(degree + 1)
+    for i, coefficient in enumerate(p):
+        if coefficient == 0.0:
+            continue
+        term = np.polymul(np.concatenate([[1.0], np.zeros(i)]), _power(factor, degree - i))
+        out = np.polyadd(out, coefficient * term)
+    return np.asarray(out[-(degree + 1):], dtype=float)
+
+
+def _power(poly, m: int):
+    out = np.array([1.0])
+    for _ in range(m):
+        out = np.polymul(out, poly)
+    return out
 
 
 class Sampled(AffineGainModel):
@@ -151,44 +218,138 @@ class Sampled(AffineGainModel):
     def __repr__(self) -> str:
         return f"Sampled(hold={self.hold!r}, compute_delay={self.compute_delay})"
 
+    # ------------------------------------------------------------ polynomials
+    def delta_polynomials(self, loop: Loop):
+        """(D, E) in the δ variable w = (z − 1)/T: P(w) = D(w) + K·E(w), descending.
+
+        D = (1 + Tw)^c det(wI − Ψ) + F0 adj(wI − Ψ) G and E = F1 adj(wI − Ψ) G,
+        each rank-one term as det(wI − Ψ + G F) − det(wI − Ψ).
+        """
+        Psi, G, F0, F1 = delta_plant(loop, self.hold)
+        p = np.poly(Psi)
+        base = np.polysub(np.poly(Psi - G @ F0[None, :]), p) if np.any(F0) else np.zeros(1)
+        e = np.polysub(np.poly(Psi - G @ F1[None, :]), p)
+        lead = np.polymul([loop.T, 1.0], p) if self.compute_delay and loop.T > 0 else p
+        return np.polyadd(lead, base), np.trim_zeros(e, "f") if np.any(e) else np.zeros(1)
+
+    def bilinear_polynomials(self, loop: Loop):
+        """(D, E) in μ (z = (1 + Tμ/2)/(1 − Tμ/2)): stable ⇔ D + K·E is Hurwitz, descending, one length."""
+        d, e = self.delta_polynomials(loop)
+        degree = len(np.trim_zeros(d, "f")) - 1
+        return _bilinear(d, degree, loop.T), _bilinear(e, degree, loop.T)
+
+    def polynomials(self, loop: Loop):
+        """(D(z), E(z)): det(zI − Φ_cl(K)) = D + K·E, descending in z (T > 0).
+
+        Formed from the δ form, P_z(z) = Σ p_i T^(d−i) (z − 1)^i; a polynomial
+        in z is ill-conditioned for T → 0 (use `bilinear_polynomials` there).
+        """
+        d, e = self.delta_polynomials(loop)
+        degree = len(np.trim_zeros(d, "f")) - 1
+        return _to_z(d, degree, loop.T), _to_z(e, degree, loop.T)
+
+    # --------------------------------------------------------------- queries
+    def compute_boundary(self, loop: Loop) -> Boundary:
+        if loop.T == 0:  # the continuous loop, KB eq (17), exactly
+            b = Continuous().boundary(loop)
+            return Boundary(self.name, b.NV_critical, b.omega_critical, b.K_critical, b.stable_set)
+        d, e = self.bilinear_polynomials(loop)
+        crossings = [Crossing(c.gain, self._frequency_of(c.frequency, loop)) for c in affine_crossings(d, e, "s")]
+        if e[0] != 0.0 and -d[0] / e[0] > 0:  # the degree of Q drops: a pole passes through z = −1
+            crossings.append(Crossing(float(-d[0] / e[0]), math.pi / loop.T))
+        crossings.sort(key=lambda c: (c.gain, c.frequency))
+        interval = stable_interval(crossings, lambda K: self.is_stable(K / loop.k, loop))
+        return Boundary.from_interval(self.name, interval, loop.k)
+
+    @staticmethod
+    def _frequency_of(Omega: float, loop: Loop) -> float:
+        """ω (rad/s) of the unit-circle point that μ = jΩ maps to."""
+        return 2.0 * math.atan(Omega * loop.T / 2.0) / loop.T if loop.T > 0 else Omega
+
+    def delta_eigenvalues(self, NV: float, loop: Loop) -> np.ndarray:
+        """Eigenvalues λ of (Φ_cl − I)/T (poles z = 1 + Tλ; T = 0: the continuous poles)."""
+        return np.linalg.eigvals(_delta_matrix(loop, loop.k * _check_NV(NV), self.hold, self.compute_delay))
+
     def closed_loop(self, NV: float, loop: Loop) -> np.ndarray:
         """Φ_cl for NV (1/s)."""
         return closed_loop_matrix(loop, loop.k * _check_NV(NV), self.hold, self.compute_delay)
 
-    def polynomials(self, loop: Loop):
-        """D(z) = det(zI − Φ_cl(0)), E(z) = det(zI − Φ_cl(1)) − D(z)."""
-        d = np.poly(closed_loop_matrix(loop, 0.0, self.hold, self.compute_delay))
-        e = np.poly(closed_loop_matrix(loop, 1.0, self.hold, self.compute_delay)) - d
-        # the difference of two characteristic polynomials carries round-off of the size of D
-        e[np.abs(e) <= 100 * np.finfo(float).eps * np.max(np.abs(d))] = 0.0
-        return d, e
-
-    def compute_boundary(self, loop: Loop) -> Boundary:
-        if loop.T == 0:
-            b = Continuous().boundary(loop)
-            return Boundary(self.name, b.NV_critical, b.omega_critical, b.K_critical)
-        return super().compute_boundary(loop)
-
     def eigenvalues(self, NV: float, loop: Loop) -> np.ndarray:
-        """Closed-loop eigenvalues z (T > 0)."""
-        return np.linalg.eigvals(self.closed_loop(NV, loop))
+        """Closed-loop poles z (T > 0), as 1 + Tλ."""
+        return 1.0 + loop.T * self.delta_eigenvalues(NV, loop)
 
     def is_stable(self, NV: float, loop: Loop) -> bool:
-        """Spectral radius of Φ_cl < 1 (T = 0: the continuous verdict)."""
+        """Every pole strictly inside the unit circle: 2 Re λ + T|λ|² < 0 (T = 0: KB eq 17 by Routh)."""
         if loop.T == 0:
             return Continuous().is_stable(NV, loop)
-        return bool(np.max(np.abs(self.eigenvalues(NV, loop))) < 1.0)
+        lam = self.delta_eigenvalues(NV, loop)
+        return bool(np.all(2.0 * lam.real + loop.T * np.abs(lam) ** 2 < 0.0))
 
     def jury_stable(self, NV: float, loop: Loop) -> bool:
         """Schur–Cohn (Jury) verdict on det(zI − Φ_cl), independent of the eigenvalues."""
         return schur_cohn_stable(self.characteristic(NV, loop))
 
     def rightmost_root(self, NV: float, loop: Loop) -> complex:
-        """Dominant pole as s = ln(z)/T: σ = ln|z|/T (1/s), ω = arg(z)/T (rad/s)."""
+        """Dominant pole as s = ln(z)/T: σ = ln|z|/T (1/s), ω = arg(z)/T in [0, π/T] (rad/s)."""
         if loop.T == 0:
             return Continuous().rightmost_root(NV, loop)
-        z = self.eigenvalues(NV, loop)
-        radius = np.abs(z)
-        top = z[radius >= radius.max() * (1 - 1e-12)]
-        z = top[np.argmax(top.imag)]
-        return complex(np.log(z) / loop.T)
+        lam = self.delta_eigenvalues(NV, loop)
+        T = loop.T
+        with np.errstate(divide="ignore"):
+            sigma = 0.5 * np.log1p(2.0 * T * lam.real + T * T * np.abs(lam) ** 2) / T
+        omega = np.abs(np.arctan2(T * lam.imag, 1.0 + T * lam.real)) / T
+        i = int(np.argmax(sigma))
+        return complex(float(sigma[i]), float(omega[i]))
+
+    def roots(self, NV: float, loop: Loop) -> np.ndarray:
+        """All closed-loop poles z (T > 0); the continuous roots s at T = 0."""
+        return self.delta_eigenvalues(NV, loop) if loop.T == 0 else self.eigenvalues(NV, loop)
+
+    def growth_rates(self, NV: float, loops) -> np.ndarray:
+        """σ = max ln|z|/T (1/s) at NV for each loop, all exponentials and eigenvalues in one batch."""
+        loops = list(loops)
+        K = np.array([loop.k for loop in loops]) * _check_NV(NV)
+        T = np.array([loop.T for loop in loops])
+        plants = [continuous_plant(loop, self.hold) for loop in loops]
+        A, B, F0, F1 = (np.stack([p[i] for p in plants]) for i in range(4))
+        n = A.shape[-1]
+        Psi, G = A.copy(), B.copy()
+        sampled = T > 0
+        if sampled.any():
+            from scipy.linalg import expm
+
+            M = np.zeros((int(sampled.sum()), 2 * n, 2 * n))
+            M[:, :n, :n] = A[sampled]
+            M[:, :n, n:] = np.eye(n)
+            E = expm(M * T[sampled, None, None])
+            Phi, integral = E[:, :n, :n], E[:, :n, n:]
+            t = T[sampled, None, None]
+            small = (np.abs(A[sampled]).sum(axis=1).max(axis=1) * T[sampled] <= 1.0)[:, None, None]
+            Psi[sampled] = np.where(small, integral @ A[sampled] / t, (Phi - np.eye(n)) / t)
+            G[sampled] = integral @ B[sampled] / t
+        F = (F0 + K[:, None] * F1)[:, None, :]
+        closed = Psi - G @ F
+        if self.compute_delay:
+            safe = np.where(sampled, T, 1.0)[:, None, None]
+            top = np.concatenate([Psi, G], axis=2)
+            bottom = np.concatenate([-F / safe, -np.ones((len(loops), 1, 1)) / safe], axis=2)
+            delayed = np.concatenate([top, bottom], axis=1)
+            lam_delayed = np.linalg.eigvals(delayed)
+            lam_plain = np.linalg.eigvals(closed)
+            lam = np.where(sampled[:, None], lam_delayed, np.concatenate([lam_plain, np.full((len(loops), 1), -np.inf)], axis=1))
+        else:
+            lam = np.linalg.eigvals(closed)
+        t = T[:, None]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            sigma = np.where(t > 0, 0.5 * np.log1p(2.0 * t * lam.real + t * t * np.abs(lam) ** 2) / np.where(t > 0, t, 1.0), lam.real)
+        return np.nanmax(np.where(np.isnan(sigma), -np.inf, sigma), axis=1)
+
+
+def _to_z(p_w, degree: int, T: float) -> np.ndarray:
+    """P_z(z) = Σ p_i T^(degree − i) (z − 1)^i for P(w) = Σ p_i w^i (descending in and out)."""
+    p = np.asarray(p_w, dtype=float)[::-1]
+    out = np.zeros(degree + 1)
+    for i, coefficient in enumerate(p):
+        if coefficient != 0.0:
+            out = np.polyadd(out, coefficient * T ** (degree - i) * _power(np.array([1.0, -1.0]), i))
+    return np.asarray(out[-(degree + 1):], dtype=float)
