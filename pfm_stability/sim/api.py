@@ -28,7 +28,7 @@ SCENARIO_PARAMETERS = (
 )
 
 
-def simulate(scenario, *, record: str = "trajectory", **options) -> RunResult:
+def simulate(scenario, *, record: str = "trajectory", progress=None, **options) -> RunResult:
     """Simulate one run.
 
     Parameters
@@ -37,6 +37,8 @@ def simulate(scenario, *, record: str = "trajectory", **options) -> RunResult:
         A `Scenario`, or a scenario name built with `options` by
         `make_scenario` (``robot=``, ``controller=``, ``env=``, ``L=``, …).
     record : {"trajectory", "offset"}
+    progress : callable, optional
+        ``progress(step, total)`` every 1024 samples (`run_batch`).
 
     Returns
     -------
@@ -46,7 +48,7 @@ def simulate(scenario, *, record: str = "trajectory", **options) -> RunResult:
         scenario = make_scenario(scenario, **options)
     elif options:
         raise ValueError("options apply to a scenario name, not to a Scenario object")
-    return run_batch([scenario], record=record).runs[0]
+    return run_batch([scenario], record=record, progress=progress).runs[0]
 
 
 def _broadcast(parameters: dict) -> tuple[int, dict]:
@@ -79,6 +81,7 @@ def simulate_batch(
     controller: Controller | None = None,
     record: str = "offset",
     metrics: bool = True,
+    progress=None,
     **parameters,
 ) -> BatchResult:
     """Simulate a named scenario for many parameter sets at once.
@@ -93,6 +96,8 @@ def simulate_batch(
         per member below.
     record : {"offset", "trajectory"}
     metrics : bool
+    progress : callable, optional
+        ``progress(step, total)`` every 1024 samples (`run_batch`).
     **parameters
         Scalars or equal-length 1-D arrays, one entry per member:
         robot fields ``V, tau, k, W, max_steering_rate``; controller fields
@@ -133,4 +138,4 @@ def simulate_batch(
         if key_c not in controllers:
             controllers[key_c] = controller.replace(**c_changes)
         scenarios.append(make_scenario(scenario, robot=robots[key_r], controller=controllers[key_c], env=env, **member))
-    return run_batch(scenarios, record=record, metrics=metrics)
+    return run_batch(scenarios, record=record, metrics=metrics, progress=progress)

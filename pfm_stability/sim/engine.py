@@ -320,7 +320,7 @@ def _advance_reference(b, theta, omega, ref, V, x, y):
     return x_new, y_new, theta_end, omega_end
 
 
-def run_batch(scenarios, *, record: str = "trajectory", metrics: bool = True) -> BatchResult:
+def run_batch(scenarios, *, record: str = "trajectory", metrics: bool = True, progress=None) -> BatchResult:
     """Simulate every scenario of `scenarios` together.
 
     Parameters
@@ -332,6 +332,10 @@ def run_batch(scenarios, *, record: str = "trajectory", metrics: bool = True) ->
     metrics : bool
         Compute the oscillation metrics of each member (DESIGN §6); if
         False, each run's ``metrics`` is None (for timing and sweeps of events).
+    progress : callable, optional
+        ``progress(step, total)`` is called every 1024 engine steps and once at
+        the end (step = samples done by the longest member, total = its
+        samples); for progress bars.
 
     Returns
     -------
@@ -405,8 +409,12 @@ def run_batch(scenarios, *, record: str = "trajectory", metrics: bool = True) ->
         rec.record(k, x, y, theta)
         if k % 64 == 0:
             _check_finite(x, y, theta, omega, k, b)
+        if progress is not None and k % 1024 == 0:
+            progress(k, max_steps)
     seconds = time.perf_counter() - started
     _check_finite(x, y, theta, omega, k, b)
+    if progress is not None:
+        progress(max_steps, max_steps)
     runs = tuple(_member_result(b, rec, m, int(done_steps[m]), events[m], metrics, float(min_gap[m])) for m in range(B))
     return BatchResult(runs, int(done_steps.sum()), seconds)
 

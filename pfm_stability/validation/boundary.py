@@ -499,6 +499,24 @@ def _map(simulate, scenario, spec, env, robot, controller, law, geometry, bounda
 
 
 # --------------------------------------------------------------------- API
+def _no_boundary_message(parameter: str, predicted: float, models, robot, controller) -> str:
+    """Why there is no simulated boundary to bisect, and what would give one."""
+    from ..criteria import loop_of
+
+    loop = loop_of(robot, controller)
+    sampled = next(m for m in models if m.name == "sampled")
+    NV_star = sampled.boundary(loop).NV_critical
+    if NV_star == 0:
+        return (
+            f"{parameter}: the sampled loop is unstable at every NV for these parameters (NV* = 0: unstable at any speed), "
+            f"so no {parameter} gives a stable run and there is no boundary to bisect; a shorter T or a lower k can help "
+            f"(pfm-stability report gives T* and k*)"
+        )
+    if math.isinf(NV_star):
+        return f"{parameter}: the sampled loop is stable at every NV for these parameters (NV* = inf); there is no boundary to bisect"
+    return f"{parameter}: no value of {parameter} reaches the sampled boundary NV* = {NV_star:.4g} 1/s (predicted {parameter}* = {predicted:g}); nothing to bisect"
+
+
 def validate_boundary(
     scenario: str,
     parameter: str | None = None,
@@ -607,7 +625,7 @@ def validate_boundary(
     predicted = predicted_boundaries(scenario, parameter, robot, controller, law, geometry, models)
     p = predicted["sampled"]
     if not (math.isfinite(p) and p > 0):
-        raise ValueError(f"{parameter}: the sampled model has no finite boundary for these parameters ({p:g}); nothing to bisect")
+        raise ValueError(_no_boundary_message(parameter, p, models, robot, controller))
     lumped = lumped_law(law) if isinstance(law, GridWallLaw) else None
     lumped_predicted = (
         predicted_boundaries(scenario, parameter, robot, controller, lumped, geometry, models) if lumped is not None else None
