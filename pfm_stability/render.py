@@ -66,11 +66,13 @@ def _rows(report):
             cells = [name, v["verdict"].upper() if v["verdict"] != "stable" else "stable", margin, _num(v["NV_critical"]), _num(v["omega_critical"])]
             cells += [_num(v[k]) for k in keys]
             rows.append(cells)
-        fixes = {name: v["to_stabilize"] for name, v in data[scenario].items() if v["to_stabilize"]}
+        fixes = {name: v["to_stabilize"] for name, v in data[scenario].items() if v["verdict"] != "stable"}
         yield title, header, rows, fixes
 
 
 def _remedy_line(model: str, fix: dict) -> str:
+    if not fix:
+        return f"  to stabilize ({model}): no change of V, T, k, alpha, L or f alone helps; change tau or several parameters"
     parts = []
     for name, entry in fix.items():
         unit = _REMEDY_UNITS[name]
@@ -105,8 +107,10 @@ def render_text(report) -> str:
             lines.append(_remedy_line(model, fix))
     lines += [
         "",
-        "margin = NV*/NV - 1 (> 0 stable); starred values are critical with the other inputs fixed; "
-        "T* = largest sampling period / delay that keeps this operating point stable; inf = no limit.",
+        "margin = relative distance in NV to the nearest stability boundary (NV*/NV - 1 when the stable set is (0, NV*); "
+        "> 0 stable). Starred values are critical with the other inputs fixed: every V below V*, T below T* and k below k* "
+        "is stable (T*, k*: where this operating point first loses stability); NV* = 0 and V* = 0 mean unstable at any speed; "
+        "inf = no limit; - = undefined.",
     ]
     if report.kb_error is not None:
         e = report.kb_error

@@ -173,3 +173,40 @@ def test_general_polynomial_form():
     w = interval.frequency
     assert 2 * math.atan(w) + w == pytest.approx(math.pi, rel=1e-12)
     assert interval.gain == pytest.approx(1 + w * w, rel=1e-12)
+
+
+def test_critical_gain_when_the_first_level_is_not_the_lowest():
+    """τ = 3 s, T = 3 s, k = 2 1/s (kτ = 6 > 2 + √3: the steering loop resonates): NV* = 0.3236174,
+    not 0 (the old doubling search started too low and fell back to a fixed gain). Checked with
+    cxroots (argument principle and Newton) in a rectangle that holds every root with Re s >= 0:
+    none in the right half-plane at K*(1 − 1e-6), the pair at ±jω* (1e-6) in it at K*(1 + 1e-6)."""
+    loop = Loop(3.0, 3.0, 2.0)
+    b = ExactDelay().boundary(loop)
+    assert b.NV_critical == pytest.approx(0.3236174, rel=1e-6)
+    R = _rhp_radius(loop.tau, loop.k, 2 * b.K_critical)
+    for factor, expected in ((1 - 1e-6, 0), (1 + 1e-6, 2)):
+        roots = _cx_roots(loop.tau, loop.T, loop.k, b.K_critical * factor, ([-0.01, R], [-R, R]))
+        right = roots[roots.real > 0]
+        assert len(right) == expected
+        assert np.all(np.abs(np.abs(right.imag) - b.omega_critical) < 1e-6)
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_resonant_critical_gain_by_two_routes_and_the_generic_count(seed):
+    """Resonant loops (kτ from 4 to 400, T up to 50 s: up to ~10⁴ phase levels below the dip):
+    the vectorized three-candidate K* equals the generic scalar `DelayLoop.critical_gain`
+    (every stretch of |a(jω)|, 1e-12) and the generic crossing count says stable at
+    K*(1 − 1e-9) and at 50 geometric gains below, unstable at K*(1 + 1e-9)."""
+    from pfm_stability.delay import kb_critical_gain
+
+    rng = np.random.default_rng(seed)
+    tau = float(rng.uniform(0.05, 4.0))
+    k = float(np.exp(rng.uniform(np.log(4.0), np.log(400.0)))) / tau
+    T = float(np.exp(rng.uniform(np.log(0.01), np.log(50.0))))
+    K, w = (float(x) for x in kb_critical_gain(tau, T, k))
+    q = DelayLoop([tau, 1.0, k, 0.0], T)
+    generic = q.critical_gain()
+    assert generic.gain == pytest.approx(K, rel=1e-12)
+    assert generic.frequency == pytest.approx(w, rel=1e-10)
+    assert q.is_stable(K * (1 - 1e-9)) and not q.is_stable(K * (1 + 1e-9))
+    assert all(q.is_stable(g) for g in np.geomspace(1e-6 * K, 0.999 * K, 50))

@@ -135,3 +135,84 @@ def test_unstable_inner_loop_gives_zero_critical_gain():
     model = Sampled("command", 1)
     assert model.boundary(loop).NV_critical == 0.0
     assert not model.is_stable(1e-6, loop)
+
+
+def _mp_spectral_radius(loop, hold, delay, NV, digits=40):
+    """ρ(Φ_cl) in 40-digit arithmetic: mpmath's expm of the Van Loan matrix and mpmath's eig.
+
+    Independent of the model's numpy exponential, δ form and bilinear polynomials.
+    """
+    import mpmath as mp
+
+    with mp.workdps(digits):
+        A, B, F0, F1 = continuous_plant(loop, hold)
+        n = A.shape[0]
+        M = mp.zeros(n + 1, n + 1)
+        for i in range(n):
+            for j in range(n):
+                M[i, j] = mp.mpf(A[i, j])
+            M[i, n] = mp.mpf(B[i, 0])
+        E = mp.expm(M * mp.mpf(loop.T))
+        K = mp.mpf(loop.k) * mp.mpf(NV)
+        F = [mp.mpf(F0[j]) + K * mp.mpf(F1[j]) for j in range(n)]
+        size = n + delay
+        C = mp.zeros(size, size)
+        for i in range(n):
+            for j in range(n):
+                C[i, j] = E[i, j] - (0 if delay else E[i, n] * F[j])
+            if delay:
+                C[i, n] = E[i, n]
+        if delay:
+            for j in range(n):
+                C[n, j] = -F[j]
+        return max(abs(z) for z in mp.eig(C, left=False, right=False))
+
+
+@pytest.mark.parametrize("hold, delay", STRUCTURES)
+@pytest.mark.parametrize("T", [1e-6, 1e-5, 1e-4, 1e-3, 1e-2, 0.1, 1.0, 10.0])
+def test_critical_gain_to_1e8_from_a_microsecond_to_ten_seconds(hold, delay, T):
+    """NV* is accurate to 1e-8 relative for T from 1e-6 to 10 s (requirement: 1e-7): the
+    40-digit spectral radius is < 1 at NV*(1 − 1e-8) and > 1 at NV*(1 + 1e-8). The old
+    z-polynomial lost 1e-3 at T = 1e-4 and returned 0 at T <= 1e-5 (cancellation as z → 1).
+    Where NV* = 0 the loop must be unstable at every NV: checked at 12 values over 9 decades."""
+    loop = Loop(0.3, T, 2.0)
+    NV = Sampled(hold, delay).boundary(loop).NV_critical
+    if NV == 0:
+        assert all(_mp_spectral_radius(loop, hold, delay, nv) > 1 for nv in np.geomspace(1e-6, 1e3, 12))
+        return
+    assert _mp_spectral_radius(loop, hold, delay, NV * (1 - 1e-8)) < 1 < _mp_spectral_radius(loop, hold, delay, NV * (1 + 1e-8))
+
+
+@pytest.mark.parametrize("hold, delay", STRUCTURES)
+@pytest.mark.parametrize("tau, T, k, K", random_loops(3, seed=53, tau=(0.0, 2.0), T=(1e-6, 1e-3), k=(0.1, 50.0)))
+def test_critical_gain_at_short_periods_far_from_carmel(hold, delay, tau, T, k, K):
+    """Random τ, k and periods of 1 µs to 1 ms: the same 40-digit check at 1e-8."""
+    loop = Loop(tau, T, k)
+    NV = Sampled(hold, delay).boundary(loop).NV_critical
+    if not 0 < NV < math.inf:
+        pytest.skip("no finite boundary (checked elsewhere)")
+    assert _mp_spectral_radius(loop, hold, delay, NV * (1 - 1e-8)) < 1 < _mp_spectral_radius(loop, hold, delay, NV * (1 + 1e-8))
+
+
+def test_unstable_at_any_NV_for_the_filed_parameters():
+    """τ = 1.07 s, T = 0.112 s, k = 6.47 1/s, command hold with a compute delay: NV* = 0, an
+    empty stable set, and the 40-digit spectral radius exceeds 1 at every one of 12 NV over 9 decades."""
+    loop = Loop(1.07, 0.112, 6.47)
+    b = Sampled("command", 1).boundary(loop)
+    assert b.NV_critical == 0.0 and b.stable_set == () and b.omega_critical is None
+    assert all(_mp_spectral_radius(loop, "command", 1, nv) > 1 for nv in np.geomspace(1e-6, 1e3, 12))
+
+
+def test_real_negative_dominant_pole_has_a_finite_rate():
+    """A dominant pole on the negative real axis (τ = 0, kT = 2.015) gives σ = ln|z|/T and
+    ω = π/T, not NaN; z from python-control's ZOH discretization and numpy eigenvalues (1e-12)."""
+    loop = Loop(0.0, 0.065, 31.0)
+    model = Sampled("command", 0)
+    A, B, F0, F1 = continuous_plant(loop, "command")
+    d = control.sample_system(control.ss(A, B, np.eye(2), np.zeros((2, 1))), loop.T, method="zoh")
+    z = np.linalg.eigvals(d.A - d.B @ (F0 + loop.k * 0.5 * F1)[None, :])
+    dominant = z[np.argmax(np.abs(z))]
+    assert dominant.real < 0 and abs(dominant.imag) < 1e-12
+    root = model.rightmost_root(0.5, loop)
+    assert root.real == pytest.approx(math.log(abs(dominant)) / loop.T, rel=1e-12)
+    assert root.imag == pytest.approx(math.pi / loop.T, rel=1e-12)

@@ -15,8 +15,9 @@ Linearized loop (Koren & Borenstein 1991 eq 6, 7, 10, 14): steering motor
 
 ``compute_delay`` = 1 applies the value computed at t_k over [t_k+1, t_k+2)
 (one more state: the stored command). The plant is discretized with a
-zero-order hold, Φ = e^(AT), Γ = ∫₀ᵀ e^(As) ds·B (python-control's
-``sample_system`` is the test oracle), and closed with the sampled feedback
+zero-order hold, Φ = e^(AT), Γ = ∫₀ᵀ e^(As) ds·B (module
+`matrix_exponential`; python-control's ``sample_system`` is the test
+oracle), and closed with the sampled feedback
 v_k = −(F0 + K·F1)·x_k.
 
 Numerics: the δ (delta-operator) form
@@ -55,6 +56,7 @@ import numpy as np
 
 from ..checks import check_choice, check_integer
 from ..crossings import Crossing, affine_crossings, stable_interval
+from ..matrix_exponential import zoh_blocks
 from ..parameters import HOLDS
 from ..routh import schur_cohn_stable
 from .base import AffineGainModel, Boundary, Loop, _check_NV
@@ -101,21 +103,9 @@ def continuous_plant(loop: Loop, hold: str):
     return A, B, F0, F1
 
 
-def _exponential_blocks(A, T: float):
-    """(e^(AT), ∫₀ᵀ e^(As) ds) from one exponential of [[A, I], [0, 0]]·T (Van Loan 1978)."""
-    from scipy.linalg import expm
-
-    n = A.shape[0]
-    M = np.zeros((2 * n, 2 * n))
-    M[:n, :n] = A
-    M[:n, n:] = np.eye(n)
-    E = expm(M * T)
-    return E[:n, :n], E[:n, n:]
-
-
 def discretize(A, B, T: float):
-    """Zero-order-hold discretization: Φ = e^(AT), Γ = ∫₀ᵀ e^(As) ds B."""
-    Phi, integral = _exponential_blocks(A, T)
+    """Zero-order-hold discretization: Φ = e^(AT), Γ = ∫₀ᵀ e^(As) ds B (`matrix_exponential.zoh_blocks`)."""
+    Phi, integral = zoh_blocks(A, T)
     return Phi, integral @ B
 
 
@@ -131,7 +121,7 @@ def delta_plant(loop: Loop, hold: str):
     if loop.T == 0:
         Psi, G = A.copy(), B.copy()
     else:
-        Phi, integral = _exponential_blocks(A, loop.T)
+        Phi, integral = zoh_blocks(A, loop.T)
         small = np.linalg.norm(A, 1) * loop.T <= 1.0
         Psi = integral @ A / loop.T if small else (Phi - np.eye(A.shape[0])) / loop.T
         G = integral @ B / loop.T
@@ -316,13 +306,7 @@ class Sampled(AffineGainModel):
         Psi, G = A.copy(), B.copy()
         sampled = T > 0
         if sampled.any():
-            from scipy.linalg import expm
-
-            M = np.zeros((int(sampled.sum()), 2 * n, 2 * n))
-            M[:, :n, :n] = A[sampled]
-            M[:, :n, n:] = np.eye(n)
-            E = expm(M * T[sampled, None, None])
-            Phi, integral = E[:, :n, :n], E[:, :n, n:]
+            Phi, integral = zoh_blocks(A[sampled], T[sampled])
             t = T[sampled, None, None]
             small = (np.abs(A[sampled]).sum(axis=1).max(axis=1) * T[sampled] <= 1.0)[:, None, None]
             Psi[sampled] = np.where(small, integral @ A[sampled] / t, (Phi - np.eye(n)) / t)
