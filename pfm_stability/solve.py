@@ -141,7 +141,7 @@ def newton_increasing(func, lo, hi, *, rtol: float = 4e-16, iterations: int = 20
     return x
 
 
-def first_crossing(measure, lo: float, hi: float, *, start: float = 0.0, points_per_decade: int = 32, rtol: float = 1e-7) -> float:
+def first_crossing(measure, lo: float, hi: float, *, start: float = 0.0, points_per_decade: int = 32, rtol: float = 1e-7, atol: float = 0.0) -> float:
     """Smallest x in (start, hi] with measure(x) >= 0, given measure(start) < 0; ``inf`` if none.
 
     `measure` is continuous (e.g. a loop's growth rate as a parameter grows)
@@ -161,8 +161,8 @@ def first_crossing(measure, lo: float, hi: float, *, start: float = 0.0, points_
         A point below lo where measure < 0 is known (e.g. T = 0).
     points_per_decade : int
         Grid density.
-    rtol : float
-        Relative width of the final bracket.
+    rtol, atol : float
+        Relative and absolute width of the final bracket (hi − lo <= max(rtol·hi, atol)).
 
     Returns
     -------
@@ -184,18 +184,18 @@ def first_crossing(measure, lo: float, hi: float, *, start: float = 0.0, points_
             bracket = (float(grid[peaks[i] - 1]), float(x[i]))
     if bracket is None:
         return math.inf
-    return refine_sign_change(measure, *bracket, rtol=rtol)
+    return refine_sign_change(measure, *bracket, rtol=rtol, atol=atol)
 
 
-def refine_sign_change(measure, lo: float, hi: float, *, members: int = 16, rtol: float = 1e-7) -> float:
+def refine_sign_change(measure, lo: float, hi: float, *, members: int = 16, rtol: float = 1e-7, atol: float = 0.0) -> float:
     """The first x in (lo, hi] where measure(x) >= 0, given measure(lo) < 0 <= measure(hi).
 
     Batched bisection: each round evaluates `members` evenly spaced points
     of the bracket in one call and keeps the cell before the first point with
     measure >= 0, so one round divides the bracket by members + 1. Returns the
-    upper end of the final bracket (hi − lo <= rtol·hi).
+    upper end of the final bracket (hi − lo <= max(rtol·hi, atol)).
     """
-    while hi - lo > rtol * abs(hi):
+    while hi - lo > max(rtol * abs(hi), atol):
         points = np.linspace(lo, hi, members + 2)[1:-1]
         values = np.asarray(measure(points), dtype=float)
         above = np.flatnonzero(values >= 0)

@@ -202,7 +202,8 @@ class LoopModel:
         def measure(Ts):
             return self.growth_rates(NV, [Loop(loop.tau, float(T), loop.k) for T in Ts])
 
-        return first_crossing(measure, _time_scale(loop, NV) * 1e-2, RANGES["T"].high, rtol=_DELAY_RTOL)
+        scale = _time_scale(loop, NV)
+        return first_crossing(measure, scale * 1e-2, RANGES["T"].high, rtol=_DELAY_RTOL, atol=1e-12 * scale)
 
     def critical_gain_k(self, NV: float, loop: Loop) -> float:
         """k*: the smallest steering gain at which NV loses stability (τ, T fixed), 1/s.
@@ -221,7 +222,7 @@ class LoopModel:
         def measure(ks):
             return self.growth_rates(NV, [Loop(loop.tau, loop.T, float(k)) for k in ks])
 
-        return first_crossing(measure, lo, hi, start=lo, rtol=_DELAY_RTOL)
+        return first_crossing(measure, lo, hi, start=lo, rtol=_DELAY_RTOL, atol=1e-12 * lo)
 
     def __repr__(self) -> str:
         return f"{type(self).__name__}()"

@@ -83,9 +83,9 @@ class Pade(AffineGainModel):
         self.order = check_integer("pade_order", order, 1, MAX_PADE_ORDER)
 
     def polynomials(self, loop: Loop):
-        """D = (τs³ + s² + ks)·Q_m, E = P_m (descending powers of s)."""
-        num, den = pade_coefficients(loop.T, self.order)
-        return np.polymul(loop.plant, den), num
+        """D = (τs³ + s² + ks)·Q_m, E = P_m (descending powers of s; Q_m(0) = P_m(0) = 1)."""
+        D, E = self.batch_polynomials([loop])
+        return np.trim_zeros(D[0], "f"), np.trim_zeros(E[0], "f")
 
     def batch_polynomials(self, loops):
         """`polynomials` of many loops at once: rows of D = (τs³ + s² + ks)·Q_m and E = P_m."""
@@ -93,10 +93,8 @@ class Pade(AffineGainModel):
         m = self.order
         c = np.array([_pade_term(m, j) for j in range(m + 1)])
         powers = T[:, None] ** np.arange(m + 1)
-        den = (c * powers)[:, ::-1]  # descending; constant term 1
+        den = (c * powers)[:, ::-1]  # descending; constant term 1 (no division by a vanishing T^m)
         num = (c * powers * (-1.0) ** np.arange(m + 1))[:, ::-1]
-        lead = np.where(T > 0, den[:, 0], 1.0)[:, None]
-        den, num = den / lead, num / lead
         plant = np.stack([tau, np.ones_like(tau), k, np.zeros_like(tau)], axis=1)
         D = np.zeros((len(loops), m + 4))
         for i in range(4):

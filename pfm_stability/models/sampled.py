@@ -285,8 +285,7 @@ class Sampled(AffineGainModel):
             return Continuous().rightmost_root(NV, loop)
         lam = self.delta_eigenvalues(NV, loop)
         T = loop.T
-        with np.errstate(divide="ignore"):
-            sigma = 0.5 * np.log1p(2.0 * T * lam.real + T * T * np.abs(lam) ** 2) / T
+        sigma = _log_radius(lam, T) / T
         omega = np.abs(np.arctan2(T * lam.imag, 1.0 + T * lam.real)) / T
         i = int(np.argmax(sigma))
         return complex(float(sigma[i]), float(omega[i]))
@@ -313,20 +312,30 @@ class Sampled(AffineGainModel):
             G[sampled] = integral @ B[sampled] / t
         F = (F0 + K[:, None] * F1)[:, None, :]
         closed = Psi - G @ F
-        if self.compute_delay:
-            safe = np.where(sampled, T, 1.0)[:, None, None]
-            top = np.concatenate([Psi, G], axis=2)
-            bottom = np.concatenate([-F / safe, -np.ones((len(loops), 1, 1)) / safe], axis=2)
-            delayed = np.concatenate([top, bottom], axis=1)
-            lam_delayed = np.linalg.eigvals(delayed)
-            lam_plain = np.linalg.eigvals(closed)
-            lam = np.where(sampled[:, None], lam_delayed, np.concatenate([lam_plain, np.full((len(loops), 1), -np.inf)], axis=1))
+        if self.compute_delay and sampled.any():
+            t = T[sampled, None, None]
+            top = np.concatenate([Psi[sampled], G[sampled]], axis=2)
+            bottom = np.concatenate([-F[sampled] / t, -np.ones((int(sampled.sum()), 1, 1)) / t], axis=2)
+            lam = np.linalg.eigvals(np.concatenate([top, bottom], axis=1))
         else:
-            lam = np.linalg.eigvals(closed)
-        t = T[:, None]
-        with np.errstate(divide="ignore", invalid="ignore"):
-            sigma = np.where(t > 0, 0.5 * np.log1p(2.0 * t * lam.real + t * t * np.abs(lam) ** 2) / np.where(t > 0, t, 1.0), lam.real)
-        return np.nanmax(np.where(np.isnan(sigma), -np.inf, sigma), axis=1)
+            lam = np.linalg.eigvals(closed[sampled]) if sampled.any() else np.empty((0, n))
+        sigma = np.empty(len(loops))
+        sigma[sampled] = np.max(_log_radius(lam, T[sampled, None]), axis=1) / T[sampled]
+        if (~sampled).any():
+            sigma[~sampled] = np.linalg.eigvals(closed[~sampled]).real.max(axis=1)
+        return sigma
+
+
+def _log_radius(lam, T):
+    """ln|1 + Tλ| without cancellation: log1p(2T Re λ + T²|λ|²)/2 while |Tλ| < 1/2, ln|1 + Tλ| beyond
+    (−inf for a pole at z = 0, never NaN)."""
+    lam = np.asarray(lam)
+    T = np.asarray(T, dtype=float)
+    near = np.abs(T * lam) < 0.5
+    with np.errstate(divide="ignore", invalid="ignore"):
+        small = 0.5 * np.log1p(np.where(near, 2.0 * T * lam.real + T * T * np.abs(lam) ** 2, 0.0))
+        large = np.log(np.abs(1.0 + T * lam))
+    return np.where(near, small, large)
 
 
 def _to_z(p_w, degree: int, T: float) -> np.ndarray:
