@@ -1,4 +1,4 @@
-"""Regenerate the figures of ``analyses/figures/`` (issue 6) in one command.
+"""Regenerate the figures of ``analyses/figures/`` in one command.
 
     python analyses/make_figures.py                 # every figure
     python analyses/make_figures.py corridor_regions wall_regions
@@ -17,7 +17,10 @@ Koren & Borenstein 1991, "KB"):
 ``simulation_vs_prediction`` simulated boundary points on the predicted curves (analytic and grid)
 ``trajectories``             stable, oscillating and colliding runs drawn like KB Figs 5 and 6
 
-The notebooks in this folder draw the same figures with short explanations.
+The region figures shade the verdicts of the model the stability report uses
+(``sampled`` with CARMEL's command hold and one-sample compute delay); every
+model's boundary is drawn as a line. The notebooks in this folder draw the
+same figures with short explanations.
 Total run time on a 2-core machine: about a minute.
 """
 
@@ -100,7 +103,8 @@ def grid_law():
 
 
 def simulation_vs_prediction(points=None):
-    from pfm_stability.plots.regions import plot_corridor_region, plot_simulated_boundary, plot_wall_alpha_critical, region_legend
+    from pfm_stability.plots.regions import plot_corridor_region, plot_simulated_boundary, plot_wall_alpha_critical, region_legend, shading_text
+    from pfm_stability.regions import region_model
 
     points = simulated_points() if points is None else points
     law = grid_law()
@@ -114,9 +118,22 @@ def simulation_vs_prediction(points=None):
         plot_wall_alpha_critical(ROBOT, CONTROLLER, law=env_law, ax=axes[1, col], legend=False, resolution=200)
         plot_simulated_boundary(points["wall", env], ax=axes[1, col], label="simulated boundary (bisection)")
         axes[1, col].set_title(f"Wall, {what}\nstable above α*(V); points: simulated α* at fixed V", fontsize=9)
-    region_legend(fig=fig, ncol=3, loc="outside lower center")
-    fig.suptitle("Simulated VFF runs against every model's predicted boundary (CARMEL; sampled = the simulator's loop)", fontsize=11)
+    region_legend(fig=fig, ncol=3)
+    fig.suptitle(
+        "Simulated VFF runs against every model's predicted boundary (CARMEL)\n"
+        f"shaded: {shading_text(region_model(CONTROLLER), CONTROLLER)}, which is also the simulator's loop",
+        fontsize=11,
+    )
     return fig
+
+
+def figure_legend(fig, **options):
+    """One legend below the panels, each label once (a legend inside an axes could hide the target arrow)."""
+    entries = {}
+    for ax in fig.axes:
+        for handle, label in zip(*ax.get_legend_handles_labels()):
+            entries.setdefault(label, handle)
+    return fig.legend(list(entries.values()), list(entries), loc="outside lower center", fontsize=8, frameon=False, **options)
 
 
 def outcome(result) -> str:
@@ -139,11 +156,12 @@ def trajectories():
     from pfm_stability.plots.trajectory import plot_trajectory
     from pfm_stability.sim import simulate
 
-    fig, axes = plt.subplots(1, 3, figsize=(13, 8.5), layout="constrained", gridspec_kw=dict(width_ratios=[1, 1.8, 1]))
+    fig, axes = plt.subplots(1, 3, figsize=(13, 9.0), layout="constrained", gridspec_kw=dict(width_ratios=[1, 1.8, 1]))
     for ax, (name, title) in zip(axes, TRAJECTORY_RUNS):
         result = simulate(name)
-        plot_trajectory(result, ax=ax, title=f"{title}\n{outcome(result)}")
+        plot_trajectory(result, ax=ax, title=f"{title}\n{outcome(result)}", legend=False)
         ax.title.set_fontsize(9)
+    figure_legend(fig, ncol=6)
     fig.suptitle("Simulated CARMEL runs in the histogram grid, drawn like Koren & Borenstein 1991 Figs 5 and 6 (robot every 1 s, to scale)", fontsize=11)
     return fig
 

@@ -1,7 +1,7 @@
-"""Stability regions and boundary curves for every loop model (issue 6; no plotting here).
+"""Stability regions and boundary curves for every loop model (no plotting here).
 
 Koren & Borenstein 1991 (KB) reduce every question to the loop gain NV: each
-model of DESIGN §4 is stable for 0 < NV < NV*(τ, T, k) (KB eq 20 for
+loop model (`pfm_stability.models`) is stable for 0 < NV < NV*(τ, T, k) (KB eq 20 for
 ``kb_first_order``), and N depends on the environment and the force law only
 (KB eq 11, 23, 25). A model's NV* therefore turns into a boundary curve in any
 plane of (V, f, α, L) through the force law:
@@ -17,14 +17,21 @@ For KB's power law these are closed forms (α* by vectorized bisection on the
 closed-form N(α)). For any other decreasing law (e.g. the grid's effective
 law, `pfm_stability.effective_force.GridWallLaw`) the curves are found by a
 vectorized bisection in the equilibrium distance d0, which parametrizes the
-wall exactly: cos α = F_r(d0)/F_a and N = −F_r′(d0)/(F_a sin α) (DESIGN §3,
-"General force law"); this assumes N decreases as d0 grows (a convex
+wall exactly: cos α = F_r(d0)/F_a and N = −F_r′(d0)/(F_a sin α) (KB eq 11
+and 23 with the general law in place of f(W/d)ⁿ); this assumes N decreases as d0 grows (a convex
 decreasing law — true for the power law and for the grid law).
 
 Dense stable/unstable maps (`wall_f_region`, `wall_alpha_region`,
-`corridor_region`) use the vectorized `exact_delay` verdicts of
-`pfm_stability.vectorized` (a crossing count per point, independent of the
-boundary curves; the tests check that the two agree to the grid resolution).
+`corridor_region`) shade one model's verdicts. In such a plane the loop
+parameters (τ, T, k, hold, compute delay) are fixed and only NV varies, so
+one `Boundary` decides every point exactly: a point is stable when its NV
+lies in the boundary's ``stable_set`` (a sampled loop can have several
+stable intervals, or none that starts at NV = 0 — NV* alone is not enough).
+The default model is the one the stability report's verdict uses
+(`verdict_model`: ``sampled`` with the controller's hold and compute delay).
+Asked for ``exact_delay``, the maps keep the vectorized crossing count of
+`pfm_stability.vectorized` (one count per point, independent of the boundary
+curves; the tests check that the two agree to the grid resolution).
 
 Model comparison (`critical_gain_vs_delay`, `kb_error_map`): NV*τ depends on
 the dimensionless kτ and T/τ only (substitute s = p/τ in KB eq 18, or scale
@@ -45,10 +52,10 @@ import numpy as np
 
 from .checks import check_number
 from .force_law import ForceLaw, PowerLaw
-from .models import Continuous, ExactDelay, KBFirstOrder, Loop, LoopModel, Pade, Sampled, make_model
+from .models import Continuous, ExactDelay, KBFirstOrder, Loop, LoopModel, Pade, Sampled, models_for
 from .parameters import Controller, Robot, check_parameter
 from .serialize import json_array, json_number
-from .vectorized import delay_verdicts_from_gain, exact_delay_verdicts
+from .vectorized import delay_verdicts_from_gain, exact_delay_verdicts, loop_gain_arrays
 
 __all__ = [
     "BoundaryCurve",
@@ -57,6 +64,9 @@ __all__ = [
     "KBErrorMap",
     "SimulatedBoundary",
     "default_models",
+    "verdict_model",
+    "region_model",
+    "stable_set_verdicts",
     "model_options",
     "wall_f_curves",
     "wall_alpha_curves",
@@ -74,7 +84,7 @@ __all__ = [
 ]
 
 SAMPLED_STRUCTURES = (("command", 0), ("command", 1), ("reference", 0), ("reference", 1))
-"""Every (hold, compute_delay) of the `sampled` model (DESIGN §4)."""
+"""Every (hold, compute_delay) of the `sampled` model."""
 
 
 # ------------------------------------------------------------------ results
@@ -94,7 +104,7 @@ class BoundaryCurve:
     Attributes
     ----------
     model : LoopModel
-        The model (its DESIGN §4 name is ``model.name``).
+        The model (its name is ``model.name``).
     NV_critical : float
         NV*, 1/s (``inf``: stable for every NV; 0: unstable for every NV > 0).
     omega_critical : float or None
@@ -146,7 +156,7 @@ class BoundaryCurve:
 
 @dataclass(frozen=True)
 class RegionGrid:
-    """Stable/unstable verdicts of the `exact_delay` model on a dense grid.
+    """One model's stable/unstable verdicts on a dense grid.
 
     Attributes
     ----------
@@ -154,12 +164,20 @@ class RegionGrid:
     x : ndarray, shape (nx,)
     y : ndarray, shape (ny,)
     stable : ndarray of bool, shape (ny, nx)
-        `exact_delay` verdict at (x[j], y[i]) (KB eq 18, crossing count,
-        `pfm_stability.vectorized.exact_delay_verdicts`).
+        The model's verdict at (x[j], y[i]).
     NV : ndarray, shape (ny, nx)
         Loop gain NV at each point, 1/s.
     model : str
-        ``"exact_delay"``.
+        Name of the shaded model (``"sampled"`` by default in the region
+        functions: the model of the report's verdict).
+    options : dict
+        The model's options (`model_options`: hold and compute delay of
+        ``sampled``, order of ``pade``).
+    stable_set : tuple of (float, float) or None
+        The NV intervals (1/s) that decided every point (the model's
+        `Boundary.stable_set`); None when each point was decided by the
+        vectorized `exact_delay` crossing count instead
+        (`pfm_stability.vectorized.exact_delay_verdicts`).
     """
 
     x_name: str
@@ -171,10 +189,12 @@ class RegionGrid:
     stable: np.ndarray
     NV: np.ndarray
     model: str = "exact_delay"
+    options: dict = field(default_factory=dict)
+    stable_set: tuple | None = None
 
     def __repr__(self) -> str:
         return (
-            f"RegionGrid({self.model}: {self.y_name} × {self.x_name}, {self.stable.shape}, "
+            f"RegionGrid({self.model}{self.options or ''}: {self.y_name} × {self.x_name}, {self.stable.shape}, "
             f"{100 * self.stable.mean():.1f} % stable)"
         )
 
@@ -182,6 +202,8 @@ class RegionGrid:
         """Plain JSON types (arrays as lists, non-finite values as None)."""
         return {
             "model": self.model,
+            "options": dict(self.options),
+            "stable_set": None if self.stable_set is None else [[json_number(lo), json_number(hi)] for lo, hi in self.stable_set],
             "x_name": self.x_name,
             "x_unit": self.x_unit,
             "y_name": self.y_name,
@@ -353,14 +375,59 @@ class SimulatedBoundary:
 
 # ------------------------------------------------------------------ helpers
 def default_models(controller: Controller, pade_order: int = 3) -> list[LoopModel]:
-    """The five DESIGN §4 models; ``sampled`` with the controller's hold and compute delay."""
-    return [
-        Continuous(),
-        KBFirstOrder(),
-        Pade(pade_order),
-        ExactDelay(),
-        make_model("sampled", hold=controller.hold, compute_delay=controller.compute_delay),
-    ]
+    """The five loop models; ``sampled`` with the controller's hold and compute delay (`models.models_for`)."""
+    return models_for(controller, pade_order=pade_order)
+
+
+def verdict_model(controller: Controller) -> LoopModel:
+    """The model whose verdict the stability report gives: ``sampled`` with the controller's hold and compute delay."""
+    return models_for(controller, ("sampled",))[0]
+
+
+def region_model(controller: Controller, model: LoopModel | str | None = None) -> LoopModel:
+    """The model a region map shades.
+
+    Parameters
+    ----------
+    controller : Controller
+        Its hold and compute delay configure ``sampled``.
+    model : LoopModel or str, optional
+        A model or a model name (`models.MODEL_NAMES`); default
+        `verdict_model` (the report's verdict).
+
+    Returns
+    -------
+    LoopModel
+
+    Raises
+    ------
+    ValueError
+        Unknown name, or a ``Sampled`` model whose structure contradicts the
+        controller (`models.models_for`).
+    """
+    return verdict_model(controller) if model is None else models_for(controller, (model,))[0]
+
+
+def stable_set_verdicts(stable_set, NV) -> np.ndarray:
+    """True where NV lies strictly inside one of the intervals (`Boundary.contains` for arrays).
+
+    Parameters
+    ----------
+    stable_set : sequence of (float, float)
+        NV intervals (lo, hi), 1/s (`Boundary.stable_set`).
+    NV : array_like
+        Loop gains, 1/s.
+
+    Returns
+    -------
+    ndarray of bool
+        Shaped like `NV`.
+    """
+    NV = np.asarray(NV, dtype=float)
+    stable = np.zeros(NV.shape, dtype=bool)
+    for lo, hi in stable_set:
+        stable |= (NV > lo) & (NV < hi)
+    return stable
 
 
 def _law(robot: Robot, controller: Controller, law: ForceLaw | None) -> ForceLaw:
@@ -597,6 +664,25 @@ def _general_verdicts(robot: Robot, controller: Controller, NV):
     return stable.reshape(NV.shape)
 
 
+def _region(robot: Robot, controller: Controller, model: LoopModel, axes, NV, stable=None) -> RegionGrid:
+    """A RegionGrid of `model` on NV: the given crossing-count verdicts, else the model's stable set."""
+    NV = np.asarray(NV, dtype=float)
+    stable_set = None
+    if stable is None:
+        if isinstance(model, ExactDelay):
+            stable = _general_verdicts(robot, controller, NV)
+        else:
+            b = model.boundary(_loop(robot, controller))
+            stable_set = tuple(b.stable_set) or (((0.0, b.NV_critical),) if b.NV_critical > 0 else ())
+            stable = stable_set_verdicts(stable_set, NV)
+    return RegionGrid(*axes, stable, NV, model.name, model_options(model), stable_set)
+
+
+def _power_law_parameters(robot: Robot, controller: Controller, law: ForceLaw | None):
+    """(f, n, W) of KB's power law: the given law's, else the controller's and the robot's."""
+    return (law.f, law.n, law.W) if law is not None else (controller.f, controller.n, robot.W)
+
+
 def _wall_gain_general(law: ForceLaw, alpha, scale_factor=1.0):
     """N (1/m) at the wall equilibrium for arrays α (rad) and force multipliers c (F = c·law)."""
     alpha, c = np.broadcast_arrays(np.asarray(alpha, dtype=float), np.asarray(scale_factor, dtype=float))
@@ -610,13 +696,13 @@ def _wall_gain_general(law: ForceLaw, alpha, scale_factor=1.0):
     return np.where(np.isnan(d0), np.inf, N)  # nan: the law never pushes that hard (robot at the wall)
 
 
-def wall_f_region(robot: Robot, controller: Controller, alpha: float, V, f, law: ForceLaw | None = None) -> RegionGrid:
-    """`exact_delay` verdicts on the (V, f) plane along a wall at angle α.
+def wall_f_region(robot: Robot, controller: Controller, alpha: float, V, f, law: ForceLaw | None = None, model=None) -> RegionGrid:
+    """One model's verdicts on the (V, f) plane along a wall at angle α.
 
     Parameters
     ----------
     robot, controller : Robot, Controller
-        τ, k, W; n, T.
+        τ, k, W; n, T, hold, compute delay.
     alpha : float
         Rad.
     V : array_like, shape (nx,)
@@ -624,8 +710,14 @@ def wall_f_region(robot: Robot, controller: Controller, alpha: float, V, f, law:
     f : array_like, shape (ny,)
         Force ratios (KB eq 13), or the `law`'s scale.
     law : ForceLaw, optional
-        Default KB's power law (`exact_delay_verdicts` directly); another
-        law's N comes from its equilibrium (vectorized bisection).
+        Default KB's power law (N in closed form); another law's N comes
+        from its equilibrium (vectorized bisection).
+    model : LoopModel or str, optional
+        The model whose verdicts are shaded (`region_model`); default the
+        report's verdict model, ``sampled`` with the controller's hold and
+        compute delay. Decided by the model's `Boundary.stable_set` (exact:
+        NV is the only quantity that varies over the plane); ``exact_delay``
+        is decided point by point by the vectorized crossing count.
 
     Returns
     -------
@@ -634,25 +726,37 @@ def wall_f_region(robot: Robot, controller: Controller, alpha: float, V, f, law:
     """
     alpha = check_parameter("alpha", alpha)
     V, f = _array("V", V, "m/s"), _array("f", f)
+    model = region_model(controller, model)
+    axes = ("V", "m/s", "f", "", V, f)
     if law is None or isinstance(law, PowerLaw):
-        n, W = (law.n, law.W) if law is not None else (controller.n, robot.W)
-        r = exact_delay_verdicts(V[None, :], robot.tau, controller.T, robot.k, f[:, None], n, W, alpha=alpha)
-        return RegionGrid("V", "m/s", "f", "", V, f, r.stable, r.NV)
+        n, W = _power_law_parameters(robot, controller, law)[1:]
+        if isinstance(model, ExactDelay):
+            r = exact_delay_verdicts(V[None, :], robot.tau, controller.T, robot.k, f[:, None], n, W, alpha=alpha)
+            return _region(robot, controller, model, axes, r.NV, r.stable)
+        NV = loop_gain_arrays(V[None, :], robot.tau, controller.T, robot.k, f[:, None], n, W, alpha=alpha)[3]
+        return _region(robot, controller, model, axes, NV)
     NV = _wall_gain_general(law, alpha, f[:, None] / law.scale) * V[None, :]
-    return RegionGrid("V", "m/s", "f", "", V, f, _general_verdicts(robot, controller, NV), NV)
+    return _region(robot, controller, model, axes, NV)
 
 
-def wall_alpha_region(robot: Robot, controller: Controller, V, alpha, law: ForceLaw | None = None) -> RegionGrid:
-    """`exact_delay` verdicts on the (V, α) plane along a wall.
+def wall_alpha_region(robot: Robot, controller: Controller, V, alpha, law: ForceLaw | None = None, model=None) -> RegionGrid:
+    """One model's verdicts on the (V, α) plane along a wall.
 
     Parameters
     ----------
+    robot, controller : Robot, Controller
     V : array_like, shape (nx,)
         m/s.
     alpha : array_like, shape (ny,)
         Rad, in (0, π/2).
     law : ForceLaw, optional
         Default KB's power law with the controller's f.
+    model : LoopModel or str, optional
+        The model whose verdicts are shaded (`region_model`); default the
+        report's verdict model, ``sampled`` with the controller's hold and
+        compute delay. Decided by the model's `Boundary.stable_set` (exact:
+        NV is the only quantity that varies over the plane); ``exact_delay``
+        is decided point by point by the vectorized crossing count.
 
     Returns
     -------
@@ -660,25 +764,37 @@ def wall_alpha_region(robot: Robot, controller: Controller, V, alpha, law: Force
         ``stable[i, j]`` at (V[j], α[i]); y in rad.
     """
     V, alpha = _array("V", V, "m/s"), _array("alpha", alpha, "rad")
+    model = region_model(controller, model)
+    axes = ("V", "m/s", "alpha", "rad", V, alpha)
     if law is None or isinstance(law, PowerLaw):
-        f, n, W = (law.f, law.n, law.W) if law is not None else (controller.f, controller.n, robot.W)
-        r = exact_delay_verdicts(V[None, :], robot.tau, controller.T, robot.k, f, n, W, alpha=alpha[:, None])
-        return RegionGrid("V", "m/s", "alpha", "rad", V, alpha, r.stable, r.NV)
+        f, n, W = _power_law_parameters(robot, controller, law)
+        if isinstance(model, ExactDelay):
+            r = exact_delay_verdicts(V[None, :], robot.tau, controller.T, robot.k, f, n, W, alpha=alpha[:, None])
+            return _region(robot, controller, model, axes, r.NV, r.stable)
+        NV = loop_gain_arrays(V[None, :], robot.tau, controller.T, robot.k, f, n, W, alpha=alpha[:, None])[3]
+        return _region(robot, controller, model, axes, NV)
     NV = _wall_gain_general(law, alpha[:, None]) * V[None, :]
-    return RegionGrid("V", "m/s", "alpha", "rad", V, alpha, _general_verdicts(robot, controller, NV), NV)
+    return _region(robot, controller, model, axes, NV)
 
 
-def corridor_region(robot: Robot, controller: Controller, L, V, law: ForceLaw | None = None) -> RegionGrid:
-    """`exact_delay` verdicts on the (L, V) plane in the middle of a corridor (KB §5.4, eq 25).
+def corridor_region(robot: Robot, controller: Controller, L, V, law: ForceLaw | None = None, model=None) -> RegionGrid:
+    """One model's verdicts on the (L, V) plane in the middle of a corridor (KB §5.4, eq 25).
 
     Parameters
     ----------
+    robot, controller : Robot, Controller
     L : array_like, shape (nx,)
         Half-widths, m (> W/2).
     V : array_like, shape (ny,)
         Speeds, m/s.
     law : ForceLaw, optional
         Default KB's power law; otherwise N(L) = −2F_r′(L)/F_a.
+    model : LoopModel or str, optional
+        The model whose verdicts are shaded (`region_model`); default the
+        report's verdict model, ``sampled`` with the controller's hold and
+        compute delay. Decided by the model's `Boundary.stable_set` (exact:
+        NV is the only quantity that varies over the plane); ``exact_delay``
+        is decided point by point by the vectorized crossing count.
 
     Returns
     -------
@@ -686,14 +802,19 @@ def corridor_region(robot: Robot, controller: Controller, L, V, law: ForceLaw | 
         ``stable[i, j]`` at (L[j], V[i]).
     """
     L, V = _array("L", L, "m"), _array("V", V, "m/s")
+    model = region_model(controller, model)
+    axes = ("L", "m", "V", "m/s", L, V)
     if law is None or isinstance(law, PowerLaw):
-        f, n, W = (law.f, law.n, law.W) if law is not None else (controller.f, controller.n, robot.W)
-        r = exact_delay_verdicts(V[:, None], robot.tau, controller.T, robot.k, f, n, W, L=L[None, :])
-        return RegionGrid("L", "m", "V", "m/s", L, V, r.stable, r.NV)
+        f, n, W = _power_law_parameters(robot, controller, law)
+        if isinstance(model, ExactDelay):
+            r = exact_delay_verdicts(V[:, None], robot.tau, controller.T, robot.k, f, n, W, L=L[None, :])
+            return _region(robot, controller, model, axes, r.NV, r.stable)
+        NV = loop_gain_arrays(V[:, None], robot.tau, controller.T, robot.k, f, n, W, L=L[None, :])[3]
+        return _region(robot, controller, model, axes, NV)
     if np.any(L <= robot.W / 2):
         raise ValueError(f"L must exceed W/2 = {robot.W / 2:g} m (the robot must fit)")
     NV = (-2.0 * np.asarray(law.slope(L), dtype=float))[None, :] * V[:, None]
-    return RegionGrid("L", "m", "V", "m/s", L, V, _general_verdicts(robot, controller, NV), NV)
+    return _region(robot, controller, model, axes, NV)
 
 
 # ---------------------------------------------------------- model comparison

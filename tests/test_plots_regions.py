@@ -1,10 +1,14 @@
-"""Region and model-comparison plots (issue 6 'must hold').
+"""Region and model-comparison plots.
 
 Checked on the figure objects (Agg backend, no pixels compared): every plot
 returns its figure, draws into a given ``ax``, never calls ``plt.show()``,
-labels its axes with units, names every model as in DESIGN §4 in the legend
-with the shared `MODEL_STYLE` colour, and marks the CARMEL operating point at
-its coordinates. Small grids keep the plot tests under a few seconds; the
+labels its axes with units, names every model by its `pfm_stability.models`
+name in the legend with the shared `MODEL_STYLE` colour, marks the CARMEL
+operating point at its coordinates, names the shaded model (by default the
+report's verdict model), keeps every legend outside the axes (window extents
+after a draw: a legend may not overlap any axes), draws ``pade`` above
+``exact_delay``, and says in the root locus's legend when a model has no
+marker. Small grids keep the plot tests under a few seconds; the
 notebooks of ``analyses/`` are executed by nbmake (``--nbmake`` in the pytest
 configuration, ``analyses`` in ``testpaths``), so a notebook failure fails CI.
 """
@@ -47,7 +51,7 @@ RES = 40
 
 @pytest.fixture(autouse=True)
 def no_show(monkeypatch):
-    """plt.show() must never be called (DESIGN §7); close figures after each test."""
+    """plt.show() must never be called; close figures after each test."""
 
     def fail(*a, **k):
         raise AssertionError("plt.show() called")
@@ -169,3 +173,130 @@ def test_kb_error_map_plot_marks_exact_value():
     assert "kτ" in ax.get_xlabel() and "T/τ" in ax.get_ylabel()
     fig = plot_kb_error_maps([m, kb_error_map(m.k_tau, m.T_over_tau, ExactDelay())], mark=(0.6, 0.2))
     assert fig.legends
+
+
+# ------------------------------------------------------------------ shaded model, legends, root locus
+SHADED_TEXT = "sampled (command hold, compute delay 1)"
+
+
+def _overlaps(a, b) -> bool:
+    return a.x0 < b.x1 and b.x0 < a.x1 and a.y0 < b.y1 and b.y0 < a.y1
+
+
+def _assert_legends_outside(fig):
+    """No legend (axes or figure) overlaps any visible axes, in display coordinates after a draw (at a low dpi: faster, same geometry)."""
+    fig.set_dpi(40)
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    legends = [a.get_legend() for a in fig.axes if a.get_legend()] + list(fig.legends)
+    assert legends
+    for legend in legends:
+        box = legend.get_window_extent(renderer)
+        for ax in fig.axes:
+            if ax.get_visible():
+                assert not _overlaps(box, ax.get_window_extent(renderer)), (ax.get_title(), [t.get_text() for t in legend.get_texts()][:3])
+
+
+@pytest.mark.parametrize(
+    "plot",
+    [
+        lambda: plot_wall_f_region(ROBOT, CONTROLLER, math.radians(30), resolution=RES),
+        lambda: plot_wall_alpha_critical(ROBOT, CONTROLLER, resolution=RES),
+        lambda: plot_corridor_region(ROBOT, CONTROLLER, resolution=RES),
+        lambda: plot_corridor_L_critical(ROBOT, CONTROLLER, resolution=RES),
+        lambda: plot_corridor_regions(ROBOT, CONTROLLER, resolution=RES),
+        lambda: plot_wall_regions(ROBOT, CONTROLLER, resolution=RES),
+    ],
+    ids=["wall_f", "wall_alpha", "corridor_LV", "corridor_Lstar", "corridor_summary", "wall_summary"],
+)
+def test_region_plots_name_the_shaded_model_and_keep_legends_outside(plot):
+    """Default shading = the report's verdict model, named in the legend (stable and unstable entries) and
+    in a title; legends hide no curve or star; pade is drawn above exact_delay (they coincide for CARMEL)."""
+    fig = plot()
+    legend = fig.legends[0] if fig.legends else fig.axes[0].get_legend()
+    texts = [t.get_text() for t in legend.get_texts()]
+    assert any(t.startswith("stable") and SHADED_TEXT in t and "the report's verdict" in t for t in texts)
+    assert any(t.startswith("unstable") and SHADED_TEXT in t for t in texts)
+    titles = [a.get_title() for a in fig.axes] + ([fig._suptitle.get_text()] if fig._suptitle else [])
+    assert any(f"shaded: {SHADED_TEXT} — the report's verdict" in t for t in titles)
+    _assert_legends_outside(fig)
+    for ax in fig.axes:
+        z = {l.get_label().split(":")[0].split(" ")[0]: l.get_zorder() for l in ax.get_lines() if not l.get_label().startswith("_")}
+        if "pade" in z:
+            assert z["pade"] > z["exact_delay"] and z["kb_first_order"] > z["exact_delay"]
+
+
+def test_region_plot_shades_the_model_asked_for():
+    """shaded="exact_delay": the mesh is the exact_delay map (crossing count) and the legend says so."""
+    from matplotlib.collections import QuadMesh
+
+    from pfm_stability.regions import corridor_region
+
+    L, V = np.linspace(0.45, 2.0, 12), np.linspace(0.05, 2.0, 10)
+    fig, ax = plt.subplots()
+    plot_corridor_region(ROBOT, CONTROLLER, L=L, V=V, shaded="exact_delay", ax=ax)
+    (mesh,) = [c for c in ax.collections if isinstance(c, QuadMesh)]
+    expected = corridor_region(ROBOT, CONTROLLER, L, V, model="exact_delay").stable
+    assert np.array_equal(np.asarray(mesh.get_array()).reshape(expected.shape), expected.astype(float))
+    assert any("shaded: exact_delay (vectorized crossing count)" in t for t in _legend_texts(ax))
+    assert "the report's verdict" not in ax.get_title()
+
+
+def test_other_legends_sit_outside_the_axes():
+    """Root locus, NV* vs k, NV* vs T/τ, the model comparison and a trajectory (target arrow): legend outside."""
+    from pfm_stability.plots.rlocus import plot_critical_gain_vs_k, plot_root_locus
+    from pfm_stability.plots.trajectory import plot_trajectory
+
+    loop = Loop(ROBOT.tau, CONTROLLER.T, ROBOT.k)
+    for fig in (
+        plot_root_locus(loop, hold="command", compute_delay=1),
+        plot_critical_gain_vs_k(0.3, 0.065, np.geomspace(0.5, 10, 5)),
+        plot_critical_gain_vs_delay(0.3, 2.0, np.geomspace(0.05, 2, 5)),
+        plot_model_comparison(0.3, 0.065, 2.0, ks=np.geomspace(0.5, 10, 5), T_over_tau=np.geomspace(0.05, 2, 5)),
+        plot_trajectory(_straight_run(), title="a run with a target at infinity (arrow)"),
+    ):
+        _assert_legends_outside(fig)
+        plt.close(fig)
+
+
+def _straight_run():
+    """A minimal recorded run (what `plot_trajectory` reads): 4 s straight up an analytic corridor, target at infinity.
+
+    Built by hand so that this legend test does not depend on the simulator.
+    """
+    from types import SimpleNamespace
+
+    t = np.linspace(0.0, 4.0, 41)
+    trajectory = SimpleNamespace(x=np.zeros_like(t), y=0.8 * t, t=t, at_times=lambda ts: (np.zeros(len(ts)), 0.8 * np.asarray(ts)))
+    walls = [SimpleNamespace(p0=(x, -1.0), p1=(x, 5.0)) for x in (-0.9, 0.9)]
+    scenario = SimpleNamespace(env="analytic", environment=SimpleNamespace(walls=walls), robot=ROBOT, name="straight",
+                               start=SimpleNamespace(x=0.0, y=0.0), target=SimpleNamespace(is_point=False, angle=0.0))
+    return SimpleNamespace(trajectory=trajectory, scenario=scenario, events=[])
+
+
+def test_root_locus_says_when_a_model_has_no_marker():
+    """NV* = 0 (command hold, kT = 2.6): "unstable at any NV … no marker" and nothing drawn; a stable set that
+    does not start at 0 is listed; a crossing outside the view and NV* = ∞ are named too."""
+    from pfm_stability.models import Boundary
+    from pfm_stability.plots.common import MODEL_STYLE
+    from pfm_stability.plots.rlocus import crossing_text, plot_root_locus
+
+    fig = plot_root_locus(Loop(0.3, 0.065, 40.0), hold="command", compute_delay=0)
+    ax = fig.axes[0]
+    (entry,) = [l for l in ax.get_lines() if l.get_label().startswith("sampled")]
+    assert "unstable at any NV" in entry.get_label() and "no marker" in entry.get_label()
+    assert len(entry.get_xdata()) == 0
+    green = to_hex(MODEL_STYLE["sampled"]["color"])
+    assert not any(len(l.get_xdata()) and to_hex(l.get_markeredgecolor()) == green for l in ax.get_lines())
+    for name in ("pade", "exact_delay", "kb_first_order"):  # these do cross: markers at ±jω*
+        (line,) = [l for l in ax.get_lines() if l.get_label().startswith(name)]
+        assert len(line.get_xdata()) == 2 and "ω* =" in line.get_label()
+
+    gap = Sampled("command", 0)
+    text, marked = crossing_text(gap, gap.boundary(Loop(0.03, 0.2, 15.0)))
+    assert not marked and "stable only for NV in (1.622, 3.823) 1/s (no marker)" in text
+    carmel = Sampled("command", 1)
+    text, marked = crossing_text(carmel, carmel.boundary(Loop(0.3, 0.065, 2.0)), omega_max=1.0)
+    assert not marked and "outside the view: no marker" in text
+    text, marked = crossing_text(carmel, Boundary("sampled", math.inf, None, math.inf, ((0.0, math.inf),)))
+    assert not marked and "stable at every NV" in text

@@ -1,4 +1,4 @@
-"""Stability regions and boundary curves (`pfm_stability.regions`, issue 6).
+"""Stability regions and boundary curves (`pfm_stability.regions`).
 
 Every curve is checked by routes that do not share its algebra:
 
@@ -7,9 +7,10 @@ Every curve is checked by routes that do not share its algebra:
   point, with NV* from the model's own `boundary`;
 * the model's `is_stable` (Routh, Schur–Cohn/eigenvalues, crossing count —
   not the boundary) must flip across the curve, on the side the curve states;
-* the dense `exact_delay` map (vectorized crossing count, `vectorized`) must
-  change verdict exactly where the `exact_delay` curve crosses each grid line,
-  to the grid resolution;
+* the dense `exact_delay` map (vectorized crossing count, `vectorized`; asked
+  for with ``model="exact_delay"``, the maps shade the report's verdict model
+  by default, see test_region_shading.py) must change verdict exactly where
+  the `exact_delay` curve crosses each grid line, to the grid resolution;
 * closed forms (power law) against the general-law bisection, and α* against
   `criteria.critical_alpha` (scalar bisection on α).
 
@@ -74,7 +75,7 @@ class Opaque(ForceLaw):
 
 
 def test_default_models_are_the_five_design_models():
-    """DESIGN §4: continuous, kb_first_order, pade, exact_delay, sampled (controller's structure)."""
+    """The five models: continuous, kb_first_order, pade, exact_delay, sampled (controller's structure)."""
     assert [m.name for m in MODELS] == ["continuous", "kb_first_order", "pade", "exact_delay", "sampled"]
     assert (MODELS[-1].hold, MODELS[-1].compute_delay) == (CONTROLLER.hold, CONTROLLER.compute_delay)
 
@@ -168,9 +169,9 @@ def test_general_law_region_equals_vectorized_power_law_region():
     Vg, fg = np.linspace(0.05, 2, 40), np.geomspace(0.01, 100, 30)
     ag, Lg = np.radians(np.linspace(2, 88, 30)), np.linspace(0.45, 2, 30)
     for a, b in [
-        (wall_f_region(ROBOT, CONTROLLER, math.radians(30), Vg, fg), wall_f_region(ROBOT, CONTROLLER, math.radians(30), Vg, fg, law=opaque)),
-        (wall_alpha_region(ROBOT, CONTROLLER, Vg, ag), wall_alpha_region(ROBOT, CONTROLLER, Vg, ag, law=opaque)),
-        (corridor_region(ROBOT, CONTROLLER, Lg, Vg), corridor_region(ROBOT, CONTROLLER, Lg, Vg, law=opaque)),
+        (wall_f_region(ROBOT, CONTROLLER, math.radians(30), Vg, fg, model="exact_delay"), wall_f_region(ROBOT, CONTROLLER, math.radians(30), Vg, fg, law=opaque, model="exact_delay")),
+        (wall_alpha_region(ROBOT, CONTROLLER, Vg, ag, model="exact_delay"), wall_alpha_region(ROBOT, CONTROLLER, Vg, ag, law=opaque, model="exact_delay")),
+        (corridor_region(ROBOT, CONTROLLER, Lg, Vg, model="exact_delay"), corridor_region(ROBOT, CONTROLLER, Lg, Vg, law=opaque, model="exact_delay")),
     ]:
         np.testing.assert_allclose(b.NV, a.NV, rtol=1e-12)
         assert np.array_equal(a.stable, b.stable)
@@ -196,7 +197,7 @@ def test_wall_f_shading_edge_matches_exact_delay_curve():
     """(V, f) map at α = 30°: the exact_delay verdicts flip between the f grid values bracketing f*(V)."""
     alpha = math.radians(30.0)
     Vg, fg = np.linspace(0.02, 2.0, 120), np.geomspace(0.01, 100.0, 150)
-    region = wall_f_region(ROBOT, CONTROLLER, alpha, Vg, fg)
+    region = wall_f_region(ROBOT, CONTROLLER, alpha, Vg, fg, model="exact_delay")
     (curve,) = wall_f_curves(ROBOT, CONTROLLER, alpha, Vg, [ExactDelay()])
     _edge_brackets_curve(region.stable, fg, curve.y, stable_above=True)
 
@@ -205,7 +206,7 @@ def test_wall_alpha_shading_edge_matches_exact_delay_curve():
     """(V, α) map: the verdicts flip between the α grid values bracketing α*(V), for both laws."""
     Vg, ag = np.linspace(0.02, 2.0, 80), np.radians(np.linspace(0.5, 89.5, 120))
     for law in (None, GRID_LAW):
-        region = wall_alpha_region(ROBOT, CONTROLLER, Vg, ag, law=law)
+        region = wall_alpha_region(ROBOT, CONTROLLER, Vg, ag, law=law, model="exact_delay")
         (curve,) = wall_alpha_curves(ROBOT, CONTROLLER, Vg, [ExactDelay()], law=law)
         _edge_brackets_curve(region.stable, ag, curve.y, stable_above=True)
 
@@ -213,7 +214,7 @@ def test_wall_alpha_shading_edge_matches_exact_delay_curve():
 def test_corridor_shading_edge_matches_exact_delay_curve():
     """(L, V) map: the verdicts flip between the V grid values bracketing V*(L) (stable below)."""
     Lg, Vg = np.linspace(0.41, 2.0, 100), np.linspace(0.02, 2.0, 130)
-    region = corridor_region(ROBOT, CONTROLLER, Lg, Vg)
+    region = corridor_region(ROBOT, CONTROLLER, Lg, Vg, model="exact_delay")
     (curve,) = corridor_V_curves(ROBOT, CONTROLLER, Lg, [ExactDelay()])
     _edge_brackets_curve(region.stable, Vg, curve.y, stable_above=False)
 

@@ -1,18 +1,20 @@
-"""Model comparison plots: how the five loop models differ, and where KB's criterion errs (issue 6).
+"""Model comparison plots: how the five loop models differ, and where KB's criterion errs.
 
 * `plot_critical_gain_vs_delay`: NV* against T/τ for every model and every
-  sampled structure (hold × compute delay; DESIGN §4). KB's eq (20) gives
+  sampled structure (hold × compute delay). KB's eq (20) gives
   NV* = 1/(τ + T).
 * `plot_kb_error_map`: NV*_KB/NV*_model − 1 over (kτ, T/τ) (`regions.kb_error_map`):
   red where KB's criterion is optimistic (it calls stable a loop that
   oscillates), blue where it is conservative.
 * `plot_kb_error_maps`: one map per reference model, one colour bar.
 * `plot_model_comparison`: NV* versus k (`plots.rlocus.plot_critical_gain_vs_k`)
-  and versus T/τ side by side.
+  and versus T/τ side by side, one legend below.
 
 Model styles follow `plots.common.MODEL_STYLE`; the four sampled structures
 are told apart as in `plots.rlocus`: solid = command hold, dashed =
-reference hold; thick = compute_delay 0, thin = 1.
+reference hold; thick = compute_delay 0, thin = 1. Broken lines are drawn
+above solid ones (`plots.common.MODEL_ZORDER`), so ``pade`` stays visible
+where it coincides with ``exact_delay``; legends sit outside the axes.
 """
 
 from __future__ import annotations
@@ -23,7 +25,7 @@ import numpy as np
 
 from ..models import Loop
 from ..regions import GainCurve, KBErrorMap, critical_gain_vs_delay, kb_relative_error
-from .common import figure_and_axes, model_label, model_style
+from .common import MODEL_ZORDER, figure_and_axes, model_label, model_style, outside_legend
 
 __all__ = [
     "plot_critical_gain_vs_delay",
@@ -36,7 +38,17 @@ _RATIO_LIMIT = 2.0
 """Colour scale of the error maps: log2(NV*_KB/NV*) clipped to ±2 (KB off by 4×)."""
 
 
-def plot_critical_gain_vs_delay(tau: float, k: float, T_over_tau=None, *, curves: list[GainCurve] | None = None, mark: float | None = None, mark_label: str = "CARMEL", ax=None):
+def plot_critical_gain_vs_delay(
+    tau: float,
+    k: float,
+    T_over_tau=None,
+    *,
+    curves: list[GainCurve] | None = None,
+    mark: float | None = None,
+    mark_label: str = "CARMEL",
+    ax=None,
+    legend: bool = True,
+):
     """NV* (1/s) against the sampling period T/τ for all models (KB eq 20: NV* = 1/(τ + T)).
 
     Parameters
@@ -52,18 +64,20 @@ def plot_critical_gain_vs_delay(tau: float, k: float, T_over_tau=None, *, curves
     mark : float, optional
         A T/τ to mark with a vertical line (e.g. CARMEL's 0.065/0.3).
     ax : matplotlib Axes, optional
+    legend : bool
+        Draw the legend outside the axes, on the right.
 
     Returns
     -------
     matplotlib.figure.Figure
     """
-    fig, ax = figure_and_axes(ax, (6.4, 4.6))
+    fig, ax = figure_and_axes(ax, (8.6, 4.6) if legend else (6.4, 4.6))
     if curves is None:
         T_over_tau = np.geomspace(0.01, 3.0, 60) if T_over_tau is None else T_over_tau
         curves = critical_gain_vs_delay(tau, k, T_over_tau)
     for c in curves:
         values = np.where(np.isfinite(c.NV_critical) & (c.NV_critical > 0), c.NV_critical, np.nan)
-        ax.plot(c.x, values, label=model_label(c.model), **model_style(c.model))
+        ax.plot(c.x, values, label=model_label(c.model), zorder=MODEL_ZORDER[c.model.name], **model_style(c.model))
     if mark is not None:
         ax.axvline(mark, color="k", lw=0.9, ls=":")
         ax.annotate(f"{mark_label}: T/τ = {mark:.3g}", (mark, 0.02), xycoords=("data", "axes fraction"), xytext=(4, 0), textcoords="offset points", fontsize=8)
@@ -73,7 +87,8 @@ def plot_critical_gain_vs_delay(tau: float, k: float, T_over_tau=None, *, curves
     ax.set_ylabel("critical NV* (1/s)")
     ax.set_title(f"Critical gain vs sampling period: τ = {tau:g} s, k = {k:g} 1/s\nKB eq (20): NV* = 1/(τ + T)", fontsize=9)
     ax.grid(alpha=0.3, which="both")
-    ax.legend(fontsize=7, loc="lower left")
+    if legend:
+        outside_legend(ax)
     return fig
 
 
@@ -199,7 +214,20 @@ def plot_kb_error_maps(maps: list[KBErrorMap], *, mark: tuple[float, float] | No
 
 
 def plot_model_comparison(tau: float, T: float, k: float, *, ks=None, T_over_tau=None, pade_order: int = 3):
-    """NV* versus k and versus T/τ for all models, side by side, the operating point marked.
+    """NV* versus k and versus T/τ for all models, side by side, the operating point marked, one legend below.
+
+    Parameters
+    ----------
+    tau, T : float
+        Steering time constant and sampling period, s.
+    k : float
+        Steering gain, 1/s.
+    ks : array_like, optional
+        Steering gains of the left panel, 1/s.
+    T_over_tau : array_like, optional
+        Sampling periods of the right panel, in units of τ.
+    pade_order : int
+        Order m of the ``pade`` model.
 
     Returns
     -------
@@ -209,9 +237,10 @@ def plot_model_comparison(tau: float, T: float, k: float, *, ks=None, T_over_tau
 
     from .rlocus import plot_critical_gain_vs_k
 
-    fig, (a, b) = plt.subplots(1, 2, figsize=(12, 4.8), layout="constrained")
-    plot_critical_gain_vs_k(tau, T, ks, pade_order=pade_order, ax=a)
+    fig, (a, b) = plt.subplots(1, 2, figsize=(12, 5.4), layout="constrained")
+    plot_critical_gain_vs_k(tau, T, ks, pade_order=pade_order, ax=a, legend=False)
     a.axvline(k, color="k", lw=0.9, ls=":")
     a.annotate(f"k = {k:g} 1/s", (k, 0.02), xycoords=("data", "axes fraction"), xytext=(4, 0), textcoords="offset points", fontsize=8)
-    plot_critical_gain_vs_delay(tau, k, T_over_tau, mark=T / tau, ax=b)
+    plot_critical_gain_vs_delay(tau, k, T_over_tau, mark=T / tau, ax=b, legend=False)
+    fig.legend(*a.get_legend_handles_labels(), loc="outside lower center", ncol=4, fontsize=8, frameon=False)
     return fig

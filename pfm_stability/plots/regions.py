@@ -1,11 +1,14 @@
-"""Stability-region plots: where the robot is safe near a wall and in a corridor (issue 6).
+"""Stability-region plots: where the robot is safe near a wall and in a corridor.
 
-Each panel shades the `exact_delay` verdicts of a dense grid (green stable,
-red unstable; `pfm_stability.regions`, vectorized crossing count of KB eq 18)
-and draws every model's boundary curve in its DESIGN §4 style
-(`plots.common.MODEL_STYLE`), with the operating points of KB's CARMEL runs
-marked (Koren & Borenstein 1991 Figs 5 and 6). Computation lives in
-`pfm_stability.regions`; these functions only draw.
+Each panel shades one model's verdicts on a dense grid (green stable, red
+unstable; `pfm_stability.regions`) and draws every model's boundary curve in
+its own style (`plots.common.MODEL_STYLE`), with the operating points of KB's
+CARMEL runs marked (Koren & Borenstein 1991 Figs 5 and 6). The shaded model
+is by default the one the stability report's verdict uses (``sampled`` with
+the controller's hold and compute delay, `regions.verdict_model`); the title
+and the legend name it. Legends sit outside the axes, so they hide no curve,
+operating point or label. Computation lives in `pfm_stability.regions`; these
+functions only draw.
 
 * `plot_wall_f_region`: (V, f) plane at one α; stable above f*(V) (KB eq 24).
 * `plot_wall_alpha_critical`: α*(V); stable above (KB eq 21, 23).
@@ -20,6 +23,7 @@ marked (Koren & Borenstein 1991 Figs 5 and 6). Computation lives in
 from __future__ import annotations
 
 import math
+import weakref
 
 import numpy as np
 
@@ -30,12 +34,14 @@ from ..regions import (
     corridor_region,
     corridor_V_curves,
     default_models,
+    region_model,
+    verdict_model,
     wall_alpha_curves,
     wall_alpha_region,
     wall_f_curves,
     wall_f_region,
 )
-from .common import MODEL_STYLE, figure_and_axes, model_label
+from .common import MODEL_STYLE, MODEL_ZORDER, figure_and_axes, model_description, model_label, outside_legend
 
 __all__ = [
     "MARK_LABEL",
@@ -49,13 +55,18 @@ __all__ = [
     "plot_corridor_regions",
     "plot_simulated_boundary",
     "region_legend",
+    "shading_text",
 ]
 
 STABLE_COLOR = "#dcefd6"
 UNSTABLE_COLOR = "#f7d9d6"
 MARK_LABEL = "CARMEL operating point (KB §4–5)"
-_MARK = dict(marker="*", ms=15, mfc="gold", mec="k", mew=1.0, ls="none", zorder=6)
+_MARK = dict(marker="*", ms=13, mfc="gold", mec="k", mew=1.0, ls="none", zorder=6)
 _NOFIT = dict(facecolor="0.85", edgecolor="0.55", hatch="///", lw=0)
+_SINGLE = (6.4, 4.8)
+_WITH_LEGEND = (9.6, 4.8)
+_SHADED = weakref.WeakKeyDictionary()
+"""Axes → text of the model its shading shows (read by `region_legend`)."""
 
 V_LABEL = "speed V (m/s)"
 F_LABEL = "force ratio f = F_cr/F_ct (dimensionless, KB eq 13)"
@@ -65,14 +76,40 @@ L_STAR_LABEL = "corridor half-width L (m); curves: critical L*(V)"
 
 
 # ------------------------------------------------------------------ pieces
-def _shade(ax, region, y_scale=1.0):
-    """Shade the exact_delay verdicts (green stable, red unstable)."""
+def shading_text(model, controller: Controller) -> str:
+    """What a shaded map shows, for titles and legends.
+
+    E.g. ``sampled (command hold, compute delay 1) — the report's verdict``
+    when `model` is the report's verdict model (`regions.verdict_model`),
+    ``exact_delay (vectorized crossing count)`` for ``exact_delay``.
+
+    Parameters
+    ----------
+    model : LoopModel
+    controller : Controller
+        Decides the report's verdict model (its hold and compute delay).
+
+    Returns
+    -------
+    str
+    """
+    text = model_description(model)
+    if model == verdict_model(controller):
+        return f"{text} — the report's verdict"
+    if model.name == "exact_delay":
+        return f"{text} (vectorized crossing count)"
+    return text
+
+
+def _shade(ax, region, text: str, y_scale=1.0):
+    """Shade the region's verdicts (green stable, red unstable); `text` names the shaded model."""
     from matplotlib.colors import ListedColormap
 
     ax.pcolormesh(
         region.x, region.y * y_scale, region.stable.astype(float), shading="nearest",
         cmap=ListedColormap([UNSTABLE_COLOR, STABLE_COLOR]), vmin=0, vmax=1, rasterized=True, zorder=0,
     )
+    _SHADED[ax] = text
 
 
 def _curve_label(curve) -> str:
@@ -85,39 +122,84 @@ def _draw_curves(ax, curves, *, swap=False, y_scale=1.0):
         y = np.where(np.isfinite(y), y, np.nan)
         if swap:
             x, y = y, x
-        ax.plot(x, y, label=_curve_label(c), zorder=3, **MODEL_STYLE[c.model.name])
+        ax.plot(x, y, label=_curve_label(c), zorder=MODEL_ZORDER[c.model.name], **MODEL_STYLE[c.model.name])
 
 
 def _mark(ax, x, y, text, *, label=None, offset=(7, 5)):
+    """A star at (x, y) with `text` at `offset` (points; negative x: text left of the star)."""
     ax.plot([x], [y], label=label, **_MARK)
     if text:
-        ax.annotate(text, (x, y), xytext=offset, textcoords="offset points", fontsize=8,
-                    bbox=dict(boxstyle="round,pad=0.2", fc="white", ec="none", alpha=0.8), zorder=7)
+        # below the curves (zorder 3.x): a label box must not hide a boundary
+        ax.annotate(text, (x, y), xytext=offset, textcoords="offset points", fontsize=8, ha="right" if offset[0] < 0 else "left",
+                    va="top" if offset[1] < 0 else "baseline",
+                    bbox=dict(boxstyle="round,pad=0.2", fc="white", ec="none", alpha=0.6), zorder=2.5)
 
 
-def region_legend(ax=None, *, fig=None, ncol=1, loc="best", fontsize=8, **kwargs):
-    """Legend with the model curves, the CARMEL mark and the shading proxies.
+def _marks(ax, marks, point, offsets):
+    """Draw `marks` ((value, text) or (value, text, offset)); `point(value)` gives (x, y)."""
+    for i, m in enumerate(marks or ()):
+        offset = m[2] if len(m) > 2 else offsets.get(m[0], (7, 5))
+        _mark(ax, *point(m[0]), m[1], label=MARK_LABEL if i == 0 else None, offset=offset)
 
-    Draws into `fig` (a figure legend) when given, else into `ax`.
-    """
+
+def _shading_entries(texts):
     from matplotlib.patches import Patch
 
-    source = ax if ax is not None else fig.axes[0]
-    handles, labels = source.get_legend_handles_labels()
+    handles, labels = [], []
+    for text in texts:
+        handles += [Patch(fc=STABLE_COLOR, ec="0.6"), Patch(fc=UNSTABLE_COLOR, ec="0.6")]
+        model, _, why = text.partition(" — ")
+        labels += [f"stable, shaded: {model}" + (f"\n— {why}" if why else ""), f"unstable (oscillates), shaded: {model}"]
+    return handles, labels
+
+
+def region_legend(ax=None, *, fig=None, ncol=1, loc=None, fontsize=8, **kwargs):
+    """Legend with the model curves, the CARMEL mark and the shading (naming the shaded model).
+
+    Draws into `fig` (a figure legend, default below the panels) when given,
+    else into `ax` (default outside the axes, on the right): a legend inside
+    the axes would hide curves or operating points.
+
+    Parameters
+    ----------
+    ax : matplotlib Axes, optional
+    fig : matplotlib Figure, optional
+        Its axes' entries are merged (each label once).
+    ncol : int
+    loc : str, optional
+        Legend location (default: outside, see above).
+    fontsize : float
+        Points.
+    **kwargs
+        Passed to ``legend``.
+
+    Returns
+    -------
+    matplotlib.legend.Legend
+    """
+    sources = [ax] if ax is not None else [a for a in fig.axes if a.get_visible()]
     seen = {}
-    for h, l in zip(handles, labels):
-        seen.setdefault(l, h)
+    for source in sources:
+        for h, l in zip(*source.get_legend_handles_labels()):
+            seen.setdefault(l, h)
     handles, labels = list(seen.values()), list(seen)
-    handles += [Patch(fc=STABLE_COLOR, ec="0.6"), Patch(fc=UNSTABLE_COLOR, ec="0.6")]
-    labels += ["stable (exact_delay verdicts, dense grid)", "unstable (exact_delay verdicts)"]
+    shaded = list(dict.fromkeys(_SHADED[a] for a in sources if a in _SHADED))
+    more_handles, more_labels = _shading_entries(shaded)
+    handles, labels = handles + more_handles, labels + more_labels
     if fig is not None:
-        return fig.legend(handles, labels, ncol=ncol, loc=loc, fontsize=fontsize, frameon=False, **kwargs)
+        return fig.legend(handles, labels, ncol=ncol, loc=loc or "outside lower center", fontsize=fontsize, frameon=False, **kwargs)
+    if loc is None:
+        return outside_legend(ax, handles, labels, ncol=ncol, fontsize=fontsize, **kwargs)
     return ax.legend(handles, labels, ncol=ncol, loc=loc, fontsize=fontsize, framealpha=0.9, **kwargs)
 
 
 def _loop_text(robot: Robot, controller: Controller, law: ForceLaw | None = None) -> str:
     law_text = f"f = {controller.f:g}, n = {controller.n:g}" if law is None or isinstance(law, PowerLaw) else f"{law.name}"
     return f"τ = {robot.tau:g} s, T = {controller.T:g} s, k = {robot.k:g} 1/s, W = {robot.W:g} m, {law_text}"
+
+
+def _title(text, shaded_text=None):
+    return text if shaded_text is None else f"{text}\nshaded: {shaded_text}"
 
 
 def _style_axes(ax, xlabel, ylabel, title):
@@ -146,6 +228,7 @@ def plot_wall_f_region(
     V=None,
     f=None,
     models=None,
+    shaded=None,
     ax=None,
     legend: bool = True,
     mark: bool = True,
@@ -153,9 +236,9 @@ def plot_wall_f_region(
 ):
     """Stable and unstable regions along a wall in the (V, f) plane at one target angle α.
 
-    Shading: `exact_delay` verdicts (`regions.wall_f_region`); curves: f*(V)
-    of every model (`regions.wall_f_curves`, KB eq 24 with the model's NV*);
-    stable above the curves. KB's power law.
+    Shading: the verdicts of the `shaded` model (`regions.wall_f_region`);
+    curves: f*(V) of every model (`regions.wall_f_curves`, KB eq 24 with the
+    model's NV*); stable above the curves. KB's power law.
 
     Parameters
     ----------
@@ -169,9 +252,14 @@ def plot_wall_f_region(
     f : array_like, optional
         Force ratios (default 300 log-spaced points in [0.01, 100]).
     models : list of LoopModel, optional
-        Default `regions.default_models(controller)`.
+        Curves drawn; default `regions.default_models(controller)`.
+    shaded : LoopModel or str, optional
+        The model whose verdicts are shaded (`regions.region_model`); default
+        the report's verdict model, ``sampled`` with the controller's hold
+        and compute delay. Named in the title and the legend.
     ax : matplotlib Axes, optional
     legend : bool
+        Draw the legend outside the axes, on the right.
     mark : bool
         Mark (robot.V, controller.f).
     resolution : int
@@ -181,22 +269,25 @@ def plot_wall_f_region(
     -------
     matplotlib.figure.Figure
     """
-    fig, ax = figure_and_axes(ax, (6.4, 4.8))
+    fig, ax = figure_and_axes(ax, _WITH_LEGEND if legend else _SINGLE)
     V = np.linspace(0.02, 2.0, resolution) if V is None else np.asarray(V, dtype=float)
     f = np.geomspace(0.01, 100.0, resolution) if f is None else np.asarray(f, dtype=float)
     models = default_models(controller) if models is None else models
-    _shade(ax, wall_f_region(robot, controller, alpha, V, f))
+    shaded = region_model(controller, shaded)
+    text = shading_text(shaded, controller)
+    _shade(ax, wall_f_region(robot, controller, alpha, V, f, model=shaded), text)
     _draw_curves(ax, wall_f_curves(robot, controller, alpha, V, models))
     if mark:
-        _mark(ax, robot.V, controller.f, f"CARMEL: V = {robot.V:g} m/s, f = {controller.f:g}", label=MARK_LABEL)
+        _mark(ax, robot.V, controller.f, "CARMEL", label=MARK_LABEL, offset=(-8, 6))
     ax.set_yscale("log")
     ax.set_xlim(V[0], V[-1])
     ax.set_ylim(f[0], f[-1])
-    _style_axes(ax, V_LABEL, F_LABEL, f"Wall, α = {math.degrees(alpha):.3g}°: stable above f*(V) (KB eq 24)\n{_loop_text(robot, controller)}")
+    title = f"Wall, α = {math.degrees(alpha):.3g}°: stable above f*(V) (KB eq 24)\n{_loop_text(robot, controller)}"
+    _style_axes(ax, V_LABEL, F_LABEL, _title(title, text))
     ax.text(0.03, 0.96, "stable", transform=ax.transAxes, va="top", fontsize=10, color="#2a6a1f", weight="bold")
     ax.text(0.97, 0.04, "oscillates", transform=ax.transAxes, ha="right", fontsize=10, color="#9b2b22", weight="bold")
     if legend:
-        region_legend(ax, loc="lower right", fontsize=7, bbox_to_anchor=(1.0, 0.08))
+        region_legend(ax, fontsize=7)
     return fig
 
 
@@ -208,6 +299,7 @@ def plot_wall_alpha_critical(
     models=None,
     law: ForceLaw | None = None,
     marks=((20.0, "KB Fig 5: α = 20°"), (50.0, "before the corner: α = 50°")),
+    shaded=None,
     ax=None,
     legend: bool = True,
     shade: bool = True,
@@ -224,33 +316,44 @@ def plot_wall_alpha_critical(
     law : ForceLaw, optional
         Default KB's power law with the controller's f; e.g. the grid's
         effective law to compare with the grid simulator.
-    marks : sequence of (alpha_deg, text)
-        Operating points (robot.V, α) to mark (default KB Fig 5's corner run).
+    marks : sequence of (alpha_deg, text) or (…, text, (dx, dy))
+        Operating points (robot.V, α) to mark (default KB Fig 5's corner run);
+        an optional offset places the text, points from the star.
+    shaded : LoopModel or str, optional
+        The model whose verdicts are shaded (default the report's verdict
+        model, see `plot_wall_f_region`).
     ax : matplotlib Axes, optional
-    legend, shade : bool
+    legend : bool
+        Draw the legend outside the axes, on the right.
+    shade : bool
+        Shade the `shaded` model's verdicts.
     resolution : int
+        Grid points per axis of the shading.
 
     Returns
     -------
     matplotlib.figure.Figure
     """
-    fig, ax = figure_and_axes(ax, (6.4, 4.8))
+    fig, ax = figure_and_axes(ax, _WITH_LEGEND if legend else _SINGLE)
     V = np.linspace(0.02, 2.0, resolution) if V is None else np.asarray(V, dtype=float)
     models = default_models(controller) if models is None else models
+    text = None
     if shade:
+        shaded = region_model(controller, shaded)
+        text = shading_text(shaded, controller)
         alpha = np.radians(np.linspace(0.2, 89.8, resolution))
-        _shade(ax, wall_alpha_region(robot, controller, V, alpha, law=law), y_scale=180 / math.pi)
+        _shade(ax, wall_alpha_region(robot, controller, V, alpha, law=law, model=shaded), text, y_scale=180 / math.pi)
     _draw_curves(ax, wall_alpha_curves(robot, controller, V, models, law=law), y_scale=180 / math.pi)
-    for i, (a, text) in enumerate(marks or ()):
-        _mark(ax, robot.V, a, text, label=MARK_LABEL if i == 0 else None)
+    _marks(ax, marks, lambda a: (robot.V, a), {50.0: (-8, 6)})
     ax.set_xlim(V[0], V[-1])
     ax.set_ylim(0, 90)
     ax.set_yticks(range(0, 91, 15))
-    _style_axes(ax, V_LABEL, ALPHA_LABEL, f"Wall: stable above α*(V) (KB eq 21 with eq 23)\n{_loop_text(robot, controller, law)}")
+    title = f"Wall: stable above α*(V) (KB eq 21 with eq 23)\n{_loop_text(robot, controller, law)}"
+    _style_axes(ax, V_LABEL, ALPHA_LABEL, _title(title, text))
     ax.text(0.03, 0.96, "stable", transform=ax.transAxes, va="top", fontsize=10, color="#2a6a1f", weight="bold")
     ax.text(0.97, 0.04, "oscillates", transform=ax.transAxes, ha="right", fontsize=10, color="#9b2b22", weight="bold")
     if legend:
-        region_legend(ax, loc="upper left", fontsize=7, bbox_to_anchor=(0.0, 0.9)) if shade else ax.legend(fontsize=7)
+        region_legend(ax, fontsize=7)
     return fig
 
 
@@ -264,6 +367,7 @@ def plot_corridor_region(
     models=None,
     law: ForceLaw | None = None,
     marks=((0.9, "KB Fig 6a\n(wide)"), (0.6, "KB Fig 6b\n(narrow)")),
+    shaded=None,
     ax=None,
     legend: bool = True,
     shade: bool = True,
@@ -271,8 +375,9 @@ def plot_corridor_region(
 ):
     """Stable and unstable regions in the middle of a corridor, (L, V) plane: stable below V*(L).
 
-    Shading: `exact_delay` verdicts (`regions.corridor_region`); curves:
-    V*(L) = NV*/N(L) of every model (`regions.corridor_V_curves`; KB eq 25).
+    Shading: the verdicts of the `shaded` model (`regions.corridor_region`);
+    curves: V*(L) = NV*/N(L) of every model (`regions.corridor_V_curves`;
+    KB eq 25).
 
     Parameters
     ----------
@@ -284,35 +389,46 @@ def plot_corridor_region(
     models : list of LoopModel, optional
     law : ForceLaw, optional
         Default KB's power law.
-    marks : sequence of (L, text)
+    marks : sequence of (L, text) or (…, text, (dx, dy))
         Operating points (L, robot.V) to mark (default KB Fig 6's corridors
-        after the step, L = 0.9 m and 0.6 m).
+        after the step, L = 0.9 m and 0.6 m); an optional offset places the
+        text, points from the star.
+    shaded : LoopModel or str, optional
+        The model whose verdicts are shaded (default the report's verdict
+        model, see `plot_wall_f_region`).
     ax : matplotlib Axes, optional
-    legend, shade : bool
+    legend : bool
+        Draw the legend outside the axes, on the right.
+    shade : bool
+        Shade the `shaded` model's verdicts.
     resolution : int
+        Grid points per axis of the shading.
 
     Returns
     -------
     matplotlib.figure.Figure
     """
-    fig, ax = figure_and_axes(ax, (6.4, 4.8))
+    fig, ax = figure_and_axes(ax, _WITH_LEGEND if legend else _SINGLE)
     lo = robot.W / 2
     L = np.linspace(lo * 1.0005, 2.0, resolution) if L is None else np.asarray(L, dtype=float)
     V = np.linspace(0.02, 2.0, resolution) if V is None else np.asarray(V, dtype=float)
     models = default_models(controller) if models is None else models
+    text = None
     if shade:
-        _shade(ax, corridor_region(robot, controller, L, V, law=law))
+        shaded = region_model(controller, shaded)
+        text = shading_text(shaded, controller)
+        _shade(ax, corridor_region(robot, controller, L, V, law=law, model=shaded), text)
     _draw_curves(ax, corridor_V_curves(robot, controller, L, models, law=law))
-    for i, (Lm, text) in enumerate(marks or ()):
-        _mark(ax, Lm, robot.V, text, label=MARK_LABEL if i == 0 else None)
+    _marks(ax, marks, lambda Lm: (Lm, robot.V), {0.9: (8, -8), 0.6: (-8, 6)})
     ax.set_xlim(min(L[0], lo) - 0.1, L[-1])
     ax.set_ylim(V[0], V[-1])
     _no_fit_band(ax, robot.W, vertical=True)
-    _style_axes(ax, L_LABEL, V_LABEL, f"Corridor: stable below V*(L) = NV*/N(L) (KB eq 25)\n{_loop_text(robot, controller, law)}")
+    title = f"Corridor: stable below V*(L) = NV*/N(L) (KB eq 25)\n{_loop_text(robot, controller, law)}"
+    _style_axes(ax, L_LABEL, V_LABEL, _title(title, text))
     ax.text(0.97, 0.04, "stable", transform=ax.transAxes, ha="right", fontsize=10, color="#2a6a1f", weight="bold")
     ax.text(0.25, 0.96, "oscillates", transform=ax.transAxes, va="top", fontsize=10, color="#9b2b22", weight="bold")
     if legend:
-        region_legend(ax, loc="upper right", fontsize=7) if shade else ax.legend(fontsize=7, loc="upper left")
+        region_legend(ax, fontsize=7)
     return fig
 
 
@@ -324,6 +440,7 @@ def plot_corridor_L_critical(
     models=None,
     law: ForceLaw | None = None,
     marks=((0.9, "KB Fig 6a\n(wide)"), (0.6, "KB Fig 6b\n(narrow)")),
+    shaded=None,
     ax=None,
     legend: bool = True,
     shade: bool = True,
@@ -338,45 +455,79 @@ def plot_corridor_L_critical(
         Speeds, m/s (default [0.02, 2]).
     models : list of LoopModel, optional
     law : ForceLaw, optional
-    marks : sequence of (L, text)
-        Operating points (robot.V, L).
+    marks : sequence of (L, text) or (…, text, (dx, dy))
+        Operating points (robot.V, L); an optional offset places the text,
+        points from the star.
+    shaded : LoopModel or str, optional
+        The model whose verdicts are shaded (default the report's verdict
+        model, see `plot_wall_f_region`).
     ax : matplotlib Axes, optional
-    legend, shade : bool
+    legend : bool
+        Draw the legend outside the axes, on the right.
+    shade : bool
+        Shade the `shaded` model's verdicts.
     resolution : int
+        Grid points per axis of the shading.
 
     Returns
     -------
     matplotlib.figure.Figure
     """
-    fig, ax = figure_and_axes(ax, (6.4, 4.8))
+    fig, ax = figure_and_axes(ax, _WITH_LEGEND if legend else _SINGLE)
     V = np.linspace(0.02, 2.0, resolution) if V is None else np.asarray(V, dtype=float)
     models = default_models(controller) if models is None else models
     curves = corridor_L_curves(robot, controller, V, models, law=law)
     top = max(1.6, 1.15 * max(float(np.nanmax(np.where(np.isfinite(c.y), c.y, np.nan))) for c in curves))
+    text = None
     if shade:
+        shaded = region_model(controller, shaded)
+        text = shading_text(shaded, controller)
         L = np.linspace(robot.W / 2 * 1.0005, top, resolution)
-        region = corridor_region(robot, controller, L, V, law=law)
+        region = corridor_region(robot, controller, L, V, law=law, model=shaded)
         # the region grid is (V rows, L columns): transpose to (L rows, V columns)
         from dataclasses import replace
 
-        _shade(ax, replace(region, x=region.y, y=region.x, stable=region.stable.T))
+        _shade(ax, replace(region, x=region.y, y=region.x, stable=region.stable.T), text)
     _draw_curves(ax, curves)
-    for i, (Lm, text) in enumerate(marks or ()):
-        _mark(ax, robot.V, Lm, text, label=MARK_LABEL if i == 0 else None)
+    _marks(ax, marks, lambda Lm: (robot.V, Lm), {0.9: (-8, 6)})
     ax.set_xlim(V[0], V[-1])
     ax.set_ylim(0.0, top)
     _no_fit_band(ax, robot.W, vertical=False)
-    _style_axes(ax, V_LABEL, L_STAR_LABEL, f"Corridor: stable above L*(V) (KB eq 25)\n{_loop_text(robot, controller, law)}")
+    title = f"Corridor: stable above L*(V) (KB eq 25)\n{_loop_text(robot, controller, law)}"
+    _style_axes(ax, V_LABEL, L_STAR_LABEL, _title(title, text))
     ax.text(0.03, 0.96, "stable", transform=ax.transAxes, va="top", fontsize=10, color="#2a6a1f", weight="bold")
     ax.text(0.97, 0.3, "oscillates", transform=ax.transAxes, ha="right", fontsize=10, color="#9b2b22", weight="bold")
     if legend:
-        region_legend(ax, loc="upper left", fontsize=7, bbox_to_anchor=(0.0, 0.9)) if shade else ax.legend(fontsize=7)
+        region_legend(ax, fontsize=7)
     return fig
 
 
 # ------------------------------------------------------------------ summaries
-def plot_wall_regions(robot: Robot, controller: Controller, alphas_deg=(20.0, 45.0, 70.0), *, models=None, resolution: int = 300):
-    """(V, f) regions at each α and α*(V), in a 2 × 2 grid with one legend (KB §5.3).
+def _suptitle(fig, where: str, section: str, shaded, controller: Controller):
+    for ax in fig.axes:  # the shaded model is named once, in the figure title
+        ax.set_title(ax.get_title().split("\nshaded: ")[0], fontsize=9)
+    fig.suptitle(
+        f"Where CARMEL is safe {where}: every model's boundary (lines), KB's runs (stars) (Koren & Borenstein 1991 {section})\n"
+        f"shaded: {shading_text(shaded, controller)}",
+        fontsize=11,
+    )
+
+
+def plot_wall_regions(robot: Robot, controller: Controller, alphas_deg=(20.0, 45.0, 70.0), *, models=None, shaded=None, resolution: int = 300):
+    """(V, f) regions at each α and α*(V), in a 2 × 2 grid with one legend below (KB §5.3).
+
+    Parameters
+    ----------
+    robot, controller : Robot, Controller
+    alphas_deg : sequence of float
+        Target angles of the (V, f) panels, deg.
+    models : list of LoopModel, optional
+        Curves drawn (default every model).
+    shaded : LoopModel or str, optional
+        The model whose verdicts are shaded (default the report's verdict
+        model, ``sampled`` with the controller's structure).
+    resolution : int
+        Grid points per axis of the shading.
 
     Returns
     -------
@@ -384,23 +535,35 @@ def plot_wall_regions(robot: Robot, controller: Controller, alphas_deg=(20.0, 45
     """
     import matplotlib.pyplot as plt
 
+    shaded = region_model(controller, shaded)
     panels = len(alphas_deg) + 1
     cols = 2
     rows = math.ceil(panels / cols)
-    fig, axes = plt.subplots(rows, cols, figsize=(11.5, 4.3 * rows + 1.3), layout="constrained")
+    fig, axes = plt.subplots(rows, cols, figsize=(11.5, 4.3 * rows + 1.6), layout="constrained")
     axes = np.ravel(axes)
     for ax, a in zip(axes, alphas_deg):
-        plot_wall_f_region(robot, controller, math.radians(a), models=models, ax=ax, legend=False, resolution=resolution)
-    plot_wall_alpha_critical(robot, controller, models=models, ax=axes[len(alphas_deg)], legend=False, resolution=resolution)
+        plot_wall_f_region(robot, controller, math.radians(a), models=models, shaded=shaded, ax=ax, legend=False, resolution=resolution)
+    plot_wall_alpha_critical(robot, controller, models=models, shaded=shaded, ax=axes[len(alphas_deg)], legend=False, resolution=resolution)
     for ax in axes[panels:]:
         ax.set_visible(False)
-    region_legend(fig=fig, ncol=3, loc="outside lower center")
-    fig.suptitle("Where CARMEL is safe along a wall: every model's boundary over exact_delay verdicts (Koren & Borenstein 1991 §5.3)", fontsize=11)
+    region_legend(fig=fig, ncol=3)
+    _suptitle(fig, "along a wall", "§5.3", shaded, controller)
     return fig
 
 
-def plot_corridor_regions(robot: Robot, controller: Controller, *, models=None, resolution: int = 300):
-    """(L, V) regions and L*(V) side by side with one legend (KB §5.4).
+def plot_corridor_regions(robot: Robot, controller: Controller, *, models=None, shaded=None, resolution: int = 300):
+    """(L, V) regions and L*(V) side by side with one legend below (KB §5.4).
+
+    Parameters
+    ----------
+    robot, controller : Robot, Controller
+    models : list of LoopModel, optional
+        Curves drawn (default every model).
+    shaded : LoopModel or str, optional
+        The model whose verdicts are shaded (default the report's verdict
+        model, ``sampled`` with the controller's structure).
+    resolution : int
+        Grid points per axis of the shading.
 
     Returns
     -------
@@ -408,11 +571,12 @@ def plot_corridor_regions(robot: Robot, controller: Controller, *, models=None, 
     """
     import matplotlib.pyplot as plt
 
-    fig, (a, b) = plt.subplots(1, 2, figsize=(11.5, 5.6), layout="constrained")
-    plot_corridor_region(robot, controller, models=models, ax=a, legend=False, resolution=resolution)
-    plot_corridor_L_critical(robot, controller, models=models, ax=b, legend=False, resolution=resolution)
-    region_legend(fig=fig, ncol=3, loc="outside lower center")
-    fig.suptitle("Where CARMEL is safe in a corridor: every model's boundary over exact_delay verdicts (Koren & Borenstein 1991 §5.4)", fontsize=11)
+    shaded = region_model(controller, shaded)
+    fig, (a, b) = plt.subplots(1, 2, figsize=(11.5, 6.0), layout="constrained")
+    plot_corridor_region(robot, controller, models=models, shaded=shaded, ax=a, legend=False, resolution=resolution)
+    plot_corridor_L_critical(robot, controller, models=models, shaded=shaded, ax=b, legend=False, resolution=resolution)
+    region_legend(fig=fig, ncol=3)
+    _suptitle(fig, "in a corridor", "§5.4", shaded, controller)
     return fig
 
 

@@ -4,7 +4,9 @@ Obstacles are the histogram grid's filled cells (squares of the cell size) or
 the analytic walls (thick lines); the robot is drawn every second as a circle
 of its diameter W, to scale (KB: "circles which are plotted to scale
 according to the 0.8 m diameter of CARMEL's sensor ring"), on equal axes in
-metres, with the path, start, target and the event that ended the run.
+metres, with the path, start, target and the event that ended the run. The
+legend sits outside the axes, so it never hides the target arrow, the path
+or an obstacle.
 """
 
 from __future__ import annotations
@@ -13,7 +15,7 @@ import math
 
 import numpy as np
 
-from .common import figure_and_axes
+from .common import figure_and_axes, outside_legend
 
 __all__ = ["plot_trajectory"]
 
@@ -21,9 +23,10 @@ _PAD = 1.2
 """Margin around the path, m."""
 
 
-def _figure_axes(ax, width, height):
+def _figure_axes(ax, width, height, legend=True):
     scale = 7.5 / max(height, width)
-    return figure_and_axes(ax, (max(4.6, width * scale + 1.6), max(3.8, height * scale + 1.2)))
+    extra = 1.6 if legend else 0.0  # the legend, right of the axes
+    return figure_and_axes(ax, (max(4.6, width * scale + 1.6) + extra, max(3.8, height * scale + 1.2)))
 
 
 def _draw_grid(ax, grid, bounds):
@@ -55,7 +58,7 @@ def _bounds(result):
     return min(xs) - pad, max(xs) + pad, min(ys) - pad, max(ys) + pad
 
 
-def plot_trajectory(result, ax=None, *, every: float = 1.0, title: str | None = None):
+def plot_trajectory(result, ax=None, *, every: float = 1.0, title: str | None = None, legend: bool = True):
     """Draw a simulated run like KB's figures.
 
     Parameters
@@ -68,6 +71,9 @@ def plot_trajectory(result, ax=None, *, every: float = 1.0, title: str | None = 
         Interval between the robot circles, s (KB: 1 s).
     title : str, optional
         Default: scenario, environment and outcome.
+    legend : bool
+        Draw the legend outside the axes, on the right (a figure with several
+        runs can draw one figure legend of the axes' labelled artists instead).
 
     Returns
     -------
@@ -80,7 +86,7 @@ def plot_trajectory(result, ax=None, *, every: float = 1.0, title: str | None = 
         raise ValueError("result has no trajectory: simulate with record='trajectory'")
     s = result.scenario
     bounds = _bounds(result)
-    fig, ax = _figure_axes(ax, bounds[1] - bounds[0], bounds[3] - bounds[2])
+    fig, ax = _figure_axes(ax, bounds[1] - bounds[0], bounds[3] - bounds[2], legend)
     if s.env == "grid":
         _draw_grid(ax, s.environment, bounds)
     else:
@@ -102,7 +108,8 @@ def plot_trajectory(result, ax=None, *, every: float = 1.0, title: str | None = 
     ax.set_xlabel("X (m)")
     ax.set_ylabel("Y (m)")
     ax.set_title(title if title is not None else _title(result), fontsize=10)
-    ax.legend(loc="best", fontsize=7, framealpha=0.85)
+    if legend:
+        outside_legend(ax, framealpha=0.85)
     ax.grid(True, lw=0.3, alpha=0.5)
     return fig
 
