@@ -26,7 +26,10 @@ One step, for every member still running (DESIGN §4, the `sampled` model):
    `SUBSTEPS` equal sub-intervals, each either saturated (constant ±ω_max)
    or linear (servo), decided at its start — exact whenever the servo is not
    saturated, first-order in the sub-interval where it switches.
-   Positions: Gauss–Legendre quadrature of V sin θ, V cos θ.
+   Positions: the part linear in Δ = θ − θ_k in closed form, the residual by
+   a composite Gauss–Legendre rule graded to the steering time scales
+   (`pfm_stability.sim.robot`; a member's rule depends on its own (τ, k, T)
+   only, so it advances identically in any batch).
 
 Everything is numpy on (B,) or (B, K) arrays; the grid's window sums use
 the precompiled occupied-cell lists of `pfm_stability.sim.window`.
@@ -44,7 +47,9 @@ from .environment import segment_clearance, wall_coordinates
 from .events import Event
 from .metrics import oscillation_metrics
 from .results import BatchResult, RunResult, Trajectory
-from .robot import NODES, advance_position, constant_input, gauss_legendre, propagate, servo
+from .robot import (
+    advance_position, constant_input, constant_input_modes, graded_rule, propagate, servo, servo_modes, slow_rate,
+)
 from .vff import cell_repulsion, direction_of, steering_command, vff_speed, wrap_angle
 from .window import compile_window_table, stack_tables
 
@@ -81,18 +86,24 @@ class _Batch:
         self._compile_measure()
         self._compile_grids()
         self._compile_walls()
-        fractions, self.weights = gauss_legendre(NODES)
-        self.command_idx = np.flatnonzero(~self.reference)
-        self.reference_idx = np.flatnonzero(self.reference)
-        self.command_coef = constant_input(self.tau[self.command_idx], self.T[self.command_idx], fractions)
-        r = self.reference_idx
-        self.servo_coef = servo(self.tau[r], self.k[r], self.T[r], fractions)
-        self.servo_sub = servo(self.tau[r], self.k[r], self.T[r] / SUBSTEPS, fractions)
-        self.saturated_sub = constant_input(self.tau[r], self.T[r] / SUBSTEPS, fractions)
+        self._compile_steering()
         self.all_command = self.command_idx.size == B
         self.uniform_n2 = bool(np.all(self.n == 2.0))
 
     # ----------------------------------------------------------- compilation
+    def _compile_steering(self):
+        """Steering coefficients and quadrature rules of the held-command and the servo members (`robot`)."""
+        slow = slow_rate(self.k, self.max_rate)
+        self.command_idx = c = np.flatnonzero(~self.reference)
+        self.reference_idx = r = np.flatnonzero(self.reference)
+        self.command_coef = constant_input(self.tau[c], graded_rule(self.T[c], *constant_input_modes(self.tau[c]), slow[c]))
+        modes = servo_modes(self.tau[r], self.k[r])
+        self.servo_coef = servo(self.tau[r], self.k[r], graded_rule(self.T[r], *modes, slow[r]))
+        both = tuple(np.concatenate(pair, axis=1) for pair in zip(modes, constant_input_modes(self.tau[r])))
+        sub = graded_rule(self.T[r] / SUBSTEPS, *both, slow[r])  # shared: each sub-interval takes either solution
+        self.servo_sub = servo(self.tau[r], self.k[r], sub)
+        self.saturated_sub = constant_input(self.tau[r], sub)
+
     def _compile_targets(self):
         s = self.scenarios
         self.point = _array(s, lambda m: m.target.is_point, bool)
@@ -290,9 +301,9 @@ def _start_state(scenarios):
     return x, y, theta
 
 
-def _advance_command(b, coef, theta, omega, u, V, x, y):
-    theta_nodes, theta_end, omega_end = propagate(coef, theta, omega, u)
-    x, y = advance_position(x, y, V, coef.h, theta_nodes, b.weights)
+def _advance_command(coef, theta, omega, u, V, x, y):
+    delta, correction, theta_end, omega_end = propagate(coef, theta, omega, u)
+    x, y = advance_position(x, y, V, coef.rule, theta, delta, correction)
     return x, y, theta_end, omega_end
 
 
@@ -300,10 +311,10 @@ def _advance_reference(b, theta, omega, ref, V, x, y):
     """Servo members over one period; saturated ones in SUBSTEPS sub-intervals."""
     r = b.reference_idx
     k, wmax = b.k[r], b.max_rate[r]
-    theta_nodes, theta_end, omega_end = propagate(b.servo_coef, theta, omega, ref)
-    x_new, y_new = advance_position(x, y, V, b.servo_coef.h, theta_nodes, b.weights)
-    servo_u = k[:, None] * (ref[:, None] - np.concatenate([theta[:, None], theta_nodes, theta_end[:, None]], axis=1))
-    sat = np.any(np.abs(servo_u) > wmax[:, None], axis=1)
+    delta, correction, theta_end, omega_end = propagate(b.servo_coef, theta, omega, ref)
+    x_new, y_new = advance_position(x, y, V, b.servo_coef.rule, theta, delta, correction)
+    heading = np.concatenate([theta[:, None], theta[:, None] + delta, theta_end[:, None]], axis=1)
+    sat = np.any(np.abs(k[:, None] * (ref[:, None] - heading)) > wmax[:, None], axis=1)
     if np.any(sat):
         s = np.flatnonzero(sat)
         th, om, xs, ys = theta[s], omega[s], x[s], y[s]
@@ -311,10 +322,10 @@ def _advance_reference(b, theta, omega, ref, V, x, y):
         for _ in range(SUBSTEPS):
             u = k[s] * (ref[s] - th)
             clipped = np.abs(u) > wmax[s]
-            n1, e1, o1 = propagate(lin, th, om, ref[s])
-            n2, e2, o2 = propagate(cst, th, om, np.clip(u, -wmax[s], wmax[s]))
-            nodes = np.where(clipped[:, None], n2, n1)
-            xs, ys = advance_position(xs, ys, V[s], lin.h, nodes, b.weights)
+            d1, c1, e1, o1 = propagate(lin, th, om, ref[s])
+            d2, c2, e2, o2 = propagate(cst, th, om, np.clip(u, -wmax[s], wmax[s]))
+            d, c = np.where(clipped[:, None], d2, d1), np.where(clipped, c2, c1)
+            xs, ys = advance_position(xs, ys, V[s], lin.rule, th, d, c)
             th, om = np.where(clipped, e2, e1), np.where(clipped, o2, o1)
         x_new[s], y_new[s], theta_end[s], omega_end[s] = xs, ys, th, om
     return x_new, y_new, theta_end, omega_end
@@ -395,12 +406,12 @@ def run_batch(scenarios, *, record: str = "trajectory", metrics: bool = True, pr
         pending, pending_V = value, speed
         # advance over [t_k, t_k+1)
         if b.all_command:
-            x_new, y_new, th_new, om_new = _advance_command(b, b.command_coef, theta, omega, applied, applied_V, x, y)
+            x_new, y_new, th_new, om_new = _advance_command(b.command_coef, theta, omega, applied, applied_V, x, y)
         else:
             x_new, y_new, th_new, om_new = x.copy(), y.copy(), theta.copy(), omega.copy()
             c, r = b.command_idx, b.reference_idx
             if c.size:
-                x_new[c], y_new[c], th_new[c], om_new[c] = _advance_command(b, b.command_coef, theta[c], omega[c], applied[c], applied_V[c], x[c], y[c])
+                x_new[c], y_new[c], th_new[c], om_new[c] = _advance_command(b.command_coef, theta[c], omega[c], applied[c], applied_V[c], x[c], y[c])
             if r.size:
                 x_new[r], y_new[r], th_new[r], om_new[r] = _advance_reference(b, theta[r], omega[r], applied[r], applied_V[r], x[r], y[r])
         x, y = np.where(running, x_new, x), np.where(running, y_new, y)

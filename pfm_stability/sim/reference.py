@@ -4,9 +4,14 @@
 the `math` module: the active window is cut out of the histogram grid and its
 occupied cells are summed in a Python loop (KB eq 1–2), the analytic walls
 likewise; the steering solutions (KB eq 6–7) are the same closed forms as in
-`pfm_stability.sim.robot`, written out per robot. It shares no stepping code
-with the batch engine, so the tests compare the two trajectories
-(`tests/test_sim_engine.py`), and `benchmarks/bench_simulator.py` times both.
+`pfm_stability.sim.robot`, written out per robot. Positions take the same
+route (∫Δ dt exact, the residuals sin Δ − Δ and cos Δ − 1 by quadrature on
+the rule of `robot.graded_rule`, the one piece shared), written out as sums
+of the residuals; for the servo ∫Δ dt comes from Van Loan's block exponential
+expm([[A, I], [0, 0]]h) = [[exp(Ah), ∫₀ʰ exp(At) dt], [0, I]] (scipy), not
+from the engine's closed form. It shares no stepping code with the batch
+engine, so the tests compare the two trajectories (`tests/test_sim_engine.py`,
+`tests/test_sim_accuracy.py`), and `benchmarks/bench_simulator.py` times both.
 """
 
 from __future__ import annotations
@@ -20,7 +25,7 @@ from .engine import SUBSTEPS
 from .events import Event
 from .grid import HistogramGrid
 from .results import Trajectory
-from .robot import NODES, gauss_legendre
+from .robot import constant_input_modes, graded_rule, servo_modes, slow_rate
 from .scenario import Scenario
 
 __all__ = ["simulate_reference"]
@@ -48,32 +53,70 @@ def _servo_matrix(tau, k, t):
     return (d, 0.0, -k * d, 0.0)
 
 
-class _Steering:
-    """Per-robot closed-form steering over one hold interval."""
+def _servo_integral(tau, k, h):
+    """(∫P, ∫Q) over [0, h], the first row of ∫₀ʰ exp(At) dt (Van Loan's block exponential; τ = 0: ∫e^(−kt))."""
+    if tau > 0:
+        from scipy.linalg import expm
 
-    def __init__(self, tau, k, h, servo: bool):
+        M = np.zeros((4, 4))
+        M[:2, :2] = [[0.0, 1.0], [-k / tau, -1.0 / tau]]
+        M[:2, 2:] = np.eye(2)
+        F = expm(M * h)
+        return float(F[0, 2]), float(F[0, 3])
+    return -math.expm1(-k * h) / k, 0.0
+
+
+def _steering_rule(tau, k, h, max_rate, solutions):
+    """(node times, weights) of `robot.graded_rule` for one robot, resolving the modes of `solutions`."""
+    one = lambda v: np.array([float(v)])
+    found = {"constant": constant_input_modes(one(tau)), "servo": servo_modes(one(tau), one(k))}
+    modes = tuple(np.concatenate(part, axis=1) for part in zip(*(found[name] for name in solutions)))
+    slow = slow_rate(one(k), one(max_rate))
+    rule = graded_rule(one(h), *modes, slow)
+    return rule.t[0].tolist(), rule.w[0].tolist()
+
+
+class _Steering:
+    """Per-robot closed-form steering over one hold interval.
+
+    `solutions` names the solutions used over the interval, "constant"
+    (held command) and/or "servo" (held reference); the quadrature rule
+    resolves all of them.
+    """
+
+    def __init__(self, tau, k, h, max_rate, solutions):
         self.tau, self.k, self.h = tau, k, h
-        fractions, self.weights = gauss_legendre(NODES)
-        self.times = [h * f for f in fractions] + [h]
-        self.const = [_constant_input(tau, t) for t in self.times]
-        self.servo = [_servo_matrix(tau, k, t) for t in self.times] if servo else None
+        self.times, self.weights = _steering_rule(tau, k, h, max_rate, solutions)
+        self.const = [_constant_input(tau, t) for t in self.times + [h]]
+        lagged = tau * (h - self.const[-1][0])
+        self.const_integral = (lagged, h * h / 2 - lagged)
+        if "servo" in solutions:
+            self.servo = [_servo_matrix(tau, k, t) for t in self.times + [h]]
+            self.servo_integral = _servo_integral(tau, k, h)
 
     def constant(self, theta, omega, u):
-        nodes = [theta + a * omega + (t - a) * u for (a, _), t in zip(self.const, self.times)]
-        decay = self.const[-1][1]
-        return nodes[:-1], nodes[-1], decay * omega + (1 - decay) * u
+        """(Δ at the nodes, ∫Δ dt, θ at the end, ω at the end) for a held command u."""
+        delta = [a * omega + (t - a) * u for (a, _), t in zip(self.const, self.times)]
+        a, decay = self.const[-1]
+        iw, iu = self.const_integral
+        return delta, iw * omega + iu * u, theta + a * omega + (self.h - a) * u, decay * omega + (1 - decay) * u
 
     def reference(self, theta, omega, ref):
+        """(Δ at the nodes, ∫Δ dt, θ at the end, ω at the end) for a held reference, the servo closed."""
         e = theta - ref
-        nodes = [ref + P * e + Q * omega for P, Q, _, _ in self.servo]
-        _, _, R, S = self.servo[-1]
-        return nodes[:-1], nodes[-1], R * e + S * omega
+        delta = [(P - 1) * e + Q * omega for P, Q, _, _ in self.servo[:-1]]
+        P, Q, R, S = self.servo[-1]
+        iP, iQ = self.servo_integral
+        return delta, (iP - self.h) * e + iQ * omega, ref + P * e + Q * omega, R * e + S * omega
 
-    def move(self, x, y, V, nodes):
-        for w, th in zip(self.weights, nodes):
-            x += V * self.h * w * math.sin(th)
-            y += V * self.h * w * math.cos(th)
-        return x, y
+    def move(self, x, y, V, theta, delta, integral):
+        """x + V∫sin θ, y + V∫cos θ: ∫Δ exact, the residuals sin Δ − Δ and cos Δ − 1 by quadrature."""
+        across, along = integral, self.h
+        for w, d in zip(self.weights, delta):
+            across += w * (math.sin(d) - d)
+            along += w * (math.cos(d) - 1.0)
+        s0, c0 = math.sin(theta), math.cos(theta)
+        return x + V * (s0 * along + c0 * across), y + V * (c0 * along - s0 * across)
 
 
 def _grid_sense(s: Scenario, x, y):
@@ -131,8 +174,8 @@ def simulate_reference(s: Scenario):
     T, k, wmax = c.T, r.k, r.max_steering_rate
     sense = _grid_sense if s.env == "grid" else _wall_sense
     servo = c.hold == "reference"
-    full = _Steering(r.tau, k, T, servo)
-    sub = _Steering(r.tau, k, T / SUBSTEPS, servo) if servo else None
+    full = _Steering(r.tau, k, T, wmax, ("servo",) if servo else ("constant",))
+    sub = _Steering(r.tau, k, T / SUBSTEPS, wmax, ("servo", "constant")) if servo else None
     x, y, theta = s.start.x, s.start.y, s.start.theta
     if s.start_jitter > 0:
         shift = float(np.random.default_rng(s.seed).normal(0.0, s.start_jitter))
@@ -184,22 +227,22 @@ def simulate_reference(s: Scenario):
         applied, V = pending if c.compute_delay == 1 else (value, speed)
         pending = (value, speed)
         if c.hold == "command":
-            nodes, theta_end, omega_end = full.constant(theta, omega, applied)
-            x, y = full.move(x, y, V, nodes)
+            nodes, integral, theta_end, omega_end = full.constant(theta, omega, applied)
+            x, y = full.move(x, y, V, theta, nodes, integral)
         else:
-            nodes, theta_end, omega_end = full.reference(theta, omega, applied)
-            checks = [theta] + nodes + [theta_end]
+            nodes, integral, theta_end, omega_end = full.reference(theta, omega, applied)
+            checks = [theta] + [theta + d for d in nodes] + [theta_end]
             if all(abs(k * (applied - th)) <= wmax for th in checks):
-                x, y = full.move(x, y, V, nodes)
+                x, y = full.move(x, y, V, theta, nodes, integral)
             else:
                 theta_end, omega_end = theta, omega
                 for _ in range(SUBSTEPS):
                     u = k * (applied - theta_end)
                     if abs(u) > wmax:
-                        nodes, th2, om2 = sub.constant(theta_end, omega_end, min(max(u, -wmax), wmax))
+                        nodes, integral, th2, om2 = sub.constant(theta_end, omega_end, min(max(u, -wmax), wmax))
                     else:
-                        nodes, th2, om2 = sub.reference(theta_end, omega_end, applied)
-                    x, y = sub.move(x, y, V, nodes)
+                        nodes, integral, th2, om2 = sub.reference(theta_end, omega_end, applied)
+                    x, y = sub.move(x, y, V, theta_end, nodes, integral)
                     theta_end, omega_end = th2, om2
         theta, omega = theta_end, omega_end
         xs.append(x), ys.append(y), ths.append(theta)

@@ -15,16 +15,65 @@ the heading). Over one hold interval of length h the input is one of
 Both are exact: θ(t) and ω(t) are linear in (θ₀, ω₀, held value) with
 coefficients that depend only on (τ, k, h), precomputed once per member.
 
-Positions need ∫ sin θ(t) and ∫ cos θ(t), which have no closed form; they are
-computed by Gauss–Legendre quadrature with `NODES` nodes on the closed-form
-θ(t) over each hold interval. Measured error of one step against 40-node
-quadrature, worst case over initial headings for a saturated reversal
-(ω₀ = −120°/s, u = +120°/s, or the servo equivalent; τ = 0.3 s, V = 0.8 m/s):
-1.6e-13 m for T = 0.065 s (CARMEL), 1.7e-9 m for T = 0.2 s, 1.3e-6 m for
-T = 0.5 s (the error falls as T⁹ and grows with T/τ: 1.1e-8 m for T = 0.2 s,
-τ = 0.1 s). In the linear regime (θ ~ 1e-6 rad) it is a further ~10⁵ times
-smaller. `tests/test_sim_robot.py` re-measures the
-CARMEL figure.
+Positions (eq 14). With θ(t) = θ₀ + Δ(t),
+
+    ∫₀ʰ sin θ dt = sin θ₀ ∫cos Δ dt + cos θ₀ ∫sin Δ dt,
+    ∫₀ʰ cos θ dt = cos θ₀ ∫cos Δ dt − sin θ₀ ∫sin Δ dt,
+    ∫sin Δ dt = ∫Δ dt + ∫(sin Δ − Δ) dt,   ∫cos Δ dt = h + ∫(cos Δ − 1) dt.
+
+Δ(t) is linear in (θ₀, ω₀, held value), and so is ∫₀ʰ Δ dt, with
+closed-form coefficients (`constant_input`, `servo`): the motion's part
+linear in the heading — all of it, to round-off, in the regime where the
+growth rate σ is measured — is exact for any h/τ. Only the residuals
+sin Δ − Δ = O(Δ³) and cos Δ − 1 = O(Δ²) are integrated numerically (in
+practice the rule is applied to sin Δ and cos Δ and corrected by its exactly
+known error on Δ, `Coefficients.maps`), by a composite Gauss–Legendre rule
+with `NODES` nodes per panel on a mesh graded to the steering time scales
+(`graded_rule`): when h ≫ τ (or ≫ 1/k, √(τ/k) for the servo) θ(t) turns
+within a boundary layer of width ~τ at the start of each interval, which a
+rule over the whole interval cannot resolve. The panels divide the phase
+
+    Φ(t) = ∫₀ᵗ r dt′,   r(t) = ω_s + Σᵢ |λᵢ| e^(−dᵢt/(2·NODES + 1))   (rad)
+
+into equal parts of at most `RESOLUTION` rad, where ω_s (rad/s) bounds |θ̇|
+(`slow_rate`) and λᵢ are the eigenvalues of the steering solution (1/s,
+dᵢ = −Re λᵢ; `constant_input_modes`, `servo_modes`). An n-node rule's error
+on a mode e^(λt) over a panel of width w starting at t is ~e^(−dt)(w|λ|)^(2n+1),
+hence the exponent: the panels are ~RESOLUTION·τ wide at the start and widen
+as the modes decay, and no panel turns the slow motion by more than
+RESOLUTION rad. A member's panel count is ⌈Φ(h)/RESOLUTION⌉ (at most
+`MAX_PANELS`) and depends on its own (τ, k, h, ω_max) only; one panel, the
+plain 4-node rule, at CARMEL's T = 0.065 s, τ = 0.3 s. A batch's rules are
+padded with zero weights to its member with the most panels, and a step's
+cost grows with that count (a 1000-member grid batch at T/τ = 4, 16 nodes,
+steps ~1.3× slower than with 4 nodes).
+
+Measured error of one step's position against adaptive quadrature (scipy
+``quad``, tolerance 1e-13 relative), worst over 17 initial headings, for the
+largest turns: a saturated reversal (held command, ω₀ = −120°/s,
+u = +120°/s) or a held reference 0.99·ω_max/k ahead with ω₀ = −120°/s (the
+largest unsaturated servo turn); V = 0.8 m/s:
+
+==========  ======  ======  =======  ======  ============  ==================
+hold        τ (s)   k (1/s) T (s)    T/τ     panels        error (m)
+==========  ======  ======  =======  ======  ============  ==================
+command     0.3     2       0.065    0.22    1             1.6e-13 (1.6e-13)
+command     0.3     2       0.5      1.7     3             3.2e-10 (1.2e-6)
+command     0.05    2       0.2      4       4             2.1e-11 (7.5e-7)
+command     0.01    2       0.3      30      10            3.6e-13 (1.2e-4)
+command     0.01    0.5     1.0      100     11            9.8e-10 (3.3e-4)
+reference   0.3     2       0.065    0.22    1             1.1e-13 (1.1e-13)
+reference   0.3     2       0.2      0.67    1             1.3e-9  (1.3e-9)
+reference   0.05    6       0.2      4       3             1.8e-10 (6.8e-7)
+reference   0.01    0.5     1.0      100     12            1.5e-10 (3.3e-4)
+==========  ======  ======  =======  ======  ============  ==================
+
+(in brackets: the former 4-node rule over the whole interval). At most
+~1e-8 of the step's length V·T; `tests/test_sim_robot.py` re-measures these
+figures. In the linear regime the simulated σ and ω equal the `sampled`
+model's dominant pole to 5e-9 relative for T/τ from 1 to 100 and every
+hold and compute delay (the former rule: up to 1.6e-3 at T/τ = 30;
+`tests/test_sim_accuracy.py`).
 """
 
 from __future__ import annotations
@@ -33,10 +82,21 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["NODES", "gauss_legendre", "Coefficients", "constant_input", "servo", "propagate", "advance_position"]
+__all__ = [
+    "NODES", "RESOLUTION", "MAX_PANELS", "gauss_legendre", "slow_rate", "constant_input_modes", "servo_modes",
+    "panel_count", "graded_rule", "node_sum", "Rule", "Coefficients", "constant_input", "servo", "propagate",
+    "advance_position",
+]
 
 NODES = 4
-"""Gauss–Legendre nodes per hold interval for x, y (error stated in the module docstring)."""
+"""Gauss–Legendre nodes per panel of the position quadrature."""
+
+RESOLUTION = 1.0
+"""Largest phase Φ per panel, rad (module docstring; the error falls roughly as RESOLUTION⁸)."""
+
+MAX_PANELS = 64
+"""Most panels per hold interval, to bound memory: Φ(h) <= 64 rad is divided as designed (each mode adds
+at most 2·NODES + 1 = 9 rad, so any T/τ and |θ̇|·T up to ~45 rad); beyond, the panels widen."""
 
 
 def gauss_legendre(nodes: int = NODES):
@@ -47,76 +107,223 @@ def gauss_legendre(nodes: int = NODES):
     return (x + 1) / 2, w / 2
 
 
+def slow_rate(k, max_steering_rate):
+    """Bound ω_s on |θ̇|, rad/s: min(ω_max, kπ).
+
+    A held command is k·wrap(δ − θ) clipped to ±ω_max, and a servo's command
+    k(δ̃ − θ) starts within ±kπ; ω lags the command (eq 6), so it stays within
+    the same bound.
+    """
+    return np.minimum(np.asarray(max_steering_rate, dtype=float), np.pi * np.asarray(k, dtype=float))
+
+
+def constant_input_modes(tau):
+    """(|λ|, −Re λ) of the held-command solution, 1/s, shape (B, 1): λ = −1/τ (absent: |λ| = 0 for τ = 0)."""
+    tau = np.asarray(tau, dtype=float)
+    lag = tau > 0
+    rate = np.where(lag, 1.0 / np.where(lag, tau, 1.0), 0.0)
+    return rate[:, None], np.where(lag, rate, 1.0)[:, None]
+
+
+def servo_modes(tau, k):
+    """(|λ|, −Re λ) of the servo's eigenvalues, 1/s, shape (B, 2).
+
+    τ > 0: the roots of τλ² + λ + k, real (fast, slow; slow = k/(τ·fast)
+    without cancellation) or a complex pair (counted once); τ = 0: λ = −k.
+    Absent modes have |λ| = 0.
+    """
+    tau = np.asarray(tau, dtype=float)
+    k = np.asarray(k, dtype=float)
+    lag = tau > 0
+    safe_tau = np.where(lag, tau, 1.0)
+    half = 0.5 / safe_tau
+    q2 = half * half - k / safe_tau
+    real = q2 >= 0
+    fast = half + np.sqrt(np.where(real, q2, 0.0))
+    rate1 = np.where(lag, np.where(real, fast, np.sqrt(k / safe_tau)), k)
+    decay1 = np.where(lag, np.where(real, fast, half), k)
+    slow = np.where(lag & real, k / (safe_tau * fast), 0.0)
+    return np.stack([rate1, slow], axis=1), np.stack([decay1, np.where(slow > 0, slow, 1.0)], axis=1)
+
+
+def _phase(t, rates, decays, slow):
+    """Φ(t) = ω_s t + Σᵢ |λᵢ|(1 − e^(−μᵢt))/μᵢ, μᵢ = dᵢ/(2·NODES + 1), rad; t shape (B, P)."""
+    mu = decays[:, None, :] / (2 * NODES + 1)
+    modes = rates[:, None, :] * -np.expm1(-mu * t[:, :, None]) / mu
+    return slow[:, None] * t + np.sum(modes, axis=2)
+
+
+def panel_count(h, rates, decays, slow):
+    """Panels per member: ⌈Φ(h)/RESOLUTION⌉, from 1 to `MAX_PANELS`.
+
+    Parameters
+    ----------
+    h : ndarray, shape (B,)
+        Interval length, s.
+    rates, decays : ndarray, shape (B, M)
+        |λᵢ| and −Re λᵢ of the solution's modes, 1/s (`constant_input_modes`, `servo_modes`).
+    slow : ndarray, shape (B,)
+        ω_s, rad/s (`slow_rate`).
+
+    Returns
+    -------
+    ndarray of int, shape (B,)
+    """
+    need = _phase(np.asarray(h, dtype=float)[:, None], rates, decays, slow)[:, 0] / RESOLUTION
+    return np.clip(np.ceil(need), 1, MAX_PANELS).astype(np.int64)
+
+
 @dataclass(frozen=True)
-class Coefficients:
-    """θ and ω after time t as linear maps of (θ₀, ω₀, held value).
+class Rule:
+    """A composite Gauss–Legendre rule per member on [0, h].
 
     Attributes
     ----------
-    theta : ndarray, shape (B, J + 1, 3)
-        θ at the J quadrature nodes and at the end: θ = c·(θ₀, ω₀, v).
-    omega : ndarray, shape (B, 3)
-        ω at the end of the interval.
+    t : ndarray, shape (B, J)
+        Node times, s. A member with fewer panels than the batch's most is
+        padded with zero-weight nodes at t = h.
+    w : ndarray, shape (B, J)
+        Weights, s (each row sums to h).
     h : ndarray, shape (B,)
         Interval length, s.
     """
 
-    theta: np.ndarray
-    omega: np.ndarray
+    t: np.ndarray
+    w: np.ndarray
     h: np.ndarray
+
+    def take(self, index) -> "Rule":
+        """The rules of some members."""
+        return Rule(self.t[index], self.w[index], self.h[index])
+
+
+def graded_rule(h, rates, decays, slow, panels=None) -> Rule:
+    """`panels` panels per member, each spanning an equal part of the phase Φ(h) (module docstring), `NODES` nodes each.
+
+    The breakpoints solve Φ(t) = jΦ(h)/panels by bisection (Φ increases
+    with t); one panel is the plain Gauss–Legendre rule on [0, h]. Every
+    member's nodes and weights depend on its own parameters only.
+
+    Parameters
+    ----------
+    h, rates, decays, slow
+        As for `panel_count`.
+    panels : ndarray of int, shape (B,), optional
+        Panels per member; default `panel_count`.
+    """
+    h = np.asarray(h, dtype=float)
+    panels = np.asarray(panel_count(h, rates, decays, slow) if panels is None else panels)
+    j = np.arange(1, int(panels.max(initial=1)))[None, :]
+    inside = j < panels[:, None]
+    target = _phase(h[:, None], rates, decays, slow) * np.where(inside, j / panels[:, None], 1.0)
+    lo, hi = np.zeros_like(target), np.broadcast_to(h[:, None], target.shape)
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        below = _phase(mid, rates, decays, slow) < target
+        lo, hi = np.where(below, mid, lo), np.where(below, hi, mid)
+    inner = np.where(inside, 0.5 * (lo + hi), h[:, None])
+    breaks = np.concatenate([np.zeros((h.size, 1)), inner, h[:, None]], axis=1)
+    start, width = breaks[:, :-1, None], np.diff(breaks, axis=1)[:, :, None]
+    fractions, weights = gauss_legendre(NODES)
+    J = NODES * (breaks.shape[1] - 1)
+    t = (start + width * fractions).reshape(h.size, J)
+    w = (width * weights).reshape(h.size, J)
+    return Rule(t, w, h)
+
+
+def node_sum(a):
+    """Σ over the node axis (axis 1) of a (B, J, …) array, left to right.
+
+    Sequential, so a member's zero-weight padding (trailing) leaves its sum
+    unchanged bit for bit: a member advances identically in any batch.
+    """
+    return np.cumsum(a, axis=1)[:, -1]
+
+
+@dataclass(frozen=True)
+class Coefficients:
+    """Linear maps of (θ₀, ω₀, held value v) over one interval, and its quadrature rule.
+
+    Attributes
+    ----------
+    maps : ndarray, shape (B, J + 3, 3)
+        Each row c gives c·(θ₀, ω₀, v): rows 0 … J − 1 are Δ = θ − θ₀ at
+        the rule's nodes (rad); row J the correction ∫₀ʰ Δ dt − Σⱼ wⱼΔⱼ
+        (∫Δ dt in closed form, minus the rule applied to Δ; rad·s); row
+        J + 1 θ(h) (rad); row J + 2 ω(h) (rad/s).
+    rule : Rule
+    """
+
+    maps: np.ndarray
+    rule: Rule
 
     def take(self, index) -> "Coefficients":
         """The coefficients of some members."""
-        return Coefficients(self.theta[index], self.omega[index], self.h[index])
+        return Coefficients(self.maps[index], self.rule.take(index))
 
 
-def _times(h, fractions):
-    return np.concatenate([h[:, None] * fractions[None, :], h[:, None]], axis=1)
+def _coefficients(delta, integral, theta, omega, rule: Rule) -> Coefficients:
+    """Stack the maps: delta (B, J, 3) at the nodes, integral, theta, omega (B, 3) (`Coefficients.maps`)."""
+    correction = integral - node_sum(rule.w[:, :, None] * delta)
+    return Coefficients(np.concatenate([delta, np.stack([correction, theta, omega], axis=1)], axis=1), rule)
 
 
-def constant_input(tau, h, fractions) -> Coefficients:
+def _with_end(rule: Rule):
+    """Node times and the end, shape (B, J + 1), s."""
+    return np.concatenate([rule.t, rule.h[:, None]], axis=1)
+
+
+def constant_input(tau, rule: Rule) -> Coefficients:
     """Coefficients for a held steering-rate command u (v = u): KB eq 6 with constant input.
+
+    Δ(t) = a(t)ω₀ + (t − a(t))u; ∫₀ʰ a dt = τ(h − a(h)), ∫₀ʰ t dt = h²/2.
 
     Parameters
     ----------
     tau : ndarray, shape (B,)
         Steering time constant, s (>= 0).
-    h : ndarray, shape (B,)
-        Interval length, s (> 0).
-    fractions : ndarray, shape (J,)
-        Quadrature nodes as fractions of the interval.
+    rule : Rule
+        Nodes and interval lengths (h > 0).
     """
     tau = np.asarray(tau, dtype=float)
-    h = np.asarray(h, dtype=float)
-    t = _times(h, fractions)
+    h = rule.h
+    t = _with_end(rule)
     lag = tau[:, None] > 0
     safe_tau = np.where(lag, tau[:, None], 1.0)
     decay = np.where(lag, np.exp(-t / safe_tau), 0.0)
     a = np.where(lag, -safe_tau * np.expm1(-t / safe_tau), 0.0)
-    theta = np.stack([np.ones_like(t), a, t - a], axis=-1)
-    omega = np.stack([np.zeros_like(h), decay[:, -1], 1.0 - decay[:, -1]], axis=-1)
-    return Coefficients(theta, omega, h)
+    zero = np.zeros_like(h)
+    delta = np.stack([np.zeros_like(t), a, t - a], axis=-1)
+    lagged = tau * (h - a[:, -1])
+    integral = np.stack([zero, lagged, 0.5 * h * h - lagged], axis=-1)
+    theta = np.stack([np.ones_like(h), a[:, -1], h - a[:, -1]], axis=-1)
+    omega = np.stack([zero, decay[:, -1], 1.0 - decay[:, -1]], axis=-1)
+    return _coefficients(delta[:, :-1], integral, theta, omega, rule)
 
 
-def servo(tau, k, h, fractions) -> Coefficients:
+def servo(tau, k, rule: Rule) -> Coefficients:
     """Coefficients for a held reference δ̃ (v = δ̃) with the servo u = k(δ̃ − θ) closed (KB eq 7).
 
-    exp(A t) of the 2 × 2 matrix A = [[0, 1], [−k/τ, −1/τ]] in closed form:
-    with s = −1/(2τ) (half the trace) and q² = s² − k/τ,
+    exp(A t) = [[P, Q], [R, S]] of the 2 × 2 matrix A = [[0, 1], [−k/τ, −1/τ]]
+    in closed form: with s = −1/(2τ) (half the trace) and q² = s² − k/τ,
     exp(A t) = e^(st)[C·I + S·(A − sI)], C = cosh(qt), S = sinh(qt)/q
     (cos βt and sin(βt)/β when q² = −β² < 0; S → t as q → 0). Checked
     against scipy's `expm` in the tests (which costs milliseconds per matrix).
+    Δ(t) = (P − 1)(θ₀ − δ̃) + Qω₀, and d/dt exp(At) = exp(At)A, i.e.
+    Ṗ = −(k/τ)Q, Q̇ = P − Q/τ, gives ∫₀ʰ Q dt = τ(1 − P(h))/k and
+    ∫₀ʰ P dt = Q(h) + (1 − P(h))/k (also for τ = 0).
 
     Parameters
     ----------
-    tau, k, h : ndarray, shape (B,)
-        s, 1/s, s.
-    fractions : ndarray, shape (J,)
+    tau, k : ndarray, shape (B,)
+        s, 1/s.
+    rule : Rule
+        Nodes and interval lengths, s.
     """
     tau = np.asarray(tau, dtype=float)
     k = np.asarray(k, dtype=float)
-    h = np.asarray(h, dtype=float)
-    t = _times(h, fractions)
+    h = rule.h
+    t = _with_end(rule)
     lag = (tau > 0)[:, None]
     safe_tau = np.where(lag, tau[:, None], 1.0)
     s = -0.5 / safe_tau
@@ -131,21 +338,47 @@ def servo(tau, k, h, fractions) -> Coefficients:
     Q = np.where(lag, decay * S, 0.0)
     R = np.where(lag, -decay * S * k[:, None] / safe_tau, -k[:, None] * np.exp(-k[:, None] * t))
     S22 = np.where(lag, decay * (C - (1.0 / safe_tau + s) * S), 0.0)
-    theta = np.stack([P, Q, 1.0 - P], axis=-1)
+    delta = np.stack([P - 1.0, Q, 1.0 - P], axis=-1)
+    Ph, Qh = P[:, -1], Q[:, -1]
+    P_minus_1 = Qh + (1.0 - Ph) / k - h
+    integral = np.stack([P_minus_1, tau * (1.0 - Ph) / k, -P_minus_1], axis=-1)
+    theta = np.stack([Ph, Qh, 1.0 - Ph], axis=-1)
     omega = np.stack([R[:, -1], S22[:, -1], -R[:, -1]], axis=-1)
-    return Coefficients(theta, omega, h)
+    return _coefficients(delta[:, :-1], integral, theta, omega, rule)
 
 
 def propagate(coef: Coefficients, theta0, omega0, v):
-    """(θ at the nodes (B, J), θ at the end (B,), ω at the end (B,)) over one interval."""
-    c = coef.theta
-    theta = c[:, :, 0] * theta0[:, None] + c[:, :, 1] * omega0[:, None] + c[:, :, 2] * v[:, None]
-    o = coef.omega
-    omega = o[:, 0] * theta0 + o[:, 1] * omega0 + o[:, 2] * v
-    return theta[:, :-1], theta[:, -1], omega
+    """Over one interval: (Δ at the nodes (B, J), correction (B,), θ at the end (B,), ω at the end (B,)).
+
+    The correction is ∫₀ʰ Δ dt − Σⱼ wⱼΔⱼ, rad·s (`Coefficients.maps`).
+    """
+    c = coef.maps
+    out = c[:, :, 0] * theta0[:, None] + c[:, :, 1] * omega0[:, None] + c[:, :, 2] * v[:, None]
+    J = out.shape[1] - 3
+    return out[:, :J], out[:, J], out[:, J + 1], out[:, J + 2]
 
 
-def advance_position(x, y, V, h, theta_nodes, weights):
-    """x + V∫sin θ, y + V∫cos θ over an interval of length h by Gauss–Legendre (KB eq 14)."""
-    step = (V * h)[:, None] * weights[None, :]
-    return x + np.sum(step * np.sin(theta_nodes), axis=1), y + np.sum(step * np.cos(theta_nodes), axis=1)
+def advance_position(x, y, V, rule: Rule, theta0, delta, correction):
+    """x + V∫sin θ, y + V∫cos θ over one interval (KB eq 14).
+
+    ∫sin Δ dt = Σⱼ wⱼ sin Δⱼ + correction (= ∫Δ dt + Σⱼ wⱼ(sin Δⱼ − Δⱼ):
+    the linear part exact), ∫cos Δ dt = Σⱼ wⱼ cos Δⱼ, then the sum formulas
+    for θ = θ₀ + Δ (module docstring).
+
+    Parameters
+    ----------
+    x, y : ndarray, shape (B,)
+        Position at the start, m.
+    V : ndarray, shape (B,)
+        Speed, m/s.
+    rule : Rule
+    theta0 : ndarray, shape (B,)
+        Heading at the start, rad.
+    delta, correction
+        Δ at the nodes (B, J), rad, and ∫Δ dt − Σⱼ wⱼΔⱼ (B,), rad·s (`propagate`).
+    """
+    w = rule.w
+    across = node_sum(w * np.sin(delta)) + correction
+    along = node_sum(w * np.cos(delta))
+    s0, c0 = np.sin(theta0), np.cos(theta0)
+    return x + V * (s0 * along + c0 * across), y + V * (c0 * along - s0 * across)
