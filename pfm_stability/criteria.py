@@ -19,13 +19,15 @@ For any other force law the same conditions are solved numerically
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import dataclass, field
 
 import numpy as np
 
+from .checks import check_number, check_type
 from .force_law import ForceLaw, PowerLaw, corridor_gain, wall_gain
 from .models import Loop, LoopModel, gain_margin, models_for, verdict_label
-from .parameters import Controller, Corridor, Robot, Wall, check_corridor_fits
+from .parameters import RANGES, Controller, Corridor, Robot, Wall, check_corridor_fits, check_parameter
 from .solve import bisect_root, expand_bracket
 
 __all__ = [
@@ -131,11 +133,31 @@ class CorridorAnalysis:
 
 def loop_of(robot: Robot, controller: Controller) -> Loop:
     """The (τ, T, k) every model needs."""
+    check_type("robot", robot, Robot, "a Robot")
+    check_type("controller", controller, Controller, "a Controller")
     return Loop(robot.tau, controller.T, robot.k)
 
 
 def _law(robot: Robot, controller: Controller, law: ForceLaw | None) -> ForceLaw:
-    return law if law is not None else PowerLaw(controller.f, controller.n, robot.W)
+    check_type("robot", robot, Robot, "a Robot")
+    check_type("controller", controller, Controller, "a Controller")
+    if law is None:
+        return PowerLaw(controller.f, controller.n, robot.W)
+    return check_type("law", law, ForceLaw, "a ForceLaw (e.g. PowerLaw or GridWallLaw)")
+
+
+NV_MAX = 1e12
+"""Largest loop gain NV (1/s) the loop models represent; a geometry beyond it is refused."""
+
+
+def _check_gain(NV: float, where: str) -> float:
+    """NV after checking it is finite and <= NV_MAX; otherwise a message that names the geometry."""
+    if not (math.isfinite(NV) and NV <= NV_MAX):
+        raise ValueError(
+            f"N*V = {NV:g} 1/s at the {where} exceeds what the loop models represent (<= {NV_MAX:g} 1/s); "
+            f"choose a less extreme force law (f, n), angle or width"
+        )
+    return NV
 
 
 # --------------------------------------------------------------- root finding
@@ -162,11 +184,29 @@ def _log_ratio(N: float, V: float, NV_critical: float) -> float:
 
 
 # ------------------------------------------------------------- closed forms
+def _numeric(values) -> bool:
+    """True unless some value is symbolic (a sympy expression): then the closed form is plain arithmetic."""
+    return not any(type(v).__module__.startswith("sympy") for v in values)
+
+
+def _check_closed_form_inputs(**values) -> None:
+    """The closed forms' inputs in their ranges (τ + T may be 0 … 200 s)."""
+    for name, value in values.items():
+        if name == "tau_plus_T":
+            check_number("tau_plus_T", value, 0.0, 2 * RANGES["T"].high, high_open=False, unit="s")
+        else:
+            check_parameter(name, value)
+
+
 def kb_critical_f_wall(alpha, V, tau_plus_T, n, W):
     """KB eq (24): f* = cos α [nV(τ+T)/(W tan α)]^n (α in rad, V in m/s, τ+T in s, W in m).
 
-    ``inf`` when the value overflows (α → 0).
+    ``inf`` when the value overflows (α → 0). Numbers are checked against their
+    ranges (ValueError); sympy symbols pass through (the tests compare this with
+    the derivation exactly).
     """
+    if _numeric((alpha, V, tau_plus_T, n, W)):
+        _check_closed_form_inputs(alpha=alpha, V=V, tau_plus_T=tau_plus_T, n=n, W=W)
     with np.errstate(over="ignore"):
         return float(np.cos(alpha) * (n * V * tau_plus_T / (W * np.tan(alpha))) ** n)
 
@@ -175,9 +215,20 @@ def kb_critical_L(n, W, V, tau_plus_T, f):
     """KB eq (25) with the W* misprint corrected: L* = (2nWⁿV(τ+T)f)^(1/(n+1)), m.
 
     Plain arithmetic, so it accepts sympy symbols: the tests compare it with the
-    derivation exactly.
+    derivation exactly. Numbers are checked against their ranges (ValueError).
     """
+    if _numeric((n, W, V, tau_plus_T, f)):
+        _check_closed_form_inputs(n=n, W=W, V=V, tau_plus_T=tau_plus_T, f=f)
+        return float((2 * n * W**n * V * tau_plus_T * f) ** (1 / (n + 1)))
     return (2 * n * W**n * V * tau_plus_T * f) ** (1 / (n + 1))
+
+
+def _check_critical_inputs(law, V, NV_critical) -> None:
+    """The law, V and NV* of the critical-value solvers (NV* may be 0 or inf)."""
+    check_type("law", law, ForceLaw, "a ForceLaw (e.g. PowerLaw or GridWallLaw)")
+    check_parameter("V", V)
+    if isinstance(NV_critical, bool) or not isinstance(NV_critical, numbers.Real) or not NV_critical >= 0:
+        raise ValueError(f"NV_critical must be a number in [0, inf] 1/s; got {NV_critical!r}")
 
 
 def critical_alpha(law: ForceLaw, V: float, NV_critical: float) -> float:
@@ -185,6 +236,7 @@ def critical_alpha(law: ForceLaw, V: float, NV_critical: float) -> float:
 
     0 when NV* is infinite; π/2 when NV* = 0.
     """
+    _check_critical_inputs(law, V, NV_critical)
     if math.isinf(NV_critical):
         return 0.0
     if NV_critical <= 0:
@@ -194,7 +246,7 @@ def critical_alpha(law: ForceLaw, V: float, NV_critical: float) -> float:
     def excess(alpha):
         return wall_gain(law, alpha)[1] - target
 
-    lo, hi = 1e-12, math.pi / 2 - 1e-12
+    lo, hi = RANGES["alpha"].low, RANGES["alpha"].high
     if excess(lo) <= 0:
         return 0.0
     if excess(hi) >= 0:
@@ -204,6 +256,8 @@ def critical_alpha(law: ForceLaw, V: float, NV_critical: float) -> float:
 
 def critical_f_wall(law: ForceLaw, alpha: float, V: float, NV_critical: float) -> float:
     """f*: the force-law strength above which the wall is stable (KB eq 24)."""
+    _check_critical_inputs(law, V, NV_critical)
+    check_parameter("alpha", alpha)
     if math.isinf(NV_critical):
         return 0.0
     if NV_critical <= 0:
@@ -216,6 +270,7 @@ def critical_f_wall(law: ForceLaw, alpha: float, V: float, NV_critical: float) -
 
 def critical_L(law: ForceLaw, V: float, NV_critical: float) -> float:
     """L*, m: corridor half-width above which the middle is stable (KB eq 25)."""
+    _check_critical_inputs(law, V, NV_critical)
     if math.isinf(NV_critical):
         return 0.0
     if NV_critical <= 0:
@@ -227,6 +282,7 @@ def critical_L(law: ForceLaw, V: float, NV_critical: float) -> float:
 
 def critical_f_corridor(law: ForceLaw, L: float, V: float, NV_critical: float) -> float:
     """f*: force-law strength below which the corridor middle is stable (N ∝ f)."""
+    _check_critical_inputs(law, V, NV_critical)
     gain = corridor_gain(law, L) * V
     if math.isinf(NV_critical) or gain == 0:
         return math.inf
@@ -281,9 +337,10 @@ def analyze_wall(robot: Robot, controller: Controller, wall: Wall, models=None, 
         ``k_critical`` say whether a shorter period or a lower gain does.
     """
     law = _law(robot, controller, law)
+    check_type("wall", wall, Wall, "a Wall")
     loop = loop_of(robot, controller)
     d0, N = wall_gain(law, wall.alpha)
-    NV = N * robot.V
+    NV = _check_gain(N * robot.V, f"wall equilibrium d0 = {d0:g} m (alpha = {math.degrees(wall.alpha):g} deg)")
     out = {}
     for model in models_for(controller, models):
         boundary = model.boundary(loop)
@@ -319,11 +376,12 @@ def analyze_corridor(robot: Robot, controller: Controller, corridor: Corridor, m
         ``f_critical``, ``T_critical`` (s), ``k_critical`` (1/s). NV* = 0 gives
         V* = 0, L* = inf and f* = 0 ("unstable at any speed").
     """
-    check_corridor_fits(corridor, robot)
     law = _law(robot, controller, law)
+    check_type("corridor", corridor, Corridor, "a Corridor")
+    check_corridor_fits(corridor, robot)
     loop = loop_of(robot, controller)
     N = corridor_gain(law, corridor.L)
-    NV = N * robot.V
+    NV = _check_gain(N * robot.V, f"corridor middle (L = {corridor.L:g} m)")
     out = {}
     for model in models_for(controller, models):
         boundary = model.boundary(loop)

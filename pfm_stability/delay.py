@@ -41,12 +41,15 @@ import numpy as np
 
 from .checks import check_number
 from .crossings import Crossing, StabilityInterval
-from .routh import routh_array, strip_leading_zeros
+from .routh import real_coefficients, routh_array, strip_leading_zeros
 from .solve import bisect_root, newton_increasing
 
 __all__ = ["DelayLoop", "DelayCrossing", "delay_verdicts_from_gain", "kb_critical_gain"]
 
 _TWO_PI = 2.0 * math.pi
+
+_K_MAX = 1e100
+"""Largest |K| of `DelayLoop`: the crossing polynomial |a(jω)|² − K² must stay inside floating point."""
 
 
 @dataclass(frozen=True)
@@ -95,7 +98,7 @@ class DelayLoop:
     """
 
     def __init__(self, a, T: float):
-        self.a = strip_leading_zeros(a)
+        self.a = strip_leading_zeros(real_coefficients(a, "a"))
         if len(self.a) < 2:
             raise ValueError("a(s) must have degree >= 1 (a retarded quasi-polynomial)")
         self.T = check_number("T", T, 0.0, low_open=False, unit="s")
@@ -133,6 +136,7 @@ class DelayLoop:
             (ω in rad/s, sign F′(ω²)) sorted by ω. A zero derivative (tangent
             touch) gives direction 0.
         """
+        K = check_number("K", K, -_K_MAX, _K_MAX, low_open=False, high_open=False)
         F = self._modulus_poly_in_y(K)
         dF = np.polyder(F)
         roots = np.roots(np.trim_zeros(F, "f")) if np.any(F[:-1]) else np.empty(0)
@@ -163,6 +167,7 @@ class DelayLoop:
         T_max : float
             Largest delay of interest, s.
         """
+        K = check_number("K", K, -_K_MAX, _K_MAX, low_open=False, high_open=False)
         out = []
         for w, direction in self.crossing_frequencies(K):
             first = self._first_delay(w, K)
@@ -178,6 +183,7 @@ class DelayLoop:
         Returns None when a root lies on the imaginary axis at this T (within a
         relative 1e-12 in delay) or at s = 0, or a crossing is tangent.
         """
+        K = check_number("K", K, -_K_MAX, _K_MAX, low_open=False, high_open=False)
         if np.polyval(self.a, 0.0) + K == 0.0:
             return None
         base = routh_array(self._delay_free(K))
@@ -194,6 +200,7 @@ class DelayLoop:
 
     def is_stable(self, K: float) -> bool:
         """True when every root has Re s < 0 (by the crossing count)."""
+        K = check_number("K", K, -_K_MAX, _K_MAX, low_open=False, high_open=False)
         return self.unstable_root_count(K) == 0
 
     def delay_margin(self, K: float) -> float:
@@ -202,6 +209,7 @@ class DelayLoop:
         0 if a(s) + K is not Hurwitz; ``inf`` when no root can reach the axis
         (delay-independent stability). Does not depend on this loop's own T.
         """
+        K = check_number("K", K, -_K_MAX, _K_MAX, low_open=False, high_open=False)
         if not routh_array(self._delay_free(K)).stable:
             return 0.0
         firsts = [self._first_delay(w, K) for w, _ in self.crossing_frequencies(K)]
@@ -282,6 +290,7 @@ class DelayLoop:
         from each eigenvalue (to |Δs| < 1e-13·max(1, |s|)). Conjugate pairs are
         both returned. T = 0 returns the polynomial roots of a(s) + K.
         """
+        K = check_number("K", K, -_K_MAX, _K_MAX, low_open=False, high_open=False)
         if self.T == 0:
             roots = np.roots(self._delay_free(K))
             return roots[np.argsort(-roots.real)][:count]
@@ -297,6 +306,7 @@ class DelayLoop:
 
     def spectral_abscissa(self, K: float) -> float:
         """max Re s over all roots, 1/s."""
+        K = check_number("K", K, -_K_MAX, _K_MAX, low_open=False, high_open=False)
         return float(self.rightmost_roots(K, count=1)[0].real)
 
     def _generator(self, K, nodes):

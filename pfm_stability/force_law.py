@@ -19,7 +19,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .checks import check_number
+from .checks import check_number, check_type
+from .parameters import check_parameter
 from .solve import bisect_root, expand_bracket
 
 __all__ = ["ForceLaw", "PowerLaw", "wall_equilibrium", "wall_gain", "corridor_gain"]
@@ -136,22 +137,44 @@ def wall_equilibrium(law: ForceLaw, alpha: float) -> float:
     ----------
     law : ForceLaw
     alpha : float
-        Target angle from the wall normal, rad, in (0, π/2).
+        Target angle from the wall normal, rad, in [1e-6°, 90° − 1e-6°].
     """
-    return law.distance_for(math.cos(alpha))
+    check_type("law", law, ForceLaw, "a ForceLaw (e.g. PowerLaw or GridWallLaw)")
+    return law.distance_for(math.cos(check_parameter("alpha", alpha)))
 
 
 def wall_gain(law: ForceLaw, alpha: float) -> tuple[float, float]:
     """(d0 in m, N in 1/m) for travel along a wall (KB eq 11 with δ = 0, eq 23).
 
     N = −F_r′(d0)/(F_a sin α); 0 when no equilibrium exists (d0 = inf).
+
+    Raises
+    ------
+    ValueError
+        For a law that is not a `ForceLaw`, α out of range, or an equilibrium
+        that floating point cannot represent (d0 = 0 or N infinite).
     """
     d0 = wall_equilibrium(law, alpha)
     if math.isinf(d0):
         return d0, 0.0
-    return d0, float(-law.slope(d0) / math.sin(alpha))
+    N = float(-law.slope(d0) / math.sin(alpha))
+    if not (d0 > 0 and math.isfinite(N)):
+        raise ValueError(f"the wall equilibrium is outside floating point (d0 = {d0:g} m, N = {N:g} 1/m) for {law!r} at alpha = {math.degrees(alpha):g} deg")
+    return d0, N
 
 
 def corridor_gain(law: ForceLaw, L: float) -> float:
-    """N = −2F_r′(L)/F_a, 1/m, in the middle of a corridor of half-width L (KB §5.4)."""
-    return float(-2.0 * law.slope(L))
+    """N = −2F_r′(L)/F_a, 1/m, in the middle of a corridor of half-width L (KB §5.4).
+
+    Raises
+    ------
+    ValueError
+        For a law that is not a `ForceLaw`, L out of range, or N that floating
+        point cannot represent.
+    """
+    check_type("law", law, ForceLaw, "a ForceLaw (e.g. PowerLaw or GridWallLaw)")
+    L = check_parameter("L", L)
+    N = float(-2.0 * law.slope(L))
+    if not math.isfinite(N):
+        raise ValueError(f"the corridor gain is outside floating point (N = {N:g} 1/m) for {law!r} at L = {L:g} m")
+    return N

@@ -16,6 +16,7 @@ from dataclasses import dataclass, field
 from .criteria import CorridorAnalysis, WallAnalysis, analyze_corridor, analyze_wall, loop_of
 from .models import MODEL_NAMES, KBFirstOrder, Sampled, models_for
 from .parameters import RANGES, Controller, Corridor, Robot, Wall
+from .checks import check_type
 from .serialize import SCHEMA_VERSION, json_number
 
 __all__ = ["StabilityReport", "KBError", "build_report", "remedies", "kb_error"]
@@ -254,8 +255,13 @@ def build_report(
         )
     wall = Wall.from_degrees(alpha_deg) if alpha_deg is not None else (Wall(alpha) if alpha is not None else None)
     corridor = Corridor(L) if L is not None else None
-    if isinstance(models, str):
-        raise ValueError(f"models must be a sequence of model names; got {models!r}")
+    check_type("robot", robot, Robot, "a Robot")
+    check_type("controller", controller, Controller, "a Controller")
+    models = MODEL_NAMES if models is None else models
+    if isinstance(models, str) or not isinstance(models, (list, tuple)) or not all(isinstance(m, str) for m in models):
+        raise ValueError(f"models must be a list or tuple of model names ({', '.join(MODEL_NAMES)}); got {models!r}")
+    if sources is not None and not isinstance(sources, dict):
+        raise ValueError(f"sources must be a dict of parameter name to provenance; got {sources!r}")
     model_objs = models_for(controller, tuple(dict.fromkeys(models)), pade_order=pade_order)
     sources = sources or {}
     values = {

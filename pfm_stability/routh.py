@@ -33,7 +33,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["RouthResult", "routh_array", "routh_count", "routh_stable", "schur_cohn_stable", "strip_leading_zeros"]
+from .checks import check_number
+
+__all__ = ["RouthResult", "real_coefficients", "routh_array", "routh_count", "routh_stable", "schur_cohn_stable", "strip_leading_zeros"]
 
 
 @dataclass(frozen=True)
@@ -70,9 +72,23 @@ class RouthResult:
         return self.sign_changes == 0 and not self.marginal and not self.epsilon_used
 
 
+def real_coefficients(coefficients, name: str = "coefficients") -> np.ndarray:
+    """A 1-D float array of finite real polynomial coefficients, or ValueError naming `name`."""
+    message = f"{name} must be a non-empty sequence of finite real numbers (descending powers); got {coefficients!r}"
+    if isinstance(coefficients, (str, bytes)) or np.ndim(coefficients) != 1:
+        raise ValueError(message)
+    try:
+        c = np.asarray(coefficients, dtype=float)
+    except (TypeError, ValueError):
+        raise ValueError(message) from None
+    if c.size == 0 or not np.all(np.isfinite(c)):
+        raise ValueError(message)
+    return c
+
+
 def strip_leading_zeros(coefficients) -> np.ndarray:
     """Drop leading (highest-power) exact zeros of a descending coefficient array."""
-    c = np.atleast_1d(np.asarray(coefficients, dtype=float))
+    c = real_coefficients(coefficients)
     nonzero = np.flatnonzero(c)
     if nonzero.size == 0:
         raise ValueError("polynomial must have a non-zero coefficient; got all zeros")
@@ -94,13 +110,9 @@ def routh_array(coefficients) -> RouthResult:
         For symbolic input, `sign_changes` is computed only when every
         first-column entry has a decidable sign (else -1).
     """
-    symbolic = any(_is_sympy(c) for c in coefficients)
-    if symbolic:
+    if np.ndim(coefficients) == 1 and any(_is_sympy(c) for c in coefficients):
         return _routh_symbolic(list(coefficients))
-    c = strip_leading_zeros(coefficients)
-    if not np.all(np.isfinite(c)):
-        raise ValueError(f"polynomial coefficients must be finite; got {list(coefficients)!r}")
-    return _routh_numeric(c)
+    return _routh_numeric(strip_leading_zeros(coefficients))
 
 
 def _first_two_rows(c):
@@ -282,6 +294,7 @@ def schur_cohn_stable(coefficients, margin: float = 0.0) -> bool:
         Require |κ_i| < 1 − margin (0 by default).
     """
     a = strip_leading_zeros(coefficients)
+    margin = check_number("margin", margin, 0.0, 1.0, low_open=False, high_open=True)
     a = a / a[0]
     while len(a) > 1:
         kappa = a[-1]

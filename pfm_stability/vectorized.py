@@ -74,7 +74,10 @@ class VectorVerdicts:
 
 def _check(name, x):
     """x as a float array, every value in ``RANGES[name]``; else the library's message and the point index."""
-    x = np.asarray(x, dtype=float)
+    try:
+        x = np.asarray(x, dtype=float)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a real number or an array of real numbers; got {x!r}") from None
     r = RANGES[name]
     bad = ~np.isfinite(x)
     bad |= (x <= r.low) if r.low_open else (x < r.low)

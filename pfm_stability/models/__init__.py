@@ -77,7 +77,13 @@ def make_models(names=MODEL_NAMES, *, controller=None, **options) -> list[LoopMo
     With `controller`, the ``sampled`` model takes the controller's hold and
     compute delay (giving ``hold``/``compute_delay`` as well is an error).
     """
+    if isinstance(names, str) or not isinstance(names, (list, tuple)) or not all(isinstance(n, str) for n in names):
+        raise ValueError(f"names must be a list or tuple of model names ({', '.join(MODEL_NAMES)}); got {names!r}")
     if controller is not None:
+        from ..parameters import Controller
+
+        if not isinstance(controller, Controller):
+            raise ValueError(f"controller must be a Controller; got {controller!r}")
         if "hold" in options or "compute_delay" in options:
             raise ValueError("hold and compute_delay come from the controller; do not give them as well")
         options = dict(options, hold=controller.hold, compute_delay=controller.compute_delay)
@@ -104,10 +110,14 @@ def models_for(controller, models=None, *, pade_order: int = 3) -> list[LoopMode
         A ``Sampled`` model whose structure contradicts the controller, or an
         unknown name.
     """
+    from ..parameters import Controller
+
+    if not isinstance(controller, Controller):
+        raise ValueError(f"controller must be a Controller; got {controller!r}")
     if models is None:
         models = MODEL_NAMES
-    if isinstance(models, (str, LoopModel)):
-        raise ValueError(f"models must be a sequence of model names or LoopModel objects; got {models!r}")
+    if isinstance(models, (str, LoopModel)) or not isinstance(models, (list, tuple)):
+        raise ValueError(f"models must be a list or tuple of model names or LoopModel objects; got {models!r}")
     out = []
     for model in models:
         if isinstance(model, str):

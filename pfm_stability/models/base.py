@@ -15,6 +15,7 @@ K = kNV. A model therefore answers three questions for given (τ, T, k):
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 from functools import lru_cache
@@ -26,7 +27,7 @@ from ..parameters import RANGES, check_parameter
 from ..crossings import first_stable_interval, verdict_at
 from ..serialize import json_number
 
-__all__ = ["Loop", "Boundary", "LoopModel", "AffineGainModel", "verdict_label", "gain_margin", "gain_range", "UNDECIDED_RTOL"]
+__all__ = ["Loop", "Boundary", "LoopModel", "AffineGainModel", "verdict_label", "gain_margin", "gain_range", "checked", "UNDECIDED_RTOL", "NV_MAX"]
 
 _DELAY_RTOL = 1e-7
 """Relative bracket width at which `critical_delay` stops (reports show 4 digits)."""
@@ -145,6 +146,35 @@ def gain_margin(NV: float, boundary: Boundary, stable: bool) -> float:
     return edge / NV - 1.0
 
 
+NV_MAX = 1e12
+"""Largest loop gain NV (1/s) a model accepts: beyond it the root finders leave floating point."""
+
+
+def _check_NV(NV) -> float:
+    return check_number("NV", NV, 0.0, unit="1/s")
+
+
+def _check_loop(loop) -> "Loop":
+    if not isinstance(loop, Loop):
+        raise ValueError(f"loop must be a Loop (tau, T, k); got {loop!r}")
+    return loop
+
+
+def checked(method):
+    """Validate a public model method's (NV, loop) arguments: ValueError naming the bad one.
+
+    NV is capped at `NV_MAX` here only: internal probes (a stable interval
+    checked beyond the last crossing gain) may go further.
+    """
+
+    @functools.wraps(method)
+    def wrapper(self, NV, loop, *args, **kwargs):
+        NV = check_number("NV", NV, 0.0, NV_MAX, high_open=False, unit="1/s")
+        return method(self, NV, _check_loop(loop), *args, **kwargs)
+
+    return wrapper
+
+
 @lru_cache(maxsize=8192)
 def _cached_boundary(model: "LoopModel", loop: Loop) -> Boundary:
     return model.compute_boundary(loop)
@@ -162,16 +192,18 @@ class LoopModel:
 
     def boundary(self, loop: Loop) -> Boundary:
         """NV* and the boundary frequency for (τ, T, k) (cached)."""
-        return _cached_boundary(self, loop)
+        return _cached_boundary(self, _check_loop(loop))
 
     def compute_boundary(self, loop: Loop) -> Boundary:  # pragma: no cover - interface
         """NV* and ω* for (τ, T, k), uncached (`boundary` caches it)."""
         raise NotImplementedError
 
+    @checked
     def is_stable(self, NV: float, loop: Loop) -> bool:  # pragma: no cover - interface
         """Verdict for NV (1/s) by a route independent of `boundary`."""
         raise NotImplementedError
 
+    @checked
     def rightmost_root(self, NV: float, loop: Loop) -> complex:  # pragma: no cover - interface
         """Dominant root σ + jω (1/s, rad/s); sampled models map z by ln(z)/T."""
         raise NotImplementedError
@@ -181,8 +213,10 @@ class LoopModel:
 
         Models override this with a vectorized version where they can.
         """
+        NV = _check_NV(NV)
         return np.array([self.rightmost_root(NV, loop).real for loop in loops])
 
+    @checked
     def critical_delay(self, NV: float, loop: Loop) -> float:
         """T*: the smallest sampling period / delay at which NV loses stability (τ, k fixed), s.
 
@@ -205,6 +239,7 @@ class LoopModel:
         scale = _time_scale(loop, NV)
         return first_crossing(measure, scale * 1e-2, RANGES["T"].high, rtol=_DELAY_RTOL, atol=1e-12 * scale)
 
+    @checked
     def critical_gain_k(self, NV: float, loop: Loop) -> float:
         """k*: the smallest steering gain at which NV loses stability (τ, T fixed), 1/s.
 
@@ -234,10 +269,6 @@ class LoopModel:
         return hash((type(self).__name__, tuple(sorted(vars(self).items()))))
 
 
-def _check_NV(NV) -> float:
-    return check_number("NV", NV, 0.0, unit="1/s")
-
-
 def _time_scale(loop: Loop, NV: float) -> float:
     """The loop's fastest time scale, s: min(τ, 1/k, 1/NV) (τ counts when > 0)."""
     scales = [1.0 / loop.k, 1.0 / NV] + ([loop.tau] if loop.tau > 0 else [])
@@ -262,6 +293,7 @@ class AffineGainModel(LoopModel):
         """(D, E), descending coefficients: the characteristic polynomial is D + kNV·E."""
         raise NotImplementedError
 
+    @checked
     def characteristic(self, NV: float, loop: Loop) -> np.ndarray:
         """Characteristic polynomial D + kNV·E, descending coefficients."""
         d, e = self.polynomials(loop)
@@ -281,10 +313,16 @@ class AffineGainModel(LoopModel):
         b = Boundary.from_interval(self.name, interval, loop.k)
         return Boundary(b.model, b.NV_critical, self._frequency(b.omega_critical, loop), b.K_critical, b.stable_set)
 
+    @checked
     def is_stable(self, NV: float, loop: Loop) -> bool:
-        d, e = self.polynomials(loop)
-        return verdict_at(d, e, loop.k * _check_NV(NV), self.domain)
+        return self._stable(NV, loop)
 
+    def _stable(self, NV: float, loop: Loop) -> bool:
+        """`is_stable` without the public argument checks (internal probes)."""
+        d, e = self.polynomials(loop)
+        return verdict_at(d, e, loop.k * NV, self.domain)
+
+    @checked
     def roots(self, NV: float, loop: Loop) -> np.ndarray:
         """All roots of the characteristic polynomial (s or z)."""
         return np.roots(self.characteristic(NV, loop))
@@ -316,6 +354,7 @@ class AffineGainModel(LoopModel):
             out[rows] = np.linalg.eigvals(companion).real.max(axis=1)
         return out
 
+    @checked
     def rightmost_root(self, NV: float, loop: Loop) -> complex:
         roots = self.roots(NV, loop)
         if self.domain == "z":

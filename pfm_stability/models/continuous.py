@@ -12,7 +12,7 @@ import math
 
 import numpy as np
 
-from .base import AffineGainModel, Loop
+from .base import AffineGainModel, Loop, checked
 
 __all__ = ["Continuous"]
 
@@ -27,10 +27,12 @@ class Continuous(AffineGainModel):
         """D = τs³ + s² + ks, E = 1 (descending powers of s)."""
         return loop.plant, np.array([1.0])
 
+    @checked
     def critical_delay(self, NV: float, loop: Loop) -> float:
         """T does not enter (17): ``inf`` if τNV < 1, else 0 (s)."""
         return math.inf if self.is_stable(NV, loop) else 0.0
 
+    @checked
     def critical_gain_k(self, NV: float, loop: Loop) -> float:
         """k cancels from Routh's condition τNV < 1: ``inf`` if it holds, else 0 (1/s)."""
         return math.inf if self.is_stable(NV, loop) else 0.0

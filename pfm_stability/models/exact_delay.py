@@ -27,7 +27,7 @@ import math
 import numpy as np
 
 from ..delay import DelayLoop, delay_verdicts_from_gain, kb_critical_gain
-from .base import Boundary, Loop, LoopModel, _check_NV, gain_range
+from .base import Boundary, Loop, LoopModel, _check_NV, checked, gain_range
 
 __all__ = ["ExactDelay"]
 
@@ -57,23 +57,28 @@ class ExactDelay(LoopModel):
         stable, Z, margin = delay_verdicts_from_gain(_one(loop.tau), _one(loop.T), _one(loop.k), _one(K))
         return bool(stable[0]), int(Z[0]), float(margin[0])
 
+    @checked
     def is_stable(self, NV: float, loop: Loop) -> bool:
         """Crossing count Z(T) = 0 (no root in Re s >= 0)."""
         return self._count(NV, loop)[0]
 
+    @checked
     def unstable_root_count(self, NV: float, loop: Loop) -> int | None:
         """Roots with Re s > 0 (None when a root is on the imaginary axis)."""
         return self.quasi_polynomial(loop).unstable_root_count(loop.k * _check_NV(NV))
 
+    @checked
     def rightmost_root(self, NV: float, loop: Loop) -> complex:
         roots = self.quasi_polynomial(loop).rightmost_roots(loop.k * _check_NV(NV), count=2)
         top = roots[roots.real >= roots[0].real - 1e-9 * max(1.0, abs(roots[0]))]
         return complex(top[top.imag.argmax()])
 
+    @checked
     def critical_delay(self, NV: float, loop: Loop) -> float:
         """Delay margin: the smallest T at which NV loses stability (τ, k fixed), s."""
         return self._count(NV, loop)[2]
 
+    @checked
     def critical_gain_k(self, NV: float, loop: Loop) -> float:
         """Smallest steering gain k at which NV loses stability (τ, T fixed), 1/s.
 

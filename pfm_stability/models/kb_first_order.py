@@ -13,7 +13,7 @@ import math
 
 import numpy as np
 
-from .base import AffineGainModel, Loop, _check_NV
+from .base import AffineGainModel, Loop, _check_NV, checked
 
 __all__ = ["KBFirstOrder"]
 
@@ -28,10 +28,12 @@ class KBFirstOrder(AffineGainModel):
         """D = τs³ + s² + ks, E = 1 − sT (descending powers of s)."""
         return loop.plant, np.array([-loop.T, 1.0])
 
+    @checked
     def critical_delay(self, NV: float, loop: Loop) -> float:
         """KB eq (20) solved for T: T* = 1/NV − τ (0 if negative), s."""
         return max(1.0 / _check_NV(NV) - loop.tau, 0.0)
 
+    @checked
     def critical_gain_k(self, NV: float, loop: Loop) -> float:
         """k cancels from eq (20): ``inf`` if NV(τ + T) < 1, else 0 (1/s)."""
         return math.inf if _check_NV(NV) * (loop.tau + loop.T) < 1.0 else 0.0

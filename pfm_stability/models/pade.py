@@ -27,7 +27,7 @@ import math
 import numpy as np
 
 from ..checks import check_integer, check_number
-from .base import AffineGainModel, Loop
+from .base import AffineGainModel, Loop, checked
 
 __all__ = ["Pade", "pade_coefficients", "MAX_PADE_ORDER"]
 

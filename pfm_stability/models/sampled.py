@@ -59,7 +59,7 @@ from ..crossings import Crossing, affine_crossings, stable_interval
 from ..matrix_exponential import zoh_blocks
 from ..parameters import HOLDS
 from ..routh import schur_cohn_stable
-from .base import AffineGainModel, Boundary, Loop, _check_NV
+from .base import AffineGainModel, Boundary, Loop, _check_NV, checked
 from .continuous import Continuous
 
 __all__ = ["Sampled", "continuous_plant", "discretize", "closed_loop_matrix", "delta_plant"]
@@ -248,7 +248,7 @@ class Sampled(AffineGainModel):
         if e[0] != 0.0 and -d[0] / e[0] > 0:  # the degree of Q drops: a pole passes through z = −1
             crossings.append(Crossing(float(-d[0] / e[0]), math.pi / loop.T))
         crossings.sort(key=lambda c: (c.gain, c.frequency))
-        interval = stable_interval(crossings, lambda K: self.is_stable(K / loop.k, loop))
+        interval = stable_interval(crossings, lambda K: self._stable(K / loop.k, loop))
         return Boundary.from_interval(self.name, interval, loop.k)
 
     @staticmethod
@@ -256,43 +256,56 @@ class Sampled(AffineGainModel):
         """ω (rad/s) of the unit-circle point that μ = jΩ maps to."""
         return 2.0 * math.atan(Omega * loop.T / 2.0) / loop.T if loop.T > 0 else Omega
 
+    @checked
     def delta_eigenvalues(self, NV: float, loop: Loop) -> np.ndarray:
         """Eigenvalues λ of (Φ_cl − I)/T (poles z = 1 + Tλ; T = 0: the continuous poles)."""
-        return np.linalg.eigvals(_delta_matrix(loop, loop.k * _check_NV(NV), self.hold, self.compute_delay))
+        return self._delta_eigenvalues(NV, loop)
 
+    def _delta_eigenvalues(self, NV: float, loop: Loop) -> np.ndarray:
+        return np.linalg.eigvals(_delta_matrix(loop, loop.k * NV, self.hold, self.compute_delay))
+
+    @checked
     def closed_loop(self, NV: float, loop: Loop) -> np.ndarray:
         """Φ_cl for NV (1/s)."""
         return closed_loop_matrix(loop, loop.k * _check_NV(NV), self.hold, self.compute_delay)
 
+    @checked
     def eigenvalues(self, NV: float, loop: Loop) -> np.ndarray:
         """Closed-loop poles z (T > 0), as 1 + Tλ."""
-        return 1.0 + loop.T * self.delta_eigenvalues(NV, loop)
+        return 1.0 + loop.T * self._delta_eigenvalues(NV, loop)
 
+    @checked
     def is_stable(self, NV: float, loop: Loop) -> bool:
         """Every pole strictly inside the unit circle: 2 Re λ + T|λ|² < 0 (T = 0: KB eq 17 by Routh)."""
+        return self._stable(NV, loop)
+
+    def _stable(self, NV: float, loop: Loop) -> bool:
         if loop.T == 0:
-            return Continuous().is_stable(NV, loop)
-        lam = self.delta_eigenvalues(NV, loop)
+            return Continuous()._stable(NV, loop)
+        lam = self._delta_eigenvalues(NV, loop)
         return bool(np.all(2.0 * lam.real + loop.T * np.abs(lam) ** 2 < 0.0))
 
+    @checked
     def jury_stable(self, NV: float, loop: Loop) -> bool:
         """Schur–Cohn (Jury) verdict on det(zI − Φ_cl), independent of the eigenvalues."""
         return schur_cohn_stable(self.characteristic(NV, loop))
 
+    @checked
     def rightmost_root(self, NV: float, loop: Loop) -> complex:
         """Dominant pole as s = ln(z)/T: σ = ln|z|/T (1/s), ω = arg(z)/T in [0, π/T] (rad/s)."""
         if loop.T == 0:
             return Continuous().rightmost_root(NV, loop)
-        lam = self.delta_eigenvalues(NV, loop)
+        lam = self._delta_eigenvalues(NV, loop)
         T = loop.T
         sigma = _log_radius(lam, T) / T
         omega = np.abs(np.arctan2(T * lam.imag, 1.0 + T * lam.real)) / T
         i = int(np.argmax(sigma))
         return complex(float(sigma[i]), float(omega[i]))
 
+    @checked
     def roots(self, NV: float, loop: Loop) -> np.ndarray:
         """All closed-loop poles z (T > 0); the continuous roots s at T = 0."""
-        return self.delta_eigenvalues(NV, loop) if loop.T == 0 else self.eigenvalues(NV, loop)
+        return self._delta_eigenvalues(NV, loop) if loop.T == 0 else 1.0 + loop.T * self._delta_eigenvalues(NV, loop)
 
     def growth_rates(self, NV: float, loops) -> np.ndarray:
         """σ = max ln|z|/T (1/s) at NV for each loop, all exponentials and eigenvalues in one batch."""
