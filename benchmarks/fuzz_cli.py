@@ -4,9 +4,13 @@ Each run calls ``pfm_stability.cli.main`` in-process with a seeded random argume
 list: valid values drawn from each parameter's range (and far outside it), edge
 values (0, the bounds, 1e-300, 1e300), NaN, inf, empty strings and text. A run is
 classified as ``exit 0``, ``exit 2``, ``traceback`` (any exception escaping
-``main``, with its type), ``timeout``, or ``bad json`` (``--format json`` whose
-stdout does not parse with NaN/Infinity rejected). Output files go to a temporary
-directory. Run:
+``main``, with its type), ``timeout``, ``bad json`` (``--format json`` whose
+stdout does not parse with NaN/Infinity rejected, or does not validate against
+``pfm_stability/schema/output.schema.json``), ``wrong success`` (exit 0 without
+the PNG an output option named), or ``exit 2, not one error line`` (stderr holds
+more than the one error line besides progress lines and Python warnings). Runs
+whose stderr holds a Python warning (e.g. a numpy RuntimeWarning) are counted
+separately. Output files go to a temporary directory. Run:
 
     python benchmarks/fuzz_cli.py [--runs 536] [--seed 0] [--timeout 60]
 """
@@ -100,7 +104,21 @@ def _alarm(signum, frame):
     raise _Timeout()
 
 
-def run_one(main, argv, timeout):
+def _schema_validator():
+    try:
+        from jsonschema import Draft202012Validator
+    except ImportError:  # the test extra is not installed: parse only
+        return None
+    from pfm_stability.schema import load_schema
+
+    return Draft202012Validator(load_schema())
+
+
+def _is_warning(line: str) -> bool:
+    return "Warning: " in line or line.startswith("  ")  # "file:line: RuntimeWarning: ..." and its source line
+
+
+def run_one(main, argv, timeout, validator=None):
     out, err = io.StringIO(), io.StringIO()
     signal.signal(signal.SIGALRM, _alarm)
     signal.alarm(timeout)
@@ -119,9 +137,17 @@ def run_one(main, argv, timeout):
                         kind = f"wrong success ({flag} {os.path.basename(path) or repr(path)})"
         if code == 0 and "--format" in argv and argv[argv.index("--format") + 1:][:1] == ["json"]:
             try:
-                json.loads(out.getvalue(), parse_constant=lambda c: (_ for _ in ()).throw(ValueError(c)))
+                data = json.loads(out.getvalue(), parse_constant=lambda c: (_ for _ in ()).throw(ValueError(c)))
             except ValueError as exc:
                 kind = f"bad json ({str(exc)[:40]})"
+            else:
+                error = next(iter(validator.iter_errors(data)), None) if validator is not None else None
+                if error is not None:
+                    kind = f"bad json (schema: {'/'.join(map(str, error.absolute_path))})"
+        if code == 2:
+            lines = [line for line in err.getvalue().splitlines() if not line.startswith(f"{argv[0]}: ") and not _is_warning(line)]
+            if len(lines) != 1 or not lines[0].startswith("pfm-stability: error: "):
+                kind = "exit 2, not one error line"
     except _Timeout:
         kind = "timeout"
     except Exception as exc:  # noqa: BLE001 - this is what the fuzz counts
@@ -146,6 +172,9 @@ def main(argv=None) -> int:
     from pfm_stability.cli import main as cli_main
 
     rng = random.Random(args.seed)
+    validator = _schema_validator()
+    warned = collections.Counter()
+    warning_examples = {}
     counts = collections.Counter()
     per_command = collections.defaultdict(collections.Counter)
     examples = collections.defaultdict(list)
@@ -153,8 +182,13 @@ def main(argv=None) -> int:
         cli = build_parser()
         for i in range(args.runs):
             command, argv = _argv(rng, cli, tmp)
-            kind, err = run_one(cli_main, argv, args.timeout)
+            kind, err = run_one(cli_main, argv, args.timeout, validator)
             counts[kind] += 1
+            for line in err.splitlines():
+                if "Warning: " in line:
+                    where = line.split(": ")[0].rsplit("/", 1)[-1] + ": " + line.split(": ", 2)[1]
+                    warned[where] += 1
+                    warning_examples.setdefault(where, argv)
             per_command[command][kind] += 1
             if not kind.startswith("exit") and len(examples[kind]) < args.show:
                 examples[kind].append((argv, err.strip().splitlines()[-1:] if err else []))
@@ -172,7 +206,12 @@ def main(argv=None) -> int:
             print("  pfm-stability " + " ".join(repr(a) if (" " in a or a == "") else a for a in argv))
             for line in last:
                 print("    " + line)
-    bad = sum(n for k, n in counts.items() if not k.startswith("exit"))
+    if warned:
+        print("Python warnings on stderr (each location is shown once per process):")
+        for where, n in warned.most_common():
+            argv = warning_examples[where]
+            print(f"  {where}: first in pfm-stability " + " ".join(repr(a) if (" " in a or a == "") else a for a in argv))
+    bad = sum(n for k, n in counts.items() if not k.startswith("exit") or k == "exit 2, not one error line")
     return 1 if bad else 0
 
 

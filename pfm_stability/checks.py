@@ -13,8 +13,9 @@ from __future__ import annotations
 
 import math
 import numbers
+import os
 
-__all__ = ["check_number", "check_choice", "check_integer", "describe_range"]
+__all__ = ["check_number", "check_choice", "check_integer", "check_output_path", "check_type", "describe_range"]
 
 
 def describe_range(low: float, high: float, low_open: bool, high_open: bool) -> str:
@@ -110,4 +111,79 @@ def check_choice(name: str, value, choices) -> str:
     if value not in choices:
         allowed = ", ".join(str(c) for c in choices)
         raise ValueError(f"{name} must be one of {allowed}; got {value!r}")
+    return value
+
+
+def check_output_path(name: str, path, suffix: str = ".png") -> str:
+    """Return `path` after checking a file can be written there, before any work is done.
+
+    The path must be non-empty, end in `suffix` (case-insensitive), not be an
+    existing directory, and name a file whose directory exists and is
+    writable (an existing file must be writable too). Nothing is created.
+
+    Parameters
+    ----------
+    name : str
+        Option name as the user knows it (``"out"``, ``"plot"``).
+    path : str or os.PathLike
+        The output path.
+    suffix : str
+        Required file-name ending, e.g. ``".png"``.
+
+    Returns
+    -------
+    str
+        The path, unchanged.
+
+    Raises
+    ------
+    ValueError
+        ``"<name> must be a writable file path ending in .png; got 'x' (no .png ending)"``.
+    """
+    text = os.fspath(path) if isinstance(path, (str, os.PathLike)) else path
+    if not isinstance(text, str):
+        raise ValueError(f"{name} must be a writable file path ending in {suffix}; got {path!r}")
+
+    def fail(why: str):
+        raise ValueError(f"{name} must be a writable file path ending in {suffix}; got {text!r} ({why})")
+
+    if not text.strip():
+        fail("empty")
+    if "\0" in text:
+        fail("contains a NUL character")
+    if os.path.isdir(text):
+        fail("an existing directory")
+    if not text.lower().endswith(suffix.lower()):
+        fail(f"the file name must end in {suffix}")
+    if os.path.basename(text).lower() == suffix.lower():
+        fail(f"no file name before {suffix}")
+    parent = os.path.dirname(os.path.abspath(text))
+    if not os.path.isdir(parent):
+        fail(f"directory {parent} does not exist")
+    if not os.access(parent, os.W_OK | os.X_OK):
+        fail(f"directory {parent} is not writable")
+    if os.path.exists(text) and not (os.path.isfile(text) and os.access(text, os.W_OK)):
+        fail("an existing file that cannot be overwritten")
+    return text
+
+
+def check_type(name: str, value, kinds, what: str):
+    """Return `value` after checking it is an instance of `kinds`.
+
+    Parameters
+    ----------
+    name : str
+        Argument name as the user knows it (``"robot"``).
+    value : object
+    kinds : type or tuple of types
+    what : str
+        What is expected, for the message (``"a Robot"``).
+
+    Raises
+    ------
+    ValueError
+        ``"robot must be a Robot; got 'x'"``.
+    """
+    if not isinstance(value, kinds):
+        raise ValueError(f"{name} must be {what}; got {value!r}")
     return value

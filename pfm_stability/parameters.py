@@ -70,11 +70,51 @@ RANGES = {
     "alpha_deg": Range(_ALPHA_MARGIN_DEG, 90.0 - _ALPHA_MARGIN_DEG, low_open=False, unit="deg"),
     "L": Range(0.0, 1e4, unit="m"),
     "max_steering_rate": Range(0.0, math.inf, high_open=True, unit="rad/s"),
+    # where a computation needs a narrower range than the parameter's own
+    "T_sampled": Range(0.0, 100.0, unit="s"),
+    # simulator and validation options
+    "offset": Range(-100.0, 100.0, low_open=False, unit="m"),
+    "duration": Range(0.0, 1e6, high_open=True, unit="s"),
+    "cell_ratio": Range(0.0, 1e6),
+    "cell_size": Range(0.01, 1.0, low_open=False, unit="m"),
+    "start_jitter": Range(0.0, 100.0, low_open=False, unit="m"),
+    "rtol": Range(0.0, 0.5, high_open=True),
+    # integers (closed bounds, checked with `checks.check_integer`)
+    "compute_delay": Range(0, 1, low_open=False, unit="samples"),
+    "pade_order": Range(1, 12, low_open=False),
+    "window_cells": Range(3, 1001, low_open=False, unit="cells"),
+    "members": Range(3, 1000, low_open=False),
+    "sweep": Range(8, 100_000, low_open=False),
+    "seed": Range(0, 2**63 - 1, low_open=False),
 }
 """The one place where parameter ranges live (library, vectorized code and CLI).
 
 Lower bounds are physical (V > 0, τ >= 0 …); upper bounds are generous caps
 (100 m/s, 100 s, 10⁴ 1/s …) that keep every computation inside floating point.
+
+Entries beyond the robot, controller and geometry:
+
+``T_sampled``
+    T where the computation samples (simulator, validation, root locus of the
+    delay loop): (0, 100] s, reported as ``T``; T = 0 (a continuous
+    controller) is allowed by the analysis only.
+``offset``
+    Start offset from the equilibrium line, m, in [−100, 100].
+``duration``
+    Simulated time, s, in (0, 10⁶).
+``cell_ratio``
+    Histogram grid: ρ = F_cr/F_ct per cell, in (0, 10⁶].
+``cell_size``
+    Histogram grid cell side, m, in [0.01, 1] (KB: 0.1 m).
+``start_jitter``
+    Standard deviation of a random lateral start offset, m, in [0, 100].
+``rtol``
+    Relative width of a bisection's final bracket, in (0, 0.5).
+``compute_delay``, ``pade_order``, ``window_cells``, ``members``, ``sweep``, ``seed``
+    Integers in closed ranges: samples from measurement to actuation [0, 1];
+    Padé order m [1, 12]; grid window side [3, 1001] cells (odd, KB: 33);
+    runs per bisection round [3, 1000]; random parameter sets of a sweep
+    [8, 10⁵]; random seeds [0, 2⁶³ − 1].
 """
 
 

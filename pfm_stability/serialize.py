@@ -9,7 +9,9 @@ Every `to_dict` in the package writes numbers with `json_number`:
 * an undefined value (NaN, or None: e.g. no boundary frequency when NV* = 0)
   is ``null``.
 
-`parse_json_number` reads them back.
+`parse_json_number` reads them back; `json_ready` applies `json_number` to
+every number of a nested structure (dicts, lists, tuples, numpy scalars and
+arrays), for `to_dict` methods that pass on dicts built elsewhere.
 """
 
 from __future__ import annotations
@@ -18,7 +20,7 @@ import math
 
 import numpy as np
 
-__all__ = ["json_number", "json_array", "parse_json_number", "SCHEMA_VERSION"]
+__all__ = ["json_number", "json_array", "json_ready", "parse_json_number", "SCHEMA_VERSION"]
 
 SCHEMA_VERSION = "1.0"
 """Version of the JSON output (`pfm_stability/schema/output.schema.json`)."""
@@ -51,3 +53,32 @@ def json_array(a):
     if a.ndim == 1:
         return [json_number(v) for v in a.tolist()]
     return [json_array(row) for row in a]
+
+
+def json_ready(value):
+    """`value` with every number written by `json_number` (recursively), ready for strict JSON.
+
+    Dicts keep their keys (as str), lists and tuples become lists, numpy
+    arrays nested lists (`json_array`), bools and integers (numpy's too) stay
+    exact, other numbers go through `json_number`; str and None are kept.
+
+    Raises
+    ------
+    TypeError
+        For a value JSON cannot represent (an object, a complex number).
+    """
+    if value is None or isinstance(value, (str, bool)):
+        return value
+    if isinstance(value, np.bool_):
+        return bool(value)
+    if isinstance(value, (int, np.integer)):
+        return int(value)
+    if isinstance(value, (float, np.floating)):
+        return json_number(value)
+    if isinstance(value, dict):
+        return {str(k): json_ready(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [json_ready(v) for v in value]
+    if isinstance(value, np.ndarray):
+        return json_array(value) if value.dtype.kind == "f" else json_ready(value.tolist())
+    raise TypeError(f"cannot write {type(value).__name__} as JSON")

@@ -1,10 +1,35 @@
-"""Shared fixtures: the CARMEL loop and seeded random parameter sets."""
+"""Shared fixtures: the CARMEL loop and seeded random parameter sets; hypothesis profiles.
+
+Hypothesis profiles, chosen with the environment variable ``HYPOTHESIS_PROFILE``:
+
+``ci`` (default)
+    100 examples per test that does not set its own count, derandomized so
+    that a run is reproducible and CI does not fail on an example no one
+    changed code for; no deadline (CLI examples vary from 10 ms to seconds).
+``dev``
+    10x the examples, random seeds (new examples on every run): for a
+    thorough local fuzz, e.g. ``HYPOTHESIS_PROFILE=dev pytest tests/test_cli_fuzz.py``.
+
+Tests that fix ``max_examples`` themselves keep it; ``tests/test_cli_fuzz.py``
+scales its budgets from the active profile's ``max_examples``.
+"""
+
+import os
 
 import numpy as np
 import pytest
+from hypothesis import HealthCheck, settings
 
 from pfm_stability.models import Loop
 from pfm_stability.parameters import CARMEL
+
+settings.register_profile(
+    "ci", max_examples=100, derandomize=True, deadline=None, print_blob=True, suppress_health_check=[HealthCheck.too_slow]
+)
+settings.register_profile(
+    "dev", max_examples=1000, deadline=None, print_blob=True, suppress_health_check=[HealthCheck.too_slow]
+)
+settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "ci"))
 
 
 @pytest.fixture

@@ -1,4 +1,4 @@
-"""``pfm-stability simulate`` (issue 4 item 9): JSON keys, text, plot, exit status 2 on bad input."""
+"""``pfm-stability simulate``: JSON keys, text, plot, exit status 2 on bad input."""
 
 import json
 
@@ -38,13 +38,16 @@ def test_text_report_and_plot(tmp_path, capsys):
     "argv,message",
     [
         (["--scenario", "corridor", "--L", "0.3"], "L must be"),
-        (["--scenario", "corridor", "--T", "0"], "T must be a finite number in (0, inf) s"),
+        (["--scenario", "corridor", "--T", "0"], "T must be a finite number in (0, 100] s; got 0.0"),
+        (["--scenario", "corridor", "--T", "101"], "T must be a finite number in (0, 100] s; got 101.0"),
         (["--scenario", "corridor", "--window-cells", "32"], "window_cells must be an odd integer"),
-        (["--scenario", "corridor", "--window-cells", "x"], "window_cells must be an integer"),
+        (["--scenario", "corridor", "--window-cells", "x"], "window_cells must be an odd integer in [3, 1001]; got 'x'"),
+        (["--scenario", "corridor", "--window-cells", "1003"], "window_cells must be an odd integer in [3, 1001]; got '1003'"),
         (["--scenario", "kb-fig3", "--env", "analytic"], "env must be grid"),
         (["--scenario", "nowhere"], "invalid choice"),
         (["--scenario", "corridor", "--V", "-1"], "V must be"),
-        (["--scenario", "corridor", "--plot", "/nonexistent/dir/x.png"], "cannot write"),
+        (["--scenario", "corridor", "--plot", "/nonexistent/dir/x.png"],
+         "plot must be a writable file path ending in .png; got '/nonexistent/dir/x.png' (directory /nonexistent/dir does not exist)"),
         (["--scenario", "corridor", "--W", "2.0"], "L must be"),
     ],
 )

@@ -1,4 +1,4 @@
-"""``pfm-stability validate`` (issue 5 item 2): JSON keys, text report, overlay PNG, sweep, exit status 2 on bad input."""
+"""``pfm-stability validate``: JSON keys, text report, overlay PNG, sweep, exit status 2 on bad input."""
 
 import json
 
@@ -63,14 +63,14 @@ def test_grid_overlay_with_stability_map(tmp_path, capsys):
         (["--scenario", "corridor", "--sweep", "3"], "sweep must be an integer in [8, 100000]"),
         (["--scenario", "corridor", "--sweep-plot", "x.png"], "sweep-plot needs --sweep N"),
         (["--scenario", "corridor", "--no-map"], "no-map applies to --plot only"),
-        (["--scenario", "corridor", "--alpha", "95"], "alpha must be a finite number in (0, 90) deg"),
+        (["--scenario", "corridor", "--alpha", "95"], "alpha must be a finite number in [1e-06, 89.999999] deg; got 95.0"),
         (["--scenario", "corridor", "--members", "2"], "members must be an integer in [3, 1000]"),
         (["--scenario", "corridor", "--V", "-1"], "V must be"),
         (["--scenario", "hall"], "invalid choice"),
         (["--scenario", "corridor", "--V", "0.5", "--tau", "0.6", "--k", "1", "--f", "0.5", "--T", "0.03", "--compute-delay", "0"],
          "lies outside the values this scenario can be simulated with"),
         (["--scenario", "corridor", "--env", "analytic", "--rtol", "0.05", "--plot", "/nonexistent/dir/x.png", "--no-map"],
-         "cannot write"),
+         "plot must be a writable file path ending in .png; got '/nonexistent/dir/x.png' (directory /nonexistent/dir does not exist)"),
     ],
 )
 def test_bad_input_exits_2_with_one_line(argv, message, capsys):

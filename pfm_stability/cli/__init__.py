@@ -9,13 +9,14 @@ the subcommand that needs them.
 Every user error — a bad value, an unknown option, an impossible scenario —
 ends with exit status 2 and one line on stderr::
 
-    pfm-stability: error: V must be a finite number in (0, inf) m/s; got -1.0
+    pfm-stability: error: V must be a finite number in (0, 100] m/s; got -1.0
 """
 
 from __future__ import annotations
 
 import argparse
 import importlib
+import re
 import sys
 
 __all__ = ["main", "build_parser", "UsageError"]
@@ -27,8 +28,20 @@ class UsageError(Exception):
     """A user error found while parsing; printed as one line, exit status 2."""
 
 
+_NEGATIVE_NUMBER = re.compile(r"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$")
+"""A negative number, also in scientific notation (``--offset -1e-3``): a value, not an option."""
+
+
 class _Parser(argparse.ArgumentParser):
-    """ArgumentParser whose errors are a single line and an exception, not an exit."""
+    """ArgumentParser whose errors are a single line and an exception, not an exit.
+
+    Negative numbers in scientific notation (``-1e-3``) are read as values;
+    argparse's own pattern (Python < 3.13) takes them for unknown options.
+    """
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        self._negative_number_matcher = _NEGATIVE_NUMBER
 
     def error(self, message):
         raise UsageError(message)

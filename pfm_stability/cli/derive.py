@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import textwrap
 
-from .options import PADE_ORDER
+from .options import PADE_ORDER, describe
 
 FORMATS = ("text", "latex")
 LAWS = ("power", "general")  # = pfm_stability.derivation.LAWS (not imported: it imports sympy)
@@ -30,7 +30,7 @@ def add_parser(sub) -> None:
         default="power",
         help="force law: KB's power law F_r = f F_a W^n/d^n (default) or a general F_r(d)",
     )
-    p.add_argument("--pade-order", type=PADE_ORDER, default=2, help="order m of the Pade form of (18) shown (1..12, default 2)")
+    p.add_argument("--pade-order", type=PADE_ORDER, default=2, help=f"order m of the Pade form of (18) shown, {describe('pade_order')} (default 2)")
     p.set_defaults(run=run)
 
 

@@ -9,21 +9,50 @@ from __future__ import annotations
 import argparse
 from dataclasses import dataclass, fields
 
-from ..checks import check_integer, check_number
-from ..parameters import HOLDS, PRESETS, RANGES, Controller, Preset, Robot, check_parameter, get_preset
+from ..checks import check_integer, check_number, check_output_path
+from ..parameters import HOLDS, PRESETS, RANGES, Controller, Preset, Robot, get_preset
 
-__all__ = ["number", "integer", "add_parameter_options", "resolve_parameters", "ResolvedParameters"]
+__all__ = [
+    "number",
+    "check",
+    "integer",
+    "output_path",
+    "describe",
+    "add_parameter_options",
+    "resolve_parameters",
+    "ResolvedParameters",
+]
+
+SHOWN_NAMES = {"alpha_deg": "alpha", "T_sampled": "T"}
+"""`RANGES` keys that messages name differently: the parameter as the user knows it."""
 
 
-def number(name: str, *bounds, **options):
-    """An argparse ``type=`` that parses a float and checks it against ``RANGES[name]``.
+def _shown(key: str) -> str:
+    return SHOWN_NAMES.get(key, key)
 
-    The message on failure is the library's (`parameters.check_parameter`),
-    so the CLI and the library name the parameter and its range the same way.
-    A parameter without an entry in ``RANGES`` gives its bounds here, as
-    `checks.check_number` takes them (``low, high, low_open=…, unit=…``).
+
+def describe(key: str) -> str:
+    """``RANGES[key]`` for a help text, e.g. ``(0, 100] m/s`` or ``[3, 1000]`` (integers exactly)."""
+    r = RANGES[key]
+    if isinstance(r.low, int) and isinstance(r.high, int):
+        return f"[{r.low}, {r.high}]" + (f" {r.unit}" if r.unit else "")
+    return r.describe()
+
+
+def check(key: str, value) -> float:
+    """`value` as a float if it lies in ``RANGES[key]``, else ValueError.
+
+    The message is the library's (`checks.check_number`, as
+    `parameters.check_parameter` words it), naming the parameter as the user
+    knows it (``alpha_deg`` → ``alpha``, ``T_sampled`` → ``T``) with the range
+    in the units the user typed, so every subcommand states one range per option.
     """
-    check = (lambda value: check_number(name, value, *bounds, **options)) if bounds or options else (lambda value: check_parameter(name, value))
+    r = RANGES[key]
+    return check_number(_shown(key), value, r.low, r.high, low_open=r.low_open, high_open=r.high_open, unit=r.unit)
+
+
+def number(key: str):
+    """An argparse ``type=`` that parses a float and checks it against ``RANGES[key]`` (`check`)."""
 
     def parse(text: str) -> float:
         try:
@@ -31,48 +60,82 @@ def number(name: str, *bounds, **options):
         except ValueError:
             value = text
         try:
-            return check(value)
+            return check(key, value)
+        except ValueError as exc:
+            raise argparse.ArgumentTypeError(str(exc)) from None
+
+    parse.__name__ = _shown(key)
+    parse.kind, parse.range_key = "number", key  # for tests that generate values of every option
+    return parse
+
+
+def integer(key: str, *, odd: bool = False):
+    """An argparse ``type=`` for an integer in the closed range ``RANGES[key]`` (odd if asked).
+
+    Message: ``"<key> must be an [odd ]integer in [low, high]; got '<text>'"``,
+    as `checks.check_integer` (and `effective_force.check_window_cells`) word it.
+    """
+    r = RANGES[key]
+    low, high = int(r.low), int(r.high)
+    shown = _shown(key)
+    message = f"{shown} must be an {'odd ' if odd else ''}integer in [{low}, {high}]; got {{!r}}"
+
+    def parse(text: str) -> int:
+        try:
+            value = check_integer(shown, int(text), low, high)
+        except ValueError:
+            raise argparse.ArgumentTypeError(message.format(text)) from None
+        if odd and value % 2 == 0:
+            raise argparse.ArgumentTypeError(message.format(text))
+        return value
+
+    parse.__name__ = shown
+    parse.kind, parse.range_key, parse.odd = "integer", key, odd
+    return parse
+
+
+def output_path(name: str, suffix: str = ".png"):
+    """An argparse ``type=`` for an output file, checked before any work (`checks.check_output_path`)."""
+
+    def parse(text: str) -> str:
+        try:
+            return check_output_path(name, text, suffix)
         except ValueError as exc:
             raise argparse.ArgumentTypeError(str(exc)) from None
 
     parse.__name__ = name
+    parse.kind, parse.suffix = "path", suffix
     return parse
 
 
-def integer(name: str, low: int, high: int):
-    """An argparse ``type=`` for an integer in [low, high], with the library's message."""
-
-    def parse(text: str) -> int:
-        try:
-            return check_integer(name, int(text), low, high)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"{name} must be an integer in [{low}, {high}]; got {text!r}") from None
-
-    parse.__name__ = name
-    return parse
-
-
-PADE_ORDER = integer("pade_order", 1, 12)
+PADE_ORDER = integer("pade_order")
 """``--pade-order`` values: Padé order m of the ``pade`` model."""
 
 
-def add_parameter_options(parser: argparse.ArgumentParser) -> None:
-    """--preset, --V, --tau, --T, --k, --f, --n, --W, --hold, --compute-delay."""
+def add_parameter_options(parser: argparse.ArgumentParser, *, sampled: bool = False) -> None:
+    """--preset, --V, --tau, --T, --k, --f, --n, --W, --hold, --compute-delay.
+
+    With ``sampled=True`` (the simulator and the validation, which sample),
+    ``--T`` takes ``RANGES["T_sampled"]``: (0, 100] s.
+    """
     group = parser.add_argument_group("robot and controller (override the preset)")
     group.add_argument("--preset", choices=sorted(PRESETS), default="carmel", help="parameter preset (default: carmel)")
     helps = {
         "V": "speed",
         "tau": "steering time constant",
-        "T": "sampling period",
+        "T": "sampling period" + ("" if sampled else " (0: a continuous controller)"),
         "k": "steering gain",
         "f": "force-constant ratio F_cr/F_ct",
         "n": "repulsion exponent",
         "W": "robot width",
     }
     for name, text in helps.items():
-        group.add_argument(f"--{name}", type=number(name), help=f"{text}, {RANGES[name].describe()}")
+        key = "T_sampled" if sampled and name == "T" else name
+        group.add_argument(f"--{name}", type=number(key), help=f"{text}, {describe(key)}")
     group.add_argument("--hold", choices=HOLDS, help="sampled structure: what is held between samples")
-    group.add_argument("--compute-delay", type=integer("compute_delay", 0, 1), help="samples from measurement to actuation (0 or 1)")
+    group.add_argument(
+        "--compute-delay", type=integer("compute_delay"), help=f"samples from measurement to actuation, {describe('compute_delay')}"
+    )
 
 
 _ROBOT_FIELDS = ("V", "tau", "k", "W")

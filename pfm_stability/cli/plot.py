@@ -7,7 +7,7 @@ every model), ``gain-vs-k`` (NV* against the steering gain k for all models),
 
 from __future__ import annotations
 
-from .options import PADE_ORDER, add_parameter_options, resolve_parameters
+from .options import PADE_ORDER, add_parameter_options, check, describe, output_path, resolve_parameters
 
 KINDS = ("rlocus", "gain-vs-k", "force-law")
 
@@ -15,8 +15,9 @@ KINDS = ("rlocus", "gain-vs-k", "force-law")
 def add_parser(sub) -> None:
     p = sub.add_parser("plot", help="save a plot as PNG (root locus, NV* vs k, grid force law)", description=__doc__.splitlines()[0])
     p.add_argument("kind", choices=KINDS, help="what to draw")
-    p.add_argument("--out", required=True, help="output PNG file")
-    p.add_argument("--pade-order", type=PADE_ORDER, default=3, metavar="M", help="Padé order m (1..12, default 3)")
+    p.add_argument("--out", required=True, type=output_path("out"), metavar="PNG",
+                   help="output file, ending in .png, in an existing writable directory")
+    p.add_argument("--pade-order", type=PADE_ORDER, default=3, metavar="M", help=f"Padé order m, {describe('pade_order')} (default 3)")
     add_parameter_options(p)
     p.set_defaults(run=run)
 
@@ -41,16 +42,23 @@ def _draw(kind, params, pade_order):
 
 
 def run(args) -> int:
+    params = resolve_parameters(args)
+    if args.kind == "rlocus":
+        try:
+            check("T_sampled", params.controller.T)
+        except ValueError as exc:
+            raise ValueError(f"{exc} (the root locus is drawn for the delay loop, which needs T > 0)") from None
     import matplotlib
 
     matplotlib.use("Agg")
-    params = resolve_parameters(args)
-    if args.kind == "rlocus" and params.controller.T == 0:
-        raise ValueError("T must be a finite number in (0, 100] s for a root locus of the delay loop; got 0.0")
+    import matplotlib.pyplot as plt
+
     fig = _draw(args.kind, params, args.pade_order)
     try:
         fig.savefig(args.out, dpi=130)
-    except OSError as exc:
-        raise ValueError(f"out must be a writable PNG path; got {args.out!r} ({exc.strerror})") from None
+    except OSError as exc:  # checked before the work; this is a race or a full disk
+        raise ValueError(f"out must be a writable file path ending in .png; got {args.out!r} ({exc.strerror or exc})") from None
+    finally:
+        plt.close(fig)
     print(f"wrote {args.out}")
     return 0

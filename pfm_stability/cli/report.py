@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from .options import PADE_ORDER, add_parameter_options, number, resolve_parameters
+from .options import PADE_ORDER, add_parameter_options, describe, number, resolve_parameters
 
 MODEL_CHOICES = ("continuous", "kb_first_order", "pade", "exact_delay", "sampled")
 
@@ -14,10 +14,10 @@ def add_parser(sub) -> None:
         description="Stability of the VFF robot-environment loop (Koren & Borenstein 1991) for every model.",
     )
     add_parameter_options(p)
-    p.add_argument("--alpha", type=number("alpha_deg"), help="wall: target angle from the wall normal, deg, in (0, 90)")
-    p.add_argument("--L", type=number("L"), help="corridor half-width, m, in (W/2, 1e4]")
+    p.add_argument("--alpha", type=number("alpha_deg"), help=f"wall: target angle from the wall normal, {describe('alpha_deg')}")
+    p.add_argument("--L", type=number("L"), help=f"corridor half-width, {describe('L')}, and more than W/2")
     p.add_argument("--model", action="append", choices=MODEL_CHOICES, help="model to include (repeatable; default: all)")
-    p.add_argument("--pade-order", type=PADE_ORDER, default=3, help="order m of the pade model (1..12, default 3)")
+    p.add_argument("--pade-order", type=PADE_ORDER, default=3, help=f"order m of the pade model, {describe('pade_order')} (default 3)")
     p.add_argument("--format", choices=("text", "json", "markdown"), default="text")
     p.set_defaults(run=run)
 

@@ -3,18 +3,26 @@
     pfm-stability simulate --scenario kb-fig6-narrow --plot fig6b.png
     pfm-stability simulate --scenario corridor --env analytic --L 0.9 --format json
 
-JSON keys: ``events`` (list of {type, t, x, y}; type ∈ collision,
-target_reached, trapped; t in s), ``metrics`` (growth_rate σ 1/s,
+JSON keys (`pfm_stability/schema/output.schema.json`): ``schema_version``,
+``command`` ("simulate"), ``events`` (list of {type, t, x, y}; type ∈
+collision, target_reached, trapped; t in s), ``metrics`` (growth_rate σ 1/s,
 angular_frequency ω rad/s, oscillating, stable, amplitude, method, …),
-``prediction`` (the `sampled` model with the run's own force law and KB's
-criterion, for corridor and wall geometries; null otherwise), ``inputs``
-(every parameter, where it came from, and the scenario's documented choices).
+``t_end`` (s), ``steps``, ``min_clearance`` (m), ``prediction`` (the
+`sampled` model with the run's own force law and KB's criterion, for corridor
+and wall geometries; null otherwise), ``inputs`` (every parameter, where it
+came from, and the scenario's documented choices), ``plot``, and ``timing``
+(wall-clock ``seconds`` and samples per second ``rate``: the only values
+that change from run to run). Infinite numbers are the strings "inf"/"-inf",
+undefined ones null.
+
+A progress bar of the simulated samples is drawn on stderr when stderr is a
+terminal (``--quiet``: never).
 """
 
 from __future__ import annotations
 
-
-from .options import add_parameter_options, integer, number, resolve_parameters
+from .options import add_parameter_options, describe, integer, number, output_path, resolve_parameters
+from .progress import step_progress
 
 SCENARIO_CHOICES = ("straight", "corridor", "wall", "kb-fig3", "kb-fig5", "kb-fig6-wide", "kb-fig6-narrow")
 
@@ -24,33 +32,37 @@ def add_parser(sub) -> None:
         "simulate",
         help="simulate a scenario (VFF on a histogram grid, or analytic walls) and measure oscillation",
         description="Simulate the VFF controller on a CARMEL-like robot (Koren & Borenstein 1991): "
-        "events, oscillation metrics (DESIGN §6), model predictions, and a trajectory plot like KB's figures.",
+        "events, oscillation metrics (growth rate and angular frequency of the lateral offset), model predictions, "
+        "and a trajectory plot like KB's figures.",
     )
     p.add_argument("--scenario", required=True, choices=SCENARIO_CHOICES, help="scenario preset")
     p.add_argument("--env", choices=("grid", "analytic"), default="grid", help="histogram grid (default) or analytic walls")
-    add_parameter_options(p)
+    add_parameter_options(p, sampled=True)
     g = p.add_argument_group("scenario")
-    g.add_argument("--L", type=number("L"), help="corridor: half-width, m, in (W/2, 1e4]")
-    g.add_argument("--alpha", type=number("alpha_deg"), help="wall: target angle from the wall normal, deg, in (0, 90)")
-    g.add_argument("--offset", type=number("offset", unit="m"), help="corridor/wall: start offset from equilibrium, m")
-    g.add_argument("--duration", type=number("duration", 0.0, 1e6, unit="s"), help="simulated time, s")
-    g.add_argument("--cell-ratio", type=number("cell_ratio", 0.0), help="grid: F_cr/F_ct per cell (default: calibrated to f_av = f)")
+    g.add_argument("--L", type=number("L"), help=f"corridor: half-width, {describe('L')}, and more than W/2 (default 1)")
+    g.add_argument("--alpha", type=number("alpha_deg"), help=f"wall: target angle from the wall normal, {describe('alpha_deg')} (default 45)")
+    g.add_argument("--offset", type=number("offset"), help=f"corridor/wall: start offset from equilibrium, {describe('offset')} (default 0.02)")
+    g.add_argument("--duration", type=number("duration"), help=f"simulated time, {describe('duration')} (default per scenario)")
+    g.add_argument("--cell-ratio", type=number("cell_ratio"), help=f"grid: F_cr/F_ct per cell, {describe('cell_ratio')} (default: calibrated to f_av = f)")
     g.add_argument("--law", choices=("power", "grid"), help="analytic: KB's lumped power law (default) or the grid's effective law")
-    g.add_argument("--window-cells", type=integer("window_cells", -10**6, 10**6), default=33, help="grid: active window side, odd >= 3 (33)")
-    g.add_argument("--cell-size", type=number("cell_size", 0.0, unit="m"), default=0.1, help="grid: cell size, m (0.1)")
+    g.add_argument("--window-cells", type=integer("window_cells", odd=True), default=33,
+                   help=f"grid: active window side, odd, {describe('window_cells')} (default 33)")
+    g.add_argument("--cell-size", type=number("cell_size"), default=0.1, help=f"grid: cell size, {describe('cell_size')} (default 0.1)")
     g.add_argument("--speed-law", action="store_true", help="use the VFF speed law V(1 - |cos phi|)")
-    g.add_argument("--seed", type=integer("seed", 0, 2**63 - 1), help="seed of the random start jitter")
-    g.add_argument("--jitter", type=number("start_jitter", 0.0, low_open=False, unit="m"), default=0.0, help="std of a random lateral start offset, m")
+    g.add_argument("--seed", type=integer("seed"), help=f"seed of the random start jitter, {describe('seed')}")
+    g.add_argument("--jitter", type=number("start_jitter"), default=0.0,
+                   help=f"standard deviation of a random lateral start offset, {describe('start_jitter')} (default 0)")
     out = p.add_argument_group("output")
-    out.add_argument("--plot", metavar="PNG", help="write a trajectory plot drawn like KB's figures")
+    out.add_argument("--plot", type=output_path("plot"), metavar="PNG",
+                     help="write a trajectory plot drawn like KB's figures (a .png file in an existing writable directory)")
     out.add_argument("--format", choices=("text", "json"), default="text")
     out.add_argument("--trajectory", action="store_true", help="json: include every sample of the trajectory")
+    out.add_argument("--quiet", action="store_true", help="no progress bar on stderr (shown only when stderr is a terminal)")
     p.set_defaults(run=run)
 
 
 def _build(args, params):
-    import math
-
+    from ..parameters import Wall
     from ..sim.presets import make_scenario
 
     return make_scenario(
@@ -59,7 +71,7 @@ def _build(args, params):
         controller=params.controller,
         env=args.env,
         L=args.L,
-        alpha=math.radians(args.alpha) if args.alpha is not None else None,
+        alpha=Wall.from_degrees(args.alpha).alpha if args.alpha is not None else None,  # rad, inside RANGES['alpha']
         offset=args.offset,
         duration=args.duration,
         cell_ratio=args.cell_ratio,
@@ -83,40 +95,56 @@ def _plot(result, path: str) -> None:
     fig = plot_trajectory(result)
     try:
         fig.savefig(path, dpi=120)
-    except OSError as exc:
-        raise ValueError(f"plot: cannot write {path}: {exc.strerror or exc}") from None
+    except OSError as exc:  # checked before the work; this is a race or a full disk
+        raise ValueError(f"plot must be a writable file path ending in .png; got {path!r} ({exc.strerror or exc})") from None
     finally:
         plt.close(fig)
 
 
 def run(args) -> int:
     import json
+    import time
 
+    from ..parameters import Corridor, check_corridor_fits
+    from ..serialize import SCHEMA_VERSION, json_number
     from ..sim.api import simulate
     from ..sim.predict import predict
 
     params = resolve_parameters(args)
+    if args.scenario == "corridor" and args.L is not None:  # the report's words for a robot wider than the corridor
+        check_corridor_fits(Corridor(args.L), params.robot)
     scenario = _build(args, params)
-    result = simulate(scenario)
+    started = time.perf_counter()
+    with step_progress("simulate", quiet=args.quiet) as progress:
+        result = simulate(scenario, progress=progress)
+    seconds = time.perf_counter() - started
     prediction = predict(scenario)
     if args.plot:
         _plot(result, args.plot)
-    out = result.to_dict(trajectory=args.trajectory)
-    out["prediction"] = prediction.to_dict() if prediction is not None else None
-    out["inputs"]["sources"] = params.sources
-    out["plot"] = args.plot
     if args.format == "json":
-        print(json.dumps(out, indent=2, allow_nan=False, default=_json_default))
+        out = {"schema_version": SCHEMA_VERSION, "command": "simulate", **result.to_dict(trajectory=args.trajectory)}
+        out["prediction"] = prediction.to_dict() if prediction is not None else None
+        out["inputs"]["sources"] = params.sources
+        out["plot"] = args.plot
+        out["timing"] = {"seconds": json_number(seconds), "rate": json_number(result.steps / seconds if seconds > 0 else None)}
+        print(json.dumps(out, indent=2, allow_nan=False, default=json_default))
     else:
         print(render_text(result, prediction, args.plot), end="")
     return 0
 
 
-def _json_default(value):
+def json_default(value):
+    """`json.dumps` ``default=``: numpy scalars as Python numbers (floats through `json_number`)."""
     import numpy as np
 
-    if isinstance(value, np.generic):
-        return value.item()
+    from ..serialize import json_number
+
+    if isinstance(value, np.bool_):
+        return bool(value)
+    if isinstance(value, np.integer):
+        return int(value)
+    if isinstance(value, np.floating):
+        return json_number(value)
     raise TypeError(f"cannot serialize {type(value).__name__}")
 
 
@@ -140,7 +168,7 @@ def render_text(result, prediction, plot_path=None) -> str:
     if result.min_clearance is not None:
         lines.append(f"  closest approach: {result.min_clearance * 100:.3g} cm between the robot disc and an obstacle")
     lines += [
-        f"metrics (DESIGN §6, {m.turning_points} turning points, method {m.method}):",
+        f"metrics ({m.turning_points} turning points, method {m.method}):",
         f"  growth rate sigma = {_fmt(m.growth_rate, '1/s')}, angular frequency omega = {_fmt(m.angular_frequency, 'rad/s')}",
         f"  oscillating: {'yes' if m.oscillating else 'no'}; stable: {'yes' if m.stable else 'no'}; "
         f"limit cycle: {'amplitude %.3g m' % m.amplitude if m.limit_cycle else 'no'}",

@@ -1,4 +1,4 @@
-"""``pfm-stability validate``: the simulated stability boundary against every model (issue 5 item 2).
+"""``pfm-stability validate``: the simulated stability boundary against every model.
 
     pfm-stability validate --scenario corridor --env grid --plot corridor.png
     pfm-stability validate --scenario wall --env analytic --hold reference --compute-delay 0 --format json
@@ -11,20 +11,28 @@ at the grid's f_av), and checks σ and ω near it against the matching
 `sampled` model. ``--sweep N`` also simulates N random parameter sets and
 reports how often each model's verdict agrees with the simulation.
 
-JSON keys: ``parameter`` (the bisected one), ``simulated_boundary`` (a
-number, in ``unit``: L m, α deg, V m/s, f), ``predicted_boundary`` and
-``relative_error`` (objects keyed by model name: continuous, kb_first_order,
-pade, exact_delay, sampled), ``lumped_predicted_boundary`` /
+JSON keys (`pfm_stability/schema/output.schema.json`): ``schema_version``,
+``command`` ("validate"), ``parameter`` (the bisected one),
+``simulated_boundary`` (a number, in ``unit``: L m, α deg, V m/s, f),
+``predicted_boundary`` and ``relative_error`` (objects keyed by model name:
+continuous, kb_first_order, pade, exact_delay, sampled; "inf" where a model
+has no finite boundary), ``lumped_predicted_boundary`` /
 ``lumped_relative_error`` (grid), ``oscillation`` (σ, ω measured vs the
 sampled model's dominant root), ``inputs`` (every parameter and where it came
-from), ``notes``, ``sweep`` (with ``--sweep``), ``plot``.
+from), ``notes``, ``sweep`` (with ``--sweep``), ``plot``, ``sweep_plot``, and
+``timing`` (wall-clock seconds of the bisection and of the sweep: the only
+values that change from run to run).
+
+Progress goes to stderr unless ``--quiet``: one line per batch of runs, above
+a status line with the elapsed time when stderr is a terminal, as plain lines
+otherwise (a log of a long validation keeps them).
 """
 
 from __future__ import annotations
 
-import sys
-
-from .options import PADE_ORDER, add_parameter_options, integer, number, resolve_parameters
+from .options import PADE_ORDER, add_parameter_options, describe, integer, number, output_path, resolve_parameters
+from .progress import line_progress
+from .simulate import json_default
 
 SCENARIO_CHOICES = ("corridor", "wall")
 PARAMETER_CHOICES = ("L", "alpha", "V", "f")
@@ -41,37 +49,30 @@ def add_parser(sub) -> None:
     p.add_argument("--parameter", choices=PARAMETER_CHOICES,
                    help="parameter to bisect: L (corridor), alpha (wall), V or f (default: L for a corridor, alpha for a wall)")
     p.add_argument("--env", choices=("grid", "analytic"), default="grid", help="histogram grid (default) or analytic walls")
-    add_parameter_options(p)
+    add_parameter_options(p, sampled=True)
     g = p.add_argument_group("scenario")
-    g.add_argument("--L", type=number("L", 0.0, unit="m"), help="corridor half-width, m, when V or f is bisected (default 1)")
-    g.add_argument("--alpha", type=number("alpha", 0.0, 90.0, unit="deg"), help="wall angle, deg, in (0, 90), when V or f is bisected (default 45)")
+    g.add_argument("--L", type=number("L"), help=f"corridor half-width, {describe('L')}, and more than W/2, when V or f is bisected (default 1)")
+    g.add_argument("--alpha", type=number("alpha_deg"), help=f"wall angle, {describe('alpha_deg')}, when V or f is bisected (default 45)")
     b = p.add_argument_group("bisection")
-    b.add_argument("--rtol", type=number("rtol", 0.0, 0.5), help="relative width of the final bracket (default 1e-4 analytic, 1e-3 grid)")
-    b.add_argument("--members", type=integer("members", 3, 1000), default=9, help="runs per bisection round (9)")
-    b.add_argument("--offset", type=number("offset", unit="m"), help="start offset from equilibrium, m (default 1e-7 analytic, 0.01 grid)")
-    b.add_argument("--duration", type=number("duration", 0.0, 1e6, unit="s"), help="simulated time per run, s (default: 10 boundary periods, >= 20/30 s)")
-    b.add_argument("--pade-order", type=PADE_ORDER, default=3, help="order m of the pade model (1..12, default 3)")
+    b.add_argument("--rtol", type=number("rtol"), help=f"relative width of the final bracket, {describe('rtol')} (default 1e-4 analytic, 1e-3 grid)")
+    b.add_argument("--members", type=integer("members"), default=9, help=f"runs per bisection round, {describe('members')} (default 9)")
+    b.add_argument("--offset", type=number("offset"), help=f"start offset from equilibrium, {describe('offset')} (default 1e-7 analytic, 0.01 grid)")
+    b.add_argument("--duration", type=number("duration"),
+                   help=f"simulated time per run, {describe('duration')} (default: 10 boundary periods, >= 20/30 s)")
+    b.add_argument("--pade-order", type=PADE_ORDER, default=3, help=f"order m of the pade model, {describe('pade_order')} (default 3)")
     s = p.add_argument_group("random sweep")
-    s.add_argument("--sweep", type=integer("sweep", 8, 100_000), metavar="N",
-                   help="also simulate N Latin-hypercube parameter sets and report each model's verdict agreement")
-    s.add_argument("--seed", type=integer("seed", 0, 2**63 - 1), default=0, help="seed of the sweep (0)")
+    s.add_argument("--sweep", type=integer("sweep"), metavar="N",
+                   help=f"also simulate N Latin-hypercube parameter sets, N in {describe('sweep')}, and report each model's verdict agreement")
+    s.add_argument("--seed", type=integer("seed"), default=0, help=f"seed of the sweep, {describe('seed')} (default 0)")
     out = p.add_argument_group("output")
-    out.add_argument("--plot", metavar="PNG", help="write the overlay: model boundary curves with simulated stable/unstable runs")
+    out.add_argument("--plot", type=output_path("plot"), metavar="PNG",
+                     help="write the overlay: model boundary curves with simulated stable/unstable runs (a .png file)")
     out.add_argument("--no-map", action="store_true", help="with --plot: skip the 7 x 9 stability map (plot the bisection runs only)")
-    out.add_argument("--sweep-plot", metavar="PNG", help="with --sweep: write the sweep figure")
+    out.add_argument("--sweep-plot", type=output_path("sweep-plot"), metavar="PNG", help="with --sweep: write the sweep figure (a .png file)")
     out.add_argument("--format", choices=("text", "json"), default="text")
-    out.add_argument("--quiet", action="store_true", help="no progress lines on stderr")
+    out.add_argument("--quiet", action="store_true",
+                     help="no progress on stderr (default: a line per batch of runs, with a status line on a terminal)")
     p.set_defaults(run=run)
-
-
-def _progress(args):
-    if args.quiet:
-        return None
-
-    def emit(line: str) -> None:
-        print(f"validate: {line}", file=sys.stderr, flush=True)
-
-    return emit
 
 
 def _save(fig, path: str, what: str) -> None:
@@ -79,28 +80,63 @@ def _save(fig, path: str, what: str) -> None:
 
     try:
         fig.savefig(path, dpi=120)
-    except OSError as exc:
-        raise ValueError(f"{what}: cannot write {path}: {exc.strerror or exc}") from None
+    except OSError as exc:  # checked before the work; this is a race or a full disk
+        raise ValueError(f"{what} must be a writable file path ending in .png; got {path!r} ({exc.strerror or exc})") from None
     finally:
         plt.close(fig)
 
 
 def run(args) -> int:
     import json
-    import math
-
-    import matplotlib
-
-    matplotlib.use("Agg")
-
-    from ..validation import validate_boundary, verdict_sweep
 
     if args.sweep_plot and not args.sweep:
         raise ValueError("sweep-plot needs --sweep N")
     if args.no_map and not args.plot:
         raise ValueError("no-map applies to --plot only")
     params = resolve_parameters(args)
-    progress = _progress(args)
+    if args.scenario == "corridor" and args.L is not None and args.parameter in ("V", "f"):  # the report's words
+        from ..parameters import Corridor, check_corridor_fits
+
+        check_corridor_fits(Corridor(args.L), params.robot)
+    if args.plot or args.sweep_plot:
+        import matplotlib
+
+        matplotlib.use("Agg")
+
+    from ..serialize import SCHEMA_VERSION
+
+    with line_progress("validate", quiet=args.quiet) as progress:
+        validation, sweep = _work(args, params, progress)
+    if args.plot:
+        from ..plots.validation import plot_validation
+
+        _save(plot_validation(validation), args.plot, "plot")
+    if args.sweep_plot:
+        from ..plots.validation import plot_sweep
+
+        _save(plot_sweep(sweep), args.sweep_plot, "sweep-plot")
+    if args.format == "json":
+        out = {"schema_version": SCHEMA_VERSION, "command": "validate", **validation.to_dict()}
+        timing = out.pop("timing")
+        out["inputs"]["sources"] = params.sources
+        out["sweep"] = None
+        if sweep is not None:
+            out["sweep"] = sweep.to_dict()
+            timing["sweep_seconds"] = out["sweep"].pop("timing")["seconds"]
+        out["plot"] = args.plot
+        out["sweep_plot"] = args.sweep_plot
+        out["timing"] = timing
+        print(json.dumps(out, indent=2, allow_nan=False, default=json_default))
+    else:
+        print(render_text(validation, sweep, params.sources, args.plot, args.sweep_plot), end="")
+    return 0
+
+
+def _work(args, params, progress):
+    """The bisection (and the sweep): (BoundaryValidation, SweepResult or None)."""
+    from ..parameters import Wall
+    from ..validation import validate_boundary, verdict_sweep
+
     validation = validate_boundary(
         args.scenario,
         args.parameter,
@@ -108,7 +144,7 @@ def run(args) -> int:
         controller=params.controller,
         env=args.env,
         L=args.L,
-        alpha=math.radians(args.alpha) if args.alpha is not None else None,
+        alpha=Wall.from_degrees(args.alpha).alpha if args.alpha is not None else None,  # rad, inside RANGES['alpha']
         rtol=args.rtol,
         members=args.members,
         offset=args.offset,
@@ -125,32 +161,7 @@ def run(args) -> int:
             args.sweep, seed=args.seed, env=args.env, robot=params.robot, controller=params.controller,
             pade_order=args.pade_order, progress=progress,
         )
-    if args.plot:
-        from ..plots.validation import plot_validation
-
-        _save(plot_validation(validation), args.plot, "plot")
-    if args.sweep_plot:
-        from ..plots.validation import plot_sweep
-
-        _save(plot_sweep(sweep), args.sweep_plot, "sweep-plot")
-    out = validation.to_dict()
-    out["inputs"]["sources"] = params.sources
-    out["sweep"] = sweep.to_dict() if sweep is not None else None
-    out["plot"] = args.plot
-    out["sweep_plot"] = args.sweep_plot
-    if args.format == "json":
-        print(json.dumps(out, indent=2, allow_nan=False, default=_json_default))
-    else:
-        print(render_text(validation, sweep, params.sources, args.plot, args.sweep_plot), end="")
-    return 0
-
-
-def _json_default(value):
-    import numpy as np
-
-    if isinstance(value, np.generic):
-        return value.item()
-    raise TypeError(f"cannot serialize {type(value).__name__}")
+    return validation, sweep
 
 
 def _num(value, digits=5):

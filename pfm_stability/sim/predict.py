@@ -56,17 +56,18 @@ class ModelPrediction:
     critical: float
 
     def to_dict(self) -> dict:
-        """The fields as a JSON-ready dict (SI units)."""
-        fin = lambda v: v if math.isfinite(v) else None
+        """The fields as a JSON-ready dict (SI units; ``"inf"``/``"-inf"`` for infinite values, null for undefined)."""
+        from ..serialize import json_number
+
         return {
             "model": self.model,
             "law": self.law,
-            "NV": self.NV,
-            "NV_critical": fin(self.NV_critical),
+            "NV": json_number(self.NV),
+            "NV_critical": json_number(self.NV_critical),
             "verdict": self.verdict,
-            "growth_rate": self.growth_rate,
-            "angular_frequency": self.angular_frequency,
-            "critical": fin(self.critical),
+            "growth_rate": json_number(self.growth_rate),
+            "angular_frequency": json_number(self.angular_frequency),
+            "critical": json_number(self.critical),
         }
 
 
@@ -94,10 +95,12 @@ class Prediction:
     kb: ModelPrediction
 
     def to_dict(self) -> dict:
-        """The fields as a JSON-ready dict (SI units)."""
+        """The fields as a JSON-ready dict (SI units; α in deg)."""
+        from ..serialize import json_number
+
         return {
             "kind": self.kind,
-            "value": self.value,
+            "value": json_number(self.value),
             "critical_name": self.critical_name,
             "sampled": self.matching.to_dict(),
             "kb_first_order": self.kb.to_dict(),

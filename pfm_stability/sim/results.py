@@ -3,7 +3,9 @@
 JSON form (`to_dict`): ``events`` (list of {type, t, x, y}), ``metrics``
 (`OscillationMetrics.to_dict`: growth_rate σ in 1/s, angular_frequency ω in
 rad/s, oscillating, stable, …) and ``inputs`` (everything that defined the
-run). Undefined numbers are ``None`` with a reason, never NaN.
+run). Numbers are written by `pfm_stability.serialize.json_number`: infinite
+ones as ``"inf"``/``"-inf"``, undefined ones as ``None`` (with a reason in
+the metrics), never NaN. Wall-clock times are under ``timing`` only.
 """
 
 from __future__ import annotations
@@ -12,6 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..serialize import json_array, json_number, json_ready
 from .events import Event
 from .metrics import OscillationMetrics
 from .scenario import Scenario
@@ -44,7 +47,7 @@ class Trajectory:
 
     def to_dict(self) -> dict:
         """The fields as a JSON-ready dict (SI units)."""
-        return {key: getattr(self, key).tolist() for key in ("t", "x", "y", "theta")}
+        return {key: json_array(getattr(self, key)) for key in ("t", "x", "y", "theta")}
 
 
 @dataclass(frozen=True)
@@ -91,14 +94,20 @@ class RunResult:
         return self.event("collision") is not None
 
     def to_dict(self, trajectory: bool = False) -> dict:
-        """Events, metrics and inputs as a JSON-ready dict (SI units); the sampled trajectory too if asked."""
+        """Events, metrics and inputs as a JSON-ready dict (SI units); the sampled trajectory too if asked.
+
+        ``inputs.measure.along_from`` is ``"-inf"`` when the metrics use the
+        whole run (a start that is infinitely far back, not an undefined one).
+        """
+        inputs = json_ready(self.scenario.inputs())
+        inputs["measure"]["along_from"] = json_number(self.scenario.measure.along_from)
         out = {
-            "events": [e.to_dict() for e in self.events],
-            "metrics": self.metrics.to_dict() if self.metrics is not None else None,
-            "t_end": self.t_end,
-            "steps": self.steps,
-            "min_clearance": self.min_clearance,
-            "inputs": self.scenario.inputs(),
+            "events": [json_ready(e.to_dict()) for e in self.events],
+            "metrics": json_ready(self.metrics.to_dict()) if self.metrics is not None else None,
+            "t_end": json_number(self.t_end),
+            "steps": int(self.steps),
+            "min_clearance": json_number(self.min_clearance),
+            "inputs": inputs,
         }
         if trajectory and self.trajectory is not None:
             out["trajectory"] = self.trajectory.to_dict()
@@ -171,5 +180,9 @@ class BatchResult:
         return self.robot_steps / self.seconds if self.seconds > 0 else float("inf")
 
     def to_dict(self) -> dict:
-        """The fields as a JSON-ready dict (SI units)."""
-        return {"members": [r.to_dict() for r in self.runs], "robot_steps": self.robot_steps, "seconds": self.seconds}
+        """The fields as a JSON-ready dict (SI units); wall-clock ``seconds`` and ``rate`` under ``timing``."""
+        return {
+            "members": [r.to_dict() for r in self.runs],
+            "robot_steps": int(self.robot_steps),
+            "timing": {"seconds": json_number(self.seconds), "rate": json_number(self.rate)},
+        }

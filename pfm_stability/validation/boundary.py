@@ -98,8 +98,10 @@ class SimulatedPoint:
     x: float | None = None
 
     def to_dict(self) -> dict:
-        """Plain JSON form (field name → value)."""
-        return dict(self.__dict__)
+        """Plain JSON form (field name → value; numbers by `serialize.json_number`)."""
+        from ..serialize import json_ready
+
+        return json_ready(dict(self.__dict__))
 
 
 @dataclass(frozen=True)
@@ -132,8 +134,10 @@ class OscillationCheck:
     frequency_error: float | None
 
     def to_dict(self) -> dict:
-        """Plain JSON form (field name → value)."""
-        return dict(self.__dict__)
+        """Plain JSON form (field name → value; numbers by `serialize.json_number`)."""
+        from ..serialize import json_ready
+
+        return json_ready(dict(self.__dict__))
 
 
 @dataclass(frozen=True)
@@ -168,17 +172,21 @@ class StabilityMap:
     nominal_x: float
 
     def to_dict(self) -> dict:
-        """Plain JSON form; infinite curve values are already None."""
+        """Plain JSON form; a curve value is ``"inf"`` where infinite, null where the curve has no value
+        inside the plotted range (numbers by `serialize.json_number`)."""
+        from ..serialize import json_ready
+
+        curves = lambda d: None if d is None else {k: [json_number(v) for v in values] for k, values in d.items()}
         return {
             "x_name": self.x_name,
             "x_unit": self.x_unit,
             "y_name": self.y_name,
             "y_unit": self.y_unit,
             "points": [p.to_dict() for p in self.points],
-            "curve_x": list(self.curve_x),
-            "curves": {k: list(v) for k, v in self.curves.items()},
-            "lumped_curves": None if self.lumped_curves is None else {k: list(v) for k, v in self.lumped_curves.items()},
-            "nominal_x": self.nominal_x,
+            "curve_x": json_ready(list(self.curve_x)),
+            "curves": curves(self.curves),
+            "lumped_curves": curves(self.lumped_curves),
+            "nominal_x": json_number(self.nominal_x),
         }
 
 
@@ -245,29 +253,49 @@ class BoundaryValidation:
     seconds: float = 0.0
 
     def to_dict(self) -> dict:
-        """JSON form: issue 5 keys ``parameter``, ``simulated_boundary``, ``predicted_boundary``,
-        ``relative_error``, ``inputs``, plus the rest (non-finite numbers → null)."""
-        fin = lambda d: None if d is None else {k: json_number(v) for k, v in d.items()}
+        """JSON form: ``parameter``, ``simulated_boundary``, ``predicted_boundary``, ``relative_error``,
+        ``inputs``, and the rest; wall-clock ``seconds`` under ``timing``.
+
+        Numbers by `serialize.json_number`: a model without a finite boundary
+        has ``"inf"`` as its predicted boundary and relative error; undefined
+        values are null.
+        """
+        from ..serialize import json_ready
+
+        s = self.simulated_boundary
+
+        def relative(predicted, errors):
+            if errors is None:
+                return None
+            out = {}
+            for name, e in errors.items():
+                p = predicted.get(name) if predicted else None
+                if e is None and p is not None and math.isinf(p) and math.isfinite(s) and s != 0:
+                    e = math.copysign(math.inf, p / s)  # (p − s)/s with p infinite
+                out[name] = json_number(e)
+            return out
+
+        boundaries = lambda d: None if d is None else {k: json_number(v) for k, v in d.items()}
         return {
             "scenario": self.scenario,
             "env": self.env,
             "parameter": self.parameter,
             "unit": self.unit,
-            "simulated_boundary": self.simulated_boundary,
-            "bracket": list(self.bracket),
-            "stable_above": self.stable_above,
-            "predicted_boundary": fin(self.predicted_boundary),
-            "relative_error": dict(self.relative_error),
+            "simulated_boundary": json_number(s),
+            "bracket": [json_number(v) for v in self.bracket],
+            "stable_above": bool(self.stable_above),
+            "predicted_boundary": boundaries(self.predicted_boundary),
+            "relative_error": relative(self.predicted_boundary, self.relative_error),
             "law": self.law,
-            "lumped_predicted_boundary": fin(self.lumped_predicted_boundary),
-            "lumped_relative_error": None if self.lumped_relative_error is None else dict(self.lumped_relative_error),
+            "lumped_predicted_boundary": boundaries(self.lumped_predicted_boundary),
+            "lumped_relative_error": relative(self.lumped_predicted_boundary, self.lumped_relative_error),
             "oscillation": [c.to_dict() for c in self.oscillation],
             "points": [p.to_dict() for p in self.points],
             "stability_map": self.stability_map.to_dict() if self.stability_map is not None else None,
-            "inputs": self.inputs,
+            "inputs": json_ready(self.inputs),
             "notes": dict(self.notes),
-            "runs": self.runs,
-            "seconds": self.seconds,
+            "runs": int(self.runs),
+            "timing": {"seconds": json_number(self.seconds)},
         }
 
 

@@ -149,8 +149,10 @@ class SweepPoint:
         )
 
     def to_dict(self) -> dict:
-        """Plain JSON form with ``gain_ratio``; infinite NV* → None."""
-        out = dict(self.__dict__)
+        """Plain JSON form with ``gain_ratio``; numbers by `serialize.json_number` (infinite NV* → ``"inf"``)."""
+        from ..serialize import json_ready
+
+        out = json_ready(dict(self.__dict__))
         out["model_NV_critical"] = {k: json_number(v) for k, v in self.model_NV_critical.items()}
         out["gain_ratio"] = json_number(self.gain_ratio)
         return out
@@ -200,19 +202,25 @@ class SweepResult:
     seconds: float
 
     def to_dict(self, points: bool = False) -> dict:
-        """Plain JSON form; every point only with ``points=True`` (the disagreements always)."""
+        """Plain JSON form; every point only with ``points=True`` (the disagreements always).
+
+        ``agreement`` and ``wrong_verdict_rate`` are null (undefined) when no
+        set was included; wall-clock ``seconds`` is under ``timing``.
+        """
+        from ..serialize import json_ready
+
         out = {
-            "count": self.count,
-            "seed": self.seed,
+            "count": int(self.count),
+            "seed": int(self.seed),
             "env": self.env,
-            "exclude": self.exclude,
-            "included": self.included,
-            "agreement": self.agreement,
+            "exclude": json_number(self.exclude),
+            "included": int(self.included),
+            "agreement": json_number(self.agreement),
             "disagreements": [p.to_dict() for p in self.disagreements],
-            "wrong_verdict_rate": dict(self.wrong_verdict_rate),
-            "wrong_verdicts": {k: dict(v) for k, v in self.wrong_verdicts.items()},
-            "ranges": {k: list(v) for k, v in self.ranges.items()},
-            "seconds": self.seconds,
+            "wrong_verdict_rate": {k: json_number(v) for k, v in self.wrong_verdict_rate.items()},
+            "wrong_verdicts": json_ready(self.wrong_verdicts),
+            "ranges": json_ready(self.ranges),
+            "timing": {"seconds": json_number(self.seconds)},
         }
         if points:
             out["points"] = [p.to_dict() for p in self.points]

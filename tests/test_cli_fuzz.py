@@ -1,0 +1,401 @@
+"""Hypothesis drives the whole command line: every subcommand, every option, good and bad values.
+
+Whatever is typed — values inside and outside each option's range
+(`pfm_stability.parameters.RANGES`), NaN, inf, huge and tiny numbers, empty
+strings, text, output paths that are directories, lack ``.png`` or lie in
+missing directories, unknown options, ``--help`` — `main` returns 0 or 2 and
+never raises. An exit 2 prints exactly one error line (after any progress
+lines) and nothing on stdout, and never blames a value drawn inside its
+option's stated range. An exit 0 with ``--format json`` prints strict JSON
+(NaN and Infinity tokens rejected) that validates against the shipped schema,
+and a reported success wrote the PNG it named.
+
+Examples run in-process (`pfm_stability.cli.main`). Their number follows the
+hypothesis profile (``HYPOTHESIS_PROFILE``, tests/conftest.py: ``ci`` by
+default, ``dev`` for 10x more), shared out by what a run costs: the
+subcommands that simulate or draw get fewer examples, and their valid values
+are kept cheap (`CHEAP`: short ``--duration``, large ``--rtol``, few
+``--members``, the smallest ``--sweep``, analytic walls unless ``--env`` is
+drawn). The ends of the ranges that are expensive to *run* (a 1001-cell
+window, a 10⁴ m corridor, a 10⁶ s simulation) are checked where they are
+parsed, for every option of every subcommand, by
+`test_every_range_end_is_accepted_or_rejected_as_stated`.
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import io
+import itertools
+import json
+import math
+import os
+
+import pytest
+from hypothesis import event, given, note, settings
+from hypothesis import strategies as st
+from jsonschema import Draft202012Validator
+
+from pfm_stability.cli import build_parser, main
+from pfm_stability.cli.options import SHOWN_NAMES, describe
+from pfm_stability.parameters import RANGES
+from pfm_stability.schema import load_schema
+
+PARSER = build_parser()
+SUBPARSERS = next(a for a in PARSER._actions if isinstance(a, argparse._SubParsersAction)).choices
+VALIDATOR = Draft202012Validator(load_schema())
+PNG = b"\x89PNG\r\n\x1a\n"
+
+SHARE = {"report": 2.0, "simulate": 1.0, "validate": 0.6, "plot": 0.2, "derive": 0.06}
+"""Examples per subcommand, as a fraction of the profile's ``max_examples`` (at least 4)."""
+
+CHEAP = {
+    ("simulate", "duration"): (0.05, 2.0),
+    ("simulate", "T_sampled"): (0.01, 100.0),
+    ("simulate", "window_cells"): (3, 61),
+    ("simulate", "L"): (0.3, 20.0),
+    ("validate", "duration"): (1.0, 5.0),
+    ("validate", "T_sampled"): (0.02, 100.0),
+    ("validate", "rtol"): (0.15, 0.5),
+    ("validate", "members"): (3, 4),
+    ("validate", "sweep"): (8, 8),
+    ("validate", "L"): (0.3, 20.0),
+}
+"""(subcommand, RANGES key) → the part of the range whose values are run (the rest costs minutes)."""
+
+ADDED = {
+    "simulate": [("--duration", "1")],
+    "validate": [("--duration", "3"), ("--rtol", "0.3"), ("--members", "3"), ("--env", "analytic")],
+}
+"""Cheap settings added when the example did not draw the option itself."""
+
+BAD_NUMBERS = ["nan", "NaN", "-nan", "inf", "-inf", "Infinity", "1e309", "-1e309", "1e308", "-1e308", "", " ", "fast",
+               "0x10", "1,5", "None", "true", "1e", "--", "-", "1_000", "٣", "1e-320", "-0", "-1e-300"]
+BAD_INTEGERS = ["", " ", "x", "1.5", "1e3", "nan", "inf", "0x3", "-", "--", "3.0", "٣", "9" * 5000]
+PATH_KINDS = ["ok", "upper", "directory", "empty", "blank", "no_suffix", "missing_dir", "only_suffix", "nul"]
+_COUNTER = itertools.count()
+
+# FIXME lead: defects in modules the CLI may not work around (it must not catch them broadly).
+# A command line that hits one is not counted as a failure but as the hypothesis event
+# "FIXME lead: <what>" (pytest --hypothesis-show-statistics lists them); the strict xfail
+# tests at the end of this file fail as soon as a defect is fixed, to remove its entry here.
+KNOWN_DEFECTS = {
+    "ZeroDivisionError in effective_force.calibrate_cell_ratio (grid) with a subnormal n "
+    "(pfm-stability simulate --scenario corridor --n 2.2250738585072014e-308 --duration 1)":
+        lambda exc, message: isinstance(exc, ZeroDivisionError) and _last_frame(exc) == ("effective_force.py", "calibrate_cell_ratio"),
+    "OverflowError in force_law.PowerLaw.distance_for for a wall with a small n "
+    "(pfm-stability report --alpha 45 --n 0.015625)":
+        lambda exc, message: isinstance(exc, OverflowError) and _last_frame(exc) == ("force_law.py", "distance_for"),
+    "OverflowError in solve.first_crossing (ExactDelay.critical_gain_k) with a subnormal k "
+    "(pfm-stability report --L 1 --k 2.2250738585072014e-308)":
+        lambda exc, message: isinstance(exc, OverflowError) and _last_frame(exc) == ("solve.py", "first_crossing"),
+    "OverflowError in delay.py rightmost_roots for the exact-delay model with a tiny tau "
+    "(pfm-stability report --model exact_delay --L 1.0 --tau 1e-300)":
+        lambda exc, message: isinstance(exc, OverflowError) and _last_frame(exc)[0] == "delay.py",
+    "IndexError in models/exact_delay.py rightmost_root (no root found) with a tiny tau "
+    "(pfm-stability report --L 1 --tau 1e-38 --V 0.03125)":
+        lambda exc, message: isinstance(exc, IndexError) and _last_frame(exc) == ("exact_delay.py", "rightmost_root"),
+    "alpha = 89.999999 deg rejected in rad by presets._wall's degrees-radians round trip "
+    "(pfm-stability simulate --scenario wall --env analytic --alpha 89.999999 --duration 2)":
+        lambda exc, message: exc is None and message.startswith("pfm-stability: error: alpha must be a finite number in [1.74532925199e-08, 1.57079630934] rad; got 1.57079630934160"),
+}
+
+
+def _last_frame(exc) -> tuple[str, str]:
+    """(file name, function) where `exc` was raised."""
+    tb = exc.__traceback__
+    while tb.tb_next is not None:
+        tb = tb.tb_next
+    return os.path.basename(tb.tb_frame.f_code.co_filename), tb.tb_frame.f_code.co_name
+
+
+def _known_defect(exc=None, message="") -> str | None:
+    return next((what for what, matches in KNOWN_DEFECTS.items() if matches(exc, message)), None)
+
+
+def _options(command):
+    """Option string → action, and the positional actions, of one subcommand."""
+    options, positionals = {}, []
+    for action in SUBPARSERS[command]._actions:
+        if isinstance(action, argparse._HelpAction):
+            continue
+        if action.option_strings:
+            options[max(action.option_strings, key=len)] = action
+        else:
+            positionals.append(action)
+    return options, positionals
+
+
+def _inside(r, x) -> bool:
+    above = x > r.low if r.low_open else x >= r.low
+    below = x < r.high if r.high_open else x <= r.high
+    return math.isfinite(x) and above and below
+
+
+def _number_values(command, key):
+    """Strategy of (text, whether it lies inside the range) for one float option."""
+    r = RANGES[key]
+    lo, hi = CHEAP.get((command, key), (r.low, r.high))
+    lo, hi = max(lo, r.low), min(hi, r.high)
+    lo, hi = max(lo, -1e300), min(hi, 1e300)
+    valid = st.floats(lo, hi, allow_nan=False, allow_infinity=False).filter(lambda x: _inside(r, x)).map(lambda x: (repr(x), True))
+    ends = []
+    for end in (r.low, r.high):
+        if math.isfinite(end):
+            for x in (end, math.nextafter(end, -math.inf), math.nextafter(end, math.inf)):
+                for text in (repr(float(x)), f"{x:.12g}"):
+                    y = float(text)
+                    if not (_inside(r, y) and not lo <= y <= hi):  # inside but expensive to run: parse-level test only
+                        ends.append((text, _inside(r, y)))
+    bad = st.sampled_from(BAD_NUMBERS).map(lambda t: (t, False))
+    far = st.sampled_from([r.low - 1, -r.high, r.high * 10 + 1]).filter(math.isfinite).map(lambda x: (repr(float(x)), _inside(r, x)))
+    other = st.one_of(st.sampled_from(ends), bad, far, st.text(max_size=8).map(lambda t: (t, False)))
+    return _mostly(valid, other)
+
+
+def _integer_values(command, key, odd):
+    """Strategy of (text, whether it lies inside the range) for one integer option."""
+    r = RANGES[key]
+    lo, hi = CHEAP.get((command, key), (r.low, r.high))
+    lo, hi = max(lo, r.low), min(hi, r.high)
+    ok = (lambda n: r.low <= n <= r.high and (n % 2 == 1 or not odd))
+    valid = st.integers(lo, hi).map(lambda n: n + 1 if odd and n % 2 == 0 and n + 1 <= hi else n).map(lambda n: (str(n), ok(n)))
+    ends = [(str(n), ok(n)) for n in (r.low - 1, r.low, r.high, r.high + 1) if not (ok(n) and not lo <= n <= hi)]
+    bad = st.sampled_from(BAD_INTEGERS).map(lambda t: (t, False))
+    return _mostly(valid, st.one_of(st.sampled_from(ends), bad, st.text(max_size=6).map(lambda t: (t, False))))
+
+
+def _mostly(valid, other):
+    """`valid` four times in five (most command lines should run), `other` otherwise."""
+    return st.integers(0, 4).flatmap(lambda i: other if i == 4 else valid)
+
+
+def _path(kind, outdir) -> str:
+    n = next(_COUNTER)
+    return {
+        "ok": os.path.join(outdir, f"out{n}.png"),
+        "upper": os.path.join(outdir, f"OUT{n}.PNG"),
+        "directory": outdir,
+        "empty": "",
+        "blank": " ",
+        "no_suffix": os.path.join(outdir, f"out{n}"),
+        "missing_dir": os.path.join(outdir, "missing", f"out{n}.png"),
+        "only_suffix": os.path.join(outdir, ".png"),
+        "nul": os.path.join(outdir, "a\0b.png"),
+    }[kind]
+
+
+@st.composite
+def command_lines(draw, command, outdir):
+    """An argv for `command`, and the options whose values were drawn inside their ranges."""
+    options, positionals = _options(command)
+    groups, inside = [], set()  # one group per positional or option with its value
+    for action in positionals:
+        groups.append([draw(_mostly(st.sampled_from(sorted(action.choices)), st.text(max_size=5)))])
+    required = [name for name, a in options.items() if a.required]
+    optional = sorted(name for name, a in options.items() if not a.required)
+    chosen = [name for name in required if draw(st.integers(0, 9)) != 9]  # now and then a required option is missing
+    chosen += draw(st.lists(st.sampled_from(optional), max_size=6, unique=True))
+    for name in chosen:
+        action = options[name]
+        kind = getattr(action.type, "kind", None)
+        if action.nargs == 0:
+            groups.append([name])
+            continue
+        if action.choices is not None:
+            value, ok = draw(_mostly(st.sampled_from(sorted(action.choices)).map(lambda c: (c, True)), st.text(max_size=6).map(lambda t: (t, False))))
+        elif kind == "number":
+            value, ok = draw(_number_values(command, action.type.range_key))
+        elif kind == "integer":
+            value, ok = draw(_integer_values(command, action.type.range_key, action.type.odd))
+        elif kind == "path":
+            value, ok = _path(draw(_mostly(st.just("ok"), st.sampled_from(PATH_KINDS))), outdir), False
+        else:
+            raise AssertionError(f"{command} {name}: an option without a range (type {action.type!r}); give it one in RANGES")
+        groups.append([name, value])
+        if ok:  # negative numbers too, e.g. --offset -1e-05 (not read as an option)
+            inside.add(name)
+    for name, value in ADDED.get(command, ()):
+        if name not in chosen:
+            groups.append([name, value])
+    if command == "report" and not {"--alpha", "--L"} & set(chosen) and draw(_mostly(st.just(True), st.just(False))):
+        groups.append(["--L", "1.0"])  # the report needs a geometry; now and then it has none
+    extra = draw(_mostly(st.none(), st.sampled_from(["--help", "--bogus", "stray", "-x", "--"])))
+    if extra:
+        groups.insert(draw(st.integers(0, len(groups))), [extra])
+    return [command] + [token for group in groups for token in group], inside
+
+
+def _reject_constant(token):
+    raise ValueError(f"non-standard JSON token {token}")
+
+
+def run_cli(argv):
+    """(exit status, stdout, stderr) of `main(argv)` in-process; exceptions propagate."""
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        try:
+            code = main(argv)
+        except SystemExit as exc:  # --help
+            code = exc.code
+    return code, out.getvalue(), err.getvalue()
+
+
+def check_run(command, argv, inside):
+    """Every property of one command line (module docstring)."""
+    note(f"argv = {argv!r}")
+    try:
+        code, out, err = run_cli(argv)
+    except Exception as exc:  # a traceback: a failure unless it is a known defect of another module
+        if (defect := _known_defect(exc)) is None:
+            raise
+        event(f"FIXME lead: {defect}")
+        return
+    note(f"exit {code}; stderr = {err!r}")
+    event(f"exit {code}")
+    assert code in (0, 2)
+    lines = err.splitlines()
+    progress = [line for line in lines if line.startswith(f"{command}: ")]
+    others = [line for line in lines if line not in progress]
+    if code == 2:
+        assert out == ""
+        assert len(others) == 1 and lines[-1] == others[0] and others[0].startswith("pfm-stability: error: ")
+        message = others[0]
+        if (defect := _known_defect(None, message)) is not None:
+            event(f"FIXME lead: {defect}")
+            return
+        assert "Traceback" not in err and "not JSON compliant" not in message
+        assert " rad; got" not in message, "a range stated in radians: every option is typed in degrees"
+        for name in inside:
+            assert not message.startswith(f"pfm-stability: error: argument {name}:"), f"{name}: a value inside the stated range was rejected"
+        return
+    if "--help" in argv:
+        assert out.startswith("usage:")
+        return
+    assert others == [] and out
+    for name in ("--out", "--plot", "--sweep-plot"):
+        if name in argv:
+            path = argv[argv.index(name) + 1]
+            assert path.lower().endswith(".png") and os.path.isfile(path), f"{name} {path!r}: success without the file"
+            with open(path, "rb") as fh:
+                assert fh.read(8) == PNG
+    if "--format" in argv and argv[argv.index("--format") + 1] == "json":
+        data = json.loads(out, parse_constant=_reject_constant)
+        errors = sorted(VALIDATOR.iter_errors(data), key=lambda e: list(e.absolute_path))
+        assert not errors, [f"{list(e.absolute_path)}: {e.message[:200]}" for e in errors[:5]]
+        assert data["command"] == command
+
+
+@pytest.fixture(scope="module")
+def outdir(tmp_path_factory):
+    return str(tmp_path_factory.mktemp("cli_fuzz"))
+
+
+def _fuzz_test(command):
+    examples = max(4, round(settings.default.max_examples * SHARE[command]))
+
+    @settings(max_examples=examples)
+    @given(data=st.data())
+    def test(outdir, data):
+        argv, inside = data.draw(command_lines(command, outdir), label="argv")
+        check_run(command, argv, inside)
+
+    test.__name__ = f"test_fuzz_{command}"
+    test.__doc__ = f"Random `pfm-stability {command}` command lines: exit 0 or 2, one error line, strict JSON, files written ({examples} examples)."
+    return test
+
+
+test_fuzz_report = _fuzz_test("report")
+test_fuzz_simulate = _fuzz_test("simulate")
+test_fuzz_validate = _fuzz_test("validate")
+test_fuzz_plot = _fuzz_test("plot")
+test_fuzz_derive = _fuzz_test("derive")
+
+
+# ------------------------------------------------------- every range, every option
+def _ranged_options():
+    for command in sorted(SUBPARSERS):
+        options, _ = _options(command)
+        for name, action in sorted(options.items()):
+            kind = getattr(action.type, "kind", None)
+            if kind in ("number", "integer"):
+                yield pytest.param(command, name, action, id=f"{command}{name}")
+
+
+@pytest.mark.parametrize("command,name,action", list(_ranged_options()))
+def test_every_range_end_is_accepted_or_rejected_as_stated(command, name, action):
+    """Each numeric option parses with `RANGES[key]` in the units typed: an end is accepted
+    exactly when the range includes it, the message states the range the help states."""
+    key = action.type.range_key
+    r = RANGES[key]
+    shown = SHOWN_NAMES.get(key, key)
+    assert describe(key) in action.help, f"{command} {name}: help does not state {describe(key)}"
+    if action.type.kind == "integer":
+        ends = [r.low - 1, r.low, r.high, r.high + 1]
+        for n in ends:
+            inside = r.low <= n <= r.high and (n % 2 == 1 or not action.type.odd)
+            if inside:
+                assert action.type(str(n)) == n
+            else:
+                with pytest.raises(argparse.ArgumentTypeError, match=rf"^{shown} must be an (odd )?integer in \[{r.low}, {r.high}\]; got"):
+                    action.type(str(n))
+        return
+    for end in (r.low, r.high):
+        if not math.isfinite(end):
+            continue
+        for x in (end, math.nextafter(end, -math.inf), math.nextafter(end, math.inf)):
+            if _inside(r, x):
+                assert action.type(repr(x)) == x
+            else:
+                with pytest.raises(argparse.ArgumentTypeError) as info:
+                    action.type(repr(x))
+                assert str(info.value) == f"{shown} must be a finite number in {describe(key)}; got {x!r}"
+    for text in ("nan", "inf", "-inf", "", "fast"):
+        with pytest.raises(argparse.ArgumentTypeError, match=rf"^{shown} must be a finite number in "):
+            action.type(text)
+
+
+def test_every_option_is_fuzzed():
+    """Every option of every subcommand has a range, choices, a path check or is a flag (so the fuzz can draw it)."""
+    for command in SUBPARSERS:
+        options, _ = _options(command)
+        for name, action in options.items():
+            assert action.nargs == 0 or action.choices is not None or getattr(action.type, "kind", None) in ("number", "integer", "path"), (command, name)
+
+
+# ------------------------------------------------------- known defects (FIXME lead)
+@pytest.mark.xfail(strict=True, reason="FIXME lead: ZeroDivisionError in effective_force.calibrate_cell_ratio (subnormal n)")
+def test_known_defect_grid_calibration_with_a_subnormal_n():
+    code, out, err = run_cli(["simulate", "--scenario", "corridor", "--n", "2.2250738585072014e-308", "--duration", "1"])
+    assert code in (0, 2)
+
+
+@pytest.mark.xfail(strict=True, reason="FIXME lead: OverflowError in force_law.PowerLaw.distance_for (wall, small n)")
+def test_known_defect_wall_with_small_n():
+    code, out, err = run_cli(["report", "--alpha", "45", "--n", "0.015625"])
+    assert code in (0, 2)
+
+
+@pytest.mark.xfail(strict=True, reason="FIXME lead: OverflowError in solve.first_crossing (exact_delay k*, subnormal k)")
+def test_known_defect_subnormal_k():
+    code, out, err = run_cli(["report", "--L", "1", "--k", "2.2250738585072014e-308"])
+    assert code in (0, 2)
+
+
+@pytest.mark.xfail(strict=True, reason="FIXME lead: OverflowError in delay.py rightmost_roots (exact_delay, tiny tau)")
+def test_known_defect_exact_delay_with_a_tiny_tau():
+    code, out, err = run_cli(["report", "--model", "exact_delay", "--L", "1.0", "--tau", "1e-300"])
+    assert code in (0, 2)
+
+
+@pytest.mark.xfail(strict=True, reason="FIXME lead: IndexError in exact_delay.rightmost_root (tiny tau)")
+def test_known_defect_exact_delay_without_roots():
+    code, out, err = run_cli(["report", "--L", "1", "--tau", "1e-38", "--V", "0.03125"])
+    assert code in (0, 2)
+
+
+@pytest.mark.xfail(strict=True, reason="FIXME lead: presets._wall turns alpha = 89.999999 deg into a radian value above RANGES['alpha']")
+def test_known_defect_alpha_at_the_end_of_its_range_in_simulate():
+    code, out, err = run_cli(["simulate", "--scenario", "wall", "--env", "analytic", "--alpha", "89.999999", "--duration", "2"])
+    assert code == 0, err
