@@ -67,8 +67,9 @@ class ModelVerdict:
     critical : dict
         Critical value of each parameter with the others fixed
         (SI units; angles in rad, plus ``alpha_critical_deg``).
-    rightmost_root : complex
-        Dominant root σ + jω (1/s, rad/s) at the operating point.
+    rightmost_root : complex or None
+        Dominant root σ + jω (1/s, rad/s) at the operating point (None where
+        the model cannot resolve it; the verdict does not depend on it).
     """
 
     model: str
@@ -78,7 +79,7 @@ class ModelVerdict:
     margin: float
     verdict: str
     critical: dict = field(default_factory=dict)
-    rightmost_root: complex = 0j
+    rightmost_root: complex | None = 0j
 
     @property
     def stable(self) -> bool:

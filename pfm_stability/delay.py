@@ -34,7 +34,9 @@ Methods
 
 from __future__ import annotations
 
+import contextlib
 import math
+import os
 from dataclasses import dataclass
 
 import numpy as np
@@ -47,6 +49,21 @@ from .solve import bisect_root, newton_increasing
 __all__ = ["DelayLoop", "DelayCrossing", "delay_verdicts_from_gain", "kb_critical_gain"]
 
 _TWO_PI = 2.0 * math.pi
+
+
+def single_blas_thread():
+    """A context that keeps BLAS to one thread around a medium-sized eigenvalue problem.
+
+    On a busy machine BLAS threads spin on such problems (the pseudospectral
+    matrix is ~120 × 120) and make them several times slower. The command
+    line pins the thread count in the environment before numpy loads (then
+    this is a no-op); library callers get `threadpoolctl`'s limit.
+    """
+    if os.environ.get("OPENBLAS_NUM_THREADS") == "1" or os.environ.get("OMP_NUM_THREADS") == "1":
+        return contextlib.nullcontext()
+    from threadpoolctl import threadpool_limits
+
+    return threadpool_limits(1, user_api="blas")
 
 _K_MAX = 1e100
 """Largest |K| of `DelayLoop`: the crossing polynomial |a(jω)|² − K² must stay inside floating point."""
@@ -289,12 +306,19 @@ class DelayLoop:
         Chebyshev nodes in [−T, 0], then Newton's method on a(s) + K·e^(−sT)
         from each eigenvalue (to |Δs| < 1e-13·max(1, |s|)). Conjugate pairs are
         both returned. T = 0 returns the polynomial roots of a(s) + K.
+
+        The discretization resolves roots up to |s|·T of the order of `nodes`;
+        where no eigenvalue polishes to a root (a loop with |s|·T in the
+        thousands, e.g. an enormous gain), the array is empty: the rightmost
+        root is then undefined, while verdicts (the crossing count) stay exact.
         """
         K = check_number("K", K, -_K_MAX, _K_MAX, low_open=False, high_open=False)
         if self.T == 0:
             roots = np.roots(self._delay_free(K))
             return roots[np.argsort(-roots.real)][:count]
-        eig = np.linalg.eigvals(self._generator(K, nodes))
+        with single_blas_thread():
+            eig = np.linalg.eigvals(self._generator(K, nodes))
+        eig = eig[np.isfinite(eig)]
         eig = eig[np.argsort(-eig.real)][: max(4 * count, 12)]
         polished = []
         for s in eig:
@@ -305,9 +329,10 @@ class DelayLoop:
         return polished[np.argsort(-polished.real)][:count]
 
     def spectral_abscissa(self, K: float) -> float:
-        """max Re s over all roots, 1/s."""
+        """max Re s over all roots, 1/s (NaN where `rightmost_roots` cannot resolve them)."""
         K = check_number("K", K, -_K_MAX, _K_MAX, low_open=False, high_open=False)
-        return float(self.rightmost_roots(K, count=1)[0].real)
+        roots = self.rightmost_roots(K, count=1)
+        return float(roots[0].real) if roots.size else math.nan
 
     def _generator(self, K, nodes):
         n = len(self.a) - 1
@@ -332,16 +357,19 @@ class DelayLoop:
         return G
 
     def _newton(self, s, K, iterations=50):
-        for _ in range(iterations):
-            f = self.value(s, K)
-            df = self._derivative(s, K)
-            if df == 0:
-                return None
-            step = f / df
-            s = s - step
-            if abs(step) <= 1e-13 * max(1.0, abs(s)):
-                return complex(s)
-        return complex(s) if abs(self.value(s, K)) <= 1e-9 * max(1.0, abs(np.polyval(self.a, s))) else None
+        """Newton's method from s; None if it fails (a zero slope or leaving floating point)."""
+        with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+            for _ in range(iterations):
+                f = self.value(s, K)
+                df = self._derivative(s, K)
+                if df == 0 or not (np.isfinite(f) and np.isfinite(df)):
+                    return None
+                step = f / df
+                s = s - step
+                if abs(step) <= 1e-13 * max(1.0, abs(s)):
+                    return complex(s)
+            residual = abs(self.value(s, K))
+        return complex(s) if residual <= 1e-9 * max(1.0, abs(np.polyval(self.a, s))) else None
 
 
 # ----------------------------------------------------------------------------
@@ -469,7 +497,7 @@ def _newton_cubic_roots(a, beta, c, D):
     F2 = np.where(critical, F(np.where(critical, c2, 0.0)), -np.inf)
     # a point right of every root: with β >= 0 each term alone bounds the root
     # (within a factor 3 of it); otherwise Fujiwara's bound
-    with np.errstate(divide="ignore"):
+    with np.errstate(divide="ignore", invalid="ignore"):
         positive_bound = np.minimum.reduce([D / c, np.sqrt(D / np.where(beta > 0, beta, 0.0)), np.cbrt(D / a)])
     right = np.where(beta >= 0, positive_bound, 2 * np.maximum.reduce([np.abs(beta) / a, np.sqrt(c / a), np.cbrt(D / (2 * a))]))
     F_inflection = np.where(inflection > 0, F(np.maximum(inflection, 0.0)), -np.inf)
@@ -507,7 +535,7 @@ def _newton_cubic_roots(a, beta, c, D):
 def delay_verdicts_from_gain(tau, T, k, K):
     """Crossing-count verdicts for arrays (τ, T, k, K = kNV); returns (stable, Z, delay margin)."""
     y = _cubic_positive_roots(tau, k, K)
-    present = np.isfinite(y)
+    present = np.isfinite(y) & (y > 0)  # y = 0: K² underflowed to 0, no crossing at ω > 0
     y0 = np.where(present, y, 1.0)
     w = np.sqrt(y0)
     t3, k3 = tau[:, None], k[:, None]

@@ -126,8 +126,9 @@ class PowerLaw(ForceLaw):
         return PowerLaw(scale, self.n, self.W)
 
     def distance_for(self, force: float) -> float:
-        """KB eq (23): d0 = W (f/F)^(1/n)."""
-        return self.W * (self.f / force) ** (1.0 / self.n)
+        """KB eq (23): d0 = W (f/F)^(1/n) (``inf`` where it overflows: no finite equilibrium)."""
+        with np.errstate(over="ignore"):
+            return float(self.W * np.power(self.f / force, 1.0 / self.n))
 
 
 def wall_equilibrium(law: ForceLaw, alpha: float) -> float:
@@ -157,7 +158,7 @@ def wall_gain(law: ForceLaw, alpha: float) -> tuple[float, float]:
     d0 = wall_equilibrium(law, alpha)
     if math.isinf(d0):
         return d0, 0.0
-    N = float(-law.slope(d0) / math.sin(alpha))
+    N = float(-law.slope(d0) / math.sin(alpha)) if d0 > 0 else math.inf
     if not (d0 > 0 and math.isfinite(N)):
         raise ValueError(f"the wall equilibrium is outside floating point (d0 = {d0:g} m, N = {N:g} 1/m) for {law!r} at alpha = {math.degrees(alpha):g} deg")
     return d0, N

@@ -28,8 +28,14 @@ __all__ = [
     "PRESETS",
     "get_preset",
     "HOLDS",
+    "TAU_RESOLUTION",
     "check_corridor_fits",
 ]
+
+TAU_RESOLUTION = 1e-9
+"""τ with τ·k below this is taken as 0, an ideal steering motor, by the models and the simulator
+alike: the lag is 10⁹ times faster than the steering loop, below the resolution of either, and its
+pole at −1/τ would leave floating point."""
 
 HOLDS = ("command", "reference")
 """Sampled-loop structures of DESIGN §4: what the sampled computer holds."""
@@ -62,10 +68,10 @@ RANGES = {
     "V": Range(0.0, 100.0, unit="m/s"),
     "tau": Range(0.0, 100.0, low_open=False, unit="s"),
     "T": Range(0.0, 100.0, low_open=False, unit="s"),
-    "k": Range(0.0, 1e4, unit="1/s"),
-    "W": Range(0.0, 100.0, unit="m"),
-    "f": Range(0.0, 1e6),
-    "n": Range(0.0, 10.0),
+    "k": Range(1e-6, 1e4, low_open=False, unit="1/s"),
+    "W": Range(1e-3, 100.0, low_open=False, unit="m"),
+    "f": Range(1e-6, 1e6, low_open=False),
+    "n": Range(0.01, 10.0, low_open=False),
     "alpha": Range(_ALPHA_MARGIN_DEG * math.pi / 180, math.pi / 2 - _ALPHA_MARGIN_DEG * math.pi / 180, low_open=False, unit="rad"),
     "alpha_deg": Range(_ALPHA_MARGIN_DEG, 90.0 - _ALPHA_MARGIN_DEG, low_open=False, unit="deg"),
     "L": Range(0.0, 1e4, unit="m"),
@@ -89,8 +95,10 @@ RANGES = {
 }
 """The one place where parameter ranges live (library, vectorized code and CLI).
 
-Lower bounds are physical (V > 0, τ >= 0 …); upper bounds are generous caps
-(100 m/s, 100 s, 10⁴ 1/s …) that keep every computation inside floating point.
+Lower bounds are physical (V > 0, τ >= 0, a steering gain of at least
+10⁻⁶ 1/s, a width of at least 1 mm, f >= 10⁻⁶, n >= 0.01 …); upper bounds
+are generous caps (100 m/s, 100 s, 10⁴ 1/s …). Both keep every computation
+inside floating point (f^(1/n) and Wⁿ of an equilibrium, a scan over k).
 
 Entries beyond the robot, controller and geometry:
 
@@ -118,6 +126,10 @@ Entries beyond the robot, controller and geometry:
 """
 
 
+SHOWN_AS = {"alpha_deg": "alpha", "T_sampled": "T"}
+"""Range entries that stand for a parameter the user knows under another name."""
+
+
 def check_parameter(name: str, value) -> float:
     """`value` as a float if it lies in ``RANGES[name]``, else ValueError.
 
@@ -125,7 +137,7 @@ def check_parameter(name: str, value) -> float:
     reported as ``alpha``), the range with its unit, and the value.
     """
     r = RANGES[name]
-    shown = "alpha" if name == "alpha_deg" else name
+    shown = SHOWN_AS.get(name, name)
     return check_number(shown, value, r.low, r.high, low_open=r.low_open, high_open=r.high_open, unit=r.unit)
 
 
@@ -141,9 +153,9 @@ class Robot:
     tau : float
         Steering-motor time constant τ, s, in [0, 100] (KB eq 6; 0 = ideal motor).
     k : float
-        Steering gain, 1/s, in (0, 10⁴] (KB eq 5: u = k(δ − θ)).
+        Steering gain, 1/s, in [10⁻⁶, 10⁴] (KB eq 5: u = k(δ − θ)).
     W : float
-        Robot width, m, in (0, 100] (KB eq 1).
+        Robot width, m, in [10⁻³, 100] (KB eq 1).
     max_steering_rate : float
         Largest steering rate |ω|, rad/s, > 0 (CARMEL: 120°/s). Used by the
         simulator only; the linear analysis assumes no saturation.
@@ -171,9 +183,9 @@ class Controller:
     Parameters
     ----------
     f : float
-        Repulsive/attractive force-constant ratio, in (0, 10⁶] (KB eq 13).
+        Repulsive/attractive force-constant ratio, in [10⁻⁶, 10⁶] (KB eq 13).
     n : float
-        Repulsion exponent, in (0, 10] (KB eq 1, 8).
+        Repulsion exponent, in [0.01, 10] (KB eq 1, 8).
     T : float
         Sampling period, s, in [0, 100] (KB eq 18; 0 = continuous controller).
     hold : {"command", "reference"}

@@ -145,7 +145,7 @@ def _verdict_dict(v, remedy) -> dict:
         "NV_critical": json_number(v.NV_critical),
         "margin": json_number(v.margin),
         "omega_critical": json_number(v.omega_critical),
-        "rightmost_root": {"sigma": json_number(root.real), "omega": json_number(abs(root.imag))},
+        "rightmost_root": {"sigma": json_number(root.real), "omega": json_number(abs(root.imag))} if root is not None else {"sigma": None, "omega": None},
     }
     out.update({key: json_number(value) for key, value in v.critical.items()})
     out["to_stabilize"] = remedy or {}

@@ -168,7 +168,7 @@ def first_crossing(measure, lo: float, hi: float, *, start: float = 0.0, points_
     -------
     float
     """
-    count = max(8, int(math.ceil(points_per_decade * math.log10(hi / lo))) + 1)
+    count = max(8, int(math.ceil(points_per_decade * (math.log10(hi) - math.log10(lo)))) + 1)
     grid = np.geomspace(lo, hi, count)
     values = np.asarray(measure(grid), dtype=float)
     above = np.flatnonzero(values >= 0)

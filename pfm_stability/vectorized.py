@@ -30,7 +30,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .delay import delay_verdicts_from_gain
-from .parameters import RANGES, check_parameter
+from .parameters import RANGES, TAU_RESOLUTION, check_parameter
 
 __all__ = ["VectorVerdicts", "exact_delay_verdicts", "loop_gain_arrays", "delay_verdicts_from_gain"]
 
@@ -118,6 +118,7 @@ def loop_gain_arrays(V, tau, T, k, f, n, W, *, alpha=None, L=None):
             raise ValueError(f"L must be a finite number in (W/2, {high:g}] m = ({W_all[i] / 2:g}, {high:g}] m; got {float(L_all[i])!r} (point {i})")
         N = 2.0 * n * f * W**n / L ** (n + 1.0)
     tau, T, k, NV = np.broadcast_arrays(tau, T, k, N * V)
+    tau = np.where(tau * k < TAU_RESOLUTION, 0.0, tau)  # an ideal motor, as `models.Loop` takes it
     return tau, T, k, NV
 
 

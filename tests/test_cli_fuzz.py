@@ -38,9 +38,11 @@ from hypothesis import strategies as st
 from jsonschema import Draft202012Validator
 
 from pfm_stability.cli import build_parser, main
-from pfm_stability.cli.options import SHOWN_NAMES, describe
-from pfm_stability.parameters import RANGES
+from pfm_stability.cli.options import describe
+from pfm_stability.parameters import RANGES, SHOWN_AS
 from pfm_stability.schema import load_schema
+
+pytestmark = pytest.mark.filterwarnings("error::RuntimeWarning")  # a numpy warning is a silent NaN or overflow
 
 PARSER = build_parser()
 SUBPARSERS = next(a for a in PARSER._actions if isinstance(a, argparse._SubParsersAction)).choices
@@ -75,44 +77,6 @@ BAD_NUMBERS = ["nan", "NaN", "-nan", "inf", "-inf", "Infinity", "1e309", "-1e309
 BAD_INTEGERS = ["", " ", "x", "1.5", "1e3", "nan", "inf", "0x3", "-", "--", "3.0", "٣", "9" * 5000]
 PATH_KINDS = ["ok", "upper", "directory", "empty", "blank", "no_suffix", "missing_dir", "only_suffix", "nul"]
 _COUNTER = itertools.count()
-
-# FIXME lead: defects in modules the CLI may not work around (it must not catch them broadly).
-# A command line that hits one is not counted as a failure but as the hypothesis event
-# "FIXME lead: <what>" (pytest --hypothesis-show-statistics lists them); the strict xfail
-# tests at the end of this file fail as soon as a defect is fixed, to remove its entry here.
-KNOWN_DEFECTS = {
-    "ZeroDivisionError in effective_force.calibrate_cell_ratio (grid) with a subnormal n "
-    "(pfm-stability simulate --scenario corridor --n 2.2250738585072014e-308 --duration 1)":
-        lambda exc, message: isinstance(exc, ZeroDivisionError) and _last_frame(exc) == ("effective_force.py", "calibrate_cell_ratio"),
-    "OverflowError in force_law.PowerLaw.distance_for for a wall with a small n "
-    "(pfm-stability report --alpha 45 --n 0.015625)":
-        lambda exc, message: isinstance(exc, OverflowError) and _last_frame(exc) == ("force_law.py", "distance_for"),
-    "OverflowError in solve.first_crossing (ExactDelay.critical_gain_k) with a subnormal k "
-    "(pfm-stability report --L 1 --k 2.2250738585072014e-308)":
-        lambda exc, message: isinstance(exc, OverflowError) and _last_frame(exc) == ("solve.py", "first_crossing"),
-    "OverflowError in delay.py rightmost_roots for the exact-delay model with a tiny tau "
-    "(pfm-stability report --model exact_delay --L 1.0 --tau 1e-300)":
-        lambda exc, message: isinstance(exc, OverflowError) and _last_frame(exc)[0] == "delay.py",
-    "IndexError in models/exact_delay.py rightmost_root (no root found) with a tiny tau "
-    "(pfm-stability report --L 1 --tau 1e-38 --V 0.03125)":
-        lambda exc, message: isinstance(exc, IndexError) and _last_frame(exc) == ("exact_delay.py", "rightmost_root"),
-    "alpha = 89.999999 deg rejected in rad by presets._wall's degrees-radians round trip "
-    "(pfm-stability simulate --scenario wall --env analytic --alpha 89.999999 --duration 2)":
-        lambda exc, message: exc is None and message.startswith("pfm-stability: error: alpha must be a finite number in [1.74532925199e-08, 1.57079630934] rad; got 1.57079630934160"),
-}
-
-
-def _last_frame(exc) -> tuple[str, str]:
-    """(file name, function) where `exc` was raised."""
-    tb = exc.__traceback__
-    while tb.tb_next is not None:
-        tb = tb.tb_next
-    return os.path.basename(tb.tb_frame.f_code.co_filename), tb.tb_frame.f_code.co_name
-
-
-def _known_defect(exc=None, message="") -> str | None:
-    return next((what for what, matches in KNOWN_DEFECTS.items() if matches(exc, message)), None)
-
 
 def _options(command):
     """Option string → action, and the positional actions, of one subcommand."""
@@ -245,13 +209,7 @@ def run_cli(argv):
 def check_run(command, argv, inside):
     """Every property of one command line (module docstring)."""
     note(f"argv = {argv!r}")
-    try:
-        code, out, err = run_cli(argv)
-    except Exception as exc:  # a traceback: a failure unless it is a known defect of another module
-        if (defect := _known_defect(exc)) is None:
-            raise
-        event(f"FIXME lead: {defect}")
-        return
+    code, out, err = run_cli(argv)  # any exception is a traceback: a failure
     note(f"exit {code}; stderr = {err!r}")
     event(f"exit {code}")
     assert code in (0, 2)
@@ -262,9 +220,6 @@ def check_run(command, argv, inside):
         assert out == ""
         assert len(others) == 1 and lines[-1] == others[0] and others[0].startswith("pfm-stability: error: ")
         message = others[0]
-        if (defect := _known_defect(None, message)) is not None:
-            event(f"FIXME lead: {defect}")
-            return
         assert "Traceback" not in err and "not JSON compliant" not in message
         assert " rad; got" not in message, "a range stated in radians: every option is typed in degrees"
         for name in inside:
@@ -329,7 +284,7 @@ def test_every_range_end_is_accepted_or_rejected_as_stated(command, name, action
     exactly when the range includes it, the message states the range the help states."""
     key = action.type.range_key
     r = RANGES[key]
-    shown = SHOWN_NAMES.get(key, key)
+    shown = SHOWN_AS.get(key, key)
     assert describe(key) in action.help, f"{command} {name}: help does not state {describe(key)}"
     if action.type.kind == "integer":
         ends = [r.low - 1, r.low, r.high, r.high + 1]
@@ -364,38 +319,32 @@ def test_every_option_is_fuzzed():
             assert action.nargs == 0 or action.choices is not None or getattr(action.type, "kind", None) in ("number", "integer", "path"), (command, name)
 
 
-# ------------------------------------------------------- known defects (FIXME lead)
-@pytest.mark.xfail(strict=True, reason="FIXME lead: ZeroDivisionError in effective_force.calibrate_cell_ratio (subnormal n)")
-def test_known_defect_grid_calibration_with_a_subnormal_n():
+# -------------------------------------------- once tracebacks, now defined answers
+def test_once_a_traceback_grid_calibration_with_a_subnormal_n():
     code, out, err = run_cli(["simulate", "--scenario", "corridor", "--n", "2.2250738585072014e-308", "--duration", "1"])
     assert code in (0, 2)
 
 
-@pytest.mark.xfail(strict=True, reason="FIXME lead: OverflowError in force_law.PowerLaw.distance_for (wall, small n)")
-def test_known_defect_wall_with_small_n():
+def test_once_a_traceback_wall_with_small_n():
     code, out, err = run_cli(["report", "--alpha", "45", "--n", "0.015625"])
     assert code in (0, 2)
 
 
-@pytest.mark.xfail(strict=True, reason="FIXME lead: OverflowError in solve.first_crossing (exact_delay k*, subnormal k)")
-def test_known_defect_subnormal_k():
+def test_once_a_traceback_subnormal_k():
     code, out, err = run_cli(["report", "--L", "1", "--k", "2.2250738585072014e-308"])
     assert code in (0, 2)
 
 
-@pytest.mark.xfail(strict=True, reason="FIXME lead: OverflowError in delay.py rightmost_roots (exact_delay, tiny tau)")
-def test_known_defect_exact_delay_with_a_tiny_tau():
+def test_once_a_traceback_exact_delay_with_a_tiny_tau():
     code, out, err = run_cli(["report", "--model", "exact_delay", "--L", "1.0", "--tau", "1e-300"])
     assert code in (0, 2)
 
 
-@pytest.mark.xfail(strict=True, reason="FIXME lead: IndexError in exact_delay.rightmost_root (tiny tau)")
-def test_known_defect_exact_delay_without_roots():
+def test_once_a_traceback_exact_delay_without_roots():
     code, out, err = run_cli(["report", "--L", "1", "--tau", "1e-38", "--V", "0.03125"])
     assert code in (0, 2)
 
 
-@pytest.mark.xfail(strict=True, reason="FIXME lead: presets._wall turns alpha = 89.999999 deg into a radian value above RANGES['alpha']")
-def test_known_defect_alpha_at_the_end_of_its_range_in_simulate():
+def test_once_a_traceback_alpha_at_the_end_of_its_range_in_simulate():
     code, out, err = run_cli(["simulate", "--scenario", "wall", "--env", "analytic", "--alpha", "89.999999", "--duration", "2"])
     assert code == 0, err

@@ -1,4 +1,4 @@
-"""`pfm-stability report` (issue 2 item 6, issue 3 item 4): output forms and bad input."""
+"""`pfm-stability report`: output forms and bad input."""
 
 import json
 import subprocess
@@ -68,10 +68,10 @@ def test_model_selection_and_options(capsys):
         (["--V", "0"], "V must be a finite number in (0, 100] m/s"),
         (["--tau", "-0.1"], "tau must be a finite number in [0, 100] s"),
         (["--T", "-0.1"], "T must be a finite number in [0, 100] s"),
-        (["--f", "0"], "f must be a finite number in (0, 1000000]"),
-        (["--n", "-2"], "n must be a finite number in (0, 10]"),
-        (["--W", "0"], "W must be a finite number in (0, 100] m"),
-        (["--k", "nan"], "k must be a finite number in (0, 10000] 1/s; got nan"),
+        (["--f", "0"], "f must be a finite number in [1e-06, 1000000]"),
+        (["--n", "-2"], "n must be a finite number in [0.01, 10]"),
+        (["--W", "0"], "W must be a finite number in [0.001, 100] m"),
+        (["--k", "nan"], "k must be a finite number in [1e-06, 10000] 1/s; got nan"),
         (["--V", "fast"], "V must be a finite number in (0, 100] m/s; got 'fast'"),
         (["--alpha", "90"], "alpha must be a finite number in [1e-06, 89.999999] deg; got 90.0"),
         (["--alpha", "0"], "alpha must be a finite number in [1e-06, 89.999999] deg"),

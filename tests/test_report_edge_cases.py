@@ -16,6 +16,8 @@ from pfm_stability import CARMEL, Corridor, Wall, analyze_corridor, analyze_wall
 from pfm_stability.models import MODEL_NAMES, Loop, Sampled, make_models, models_for
 from pfm_stability.models.sampled import continuous_plant
 
+pytestmark = pytest.mark.filterwarnings("error::RuntimeWarning")  # a numpy warning is a silent NaN or overflow
+
 
 def _sampled_stable(robot, controller, NV):
     loop = Loop(robot.tau, controller.T, robot.k)

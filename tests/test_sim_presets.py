@@ -73,8 +73,8 @@ def test_analytic_variants_exist():
     "kwargs,message",
     [
         (dict(name="corridor", L=0.35), r"L must be a finite number in \(W/2 \+ c/2"),
-        (dict(name="corridor", L=0.35, env="analytic"), r"L must be a finite number in \(W/2, inf\)"),
-        (dict(name="corridor", controller=CARMEL.controller.replace(T=0.0)), r"T must be a finite number in \(0, inf\) s"),
+        (dict(name="corridor", L=0.35, env="analytic"), r"L must be a finite number in \(W/2, 10000\]"),
+        (dict(name="corridor", controller=CARMEL.controller.replace(T=0.0)), r"T must be a finite number in \(0, 100\] s"),
         (dict(name="corridor", window_cells=32), "window_cells must be an odd integer"),
         (dict(name="corridor", window_cells=1), "window_cells must be an odd integer"),
         (dict(name="kb-fig3", env="analytic"), "env must be grid for kb-fig3"),

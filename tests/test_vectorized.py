@@ -67,7 +67,7 @@ def test_broadcasting_shapes_and_relative_margin():
         (dict(V=[0.8, -1.0]), r"V must be a finite number in \(0, 100\] m/s; got -1.0 \(point 1\)"),
         (dict(T=np.nan), r"T must be a finite number in \[0, 100\] s; got nan"),
         (dict(L=0.3), r"L must be a finite number in \(W/2, 10000\] m = \(0.4, 10000\] m; got 0.3"),
-        (dict(n=0.0), r"n must be a finite number in \(0, 10\]"),
+        (dict(n=0.0), r"n must be a finite number in \[0.01, 10\]"),
     ],
 )
 def test_bad_arrays_name_parameter_and_point(kwargs, message):

@@ -10,7 +10,7 @@ import argparse
 from dataclasses import dataclass, fields
 
 from ..checks import check_integer, check_number, check_output_path
-from ..parameters import HOLDS, PRESETS, RANGES, Controller, Preset, Robot, get_preset
+from ..parameters import HOLDS, PRESETS, RANGES, SHOWN_AS, Controller, Preset, Robot, get_preset
 
 __all__ = [
     "number",
@@ -23,12 +23,9 @@ __all__ = [
     "ResolvedParameters",
 ]
 
-SHOWN_NAMES = {"alpha_deg": "alpha", "T_sampled": "T"}
-"""`RANGES` keys that messages name differently: the parameter as the user knows it."""
-
-
 def _shown(key: str) -> str:
-    return SHOWN_NAMES.get(key, key)
+    """The parameter as the user knows it (`parameters.SHOWN_AS`)."""
+    return SHOWN_AS.get(key, key)
 
 
 def describe(key: str) -> str:

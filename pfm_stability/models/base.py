@@ -23,7 +23,7 @@ from functools import lru_cache
 import numpy as np
 
 from ..checks import check_number
-from ..parameters import RANGES, check_parameter
+from ..parameters import RANGES, TAU_RESOLUTION, check_parameter
 from ..crossings import first_stable_interval, verdict_at
 from ..serialize import json_number
 
@@ -43,7 +43,8 @@ class Loop:
     Parameters
     ----------
     tau : float
-        Steering time constant τ, s, >= 0 (KB eq 6).
+        Steering time constant τ, s, >= 0 (KB eq 6); τ with τk < 10⁻⁹ is
+        stored as 0 (`TAU_RESOLUTION`).
     T : float
         Sampling period / loop delay, s, >= 0 (KB eq 18).
     k : float
@@ -57,6 +58,8 @@ class Loop:
     def __post_init__(self):
         for name in ("tau", "T", "k"):
             object.__setattr__(self, name, check_parameter(name, getattr(self, name)))
+        if self.tau * self.k < TAU_RESOLUTION:  # a lag 10⁹ times faster than the steering loop: an ideal motor
+            object.__setattr__(self, "tau", 0.0)
 
     @property
     def plant(self) -> np.ndarray:

@@ -68,10 +68,16 @@ class ExactDelay(LoopModel):
         return self.quasi_polynomial(loop).unstable_root_count(loop.k * _check_NV(NV))
 
     @checked
-    def rightmost_root(self, NV: float, loop: Loop) -> complex:
-        roots = self.quasi_polynomial(loop).rightmost_roots(loop.k * _check_NV(NV), count=2)
-        top = roots[roots.real >= roots[0].real - 1e-9 * max(1.0, abs(roots[0]))]
-        return complex(top[top.imag.argmax()])
+    def rightmost_root(self, NV: float, loop: Loop) -> complex | None:
+        """Dominant root σ + jω (1/s, rad/s); None where the pseudospectral method cannot resolve
+        it (|s|·T in the thousands: `DelayLoop.rightmost_roots`). The verdict does not need it."""
+        q = self.quasi_polynomial(loop)
+        for nodes in (40, 160):
+            roots = q.rightmost_roots(loop.k * NV, count=2, nodes=nodes)
+            if roots.size:
+                top = roots[roots.real >= roots[0].real - 1e-9 * max(1.0, abs(roots[0]))]
+                return complex(top[top.imag.argmax()])
+        return None
 
     @checked
     def critical_delay(self, NV: float, loop: Loop) -> float:

@@ -43,6 +43,7 @@ import time
 import numpy as np
 
 from ..force_law import PowerLaw
+from ..parameters import TAU_RESOLUTION
 from .environment import segment_clearance, wall_coordinates
 from .events import Event
 from .metrics import oscillation_metrics
@@ -74,6 +75,7 @@ class _Batch:
         robot = lambda name: _array(scenarios, lambda s: getattr(s.robot, name))
         ctrl = lambda name: _array(scenarios, lambda s: getattr(s.controller, name))
         self.V, self.tau, self.k, self.W = robot("V"), robot("tau"), robot("k"), robot("W")
+        self.tau = np.where(self.tau * self.k < TAU_RESOLUTION, 0.0, self.tau)  # an ideal motor, as the models take it
         self.max_rate = robot("max_steering_rate")
         self.n, self.T, self.f = ctrl("n"), ctrl("T"), ctrl("f")
         self.reference = _array(scenarios, lambda s: s.controller.hold == "reference", bool)

@@ -72,7 +72,7 @@ from functools import lru_cache
 from ..checks import check_choice, check_number
 from ..effective_force import GridWallLaw, calibrate_cell_ratio, f_average, measured_wall_force
 from ..force_law import ForceLaw, PowerLaw
-from ..parameters import CARMEL, Controller, Robot
+from ..parameters import CARMEL, RANGES, Controller, Robot, Wall
 from .environment import AnalyticEnvironment, AnalyticWall
 from .grid import HistogramGrid
 from .scenario import MeasureAxis, Pose, Scenario, Target
@@ -186,8 +186,9 @@ def _check_fits(L, robot, env, cell_size, name="L", given=None):
     low = robot.W / 2 + face
     if not L > low:
         where = "W/2 + c/2" if env == "grid" else "W/2"
+        high = RANGES["L"].high
         got = f"{given!r} ({L:g} on the cell grid)" if given is not None and abs(given - L) > 1e-12 else f"{given if given is not None else L!r}"
-        raise ValueError(f"{name} must be a finite number in ({where}, inf) m = ({low:g}, inf) m (the robot must fit); got {got}")
+        raise ValueError(f"{name} must be a finite number in ({where}, {high:g}] m = ({low:g}, {high:g}] m (the robot must fit); got {got}")
 
 
 def _corridor(o):
@@ -210,8 +211,8 @@ def _corridor(o):
 
 
 def _wall(o):
-    alpha_deg = check_number("alpha", math.degrees(o["alpha"]) if o["alpha"] is not None else 45.0, 0.0, 90.0, unit="deg")
-    alpha = math.radians(alpha_deg)
+    alpha = Wall(o["alpha"]).alpha if o["alpha"] is not None else math.radians(45.0)
+    alpha_deg = math.degrees(alpha)
     env, robot, c = o["env"], o["robot"], o["cell_size"]
     law = o["law_object"] or o["grid_law"]
     d0 = law.distance_for(math.cos(alpha))
@@ -229,7 +230,11 @@ def _wall(o):
         "d0": f"{d0:.4f} m equilibrium distance (KB eq 22-23 with the {law.name})",
     }
     if env == "grid" and d0 > law.reach:
-        notes["warning"] = f"d0 exceeds the window reach {law.reach:g} m: the grid has no linear equilibrium here"
+        raise ValueError(
+            f"alpha = {alpha_deg:g} deg puts the grid wall's equilibrium at d0 = {d0:.4g} m, beyond the active window's "
+            f"reach {law.reach:g} m, where the grid wall exerts no force: choose a smaller alpha, a larger f or "
+            f"cell ratio, a larger window, or env=analytic"
+        )
     return dict(
         walls=walls,
         start=Pose(-d0 - offset, 0.0, 0.0),

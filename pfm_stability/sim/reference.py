@@ -21,6 +21,7 @@ import math
 import numpy as np
 
 from ..force_law import PowerLaw
+from ..parameters import TAU_RESOLUTION
 from .engine import SUBSTEPS
 from .events import Event
 from .grid import HistogramGrid
@@ -174,8 +175,9 @@ def simulate_reference(s: Scenario):
     T, k, wmax = c.T, r.k, r.max_steering_rate
     sense = _grid_sense if s.env == "grid" else _wall_sense
     servo = c.hold == "reference"
-    full = _Steering(r.tau, k, T, wmax, ("servo",) if servo else ("constant",))
-    sub = _Steering(r.tau, k, T / SUBSTEPS, wmax, ("servo", "constant")) if servo else None
+    tau = r.tau if r.tau * k >= TAU_RESOLUTION else 0.0  # an ideal motor, as the engine and the models take it
+    full = _Steering(tau, k, T, wmax, ("servo",) if servo else ("constant",))
+    sub = _Steering(tau, k, T / SUBSTEPS, wmax, ("servo", "constant")) if servo else None
     x, y, theta = s.start.x, s.start.y, s.start.theta
     if s.start_jitter > 0:
         shift = float(np.random.default_rng(s.seed).normal(0.0, s.start_jitter))

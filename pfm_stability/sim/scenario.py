@@ -20,11 +20,14 @@ import numpy as np
 from ..checks import check_number
 from ..effective_force import GridWallLaw, calibrate_cell_ratio, check_window_cells, working_range
 from ..force_law import ForceLaw, PowerLaw
-from ..parameters import Controller, Robot
+from ..parameters import Controller, Robot, check_parameter
 from .environment import AnalyticEnvironment
 from .grid import HistogramGrid
 
-__all__ = ["Pose", "Target", "MeasureAxis", "Scenario"]
+__all__ = ["Pose", "Target", "MeasureAxis", "Scenario", "MAX_SAMPLES"]
+
+MAX_SAMPLES = 5e7
+"""Most samples one run may take (the recorder keeps two float arrays of this length: 800 MB)."""
 
 
 @dataclass(frozen=True)
@@ -194,8 +197,14 @@ class Scenario:
     notes: dict = field(default_factory=dict)
 
     def __post_init__(self):
-        check_number("T", self.controller.T, 0.0, unit="s")
+        check_parameter("T_sampled", self.controller.T)
         object.__setattr__(self, "duration", check_number("duration", self.duration, 0.0, 1e6, unit="s"))
+        samples = self.duration / self.controller.T
+        if samples > MAX_SAMPLES:
+            raise ValueError(
+                f"duration must be at most {MAX_SAMPLES:g} sampling periods ({MAX_SAMPLES * self.controller.T:g} s at "
+                f"T = {self.controller.T:g} s); got {self.duration!r} s ({samples:.3g} periods)"
+            )
         object.__setattr__(self, "trap_time", check_number("trap_time", self.trap_time, 0.0, unit="s"))
         object.__setattr__(self, "trap_distance", check_number("trap_distance", self.trap_distance, 0.0, unit="m"))
         object.__setattr__(self, "start_jitter", check_number("start_jitter", self.start_jitter, 0.0, low_open=False, unit="m"))

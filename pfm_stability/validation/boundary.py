@@ -670,8 +670,10 @@ def validate_boundary(
     domain = parameter_domain(parameter, scenario, env, robot, controller, law, geometry if scenario == "wall" else None, cell_size)
     if quantum is not None:  # the representable values: multiples of c/2
         domain = (math.ceil(domain[0] / quantum - 1e-9) * quantum, math.floor(domain[1] / quantum + 1e-9) * quantum)
+    why = "the robot must fit (clear of the walls)" + (" and the wall must lie inside the active window" if env == "grid" else "")
+    if not domain[0] < domain[1]:
+        raise ValueError(f"{parameter}: no value of {parameter} gives a run that can be simulated with these settings ({why})")
     if not domain[0] < p < domain[1]:
-        why = "the robot must fit (clear of the walls)" + (" and the wall must lie inside the active window" if env == "grid" else "")
         raise ValueError(
             f"{parameter}: the sampled model's boundary {p:.4g} {spec.unit} lies outside the values this scenario can be "
             f"simulated with, [{domain[0]:.4g}, {domain[1]:.4g}] {spec.unit} ({why})".replace(" ]", "]")
