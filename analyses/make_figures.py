@@ -67,8 +67,8 @@ def model_comparison():
 
 def kb_error_maps(resolution: int = 40):
     from pfm_stability.plots.comparison import plot_kb_error_maps
-    from pfm_stability.regions import kb_error_map
-    from pfm_stability.regions import kb_error_maps as maps_of
+    from pfm_stability.comparison import kb_error_map
+    from pfm_stability.comparison import kb_error_maps as maps_of
 
     k_tau = np.geomspace(0.05, 20.0, resolution)
     T_over_tau = np.geomspace(0.01, 3.0, resolution)
@@ -84,7 +84,7 @@ def root_locus():
 
 def simulated_points():
     """Bisected simulated boundaries: corridor V*(L) and wall α*(V), analytic and grid (about 30 s)."""
-    from pfm_stability.regions import simulated_boundary
+    from pfm_stability.validation import simulated_boundary
 
     corridor_L = [0.6, 0.7, 0.8, 0.9, 1.0]
     wall_V = [0.4, 0.8, 1.2]
@@ -103,7 +103,8 @@ def grid_law():
 
 
 def simulation_vs_prediction(points=None):
-    from pfm_stability.plots.regions import plot_corridor_region, plot_simulated_boundary, plot_wall_alpha_critical, region_legend, shading_text
+    from pfm_stability.plots.regions import plot_corridor_region, plot_wall_alpha_critical, region_legend, shading_text
+    from pfm_stability.plots.validation import plot_simulated_boundary
     from pfm_stability.regions import region_model
 
     points = simulated_points() if points is None else points

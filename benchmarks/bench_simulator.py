@@ -1,4 +1,4 @@
-"""Benchmark of the batch simulator against a plain per-robot Python loop (issue 4 item 7).
+"""Benchmark of the batch simulator against a plain per-robot Python loop (docs/simulator.md, batches).
 
     python benchmarks/bench_simulator.py [--members 1000] [--duration 10] [--loop-members 4] [--repeat 3]
 

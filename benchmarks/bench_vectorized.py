@@ -1,4 +1,4 @@
-"""Vectorized `exact_delay` verdicts (issue 3 item 6) against qpmr per point.
+"""Vectorized `exact_delay` verdicts against qpmr per point (docs/models.md).
 
 Targets: >= 1,000,000 points/s on this 2-core machine, and >= 1000x faster per
 point than calling qpmr (Vyhlidal & Zitek's QPmR, GPL, test-only extra) per

@@ -111,7 +111,7 @@ def share_limits(axes, runs) -> None:
 
 
 def run_summary(run, prediction, key: str) -> dict:
-    """JSON summary of one simulated run beside its prediction (`sim.predict`).
+    """JSON summary of one simulated run beside its prediction (`pfm_stability.validation.predict`).
 
     ``key`` names the varied quantity (``"L"`` in m, ``"alpha_deg"``), whose
     value is the prediction's.

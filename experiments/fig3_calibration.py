@@ -11,8 +11,8 @@ command hold and a one-sample compute delay): `barely_avoiding_ratio` finds
 the smallest cell ratio ρ = F_cr/F_ct with which the run avoids the obstacle,
 and the grid's f_av (KB's lumped f averaged over the window's working range,
 `f_average`) is compared with KB's 0.8. Then the run is repeated with the
-ratio that gives f_av = 0.8 (`calibrate_cell_ratio`, what every ``kb-*``
-preset uses).
+ratio that gives f_av = 0.8 (`calibrate_cell_ratio` through
+`pfm_stability.sim.scenario_law`, what every ``kb-*`` preset uses).
 
 Finding: KB's procedure gives ρ = 0.00837, f_av = 2.15 — and f(d) of that
 grid ranges from 1.09 (robot touching the wall) to 2.93 (window edge), never
@@ -45,18 +45,18 @@ KB_F_AV = 0.8
 def run(out, quick: bool = False) -> dict:
     import matplotlib.pyplot as plt
 
-    from pfm_stability.effective_force import GridWallLaw, calibrate_cell_ratio, f_average, working_range
+    from pfm_stability.effective_force import f_average, working_range
     from pfm_stability.parameters import CARMEL
     from pfm_stability.plots.trajectory import plot_trajectory
-    from pfm_stability.sim import barely_avoiding_ratio, simulate
+    from pfm_stability.sim import barely_avoiding_ratio, scenario_law, simulate
 
     out = output_dir(out)
     robot, controller = CARMEL.robot, CARMEL.controller
     n, W, c, w = controller.n, robot.W, CARMEL.cell_size, CARMEL.window_cells
     members, rounds = (12, 2) if quick else (24, 3)
     rho_kb_procedure = barely_avoiding_ratio(robot, controller, window_cells=w, cell_size=c, members=members, rounds=rounds)
-    rho_f08 = calibrate_cell_ratio(KB_F_AV, n, W, c, w)
-    law = GridWallLaw(rho_kb_procedure, n, W, c, w)
+    rho_f08 = scenario_law("grid", robot, controller.replace(f=KB_F_AV), w, c).ratio  # calibrated: f_av = 0.8
+    law = scenario_law("grid", robot, controller, w, c, cell_ratio=rho_kb_procedure)
     f_av = f_average(law)
     lo, hi = working_range(W, c, w)
     d = np.linspace(lo, hi, 121)
@@ -93,7 +93,7 @@ def run(out, quick: bool = False) -> dict:
             "averaging_range_m": [lo, hi],
             **outcome(runs["kb_procedure"]),
         },
-        "f_av_0.8": {"cell_ratio": rho_f08, "f_av": f_average(GridWallLaw(rho_f08, n, W, c, w)), **outcome(runs["f_av_0.8"])},
+        "f_av_0.8": {"cell_ratio": rho_f08, "f_av": f_average(scenario_law("grid", robot, controller, w, c, cell_ratio=rho_f08)), **outcome(runs["f_av_0.8"])},
         "finding": (
             f"KB's procedure (smallest ratio that avoids the obstacle) gives F_cr/F_ct = {rho_kb_procedure:.4g}, "
             f"f_av = {f_av:.3g} (KB: {KB_F_AV}); f(d) of that grid spans {f_of_d.min():.3g}-{f_of_d.max():.3g} over "

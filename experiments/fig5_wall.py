@@ -32,8 +32,6 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-import numpy as np  # noqa: E402
-
 from _common import boundary_row, output_dir, row, run_summary, save_figure, script_main, share_limits, write_json  # noqa: E402
 
 KB_ALPHA = 20.0
@@ -50,18 +48,14 @@ def above_scenario(alpha_deg: float = ABOVE_ALPHA):
     Same walls (section 1 drawn at 30° to Y, a staircase of cells; section 2
     along +Y from the corner at (0, 4) m); the start is 5 m before the corner
     at the equilibrium distance of section 1 (α + 30°) measured on the drawn
-    staircase (`measured_wall_force`), like the preset's.
+    staircase (`pfm_stability.sim.vff.measured_equilibrium`), like the preset's.
     """
-    from pfm_stability.effective_force import measured_wall_force
     from pfm_stability.sim import Pose, Target, make_scenario
+    from pfm_stability.sim.vff import measured_equilibrium
 
     base = make_scenario("kb-fig5")
     law = base.effective_law()
-    alpha1 = math.radians(alpha_deg + TURN)
-    d = np.arange(law.W / 2 + law.cell_size, law.reach, 0.005)
-    F = measured_wall_force(law, d, angle=math.radians(TURN))
-    i = int(np.flatnonzero(F < math.cos(alpha1))[0])
-    d0 = float(d[i - 1] + (d[i] - d[i - 1]) * (F[i - 1] - math.cos(alpha1)) / (F[i - 1] - F[i]))
+    d0 = measured_equilibrium(law, math.radians(TURN), math.cos(math.radians(alpha_deg + TURN)))
     turn, along = math.radians(TURN), 5.0
     start = Pose(-along * math.sin(turn) - d0 * math.cos(turn), 4.0 - along * math.cos(turn) + d0 * math.sin(turn), turn)
     notes = dict(base.notes)
@@ -81,8 +75,8 @@ def run(out, quick: bool = False) -> dict:
 
     from pfm_stability.plots.trajectory import plot_trajectory
     from pfm_stability.plots.validation import plot_validation
-    from pfm_stability.sim import make_scenario, predict, simulate
-    from pfm_stability.validation import validate_boundary
+    from pfm_stability.sim import make_scenario, simulate
+    from pfm_stability.validation import predict, validate_boundary
 
     out = output_dir(out)
     kb_scenario = make_scenario("kb-fig5")

@@ -37,8 +37,8 @@ def run(out, quick: bool = False) -> dict:
 
     from pfm_stability.plots.trajectory import plot_trajectory
     from pfm_stability.plots.validation import plot_validation
-    from pfm_stability.sim import make_scenario, predict, simulate
-    from pfm_stability.validation import validate_boundary
+    from pfm_stability.sim import make_scenario, simulate
+    from pfm_stability.validation import predict, validate_boundary
 
     out = output_dir(out)
     scenarios = {"wide": make_scenario("kb-fig6-wide"), "narrow": make_scenario("kb-fig6-narrow")}

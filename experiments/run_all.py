@@ -3,7 +3,7 @@
     python experiments/run_all.py [--out experiments/results] [--quick] [--no-readme]
 
 Runs, in order, ``fig3_calibration``, ``fig5_wall``, ``fig6_corridor`` (KB
-1991 Figs 3, 5, 6) and ``validation_summary`` (issue 5 items 2–3), each
+1991 Figs 3, 5, 6) and ``validation_summary`` (docs/validation.md), each
 writing into `--out`, then replaces the table between the markers
 ``<!-- results-table:begin -->`` and ``<!-- results-table:end -->`` of
 ``experiments/README.md`` (unless ``--no-readme``; ``--quick`` never touches
@@ -21,7 +21,7 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 
-EXPERIMENTS = ("fig3_calibration", "fig5_wall", "fig6_corridor", "validation_summary")
+EXPERIMENTS = ("fig3_calibration", "fig5_wall", "fig6_corridor", "validation_summary", "gc2000_traps")
 BEGIN, END = "<!-- results-table:begin -->", "<!-- results-table:end -->"
 README = HERE / "README.md"
 

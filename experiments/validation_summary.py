@@ -1,4 +1,4 @@
-"""Simulation against prediction over many parameter sets (issue 5 items 2–3): the numbers behind the tests.
+"""Simulation against prediction over many parameter sets (docs/validation.md): the numbers behind the tests.
 
 1. **Analytic boundaries**: for each reference set (`REFERENCE_SETS`: KB's
    CARMEL, a fast and a slow robot), each sampled structure (hold command or

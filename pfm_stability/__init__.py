@@ -4,7 +4,7 @@ Koren & Borenstein 1991 ("Potential Field Methods and Their Inherent
 Limitations for Mobile Robot Navigation", ICRA) reduce a VFF-controlled robot
 near a wall or in a corridor to a third-order loop (their eq 15–20). This
 package derives that loop symbolically, decides its stability with five models
-of increasing fidelity (DESIGN §4), and checks the predictions against a
+of increasing fidelity (docs/models.md), and checks the predictions against a
 simulation of the VFF algorithm on a histogram grid.
 
 The public names below are imported lazily (PEP 562) so that the command line
@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import importlib
 
-__version__ = "0.1.0"
+from .version import __version__
 
 _EXPORTS = {
     "Robot": "parameters",
@@ -31,7 +31,7 @@ _EXPORTS = {
     "corridor_gain": "force_law",
     "Loop": "models",
     "Boundary": "models",
-    "MODEL_NAMES": "models",
+    "MODEL_NAMES": "parameters",
     "make_model": "models",
     "make_models": "models",
     "Continuous": "models",

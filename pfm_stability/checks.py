@@ -15,7 +15,7 @@ import math
 import numbers
 import os
 
-__all__ = ["check_number", "check_choice", "check_integer", "check_output_path", "check_type", "describe_range"]
+__all__ = ["check_number", "check_choice", "check_integer", "check_output_path", "check_type", "check_positive_axis", "describe_range"]
 
 
 def describe_range(low: float, high: float, low_open: bool, high_open: bool) -> str:
@@ -187,3 +187,22 @@ def check_type(name: str, value, kinds, what: str):
     if not isinstance(value, kinds):
         raise ValueError(f"{name} must be {what}; got {value!r}")
     return value
+
+
+def check_positive_axis(name: str, values, unit: str = ""):
+    """Return `values` as a 1-D float ndarray after checking it is non-empty, finite and positive.
+
+    For the axes of curves and maps (speeds, periods, gains). numpy is imported
+    here, not at module level, so the CLI can check scalars before loading it.
+
+    Raises
+    ------
+    ValueError
+        ``"T_over_tau must be a non-empty 1-D array of positive finite numbers"``.
+    """
+    import numpy as np
+
+    x = np.atleast_1d(np.asarray(values, dtype=float))
+    if x.ndim != 1 or x.size == 0 or not np.all(np.isfinite(x)) or np.any(x <= 0):
+        raise ValueError(f"{name} must be a non-empty 1-D array of positive finite numbers{' (' + unit + ')' if unit else ''}")
+    return x

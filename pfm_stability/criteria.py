@@ -20,17 +20,21 @@ from __future__ import annotations
 
 import math
 import numbers
-from dataclasses import dataclass, field
+from collections.abc import Mapping
+from dataclasses import dataclass, field, fields
 
 import numpy as np
 
 from .checks import check_number, check_type
-from .force_law import ForceLaw, PowerLaw, corridor_gain, wall_gain
+from .force_law import ForceLaw, PowerLaw, corridor_gain, law_in_force, wall_gain
 from .models import Loop, LoopModel, gain_margin, models_for, verdict_label
-from .parameters import RANGES, Controller, Corridor, Robot, Wall, check_corridor_fits, check_parameter
+from .parameters import RANGES, Controller, Corridor, Robot, Wall, check_corridor_fits, check_parameter, to_degrees
 from .solve import bisect_root, expand_bracket
 
 __all__ = [
+    "CriticalValues",
+    "WallCritical",
+    "CorridorCritical",
     "ModelVerdict",
     "WallAnalysis",
     "CorridorAnalysis",
@@ -46,6 +50,100 @@ __all__ = [
 ]
 
 
+class CriticalValues(Mapping):
+    """Critical values of one model in one geometry: named fields, read-only mapping too.
+
+    Subclasses are frozen dataclasses. As a `Mapping` they hold their fields
+    in declaration order, leaving out those that are None (``critical["L_critical"]``,
+    ``.items()``, ``in``, ``len``, iteration): the keys and the order of the
+    report's JSON. Equality is the mapping's (so a plain dict of the same
+    items compares equal).
+    """
+
+    __slots__ = ()
+
+    def _keys(self) -> tuple:
+        return tuple(f.name for f in fields(self) if getattr(self, f.name) is not None)
+
+    def __getitem__(self, key: str):
+        if isinstance(key, str) and key in self._keys():
+            return getattr(self, key)
+        raise KeyError(key)
+
+    def __iter__(self):
+        return iter(self._keys())
+
+    def __len__(self) -> int:
+        return len(self._keys())
+
+    def __repr__(self) -> str:
+        return f"{type(self).__name__}({', '.join(f'{k}={v!r}' for k, v in self.items())})"
+
+
+@dataclass(frozen=True, eq=False, repr=False)
+class WallCritical(CriticalValues):
+    """One model's critical values along a wall, each with the other inputs fixed (docs/models.md).
+
+    Attributes
+    ----------
+    alpha_critical : float
+        α*, rad: stable for α > α* (0 when NV* = inf; π/2 when NV* = 0).
+    alpha_critical_deg : float
+        α* in degrees (set from `alpha_critical`).
+    f_critical : float
+        f*: stable for f > f* (KB eq 24 generalized; ``inf`` when NV* = 0).
+    V_critical : float
+        V* = NV*/N, m/s: every slower speed is stable.
+    T_critical : float
+        T*, s: the smallest sampling period / delay at which the operating
+        point loses stability (0: already at T → 0; ``inf``: stable up to 100 s).
+    k_critical : float
+        k*, 1/s: the smallest steering gain at which it loses stability.
+    tau_plus_T_critical : float or None
+        (τ + T)* = 1/NV, s: KB eq (20) solved for the loop's time constants
+        (``kb_first_order`` only; None, and no key, otherwise).
+    """
+
+    alpha_critical: float
+    alpha_critical_deg: float = field(init=False)
+    f_critical: float
+    V_critical: float
+    T_critical: float
+    k_critical: float
+    tau_plus_T_critical: float | None = None
+
+    def __post_init__(self):
+        object.__setattr__(self, "alpha_critical_deg", to_degrees(self.alpha_critical))
+
+
+@dataclass(frozen=True, eq=False, repr=False)
+class CorridorCritical(CriticalValues):
+    """One model's critical values in the middle of a corridor, each with the other inputs fixed (docs/models.md).
+
+    Attributes
+    ----------
+    L_critical : float
+        L*, m: stable for L > L* (KB eq 25 generalized; ``inf`` when NV* = 0).
+    V_critical : float
+        V* = NV*/N, m/s: every slower speed is stable.
+    f_critical : float
+        f*: stable for f < f* (N ∝ f; 0 when NV* = 0).
+    T_critical : float
+        T*, s (see `WallCritical`).
+    k_critical : float
+        k*, 1/s (see `WallCritical`).
+    tau_plus_T_critical : float or None
+        (τ + T)* = 1/NV, s (``kb_first_order`` only; None, and no key, otherwise).
+    """
+
+    L_critical: float
+    V_critical: float
+    f_critical: float
+    T_critical: float
+    k_critical: float
+    tau_plus_T_critical: float | None = None
+
+
 @dataclass(frozen=True)
 class ModelVerdict:
     """One model's answer for one scenario.
@@ -53,7 +151,7 @@ class ModelVerdict:
     Attributes
     ----------
     model : str
-        Model name (DESIGN §4).
+        Model name (`parameters.MODEL_NAMES`, docs/models.md).
     NV : float
         Operating NV, 1/s.
     NV_critical : float
@@ -64,9 +162,10 @@ class ModelVerdict:
         NV*/NV − 1: > 0 stable, < 0 unstable (relative gain margin).
     verdict : str
         "stable", "unstable" or "undecided" (|margin| <= 1e-9).
-    critical : dict
-        Critical value of each parameter with the others fixed
-        (SI units; angles in rad, plus ``alpha_critical_deg``).
+    critical : WallCritical or CorridorCritical
+        Critical value of each parameter with the others fixed (SI units;
+        angles in rad, plus ``alpha_critical_deg``); also a read-only mapping
+        by key (``critical["L_critical"]``).
     rightmost_root : complex or None
         Dominant root σ + jω (1/s, rad/s) at the operating point (None where
         the model cannot resolve it; the verdict does not depend on it).
@@ -78,7 +177,7 @@ class ModelVerdict:
     omega_critical: float | None
     margin: float
     verdict: str
-    critical: dict = field(default_factory=dict)
+    critical: CriticalValues
     rightmost_root: complex | None = 0j
 
     @property
@@ -110,6 +209,11 @@ class WallAnalysis:
     NV: float
     models: dict
 
+    @property
+    def alpha_deg(self) -> float:
+        """α in degrees (`parameters.to_degrees`), for output."""
+        return to_degrees(self.alpha)
+
 
 @dataclass(frozen=True)
 class CorridorAnalysis:
@@ -137,14 +241,6 @@ def loop_of(robot: Robot, controller: Controller) -> Loop:
     check_type("robot", robot, Robot, "a Robot")
     check_type("controller", controller, Controller, "a Controller")
     return Loop(robot.tau, controller.T, robot.k)
-
-
-def _law(robot: Robot, controller: Controller, law: ForceLaw | None) -> ForceLaw:
-    check_type("robot", robot, Robot, "a Robot")
-    check_type("controller", controller, Controller, "a Controller")
-    if law is None:
-        return PowerLaw(controller.f, controller.n, robot.W)
-    return check_type("law", law, ForceLaw, "a ForceLaw (e.g. PowerLaw or GridWallLaw)")
 
 
 NV_MAX = 1e12
@@ -291,16 +387,32 @@ def critical_f_corridor(law: ForceLaw, L: float, V: float, NV_critical: float) -
 
 
 # ------------------------------------------------------------------ analyses
-def _verdict(model: LoopModel, loop: Loop, NV: float, boundary, critical: dict) -> ModelVerdict:
-    critical = dict(critical)
+def _verdicts(controller: Controller, models, loop: Loop, N: float, NV: float, critical_values, geometric) -> dict:
+    """Model name → `ModelVerdict` for every model of the analysis.
+
+    `geometric(NV*)` gives the geometry's own critical values (α* and f*, or
+    L* and f*); V* = NV*/N, T* and k* are the same for every geometry.
+    """
+    out = {}
+    for model in models_for(controller, models):
+        boundary = model.boundary(loop)
+        V_critical = boundary.NV_critical / N if N > 0 else math.inf
+        out[model.name] = _verdict(model, loop, NV, boundary, critical_values, V_critical=V_critical, **geometric(boundary.NV_critical))
+    return out
+
+
+def _verdict(model: LoopModel, loop: Loop, NV: float, boundary, critical_values, **geometry) -> ModelVerdict:
+    """The verdict; `critical_values` (WallCritical or CorridorCritical) built from `geometry` plus T*, k*."""
     if NV == 0:  # no equilibrium force gradient: nothing to oscillate
-        critical.update(T_critical=math.inf, k_critical=math.inf)
+        critical = critical_values(**geometry, T_critical=math.inf, k_critical=math.inf)
         return ModelVerdict(model.name, NV, boundary.NV_critical, boundary.omega_critical, math.inf, "stable", critical, 0j)
     stable = model.is_stable(NV, loop)
-    critical["T_critical"] = model.critical_delay(NV, loop)
-    critical["k_critical"] = model.critical_gain_k(NV, loop)
-    if model.name == "kb_first_order":
-        critical["tau_plus_T_critical"] = 1.0 / NV
+    critical = critical_values(
+        **geometry,
+        T_critical=model.critical_delay(NV, loop),
+        k_critical=model.critical_gain_k(NV, loop),
+        tau_plus_T_critical=1.0 / NV if model.name == "kb_first_order" else None,
+    )
     return ModelVerdict(
         model=model.name,
         NV=NV,
@@ -331,29 +443,26 @@ def analyze_wall(robot: Robot, controller: Controller, wall: Wall, models=None, 
     Returns
     -------
     WallAnalysis
-        Critical values per model: ``alpha_critical`` (rad), ``alpha_critical_deg``,
-        ``f_critical``, ``V_critical`` (m/s), ``T_critical`` (s), ``k_critical`` (1/s).
+        Critical values per model (`WallCritical`): ``alpha_critical`` (rad),
+        ``alpha_critical_deg``, ``f_critical``, ``V_critical`` (m/s), ``T_critical`` (s),
+        ``k_critical`` (1/s), and ``tau_plus_T_critical`` (s) for ``kb_first_order``.
         A model that is unstable at every NV (NV* = 0) gives V* = 0, α* = 90°
         and f* = inf: no speed, angle or force ratio helps; ``T_critical`` and
         ``k_critical`` say whether a shorter period or a lower gain does.
     """
-    law = _law(robot, controller, law)
+    law = law_in_force(robot, controller, law)
     check_type("wall", wall, Wall, "a Wall")
     loop = loop_of(robot, controller)
     d0, N = wall_gain(law, wall.alpha)
-    NV = _check_gain(N * robot.V, f"wall equilibrium d0 = {d0:g} m (alpha = {math.degrees(wall.alpha):g} deg)")
-    out = {}
-    for model in models_for(controller, models):
-        boundary = model.boundary(loop)
-        alpha_star = critical_alpha(law, robot.V, boundary.NV_critical)
-        critical = {
-            "alpha_critical": alpha_star,
-            "alpha_critical_deg": math.degrees(alpha_star),
-            "f_critical": critical_f_wall(law, wall.alpha, robot.V, boundary.NV_critical),
-            "V_critical": boundary.NV_critical / N if N > 0 else math.inf,
+    NV = _check_gain(N * robot.V, f"wall equilibrium d0 = {d0:g} m (alpha = {wall.alpha_deg:g} deg)")
+
+    def geometric(NV_critical):
+        return {
+            "alpha_critical": critical_alpha(law, robot.V, NV_critical),
+            "f_critical": critical_f_wall(law, wall.alpha, robot.V, NV_critical),
         }
-        out[model.name] = _verdict(model, loop, NV, boundary, critical)
-    return WallAnalysis(wall.alpha, d0, N, NV, out)
+
+    return WallAnalysis(wall.alpha, d0, N, NV, _verdicts(controller, models, loop, N, NV, WallCritical, geometric))
 
 
 def analyze_corridor(robot: Robot, controller: Controller, corridor: Corridor, models=None, law: ForceLaw | None = None) -> CorridorAnalysis:
@@ -373,23 +482,22 @@ def analyze_corridor(robot: Robot, controller: Controller, corridor: Corridor, m
     Returns
     -------
     CorridorAnalysis
-        Critical values per model: ``L_critical`` (m), ``V_critical`` (m/s),
-        ``f_critical``, ``T_critical`` (s), ``k_critical`` (1/s). NV* = 0 gives
+        Critical values per model (`CorridorCritical`): ``L_critical`` (m),
+        ``V_critical`` (m/s), ``f_critical``, ``T_critical`` (s), ``k_critical`` (1/s),
+        and ``tau_plus_T_critical`` (s) for ``kb_first_order``. NV* = 0 gives
         V* = 0, L* = inf and f* = 0 ("unstable at any speed").
     """
-    law = _law(robot, controller, law)
+    law = law_in_force(robot, controller, law)
     check_type("corridor", corridor, Corridor, "a Corridor")
     check_corridor_fits(corridor, robot)
     loop = loop_of(robot, controller)
     N = corridor_gain(law, corridor.L)
     NV = _check_gain(N * robot.V, f"corridor middle (L = {corridor.L:g} m)")
-    out = {}
-    for model in models_for(controller, models):
-        boundary = model.boundary(loop)
-        critical = {
-            "L_critical": critical_L(law, robot.V, boundary.NV_critical),
-            "V_critical": boundary.NV_critical / N if N > 0 else math.inf,
-            "f_critical": critical_f_corridor(law, corridor.L, robot.V, boundary.NV_critical),
+
+    def geometric(NV_critical):
+        return {
+            "L_critical": critical_L(law, robot.V, NV_critical),
+            "f_critical": critical_f_corridor(law, corridor.L, robot.V, NV_critical),
         }
-        out[model.name] = _verdict(model, loop, NV, boundary, critical)
-    return CorridorAnalysis(corridor.L, N, NV, out)
+
+    return CorridorAnalysis(corridor.L, N, NV, _verdicts(controller, models, loop, N, NV, CorridorCritical, geometric))

@@ -5,7 +5,7 @@ the robot's kinematics into one differential equation and read their stability
 conditions off it. This module re-derives every step with sympy instead of
 transcribing the printed formulas, so that the closed forms used numerically
 elsewhere (`criteria`, `force_law`, `models`) can be tested against it
-(DESIGN §1: the derivation is the source of truth):
+(docs/theory.md: the derivation is the source of truth):
 
 =====================  =======================================================
 KB eq                  how it is obtained here
@@ -29,12 +29,12 @@ KB eq                  how it is obtained here
 
 Every result accepts a *force law*: KB's power law F_r = f F_a Wⁿ/dⁿ (eq 8,
 13; ``"power"``, the default), a general undefined function F_r(d)
-(``"general"``; DESIGN §3 "General force law": wall equilibrium
+(``"general"``; docs/theory.md, "Any force law": wall equilibrium
 F_r(d0) = F_a cos α, N = −F_r′(d0)/(F_a sin α); corridor N = −2F_r′(L)/F_a),
 or any ``sympy.Lambda`` d ↦ F_r(d) (a force, i.e. proportional to F_a).
 
-KB misprints and OCR garbles handled (DESIGN §3)
--------------------------------------------------
+KB misprints and OCR garbles handled (docs/theory.md)
+-----------------------------------------------------
 * (6): "α̇ is the steering-rate command" means the command u = k(δ − θ) of (5);
   KB overload α (steering-rate command in (5)–(6), target angle from (9) on).
   Here the command is ``u``.
@@ -55,9 +55,9 @@ X), Y runs along the wall; θ and δ are measured from +Y towards +X, so
 ẋ = V sin θ (14) and tan δ = R_X/R_Y (9). KB's (18) puts the delay on the
 environment path only (kNV e^(−sT)): the sampled reference δ is delayed, the
 steering servo u = k(δ − θ) is continuous — the ``reference`` structure of
-DESIGN §4.
+the ``sampled`` model (docs/models.md).
 
-Symbols use the paper's names (DESIGN §2), all positive except the angles
+Symbols use the paper's names (docs/theory.md, Notation), all positive except the angles
 θ, δ (real) and the lateral offset x (real): `tau` (s), `k` (1/s), `V` (m/s),
 `T` (s), `f`, `n`, `W` (m), `alpha` (rad, in (0, π/2)), `d` (m), `L` (m),
 `N` (1/m), `F_a` (force), and `NV_star` (NV*, 1/s) for a generic critical
@@ -77,6 +77,7 @@ from functools import lru_cache
 
 import sympy as sp
 
+from .parameters import DERIVATION_LAWS
 from .routh import routh_array
 
 __all__ = [
@@ -135,7 +136,7 @@ N = sp.Symbol("N", positive=True)
 M = sp.Symbol("M", real=True)
 """Gain of the target-angle rate, dimensionless (eq 10, 12)."""
 NV_star = sp.Symbol("NV*", positive=True)
-"""A critical loop gain NV*, 1/s (KB's 1/(τ + T) or any model's, DESIGN §4)."""
+"""A critical loop gain NV*, 1/s (KB's 1/(τ + T) or any model's, docs/models.md)."""
 omega = sp.Symbol("omega", positive=True)
 """Angular frequency, rad/s."""
 
@@ -152,13 +153,13 @@ omega_t = sp.Function("omega", real=True)
 u = sp.Function("u", real=True)
 """Steering-rate command u(t), rad/s (KB's overloaded α in eq 5–6)."""
 F_r = sp.Function("F_r")
-"""A general lateral repulsion law F_r(d), force units (DESIGN §3)."""
+"""A general lateral repulsion law F_r(d), force units (docs/theory.md, "Any force law")."""
 
-LAWS = ("power", "general")
-"""Named force laws: KB's power law (eq 8, 13) and a general F_r(d)."""
+LAWS = DERIVATION_LAWS
+"""Named force laws: KB's power law (eq 8, 13) and a general F_r(d) (`parameters.DERIVATION_LAWS`)."""
 
 KINDS = ("continuous", "exact_delay", "kb_first_order", "pade")
-"""Characteristic equations by loop-model name (DESIGN §4): (17), (18), (19), (18)+Padé."""
+"""Characteristic equations by loop-model name (docs/models.md): (17), (18), (19), (18)+Padé."""
 
 
 # ------------------------------------------------------------------ results
@@ -515,7 +516,7 @@ def pade_approximant(m: int) -> tuple:
 
 @lru_cache(maxsize=None)
 def delay_transfer(kind: str = "exact_delay", m: int = 2) -> sp.Expr:
-    """The loop delay's transfer function in each model (DESIGN §4).
+    """The loop delay's transfer function in each model (docs/models.md).
 
     ``continuous``: 1; ``exact_delay``: L{δ(t − T)}(s) = e^(−sT) (eq 18);
     ``kb_first_order``: its first-order Taylor polynomial 1 − sT (KB §3,

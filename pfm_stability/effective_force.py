@@ -6,7 +6,7 @@ centred on the robot's *cell* (KB §2). For a straight wall of cells (one cell
 thick, certainty value C, cell size c) at lateral distance d from the robot
 centre, the window holds the 2h + 1 wall cells of rows j_r − h … j_r + h
 (h = (w_s − 1)/2), at along-wall offsets y_j = jc − s, where s ∈ [−c/2, c/2)
-is the robot's position inside its cell. Averaged over s (issue 5: "averaged
+is the robot's position inside its cell. Averaged over s (docs/simulator.md: "averaged
 over the robot's position along the wall within a cell"), the sum over cells
 becomes an integral over a continuous line of length (2h + 1)c, exactly:
 
@@ -14,10 +14,11 @@ becomes an integral over a continuous line of length (2h + 1)c, exactly:
                 = ρ C Wⁿ/c · d^(1−n) · B(½, n/2) · I(Y²/(d² + Y²); ½, n/2),
 
 with ρ = F_cr/F_ct the cell force ratio and I the regularized incomplete beta
-function (n = 2: 2Y/(d√(d² + Y²)), so F_r ∝ 1/d for d ≪ Y — DESIGN §5). The
+function (n = 2: 2Y/(d√(d² + Y²)), so F_r ∝ 1/d for d ≪ Y — docs/simulator.md). The
 gradient is F_r′(d) = ρ C Wⁿ/c · [(1 − n)G(d)/d − 2Y/(d² + Y²)^((n+1)/2)], G
-the integral. `measured_wall_force` checks the closed form by summing the
-simulator's own eq (1) over drawn cells.
+the integral. The simulator's `pfm_stability.sim.vff.measured_wall_force`
+checks the closed form by summing its own eq (1) over drawn cells (this
+module imports nothing from the simulator).
 
 The window stops seeing the wall at d = (h + ½)c (the wall column leaves the
 window; 1.65 m for CARMEL), where the grid force drops to 0. The general-law
@@ -36,12 +37,12 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from functools import lru_cache
 
 import numpy as np
 
 from .checks import check_integer, check_number
 from .force_law import ForceLaw, PowerLaw
+from .solve import gauss_legendre
 
 __all__ = [
     "DEFAULT_CV",
@@ -49,13 +50,12 @@ __all__ = [
     "working_range",
     "f_average",
     "calibrate_cell_ratio",
-    "measured_wall_force",
     "corridor_lateral_force",
     "check_window_cells",
 ]
 
 DEFAULT_CV = 15
-"""Certainty value of a drawn obstacle cell: the maximum of KB's histogram grid (DESIGN §5)."""
+"""Certainty value of a drawn obstacle cell: the maximum of KB's histogram grid (docs/simulator.md)."""
 
 
 def check_window_cells(window_cells) -> int:
@@ -192,14 +192,6 @@ class GridWallLaw(ForceLaw):
         return PowerLaw(f_average(self) if f is None else f, self.n, self.W)
 
 
-@lru_cache(maxsize=16)
-def _leggauss(points: int):
-    """Gauss–Legendre nodes and weights on [−1, 1] (cached: numpy solves an eigenproblem each time)."""
-    x, w = np.polynomial.legendre.leggauss(points)
-    x.flags.writeable = w.flags.writeable = False
-    return x, w
-
-
 def working_range(W: float, cell_size: float = 0.1, window_cells: int = 33) -> tuple[float, float]:
     """Distances at which a wall acts on a robot that does not touch it, m.
 
@@ -229,7 +221,7 @@ def f_average(law: GridWallLaw, d_range: tuple[float, float] | None = None, poin
         round-off, checked against 256 in the tests).
     """
     lo, hi = d_range if d_range is not None else working_range(law.W, law.cell_size, law.window_cells)
-    x, w = _leggauss(points)
+    x, w = gauss_legendre(points)
     d = lo + (hi - lo) * (x + 1) / 2
     return float(np.sum(w * law.equivalent_f(d, law.n, law.W)) / 2)
 
@@ -263,68 +255,11 @@ def calibrate_cell_ratio(
     return f_av / f_average(unit, d_range)
 
 
-def measured_wall_force(law: GridWallLaw, d, angle: float = 0.0, nodes: int = 24, samples: int = 400) -> np.ndarray:
-    """F_r(d)/F_ct summed cell by cell by the simulator's VFF (KB eq 1–2), averaged along the wall.
-
-    A one-cell-thick wall through the origin is drawn into a `HistogramGrid`
-    (`HistogramGrid.draw_segment`) and the robot sits at distance d from its
-    line on the wall's left side; the component of the window sum along that
-    normal is averaged over the robot's position along the wall.
-
-    * ``angle = 0`` (a wall along Y, cell centres on x = 0): the sum is smooth
-      in the robot's position inside its cell, so Gauss–Legendre with `nodes`
-      nodes over one cell gives the exact average — the check of the closed
-      form of `GridWallLaw`.
-    * other angles (a staircase of cells): the mean over `samples` positions
-      spread evenly over 2 m along the wall (the staircase is not periodic in
-      general); it is stronger than the axis-aligned law (≈ 1.33× at 30°,
-      more cells per metre of wall).
-
-    Parameters
-    ----------
-    law : GridWallLaw
-        Cell ratio, exponent, width, cell size, window and CV.
-    d : array_like
-        Distances robot centre → wall line, m, in (0, reach].
-    angle : float
-        Wall direction, rad from +Y towards +X.
-    nodes, samples : int
-        Quadrature nodes per cell (angle 0) or sample positions (otherwise).
-
-    Returns
-    -------
-    ndarray
-        F_r/F_ct pushing away from the wall (positive).
-    """
-    from .sim.grid import HistogramGrid
-    from .sim.vff import window_repulsion
-
-    c, h = law.cell_size, law.window_cells // 2
-    d = np.atleast_1d(np.asarray(d, dtype=float))
-    span = (h + 2) * c + float(np.max(d)) + 1.0
-    grid = HistogramGrid.centred(-span, span, -span, span, cell_size=c)
-    ux, uy = math.sin(angle), math.cos(angle)
-    nx, ny = -uy, ux  # left of the wall direction
-    reach = span - c
-    grid.draw_segment((-reach * ux, -reach * uy), (reach * ux, reach * uy), cv=law.cv)
-    if angle == 0.0:
-        x, w = _leggauss(nodes)
-        along, weights = x * c / 2, w / 2  # the cell centred on y = 0
-    else:
-        along = np.linspace(-1.0, 1.0, samples, endpoint=False)
-        weights = np.full(samples, 1.0 / samples)
-    px = d[:, None] * nx + along[None, :] * ux
-    py = d[:, None] * ny + along[None, :] * uy
-    fx, fy = window_repulsion(grid, px.ravel(), py.ravel(), ratio=law.ratio, n=law.n, W=law.W, window_cells=law.window_cells)
-    normal = (fx * nx + fy * ny).reshape(d.size, along.size)
-    return normal @ weights
-
-
 def corridor_lateral_force(law: ForceLaw, L: float, x):
     """Lateral F_x/F_ct at offset x (m, towards the right wall) in a corridor of half-width L.
 
     F_x = F_r(L + x) − F_r(L − x) (the left wall pushes right, the right wall
-    left); linearized, F_x ≈ 2F_r′(L)·x = −N·F_ct·x (DESIGN §3).
+    left); linearized, F_x ≈ 2F_r′(L)·x = −N·F_ct·x (docs/theory.md).
     """
     x = np.asarray(x, dtype=float)
     return law.force(L + x) - law.force(L - x)

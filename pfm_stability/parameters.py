@@ -1,6 +1,13 @@
-"""Robot, controller and scenario parameters, and the CARMEL preset.
+"""Robot, controller and scenario parameters, every vocabulary and range, and the CARMEL preset.
 
-All quantities are SI (m, s, rad); the CLI converts degrees at its edge.
+The one place where names and ranges live: model names, sampled structures,
+geometries, simulator environments and force laws, and `RANGES` (library,
+vectorized code and CLI). This module imports no numpy, so the command line
+can validate input before loading it.
+
+All quantities are SI (m, s, rad); degrees exist only at the edges: typed
+angles come in through `Wall.from_degrees` (`to_radians` for arrays), and
+reported ones go out through `to_degrees`.
 Symbols follow Koren & Borenstein 1991 ("KB"): V, tau (τ, eq 6), k (eq 5),
 W (eq 1), f (eq 13), n (eq 1, 8), T (eq 18), alpha (α, eq 9), L (eq 25).
 
@@ -28,6 +35,17 @@ __all__ = [
     "PRESETS",
     "get_preset",
     "HOLDS",
+    "COMPUTE_DELAYS",
+    "SAMPLED_STRUCTURES",
+    "MODEL_NAMES",
+    "GEOMETRIES",
+    "ENVIRONMENTS",
+    "FORCE_LAWS",
+    "DERIVATION_LAWS",
+    "DEGREES_PER_RADIAN",
+    "RADIANS_PER_DEGREE",
+    "to_degrees",
+    "to_radians",
     "TAU_RESOLUTION",
     "check_corridor_fits",
 ]
@@ -37,9 +55,54 @@ TAU_RESOLUTION = 1e-9
 alike: the lag is 10⁹ times faster than the steering loop, below the resolution of either, and its
 pole at −1/τ would leave floating point."""
 
-HOLDS = ("command", "reference")
-"""Sampled-loop structures of DESIGN §4: what the sampled computer holds."""
+MODEL_NAMES = ("continuous", "kb_first_order", "pade", "exact_delay", "sampled")
+"""The loop models, in order of fidelity (docs/models.md)."""
 
+HOLDS = ("command", "reference")
+"""What the sampled computer holds between samples: the whole steering command, or the reference δ."""
+
+COMPUTE_DELAYS = (0, 1)
+"""Samples from measurement to actuation."""
+
+SAMPLED_STRUCTURES = tuple((hold, delay) for hold in HOLDS for delay in COMPUTE_DELAYS)
+"""Every (hold, compute_delay) of the ``sampled`` model."""
+
+GEOMETRIES = ("corridor", "wall")
+"""The environments the analysis linearizes: the middle of a corridor, travel along a wall."""
+
+ENVIRONMENTS = ("grid", "analytic")
+"""Simulator environments: a histogram grid of cells, or continuous walls with a force law."""
+
+FORCE_LAWS = ("power", "grid")
+"""Lateral force laws by name: KB's lumped power law, the histogram grid's effective law."""
+
+DERIVATION_LAWS = ("power", "general")
+"""Force laws of the symbolic derivation (`pfm_stability.derivation`, ``pfm-stability derive --law``):
+KB's power law (eq 8, 13) and a general F_r(d) (docs/theory.md)."""
+
+DEGREES_PER_RADIAN = 180.0 / math.pi
+"""Degrees per radian, for output (`to_degrees`)."""
+
+RADIANS_PER_DEGREE = math.pi / 180.0
+"""Radians per degree, for input (`to_radians`, `Wall.from_degrees`)."""
+
+
+def to_degrees(angle):
+    """An angle in rad (a number or a numpy array) in degrees, for output.
+
+    Bit for bit ``math.degrees`` and ``numpy.degrees`` (both multiply by 180/π),
+    without importing numpy here.
+    """
+    return angle * DEGREES_PER_RADIAN
+
+
+def to_radians(angle_deg):
+    """An angle in degrees (a number or a numpy array) in rad, for input.
+
+    Bit for bit ``math.radians`` and ``numpy.radians`` (both multiply by π/180).
+    Unchecked: a single wall angle goes through `Wall.from_degrees`, which checks it.
+    """
+    return angle_deg * RADIANS_PER_DEGREE
 
 
 @dataclass(frozen=True)
@@ -90,6 +153,7 @@ RANGES = {
     "pade_order": Range(1, 12, low_open=False),
     "window_cells": Range(3, 1001, low_open=False, unit="cells"),
     "members": Range(3, 1000, low_open=False),
+    "resolution": Range(10, 1000, low_open=False, unit="points per side"),
     "sweep": Range(8, 100_000, low_open=False),
     "seed": Range(0, 2**63 - 1, low_open=False),
 }
@@ -189,7 +253,7 @@ class Controller:
     T : float
         Sampling period, s, in [0, 100] (KB eq 18; 0 = continuous controller).
     hold : {"command", "reference"}
-        What the sampled computer holds between samples (DESIGN §4):
+        What the sampled computer holds between samples (docs/models.md, `sampled`):
         ``"command"`` holds u = k(δ_k − θ_k); ``"reference"`` holds δ_k and the
         steering servo closes k(δ − θ) continuously.
     compute_delay : {0, 1}
@@ -235,7 +299,12 @@ class Wall:
         """Build from α in degrees, with the range stated in degrees on error."""
         alpha_deg = check_parameter("alpha_deg", alpha_deg)
         r = RANGES["alpha"]
-        return cls(min(max(math.radians(alpha_deg), r.low), r.high))  # round-off at the ends
+        return cls(min(max(to_radians(alpha_deg), r.low), r.high))  # round-off at the ends
+
+    @property
+    def alpha_deg(self) -> float:
+        """α in degrees (`to_degrees`), for output."""
+        return to_degrees(self.alpha)
 
 
 @dataclass(frozen=True)

@@ -3,9 +3,10 @@
 `build_report` runs the criteria of `pfm_stability.criteria` for the chosen
 models and adds what a user acts on: the margin, the critical value of every
 parameter, the change that would make the loop stable, and how far KB's
-criterion (Koren & Borenstein 1991 eq 20) is from the sampled loop. The text
-and Markdown renderings live in `pfm_stability.render`; `StabilityReport.to_dict`
-is the JSON form (infinite values become ``null``: "no finite critical value").
+criterion (Koren & Borenstein 1991 eq 20) is from the sampled loop
+(docs/models.md). The text and Markdown renderings live in
+`pfm_stability.cli.render`; `StabilityReport.to_dict` is the JSON form
+(infinite values become ``"inf"``: "no finite critical value").
 """
 
 from __future__ import annotations
@@ -13,28 +14,20 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
-from .criteria import CorridorAnalysis, WallAnalysis, analyze_corridor, analyze_wall, loop_of
-from .models import MODEL_NAMES, KBFirstOrder, Sampled, models_for
-from .parameters import RANGES, Controller, Corridor, Robot, Wall
 from .checks import check_type
+from .comparison import relative_error
+from .criteria import CorridorAnalysis, WallAnalysis, analyze_corridor, analyze_wall, loop_of
+from .models import KBFirstOrder, Sampled, models_for
+from .parameters import MODEL_NAMES, RANGES, Controller, Corridor, Robot, Wall
 from .serialize import SCHEMA_VERSION, json_number
 
 __all__ = ["StabilityReport", "KBError", "build_report", "remedies", "kb_error"]
 
-UNITS = {
-    "V": "m/s",
-    "tau": "s",
-    "T": "s",
-    "k": "1/s",
-    "f": "",
-    "n": "",
-    "W": "m",
-    "hold": "",
-    "compute_delay": "samples",
-    "alpha_deg": "deg",
-    "L": "m",
-    "pade_order": "",
-}
+INPUTS = ("V", "tau", "T", "k", "f", "n", "W", "hold", "compute_delay", "pade_order", "alpha_deg", "L")
+"""The report's inputs, in the order it lists them (``alpha_deg`` and ``L`` when given)."""
+
+UNITS = {name: RANGES[name].unit if name in RANGES else "" for name in INPUTS}
+"""Unit of each input (`parameters.RANGES`; ``hold`` has none)."""
 
 REMEDY_PARAMETERS = ("V", "T", "k", "alpha_deg", "L", "f")
 """Parameters a remedy may change (one at a time), in the order they are listed."""
@@ -122,7 +115,7 @@ class StabilityReport:
         out = {"schema_version": SCHEMA_VERSION, "command": "report", "inputs": self.inputs, "models": self.model_options}
         if self.wall is not None:
             out.setdefault("environment", {})["wall"] = {
-                "alpha_deg": math.degrees(self.wall.alpha),
+                "alpha_deg": self.wall.alpha_deg,
                 "d0": json_number(self.wall.d0),
                 "N": self.wall.N,
                 "NV": self.wall.NV,
@@ -176,11 +169,11 @@ def remedies(scenario: str, verdict, robot: Robot, controller: Controller) -> di
         return {}
     c = verdict.critical
     current = {"V": robot.V, "f": controller.f, "T": controller.T, "k": robot.k}
-    wanted = [("V", "lower", c["V_critical"]), ("T", "lower", c["T_critical"]), ("k", "lower", c["k_critical"])]
+    wanted = [("V", "lower", c.V_critical), ("T", "lower", c.T_critical), ("k", "lower", c.k_critical)]
     if scenario == "wall":
-        wanted += [("alpha_deg", "raise", c["alpha_critical_deg"]), ("f", "raise", c["f_critical"])]
+        wanted += [("alpha_deg", "raise", c.alpha_critical_deg), ("f", "raise", c.f_critical)]
     else:
-        wanted += [("L", "raise", c["L_critical"]), ("f", "lower", c["f_critical"])]
+        wanted += [("L", "raise", c.L_critical), ("f", "lower", c.f_critical)]
     out = {}
     for name, direction, target in wanted:
         if not math.isfinite(target) or target <= 0 or (name == "alpha_deg" and target >= 90):
@@ -200,13 +193,7 @@ def kb_error(robot: Robot, controller: Controller) -> KBError:
     loop = loop_of(robot, controller)
     kb = KBFirstOrder().boundary(loop).NV_critical
     sampled = Sampled(controller.hold, controller.compute_delay).boundary(loop).NV_critical
-    if sampled == 0:
-        relative = math.inf
-    elif math.isinf(sampled) and math.isinf(kb):
-        relative = math.nan
-    else:
-        relative = kb / sampled - 1.0
-    return KBError(relative, kb, sampled, controller.hold, controller.compute_delay)
+    return KBError(relative_error(kb, sampled), kb, sampled, controller.hold, controller.compute_delay)
 
 
 def build_report(
@@ -229,11 +216,11 @@ def build_report(
     alpha : float, optional
         Wall target angle, rad, in [1e-6°, 90° − 1e-6°].
     alpha_deg : float, optional
-        The same in degrees (what the CLI passes; checked in degrees).
+        The same in degrees (checked in degrees; `Wall.from_degrees`).
     L : float, optional
         Corridor half-width, m, > W/2.
     models : sequence of str
-        Model names (DESIGN §4); all by default.
+        Model names (`parameters.MODEL_NAMES`, docs/models.md); all by default.
     pade_order : int
         Order m of the ``pade`` model.
     sources : dict, optional
@@ -277,18 +264,11 @@ def build_report(
         "pade_order": pade_order,
     }
     if wall is not None:
-        values["alpha_deg"] = math.degrees(wall.alpha)
+        values["alpha_deg"] = wall.alpha_deg
     if corridor is not None:
         values["L"] = corridor.L
     inputs = {name: {"value": value, "unit": UNITS[name], "source": sources.get(name, "user")} for name, value in values.items()}
-    options = {}
-    for m in model_objs:
-        entry = {"equation": m.equation}
-        if m.name == "pade":
-            entry["order"] = m.order
-        if m.name == "sampled":
-            entry.update(hold=m.hold, compute_delay=m.compute_delay)
-        options[m.name] = entry
+    options = {m.name: {"equation": m.equation, **m.options()} for m in model_objs}
     wall_result = analyze_wall(robot, controller, wall, model_objs, law) if wall else None
     corridor_result = analyze_corridor(robot, controller, corridor, model_objs, law) if corridor else None
     fixes = {}

@@ -12,15 +12,19 @@ Every `to_dict` in the package writes numbers with `json_number`:
 `parse_json_number` reads them back; `json_ready` applies `json_number` to
 every number of a nested structure (dicts, lists, tuples, numpy scalars and
 arrays), for `to_dict` methods that pass on dicts built elsewhere.
+
+`dumps` is how every command writes its JSON: strict JSON (``allow_nan=False``),
+indented by 2, with `json_default` for the numpy scalars a `to_dict` may leave.
 """
 
 from __future__ import annotations
 
+import json
 import math
 
 import numpy as np
 
-__all__ = ["json_number", "json_array", "json_ready", "parse_json_number", "SCHEMA_VERSION"]
+__all__ = ["json_number", "json_array", "json_ready", "json_default", "dumps", "parse_json_number", "SCHEMA_VERSION"]
 
 SCHEMA_VERSION = "1.0"
 """Version of the JSON output (`pfm_stability/schema/output.schema.json`)."""
@@ -82,3 +86,25 @@ def json_ready(value):
     if isinstance(value, np.ndarray):
         return json_array(value) if value.dtype.kind == "f" else json_ready(value.tolist())
     raise TypeError(f"cannot write {type(value).__name__} as JSON")
+
+
+def json_default(value):
+    """`json.dumps` ``default=``: numpy scalars as Python numbers (floats through `json_number`).
+
+    Raises
+    ------
+    TypeError
+        For any other object (as `json.dumps` does without a ``default``).
+    """
+    if isinstance(value, np.bool_):
+        return bool(value)
+    if isinstance(value, np.integer):
+        return int(value)
+    if isinstance(value, np.floating):
+        return json_number(value)
+    raise TypeError(f"cannot serialize {type(value).__name__}")
+
+
+def dumps(data) -> str:
+    """`data` as the commands print it: strict JSON, indent 2, numpy scalars by `json_default`."""
+    return json.dumps(data, indent=2, allow_nan=False, default=json_default)

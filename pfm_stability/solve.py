@@ -15,10 +15,12 @@ Vectorized code (many points at once) uses `scipy.optimize.elementwise`.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 
-__all__ = ["bisect_root", "expand_bracket", "newton_increasing", "first_crossing", "refine_sign_change"]
+__all__ = ["Bracket", "bisect_batched", "bisect_root", "expand_bracket", "first_crossing", "gauss_legendre", "invert_decreasing", "newton_increasing", "refine_sign_change", "spread_values"]
 
 
 def bisect_root(func, lo: float, hi: float, rtol: float = 1e-13) -> float:
@@ -190,21 +192,186 @@ def first_crossing(measure, lo: float, hi: float, *, start: float = 0.0, points_
 def refine_sign_change(measure, lo: float, hi: float, *, members: int = 16, rtol: float = 1e-7, atol: float = 0.0) -> float:
     """The first x in (lo, hi] where measure(x) >= 0, given measure(lo) < 0 <= measure(hi).
 
-    Batched bisection: each round evaluates `members` evenly spaced points
-    of the bracket in one call and keeps the cell before the first point with
-    measure >= 0, so one round divides the bracket by members + 1. Returns the
-    upper end of the final bracket (hi − lo <= max(rtol·hi, atol)).
+    `bisect_batched` on the label measure >= 0; returns the upper end of the
+    final bracket (hi − lo <= max(rtol·hi, atol)).
     """
-    while hi - lo > max(rtol * abs(hi), atol):
-        points = np.linspace(lo, hi, members + 2)[1:-1]
-        values = np.asarray(measure(points), dtype=float)
-        above = np.flatnonzero(values >= 0)
-        if above.size:
-            i = int(above[0])
-            lo, hi = (float(points[i - 1]) if i else lo), float(points[i])
-        else:
-            lo = float(points[-1])
-    return hi
+    return bisect_batched(lambda x: np.asarray(measure(x), dtype=float) >= 0, lo, hi, members=members, rtol=rtol, atol=atol, ends=(False, True)).hi
+
+
+@dataclass(frozen=True)
+class Bracket:
+    """Where a batched bisection left the change of label.
+
+    Attributes
+    ----------
+    lo, hi : float
+        The final bracket: the labels at its ends differ.
+    low_label, high_label : object
+        The labels at lo and hi.
+    rounds : int
+        Rounds run (batches of evaluations).
+    evaluations : int
+        Values classified.
+    most_changes : int
+        The largest number of label changes seen inside one round's values
+        (> 1: the label is not monotone there; the change nearest lo was kept).
+    """
+
+    lo: float
+    hi: float
+    low_label: object
+    high_label: object
+    rounds: int
+    evaluations: int
+    most_changes: int
+
+
+def bisect_batched(
+    classify,
+    lo: float,
+    hi: float,
+    *,
+    members: int = 9,
+    rtol: float = 1e-7,
+    atol: float = 0.0,
+    quantum: float | None = None,
+    geometric: bool = False,
+    max_rounds: int = 60,
+    ends=None,
+    on_round=None,
+) -> Bracket:
+    """Narrow [lo, hi] around the value where a label changes, many values per round.
+
+    The one batched bisection of the package: every caller whose evaluations
+    are cheaper together than apart (a vectorized growth rate, a batch of
+    simulations) uses it. Each round classifies `members` values spread over
+    the bracket in one call and keeps the cell before the first value whose
+    label differs from the label at lo, so a round divides the bracket by
+    members − 1 (the ends are not classified again).
+
+    Parameters
+    ----------
+    classify : callable
+        ndarray of values → sequence of labels (bools, strings …), one per value.
+    lo, hi : float
+        The bracket; the labels at its ends must differ.
+    members : int
+        Values per round, >= 3 (ends included in the first round).
+    rtol, atol : float
+        Stop when hi − lo <= max(rtol·|hi|, atol).
+    quantum : float, optional
+        Only multiples of `quantum` are valid values (e.g. corridor widths on a
+        cell grid); stop when the bracket holds no further multiple.
+    geometric : bool
+        Spread values geometrically (lo > 0), for brackets over decades.
+    max_rounds : int
+        Stop after this many rounds.
+    ends : (label, label), optional
+        The labels at lo and hi when already known (not classified again).
+    on_round : callable, optional
+        ``on_round(bracket)`` after each round (progress).
+
+    Raises
+    ------
+    ValueError
+        If the labels at the two ends are the same.
+    """
+    members = max(3, int(members))
+    evaluations = rounds = most = 0
+    if ends is None:
+        values = spread_values(lo, hi, members, quantum, geometric)
+        labels = list(classify(values))
+        evaluations, rounds = len(values), 1
+        lo_label, hi_label = labels[0], labels[-1]
+        lo, hi = float(values[0]), float(values[-1])
+        if lo_label == hi_label:
+            raise ValueError(f"the label is {lo_label!r} at both ends of [{lo:g}, {hi:g}]; no change to bisect")
+        lo, hi, most = _first_change(values, labels, lo_label, lo, hi)
+    else:
+        lo_label, hi_label = ends
+    bracket = Bracket(lo, hi, lo_label, hi_label, rounds, evaluations, most)
+    while rounds < max_rounds and hi - lo > max(rtol * abs(hi), atol):
+        inner = spread_values(lo, hi, members, quantum, geometric)[1:-1]
+        if inner.size == 0:
+            break
+        labels = list(classify(inner))
+        evaluations += len(inner)
+        rounds += 1
+        lo, hi, changes = _first_change(np.concatenate([[lo], inner, [hi]]), [lo_label] + labels + [hi_label], lo_label, lo, hi)
+        most = max(most, changes)
+        bracket = Bracket(lo, hi, lo_label, hi_label, rounds, evaluations, most)
+        if on_round is not None:
+            on_round(bracket)
+    return bracket
+
+
+def spread_values(lo, hi, members, quantum, geometric):
+    """`members` values over [lo, hi] (ends included): evenly, geometrically, or on multiples of `quantum`."""
+    if quantum is not None:
+        k0, k1 = math.ceil(lo / quantum - 1e-9), math.floor(hi / quantum + 1e-9)
+        k = np.unique(np.round(np.linspace(k0, k1, members))) if k1 >= k0 else np.array([])
+        return k * quantum
+    return np.geomspace(lo, hi, members) if geometric else np.linspace(lo, hi, members)
+
+
+def _first_change(values, labels, lo_label, lo, hi):
+    """(lo, hi) of the cell before the first label that differs from lo_label, and how many changes the sequence has."""
+    changes = sum(a != b for a, b in zip(labels[:-1], labels[1:]))
+    first = next((i for i, label in enumerate(labels) if label != lo_label), None)
+    if first is None or first == 0:
+        return lo, hi, changes
+    return float(values[first - 1]), float(values[first]), changes
+
+
+def invert_decreasing(g, targets, lo: float, hi: float, iterations: int = 200):
+    """x in [lo, hi] with g(x) = target for many targets at once, g vectorized and decreasing in x > 0.
+
+    Elementwise bisection on log x (to round-off): each target has its own
+    bracket, all narrowed together (`bisect_batched` narrows one bracket with
+    many evaluations per round instead). Used for boundary curves in the
+    equilibrium distance (`pfm_stability.curves`).
+
+    Parameters
+    ----------
+    g : callable
+        ndarray → ndarray, decreasing.
+    targets : array_like
+        Values of g to reach.
+    lo, hi : float
+        Initial bracket, 0 < lo < hi; hi is doubled (up to 100 times) until g(hi) <= min(targets).
+    iterations : int
+        Bisection steps at most.
+
+    Returns
+    -------
+    ndarray
+        Shaped like `targets`: ``nan`` for targets above g(lo), ``inf`` for targets below g(hi).
+    """
+    targets = np.asarray(targets, dtype=float)
+    for _ in range(100):
+        if g(np.array([hi]))[0] <= np.min(targets):
+            break
+        hi *= 2.0
+    a = np.full(targets.shape, math.log(lo))
+    b = np.full(targets.shape, math.log(hi))
+    for _ in range(iterations):
+        m = 0.5 * (a + b)
+        above = g(np.exp(m)) > targets
+        a = np.where(above, m, a)
+        b = np.where(above, b, m)
+        if np.all(b - a <= 4e-16 * np.maximum(1.0, np.abs(a))):
+            break
+    x = np.exp(0.5 * (a + b))
+    x = np.where(targets > g(np.array([lo]))[0], np.nan, x)
+    return np.where(targets < g(np.array([hi]))[0], np.inf, x)
+
+
+@lru_cache(maxsize=32)
+def gauss_legendre(points: int):
+    """Gauss–Legendre nodes and weights on [−1, 1], cached and read-only (numpy solves an eigenproblem each time)."""
+    x, w = np.polynomial.legendre.leggauss(points)
+    x.flags.writeable = w.flags.writeable = False
+    return x, w
 
 
 def _golden_maxima(measure, a, b, iterations: int = 16):

@@ -22,7 +22,6 @@ Chunks of the arrays are processed on all cores (numpy releases the GIL).
 
 from __future__ import annotations
 
-import math
 import os
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
@@ -30,12 +29,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from .delay import delay_verdicts_from_gain
+from .force_law import power_law_corridor_gain, power_law_wall_gain
 from .parameters import RANGES, TAU_RESOLUTION, check_parameter
 
 __all__ = ["VectorVerdicts", "exact_delay_verdicts", "loop_gain_arrays", "delay_verdicts_from_gain"]
 
 _CHUNK = 32768
-_TWO_PI = 2.0 * math.pi
 
 
 @dataclass(frozen=True)
@@ -107,7 +106,7 @@ def loop_gain_arrays(V, tau, T, k, f, n, W, *, alpha=None, L=None):
     V, tau, T, k, f, n, W = (_check(name, x) for name, x in zip(("V", "tau", "T", "k", "f", "n", "W"), (V, tau, T, k, f, n, W)))
     if alpha is not None:
         alpha = _check("alpha", alpha)
-        N = (n / W) * f ** (-1.0 / n) * np.cos(alpha) ** ((n + 1.0) / n) / np.sin(alpha)
+        N = power_law_wall_gain(f, n, W, alpha)
     else:
         L = _check("L", L)
         L_all, W_all = (a.ravel() for a in np.broadcast_arrays(L, W))
@@ -116,7 +115,7 @@ def loop_gain_arrays(V, tau, T, k, f, n, W, *, alpha=None, L=None):
             i = int(narrow[0])
             high = RANGES["L"].high
             raise ValueError(f"L must be a finite number in (W/2, {high:g}] m = ({W_all[i] / 2:g}, {high:g}] m; got {float(L_all[i])!r} (point {i})")
-        N = 2.0 * n * f * W**n / L ** (n + 1.0)
+        N = power_law_corridor_gain(f, n, W, L)
     tau, T, k, NV = np.broadcast_arrays(tau, T, k, N * V)
     tau = np.where(tau * k < TAU_RESOLUTION, 0.0, tau)  # an ideal motor, as `models.Loop` takes it
     return tau, T, k, NV

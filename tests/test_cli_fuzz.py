@@ -39,6 +39,7 @@ from jsonschema import Draft202012Validator
 
 from pfm_stability.cli import build_parser, main
 from pfm_stability.cli.options import describe
+from pfm_stability.cli.traps import SHIPPED_SCENES
 from pfm_stability.parameters import RANGES, SHOWN_AS
 from pfm_stability.schema import load_schema
 
@@ -49,7 +50,9 @@ SUBPARSERS = next(a for a in PARSER._actions if isinstance(a, argparse._SubParse
 VALIDATOR = Draft202012Validator(load_schema())
 PNG = b"\x89PNG\r\n\x1a\n"
 
-SHARE = {"report": 2.0, "simulate": 1.0, "validate": 0.6, "plot": 0.2, "derive": 0.06}
+POSITIONAL_VALUES = {"traps": SHIPPED_SCENES}
+"""Valid values of positionals that are not choices (a scene file or a shipped scene's name)."""
+SHARE = {"report": 2.0, "simulate": 1.0, "validate": 0.6, "plot": 0.2, "derive": 0.06, "traps": 0.15}
 """Examples per subcommand, as a fraction of the profile's ``max_examples`` (at least 4)."""
 
 CHEAP = {
@@ -156,7 +159,8 @@ def command_lines(draw, command, outdir):
     options, positionals = _options(command)
     groups, inside = [], set()  # one group per positional or option with its value
     for action in positionals:
-        groups.append([draw(_mostly(st.sampled_from(sorted(action.choices)), st.text(max_size=5)))])
+        valid = sorted(action.choices) if action.choices else list(POSITIONAL_VALUES[command])
+        groups.append([draw(_mostly(st.sampled_from(valid), st.text(max_size=5)))])
     required = [name for name, a in options.items() if a.required]
     optional = sorted(name for name, a in options.items() if not a.required)
     chosen = [name for name in required if draw(st.integers(0, 9)) != 9]  # now and then a required option is missing
@@ -266,6 +270,7 @@ test_fuzz_simulate = _fuzz_test("simulate")
 test_fuzz_validate = _fuzz_test("validate")
 test_fuzz_plot = _fuzz_test("plot")
 test_fuzz_derive = _fuzz_test("derive")
+test_fuzz_traps = _fuzz_test("traps")
 
 
 # ------------------------------------------------------- every range, every option

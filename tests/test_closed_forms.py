@@ -1,4 +1,4 @@
-"""Every closed form used numerically agrees with the symbolic derivation (DESIGN §1).
+"""Every closed form used numerically agrees with the symbolic derivation (docs/theory.md).
 
 `pfm_stability.derivation` derives KB's eq (5)–(25) with sympy; here each
 numeric shortcut (the models' NV* and ω*, `force_law`, `criteria`) is checked
@@ -213,7 +213,7 @@ def _shifted(p):
 
 def test_general_law_wall_and_corridor_gains():
     """Numeric equilibrium (bisection) and gains for a non-power law = the general derivation
-    (DESIGN §3: F_r(d0) = F_a cos α, N = −F_r′(d0)/(F_a sin α), corridor N = −2F_r′(L)/F_a)."""
+    (docs/theory.md, "Any force law": F_r(d0) = F_a cos α, N = −F_r′(d0)/(F_a sin α), corridor N = −2F_r′(L)/F_a)."""
     d0 = numeric(D.wall_equilibrium(SHIFTED), (alpha, c_, m_, W, a_))
     N_eq = numeric(D.wall_equilibrium_gain(SHIFTED), (alpha, c_, m_, W, a_))
     N_c = numeric(D.corridor_gain(SHIFTED), (L, c_, m_, W, a_))

@@ -84,7 +84,7 @@ def test_corridor_critical_values_are_on_the_boundary():
 
 
 def test_general_force_law_reproduces_power_law_closed_forms():
-    """General force law (DESIGN §3): the numerical solution with a law that
+    """General force law (docs/theory.md, "Any force law"): the numerical solution with a law that
     hides its closed form gives KB's closed forms (1e-9 relative: bisection
     stops at 1e-13–1e-14 relative in the solved variable)."""
     r, c = CARMEL.robot, CARMEL.controller

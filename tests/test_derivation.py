@@ -1,7 +1,7 @@
 """The symbolic derivation reproduces Koren & Borenstein 1991 (KB), eq (5)–(25).
 
 Every derived result is compared *exactly* with the paper's printed formula —
-corrected where DESIGN §3 says it is misprinted — by ``simplify(a − b) == 0``
+corrected where docs/theory.md says it is misprinted — by ``simplify(a − b) == 0``
 (or `simplify_physical`, the same on 0 < α < π/2, where powers of sin α,
 cos α must combine: sympy cannot be told α < π/2). The only floating-point
 comparisons are the Padé coefficients against the numeric implementations,
@@ -107,7 +107,7 @@ def test_rate_eq10():
 
 
 def test_general_law_gains():
-    """DESIGN §3 general law: N = −F_r′(d)cos²δ/(F_a sin α); the power law substituted gives (11)."""
+    """docs/theory.md, "Any force law": N = −F_r′(d)cos²δ/(F_a sin α); the power law substituted gives (11)."""
     general = D.linearization_gains("general").N
     assert same(general, -sp.Derivative(F_r(d), d) * sp.cos(delta) ** 2 / (F_a * sp.sin(alpha)))
     powered = general.subs(F_r, D.force_law("power")).doit()
@@ -121,7 +121,7 @@ def test_kinematics_eq14():
 
 # ------------------------------------------------------------------ (15)–(16)
 def test_ode_eq15_corrected():
-    """KB (15), corrected (DESIGN §3.4): τθ⃛ + θ̈ + kθ̇ + kNV sin θ = kMα̇.
+    """KB (15), corrected (docs/theory.md, misprints): τθ⃛ + θ̈ + kθ̇ + kNV sin θ = kMα̇.
 
     KB print τθ̈ + θ̇ + kθ + … (second order); differentiating (7) gives the
     third-order form, whose characteristic equation is (17).
@@ -215,7 +215,7 @@ def test_routh_eq20():
     """KB (20): Routh on (19) gives 1 − NV(τ + T) > 0, NV* = 1/(τ + T), ω* = √(k/(τ + T)).
 
     The s¹ entry of the first column is k(1 − NV(τ + T)): k cancels from the
-    condition only in this first-order approximation (DESIGN §3.6).
+    condition only in this first-order approximation (docs/models.md: exact only as k → 0).
     """
     crit = D.routh_criterion("kb_first_order")
     assert isinstance(crit.condition, sp.StrictGreaterThan)
@@ -274,7 +274,7 @@ def test_wall_gain_at_equilibrium():
 
 
 def test_wall_general_law():
-    """DESIGN §3: N = −F_r′(d0)/(F_a sin α); with the power law the general (20) is (21)."""
+    """docs/theory.md, "Any force law": N = −F_r′(d0)/(F_a sin α); with the power law the general (20) is (21)."""
     assert same(D.wall_gain("general"), -sp.Derivative(F_r(d), d) / (F_a * sp.sin(alpha)))
     general = D.wall_condition("general").lhs.subs(F_r, D.force_law("power")).doit()
     # 1 − N V (τ+T) = 1 − rhs(21)/d^(n+1): the same condition, since d^(n+1) > 0

@@ -1,4 +1,4 @@
-"""House style (DESIGN §7): every module has a docstring and every public
+"""House style (docs/architecture.md): every module has a docstring and every public
 function, class and method of the package documents itself (numpydoc)."""
 
 import importlib

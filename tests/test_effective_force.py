@@ -1,4 +1,4 @@
-"""The grid's effective force law (issue 5 item 1; DESIGN §5; KB eq 1–2, 8, §4 f_av)."""
+"""The grid's effective force law (docs/simulator.md, grid quantization; KB eq 1–2, 8, §4 f_av)."""
 
 import math
 
@@ -12,12 +12,12 @@ from pfm_stability.effective_force import (
     check_window_cells,
     corridor_lateral_force,
     f_average,
-    measured_wall_force,
     working_range,
 )
 from pfm_stability.force_law import PowerLaw, corridor_gain
 from pfm_stability.models import Loop, Sampled
 from pfm_stability.parameters import CARMEL, Corridor, Wall
+from pfm_stability.sim.vff import measured_wall_force
 
 RHO = calibrate_cell_ratio(0.8, 2.0, 0.8)
 
@@ -46,11 +46,11 @@ def test_slope_matches_central_difference(n):
 
 
 def test_n2_form_and_one_over_d_behaviour():
-    """n = 2: F = ρCW²(2/c)·Y/(d√(d²+Y²)) — ∝ 1/d for d ≪ Y (DESIGN §5: 'pushes ∝ ~1/d').
+    """n = 2: F = ρCW²(2/c)·Y/(d√(d²+Y²)) — ∝ 1/d for d ≪ Y (docs/simulator.md: 'pushes ∝ ~1/d').
 
     The local exponent is 1 + d²/(d² + Y²) (exact identity, 1e-12): 1.07 at
-    contact (0.45 m), 1.19 at 0.8 m, 1.5 at the reach where d = Y — DESIGN
-    quotes ≈ 1–1.4 for the distances a robot usually keeps.
+    contact (0.45 m), 1.19 at 0.8 m, 1.5 at the reach where d = Y — the
+    design quoted ≈ 1–1.4 for the distances a robot usually keeps.
     """
     law = GridWallLaw(RHO, 2.0, 0.8)
     Y = law.half_length
@@ -65,7 +65,7 @@ def test_n2_form_and_one_over_d_behaviour():
 
 
 def test_uncalibrated_grid_pushes_about_ten_times_harder():
-    """DESIGN §5: with each cell as strong as KB's lumped constant (ρ·C = f) the grid pushes ~10× harder.
+    """docs/simulator.md: with each cell as strong as KB's lumped constant (ρ·C = f) the grid pushes ~10× harder.
 
     Over the working range the ratio to f(W/d)² is 2·Y·d/(c√(d²+Y²)): 8.5 at
     0.45 m to 23 at 1.65 m for CARMEL (exact values; bounds 5–30 leave room
@@ -120,7 +120,7 @@ def test_equivalent_f_brackets_f_av():
 
 
 def test_corridor_force_and_gain():
-    """Corridor: F_x(x) = F(L+x) − F(L−x) is odd in x and its slope at 0 is −N = 2F′(L) (DESIGN §3)."""
+    """Corridor: F_x(x) = F(L+x) − F(L−x) is odd in x and its slope at 0 is −N = 2F′(L) (docs/theory.md)."""
     law = GridWallLaw(RHO, 2.0, 0.8)
     L = 0.8
     x = np.array([0.01, 0.05, 0.2])

@@ -37,7 +37,7 @@ def _cx_roots(tau, T, k, K, box):
 
 @pytest.mark.parametrize("tau, T, k, K", ORACLE_SETS)
 def test_rightmost_root_and_verdict_against_cxroots(tau, T, k, K):
-    """Issue 3: rightmost root to 1e-6 and verdict agreement on 50 random sets.
+    """Rightmost root to 1e-6 and verdict agreement on 50 random sets.
 
     cxroots searches a rectangle around our rightmost root that also contains
     the whole right half-plane disc |s| < R (so a missed unstable root would
@@ -71,7 +71,7 @@ def test_rightmost_root_against_qpmr(tau, T, k, K):
 
 
 def test_carmel_boundary_above_kb_and_growing_with_k():
-    """Issue 3 must-hold: for τ = 0.3 s, T = 0.065 s the exact NV* lies above KB's
+    """Must hold (docs/models.md: KB is exact only as k → 0): for τ = 0.3 s, T = 0.065 s the exact NV* lies above KB's
     1/(τ+T) and grows with k (KB eq 20 claims no k-dependence)."""
     values = [ExactDelay().boundary(Loop(0.3, 0.065, k)).NV_critical for k in (0.5, 1.0, 2.0, 4.0, 8.0)]
     assert all(v > 1 / 0.365 for v in values)

@@ -77,7 +77,7 @@ def without_timing(data) -> dict:
 def test_schema_is_a_valid_draft_2020_12_schema_of_this_version():
     Draft202012Validator.check_schema(SCHEMA)
     assert SCHEMA["properties"]["schema_version"]["const"] == SCHEMA_VERSION
-    assert SCHEMA["properties"]["command"]["enum"] == ["report", "simulate", "validate"]
+    assert SCHEMA["properties"]["command"]["enum"] == ["report", "simulate", "validate", "traps"]
 
 
 def test_schema_ships_as_package_data():
@@ -161,7 +161,7 @@ def test_simulate_output_is_identical_across_processes():
 
 # ---------------------------------------------------- infinite vs undefined in the to_dict methods
 def test_model_prediction_infinite_and_undefined():
-    from pfm_stability.sim.predict import ModelPrediction, Prediction
+    from pfm_stability.validation.predict import ModelPrediction, Prediction
 
     p = ModelPrediction("sampled", "power law", 1.0, math.inf, "stable", -0.5, math.nan, -math.inf)
     d = p.to_dict()

@@ -38,12 +38,13 @@ from pfm_stability.plots.regions import (  # noqa: E402
     plot_corridor_L_critical,
     plot_corridor_region,
     plot_corridor_regions,
-    plot_simulated_boundary,
     plot_wall_alpha_critical,
     plot_wall_f_region,
     plot_wall_regions,
 )
-from pfm_stability.regions import SimulatedBoundary, kb_error_map, kb_relative_error  # noqa: E402
+from pfm_stability.comparison import kb_error_map, kb_relative_error  # noqa: E402
+from pfm_stability.plots.validation import plot_simulated_boundary  # noqa: E402
+from pfm_stability.validation import SimulatedBoundary  # noqa: E402
 
 ROBOT, CONTROLLER = CARMEL.robot, CARMEL.controller
 RES = 40

@@ -1,4 +1,4 @@
-"""Stability regions and boundary curves (`pfm_stability.regions`).
+"""Stability regions and boundary curves (`pfm_stability.regions`, `pfm_stability.curves`).
 
 Every curve is checked by routes that do not share its algebra:
 
@@ -30,21 +30,10 @@ from pfm_stability.effective_force import GridWallLaw, calibrate_cell_ratio
 from pfm_stability.force_law import ForceLaw, PowerLaw, corridor_gain, wall_gain
 from pfm_stability.models import ExactDelay, KBFirstOrder, Loop, Sampled, make_models
 from pfm_stability.parameters import CARMEL
-from pfm_stability.regions import (
-    SAMPLED_STRUCTURES,
-    critical_gain_vs_delay,
-    corridor_L_curves,
-    corridor_region,
-    corridor_V_curves,
-    default_models,
-    kb_error_map,
-    kb_relative_error,
-    simulated_boundary,
-    wall_alpha_curves,
-    wall_alpha_region,
-    wall_f_curves,
-    wall_f_region,
-)
+from pfm_stability.comparison import critical_gain_vs_delay, kb_error_map, kb_relative_error
+from pfm_stability.parameters import SAMPLED_STRUCTURES
+from pfm_stability.curves import corridor_L_curves, corridor_V_curves, default_models, wall_alpha_curves, wall_f_curves
+from pfm_stability.regions import corridor_region, wall_alpha_region, wall_f_region
 
 ROBOT, CONTROLLER = CARMEL.robot, CARMEL.controller
 LOOP = Loop(ROBOT.tau, CONTROLLER.T, ROBOT.k)
@@ -305,6 +294,8 @@ def test_bad_inputs_raise_value_error(call):
 def test_simulated_boundary_on_the_sampled_curve():
     """Analytic corridor (KB's law), bisection on V at L = 0.8, 1.0 m: within 2e-3 of V*(L) of `sampled`
     (the bracket is rtol = 1e-3 wide; the analytic simulator matches the sampled model to ~1e-4, test_sim_validation)."""
+    from pfm_stability.validation import simulated_boundary
+
     sim = simulated_boundary("corridor", "V", 0.2, 2.0, over="L", values=[0.8, 1.0], env="analytic", rtol=1e-3, offset=1e-6, duration=20.0)
     (pred,) = corridor_V_curves(ROBOT, CONTROLLER, sim.values, [Sampled("command", 1)])
     np.testing.assert_allclose(sim.critical, pred.y, rtol=2e-3)

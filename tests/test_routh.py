@@ -1,7 +1,7 @@
 """Routh–Hurwitz and Schur–Cohn tests (module `pfm_stability.routh`).
 
 The Routh count is checked against `numpy.roots` on random polynomials
-(issue: degree 1–8, skip roots within 1e-9 of the axis) and on the textbook
+(degree 1–8, skip roots within 1e-9 of the axis) and on the textbook
 special cases; KB eq (19) → (20) is checked symbolically.
 """
 

@@ -1,4 +1,4 @@
-"""`sampled` model (DESIGN §4) against python-control, a bracketing root finder
+"""`sampled` model (docs/models.md) against python-control, a bracketing root finder
 on the spectral radius, and a direct simulation of the continuous plant."""
 
 import math
@@ -37,7 +37,7 @@ def _spectral_radius(model, NV, loop):
 @pytest.mark.parametrize("hold, delay", STRUCTURES)
 @pytest.mark.parametrize("tau, T, k, K", random_loops(6, seed=31, T=(0.01, 0.3), k=(0.3, 6.0)))
 def test_critical_gain_equals_bracketing_on_spectral_radius(hold, delay, tau, T, k, K):
-    """Issue 3: NV* from the unit-circle crossings = brentq on ρ(Φ_cl(NV)) − 1 (1e-9)."""
+    """NV* from the unit-circle crossings = brentq on ρ(Φ_cl(NV)) − 1 (1e-9)."""
     model = Sampled(hold, delay)
     loop = Loop(tau, T, k)
     star = model.boundary(loop).NV_critical

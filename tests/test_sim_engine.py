@@ -47,7 +47,7 @@ def test_batch_engine_equals_per_robot_loop():
 
 
 def test_straight_run_reaches_the_target():
-    """No obstacles, target 17° off the initial heading: the robot turns and reaches it (issue 4 'must hold')."""
+    """No obstacles, target 17° off the initial heading: the robot turns and reaches it (docs/simulator.md)."""
     run = simulate("straight")
     assert [e.type for e in run.events] == ["target_reached"]
     t = run.scenario.target
@@ -88,7 +88,7 @@ def test_heterogeneous_batch_equals_separate_runs():
 
 
 def test_results_serialize_without_nan():
-    """Every run's JSON has the issue's keys and no NaN (DESIGN §5: never a silent NaN)."""
+    """Every run's JSON has the documented keys and no NaN (docs/simulator.md: never a silent NaN)."""
     batch = simulate_batch("corridor", env="grid", L=[0.6, 1.0], offset=0.05, duration=12.0)
     for run in batch.runs:
         d = json.loads(json.dumps(run.to_dict(), allow_nan=False))

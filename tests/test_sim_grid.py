@@ -1,4 +1,4 @@
-"""Histogram grid, drawing helpers and the active-window tables (KB §2, DESIGN §5)."""
+"""Histogram grid, drawing helpers and the active-window tables (KB §2; docs/simulator.md)."""
 
 import math
 
@@ -25,7 +25,7 @@ def test_centred_grid_puts_cell_centres_on_multiples_of_c():
 
 
 def test_drawing_helpers():
-    """Walls of any orientation, filled rectangles, gaps, protrusions (issue 4 item 1)."""
+    """Walls of any orientation, filled rectangles, gaps, protrusions (docs/simulator.md)."""
     g = HistogramGrid.centred(-2, 2, -2, 2)
     g.draw_segment((0.0, -1.0), (0.0, 1.0))
     assert np.count_nonzero(g.cv) == 21  # 2 m of cells on centres, both ends included

@@ -1,4 +1,4 @@
-"""Oscillation metrics (DESIGN §6) on signals whose σ and ω are known exactly."""
+"""Oscillation metrics (docs/simulator.md, measuring oscillation) on signals whose σ and ω are known exactly."""
 
 import json
 import math

@@ -1,4 +1,4 @@
-"""KB's figures as presets (issue 4 item 8, 'must hold'), and invalid scenario parameters."""
+"""KB's figures as presets (docs/simulator.md, scenarios), and invalid scenario parameters."""
 
 import math
 
@@ -6,7 +6,8 @@ import pytest
 
 from pfm_stability.effective_force import GridWallLaw, calibrate_cell_ratio, f_average
 from pfm_stability.parameters import CARMEL
-from pfm_stability.sim import SCENARIO_NAMES, make_scenario, predict, simulate
+from pfm_stability.sim import SCENARIO_NAMES, make_scenario, simulate
+from pfm_stability.validation import predict
 
 
 def test_fig6_narrow_oscillates_and_wide_settles():
@@ -55,7 +56,7 @@ def test_fig3_calibration_barely_avoids_and_f_av_calibration_collides():
 
 
 def test_presets_document_their_choices():
-    """Every preset records its geometry and how F_cr/F_ct was set (issue 5: presets quoting f = 0.8)."""
+    """Every preset records its geometry and how F_cr/F_ct was set (presets quoting f = 0.8; docs/simulator.md)."""
     for name in SCENARIO_NAMES:
         s = make_scenario(name)
         assert "geometry" in s.notes and "cell_ratio" in s.notes

@@ -1,13 +1,13 @@
-"""Simulated oscillation against the loop models (issue 5 item 3; DESIGN §4, §6).
+"""Simulated oscillation against the loop models (docs/validation.md; docs/models.md; docs/simulator.md).
 
-The simulator implements the `sampled` loop of DESIGN §4 exactly, so in the
+The simulator implements the `sampled` loop of docs/models.md exactly, so in the
 analytic environment (continuous walls, KB's lumped law) its stability
 boundary and its σ, ω near the boundary must equal the `sampled` model's
 (KB eq 24, 25 with the sampled NV*), for every hold and compute delay; in the
 histogram grid the same holds with the grid's effective law (`GridWallLaw`)
 up to quantization; and over random parameter sets the sign of the measured
 growth rate must agree with the `sampled` verdict. Tolerances are the
-issue's bars (1 %, 5 %, 5 %, 98 %); the measured values are far inside them
+validation's bars (1 %, 5 %, 5 %, 98 %; docs/validation.md); the measured values are far inside them
 (analytic ~1e-7, grid < 0.5 %, sweep 100 %: experiments/README.md) and each
 test says why.
 
@@ -74,7 +74,7 @@ def test_analytic_boundary_within_1pct_of_sampled(analytic_bracket):
     """KB eq 24/25 with the sampled NV*: every set and structure oscillates 1 % below L*/α* and settles 1 % above.
 
     That brackets the simulated boundary within ±1 % of the prediction (the
-    issue's bar); σ at the prediction itself is 0 to 1e-6 1/s, i.e. the
+    bar of docs/validation.md); σ at the prediction itself is 0 to 1e-6 1/s, i.e. the
     boundary is exact to ~1e-6 relative (σ comes from the linear-prediction
     fit, exact to ~1e-8 at a 1e-7 m offset: tests/test_sim_validation.py).
     """
@@ -96,7 +96,7 @@ def test_analytic_boundary_within_1pct_of_sampled(analytic_bracket):
 def test_analytic_growth_rate_and_frequency_equal_the_dominant_root(analytic_bracket):
     """σ, ω at and ±1 % around the boundary equal the sampled dominant pole (σ = ln|z|/T, ω = arg z/T).
 
-    Bar: ω within 5 % (issue); asserted to 1e-6 relative and σ to 1e-6 1/s,
+    Bar: ω within 5 % (docs/validation.md); asserted to 1e-6 relative and σ to 1e-6 1/s,
     the linear fit's accuracy at this offset (measured worst 1.5e-8).
     """
     kind, expected, batch = analytic_bracket
@@ -168,7 +168,7 @@ def test_grid_boundary_within_5pct_of_the_effective_law(grid_validation):
 
 
 def test_grid_frequency_near_the_boundary_within_5pct(grid_validation):
-    """ω at the boundary and 3 % either side within 5 % of the sampled dominant root's (issue bar).
+    """ω at the boundary and 3 % either side within 5 % of the sampled dominant root's (the bar of docs/validation.md).
 
     Measured < 0.5 %: the peaks estimator sees turning points at sample
     instants only (phase error ≲ ωT/2 per turning point, averaged over ~20).
@@ -183,7 +183,7 @@ def test_grid_frequency_near_the_boundary_within_5pct(grid_validation):
 
 
 def test_kb_lumped_law_misses_the_grid_boundary():
-    """KB's eq (25) with f_av = 0.8 puts CARMEL's grid corridor boundary at 0.84 m; the grid's is 0.69 m (DESIGN §5)."""
+    """KB's eq (25) with f_av = 0.8 puts CARMEL's grid corridor boundary at 0.84 m; the grid's is 0.69 m (docs/simulator.md)."""
     v = validate_boundary("corridor", env="grid")
     assert v.simulated_boundary == pytest.approx(0.691, abs=0.005)
     assert v.lumped_predicted_boundary["kb_first_order"] == pytest.approx(0.843, abs=0.002)
@@ -199,7 +199,7 @@ def sweep():
 
 
 def test_sweep_sign_of_growth_rate_agrees_with_sampled(sweep):
-    """200 Latin-hypercube sets (V, τ, T, k, f, L or α; both holds and compute delays): ≥ 98 % agree (issue bar).
+    """200 Latin-hypercube sets (V, τ, T, k, f, L or α; both holds and compute delays): ≥ 98 % agree (the bar of docs/validation.md).
 
     Sets within 3 % of the sampled boundary in NV are excluded (σ too small to
     tell from 0). Measured: 100 % of 199. Any disagreement is listed.
@@ -215,7 +215,7 @@ def test_sweep_sign_of_growth_rate_agrees_with_sampled(sweep):
 def test_sweep_states_how_often_kb_and_exact_delay_are_wrong(sweep, record_property, capsys):
     """The same sweep states the wrong-verdict rates of kb_first_order (KB eq 20) and exact_delay (eq 18).
 
-    A figure, not a pass/fail bar (issue): measured 7.5 % and 5.5 %, mostly
+    A figure, not a pass/fail bar (docs/validation.md): measured 7.5 % and 5.5 %, mostly
     "stable" for a robot that oscillates. Asserted only to be consistent counts.
     """
     for name in ("kb_first_order", "exact_delay"):
@@ -301,7 +301,7 @@ def test_bad_input_raises_one_line_value_error(call, message):
 
 
 def test_to_dict_has_the_issue_keys_and_is_json():
-    """JSON keys (issue 5 item 2): parameter, simulated_boundary (a number), predicted_boundary, relative_error, inputs."""
+    """JSON keys (docs/validation.md): parameter, simulated_boundary (a number), predicted_boundary, relative_error, inputs."""
     import json
 
     v = validate_boundary("wall", "V", env="analytic", rtol=1e-2, alpha=math.radians(50))

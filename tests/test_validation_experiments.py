@@ -1,4 +1,4 @@
-"""experiments/ (issue 5 item 4) still run: every script in quick mode, the README results table.
+"""experiments/ (docs/validation.md) still run: every script in quick mode, the README results table.
 
 The full runs (``python experiments/run_all.py``) regenerate the committed
 PNG/JSON under experiments/results; here each script runs reduced into a

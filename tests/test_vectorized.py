@@ -1,4 +1,4 @@
-"""Vectorized exact-delay verdicts (issue 3 item 6) against the scalar crossing count."""
+"""Vectorized exact-delay verdicts (docs/models.md, `exact_delay`) against the scalar crossing count."""
 
 import math
 

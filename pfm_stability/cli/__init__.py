@@ -1,10 +1,12 @@
 """The ``pfm-stability`` command line.
 
 Subcommands live in their own modules (``report``, ``derive``, ``simulate``,
-``validate``, ``plot``); each exposes ``add_parser(subparsers)`` and
-``run(args) -> int``. Module imports here are light (no numpy, scipy, sympy or
-matplotlib) so that start-up stays fast; the heavy libraries are imported by
-the subcommand that needs them.
+``validate``, ``plot``, ``traps``); each exposes ``add_parser(subparsers)`` and
+``run(args) -> int``; their text, Markdown and LaTeX renderings are in
+`render`, their JSON is written by `pfm_stability.serialize.dumps`. Module
+imports here are light (no numpy, scipy, sympy or matplotlib) so that
+start-up stays fast; the heavy libraries are imported by the subcommand that
+needs them.
 
 Every user error — a bad value, an unknown option, an impossible scenario —
 ends with exit status 2 and one line on stderr::
@@ -22,7 +24,7 @@ import sys
 
 __all__ = ["main", "build_parser", "UsageError"]
 
-SUBCOMMANDS = ("report", "derive", "simulate", "validate", "plot")
+SUBCOMMANDS = ("report", "derive", "simulate", "validate", "plot", "traps")
 
 
 class UsageError(Exception):
@@ -55,7 +57,7 @@ def build_parser() -> argparse.ArgumentParser:
         description="Will a potential-field (VFF) controller oscillate near walls and in corridors? "
         "Koren & Borenstein 1991 analysis with exact-delay and sampled-data models, and a simulator that checks it.",
     )
-    from .. import __version__
+    from ..version import __version__
 
     parser.add_argument("--version", action="version", version=f"pfm-stability {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)

@@ -34,11 +34,10 @@ def _draw(kind, params, pade_order):
         from ..plots.rlocus import plot_critical_gain_vs_k
 
         return plot_critical_gain_vs_k(robot.tau, controller.T, pade_order=pade_order)
-    from ..effective_force import GridWallLaw, calibrate_cell_ratio
     from ..plots.force import plot_force_summary
+    from ..sim.scenario import scenario_law
 
-    ratio = calibrate_cell_ratio(controller.f, controller.n, robot.W, params.preset.cell_size, params.preset.window_cells)
-    return plot_force_summary(GridWallLaw(ratio, controller.n, robot.W, params.preset.cell_size, params.preset.window_cells))
+    return plot_force_summary(scenario_law("grid", robot, controller, params.preset.window_cells, params.preset.cell_size))
 
 
 def run(args) -> int:

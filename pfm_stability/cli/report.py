@@ -2,9 +2,11 @@
 
 from __future__ import annotations
 
+from ..parameters import MODEL_NAMES, Wall
 from .options import PADE_ORDER, add_parameter_options, describe, number, resolve_parameters
 
-MODEL_CHOICES = ("continuous", "kb_first_order", "pade", "exact_delay", "sampled")
+FORMATS = ("text", "json", "markdown")
+DEFAULT_PADE_ORDER = 3
 
 
 def add_parser(sub) -> None:
@@ -16,30 +18,35 @@ def add_parser(sub) -> None:
     add_parameter_options(p)
     p.add_argument("--alpha", type=number("alpha_deg"), help=f"wall: target angle from the wall normal, {describe('alpha_deg')}")
     p.add_argument("--L", type=number("L"), help=f"corridor half-width, {describe('L')}, and more than W/2")
-    p.add_argument("--model", action="append", choices=MODEL_CHOICES, help="model to include (repeatable; default: all)")
-    p.add_argument("--pade-order", type=PADE_ORDER, default=3, help=f"order m of the pade model, {describe('pade_order')} (default 3)")
-    p.add_argument("--format", choices=("text", "json", "markdown"), default="text")
+    p.add_argument("--model", action="append", choices=MODEL_NAMES, help="model to include (repeatable; default: all)")
+    p.add_argument(
+        "--pade-order", type=PADE_ORDER, default=DEFAULT_PADE_ORDER,
+        help=f"order m of the pade model, {describe('pade_order')} (default {DEFAULT_PADE_ORDER})",
+    )
+    p.add_argument("--format", choices=FORMATS, default="text")
     p.set_defaults(run=run)
 
 
 def run(args) -> int:
-    import json
-
     from ..report import build_report
-    from ..render import render_markdown, render_text
+    from ..serialize import dumps
+    from .render import render_markdown, render_text
 
     params = resolve_parameters(args)
     report = build_report(
         params.robot,
         params.controller,
-        alpha_deg=args.alpha,
+        alpha=Wall.from_degrees(args.alpha).alpha if args.alpha is not None else None,  # degrees in, radians on
         L=args.L,
-        models=tuple(dict.fromkeys(args.model)) if args.model else MODEL_CHOICES,
+        models=tuple(dict.fromkeys(args.model)) if args.model else MODEL_NAMES,
         pade_order=args.pade_order,
-        sources={**params.sources, "alpha_deg": "user", "L": "user", "pade_order": "user" if args.pade_order != 3 else "default"},
+        sources={
+            **params.sources, "alpha_deg": "user", "L": "user",
+            "pade_order": "user" if args.pade_order != DEFAULT_PADE_ORDER else "default",
+        },
     )
     if args.format == "json":
-        print(json.dumps(report.to_dict(), indent=2, allow_nan=False))
+        print(dumps(report.to_dict()))
     elif args.format == "markdown":
         print(render_markdown(report), end="")
     else:

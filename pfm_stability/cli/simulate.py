@@ -102,13 +102,14 @@ def _plot(result, path: str) -> None:
 
 
 def run(args) -> int:
-    import json
+    from .render import render_simulation_text
+
     import time
 
     from ..parameters import Corridor, check_corridor_fits
-    from ..serialize import SCHEMA_VERSION, json_number
+    from ..serialize import SCHEMA_VERSION, dumps, json_number
     from ..sim.api import simulate
-    from ..sim.predict import predict
+    from ..validation.predict import predict
 
     params = resolve_parameters(args)
     if args.scenario == "corridor" and args.L is not None:  # the report's words for a robot wider than the corridor
@@ -127,65 +128,7 @@ def run(args) -> int:
         out["inputs"]["sources"] = params.sources
         out["plot"] = args.plot
         out["timing"] = {"seconds": json_number(seconds), "rate": json_number(result.steps / seconds if seconds > 0 else None)}
-        print(json.dumps(out, indent=2, allow_nan=False, default=json_default))
+        print(dumps(out))
     else:
-        print(render_text(result, prediction, args.plot), end="")
+        print(render_simulation_text(result, prediction, args.plot), end="")
     return 0
-
-
-def json_default(value):
-    """`json.dumps` ``default=``: numpy scalars as Python numbers (floats through `json_number`)."""
-    import numpy as np
-
-    from ..serialize import json_number
-
-    if isinstance(value, np.bool_):
-        return bool(value)
-    if isinstance(value, np.integer):
-        return int(value)
-    if isinstance(value, np.floating):
-        return json_number(value)
-    raise TypeError(f"cannot serialize {type(value).__name__}")
-
-
-def _fmt(value, unit="", digits=4):
-    return "undefined" if value is None else f"{value:+.{digits}g}{' ' + unit if unit else ''}"
-
-
-def render_text(result, prediction, plot_path=None) -> str:
-    """The human-readable report of one run."""
-    s, m = result.scenario, result.metrics
-    r, c = s.robot, s.controller
-    lines = [
-        f"scenario {s.name} ({s.env}), {s.duration:g} s simulated, {result.steps} samples of T = {c.T:g} s",
-        f"  robot: V = {r.V:g} m/s, tau = {r.tau:g} s, k = {r.k:g} 1/s, W = {r.W:g} m; "
-        f"controller: f = {c.f:g}, n = {c.n:g}, hold = {c.hold}, compute_delay = {c.compute_delay}",
-        "events:",
-    ]
-    lines += [f"  {e.type} at t = {e.t:.3f} s (x = {e.x:.3f} m, y = {e.y:.3f} m)" for e in result.events] or [
-        f"  none (ran {result.t_end:.3f} s)"
-    ]
-    if result.min_clearance is not None:
-        lines.append(f"  closest approach: {result.min_clearance * 100:.3g} cm between the robot disc and an obstacle")
-    lines += [
-        f"metrics ({m.turning_points} turning points, method {m.method}):",
-        f"  growth rate sigma = {_fmt(m.growth_rate, '1/s')}, angular frequency omega = {_fmt(m.angular_frequency, 'rad/s')}",
-        f"  oscillating: {'yes' if m.oscillating else 'no'}; stable: {'yes' if m.stable else 'no'}; "
-        f"limit cycle: {'amplitude %.3g m' % m.amplitude if m.limit_cycle else 'no'}",
-    ]
-    if m.reason:
-        lines.append(f"  ({m.reason})")
-    if prediction is not None:
-        unit = "m" if prediction.kind == "corridor" else "deg"
-        label = "L" if prediction.kind == "corridor" else "alpha"
-        lines.append(f"prediction ({prediction.kind}, {label} = {prediction.value:g} {unit}):")
-        for p in (prediction.matching, prediction.kb):
-            lines.append(
-                f"  {p.model:15s} {p.verdict:9s} sigma = {p.growth_rate:+.4g} 1/s, omega = {p.angular_frequency:.4g} rad/s, "
-                f"{label}* = {p.critical:.4g} {unit}  [{p.law}]"
-            )
-    lines.append("notes:")
-    lines += [f"  {key}: {value}" for key, value in s.notes.items()]
-    if plot_path:
-        lines.append(f"plot: {plot_path}")
-    return "\n".join(lines) + "\n"

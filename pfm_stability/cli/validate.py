@@ -32,7 +32,6 @@ from __future__ import annotations
 
 from .options import PADE_ORDER, add_parameter_options, describe, integer, number, output_path, resolve_parameters
 from .progress import line_progress
-from .simulate import json_default
 
 SCENARIO_CHOICES = ("corridor", "wall")
 PARAMETER_CHOICES = ("L", "alpha", "V", "f")
@@ -87,7 +86,7 @@ def _save(fig, path: str, what: str) -> None:
 
 
 def run(args) -> int:
-    import json
+    from .render import render_validation_text
 
     if args.sweep_plot and not args.sweep:
         raise ValueError("sweep-plot needs --sweep N")
@@ -103,7 +102,7 @@ def run(args) -> int:
 
         matplotlib.use("Agg")
 
-    from ..serialize import SCHEMA_VERSION
+    from ..serialize import SCHEMA_VERSION, dumps
 
     with line_progress("validate", quiet=args.quiet) as progress:
         validation, sweep = _work(args, params, progress)
@@ -126,9 +125,9 @@ def run(args) -> int:
         out["plot"] = args.plot
         out["sweep_plot"] = args.sweep_plot
         out["timing"] = timing
-        print(json.dumps(out, indent=2, allow_nan=False, default=json_default))
+        print(dumps(out))
     else:
-        print(render_text(validation, sweep, params.sources, args.plot, args.sweep_plot), end="")
+        print(render_validation_text(validation, sweep, params.sources, args.plot, args.sweep_plot), end="")
     return 0
 
 
@@ -162,78 +161,3 @@ def _work(args, params, progress):
             pade_order=args.pade_order, progress=progress,
         )
     return validation, sweep
-
-
-def _num(value, digits=5):
-    import math
-
-    if value is None or not math.isfinite(value):
-        return "none" if value is None or value > 0 else "0"
-    return f"{value:.{digits}g}"
-
-
-def _pct(value):
-    return "      -" if value is None else f"{100 * value:+7.2f} %"
-
-
-def render_text(v, sweep=None, sources=None, plot=None, sweep_plot=None) -> str:
-    """Human-readable validation report: boundaries, errors, oscillation checks, sweep."""
-    i = v.inputs
-    unit = f" {v.unit}" if v.unit else ""
-    name = {"L": "L*", "alpha": "alpha*", "V": "V*", "f": "f*"}[v.parameter]
-    head = f"{name} ({v.unit})" if v.unit else name
-    assumed = [k for k, s in (sources or {}).items() if str(s).startswith("ASSUMED")]
-    fixed = f", L = {i['L']:g} m" if i.get("L") is not None else (f", alpha = {i['alpha_deg']:g} deg" if i.get("alpha_deg") is not None else "")
-    lines = [
-        f"validate {v.scenario} ({v.env}{fixed}): bisecting {v.parameter}",
-        f"  robot: V = {i['V']:g} m/s, tau = {i['tau']:g} s, k = {i['k']:g} 1/s, W = {i['W']:g} m; controller: f = {i['f']:g}, "
-        f"n = {i['n']:g}, T = {i['T']:g} s, hold = {i['hold']}, compute_delay = {i['compute_delay']}",
-    ]
-    if assumed:
-        lines.append(f"  assumed by the preset: {', '.join(assumed)} (see --format json inputs.sources)")
-    lines += [
-        f"simulated boundary: {name} = {_num(v.simulated_boundary, 6)}{unit} (stable {'above' if v.stable_above else 'below'}; "
-        f"bracket [{_num(v.bracket[0], 6)}, {_num(v.bracket[1], 6)}]{unit}; {v.runs} runs in {v.seconds:.1f} s)",
-        f"predicted boundary, law: {v.law}" + (f"   | KB's lumped law, f_av = {i['f_av']:.4g}" if v.lumped_predicted_boundary else ""),
-        f"  {'model':16s} {head:>12s} {'rel. error':>10s}" + (f"   | {head:>12s} {'rel. error':>10s}" if v.lumped_predicted_boundary else ""),
-    ]
-    for model, value in v.predicted_boundary.items():
-        row = f"  {model:16s} {_num(value):>12s} {_pct(v.relative_error[model]):>10s}"
-        if v.lumped_predicted_boundary:
-            row += f"   | {_num(v.lumped_predicted_boundary[model]):>12s} {_pct(v.lumped_relative_error[model]):>10s}"
-        lines.append(row)
-    lines.append("oscillation near the boundary (measured vs the sampled model's dominant root):")
-    for c in v.oscillation:
-        s = "undefined" if c.growth_rate is None else f"{c.growth_rate:+.4f}"
-        w = "undefined" if c.angular_frequency is None else f"{c.angular_frequency:.4f}"
-        fe = "" if c.frequency_error is None else f", {100 * c.frequency_error:+.3f} %"
-        lines.append(
-            f"  {v.parameter} = {c.value:.6g}{unit}: sigma = {s} 1/s (model {c.predicted_growth_rate:+.4f}), "
-            f"omega = {w} rad/s (model {c.predicted_angular_frequency:.4f}{fe}) [{c.method}]"
-        )
-    if sweep is not None:
-        lines += render_sweep(sweep).splitlines()
-    lines.append("notes:")
-    lines += [f"  {key}: {value}" for key, value in v.notes.items()]
-    if plot:
-        lines.append(f"plot: {plot}")
-    if sweep_plot:
-        lines.append(f"sweep plot: {sweep_plot}")
-    return "\n".join(lines) + "\n"
-
-
-def render_sweep(sweep) -> str:
-    """The sweep's agreement, each model's wrong-verdict rate, and every disagreement."""
-    lines = [
-        f"random sweep: {sweep.count} Latin-hypercube sets ({sweep.env}, seed {sweep.seed}), {sweep.included} outside "
-        f"+-{100 * sweep.exclude:g} % of the sampled boundary (in NV), {sweep.seconds:.1f} s",
-        f"  simulated sign of sigma agrees with sampled on {100 * sweep.agreement:.2f} % ({len(sweep.disagreements)} disagreements)",
-        "  wrong verdicts for the sampled robot (model stable but robot oscillates / model unstable but robot stable):",
-    ]
-    for model, rate in sweep.wrong_verdict_rate.items():
-        w = sweep.wrong_verdicts[model]
-        lines.append(f"    {model:16s} {100 * rate:6.2f} %  ({w['stable_but_unstable']} / {w['unstable_but_stable']})")
-    if sweep.disagreements:
-        lines.append("  disagreements:")
-        lines += [f"    {p.describe()}" for p in sweep.disagreements]
-    return "\n".join(lines) + "\n"

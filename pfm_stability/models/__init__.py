@@ -1,4 +1,4 @@
-"""Loop models by name (DESIGN §4).
+"""Loop models by name (docs/models.md; the names are `parameters.MODEL_NAMES`).
 
 =================  ============================================  ==========================
 name               characteristic equation                       decided by
@@ -13,6 +13,8 @@ sampled            det(zI − Φ_cl(kNV)) = 0, ZOH                   eigenvalues
 
 from __future__ import annotations
 
+from ..checks import check_choice
+from ..parameters import MODEL_NAMES, Controller
 from .base import Boundary, Loop, LoopModel, gain_margin, verdict_label
 from .continuous import Continuous
 from .exact_delay import ExactDelay
@@ -38,27 +40,24 @@ __all__ = [
     "verdict_label",
 ]
 
-MODEL_NAMES = ("continuous", "kb_first_order", "pade", "exact_delay", "sampled")
-
 
 def make_model(name: str, *, pade_order: int = 3, hold: str = "command", compute_delay: int = 0) -> LoopModel:
     """The model called `name`, configured.
 
     Parameters
     ----------
-    name : {"continuous", "kb_first_order", "pade", "exact_delay", "sampled"}
+    name : str
+        One of `MODEL_NAMES` (``continuous``, ``kb_first_order``, ``pade``, ``exact_delay``, ``sampled``).
     pade_order : int
         Order m of the ``pade`` model.
     hold, compute_delay
-        Structure of the ``sampled`` model (DESIGN §4).
+        Structure of the ``sampled`` model (docs/models.md).
 
     Raises
     ------
     ValueError
         Unknown name or option.
     """
-    from ..checks import check_choice
-
     check_choice("model", name, MODEL_NAMES)
     if name == "continuous":
         return Continuous()
@@ -80,8 +79,6 @@ def make_models(names=MODEL_NAMES, *, controller=None, **options) -> list[LoopMo
     if isinstance(names, str) or not isinstance(names, (list, tuple)) or not all(isinstance(n, str) for n in names):
         raise ValueError(f"names must be a list or tuple of model names ({', '.join(MODEL_NAMES)}); got {names!r}")
     if controller is not None:
-        from ..parameters import Controller
-
         if not isinstance(controller, Controller):
             raise ValueError(f"controller must be a Controller; got {controller!r}")
         if "hold" in options or "compute_delay" in options:
@@ -110,8 +107,6 @@ def models_for(controller, models=None, *, pade_order: int = 3) -> list[LoopMode
         A ``Sampled`` model whose structure contradicts the controller, or an
         unknown name.
     """
-    from ..parameters import Controller
-
     if not isinstance(controller, Controller):
         raise ValueError(f"controller must be a Controller; got {controller!r}")
     if models is None:

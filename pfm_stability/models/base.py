@@ -74,7 +74,7 @@ class Boundary:
     Attributes
     ----------
     model : str
-        Model name (DESIGN §4).
+        Model name (`parameters.MODEL_NAMES`, docs/models.md).
     NV_critical : float
         NV*, 1/s: stable for every 0 < NV < NV* (``inf``: stable for every
         NV; 0: unstable at every NV close to 0 — "unstable at any speed").
@@ -192,6 +192,14 @@ class LoopModel:
 
     name: str = ""
     equation: str = ""
+
+    def options(self) -> dict:
+        """The options that configure this model, in the order JSON writes them.
+
+        ``{}`` for a model without options; ``{"order": m}`` for `Pade`,
+        ``{"hold": …, "compute_delay": …}`` for `Sampled` (docs/models.md).
+        """
+        return {}
 
     def boundary(self, loop: Loop) -> Boundary:
         """NV* and the boundary frequency for (τ, T, k) (cached)."""

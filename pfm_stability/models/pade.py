@@ -27,7 +27,7 @@ import math
 import numpy as np
 
 from ..checks import check_integer, check_number
-from .base import AffineGainModel, Loop, checked
+from .base import AffineGainModel, Loop
 
 __all__ = ["Pade", "pade_coefficients", "MAX_PADE_ORDER"]
 
@@ -102,6 +102,10 @@ class Pade(AffineGainModel):
         E = np.zeros_like(D)
         E[:, 3:] = num
         return D, E
+
+    def options(self) -> dict:
+        """``{"order": m}``."""
+        return {"order": self.order}
 
     def __repr__(self) -> str:
         return f"Pade(order={self.order})"

@@ -1,4 +1,4 @@
-"""`sampled`: the discrete-time loop a real VFF controller closes (DESIGN §4).
+"""`sampled`: the discrete-time loop a real VFF controller closes (docs/models.md).
 
 Linearized loop (Koren & Borenstein 1991 eq 6, 7, 10, 14): steering motor
 τω̇ + ω = u, heading θ̇ = ω, lateral offset ẋ = Vθ, and the reference
@@ -192,7 +192,7 @@ class Sampled(AffineGainModel):
     Parameters
     ----------
     hold : {"command", "reference"}
-        What is held between samples (DESIGN §4).
+        What is held between samples (`parameters.HOLDS`, docs/models.md).
     compute_delay : {0, 1}
         Samples between measurement and actuation.
     """
@@ -204,6 +204,10 @@ class Sampled(AffineGainModel):
     def __init__(self, hold: str = "command", compute_delay: int = 0):
         self.hold = check_choice("hold", hold, HOLDS)
         self.compute_delay = check_integer("compute_delay", compute_delay, 0, 1)
+
+    def options(self) -> dict:
+        """``{"hold": …, "compute_delay": …}``: the sampled structure (docs/models.md)."""
+        return {"hold": self.hold, "compute_delay": self.compute_delay}
 
     def __repr__(self) -> str:
         return f"Sampled(hold={self.hold!r}, compute_delay={self.compute_delay})"

@@ -26,34 +26,34 @@ solid ones, so that ``pade`` stays visible where it coincides with ``exact_delay
 where it is close to both."""
 
 
+def _with_options(model, formats: dict) -> str:
+    """``name (…)``: the first of `formats` (option → template) whose option the model has; the name alone if none."""
+    options = model.options()
+    for option, template in formats.items():
+        if option in options:
+            return f"{model.name} ({template.format(**options)})"
+    return model.name
+
+
 def model_label(model) -> str:
-    """Legend text: the model name plus its options (``sampled (command, cd=1)``)."""
-    name = model.name
-    if name == "pade":
-        return f"pade (m={model.order})"
-    if name == "sampled":
-        return f"sampled ({model.hold}, cd={model.compute_delay})"
-    return name
+    """Legend text: the model name plus its options (`LoopModel.options`): ``sampled (command, cd=1)``, ``pade (m=3)``."""
+    return _with_options(model, {"order": "m={order}", "hold": "{hold}, cd={compute_delay}"})
 
 
 def model_description(model) -> str:
     """Longer text for titles and captions: ``sampled (command hold, compute delay 1)``, ``pade (order 3)``."""
-    name = model.name
-    if name == "pade":
-        return f"pade (order {model.order})"
-    if name == "sampled":
-        return f"sampled ({model.hold} hold, compute delay {model.compute_delay})"
-    return name
+    return _with_options(model, {"order": "order {order}", "hold": "{hold} hold, compute delay {compute_delay}"})
 
 
 def model_style(model) -> dict:
     """Line style of `model`: `MODEL_STYLE`, the four sampled structures told
     apart (command solid, reference dashed; compute delay 1 thinner)."""
     style = dict(MODEL_STYLE[model.name])
-    if model.name == "sampled":
-        style["ls"] = "-" if model.hold == "command" else "--"
-        style["lw"] = 2.4 if model.compute_delay == 0 else 1.4
-        style["alpha"] = 1.0 if model.compute_delay == 0 else 0.7
+    options = model.options()
+    if "hold" in options:
+        style["ls"] = "-" if options["hold"] == "command" else "--"
+        style["lw"] = 2.4 if options["compute_delay"] == 0 else 1.4
+        style["alpha"] = 1.0 if options["compute_delay"] == 0 else 0.7
     return style
 
 

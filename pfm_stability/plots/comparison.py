@@ -3,7 +3,7 @@
 * `plot_critical_gain_vs_delay`: NV* against T/τ for every model and every
   sampled structure (hold × compute delay). KB's eq (20) gives
   NV* = 1/(τ + T).
-* `plot_kb_error_map`: NV*_KB/NV*_model − 1 over (kτ, T/τ) (`regions.kb_error_map`):
+* `plot_kb_error_map`: NV*_KB/NV*_model − 1 over (kτ, T/τ) (`comparison.kb_error_map`):
   red where KB's criterion is optimistic (it calls stable a loop that
   oscillates), blue where it is conservative.
 * `plot_kb_error_maps`: one map per reference model, one colour bar.
@@ -23,8 +23,7 @@ import math
 
 import numpy as np
 
-from ..models import Loop
-from ..regions import GainCurve, KBErrorMap, critical_gain_vs_delay, kb_relative_error
+from ..comparison import GainCurve, KBErrorMap, critical_gain_vs_delay
 from .common import MODEL_ZORDER, figure_and_axes, model_label, model_style, outside_legend
 
 __all__ = [
@@ -60,7 +59,7 @@ def plot_critical_gain_vs_delay(
     T_over_tau : array_like, optional
         Default 60 log-spaced values in [0.01, 3].
     curves : list of GainCurve, optional
-        Precomputed `regions.critical_gain_vs_delay` (else computed here).
+        Precomputed `comparison.critical_gain_vs_delay` (else computed here).
     mark : float, optional
         A T/τ to mark with a vertical line (e.g. CARMEL's 0.065/0.3).
     ax : matplotlib Axes, optional
@@ -106,7 +105,7 @@ def plot_kb_error_map(error_map: KBErrorMap, ax=None, *, mark: tuple[float, floa
     Parameters
     ----------
     error_map : KBErrorMap
-        From `regions.kb_error_map`.
+        From `comparison.kb_error_map`.
     ax : matplotlib Axes, optional
     mark : (k_tau, T_over_tau), optional
         A robot to mark, with its exact relative error.
@@ -141,7 +140,7 @@ def plot_kb_error_map(error_map: KBErrorMap, ax=None, *, mark: tuple[float, floa
         ax.contour(x, y, level, levels=[0.0], colors="k", linewidths=1.6)
     if mark is not None:
         kt, tt = mark
-        err = kb_relative_error(Loop(1.0, tt, kt), error_map.reference)
+        err = error_map.exact(kt, tt)
         ax.plot([kt], [tt], marker="*", ms=15, mfc="gold", mec="k", ls="none", zorder=6)
         ax.annotate(f"{mark_label}: {_percent(err)}", (kt, tt), xytext=(7, 5), textcoords="offset points", fontsize=8,
                     bbox=dict(boxstyle="round,pad=0.2", fc="white", ec="none", alpha=0.85))

@@ -1,4 +1,4 @@
-"""The grid's effective force law against KB's lumped law (issue 5, DESIGN §5).
+"""The grid's effective force law against KB's lumped law (docs/simulator.md, grid quantization).
 
 `plot_force_laws` draws F_r(d)/F_ct of a straight wall in the histogram grid
 (`GridWallLaw`: the window sum of KB eq 1, averaged along the wall) against

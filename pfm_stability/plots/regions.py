@@ -16,8 +16,9 @@ functions only draw.
 * `plot_corridor_L_critical`: L*(V); stable above (KB eq 25).
 * `plot_wall_regions`, `plot_corridor_regions`: the panels above side by side
   with one legend (the figures of ``analyses/``).
-* `plot_simulated_boundary`: simulated boundary points (`regions.simulated_boundary`)
-  on top of any of these.
+
+Simulated boundary points go on top of any of these with
+`pfm_stability.plots.validation.plot_simulated_boundary`.
 """
 
 from __future__ import annotations
@@ -29,18 +30,8 @@ import numpy as np
 
 from ..force_law import ForceLaw, PowerLaw
 from ..parameters import Controller, Robot
-from ..regions import (
-    corridor_L_curves,
-    corridor_region,
-    corridor_V_curves,
-    default_models,
-    region_model,
-    verdict_model,
-    wall_alpha_curves,
-    wall_alpha_region,
-    wall_f_curves,
-    wall_f_region,
-)
+from ..curves import corridor_L_curves, corridor_V_curves, default_models, wall_alpha_curves, wall_f_curves
+from ..regions import corridor_region, region_model, verdict_model, wall_alpha_region, wall_f_region
 from .common import MODEL_STYLE, MODEL_ZORDER, figure_and_axes, model_description, model_label, outside_legend
 
 __all__ = [
@@ -53,7 +44,6 @@ __all__ = [
     "plot_corridor_L_critical",
     "plot_wall_regions",
     "plot_corridor_regions",
-    "plot_simulated_boundary",
     "region_legend",
     "shading_text",
 ]
@@ -237,7 +227,7 @@ def plot_wall_f_region(
     """Stable and unstable regions along a wall in the (V, f) plane at one target angle α.
 
     Shading: the verdicts of the `shaded` model (`regions.wall_f_region`);
-    curves: f*(V) of every model (`regions.wall_f_curves`, KB eq 24 with the
+    curves: f*(V) of every model (`curves.wall_f_curves`, KB eq 24 with the
     model's NV*); stable above the curves. KB's power law.
 
     Parameters
@@ -252,7 +242,7 @@ def plot_wall_f_region(
     f : array_like, optional
         Force ratios (default 300 log-spaced points in [0.01, 100]).
     models : list of LoopModel, optional
-        Curves drawn; default `regions.default_models(controller)`.
+        Curves drawn; default `curves.default_models(controller)`.
     shaded : LoopModel or str, optional
         The model whose verdicts are shaded (`regions.region_model`); default
         the report's verdict model, ``sampled`` with the controller's hold
@@ -376,7 +366,7 @@ def plot_corridor_region(
     """Stable and unstable regions in the middle of a corridor, (L, V) plane: stable below V*(L).
 
     Shading: the verdicts of the `shaded` model (`regions.corridor_region`);
-    curves: V*(L) = NV*/N(L) of every model (`regions.corridor_V_curves`;
+    curves: V*(L) = NV*/N(L) of every model (`curves.corridor_V_curves`;
     KB eq 25).
 
     Parameters
@@ -577,27 +567,4 @@ def plot_corridor_regions(robot: Robot, controller: Controller, *, models=None, 
     plot_corridor_L_critical(robot, controller, models=models, shaded=shaded, ax=b, legend=False, resolution=resolution)
     region_legend(fig=fig, ncol=3)
     _suptitle(fig, "in a corridor", "§5.4", shaded, controller)
-    return fig
-
-
-# ------------------------------------------------------------------ simulation
-def plot_simulated_boundary(sim, ax=None, *, label: str | None = None, color="k", marker="o", **style):
-    """Simulated boundary points (`regions.SimulatedBoundary`) with their bisection brackets.
-
-    x = the values of ``sim.over``, y = the bisected ``sim.parameter``
-    (angles drawn in degrees), so the points sit on `plot_corridor_region`
-    (over L, bisected V) or `plot_wall_alpha_critical` (over V, bisected α).
-
-    Returns
-    -------
-    matplotlib.figure.Figure
-    """
-    fig, ax = figure_and_axes(ax)
-    sx = 180 / math.pi if sim.over == "alpha" else 1.0
-    sy = 180 / math.pi if sim.parameter == "alpha" else 1.0
-    x = sim.values * sx
-    y = sim.critical * sy
-    err = np.vstack([y - sim.lo * sy, sim.hi * sy - y])
-    label = label if label is not None else f"simulated boundary ({sim.env}, {sim.scenario}; bisection on {sim.parameter})"
-    ax.errorbar(x, y, yerr=err, ls="none", marker=marker, ms=7, mfc="white", mec=color, mew=1.8, ecolor=color, capsize=3, label=label, zorder=8, **style)
     return fig

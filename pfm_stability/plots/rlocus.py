@@ -16,36 +16,11 @@ import math
 
 import numpy as np
 
-from ..models import ExactDelay, KBFirstOrder, Loop, Pade, Sampled, make_models
+from ..comparison import GainCurve, RootLocus, critical_gain_vs_k, root_locus
+from ..models import Loop
 from .common import MODEL_STYLE, MODEL_ZORDER, figure_and_axes, model_label, model_style, outside_legend
 
-__all__ = ["root_locus_data", "plot_root_locus", "critical_gain_vs_k", "plot_critical_gain_vs_k", "crossing_text"]
-
-
-def root_locus_data(loop: Loop, pade_order: int = 3, NV_max: float | None = None, points: int = 400):
-    """Closed-loop roots of the Padé loop for NV in (0, NV_max].
-
-    The loop transfer function in the gain NV is G(s) = k·P_m(s)/((τs³ + s² + ks)·Q_m(s))
-    (KB eq 18 with e^(−sT) ≈ P_m/Q_m), computed by python-control's
-    ``root_locus_map``.
-
-    Returns
-    -------
-    gains : ndarray
-        NV values, 1/s.
-    loci : ndarray, complex, shape (len(gains), branches)
-        Root positions, 1/s.
-    open_loop : (poles, zeros)
-    """
-    import control
-
-    d, e = Pade(pade_order).polynomials(loop)
-    G = control.tf(loop.k * np.asarray(e), d)
-    if NV_max is None:
-        NV_max = 2.5 * ExactDelay().boundary(loop).NV_critical
-    gains = np.linspace(0.0, NV_max, points)
-    data = control.root_locus_map(G, gains=gains)
-    return np.asarray(data.gains), np.asarray(data.loci), (np.asarray(G.poles()), np.asarray(G.zeros()))
+__all__ = ["plot_root_locus", "plot_critical_gain_vs_k", "crossing_text"]
 
 
 _MARKER_SIZE = {"pade": 13, "exact_delay": 10.5, "kb_first_order": 8, "sampled": 5.5}
@@ -97,7 +72,8 @@ def crossing_text(model, boundary, omega_max: float | None = None) -> tuple[str,
     return text + extra, True
 
 
-def plot_root_locus(loop: Loop, *, pade_order: int = 3, hold: str = "command", compute_delay: int = 0, NV_max=None, ax=None):
+def plot_root_locus(loop: Loop | None = None, *, pade_order: int = 3, hold: str = "command", compute_delay: int = 0, NV_max=None,
+                    ax=None, locus: RootLocus | None = None):
     """Root locus of the Padé(m) loop in NV with the critical crossings marked.
 
     Markers (concentric rings where they coincide): the Padé locus crossing
@@ -110,7 +86,7 @@ def plot_root_locus(loop: Loop, *, pade_order: int = 3, hold: str = "command", c
     Parameters
     ----------
     loop : Loop
-        τ (s), T (s, > 0), k (1/s).
+        τ (s), T (s, > 0), k (1/s); not needed when `locus` is given.
     pade_order : int
         Order m of the Padé approximation of e^(−sT).
     hold, compute_delay
@@ -118,30 +94,34 @@ def plot_root_locus(loop: Loop, *, pade_order: int = 3, hold: str = "command", c
     NV_max : float, optional
         Largest loop gain of the locus, 1/s (default 2.5·NV* of ``exact_delay``).
     ax : matplotlib Axes, optional
+    locus : RootLocus, optional
+        Precomputed `comparison.root_locus` (else computed from the other arguments).
 
     Returns
     -------
     matplotlib.figure.Figure
     """
+    if locus is None:
+        locus = root_locus(loop, pade_order=pade_order, hold=hold, compute_delay=compute_delay, NV_max=NV_max)
+    loop, poles, zeros = locus.loop, locus.poles, locus.zeros
     fig, ax = figure_and_axes(ax, (10.0, 5.4))
-    gains, loci, (poles, zeros) = root_locus_data(loop, pade_order, NV_max)
-    for branch in loci.T:
+    for branch in locus.loci.T:
         ax.plot(branch.real, branch.imag, color="0.35", lw=1.1)
-    w_star = ExactDelay().boundary(loop).omega_critical or 1.0
+    w_star = locus.omega_scale
     omega_max = 2.5 * w_star
     ax.plot(poles.real, poles.imag, "x", color="k", ms=8, mew=1.6, label="open-loop poles (Padé loop)")
     if zeros.size:
         in_view = (zeros.real >= -4 * w_star) & (zeros.real <= 1.5 * w_star) & (np.abs(zeros.imag) <= omega_max)
         where = "" if in_view.all() else (" — outside the view" if not in_view.any() else f" — {np.count_nonzero(~in_view)} outside the view")
         ax.plot(zeros.real, zeros.imag, "o", mfc="none", color="k", ms=7, label=f"open-loop zeros (Padé numerator{where})")
-    for model in (Pade(pade_order), ExactDelay(), KBFirstOrder(), Sampled(hold, compute_delay)):
-        text, marked = crossing_text(model, model.boundary(loop), omega_max)
+    for model, boundary in locus.crossings:
+        text, marked = crossing_text(model, boundary, omega_max)
         color = MODEL_STYLE[model.name]["color"]
         filled = model.name == "sampled"
         style = dict(ls="none", marker="o", ms=_MARKER_SIZE[model.name], mfc=color if filled else "none", mec=color, mew=2,
                      zorder=MODEL_ZORDER[model.name] + 2)
         if marked:
-            w = model.boundary(loop).omega_critical
+            w = boundary.omega_critical
             ax.plot([0, 0], [w, -w], label=text, **style)
         else:  # legend entry only: a faded marker that is drawn nowhere
             ax.plot([], [], label=text, alpha=0.35, **style)
@@ -151,26 +131,15 @@ def plot_root_locus(loop: Loop, *, pade_order: int = 3, hold: str = "command", c
     ax.set_ylim(-omega_max, omega_max)
     ax.set_xlabel("Re s (1/s)")
     ax.set_ylabel("Im s (rad/s)")
-    ax.set_title(f"Root locus in NV, Padé({pade_order}) of KB eq (18): τ = {loop.tau:g} s, T = {loop.T:g} s, k = {loop.k:g} 1/s", fontsize=9)
+    ax.set_title(f"Root locus in NV, Padé({locus.pade_order}) of KB eq (18): τ = {loop.tau:g} s, T = {loop.T:g} s, k = {loop.k:g} 1/s",
+                 fontsize=9)
     outside_legend(ax)
     ax.grid(alpha=0.3)
     return fig
 
 
-def critical_gain_vs_k(tau: float, T: float, ks, *, pade_order: int = 3, structures=(("command", 0), ("command", 1), ("reference", 0), ("reference", 1))):
-    """NV* (1/s) of every model for each steering gain k (1/s).
-
-    Returns
-    -------
-    dict
-        Model label → ndarray of NV* (``inf`` where no finite boundary).
-    """
-    models = make_models(("continuous", "kb_first_order", "pade", "exact_delay"), pade_order=pade_order)
-    models += [Sampled(h, c) for h, c in structures]
-    return {model_label(m): np.array([m.boundary(Loop(tau, T, k)).NV_critical for k in ks]) for m in models}, models
-
-
-def plot_critical_gain_vs_k(tau: float, T: float, ks=None, *, pade_order: int = 3, ax=None, legend: bool = True):
+def plot_critical_gain_vs_k(tau: float, T: float, ks=None, *, pade_order: int = 3, ax=None, legend: bool = True,
+                            curves: list[GainCurve] | None = None):
     """NV* against k for all models: the k-dependence that KB's eq (20) hides.
 
     Parameters
@@ -184,18 +153,19 @@ def plot_critical_gain_vs_k(tau: float, T: float, ks=None, *, pade_order: int = 
     ax : matplotlib Axes, optional
     legend : bool
         Draw the legend outside the axes, on the right.
+    curves : list of GainCurve, optional
+        Precomputed `comparison.critical_gain_vs_k` (else computed here).
 
     Returns
     -------
     matplotlib.figure.Figure
     """
     fig, ax = figure_and_axes(ax, (8.6, 4.6) if legend else (6.4, 4.6))
-    ks = np.geomspace(0.2, 30, 60) if ks is None else np.asarray(ks, dtype=float)
-    curves, models = critical_gain_vs_k(tau, T, ks, pade_order=pade_order)
-    for model, (label, values) in zip(models, curves.items()):
-        style = model_style(model)
-        shown = np.where(np.isfinite(values) & (values > 0), values, np.nan)
-        ax.plot(ks, shown, label=label, zorder=MODEL_ZORDER[model.name], **style)
+    if curves is None:
+        curves = critical_gain_vs_k(tau, T, np.geomspace(0.2, 30, 60) if ks is None else ks, pade_order=pade_order)
+    for curve in curves:
+        shown = np.where(np.isfinite(curve.NV_critical) & (curve.NV_critical > 0), curve.NV_critical, np.nan)
+        ax.plot(curve.x, shown, label=model_label(curve.model), zorder=MODEL_ZORDER[curve.model.name], **model_style(curve.model))
     ax.set_xscale("log")
     ax.set_xlabel("steering gain k (1/s)")
     ax.set_ylabel("critical NV* (1/s)")
@@ -203,6 +173,6 @@ def plot_critical_gain_vs_k(tau: float, T: float, ks=None, *, pade_order: int = 
     ax.grid(alpha=0.3, which="both")
     if legend:
         outside_legend(ax)
-    if not math.isnan(np.nanmax([np.nanmax(np.where(np.isfinite(v), v, np.nan)) for v in curves.values()])):
+    if not math.isnan(np.nanmax([np.nanmax(np.where(np.isfinite(c.NV_critical), c.NV_critical, np.nan)) for c in curves])):
         ax.set_ylim(bottom=0)
     return fig

@@ -2,14 +2,19 @@
 
 `plot_boundary_overlay` draws a `BoundaryValidation`'s stability map: each
 model's boundary curve (critical L, α, V or f against V, or against the
-geometry when V is bisected; KB eq 20, 24, 25 generalized, DESIGN §4) with
+geometry when V is bisected; KB eq 20, 24, 25 generalized, docs/models.md) with
 the simulated runs marked stable (○) or unstable (×) and the bisected
 boundary (★). `plot_growth_rate` shows the measured σ against the bisected
 parameter with every model's predicted boundary as a vertical line.
 `plot_relative_errors` compares every model's error over many validations.
 `plot_sweep` shows the random sweep: measured σ against NV/NV* of the
 ``sampled`` model, and where ``kb_first_order`` and ``exact_delay`` put the
-same points.
+same points. `plot_simulated_boundary` draws a `SimulatedBoundary`'s bisected
+points with their brackets (and, if asked, its model curves).
+
+Drawing only: every number comes from the results
+(`pfm_stability.validation`), which also carry the configured models whose
+labels and styles the legends use.
 """
 
 from __future__ import annotations
@@ -18,10 +23,9 @@ import math
 
 import numpy as np
 
-from ..models import make_model
 from .common import MODEL_STYLE, figure_and_axes, model_label, model_style
 
-__all__ = ["plot_boundary_overlay", "plot_growth_rate", "plot_validation", "plot_sweep", "plot_relative_errors"]
+__all__ = ["plot_boundary_overlay", "plot_growth_rate", "plot_validation", "plot_sweep", "plot_relative_errors", "plot_simulated_boundary"]
 
 _AXIS = {"L": "L, corridor half-width", "alpha": "α, wall angle", "V": "V, speed", "f": "f, force ratio"}
 
@@ -30,18 +34,15 @@ def _axis_label(name, unit):
     return f"{_AXIS.get(name, name)} ({unit})" if unit else _AXIS.get(name, name)
 
 
-def _models(v):
-    """The validated models, configured as in the validation (pade order, sampled structure)."""
-    i = v.inputs
-    return {name: make_model(name, pade_order=i["pade_order"], hold=i["hold"], compute_delay=i["compute_delay"]) for name in v.predicted_boundary}
+def _labels(result, names):
+    """Legend label of each model name: the result's configured model's (pade order, sampled structure), else the name."""
+    models = {m.name: m for m in result.models}
+    return {name: model_label(models[name]) if name in models else name for name in names}
 
 
-def _labels(v):
-    return {name: model_label(m) for name, m in _models(v).items()}
-
-
-def _styles(v):
-    return {name: model_style(m) for name, m in _models(v).items()}
+def _styles(result, names):
+    models = {m.name: m for m in result.models}
+    return {name: model_style(models[name]) if name in models else dict(MODEL_STYLE[name]) for name in names}
 
 
 def _verdict_markers(ax, xs, ys, verdicts, size=36):
@@ -72,7 +73,7 @@ def plot_boundary_overlay(validation, ax=None):
     if m is None:
         return plot_growth_rate(v, ax=ax)
     fig, ax = figure_and_axes(ax, (6.4, 6.0))
-    labels, styles = _labels(v), _styles(v)
+    labels, styles = _labels(v, m.curves), _styles(v, m.curves)
     x = np.asarray(m.curve_x)
     for name, ys in m.curves.items():
         y = np.array([np.nan if y is None else y for y in ys], dtype=float)
@@ -102,7 +103,7 @@ def plot_growth_rate(validation, ax=None):
 
     The bisection runs and the oscillation checks are marked stable/unstable;
     σ = 0 at the bisected boundary (★). Vertical lines: each model's
-    prediction with the run's own law (DESIGN §4 styles).
+    prediction with the run's own law (the model styles of `plots.common`).
 
     Returns
     -------
@@ -110,7 +111,7 @@ def plot_growth_rate(validation, ax=None):
     """
     v = validation
     fig, ax = figure_and_axes(ax, (6.4, 5.6))
-    labels, styles = _labels(v), _styles(v)
+    labels, styles = _labels(v, v.predicted_boundary), _styles(v, v.predicted_boundary)
     pts = [p for p in v.points if p.growth_rate is not None]
     _verdict_markers(ax, [p.value for p in pts], [p.growth_rate for p in pts], [p.verdict for p in pts])
     checks = [c for c in v.oscillation if c.growth_rate is not None]
@@ -235,8 +236,8 @@ def plot_sweep(sweep, axes=None):
 def plot_relative_errors(validations, labels=None, ax=None):
     """Each model's relative boundary error (predicted/simulated − 1) for several validations.
 
-    Grouped bars, one group per validation, one bar per model (DESIGN §4
-    colours); in the grid, KB's lumped-law ``kb_first_order`` is added as a
+    Grouped bars, one group per validation, one bar per model (the model
+    colours of `plots.common`); in the grid, KB's lumped-law ``kb_first_order`` is added as a
     hatched bar (KB eq 24/25 with f_av).
 
     Parameters
@@ -268,4 +269,46 @@ def plot_relative_errors(validations, labels=None, ax=None):
     ax.set_title("boundary error of each model against the simulated VFF robot", fontsize=9)
     ax.legend(fontsize=7, ncol=3, loc="best", framealpha=0.85)
     ax.grid(True, axis="y", lw=0.3, alpha=0.5)
+    return fig
+
+
+def plot_simulated_boundary(sim, ax=None, *, label: str | None = None, color="k", marker="o", curves: bool = False, **style):
+    """Simulated boundary points (`validation.SimulatedBoundary`) with their bisection brackets.
+
+    x = the values of ``sim.over``, y = the bisected ``sim.parameter``
+    (angles drawn in degrees), so the points sit on `plots.regions.plot_corridor_region`
+    (over L, bisected V) or `plots.regions.plot_wall_alpha_critical` (over V, bisected α).
+
+    Parameters
+    ----------
+    sim : SimulatedBoundary
+    ax : matplotlib Axes, optional
+    label : str, optional
+        Legend label of the points.
+    color, marker, **style
+        Style of the points.
+    curves : bool
+        Also draw the model curves the result carries (``sim.curves``; KB's
+        lumped law dotted in the grid), for a figure without region plots.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    fig, ax = figure_and_axes(ax)
+    sx = 180 / math.pi if sim.over == "alpha" else 1.0
+    sy = 180 / math.pi if sim.parameter == "alpha" else 1.0
+    if curves and sim.curves is not None:
+        x = np.asarray(sim.curve_x, dtype=float) * sx
+        labels, styles = _labels(sim, sim.curves), _styles(sim, sim.curves)
+        for name, y in sim.curves.items():
+            ax.plot(x, np.asarray(y, dtype=float) * sy, label=labels[name], **styles[name])
+        if sim.lumped_curves is not None:
+            ax.plot(x, np.asarray(sim.lumped_curves["kb_first_order"], dtype=float) * sy, color=MODEL_STYLE["kb_first_order"]["color"],
+                    ls=(0, (1, 2)), lw=1.4, label="kb_first_order, KB's lumped law")
+    x = sim.values * sx
+    y = sim.critical * sy
+    err = np.vstack([y - sim.lo * sy, sim.hi * sy - y])
+    label = label if label is not None else f"simulated boundary ({sim.env}, {sim.scenario}; bisection on {sim.parameter})"
+    ax.errorbar(x, y, yerr=err, ls="none", marker=marker, ms=7, mfc="white", mec=color, mew=1.8, ecolor=color, capsize=3, label=label, zorder=8, **style)
     return fig

@@ -1,10 +1,12 @@
-"""Time-domain simulator of the VFF algorithm driving a CARMEL-like robot (DESIGN §5).
+"""Time-domain simulator of the VFF algorithm driving a CARMEL-like robot (docs/simulator.md).
 
 Koren & Borenstein 1991 (KB) §2 (VFF on a histogram grid, eq 1–5) drives the
 synchro-drive robot of §3–4 (steering lag eq 6, |ω| <= 120°/s), sampled
-exactly as the `sampled` loop model (DESIGN §4: ``hold="command"`` or
+exactly as the `sampled` loop model (docs/models.md: ``hold="command"`` or
 ``"reference"``, ``compute_delay`` 0 or 1), so that in the linear regime the
-simulated σ and ω equal the model's dominant pole to round-off.
+simulated σ and ω equal the model's dominant pole to round-off. The
+simulator imports none of the prediction modules (models, criteria,
+regions, report): `pfm_stability.validation` is where the two meet.
 
 Library API
 -----------
@@ -15,28 +17,33 @@ Library API
     f, n, T, hold, compute_delay, L, alpha (rad), offset, duration,
     cell_ratio, law, window_cells, cell_size, speed_law, seed,
     start_jitter`` may be a scalar or a 1-D array (one entry per member).
-    ``BatchResult.stable / .oscillating / .collided`` are bool arrays,
+    ``BatchResult.stable / .oscillating / .collided`` are bool arrays
+    (``stable``: the run settled, see `verdict`),
     ``.growth_rate / .angular_frequency`` masked arrays (masked = undefined,
     the reason is in ``.runs[i].metrics.reason``), ``.runs[i]`` the full
     `RunResult` (events, metrics, inputs, `to_dict`).
-``boundary_by_bisection(name, parameter, lo, hi, *, env, rtol, members, **fixed) -> BoundaryEstimate``
-    The value of L, alpha, V, f, … where the simulated run changes from
-    stable to unstable, by batched bisection (each round simulates
-    `members` values at once).
+``simulated_verdict(run) -> (verdict, basis)`` / ``linearly_stable(batch)``
+    The linear-stability verdict (sign of σ; collision: unstable), what the
+    loop models predict — not the settled flag ``stable`` (module `verdict`).
 ``make_scenario(name, *, robot, controller, env, L, alpha, offset, duration, cell_ratio, law, window_cells, cell_size, speed_law, seed, start_jitter) -> Scenario``
     Presets: ``straight``, ``corridor``, ``wall`` (validation geometries,
     target at infinity) and ``kb-fig3``, ``kb-fig5``, ``kb-fig6-wide``,
     ``kb-fig6-narrow`` (KB's figures; geometry choices in
     `pfm_stability.sim.presets`).
-``predict(scenario) -> Prediction | None``
-    The `sampled` model with the run's own force law (the grid's
-    `GridWallLaw` in the grid) and KB's criterion, for corridor and wall
-    geometries.
+``scenario_law(env, robot, controller, …) -> ForceLaw``
+    The lateral law a straight wall of the environment exerts: the one place
+    that decides it (`Scenario.effective_law`, the presets and the validation use it).
+``measured_wall_force(law, d, angle)``
+    A wall drawn into a grid, its VFF window summed: the check of `GridWallLaw`.
 ``run_batch(scenarios, *, record, metrics) -> BatchResult``
     The engine, for hand-built `Scenario` objects (own grids: `HistogramGrid`;
     analytic walls: `AnalyticEnvironment`).
 ``simulate_reference(scenario) -> (Trajectory, Event | None)``
     The same model in a plain per-robot Python loop (baseline, cross-check).
+
+Predictions for a scenario (`predict`) and the simulated stability boundary
+(`boundary_by_bisection`) join simulations with the models: they are in
+`pfm_stability.validation`.
 
 Environments: ``env="grid"`` (cells of CV 15; the cell ratio ρ = F_cr/F_ct is
 calibrated so that the grid's f_av equals the controller's f unless given,
@@ -45,48 +52,49 @@ KB's lumped power law, or ``law="grid"`` for the grid's averaged law without
 quantization).
 
 Modules: `grid` (histogram grid and drawing), `window` (occupied-cell lists
-of the active windows), `vff` (KB eq 1–5), `robot` (exact steering solution,
-quadrature of the motion), `environment` (analytic walls), `scenario`,
-`presets`, `engine` (batched stepping), `events`, `metrics` (DESIGN §6),
-`results`, `predict`, `bisect`, `api`, `reference`.
+of the active windows), `vff` (KB eq 1–5, the measured wall force), `robot`
+(exact steering solution, quadrature of the motion), `environment` (analytic
+walls), `scenario` (and `scenario_law`), `presets`, `engine` (batched
+stepping), `events`, `metrics` (docs/simulator.md, measuring oscillation),
+`verdict`, `results`, `api`, `reference`.
 """
 
 from .api import simulate, simulate_batch
-from .bisect import BoundaryEstimate, boundary_by_bisection
 from .engine import run_batch
 from .environment import AnalyticEnvironment, AnalyticWall
 from .events import Event
 from .grid import HistogramGrid
 from .metrics import OscillationMetrics, oscillation_metrics
-from .predict import Prediction, predict
 from .presets import SCENARIO_NAMES, barely_avoiding_ratio, make_scenario
 from .reference import simulate_reference
 from .results import BatchResult, RunResult, Trajectory
-from .scenario import MeasureAxis, Pose, Scenario, Target
+from .scenario import MeasureAxis, Pose, Scenario, Target, scenario_law
+from .verdict import linearly_stable, simulated_verdict
+from .vff import measured_wall_force
 
 __all__ = [
     "AnalyticEnvironment",
     "AnalyticWall",
     "BatchResult",
-    "BoundaryEstimate",
     "Event",
     "HistogramGrid",
     "MeasureAxis",
     "OscillationMetrics",
     "Pose",
-    "Prediction",
     "RunResult",
     "SCENARIO_NAMES",
     "Scenario",
     "Target",
     "Trajectory",
     "barely_avoiding_ratio",
-    "boundary_by_bisection",
+    "linearly_stable",
     "make_scenario",
+    "measured_wall_force",
     "oscillation_metrics",
-    "predict",
     "run_batch",
+    "scenario_law",
     "simulate",
     "simulate_batch",
     "simulate_reference",
+    "simulated_verdict",
 ]

@@ -18,7 +18,7 @@ from .presets import make_scenario
 from .results import BatchResult, RunResult
 from .scenario import Scenario
 
-__all__ = ["simulate", "simulate_batch", "ROBOT_PARAMETERS", "CONTROLLER_PARAMETERS", "SCENARIO_PARAMETERS"]
+__all__ = ["simulate", "simulate_batch", "batch_scenarios", "ROBOT_PARAMETERS", "CONTROLLER_PARAMETERS", "SCENARIO_PARAMETERS"]
 
 ROBOT_PARAMETERS = ("V", "tau", "k", "W", "max_steering_rate")
 CONTROLLER_PARAMETERS = ("f", "n", "T", "hold", "compute_delay")
@@ -108,7 +108,7 @@ def simulate_batch(
     Returns
     -------
     BatchResult
-        ``.stable``, ``.oscillating``, ``.collided`` (bool arrays),
+        ``.stable`` (the runs that settled), ``.oscillating``, ``.collided`` (bool arrays),
         ``.growth_rate``, ``.angular_frequency`` (masked arrays) and
         ``.runs[i]`` (events, metrics, inputs) in member order.
 
@@ -119,6 +119,18 @@ def simulate_batch(
     array([False,  True,  True])
     """
     check_choice("record", record, RECORD_MODES)
+    scenarios = batch_scenarios(scenario, env=env, robot=robot, controller=controller, **parameters)
+    return run_batch(scenarios, record=record, metrics=metrics, progress=progress)
+
+
+def batch_scenarios(scenario: str, *, env: str = "grid", robot: Robot | None = None, controller: Controller | None = None, **parameters) -> list:
+    """The member scenarios `simulate_batch` runs for these arguments (nothing is simulated).
+
+    Returns
+    -------
+    list of Scenario
+        One per member, in order; members with equal robots and controllers share them.
+    """
     known = set(ROBOT_PARAMETERS) | set(CONTROLLER_PARAMETERS) | set(SCENARIO_PARAMETERS)
     for name in parameters:
         if name not in known:
@@ -138,4 +150,4 @@ def simulate_batch(
         if key_c not in controllers:
             controllers[key_c] = controller.replace(**c_changes)
         scenarios.append(make_scenario(scenario, robot=robots[key_r], controller=controllers[key_c], env=env, **member))
-    return run_batch(scenarios, record=record, metrics=metrics, progress=progress)
+    return scenarios

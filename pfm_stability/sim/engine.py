@@ -1,11 +1,11 @@
-"""Batch engine: many robots advance together, one sampling period per step (DESIGN §4–5).
+"""Batch engine: many robots advance together, one sampling period per step (docs/simulator.md; the `sampled` loop of docs/models.md).
 
 Every member is a `Scenario`; members may differ in everything (robot,
 controller, environment, target, T). The state of all members lives in
 arrays of shape (B,), and one engine step is one sampling period of each
 member (member m is at t = k·T_m after k steps).
 
-One step, for every member still running (DESIGN §4, the `sampled` model):
+One step, for every member still running (the `sampled` model, docs/models.md):
 
 1. **Events** at t_k (`pfm_stability.sim.events`): collision, target
    reached, trapped. A member with an event stops.
@@ -343,7 +343,7 @@ def run_batch(scenarios, *, record: str = "trajectory", metrics: bool = True, pr
         Keep every sample's (x, y, θ), or only the lateral offset needed by
         the metrics (less memory for large batches).
     metrics : bool
-        Compute the oscillation metrics of each member (DESIGN §6); if
+        Compute the oscillation metrics of each member (docs/simulator.md, measuring oscillation); if
         False, each run's ``metrics`` is None (for timing and sweeps of events).
     progress : callable, optional
         ``progress(step, total)`` is called every 1024 engine steps and once at

@@ -1,4 +1,4 @@
-"""Analytic environment: continuous walls with a chosen force law, no grid (issue 4 item 5).
+"""Analytic environment: continuous walls with a chosen force law, no grid (docs/simulator.md).
 
 KB's analysis (Koren & Borenstein 1991 §3, eq 8–9) replaces the cells of a
 long wall by one lateral force F_r(d) normal to the wall. This module does

@@ -1,4 +1,4 @@
-"""Events that end a run: collision, target reached, trapped (DESIGN §5).
+"""Events that end a run: collision, target reached, trapped (docs/simulator.md).
 
 Events are checked at every sample instant t_k, before the controller senses:
 

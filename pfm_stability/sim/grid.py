@@ -1,4 +1,4 @@
-"""The histogram grid of the VFF method (Koren & Borenstein 1991 §2, DESIGN §5).
+"""The histogram grid of the VFF method (Koren & Borenstein 1991 §2; docs/simulator.md).
 
 Square cells of side c (default 0.1 m) hold integer certainty values (CV,
 0 … `cv_max`, default 15). Cell (i, j) covers

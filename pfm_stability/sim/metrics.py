@@ -1,9 +1,9 @@
-"""Oscillation metrics of a simulated run (DESIGN §6).
+"""Oscillation metrics of a simulated run (docs/simulator.md, measuring oscillation).
 
 The input is the lateral offset x_k of the robot at the sample instants
 t_k = kT inside the measurement window. Two estimators:
 
-**Peaks** (DESIGN §6, robust; used for every run). Turning points of x_k are
+**Peaks** (robust; used for every run). Turning points of x_k are
 found with a hysteresis of 1 % of the window's range (so cell-quantization
 ripple does not count as an oscillation); each swing between consecutive
 turning points gives a half peak-to-peak amplitude a_i at the swing's mid
@@ -37,8 +37,9 @@ Classification: a **limit cycle** is ≥ 4 swings in the second half of the
 window whose amplitudes differ by less than 30 % and whose fitted trend
 changes the amplitude by less than 10 % across that half (in a run that did
 not stay linear; a slow decay, σ = −0.02 1/s over 15 s, is not one); **oscillating** = a limit cycle, or σ > 0 with ω > 0 (a growing
-oscillation); **stable** = no collision, not oscillating, and σ < 0 when σ is
-defined. When too few turning points exist and the fit is rejected, σ and ω
+oscillation); **stable** (the run *settled*) = no collision, not oscillating,
+and σ < 0 when σ is defined — not the linear-stability verdict (the sign of σ)
+that is compared with the models (`pfm_stability.sim.verdict`). When too few turning points exist and the fit is rejected, σ and ω
 are ``None`` with a `reason`, never NaN.
 """
 
@@ -69,7 +70,7 @@ _MIN_SAMPLES = 8
 
 @dataclass(frozen=True)
 class OscillationMetrics:
-    """DESIGN §6 metrics of one run.
+    """Oscillation metrics of one run (docs/simulator.md, measuring oscillation).
 
     Attributes
     ----------
@@ -83,7 +84,9 @@ class OscillationMetrics:
     oscillating : bool
         A growing oscillation or a limit cycle.
     stable : bool
-        No collision, not oscillating, σ < 0 when defined.
+        The run settled: no collision, not oscillating, σ < 0 when defined.
+        (The linear-stability verdict the loop models predict is the sign of
+        σ alone: `pfm_stability.sim.verdict.simulated_verdict`.)
     method : {"linear_prediction", "peaks", "none"}
         Estimator that produced σ and ω.
     turning_points : int
@@ -198,7 +201,7 @@ def _limit_cycle(t, amplitudes, mid):
 
 
 def oscillation_metrics(t, x, T: float, *, order: int = 4, collision_time: float | None = None) -> OscillationMetrics:
-    """Growth rate, frequency, limit cycle and verdict of a sampled lateral offset (DESIGN §6).
+    """Growth rate, frequency, limit cycle and verdict of a sampled lateral offset (docs/simulator.md).
 
     Parameters
     ----------

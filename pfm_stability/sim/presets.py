@@ -46,8 +46,8 @@ Paper figures (geometry KB do not give is chosen to match their text):
     along the grid's Y axis (its effective law is exact there); the first is
     drawn at 30°, a staircase of cells that pushes ≈ 1.33× harder, so the
     robot starts at that staircase's measured equilibrium
-    (`measured_wall_force`). The target is at infinity so α is constant on
-    each section.
+    (`pfm_stability.sim.vff.measured_equilibrium`). The target is at infinity
+    so α is constant on each section.
 ``kb-fig6-wide`` / ``kb-fig6-narrow``
     KB §5.4: f_av = 0.8, n = 2, T = 0.065 s, τ = 0.3 s, V = 0.8 m/s. The
     robot starts on the centre line; at Y = 4 m the left wall steps 0.2 m into
@@ -61,7 +61,8 @@ Force ratio. In the grid, the controller's parameter is the cell ratio
 ρ = F_cr/F_ct; KB's f is an output (f_av). Unless `cell_ratio` is given,
 ρ = `calibrate_cell_ratio(f)`: the ρ whose grid wall has f_av = f averaged
 over the window's working range d ∈ [(W + c)/2, (h + ½)c] = [0.45, 1.65] m
-for CARMEL (ρ = 0.00311 for f = 0.8 with CV 15; `effective_force`).
+for CARMEL (ρ = 0.00311 for f = 0.8 with CV 15; `effective_force`). The law
+of every preset's walls is `pfm_stability.sim.scenario.scenario_law`'s.
 """
 
 from __future__ import annotations
@@ -70,12 +71,14 @@ import math
 from functools import lru_cache
 
 from ..checks import check_choice, check_number
-from ..effective_force import GridWallLaw, calibrate_cell_ratio, f_average, measured_wall_force
-from ..force_law import ForceLaw, PowerLaw
+from ..effective_force import GridWallLaw, f_average
+from ..force_law import ForceLaw
 from ..parameters import CARMEL, RANGES, Controller, Robot, Wall
+from ..solve import bisect_batched
 from .environment import AnalyticEnvironment, AnalyticWall
 from .grid import HistogramGrid
-from .scenario import MeasureAxis, Pose, Scenario, Target
+from .scenario import MeasureAxis, Pose, Scenario, Target, scenario_law
+from .vff import measured_equilibrium
 
 __all__ = ["SCENARIO_NAMES", "ENVS", "LAWS", "make_scenario", "barely_avoiding_ratio"]
 
@@ -145,31 +148,28 @@ def _length(robot, duration) -> float:
 
 
 def _grid_law(name, robot, controller, cell_ratio, window_cells, cell_size) -> tuple[GridWallLaw, str]:
-    """The grid wall's law for this run and how its cell ratio ρ = F_cr/F_ct was set."""
+    """The grid wall's law for this run (`scenario_law`) and how its cell ratio ρ = F_cr/F_ct was set."""
     if cell_ratio is not None:
         ratio, how = check_number("cell_ratio", cell_ratio, 0.0), "given"
     elif name == "kb-fig3":
         ratio = _fig3_ratio(robot, controller, window_cells, cell_size)
         how = "KB's Fig 3 procedure: the smallest ratio that avoids the obstacle (barely_avoiding_ratio)"
     else:
-        ratio = calibrate_cell_ratio(controller.f, controller.n, robot.W, cell_size, window_cells)
+        ratio = None  # scenario_law calibrates
         how = f"calibrated: f_av = {controller.f:g} over d in [(W+c)/2, (h+1/2)c] (calibrate_cell_ratio)"
-    return GridWallLaw(ratio, controller.n, robot.W, cell_size, window_cells), how
+    return scenario_law("grid", robot, controller, window_cells, cell_size, cell_ratio=ratio), how
 
 
 def _law_of(law, env, robot, controller, grid_law):
-    """Analytic mode's lateral law: KB's power law, the grid's averaged law, or a given ForceLaw."""
+    """Analytic mode's lateral law (`scenario_law`): KB's power law, the grid's averaged law, or a given ForceLaw."""
     if env == "grid":
         if law is not None:
             raise ValueError("law applies to env=analytic only (the grid's law is its cells)")
         return None
-    if law is None or law == "power":
-        return PowerLaw(controller.f, controller.n, robot.W)
-    if law == "grid":
-        return grid_law
-    if isinstance(law, ForceLaw):
-        return law
-    check_choice("law", law, LAWS)
+    if law is not None and not isinstance(law, ForceLaw):
+        check_choice("law", law, LAWS)
+        law = grid_law if law == "grid" else None  # "power": KB's law, scenario_law's default
+    return scenario_law("analytic", robot, controller, law=law)
 
 
 def _snap_L(L, cell_size):
@@ -275,20 +275,6 @@ def _fig3(o):
     )
 
 
-@lru_cache(maxsize=16)
-def _staircase_equilibrium(law: GridWallLaw, angle: float, force: float) -> float:
-    """d0 (m) where a wall drawn at `angle` pushes with `force` (measured on a 5 mm grid of d, interpolated)."""
-    import numpy as np
-
-    d = np.arange(law.W / 2 + law.cell_size, law.reach, 0.005)
-    F = measured_wall_force(law, d, angle=angle)
-    below = np.flatnonzero(F < force)
-    if below.size == 0 or below[0] == 0:
-        raise ValueError(f"the drawn wall never pushes with {force:g} F_ct inside the window (d in [{d[0]:g}, {d[-1]:g}] m)")
-    i = below[0]  # first crossing: linear interpolation between the bracketing samples
-    return float(d[i - 1] + (d[i] - d[i - 1]) * (F[i - 1] - force) / (F[i - 1] - F[i]))
-
-
 def _fig5(o):
     walls = _fig5_walls()
     env = o["env"]
@@ -296,7 +282,7 @@ def _fig5(o):
     alpha1 = math.radians(50.0)
     turn = math.radians(30.0)
     if env == "grid":  # the first section is a 30° staircase of cells: its own (stronger) law
-        d0 = _staircase_equilibrium(law, turn, math.cos(alpha1))
+        d0 = measured_equilibrium(law, turn, math.cos(alpha1))
     else:
         d0 = law.distance_for(math.cos(alpha1))
     # start 5 m before the corner, d0 from the first section, heading along it
@@ -477,30 +463,39 @@ def barely_avoiding_ratio(
 ) -> float:
     """KB's own calibration (their Fig 3): the smallest cell ratio with which the head-on run avoids the obstacle.
 
-    Bisection on ρ = F_cr/F_ct by batches: each round simulates `members`
-    ratios spaced geometrically across the bracket at once and keeps the
-    interval between the largest colliding and the smallest avoiding ratio.
+    `pfm_stability.solve.bisect_batched` on ρ = F_cr/F_ct in [1e-4, 0.1]
+    (geometric), `rounds` rounds: the first simulates `members` ratios across
+    the bracket (its ends included) in one batch, each later one the
+    `members` − 2 inside the current bracket; each keeps the interval between
+    the largest colliding and the smallest avoiding ratio.
 
     Returns
     -------
     float
-        ρ, to a relative precision of about (bracket ratio)^(1/members^rounds).
+        ρ, the bracket's avoiding end, to a relative precision of about
+        (bracket ratio)^(1/(members − 1)^rounds).
+
+    Raises
+    ------
+    ValueError
+        If every ratio in [1e-4, 0.1] collides, or none does.
     """
     from .engine import run_batch
 
-    lo, hi = 1e-4, 1e-1
-    for _ in range(rounds):
-        ratios = [lo * (hi / lo) ** (i / (members - 1)) for i in range(members)]
-        result = run_batch(
-            [
-                make_scenario("kb-fig3", robot=robot, controller=controller, cell_ratio=r, window_cells=window_cells, cell_size=cell_size)
-                for r in ratios
-            ],
-            record="offset", metrics=False,
-        )
-        avoided = ~result.collided
-        if not avoided.any() or avoided.all():
-            raise ValueError("kb-fig3: no sign change of the collision over cell ratios in [1e-4, 0.1]")
-        first = int(avoided.argmax())
-        lo, hi = ratios[max(first - 1, 0)], ratios[first]
-    return hi
+    batches = []
+
+    def avoids(ratios):
+        scenarios = [
+            make_scenario("kb-fig3", robot=robot, controller=controller, cell_ratio=float(r), window_cells=window_cells, cell_size=cell_size)
+            for r in ratios
+        ]
+        batches.append(~run_batch(scenarios, record="offset", metrics=False).collided)
+        return batches[-1]
+
+    try:
+        bracket = bisect_batched(avoids, 1e-4, 1e-1, members=members, geometric=True, rtol=0.0, max_rounds=rounds)
+    except ValueError:
+        if len(batches) == 1 and batches[0][0] == batches[0][-1]:  # the same outcome at both ends
+            raise ValueError("kb-fig3: no sign change of the collision over cell ratios in [1e-4, 0.1]") from None
+        raise
+    return bracket.hi

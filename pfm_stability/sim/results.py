@@ -147,7 +147,13 @@ class BatchResult:
 
     @property
     def stable(self) -> np.ndarray:
-        """bool per member."""
+        """bool per member: the run **settled** (`OscillationMetrics.stable`: no collision, no growing
+        oscillation, no limit cycle, σ < 0 when defined).
+
+        Not the linear-stability verdict the loop models predict (sign of σ):
+        that is `pfm_stability.sim.verdict.linearly_stable` (a slow decay
+        flagged as a limit cycle is linearly stable but has not settled).
+        """
         return self._bools("stable")
 
     @property

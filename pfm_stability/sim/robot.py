@@ -82,6 +82,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..solve import gauss_legendre as legendre_nodes
+
 __all__ = [
     "NODES", "RESOLUTION", "MAX_PANELS", "gauss_legendre", "slow_rate", "constant_input_modes", "servo_modes",
     "panel_count", "graded_rule", "node_sum", "Rule", "Coefficients", "constant_input", "servo", "propagate",
@@ -101,9 +103,7 @@ at most 2·NODES + 1 = 9 rad, so any T/τ and |θ̇|·T up to ~45 rad); beyond, 
 
 def gauss_legendre(nodes: int = NODES):
     """Nodes as fractions of an interval (0, 1) and weights summing to 1."""
-    from ..effective_force import _leggauss
-
-    x, w = _leggauss(nodes)
+    x, w = legendre_nodes(nodes)
     return (x + 1) / 2, w / 2
 
 

@@ -6,8 +6,15 @@ naming the parameter (T <= 0, an even window, a robot that does not fit the
 window, a start pose touching an obstacle, a target inside an obstacle, …).
 Presets (``kb-fig3``, ``corridor``, …) live in `pfm_stability.sim.presets`.
 
-Directions are radians from +Y towards +X (DESIGN §2: X lateral, Y along the
-corridor), so heading θ moves the robot by (V sin θ, V cos θ).
+`scenario_law` is the one place that decides which lateral force law a
+straight wall of the simulated environment exerts (the grid's `GridWallLaw`,
+KB's power law, or a given law): `Scenario.effective_law`, the presets, the
+validation and the command line all ask it (docs/simulator.md, grid
+quantization and the effective force law).
+
+Directions are radians from +Y towards +X (docs/theory.md, notation: X
+lateral, Y along the corridor), so heading θ moves the robot by
+(V sin θ, V cos θ).
 """
 
 from __future__ import annotations
@@ -18,16 +25,56 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..checks import check_number
-from ..effective_force import GridWallLaw, calibrate_cell_ratio, check_window_cells, working_range
-from ..force_law import ForceLaw, PowerLaw
+from ..effective_force import DEFAULT_CV, GridWallLaw, calibrate_cell_ratio, check_window_cells, working_range
+from ..force_law import ForceLaw, law_in_force
 from ..parameters import Controller, Robot, check_parameter
 from .environment import AnalyticEnvironment
 from .grid import HistogramGrid
 
-__all__ = ["Pose", "Target", "MeasureAxis", "Scenario", "MAX_SAMPLES"]
+__all__ = ["Pose", "Target", "MeasureAxis", "Scenario", "MAX_SAMPLES", "scenario_law"]
 
 MAX_SAMPLES = 5e7
 """Most samples one run may take (the recorder keeps two float arrays of this length: 800 MB)."""
+
+
+def scenario_law(
+    env: str,
+    robot: Robot,
+    controller: Controller,
+    window_cells: int = 33,
+    cell_size: float = 0.1,
+    *,
+    law: ForceLaw | None = None,
+    cell_ratio: float | None = None,
+    cv: float = DEFAULT_CV,
+) -> ForceLaw:
+    """The lateral force law a straight wall of the simulated environment exerts.
+
+    ``env="grid"``: the grid's `GridWallLaw` (KB eq 1–2 summed over a wall of
+    cells and averaged along it; exact for walls along the grid axes) with
+    cell ratio ρ = `cell_ratio`, or, when not given, the ρ whose f_av equals
+    the controller's f over the window's working range (KB §4,
+    `calibrate_cell_ratio`). ``env="analytic"``: `law`, or KB's power law
+    f(W/d)^n (eq 8, 13).
+
+    Parameters
+    ----------
+    env : {"grid", "analytic"}
+    robot, controller : Robot, Controller
+        W; f and n.
+    window_cells, cell_size, cv
+        Grid window side (odd), cell size (m) and the wall cells' certainty value.
+    law : ForceLaw, optional
+        Analytic walls' law (a grid's law is its cells: not allowed with ``env="grid"``).
+    cell_ratio : float, optional
+        Grid: ρ = F_cr/F_ct.
+    """
+    if env == "grid":
+        if law is not None:
+            raise ValueError("law applies to env=analytic only; the grid's law is its cells")
+        ratio = cell_ratio if cell_ratio is not None else calibrate_cell_ratio(controller.f, controller.n, robot.W, cell_size, window_cells, cv)
+        return GridWallLaw(ratio, controller.n, robot.W, cell_size, window_cells, cv)
+    return law_in_force(robot, controller, law)
 
 
 @dataclass(frozen=True)
@@ -46,7 +93,7 @@ class Pose:
 
 @dataclass(frozen=True)
 class Target:
-    """A point target, or a direction "at infinity" (KB eq 3; DESIGN §5).
+    """A point target, or a direction "at infinity" (KB eq 3; docs/simulator.md).
 
     Use `Target.point` or `Target.direction`. A direction keeps α constant
     along a wall, as KB's analysis assumes (α̇ ≈ 0).
@@ -98,7 +145,7 @@ class Target:
 
 @dataclass(frozen=True)
 class MeasureAxis:
-    """Where and along which line the oscillation metrics are measured (DESIGN §6).
+    """Where and along which line the oscillation metrics are measured (docs/simulator.md, measuring oscillation).
 
     The lateral offset is the coordinate of the robot centre to the right of
     the line through `origin` in direction `angle`; samples count once the
@@ -168,7 +215,7 @@ class Scenario:
     analysis : dict or None
         The linear analysis that applies inside the measurement window:
         ``{"kind": "corridor", "L": m}`` or ``{"kind": "wall", "alpha": rad}``
-        (used by `pfm_stability.sim.predict`); None when none applies.
+        (used by `pfm_stability.validation.predict`); None when none applies.
     seed : int or None
         Seed of the random start jitter (with `start_jitter`).
     start_jitter : float
@@ -232,12 +279,12 @@ class Scenario:
         return "grid" if isinstance(self.environment, HistogramGrid) else "analytic"
 
     def calibrated_ratio(self) -> float:
-        """ρ giving the grid's f_av = controller.f over the working range (KB §4)."""
+        """ρ giving the grid's f_av = controller.f over the working range (KB §4; `scenario_law`)."""
         g = self.environment
-        return calibrate_cell_ratio(self.controller.f, self.controller.n, self.robot.W, g.cell_size, self.window_cells, g.cv_max)
+        return scenario_law("grid", self.robot, self.controller, self.window_cells, g.cell_size, cv=g.cv_max).ratio
 
     def effective_law(self) -> ForceLaw:
-        """The lateral law the analysis should use for this run.
+        """The lateral law the analysis should use for this run (`scenario_law`).
 
         Grid: `GridWallLaw` of a straight wall with this run's ρ, n, W, cells
         and window (exact for straight walls along the grid axes). Analytic:
@@ -245,8 +292,8 @@ class Scenario:
         """
         if self.env == "grid":
             g = self.environment
-            return GridWallLaw(self.cell_ratio, self.controller.n, self.robot.W, g.cell_size, self.window_cells, g.cv_max)
-        return self.law if self.law is not None else PowerLaw(self.controller.f, self.controller.n, self.robot.W)
+            return scenario_law("grid", self.robot, self.controller, self.window_cells, g.cell_size, cell_ratio=self.cell_ratio, cv=g.cv_max)
+        return scenario_law("analytic", self.robot, self.controller, law=self.law)
 
     def clearance(self, x, y) -> np.ndarray:
         """Distance from robot centres to the nearest obstacle, m (minus W/2: < 0 = collision)."""

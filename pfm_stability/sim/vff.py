@@ -10,24 +10,36 @@ printed has the unit vector (x_i − x_0, y_i − y_0)/d, from the robot to the
 cell; their text ("each active cell exerts a virtual repulsive force") and
 eq (9) need the repulsive sign, which is what is implemented here.
 
-Angles follow DESIGN §2 and the `sampled` model: X lateral, Y forward, a
+Angles follow the `sampled` model (docs/theory.md, notation): X lateral, Y forward, a
 direction is measured from +Y towards +X, so a heading θ moves the robot by
 (V sin θ, V cos θ) (KB eq 14) and δ = atan2(R_x, R_y) is the direction of the
 resultant R (eq 4). The steering-rate command is u = k·wrap(δ − θ) (eq 5),
 wrap giving the shortest rotational difference in [−π, π).
+
+`measured_wall_force` sums this window over a wall drawn into a grid: the
+check of the closed-form grid law `pfm_stability.effective_force.GridWallLaw`
+(docs/simulator.md, grid quantization), and the force of walls that are not
+along a grid axis (a staircase of cells), whose equilibrium distance
+`measured_equilibrium` finds.
 """
 
 from __future__ import annotations
 
 import math
+from functools import lru_cache
 
 import numpy as np
+
+from ..solve import gauss_legendre
+from .grid import HistogramGrid
 
 __all__ = [
     "wrap_angle",
     "direction_of",
     "cell_repulsion",
     "window_repulsion",
+    "measured_wall_force",
+    "measured_equilibrium",
     "steering_command",
     "vff_speed",
 ]
@@ -113,6 +125,83 @@ def window_repulsion(grid, px, py, *, ratio, n, W, window_cells=33):
     fx, fy = cell_repulsion(px[:, None], py[:, None], table.wx[row], table.wy[row], table.wcv[row], n)
     scale = ratio * W**n
     return scale * fx, scale * fy
+
+
+def measured_wall_force(law, d, angle: float = 0.0, nodes: int = 24, samples: int = 400) -> np.ndarray:
+    """F_r(d)/F_ct summed cell by cell by the simulator's VFF (KB eq 1–2), averaged along the wall.
+
+    A one-cell-thick wall through the origin is drawn into a `HistogramGrid`
+    (`HistogramGrid.draw_segment`) and the robot sits at distance d from its
+    line on the wall's left side; the component of the window sum along that
+    normal is averaged over the robot's position along the wall.
+
+    * ``angle = 0`` (a wall along Y, cell centres on x = 0): the sum is smooth
+      in the robot's position inside its cell, so Gauss–Legendre with `nodes`
+      nodes over one cell gives the exact average — the check of the closed
+      form of `GridWallLaw`.
+    * other angles (a staircase of cells): the mean over `samples` positions
+      spread evenly over 2 m along the wall (the staircase is not periodic in
+      general); it is stronger than the axis-aligned law (≈ 1.33× at 30°,
+      more cells per metre of wall).
+
+    Parameters
+    ----------
+    law : GridWallLaw
+        Cell ratio, exponent, width, cell size, window and CV.
+    d : array_like
+        Distances robot centre → wall line, m, in (0, reach].
+    angle : float
+        Wall direction, rad from +Y towards +X.
+    nodes, samples : int
+        Quadrature nodes per cell (angle 0) or sample positions (otherwise).
+
+    Returns
+    -------
+    ndarray
+        F_r/F_ct pushing away from the wall (positive).
+    """
+    c, h = law.cell_size, law.window_cells // 2
+    d = np.atleast_1d(np.asarray(d, dtype=float))
+    span = (h + 2) * c + float(np.max(d)) + 1.0
+    grid = HistogramGrid.centred(-span, span, -span, span, cell_size=c)
+    ux, uy = math.sin(angle), math.cos(angle)
+    nx, ny = -uy, ux  # left of the wall direction
+    reach = span - c
+    grid.draw_segment((-reach * ux, -reach * uy), (reach * ux, reach * uy), cv=law.cv)
+    if angle == 0.0:
+        x, w = gauss_legendre(nodes)
+        along, weights = x * c / 2, w / 2  # the cell centred on y = 0
+    else:
+        along = np.linspace(-1.0, 1.0, samples, endpoint=False)
+        weights = np.full(samples, 1.0 / samples)
+    px = d[:, None] * nx + along[None, :] * ux
+    py = d[:, None] * ny + along[None, :] * uy
+    fx, fy = window_repulsion(grid, px.ravel(), py.ravel(), ratio=law.ratio, n=law.n, W=law.W, window_cells=law.window_cells)
+    normal = (fx * nx + fy * ny).reshape(d.size, along.size)
+    return normal @ weights
+
+
+@lru_cache(maxsize=16)
+def measured_equilibrium(law, angle: float, force: float) -> float:
+    """d0 (m) where a wall drawn at `angle` (rad from +Y) pushes with `force` (F_r/F_ct).
+
+    `measured_wall_force` on a 5 mm grid of d from W/2 + c to the window's
+    reach, interpolated linearly at the first sample that pushes less than
+    `force` (KB eq 22–23 for a drawn wall, e.g. the 30° staircase of
+    ``kb-fig5``).
+
+    Raises
+    ------
+    ValueError
+        If the drawn wall never pushes that hard inside the window.
+    """
+    d = np.arange(law.W / 2 + law.cell_size, law.reach, 0.005)
+    F = measured_wall_force(law, d, angle=angle)
+    below = np.flatnonzero(F < force)
+    if below.size == 0 or below[0] == 0:
+        raise ValueError(f"the drawn wall never pushes with {force:g} F_ct inside the window (d in [{d[0]:g}, {d[-1]:g}] m)")
+    i = below[0]  # first crossing: linear interpolation between the bracketing samples
+    return float(d[i - 1] + (d[i] - d[i - 1]) * (F[i - 1] - force) / (F[i - 1] - F[i]))
 
 
 def steering_command(delta, theta, k, max_rate):

@@ -12,7 +12,7 @@ every window are listed once per grid:
   (coordinates rather than indices: a step then gathers whole rows, which
   made the whole 1000-robot step 1.3× faster than gathering cell by cell);
 * ``near[row]`` — the occupied cells whose square lies within W_max/2 of the
-  robot cell's square: the only candidates for a collision (DESIGN §5);
+  robot cell's square: the only candidates for a collision (docs/simulator.md);
 * ``row_of_cell`` — row of each robot cell of the grid padded by h cells on
   every side (a window can see the grid from outside it). Robot cells with no
   occupied cell in their window share row 0 (empty). Cells that no robot of

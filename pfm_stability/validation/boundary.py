@@ -1,28 +1,31 @@
-"""The simulated stability boundary against every model's prediction (issue 5 item 2).
+"""The simulated stability boundary against every model's prediction (docs/validation.md).
 
 `validate_boundary` bisects the simulated boundary of a straight corridor or
 wall (`pfm_stability.sim.presets`: target at infinity, so α is constant as KB
 assume) in one parameter — L (KB eq 25), α (eq 24), V (eq 20) or f (eq 13) —
-and sets every model of DESIGN §4 beside it, each fed the lateral law the
-simulation really has (`Scenario.effective_law`: KB's power law in the
-analytic environment, the grid's `GridWallLaw` in the histogram grid, DESIGN
-§5). In the grid, the predictions of KB's lumped law with the grid's f_av are
-reported beside them, as KB compared (§4).
+and sets every model of docs/models.md beside it, each fed the lateral law
+the simulation really has (`pfm_stability.sim.scenario_law`: KB's power law
+in the analytic environment, the grid's `GridWallLaw` in the histogram grid,
+docs/simulator.md). In the grid, the predictions of KB's lumped law with the
+grid's f_av are reported beside them, as KB compared (§4).
 
-Bisection (DESIGN §6): each round simulates `members` values spread over the
-bracket in one batch (`simulate_batch`), keeps the two neighbours where the
-verdict changes, and stops when the bracket is narrower than `rtol`
-relative. The verdict is the sign of the measured growth rate σ
-(`sim.bisect.simulated_verdict`); the reported boundary interpolates σ linearly to
-zero between the final bracket's ends (σ is smooth in the parameter; the
-midpoint when σ is undefined at an end). In the grid a corridor's walls lie
-on cell centres, so L takes only multiples of c/2 (0.05 m): the bracket is
-then two neighbouring widths and the interpolation of σ gives the boundary
-between them.
+Bisection (`bisection.bisect_boundary`, the package's one batched bisection
+`pfm_stability.solve.bisect_batched`): each round simulates `members` values
+spread over the bracket in one batch (`simulate_batch`), keeps the two
+neighbours where the verdict changes, and stops when the bracket is narrower
+than `rtol` relative. The verdict is the sign of the measured growth rate σ
+(`pfm_stability.sim.verdict.simulated_verdict`); the reported boundary
+interpolates σ linearly to zero between the final bracket's ends (σ is
+smooth in the parameter; the midpoint when σ is undefined at an end). In the
+grid a corridor's walls lie on cell centres, so L takes only multiples of
+c/2 (0.05 m): the bracket is then two neighbouring widths and the
+interpolation of σ gives the boundary between them.
 
 Near the boundary, σ and ω are measured at the boundary and `probe` (3 %)
 either side, and compared with the dominant root of the matching `sampled`
-model at each run's own operating point (`pfm_stability.sim.predict`).
+model at each run's own operating point (`pfm_stability.validation.predict`).
+With ``stability_map=(nx, ny)`` the verdicts on a grid around the boundary and
+every model's boundary curve are added (`region.StabilityMap`).
 """
 
 from __future__ import annotations
@@ -36,11 +39,9 @@ import numpy as np
 from ..checks import check_choice, check_integer, check_number
 from ..criteria import loop_of
 from ..effective_force import GridWallLaw
-from ..force_law import corridor_gain, wall_gain
-from ..models import Sampled
 from ..parameters import CARMEL, Controller, Robot
-from ..serialize import json_number
-from ..sim.bisect import simulated_verdict
+from ..serialize import json_number, json_ready
+from .bisection import ParameterRuns, SimulatedPoint, bisect_boundary, crossing, run_value
 from .common import (
     SCENARIOS,
     default_parameter,
@@ -53,12 +54,13 @@ from .common import (
     scenario_law,
     validation_models,
 )
+from .predict import model_answer, predict
+from .region import StabilityMap, stability_map as simulate_stability_map
 
 __all__ = [
-    "SimulatedPoint",
     "OscillationCheck",
-    "StabilityMap",
     "BoundaryValidation",
+    "SimulatedPoint",  # re-exported from `bisection`: the type of `BoundaryValidation.points`
     "validate_boundary",
     "ENVS",
     "DEFAULT_OFFSET",
@@ -74,37 +76,6 @@ ripples with the robot's position in its cell and forces a response of
 
 
 @dataclass(frozen=True)
-class SimulatedPoint:
-    """One simulated run of the bisection or the stability map.
-
-    Attributes
-    ----------
-    value : float
-        Parameter value (reported units: L m, α deg, V m/s, f).
-    verdict : str
-        "stable" or "unstable" (`sim.bisect.simulated_verdict`).
-    basis : str
-        "growth_rate", "collision" or "metrics".
-    growth_rate : float or None
-        Measured σ, 1/s.
-    x : float or None
-        Second coordinate in a stability map (None in the bisection).
-    """
-
-    value: float
-    verdict: str
-    basis: str
-    growth_rate: float | None
-    x: float | None = None
-
-    def to_dict(self) -> dict:
-        """Plain JSON form (field name → value; numbers by `serialize.json_number`)."""
-        from ..serialize import json_ready
-
-        return json_ready(dict(self.__dict__))
-
-
-@dataclass(frozen=True)
 class OscillationCheck:
     """σ and ω measured near the boundary against the matching `sampled` model's dominant root.
 
@@ -113,7 +84,7 @@ class OscillationCheck:
     value : float
         Parameter value of the run (reported units; for a grid corridor the L actually drawn).
     growth_rate, angular_frequency : float or None
-        Measured σ (1/s) and ω (rad/s), DESIGN §6.
+        Measured σ (1/s) and ω (rad/s) (docs/simulator.md, measuring oscillation).
     method : str
         Estimator: "linear_prediction" (exact for a linear run) or "peaks".
     predicted_growth_rate, predicted_angular_frequency : float
@@ -135,59 +106,7 @@ class OscillationCheck:
 
     def to_dict(self) -> dict:
         """Plain JSON form (field name → value; numbers by `serialize.json_number`)."""
-        from ..serialize import json_ready
-
         return json_ready(dict(self.__dict__))
-
-
-@dataclass(frozen=True)
-class StabilityMap:
-    """Simulated verdicts on a grid of two parameters, and every model's boundary curve.
-
-    Attributes
-    ----------
-    x_name, x_unit : str
-        Horizontal parameter: V, or the geometry (L, α) when V is bisected.
-    y_name, y_unit : str
-        The bisected parameter.
-    points : tuple of SimulatedPoint
-        ``value`` is y, ``x`` is x.
-    curve_x : tuple of float
-    curves : dict
-        Model name → critical y at each ``curve_x`` (None where infinite).
-    lumped_curves : dict or None
-        The same with KB's lumped law (grid only).
-    nominal_x : float
-        Where the bisection ran.
-    """
-
-    x_name: str
-    x_unit: str
-    y_name: str
-    y_unit: str
-    points: tuple
-    curve_x: tuple
-    curves: dict
-    lumped_curves: dict | None
-    nominal_x: float
-
-    def to_dict(self) -> dict:
-        """Plain JSON form; a curve value is ``"inf"`` where infinite, null where the curve has no value
-        inside the plotted range (numbers by `serialize.json_number`)."""
-        from ..serialize import json_ready
-
-        curves = lambda d: None if d is None else {k: [json_number(v) for v in values] for k, values in d.items()}
-        return {
-            "x_name": self.x_name,
-            "x_unit": self.x_unit,
-            "y_name": self.y_name,
-            "y_unit": self.y_unit,
-            "points": [p.to_dict() for p in self.points],
-            "curve_x": json_ready(list(self.curve_x)),
-            "curves": curves(self.curves),
-            "lumped_curves": curves(self.lumped_curves),
-            "nominal_x": json_number(self.nominal_x),
-        }
 
 
 @dataclass(frozen=True)
@@ -230,6 +149,8 @@ class BoundaryValidation:
         Simulations run.
     seconds : float
         Wall-clock time, s.
+    models : tuple of LoopModel
+        The validated models, configured (labels and styles for plotting; not in `to_dict`).
     """
 
     scenario: str
@@ -251,6 +172,7 @@ class BoundaryValidation:
     notes: dict = field(default_factory=dict)
     runs: int = 0
     seconds: float = 0.0
+    models: tuple = ()
 
     def to_dict(self) -> dict:
         """JSON form: ``parameter``, ``simulated_boundary``, ``predicted_boundary``, ``relative_error``,
@@ -260,8 +182,6 @@ class BoundaryValidation:
         has ``"inf"`` as its predicted boundary and relative error; undefined
         values are null.
         """
-        from ..serialize import json_ready
-
         s = self.simulated_boundary
 
         def relative(predicted, errors):
@@ -300,140 +220,13 @@ class BoundaryValidation:
 
 
 # ------------------------------------------------------------------ helpers
-def _values(lo, hi, members, quantum):
-    """`members` values spread over [lo, hi]; multiples of `quantum` when given (unique)."""
-    if quantum is None:
-        return np.linspace(lo, hi, members)
-    k0, k1 = math.ceil(lo / quantum - 1e-9), math.floor(hi / quantum + 1e-9)  # stay inside [lo, hi]
-    k = np.unique(np.round(np.linspace(k0, k1, members))) if k1 >= k0 else np.array([])
-    return k * quantum
-
-
 def _snap(value, quantum, how=round):
     """`value` rounded (or floored, ceiled) to a multiple of `quantum`."""
     return how(value / quantum) * quantum
 
 
-class _Simulator:
-    """Runs batches of one scenario with one parameter varied (and optionally a second one)."""
-
-    def __init__(self, scenario, env, robot, controller, fixed, common):
-        self.scenario, self.env = scenario, env
-        self.robot, self.controller = robot, controller
-        self.fixed = fixed
-        self.common = common
-        self.runs = 0
-
-    @staticmethod
-    def _sim_values(name, values):
-        return np.radians(values) if name == "alpha" else np.asarray(values, dtype=float)
-
-    def __call__(self, name, values, second=None):
-        from ..sim.api import simulate_batch
-
-        arrays = {name: self._sim_values(name, values)}
-        if second is not None:
-            arrays[second[0]] = self._sim_values(second[0], second[1])
-        fixed = {k: v for k, v in self.fixed.items() if k not in arrays}
-        batch = simulate_batch(
-            self.scenario, env=self.env, robot=self.robot, controller=self.controller, record="offset", metrics=True,
-            **fixed, **self.common, **arrays,
-        )
-        self.runs += len(batch)
-        return batch.runs
-
-
-def _actual(run, name):
-    """The parameter value a run really used (reported units): grid corridors snap L to c/2."""
-    s = run.scenario
-    if name == "L":
-        return float(s.analysis["L"])
-    if name == "alpha":
-        return math.degrees(s.analysis["alpha"])
-    if name == "V":
-        return s.robot.V
-    return s.controller.f
-
-
-def _point(run, name, x_name=None) -> SimulatedPoint:
-    verdict, basis = simulated_verdict(run)
-    sigma = run.metrics.growth_rate
-    return SimulatedPoint(_actual(run, name), verdict, basis, sigma, _actual(run, x_name) if x_name else None)
-
-
-def _bisect(simulate, name, p, domain, *, stable_above, members, rtol, quantum, progress):
-    """Bracket around the prediction p, then batched bisection.
-
-    Returns
-    -------
-    (SimulatedPoint, SimulatedPoint, list, dict)
-        The final bracket's low and high ends, every run, notes.
-    """
-    points = []
-    notes = {}
-    width = 1.25
-    for _ in range(5):  # widen the bracket (1.25, 1.56, 2.4, 5.96, 35.5) until the verdicts at its ends differ
-        lo = max(domain[0], p / width)
-        hi = min(domain[1], p * width)
-        values = _values(lo, hi, members, quantum)
-        if values.size < 2:
-            raise ValueError(f"{name}: the bracket [{lo:g}, {hi:g}] holds fewer than two values the simulator can represent")
-        runs = simulate(name, values)
-        pts = [_point(r, name) for r in runs]
-        points += pts
-        low_expected = "unstable" if stable_above else "stable"
-        if pts[0].verdict == low_expected and pts[-1].verdict != low_expected:
-            break
-        if lo <= domain[0] and hi >= domain[1]:
-            break
-        width = width**2
-    if pts[0].verdict == pts[-1].verdict:
-        raise ValueError(
-            f"{name}: the simulated verdict is {pts[0].verdict} at both ends of [{pts[0].value:g}, {pts[-1].value:g}] "
-            f"around the sampled model's prediction {p:g}; no boundary to bisect"
-        )
-    rounds = 1
-    seq = pts
-    while True:
-        change = next(i for i in range(1, len(seq)) if seq[i].verdict == seq[-1].verdict)
-        changes = sum(a.verdict != b.verdict for a, b in zip(seq[:-1], seq[1:]))
-        if changes > 1:
-            notes["non_monotone"] = f"the verdict changed {changes} times inside one bracket; the change nearest the low end was kept"
-        lo_pt, hi_pt = seq[change - 1], seq[change]
-        lo, hi = lo_pt.value, hi_pt.value
-        if progress:
-            progress(f"round {rounds}: {name} in [{lo:.6g}, {hi:.6g}]")
-        if quantum is not None:
-            if round(hi / quantum) - round(lo / quantum) <= 1:
-                break
-        elif hi - lo <= rtol * abs(lo + hi) / 2:
-            break
-        if rounds >= 30:
-            notes["rounds"] = "stopped after 30 rounds"
-            break
-        inner = _values(lo, hi, members, quantum)[1:-1]
-        if inner.size == 0:
-            break
-        runs = simulate(name, inner)
-        new = [_point(r, name) for r in runs]
-        points += new
-        seq = [lo_pt] + new + [hi_pt]
-        rounds += 1
-    notes.setdefault("rounds", f"{rounds} round{'s' if rounds > 1 else ''} of at most {members} runs")
-    return lo_pt, hi_pt, points, notes
-
-
-def _crossing(lo_pt, hi_pt):
-    """Zero of σ by linear interpolation between the bracket's ends (midpoint when σ is not usable)."""
-    a, b = lo_pt.growth_rate, hi_pt.growth_rate
-    if lo_pt.basis == hi_pt.basis == "growth_rate" and a is not None and b is not None and a * b < 0:
-        return lo_pt.value + (hi_pt.value - lo_pt.value) * a / (a - b)
-    return (lo_pt.value + hi_pt.value) / 2
-
-
 def _oscillation(runs, name) -> tuple:
-    from ..sim.predict import predict
-
+    """σ, ω of each run against the matching `sampled` model's dominant root at its own operating point (`predict`)."""
     out = []
     for run in runs:
         m = run.metrics
@@ -441,7 +234,7 @@ def _oscillation(runs, name) -> tuple:
         sigma, omega = m.growth_rate, m.angular_frequency
         out.append(
             OscillationCheck(
-                value=_actual(run, name),
+                value=run_value(run, name),
                 growth_rate=sigma,
                 angular_frequency=omega,
                 method=m.method,
@@ -454,86 +247,11 @@ def _oscillation(runs, name) -> tuple:
     return tuple(out)
 
 
-def _gain(scenario, parameter, y, law, geometry, f):
-    """Environment gain N (1/m) with `parameter` = y (reported units) and the rest fixed."""
-    if parameter == "f":
-        law = law.with_scale(law.scale * y / f)
-    elif parameter == "L":
-        geometry = y
-    elif parameter == "alpha":
-        geometry = math.radians(y)
-    return corridor_gain(law, geometry) if scenario == "corridor" else wall_gain(law, geometry)[1]
-
-
-def _curves(scenario, parameter, x_name, xs, y_range, robot, controller, law, geometry, models):
-    """Critical `parameter` of each model at each x, for drawing.
-
-    x = V: the boundary is N(y)·V = NV*, and N does not depend on V, so N is
-    tabulated once over `y_range` (400 points) and inverted by interpolation
-    of log N (exact to plotting precision; None outside the table). x = L or
-    α (V bisected): V* = NV*/N(x) directly.
-    """
-    loop = loop_of(robot, controller)
-    stars = {m.name: m.boundary(loop).NV_critical for m in models}
-    if x_name != "V":
-        N = np.array([_gain(scenario, x_name, x, law, geometry, controller.f) for x in xs])
-        return {name: [json_number(s / n) if n > 0 else None for n in N] for name, s in stars.items()}
-    ys = np.linspace(y_range[0], y_range[1], 400)
-    N = np.array([_gain(scenario, parameter, y, law, geometry, controller.f) for y in ys])
-    ok = N > 0
-    order = np.argsort(N[ok])
-    logN, table = np.log(N[ok][order]), ys[ok][order]
-    out = {}
-    for name, s in stars.items():
-        values = []
-        for x in xs:
-            target = math.log(s / x) if math.isfinite(s) and s > 0 else math.nan
-            inside = logN.size > 1 and logN[0] <= target <= logN[-1]
-            values.append(float(np.interp(target, logN, table)) if inside else None)
-        out[name] = values
-    return out
-
-
-def _map(simulate, scenario, spec, env, robot, controller, law, geometry, boundary, domain, shape, cell_size, models, progress):
-    """Simulate an nx × ny map around the boundary in one batch, and every model's boundary curve over it."""
-    nx, ny = shape
-    quantum = cell_size / 2 if env == "grid" else None  # grid corridors: L in steps of c/2
-    geometry_name = "L" if scenario == "corridor" else "alpha"
-    x_name = geometry_name if spec.name == "V" else "V"
-    if x_name == "V":
-        x0 = robot.V
-        x_lo, x_hi = 0.6 * x0, 1.4 * x0
-        x_quantum = None
-    else:
-        x0 = geometry if x_name == "L" else math.degrees(geometry)
-        x_dom = parameter_domain(x_name, scenario, env, robot, controller, law, None, cell_size)
-        x_lo, x_hi = max(0.75 * x0, x_dom[0]), min(1.25 * x0, x_dom[1])
-        x_quantum = quantum if x_name == "L" else None
-    xs = _values(x_lo, x_hi, nx, x_quantum)
-    ys = _values(max(0.7 * boundary, domain[0]), min(1.3 * boundary, domain[1]), ny, quantum if spec.name == "L" else None)
-    X, Y = np.meshgrid(xs, ys, indexing="ij")
-    if progress:
-        progress(f"stability map: {X.size} runs")
-    runs = simulate(spec.name, Y.ravel(), second=(x_name, X.ravel()))
-    points = tuple(_point(r, spec.name, x_name) for r in runs)
-    curve_x = np.linspace(xs.min(), xs.max(), 41)
-    y_range = (max(0.5 * ys.min(), domain[0]), min(1.5 * ys.max(), domain[1]))
-    curves = _curves(scenario, spec.name, x_name, curve_x, y_range, robot, controller, law, geometry, models)
-    lumped = None
-    if isinstance(law, GridWallLaw):
-        lumped = _curves(scenario, spec.name, x_name, curve_x, y_range, robot, controller, lumped_law(law), geometry, models)
-    units = {"V": "m/s", "L": "m", "alpha": "deg"}
-    return StabilityMap(x_name, units[x_name], spec.name, spec.unit, points, tuple(curve_x.tolist()), curves, lumped, float(x0))
-
-
 # --------------------------------------------------------------------- API
 def _no_boundary_message(parameter: str, predicted: float, models, robot, controller) -> str:
     """Why there is no simulated boundary to bisect, and what would give one."""
-    from ..criteria import loop_of
-
-    loop = loop_of(robot, controller)
     sampled = next(m for m in models if m.name == "sampled")
-    NV_star = sampled.boundary(loop).NV_critical
+    NV_star = model_answer(sampled, loop_of(robot, controller)).NV_critical
     if NV_star == 0:
         return (
             f"{parameter}: the sampled loop is unstable at every NV for these parameters (NV* = 0: unstable at any speed), "
@@ -659,7 +377,8 @@ def validate_boundary(
         predicted_boundaries(scenario, parameter, robot, controller, lumped, geometry, models) if lumped is not None else None
     )
 
-    boundary = Sampled(controller.hold, controller.compute_delay).boundary(loop_of(robot, controller))
+    sampled = next(m for m in models if m.name == "sampled")
+    boundary = model_answer(sampled, loop_of(robot, controller))
     if duration is None:
         period = 2 * math.pi / boundary.omega_critical if boundary.omega_critical else 0.0
         duration = min(150.0, max(20.0 if env == "analytic" else 30.0, 10 * period))
@@ -684,15 +403,15 @@ def validate_boundary(
     common = dict(offset=offset, duration=duration)
     if env == "grid":
         common.update(window_cells=window_cells, cell_size=cell_size)
-    simulate = _Simulator(scenario, env, robot, controller, fixed, common)
+    simulate = ParameterRuns(scenario, env, robot, controller, fixed, common)
 
     if progress:
         progress(f"validate {scenario} ({env}): bisecting {parameter} around the sampled prediction {p:.6g} {spec.unit}".rstrip())
-    lo_pt, hi_pt, points, notes = _bisect(
+    lo_pt, hi_pt, points, notes = bisect_boundary(
         simulate, parameter, p, domain, stable_above=spec.stable_above(scenario), members=members, rtol=rtol,
         quantum=quantum, progress=progress,
     )
-    simulated = _crossing(lo_pt, hi_pt)
+    simulated = crossing(lo_pt, hi_pt)
 
     # σ and ω at the boundary and `probe` either side
     probes = [simulated * (1 - probe), simulated, simulated * (1 + probe)]
@@ -706,7 +425,7 @@ def validate_boundary(
     smap = None
     if stability_map is not None:
         shape = tuple(check_integer("stability_map", int(v), 2, 50) for v in stability_map)
-        smap = _map(simulate, scenario, spec, env, robot, controller, law, geometry, simulated, domain, shape, cell_size, models, progress)
+        smap = simulate_stability_map(simulate, scenario, spec, env, robot, controller, law, geometry, simulated, domain, shape, cell_size, models, progress)
 
     notes = dict(notes)
     notes["verdict"] = "sign of the measured growth rate sigma (collision: unstable); boundary where sigma crosses 0, interpolated linearly between the final bracket's ends"
@@ -761,4 +480,5 @@ def validate_boundary(
         notes=notes,
         runs=simulate.runs,
         seconds=time.perf_counter() - started,
+        models=tuple(models),
     )

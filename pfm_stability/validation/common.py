@@ -1,13 +1,18 @@
-"""What the validations share: the bisected parameters, the simulated verdict, the model set.
+"""What the validations share: the bisected parameters, their domains, the model set, predicted boundaries.
 
-The simulated verdict (DESIGN §6) is the sign of the measured growth rate σ,
-not `OscillationMetrics.stable`: that flag also calls a run "not stable" when
-its swings change by less than 10 % over the second half of the window (the
+The simulated verdict is the sign of the measured growth rate σ
+(`pfm_stability.sim.verdict.simulated_verdict`), not the settled flag
+`OscillationMetrics.stable`: that flag also calls a run "not stable" when its
+swings change by less than 10 % over the second half of the window (the
 limit-cycle test), which near the boundary catches slowly *decaying*
 oscillations (|σ| ≲ ln 1.1/(duration/2) ≈ 0.006 1/s over 30 s) and would bias
 every bisected boundary towards the stable side — measured on the grid wall
 at α = 33°: σ = −0.0009 1/s, flagged as a limit cycle. The loop models have
-no limit cycle; the quantity they predict is σ.
+no limit cycle; the quantity they predict is σ (docs/validation.md).
+
+The lateral law a validation geometry sees is `pfm_stability.sim.scenario_law`'s
+(re-exported here); the models are asked through `predict.model_answer` and
+`predict.critical_value` only.
 """
 
 from __future__ import annotations
@@ -15,11 +20,13 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from ..criteria import critical_alpha, critical_f_corridor, critical_f_wall, critical_L, loop_of
-from ..effective_force import GridWallLaw, calibrate_cell_ratio, f_average
-from ..force_law import ForceLaw, PowerLaw, corridor_gain, wall_gain
+from ..criteria import loop_of
+from ..effective_force import GridWallLaw, f_average
+from ..force_law import ForceLaw
 from ..models import MODEL_NAMES, make_model
 from ..parameters import CARMEL, Controller, Robot
+from ..sim.scenario import scenario_law
+from .predict import critical_value, lumped_law, model_answer
 
 __all__ = [
     "SCENARIOS",
@@ -79,7 +86,7 @@ PARAMETERS = {
     "V": ParameterSpec("V", "m/s", SCENARIOS),
     "f": ParameterSpec("f", "", SCENARIOS),
 }
-"""The parameters `validate_boundary` bisects (issue 5 item 2: L, α or V; f as KB's tuning knob, §3)."""
+"""The parameters `validate_boundary` bisects (L, α or V; f as KB's tuning knob, §3; docs/validation.md)."""
 
 
 def parameter_spec(scenario: str, parameter: str) -> ParameterSpec:
@@ -102,16 +109,11 @@ def default_parameter(scenario: str) -> str:
 
 
 def validation_models(controller: Controller, pade_order: int = 3) -> list:
-    """The five models of DESIGN §4, ``sampled`` with the controller's hold and compute delay."""
+    """The five models of docs/models.md, ``sampled`` with the controller's hold and compute delay."""
     return [
         make_model(name, pade_order=pade_order, hold=controller.hold, compute_delay=controller.compute_delay)
         for name in MODEL_NAMES
     ]
-
-
-def lumped_law(law: ForceLaw) -> PowerLaw:
-    """KB's lumped law beside a grid law: f = the grid's f_av (KB §4); a power law is its own."""
-    return law.lumped() if isinstance(law, GridWallLaw) else law
 
 
 def predicted_boundaries(
@@ -119,10 +121,9 @@ def predicted_boundaries(
 ) -> dict:
     """Each model's critical value of `parameter` (reported units), all else fixed.
 
-    From each model's NV* (`LoopModel.boundary`, cached per loop) through the
-    general-law conditions of `pfm_stability.criteria` (KB eq 20 with 1/NV*
-    in place of τ + T): L* (`critical_L`, eq 25), α* (`critical_alpha`,
-    eq 24), V* = NV*/N, f* (`critical_f_corridor`, `critical_f_wall`).
+    Each model's NV* (`predict.model_answer`) through `predict.critical_value`
+    (the general-law conditions of `pfm_stability.criteria`, KB eq 20 with
+    1/NV* in place of τ + T): L* (eq 25), α* (eq 24), V* = NV*/N, f*.
 
     Parameters
     ----------
@@ -145,23 +146,10 @@ def predicted_boundaries(
     """
     parameter_spec(scenario, parameter)
     loop = loop_of(robot, controller)
-    V = robot.V
-    out = {}
-    for model in models:
-        NV_star = model.boundary(loop).NV_critical
-        if parameter == "L":
-            value = critical_L(law, V, NV_star)
-        elif parameter == "alpha":
-            value = math.degrees(critical_alpha(law, V, NV_star))
-        elif parameter == "V":
-            N = corridor_gain(law, geometry) if scenario == "corridor" else wall_gain(law, geometry)[1]
-            value = NV_star / N if N > 0 else math.inf
-        elif scenario == "corridor":
-            value = critical_f_corridor(law, geometry, V, NV_star) * controller.f / law.scale
-        else:
-            value = critical_f_wall(law, geometry, V, NV_star) * controller.f / law.scale
-        out[model.name] = float(value)
-    return out
+    return {
+        model.name: critical_value(parameter, scenario, law, robot.V, model_answer(model, loop).NV_critical, geometry, controller.f)
+        for model in models
+    }
 
 
 def relative_errors(predicted: dict, simulated: float) -> dict:
@@ -175,19 +163,6 @@ def relative_errors(predicted: dict, simulated: float) -> dict:
 def f_av_of(law: ForceLaw) -> float:
     """KB's f_av of a grid law (§4), or a power law's f."""
     return f_average(law) if isinstance(law, GridWallLaw) else law.scale
-
-
-def scenario_law(env: str, robot: Robot, controller: Controller, window_cells: int = 33, cell_size: float = 0.1) -> ForceLaw:
-    """The lateral law `make_scenario` gives a straight wall or corridor.
-
-    Analytic: KB's power law f(W/d)^n (eq 8, 13). Grid: `GridWallLaw` with the
-    cell ratio calibrated so that its f_av equals the controller's f (KB §4,
-    `calibrate_cell_ratio`), exactly as the ``corridor`` and ``wall`` presets do.
-    """
-    if env == "analytic":
-        return PowerLaw(controller.f, controller.n, robot.W)
-    ratio = calibrate_cell_ratio(controller.f, controller.n, robot.W, cell_size, window_cells)
-    return GridWallLaw(ratio, controller.n, robot.W, cell_size, window_cells)
 
 
 def parameter_domain(parameter: str, scenario: str, env: str, robot: Robot, controller: Controller, law: ForceLaw, alpha, cell_size: float = 0.1):

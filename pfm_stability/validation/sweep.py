@@ -1,4 +1,4 @@
-"""Random parameter sets: does the sign of the simulated growth rate agree with each model? (issue 5 item 3)
+"""Random parameter sets: does the sign of the simulated growth rate agree with each model? (docs/validation.md)
 
 `verdict_sweep` draws `count` parameter sets from a seeded Latin hypercube
 (`scipy.stats.qmc.LatinHypercube`) over `SWEEP_RANGES` — V, τ, T, k, f and
@@ -11,10 +11,12 @@ starting `offset` from equilibrium for long enough to measure σ (8 periods
 of the sampled model's boundary oscillation, 20–150 s, at most 4000 samples).
 
 Each member's NV comes from its own scenario (`Scenario.effective_law`,
-`Scenario.analysis`: the grid's law and the L actually drawn in the grid).
+`Scenario.analysis`: the grid's law and the L actually drawn in the grid), and
+each model is asked through `predict.model_answer` (the validation's one path
+to the models; a verdict within `UNDECIDED_RTOL` of a boundary is "undecided").
 Members within `exclude` (3 %) of the `sampled` model's boundary in NV,
 |NV/NV* − 1| < `exclude`, are excluded: there σ is too small to tell from
-zero. On the rest, the simulated verdict (sign of σ, `sim.bisect.simulated_verdict`)
+zero. On the rest, the simulated verdict (sign of σ, `pfm_stability.sim.verdict.simulated_verdict`)
 is compared with every model's verdict: the agreement with ``sampled`` is
 the validation, the other models' wrong-verdict rates say how misleading
 they are for a sampled robot (KB's ``kb_first_order`` eq 20, the delay
@@ -30,12 +32,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..checks import check_choice, check_integer, check_number
-from ..force_law import corridor_gain, wall_gain
 from ..models import Loop, MODEL_NAMES, make_model
 from ..parameters import CARMEL, Controller, Robot
-from ..serialize import json_number
-from ..sim.bisect import simulated_verdict
+from ..serialize import json_number, json_ready
+from ..sim.api import simulate_batch
+from ..sim.verdict import simulated_verdict
 from .common import SCENARIOS, parameter_domain, scenario_law
+from .predict import environment_gain, model_answer
 
 __all__ = ["SWEEP_RANGES", "STRUCTURES", "SweepPoint", "SweepResult", "verdict_sweep", "sweep_parameters"]
 
@@ -61,7 +64,7 @@ cells of 0.1 m, and the robot clears the wall (`common.parameter_domain`):
 beyond the window's reach the grid wall exerts no force at all."""
 
 STRUCTURES = (("command", 0), ("command", 1), ("reference", 0), ("reference", 1))
-"""The sampled structures of DESIGN §4, in the order members take them."""
+"""The sampled structures of docs/models.md, in the order members take them."""
 
 _DIMENSIONS = ("V", "tau", "T", "k", "f", "geometry")
 
@@ -150,8 +153,6 @@ class SweepPoint:
 
     def to_dict(self) -> dict:
         """Plain JSON form with ``gain_ratio``; numbers by `serialize.json_number` (infinite NV* → ``"inf"``)."""
-        from ..serialize import json_ready
-
         out = json_ready(dict(self.__dict__))
         out["model_NV_critical"] = {k: json_number(v) for k, v in self.model_NV_critical.items()}
         out["gain_ratio"] = json_number(self.gain_ratio)
@@ -207,8 +208,6 @@ class SweepResult:
         ``agreement`` and ``wrong_verdict_rate`` are null (undefined) when no
         set was included; wall-clock ``seconds`` is under ``timing``.
         """
-        from ..serialize import json_ready
-
         out = {
             "count": int(self.count),
             "seed": int(self.seed),
@@ -303,7 +302,6 @@ def verdict_sweep(
     -------
     SweepResult
     """
-    from ..sim.api import simulate_batch
     from .boundary import DEFAULT_OFFSET
 
     started = time.perf_counter()
@@ -390,26 +388,18 @@ def verdict_sweep(
 def _assess(index, kind, robot, controller, run, models, exclude) -> SweepPoint:
     """Predictions at the member's own operating point, and its simulated verdict."""
     s = run.scenario
-    law = s.effective_law()
-    if kind == "corridor":
-        geometry = float(s.analysis["L"])
-        N = corridor_gain(law, geometry)
-    else:
-        geometry = math.degrees(s.analysis["alpha"])
-        N = wall_gain(law, s.analysis["alpha"])[1]
-    NV = N * robot.V
+    operating = s.analysis["L"] if kind == "corridor" else s.analysis["alpha"]
+    geometry = float(operating) if kind == "corridor" else math.degrees(operating)
+    NV = environment_gain(kind, s.effective_law(), operating) * robot.V
     loop = Loop(robot.tau, controller.T, robot.k)
     sampled = make_model("sampled", hold=controller.hold, compute_delay=controller.compute_delay)
-    NV_star = sampled.boundary(loop).NV_critical
-    verdicts, critical = {}, {}
-    for name in COMPARED_MODELS:
-        model = sampled if name == "sampled" else models[name]
-        b = model.boundary(loop)
-        critical[name] = b.NV_critical
-        if math.isfinite(b.NV_critical) and b.NV_critical > 0 and abs(NV / b.NV_critical - 1) <= 1e-9:
-            verdicts[name] = "undecided"
-        else:
-            verdicts[name] = "stable" if model.is_stable(NV, loop) else "unstable"
+    answers = {
+        name: model_answer(sampled if name == "sampled" else models[name], loop, NV, root=name == "sampled")
+        for name in COMPARED_MODELS
+    }
+    NV_star = answers["sampled"].NV_critical
+    verdicts = {name: a.verdict for name, a in answers.items()}
+    critical = {name: a.NV_critical for name, a in answers.items()}
     simulated, basis = simulated_verdict(run)
     m = run.metrics
     return SweepPoint(
@@ -430,7 +420,7 @@ def _assess(index, kind, robot, controller, run, models, exclude) -> SweepPoint:
         simulated=simulated,
         basis=basis,
         growth_rate=m.growth_rate,
-        predicted_growth_rate=sampled.rightmost_root(NV, loop).real,
+        predicted_growth_rate=answers["sampled"].root.real,
         method=m.method,
         excluded=bool(math.isfinite(NV_star) and NV_star > 0 and abs(NV / NV_star - 1) < exclude),
     )

@@ -1,0 +1,381 @@
+"""Text, Markdown and LaTeX renderings of what the commands print (JSON is `serialize.dumps`).
+
+One module for every human-readable rendering, with the number formatters
+they share:
+
+* ``report``: `render_text` and `render_markdown` of a `StabilityReport`,
+  rendered from its JSON form (`StabilityReport.to_dict`), so the text says
+  exactly what the JSON says;
+* ``derive``: `render_derivation_text` (sympy's pretty printer) and
+  `render_derivation_latex` (one ``equation*`` per step) of
+  `pfm_stability.derivation.derivation`.
+
+Nothing heavy is imported at module level: sympy only inside the derivation
+renderers.
+"""
+
+from __future__ import annotations
+
+import math
+import textwrap
+
+from ..parameters import RANGES, SHOWN_AS
+
+__all__ = [
+    "number",
+    "percent",
+    "table",
+    "render_text",
+    "render_markdown",
+    "render_derivation_text",
+    "render_derivation_latex",
+    "render_simulation_text",
+    "render_validation_text",
+    "render_sweep_text",
+    "render_traps_text",
+]
+
+
+# ------------------------------------------------------------------ numbers
+def number(x, digits: int = 4) -> str:
+    """A JSON number as text: ``digits`` significant digits, "-" undefined (None), "inf"/"-inf", strings as they are."""
+    if x is None:
+        return "-"
+    if isinstance(x, str):
+        return x
+    if math.isinf(x):
+        return "inf" if x > 0 else "-inf"
+    return f"{x:.{digits}g}"
+
+
+def percent(x) -> str:
+    """A JSON ratio as a signed percentage with one decimal ("-" undefined, "inf" infinite)."""
+    if x is None or isinstance(x, str):
+        return number(x)
+    return f"{x * 100:+.1f}%"
+
+
+def table(header, rows, sep: str = "  ") -> list[str]:
+    """Aligned text table: the first column left-aligned, the others right-aligned; one string per line."""
+    widths = [max(len(str(r[i])) for r in [header] + rows) for i in range(len(header))]
+
+    def line(cells):
+        return sep.join(str(c).ljust(w) if i == 0 else str(c).rjust(w) for i, (c, w) in enumerate(zip(cells, widths)))
+
+    return [line(header)] + [line(r) for r in rows]
+
+
+# ------------------------------------------------------------------ report
+_LABELS = {
+    "V": "V (speed)",
+    "tau": "tau (steering time constant)",
+    "T": "T (sampling period)",
+    "k": "k (steering gain)",
+    "f": "f (force ratio)",
+    "n": "n (repulsion exponent)",
+    "W": "W (robot width)",
+    "hold": "hold (sampled structure)",
+    "compute_delay": "compute delay",
+    "pade_order": "Pade order m",
+    "alpha_deg": "alpha (target angle to wall normal)",
+    "L": "L (corridor half-width)",
+}
+
+_REPORT_SCENARIOS = ("wall", "corridor")
+"""The report's order of the geometries (a wall first), as `build_report` writes them."""
+
+_COLUMNS = {
+    "wall": (["alpha* deg", "f*", "V* m/s", "T* s", "k* 1/s"], ["alpha_critical_deg", "f_critical", "V_critical", "T_critical", "k_critical"]),
+    "corridor": (["L* m", "V* m/s", "f*", "T* s", "k* 1/s"], ["L_critical", "V_critical", "f_critical", "T_critical", "k_critical"]),
+}
+"""Per geometry: the table's critical-value columns and their JSON keys (`criteria.WallCritical`, `CorridorCritical`)."""
+
+_FOOTNOTE = (
+    "margin = relative distance in NV to the nearest stability boundary (NV*/NV - 1 when the stable set is (0, NV*); "
+    "> 0 stable). Starred values are critical with the other inputs fixed: every V below V*, T below T* and k below k* "
+    "is stable (T*, k*: where this operating point first loses stability); NV* = 0 and V* = 0 mean unstable at any speed; "
+    "inf = no limit; - = undefined."
+)
+
+
+def _scenarios(data: dict):
+    """Yield (title, header, rows, remedies) for each geometry of the report's JSON form."""
+    for scenario in _REPORT_SCENARIOS:
+        if scenario not in data:
+            continue
+        env = data["environment"][scenario]
+        if scenario == "wall":
+            title = (
+                f"Wall, alpha = {number(env['alpha_deg'])} deg: equilibrium d0 = {number(env['d0'])} m, "
+                f"N = {number(env['N'])} 1/m, NV = {number(env['NV'])} 1/s"
+            )
+        else:
+            title = f"Corridor, L = {number(env['L'])} m: N = {number(env['N'])} 1/m, NV = {number(env['NV'])} 1/s"
+        columns, keys = _COLUMNS[scenario]
+        header = ["model", "verdict", "margin", "NV* 1/s", "omega* rad/s"] + columns
+        rows = []
+        for name, v in data[scenario].items():
+            cells = [name, v["verdict"].upper() if v["verdict"] != "stable" else "stable", percent(v["margin"]), number(v["NV_critical"]), number(v["omega_critical"])]
+            cells += [number(v[k]) for k in keys]
+            rows.append(cells)
+        fixes = {name: v["to_stabilize"] for name, v in data[scenario].items() if v["verdict"] != "stable"}
+        yield title, header, rows, fixes
+
+
+def _remedy_line(model: str, fix: dict) -> str:
+    if not fix:
+        return f"  to stabilize ({model}): no change of V, T, k, alpha, L or f alone helps; change tau or several parameters"
+    parts = []
+    for name, entry in fix.items():
+        unit = RANGES[name].unit
+        bound = ">=" if entry["direction"] == "raise" else "<="
+        change = f" ({entry['change_percent']:+.0f} %)" if "change_percent" in entry else ""
+        parts.append(f"{entry['direction']} {SHOWN_AS.get(name, name)} to {bound} {number(entry['to'])}{(' ' + unit) if unit else ''}{change}")
+    return f"  to stabilize ({model}), change one of: " + "; ".join(parts)
+
+
+def _kb_error_line(report) -> list[str]:
+    if report.kb_error is None:
+        return []
+    e = report.kb_error
+    return ["", f"{e.sentence()}: NV* = {number(e.NV_kb)} vs {number(e.NV_sampled)} 1/s."]
+
+
+def render_text(report) -> str:
+    """Readable plain-text report: inputs, per-model table, remedies, KB's error."""
+    data = report.to_dict()
+    lines = ["pfm-stability report (Koren & Borenstein 1991 robot-environment loop)", "", "Inputs"]
+    for name, entry in data["inputs"].items():
+        unit = f" {entry['unit']}" if entry["unit"] else ""
+        mark = "  <-- " + entry["source"] if entry["source"].startswith("ASSUMED") else f"  ({entry['source']})"
+        lines.append(f"  {_LABELS[name]:<38} {number(entry['value'])}{unit}{mark}")
+    lines += ["", "Models"]
+    for name, entry in data["models"].items():
+        options = ", ".join(f"{k}={v}" for k, v in entry.items() if k != "equation")
+        lines.append(f"  {name:<15} {entry['equation']}{'  [' + options + ']' if options else ''}")
+    for title, header, rows, fixes in _scenarios(data):
+        lines += ["", title]
+        lines += ["  " + line for line in table(header, rows)]
+        for model, fix in fixes.items():
+            lines.append(_remedy_line(model, fix))
+    lines += ["", _FOOTNOTE]
+    lines += _kb_error_line(report)
+    return "\n".join(lines) + "\n"
+
+
+def render_markdown(report) -> str:
+    """The same content as `render_text`, as Markdown tables."""
+    data = report.to_dict()
+    lines = ["# pfm-stability report", "", "| input | value | unit | source |", "| --- | --- | --- | --- |"]
+    for name, entry in data["inputs"].items():
+        source = f"**{entry['source']}**" if entry["source"].startswith("ASSUMED") else entry["source"]
+        lines.append(f"| {_LABELS[name]} | {number(entry['value'])} | {entry['unit']} | {source} |")
+    for title, header, rows, fixes in _scenarios(data):
+        lines += ["", f"## {title}", "", "| " + " | ".join(header) + " |", "|" + " --- |" * len(header)]
+        lines += ["| " + " | ".join(str(c) for c in r) + " |" for r in rows]
+        for model, fix in fixes.items():
+            lines.append("")
+            lines.append("-" + _remedy_line(model, fix)[1:])
+    lines += _kb_error_line(report)
+    return "\n".join(lines) + "\n"
+
+
+# ---------------------------------------------------------------- derivation
+def _derivation_heading(law: str) -> str:
+    return f"Koren & Borenstein 1991, eq (5)-(25), derived with sympy ({law} force law)"
+
+
+def render_derivation_text(steps, law: str) -> str:
+    """Steps as plain text: a numbered heading, the pretty-printed result, the explanation."""
+    import sympy as sp
+
+    lines = [
+        _derivation_heading(law) + ".",
+        "Misprints corrected: see `pydoc pfm_stability.derivation`.",
+        "",
+    ]
+    for index, step in enumerate(steps, 1):
+        lines.append(f"{index:2d}. KB ({step.equation}) {step.title}")
+        lines.append(textwrap.indent(sp.pretty(step.expr, order="none", use_unicode=True, num_columns=76), "    "))
+        lines.extend(textwrap.wrap(step.explanation, 76, initial_indent="    ", subsequent_indent="    "))
+        lines.append("")
+    return "\n".join(lines)
+
+
+def render_derivation_latex(steps, law: str) -> str:
+    """Steps as a LaTeX fragment (amsmath): a paragraph and an ``equation*`` per step."""
+    import sympy as sp
+
+    lines = [f"% {_derivation_heading(law)}; needs amsmath.", ""]
+    for step in steps:
+        lines.append(rf"\paragraph{{{_latex_text(step.title)}}} {_latex_text(step.explanation)}")
+        lines.append(r"\begin{equation*}")
+        lines.append(f"  {sp.latex(step.expr, order='none')} \\tag{{{step.equation}}}")
+        lines.append(r"\end{equation*}")
+        lines.append("")
+    return "\n".join(lines)
+
+
+_LATEX_SPECIALS = {"\\": r"\textbackslash{}", "&": r"\&", "%": r"\%", "$": r"\$", "#": r"\#", "_": r"\_", "{": r"\{", "}": r"\}", "~": r"\textasciitilde{}", "^": r"\textasciicircum{}"}
+
+
+def _latex_text(text: str) -> str:
+    """Escape LaTeX's special characters in running text."""
+    return "".join(_LATEX_SPECIALS.get(ch, ch) for ch in text)
+
+
+# ------------------------------------------------------------------ simulate
+def _quantity(value, unit="", digits=4):
+    return "undefined" if value is None else f"{value:+.{digits}g}{' ' + unit if unit else ''}"
+
+
+def render_simulation_text(result, prediction, plot_path=None) -> str:
+    """The human-readable report of one run."""
+    s, m = result.scenario, result.metrics
+    r, c = s.robot, s.controller
+    lines = [
+        f"scenario {s.name} ({s.env}), {s.duration:g} s simulated, {result.steps} samples of T = {c.T:g} s",
+        f"  robot: V = {r.V:g} m/s, tau = {r.tau:g} s, k = {r.k:g} 1/s, W = {r.W:g} m; "
+        f"controller: f = {c.f:g}, n = {c.n:g}, hold = {c.hold}, compute_delay = {c.compute_delay}",
+        "events:",
+    ]
+    lines += [f"  {e.type} at t = {e.t:.3f} s (x = {e.x:.3f} m, y = {e.y:.3f} m)" for e in result.events] or [
+        f"  none (ran {result.t_end:.3f} s)"
+    ]
+    if result.min_clearance is not None:
+        lines.append(f"  closest approach: {result.min_clearance * 100:.3g} cm between the robot disc and an obstacle")
+    lines += [
+        f"metrics ({m.turning_points} turning points, method {m.method}):",
+        f"  growth rate sigma = {_quantity(m.growth_rate, '1/s')}, angular frequency omega = {_quantity(m.angular_frequency, 'rad/s')}",
+        f"  oscillating: {'yes' if m.oscillating else 'no'}; stable: {'yes' if m.stable else 'no'}; "
+        f"limit cycle: {'amplitude %.3g m' % m.amplitude if m.limit_cycle else 'no'}",
+    ]
+    if m.reason:
+        lines.append(f"  ({m.reason})")
+    if prediction is not None:
+        unit = "m" if prediction.kind == "corridor" else "deg"
+        label = "L" if prediction.kind == "corridor" else "alpha"
+        lines.append(f"prediction ({prediction.kind}, {label} = {prediction.value:g} {unit}):")
+        for p in (prediction.matching, prediction.kb):
+            lines.append(
+                f"  {p.model:15s} {p.verdict:9s} sigma = {p.growth_rate:+.4g} 1/s, omega = {p.angular_frequency:.4g} rad/s, "
+                f"{label}* = {p.critical:.4g} {unit}  [{p.law}]"
+            )
+    lines.append("notes:")
+    lines += [f"  {key}: {value}" for key, value in s.notes.items()]
+    if plot_path:
+        lines.append(f"plot: {plot_path}")
+    return "\n".join(lines) + "\n"
+
+
+# ------------------------------------------------------------------ validate
+def _digits(value, digits=5):
+    import math
+
+    if value is None or not math.isfinite(value):
+        return "none" if value is None or value > 0 else "0"
+    return f"{value:.{digits}g}"
+
+
+def _pct(value):
+    return "      -" if value is None else f"{100 * value:+7.2f} %"
+
+
+def render_validation_text(v, sweep=None, sources=None, plot=None, sweep_plot=None) -> str:
+    """Human-readable validation report: boundaries, errors, oscillation checks, sweep."""
+    i = v.inputs
+    unit = f" {v.unit}" if v.unit else ""
+    name = {"L": "L*", "alpha": "alpha*", "V": "V*", "f": "f*"}[v.parameter]
+    head = f"{name} ({v.unit})" if v.unit else name
+    assumed = [k for k, s in (sources or {}).items() if str(s).startswith("ASSUMED")]
+    fixed = f", L = {i['L']:g} m" if i.get("L") is not None else (f", alpha = {i['alpha_deg']:g} deg" if i.get("alpha_deg") is not None else "")
+    lines = [
+        f"validate {v.scenario} ({v.env}{fixed}): bisecting {v.parameter}",
+        f"  robot: V = {i['V']:g} m/s, tau = {i['tau']:g} s, k = {i['k']:g} 1/s, W = {i['W']:g} m; controller: f = {i['f']:g}, "
+        f"n = {i['n']:g}, T = {i['T']:g} s, hold = {i['hold']}, compute_delay = {i['compute_delay']}",
+    ]
+    if assumed:
+        lines.append(f"  assumed by the preset: {', '.join(assumed)} (see --format json inputs.sources)")
+    lines += [
+        f"simulated boundary: {name} = {_digits(v.simulated_boundary, 6)}{unit} (stable {'above' if v.stable_above else 'below'}; "
+        f"bracket [{_digits(v.bracket[0], 6)}, {_digits(v.bracket[1], 6)}]{unit}; {v.runs} runs in {v.seconds:.1f} s)",
+        f"predicted boundary, law: {v.law}" + (f"   | KB's lumped law, f_av = {i['f_av']:.4g}" if v.lumped_predicted_boundary else ""),
+        f"  {'model':16s} {head:>12s} {'rel. error':>10s}" + (f"   | {head:>12s} {'rel. error':>10s}" if v.lumped_predicted_boundary else ""),
+    ]
+    for model, value in v.predicted_boundary.items():
+        row = f"  {model:16s} {_digits(value):>12s} {_pct(v.relative_error[model]):>10s}"
+        if v.lumped_predicted_boundary:
+            row += f"   | {_digits(v.lumped_predicted_boundary[model]):>12s} {_pct(v.lumped_relative_error[model]):>10s}"
+        lines.append(row)
+    lines.append("oscillation near the boundary (measured vs the sampled model's dominant root):")
+    for c in v.oscillation:
+        s = "undefined" if c.growth_rate is None else f"{c.growth_rate:+.4f}"
+        w = "undefined" if c.angular_frequency is None else f"{c.angular_frequency:.4f}"
+        fe = "" if c.frequency_error is None else f", {100 * c.frequency_error:+.3f} %"
+        lines.append(
+            f"  {v.parameter} = {c.value:.6g}{unit}: sigma = {s} 1/s (model {c.predicted_growth_rate:+.4f}), "
+            f"omega = {w} rad/s (model {c.predicted_angular_frequency:.4f}{fe}) [{c.method}]"
+        )
+    if sweep is not None:
+        lines += render_sweep_text(sweep).splitlines()
+    lines.append("notes:")
+    lines += [f"  {key}: {value}" for key, value in v.notes.items()]
+    if plot:
+        lines.append(f"plot: {plot}")
+    if sweep_plot:
+        lines.append(f"sweep plot: {sweep_plot}")
+    return "\n".join(lines) + "\n"
+
+
+def render_sweep_text(sweep) -> str:
+    """The sweep's agreement, each model's wrong-verdict rate, and every disagreement."""
+    lines = [
+        f"random sweep: {sweep.count} Latin-hypercube sets ({sweep.env}, seed {sweep.seed}), {sweep.included} outside "
+        f"+-{100 * sweep.exclude:g} % of the sampled boundary (in NV), {sweep.seconds:.1f} s",
+        f"  simulated sign of sigma agrees with sampled on {100 * sweep.agreement:.2f} % ({len(sweep.disagreements)} disagreements)",
+        "  wrong verdicts for the sampled robot (model stable but robot oscillates / model unstable but robot stable):",
+    ]
+    for model, rate in sweep.wrong_verdict_rate.items():
+        w = sweep.wrong_verdicts[model]
+        lines.append(f"    {model:16s} {100 * rate:6.2f} %  ({w['stable_but_unstable']} / {w['unstable_but_stable']})")
+    if sweep.disagreements:
+        lines.append("  disagreements:")
+        lines += [f"    {p.describe()}" for p in sweep.disagreements]
+    return "\n".join(lines) + "\n"
+
+
+# ------------------------------------------------------------------ traps
+def _or_dash(x) -> str:
+    return "-" if x is None else f"{x:.6g}"
+
+
+def render_traps_text(analysis) -> str:
+    """The text output: stationary points, goal verdict, bounds and the conclusion."""
+    scene = analysis.scene
+    lines = [f"law: {scene.law.describe()}", f"goal: ({scene.goal[0]:g}, {scene.goal[1]:g}); {len(scene.obstacles)} obstacle(s); "
+             f"region [{scene.region[0][0]:g}, {scene.region[1][0]:g}] x [{scene.region[0][1]:g}, {scene.region[1][1]:g}] m; "
+             f"search grid {analysis.resolution} points", "", "stationary points:",
+             f"  {'x (m)':>12} {'y (m)':>12}  {'kind':<10} {'U':>12}  Hessian eigenvalues"]
+    for p in analysis.stationary_points:
+        eig = "not C2 there" if p.hessian_eigenvalues is None else ", ".join(f"{v:.6g}" for v in p.hessian_eigenvalues)
+        lines.append(f"  {p.x:>12.6g} {p.y:>12.6g}  {p.kind:<10} {p.potential:>12.6g}  {eig}{'   <- goal' if p.goal else ''}")
+    if not analysis.stationary_points:
+        lines.append("  (none)")
+    goal = next((p for p in analysis.stationary_points if p.goal), None)
+    if analysis.goal_is_global_minimum:
+        verdict = "the global minimum (no minimum found lies lower)"
+    elif goal is not None:
+        verdict = "a local minimum, but a trap lies lower" if goal.kind == "minimum" else f"a {goal.kind}, NOT a minimum"
+    else:
+        verdict = "NOT a stationary point: the repulsion of an obstacle within rho0 moves the minimum off it"
+    lines += ["", f"goal: {verdict}", ""]
+    if analysis.gnron_bounds:
+        lines += ["Ge & Cui 2000 bounds on xi/eta (no stationary point on the goal-obstacle ray iff xi/eta > k_n):",
+                  f"  {'obstacle':<14} {'r (m)':>10} {'k_n exact':>12} {'k_n conserv.':>13} {'xi/eta':>10}  satisfied"]
+        for b in analysis.gnron_bounds:
+            lines.append(f"  {f'{b.index} {b.kind}':<14} {b.r:>10.6g} {_or_dash(b.k_exact):>12} {_or_dash(b.k_conservative):>13} {b.ratio:>10.6g}  "
+                         f"{'yes' if b.satisfied else 'no'}{f'  ({b.reason})' if b.reason else ''}")
+    else:
+        lines.append(f"no obstacle within rho0 = {scene.law.rho0:g} m of the goal: Ge & Cui's bound puts no condition on xi/eta")
+    lines += ["", f"conclusion: {analysis.conclusion}"]
+    return "\n".join(lines) + "\n"

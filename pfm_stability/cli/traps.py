@@ -1,0 +1,79 @@
+"""``pfm-stability traps``: every stationary point of a 2-D scene's potential, and Ge & Cui's bounds on ξ/η.
+
+    pfm-stability traps SCENE.yaml [--format text|json] [--plot FILE.png] [--resolution N]
+    pfm-stability traps gc2000_fig4            # a scene shipped with the package
+
+SCENE is a YAML scene file (docs/traps.md, "Scene files") or the name of a
+scene shipped in ``pfm_stability/data/scenes`` (`SHIPPED_SCENES`). The text
+output lists the stationary points (minima, saddles, maxima; the goal
+marked), whether the goal is the global minimum, GC2000's exact and
+conservative bounds k_n, k′_n for every obstacle within ρ0 of the goal, and a
+one-line conclusion. JSON keys (`pfm_stability/schema/output.schema.json`):
+``schema_version``, ``command`` ("traps"), ``inputs`` (the scene as read,
+the resolution), ``stationary_points``, ``goal_is_global_minimum``,
+``gnron_bounds``, ``conclusion``, ``plot``. A bad scene is one line naming
+the field, exit status 2.
+"""
+
+from __future__ import annotations
+
+from .options import describe, integer, output_path
+
+FORMATS = ("text", "json")
+SHIPPED_SCENES = ("gc2000_fig3", "gc2000_fig4", "gc2000_sec6b_khatib", "gc2000_sec6b_gnron")
+"""Scene files in ``pfm_stability/data/scenes`` (without ``.yaml``), usable by name."""
+DEFAULT_RESOLUTION = 81
+"""`pfm_stability.traps.DEFAULT_RESOLUTION`, repeated here so that ``--help`` does not load numpy."""
+
+
+def add_parser(sub) -> None:
+    p = sub.add_parser(
+        "traps",
+        help="find every stationary point (traps) of a 2-D potential field scene; Ge & Cui's bounds on xi/eta",
+        description="Stationary points of the total potential of a 2-D scene (goal, circles, segments, polygons; "
+        "Khatib's or Ge & Cui's goal-aware repulsion), the goal's verdict, and Ge & Cui 2000's exact and conservative "
+        "bounds on xi/eta (eq 25-37) for every obstacle within rho0 of the goal.",
+    )
+    p.add_argument("scene", metavar="SCENE", help=f"scene YAML file, or a shipped scene: {', '.join(SHIPPED_SCENES)}")
+    p.add_argument("--format", choices=FORMATS, default="text")
+    p.add_argument("--plot", type=output_path("plot"), metavar="PNG",
+                   help="write the potential with obstacles and stationary points (a .png file in an existing writable directory)")
+    p.add_argument("--resolution", type=integer("resolution"), default=DEFAULT_RESOLUTION,
+                   help=f"grid points of the search along the region's longer side, {describe('resolution')} "
+                   f"(default {DEFAULT_RESOLUTION})")
+    p.set_defaults(run=run)
+
+
+def scene_path(name: str):
+    """The file of `name`: a shipped scene's (by name) or `name` itself."""
+    if name in SHIPPED_SCENES:
+        from importlib import resources
+
+        return resources.files("pfm_stability").joinpath("data", "scenes", f"{name}.yaml")
+    return name
+
+
+def run(args) -> int:
+    from .render import render_traps_text
+
+    from ..serialize import dumps
+    from ..scene import Scene
+    from ..traps import find_stationary_points
+
+    analysis = find_stationary_points(Scene.load(scene_path(args.scene)), args.resolution)
+    if args.plot:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+
+        from ..plots.traps import plot_traps
+
+        fig = plot_traps(analysis)
+        fig.savefig(args.plot, dpi=110)
+        plt.close(fig)
+    if args.format == "json":
+        print(dumps({**analysis.to_dict(), "plot": args.plot}))
+    else:
+        print(render_traps_text(analysis) + (f"plot: {args.plot}\n" if args.plot else ""), end="")
+    return 0
