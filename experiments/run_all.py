@@ -21,7 +21,7 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 
-EXPERIMENTS = ("fig3_calibration", "fig5_wall", "fig6_corridor", "validation_summary", "gc2000_traps")
+EXPERIMENTS = ("fig3_calibration", "fig5_wall", "fig6_corridor", "validation_summary", "gc2000_traps", "gc2000_corridor", "kb_fig4_door")
 BEGIN, END = "<!-- results-table:begin -->", "<!-- results-table:end -->"
 README = HERE / "README.md"
 

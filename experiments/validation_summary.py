@@ -138,7 +138,7 @@ def run(out, quick: bool = False) -> dict:
     n_a, n_g = len(analytic), len(grid)
     rows = [
         row("Validation", f"analytic boundary, {len(sets)} sets x {len(structures)} structures x corridor/wall ({n_a})",
-            "-", "sampled model", f"bisected (rtol 1e-3, sigma interpolated)",
+            "-", "sampled model", "bisected (rtol 1e-3, sigma interpolated)",
             f"max |error| sampled {worst(analytic):.1e} (bar 1 %); kb_first_order {span(analytic, 'kb_first_order')}, "
             f"exact_delay {span(analytic, 'exact_delay')}"),
         row("Validation", f"omega near the analytic boundary ({3 * n_a} runs)", "-", "sampled dominant root", "linear-prediction fit",

@@ -13,20 +13,27 @@ gives each model's critical values with 1/NV* in place of KB's (τ + T):
   L* = (2nWⁿVf/NV*)^(1/(n+1)) (eq 25 generalized), f* = L^(n+1)NV*/(2nWⁿV).
 
 For any other force law the same conditions are solved numerically
-(bisection on a bracket found by geometric expansion, module `solve`).
+(bisection on a bracket found by geometric expansion, module `solve`). A law
+that is not `monotone` (Khatib's, Ge & Cui's goal-aware law, a law built in
+code) is analysed at every one of its wall equilibria, and its α*, L* and the
+critical values of its own parameters (f*, or η*, ρ0*, ξ*) are found on each
+equilibrium by following it (`pfm_stability.critical`, docs/fields.md).
+An equilibrium with N < 0 is unstable in the field itself: every model's
+verdict is "unstable", with the reason.
 """
 
 from __future__ import annotations
 
 import math
 import numbers
-from collections.abc import Mapping
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass
 
 import numpy as np
 
 from .checks import check_number, check_type
-from .force_law import ForceLaw, PowerLaw, corridor_gain, law_in_force, wall_gain
+from .critical import CorridorBranches, CorridorCritical, CriticalValues, WallBranches, WallCritical, is_field_law
+from .fields import finite_goal_gain
+from .force_law import Equilibrium, ForceLaw, PowerLaw, corridor_equilibria, corridor_gain, law_in_force, wall_equilibria, wall_gain
 from .models import Loop, LoopModel, gain_margin, models_for, verdict_label
 from .parameters import RANGES, Controller, Corridor, Robot, Wall, check_corridor_fits, check_parameter, to_degrees
 from .solve import bisect_root, expand_bracket
@@ -36,6 +43,7 @@ __all__ = [
     "WallCritical",
     "CorridorCritical",
     "ModelVerdict",
+    "WallEquilibrium",
     "WallAnalysis",
     "CorridorAnalysis",
     "analyze_wall",
@@ -48,100 +56,6 @@ __all__ = [
     "kb_critical_L",
     "loop_of",
 ]
-
-
-class CriticalValues(Mapping):
-    """Critical values of one model in one geometry: named fields, read-only mapping too.
-
-    Subclasses are frozen dataclasses. As a `Mapping` they hold their fields
-    in declaration order, leaving out those that are None (``critical["L_critical"]``,
-    ``.items()``, ``in``, ``len``, iteration): the keys and the order of the
-    report's JSON. Equality is the mapping's (so a plain dict of the same
-    items compares equal).
-    """
-
-    __slots__ = ()
-
-    def _keys(self) -> tuple:
-        return tuple(f.name for f in fields(self) if getattr(self, f.name) is not None)
-
-    def __getitem__(self, key: str):
-        if isinstance(key, str) and key in self._keys():
-            return getattr(self, key)
-        raise KeyError(key)
-
-    def __iter__(self):
-        return iter(self._keys())
-
-    def __len__(self) -> int:
-        return len(self._keys())
-
-    def __repr__(self) -> str:
-        return f"{type(self).__name__}({', '.join(f'{k}={v!r}' for k, v in self.items())})"
-
-
-@dataclass(frozen=True, eq=False, repr=False)
-class WallCritical(CriticalValues):
-    """One model's critical values along a wall, each with the other inputs fixed (docs/models.md).
-
-    Attributes
-    ----------
-    alpha_critical : float
-        α*, rad: stable for α > α* (0 when NV* = inf; π/2 when NV* = 0).
-    alpha_critical_deg : float
-        α* in degrees (set from `alpha_critical`).
-    f_critical : float
-        f*: stable for f > f* (KB eq 24 generalized; ``inf`` when NV* = 0).
-    V_critical : float
-        V* = NV*/N, m/s: every slower speed is stable.
-    T_critical : float
-        T*, s: the smallest sampling period / delay at which the operating
-        point loses stability (0: already at T → 0; ``inf``: stable up to 100 s).
-    k_critical : float
-        k*, 1/s: the smallest steering gain at which it loses stability.
-    tau_plus_T_critical : float or None
-        (τ + T)* = 1/NV, s: KB eq (20) solved for the loop's time constants
-        (``kb_first_order`` only; None, and no key, otherwise).
-    """
-
-    alpha_critical: float
-    alpha_critical_deg: float = field(init=False)
-    f_critical: float
-    V_critical: float
-    T_critical: float
-    k_critical: float
-    tau_plus_T_critical: float | None = None
-
-    def __post_init__(self):
-        object.__setattr__(self, "alpha_critical_deg", to_degrees(self.alpha_critical))
-
-
-@dataclass(frozen=True, eq=False, repr=False)
-class CorridorCritical(CriticalValues):
-    """One model's critical values in the middle of a corridor, each with the other inputs fixed (docs/models.md).
-
-    Attributes
-    ----------
-    L_critical : float
-        L*, m: stable for L > L* (KB eq 25 generalized; ``inf`` when NV* = 0).
-    V_critical : float
-        V* = NV*/N, m/s: every slower speed is stable.
-    f_critical : float
-        f*: stable for f < f* (N ∝ f; 0 when NV* = 0).
-    T_critical : float
-        T*, s (see `WallCritical`).
-    k_critical : float
-        k*, 1/s (see `WallCritical`).
-    tau_plus_T_critical : float or None
-        (τ + T)* = 1/NV, s (``kb_first_order`` only; None, and no key, otherwise).
-    """
-
-    L_critical: float
-    V_critical: float
-    f_critical: float
-    T_critical: float
-    k_critical: float
-    tau_plus_T_critical: float | None = None
 
 
 @dataclass(frozen=True)
@@ -169,6 +83,9 @@ class ModelVerdict:
     rightmost_root : complex or None
         Dominant root σ + jω (1/s, rad/s) at the operating point (None where
         the model cannot resolve it; the verdict does not depend on it).
+    reason : str or None
+        Why the verdict does not come from the model (N < 0: an unstable
+        equilibrium of the field); None otherwise.
     """
 
     model: str
@@ -179,6 +96,7 @@ class ModelVerdict:
     verdict: str
     critical: CriticalValues
     rightmost_root: complex | None = 0j
+    reason: str | None = None
 
     @property
     def stable(self) -> bool:
@@ -187,8 +105,35 @@ class ModelVerdict:
 
 
 @dataclass(frozen=True)
+class WallEquilibrium:
+    """One wall equilibrium and every model's verdict there.
+
+    Attributes
+    ----------
+    d0 : float
+        Distance to the wall, m.
+    N : float
+        Position gain, 1/m (< 0: unstable in the field itself).
+    c : float
+        Heading gain (0 for a static law).
+    NV : float
+        1/s.
+    models : dict[str, ModelVerdict]
+    """
+
+    d0: float
+    N: float
+    c: float
+    NV: float
+    models: dict
+
+
+@dataclass(frozen=True)
 class WallAnalysis:
-    """Travel along a wall: equilibrium, gain and every model's verdict.
+    """Travel along a wall: equilibria, gains and every model's verdict.
+
+    The fields d0, N, NV and models are those of the first (nearest)
+    equilibrium; `equilibria` lists every one, sorted by d0.
 
     Attributes
     ----------
@@ -201,6 +146,10 @@ class WallAnalysis:
     NV : float
         1/s.
     models : dict[str, ModelVerdict]
+    c : float
+        Heading gain of the first equilibrium (0 for a static law).
+    equilibria : tuple of WallEquilibrium
+        Every equilibrium (one for a `monotone` law).
     """
 
     alpha: float
@@ -208,6 +157,8 @@ class WallAnalysis:
     N: float
     NV: float
     models: dict
+    c: float = 0.0
+    equilibria: tuple = ()
 
     @property
     def alpha_deg(self) -> float:
@@ -224,16 +175,28 @@ class CorridorAnalysis:
     L : float
         Half-width, m.
     N : float
-        Environment gain, 1/m (N = 2nfWⁿ/L^(n+1) for KB's law).
+        Environment gain in the middle, 1/m (N = 2nfWⁿ/L^(n+1) for KB's law;
+        −2P′(L)/(1 + 2Q(L)) in general).
     NV : float
         1/s.
     models : dict[str, ModelVerdict]
+        The verdicts in the middle.
+    c : float
+        Heading gain (0 for a static law).
+    equilibria : tuple of Equilibrium
+        Every lateral equilibrium (x0, N, c), sorted by x0; the middle x0 = 0 is one.
+    N_finite_goal : float or None
+        N + 1/ρ_g: the gain with a finite goal straight ahead at the law's goal
+        distance (docs/fields.md); None for a target at infinity. Not in NV.
     """
 
     L: float
     N: float
     NV: float
     models: dict
+    c: float = 0.0
+    equilibria: tuple = ()
+    N_finite_goal: float | None = None
 
 
 def loop_of(robot: Robot, controller: Controller) -> Loop:
@@ -249,7 +212,7 @@ NV_MAX = 1e12
 
 def _check_gain(NV: float, where: str) -> float:
     """NV after checking it is finite and <= NV_MAX; otherwise a message that names the geometry."""
-    if not (math.isfinite(NV) and NV <= NV_MAX):
+    if not (math.isfinite(NV) and abs(NV) <= NV_MAX):
         raise ValueError(
             f"N*V = {NV:g} 1/s at the {where} exceeds what the loop models represent (<= {NV_MAX:g} 1/s); "
             f"choose a less extreme force law (f, n), angle or width"
@@ -396,13 +359,32 @@ def _verdicts(controller: Controller, models, loop: Loop, N: float, NV: float, c
     out = {}
     for model in models_for(controller, models):
         boundary = model.boundary(loop)
-        V_critical = boundary.NV_critical / N if N > 0 else math.inf
+        V_critical = boundary.NV_critical / N if N > 0 else (0.0 if N < 0 else math.inf)
         out[model.name] = _verdict(model, loop, NV, boundary, critical_values, V_critical=V_critical, **geometric(boundary.NV_critical))
     return out
 
 
+NEGATIVE_N = (
+    "N < 0: this equilibrium is unstable in the field itself (the lateral force pushes away from it); "
+    "k*N*V < 0 gives a positive real root in every model, at every speed, delay and gain"
+)
+"""The reason every model's verdict is "unstable" at an equilibrium with N < 0 (docs/fields.md)."""
+
+
+def _negative_gain_root(model: LoopModel, NV: float, loop: Loop):
+    """The dominant root at NV < 0, or None where the model does not take a negative gain."""
+    try:
+        return model.rightmost_root(NV, loop)
+    except ValueError:
+        return None
+
+
 def _verdict(model: LoopModel, loop: Loop, NV: float, boundary, critical_values, **geometry) -> ModelVerdict:
     """The verdict; `critical_values` (WallCritical or CorridorCritical) built from `geometry` plus T*, k*."""
+    if NV < 0:  # an unstable equilibrium of the field: no T or k helps, margin −1
+        critical = critical_values(**geometry, T_critical=0.0, k_critical=0.0)
+        root = _negative_gain_root(model, NV, loop)
+        return ModelVerdict(model.name, NV, boundary.NV_critical, boundary.omega_critical, -1.0, "unstable", critical, root, NEGATIVE_N)
     if NV == 0:  # no equilibrium force gradient: nothing to oscillate
         critical = critical_values(**geometry, T_critical=math.inf, k_critical=math.inf)
         return ModelVerdict(model.name, NV, boundary.NV_critical, boundary.omega_critical, math.inf, "stable", critical, 0j)
@@ -426,7 +408,7 @@ def _verdict(model: LoopModel, loop: Loop, NV: float, boundary, critical_values,
 
 
 def analyze_wall(robot: Robot, controller: Controller, wall: Wall, models=None, law: ForceLaw | None = None) -> WallAnalysis:
-    """Stability along a wall for each model (KB §5.3, eq 20–24).
+    """Stability along a wall for each model (KB §5.3, eq 20–24), at every equilibrium.
 
     Parameters
     ----------
@@ -438,31 +420,55 @@ def analyze_wall(robot: Robot, controller: Controller, wall: Wall, models=None, 
         compute delay (the controller is the one source of truth: a
         ``Sampled`` model that contradicts it raises ValueError).
     law : ForceLaw, optional
-        Lateral repulsion law; KB's power law f(W/d)^n by default.
+        Lateral law; KB's power law f(W/d)^n by default. A law that is not
+        `monotone` may have several equilibria (`force_law.wall_equilibria`).
 
     Returns
     -------
     WallAnalysis
+        The first equilibrium's verdicts, and `equilibria` (every one).
         Critical values per model (`WallCritical`): ``alpha_critical`` (rad),
-        ``alpha_critical_deg``, ``f_critical``, ``V_critical`` (m/s), ``T_critical`` (s),
-        ``k_critical`` (1/s), and ``tau_plus_T_critical`` (s) for ``kb_first_order``.
+        ``alpha_critical_deg``, ``f_critical`` (or ``eta_critical``,
+        ``rho0_critical``, ``xi_critical`` for Khatib's and the goal-aware
+        law), ``V_critical`` (m/s), ``T_critical`` (s), ``k_critical`` (1/s),
+        and ``tau_plus_T_critical`` (s) for ``kb_first_order``.
         A model that is unstable at every NV (NV* = 0) gives V* = 0, α* = 90°
         and f* = inf: no speed, angle or force ratio helps; ``T_critical`` and
-        ``k_critical`` say whether a shorter period or a lower gain does.
+        ``k_critical`` say whether a shorter period or a lower gain does. At an
+        equilibrium with N < 0 every verdict is "unstable" (``reason``).
+
+    Raises
+    ------
+    ValueError
+        No equilibrium (a law that never balances the target's pull), or N·V
+        beyond what the models represent.
     """
     law = law_in_force(robot, controller, law)
     check_type("wall", wall, Wall, "a Wall")
     loop = loop_of(robot, controller)
-    d0, N = wall_gain(law, wall.alpha)
-    NV = _check_gain(N * robot.V, f"wall equilibrium d0 = {d0:g} m (alpha = {wall.alpha_deg:g} deg)")
+    if law.monotone:
+        equilibria = (Equilibrium(*wall_gain(law, wall.alpha)),)
+    else:
+        equilibria = wall_equilibria(law, wall.alpha) or (Equilibrium(*wall_gain(law, wall.alpha)),)  # none: wall_gain says why
+    analyses = tuple(_wall_equilibrium(robot, controller, wall, models, loop, law, e) for e in equilibria)
+    first = analyses[0]
+    return WallAnalysis(wall.alpha, first.d0, first.N, first.NV, first.models, first.c, analyses)
 
-    def geometric(NV_critical):
-        return {
-            "alpha_critical": critical_alpha(law, robot.V, NV_critical),
-            "f_critical": critical_f_wall(law, wall.alpha, robot.V, NV_critical),
-        }
 
-    return WallAnalysis(wall.alpha, d0, N, NV, _verdicts(controller, models, loop, N, NV, WallCritical, geometric))
+def _wall_equilibrium(robot: Robot, controller: Controller, wall: Wall, models, loop: Loop, law: ForceLaw, e: Equilibrium) -> WallEquilibrium:
+    """Every model's verdict at one wall equilibrium."""
+    NV = _check_gain(e.N * robot.V, f"wall equilibrium d0 = {e.x0:g} m (alpha = {wall.alpha_deg:g} deg)")
+    if law.monotone:
+
+        def geometric(NV_critical):
+            return {
+                "alpha_critical": critical_alpha(law, robot.V, NV_critical),
+                "f_critical": critical_f_wall(law, wall.alpha, robot.V, NV_critical),
+            }
+
+    else:
+        geometric = WallBranches(law, wall.alpha, e, robot.V).critical
+    return WallEquilibrium(e.x0, e.N, e.c, NV, _verdicts(controller, models, loop, e.N, NV, WallCritical, geometric))
 
 
 def analyze_corridor(robot: Robot, controller: Controller, corridor: Corridor, models=None, law: ForceLaw | None = None) -> CorridorAnalysis:
@@ -483,9 +489,12 @@ def analyze_corridor(robot: Robot, controller: Controller, corridor: Corridor, m
     -------
     CorridorAnalysis
         Critical values per model (`CorridorCritical`): ``L_critical`` (m),
-        ``V_critical`` (m/s), ``f_critical``, ``T_critical`` (s), ``k_critical`` (1/s),
+        ``V_critical`` (m/s), ``f_critical`` (or ``eta_critical``,
+        ``rho0_critical``, ``xi_critical``), ``T_critical`` (s), ``k_critical`` (1/s),
         and ``tau_plus_T_critical`` (s) for ``kb_first_order``. NV* = 0 gives
-        V* = 0, L* = inf and f* = 0 ("unstable at any speed").
+        V* = 0, L* = inf and f* = 0 ("unstable at any speed"). `equilibria`
+        lists every lateral equilibrium (`force_law.corridor_equilibria`) and
+        `N_finite_goal` the gain with a finite goal straight ahead.
     """
     law = law_in_force(robot, controller, law)
     check_type("corridor", corridor, Corridor, "a Corridor")
@@ -493,11 +502,14 @@ def analyze_corridor(robot: Robot, controller: Controller, corridor: Corridor, m
     loop = loop_of(robot, controller)
     N = corridor_gain(law, corridor.L)
     NV = _check_gain(N * robot.V, f"corridor middle (L = {corridor.L:g} m)")
+    branches = None if law.monotone else CorridorBranches(law, corridor.L, robot.W, N, robot.V)
 
     def geometric(NV_critical):
-        return {
-            "L_critical": critical_L(law, robot.V, NV_critical),
-            "f_critical": critical_f_corridor(law, corridor.L, robot.V, NV_critical),
-        }
+        L_critical = critical_L(law, robot.V, NV_critical) if branches is None else branches.critical_L(NV_critical)
+        if branches is not None and is_field_law(law):
+            return {"L_critical": L_critical, **branches.law_parameters(NV_critical)}
+        return {"L_critical": L_critical, "f_critical": critical_f_corridor(law, corridor.L, robot.V, NV_critical)}
 
-    return CorridorAnalysis(corridor.L, N, NV, _verdicts(controller, models, loop, N, NV, CorridorCritical, geometric))
+    verdicts = _verdicts(controller, models, loop, N, NV, CorridorCritical, geometric)
+    equilibria = corridor_equilibria(law, corridor.L, robot.W)
+    return CorridorAnalysis(corridor.L, N, NV, verdicts, 0.0, equilibria, finite_goal_gain(law, N))

@@ -20,7 +20,11 @@ law, `pfm_stability.effective_force.GridWallLaw`) the curves are found by a
 vectorized bisection in the equilibrium distance d0, which parametrizes the
 wall exactly: cos α = F_r(d0)/F_a and N = −F_r′(d0)/(F_a sin α) (KB eq 11
 and 23 with the general law in place of f(W/d)ⁿ); this assumes N decreases as d0 grows (a convex
-decreasing law — true for the power law and for the grid law).
+decreasing law — true for the power law and for the grid law). A law that does not declare
+itself `monotone` is checked on a grid of its domain first: where the inverted quantity is
+not monotone (Khatib's law, the goal-aware law: several equilibria, N not monotone in d0 —
+docs/fields.md) the curve would not be one curve, and a ValueError says so; V*(α) and V*(L)
+need no inversion and take the first equilibrium.
 
 Dense stable/unstable maps of one model are `pfm_stability.regions`; how the
 models differ from one another is `pfm_stability.comparison`; the simulated
@@ -36,9 +40,9 @@ import numpy as np
 
 from .checks import check_positive_axis
 from .criteria import loop_of
-from .force_law import ForceLaw, PowerLaw, corridor_gain, law_in_force, wall_gain_arrays, wall_gain_at_distance
+from .force_law import ForceLaw, PowerLaw, corridor_gain, law_in_force, wall_equilibria, wall_gain_arrays, wall_gain_at_distance
 from .models import Loop, LoopModel, models_for
-from .parameters import Controller, Robot, check_parameter
+from .parameters import RANGES, Controller, Robot, check_parameter
 from .solve import invert_decreasing
 from .serialize import json_array, json_number
 
@@ -164,6 +168,22 @@ def wall_f_curves(robot: Robot, controller: Controller, alpha: float, V, models=
     return out
 
 
+def _check_decreasing(law: ForceLaw, g, lo: float, what: str, hi: float = math.inf) -> None:
+    """ValueError unless g (vectorized) does not increase on [lo, hi] (a log grid), for a law not declared `monotone`."""
+    if law.monotone:
+        return
+    top = min(hi, law.domain()[1])
+    top = top if math.isfinite(top) else max(1e6, 1e3 * lo)
+    with np.errstate(all="ignore"):
+        v = np.asarray(g(np.geomspace(lo, top, 2000)), dtype=float)
+    v = v[np.isfinite(v)]
+    if np.any(np.diff(v) > 1e-9 * np.max(np.abs(v), initial=0.0)) or (law.has_goal_part and what.startswith("the law's strength")):
+        raise ValueError(
+            f"{what} is not monotone for {law.name}: the boundary is not one curve; analyse each point with "
+            f"criteria.analyze_wall / analyze_corridor instead (docs/fields.md)"
+        )
+
+
 def _wall_scale_general(law: ForceLaw, alpha: float, V, NV_critical: float):
     """Law scale c* with N(c*)·V = NV* at angle α, for a law whose force ∝ scale.
 
@@ -176,6 +196,7 @@ def _wall_scale_general(law: ForceLaw, alpha: float, V, NV_critical: float):
         return -np.asarray(law.slope(d), dtype=float) / np.asarray(law.force(d), dtype=float)
 
     lo = max(law.domain()[0], 1e-9)
+    _check_decreasing(law, log_slope, lo, "the law's strength against N (-F'/F in d0)")
     d0 = invert_decreasing(log_slope, NV_critical * math.tan(alpha) / V, lo, 1.0)
     with np.errstate(divide="ignore", invalid="ignore"):
         c = law.scale * math.cos(alpha) / np.asarray(law.force(np.where(np.isfinite(d0), d0, 1.0)), dtype=float)
@@ -206,7 +227,11 @@ def wall_alpha_curves(robot: Robot, controller: Controller, V, models=None, law:
     V = check_positive_axis("V", V, "m/s")
     models = default_models(controller) if models is None else list(models)
     law = law_in_force(robot, controller, law)
-    d_contact = law.distance_for(1.0)  # α = 0: the law alone balances the full target force
+    lo = max(law.domain()[0], 1e-9)
+    _check_decreasing(law, law.wall_ratio, lo, "the equilibrium condition P/(1 + Q) in d0")
+    _check_decreasing(law, lambda d: wall_gain_at_distance(law, d)[1], lo, "N against the equilibrium distance d0")
+    # α = 0: the law alone balances the full target force
+    d_contact = law.distance_for(1.0) if not law.has_goal_part else wall_equilibria(law, RANGES["alpha"].low)[0].x0
     out = []
     for model, b in _boundaries(models, loop_of(robot, controller)):
         NVs = b.NV_critical
@@ -278,7 +303,8 @@ def corridor_V_curves(robot: Robot, controller: Controller, L, models=None, law:
     N = corridor_gain(law, L)
     out = []
     for model, b in _boundaries(models, loop_of(robot, controller)):
-        y = b.NV_critical / N
+        with np.errstate(divide="ignore"):  # N = 0 (a law with a finite reach, beyond it): stable at every V
+            y = b.NV_critical / N
         out.append(BoundaryCurve(model, b.NV_critical, b.omega_critical, "L", "m", "V", "m/s", L, y, "below"))
     return out
 
@@ -316,6 +342,7 @@ def corridor_L_curves(robot: Robot, controller: Controller, V, models=None, law:
             y = (2 * law.n * law.W**law.n * V * law.f / NVs) ** (1 / (law.n + 1))
         else:
             lo = max(law.domain()[0], 1e-9)
+            _check_decreasing(law, lambda d: corridor_gain(law, d), max(lo, robot.W / 2), "N against the corridor half-width L")
             y = invert_decreasing(lambda d: corridor_gain(law, d), NVs / V, lo, 1.0)
         out.append(BoundaryCurve(model, NVs, b.omega_critical, "V", "m/s", "L", "m", V, y, "above"))
     return out

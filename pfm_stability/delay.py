@@ -1,30 +1,32 @@
-"""Roots, crossings and stability of the retarded quasi-polynomial a(s) + K·e^(−sT).
+"""Roots, crossings and stability of the retarded quasi-polynomial a(s) + (d(s) + K)·e^(−sT).
 
 Koren & Borenstein 1991 (KB) eq (18) is τs³ + s² + ks + K·e^(−sT) = 0 with
-K = kNV; this module handles the general form a(s) + K·e^(−sT) with any real
-polynomial a(s) of degree ≥ 1 (a retarded equation: the delayed term has lower
-degree than a).
+K = kNV; a heading gain c adds d(s) = kc·s to the delayed term (docs/models.md).
+This module handles a(s) + (d(s) + K)·e^(−sT) with any real polynomials,
+deg d < deg a (a retarded equation); d = 0, a(s) + K·e^(−sT), runs the code it
+always ran. Below, b(s) = d(s) + K.
 
 Methods
 -------
 * **Delay crossings** (K fixed, T varies). A root s = jω exists iff
-  |a(jω)| = |K| and e^(−jωT) = −a(jω)/K: the frequencies are the positive
-  real roots of the polynomial F(ω²) = |a(jω)|² − K², and each gives the delay
-  sequence T_m = (θ + 2πm)/ω. A root crosses towards Re s > 0 as T increases
-  through T_m iff F′(ω²) > 0, whatever m is (Cooke & van den Driessche, "On
-  zeroes of some transcendental equations", Funkcial. Ekvac. 29, 1986; Walton &
-  Marshall, IEE Proc. D 134, 1987). Hence the number of roots with Re s > 0 at
-  delay T is exactly
+  |a(jω)| = |b(jω)| and e^(−jωT) = −a(jω)/b(jω): the frequencies are the
+  positive real roots of the polynomial F(ω²) = |a(jω)|² − |b(jω)|², and each
+  gives the delay sequence T_m = (θ + 2πm)/ω. A root crosses towards Re s > 0
+  as T increases through T_m iff F′(ω²) > 0, whatever m is (Cooke & van den
+  Driessche, "On zeroes of some transcendental equations", Funkcial. Ekvac. 29,
+  1986; Walton & Marshall, IEE Proc. D 134, 1987). Hence the number of roots
+  with Re s > 0 at delay T is exactly
 
       Z(T) = Z(0) + 2·Σ_{T_m < T} sign F′(ω²),
 
-  where Z(0) is the Routh count of a(s) + K. This is the *crossing count* used
-  for every verdict; it never rests on a root found by Newton.
+  where Z(0) is the Routh count of a(s) + b(s). This is the *crossing count*
+  used for every verdict; it never rests on a root found by Newton.
 * **Gain crossings** (T fixed, K grows). s = jω is a root for a real K > 0 iff
   arg a(jω) + ωT ≡ π (mod 2π); the phase is unwrapped through the roots of a
   (continuous in ω) and every level (2m + 1)π is bracketed on a grid and refined
   by bisection; K_m = |a(jω_m)|. When a(s) has no roots with Re > 0 the
-  phase is monotone and the crossings found are provably all of them.
+  phase is monotone and the crossings found are provably all of them (d = 0;
+  KB's loop with a heading gain has its own route, `models.heading`).
 * **Rightmost roots** by pseudospectral collocation of the infinitesimal
   generator (Breda, Maset & Vermiglio, "Pseudospectral differencing methods for
   characteristic roots of delay differential equations", SIAM J. Sci. Comput.
@@ -103,8 +105,19 @@ def _polyval_derivative(p, s):
     return np.polyval(np.polyder(p), s) if len(p) > 1 else 0.0 * s
 
 
+def _modulus_in_y(p):
+    """|p(j√y)|² as a polynomial in y = ω² (descending), for real p (descending)."""
+    n = len(p) - 1
+    # p(jω) conj p(jω) = Σ c_m (jω)^m with c = p * p(−s) coefficients
+    p_minus = p * (-1.0) ** np.arange(n, -1, -1)
+    prod = np.polymul(p, p_minus)  # p(s)·p(−s): even polynomial in s
+    # p(s)p(−s) at s = jω equals |p(jω)|²; only even powers survive: s^(2i) = (−y)^i
+    deg = len(prod) - 1
+    return np.array([prod[idx] * (-1.0) ** ((deg - idx) // 2) for idx in range(0, deg + 1, 2)])
+
+
 class DelayLoop:
-    """The quasi-polynomial a(s) + K·e^(−sT) for fixed a(s) and T.
+    """The quasi-polynomial a(s) + (d(s) + K)·e^(−sT) for fixed a(s), d(s) and T.
 
     Parameters
     ----------
@@ -112,40 +125,53 @@ class DelayLoop:
         Real coefficients of a(s), descending powers, degree ≥ 1.
     T : float
         Delay, s, >= 0.
+    delayed : array_like, optional
+        Real coefficients of d(s), descending, degree < deg a (KB's loop with
+        a heading gain c: d(s) = kc·s, ``[k*c, 0]``). Default: d = 0, the
+        quasi-polynomial a(s) + K·e^(−sT).
     """
 
-    def __init__(self, a, T: float):
+    def __init__(self, a, T: float, delayed=None):
         self.a = strip_leading_zeros(real_coefficients(a, "a"))
         if len(self.a) < 2:
             raise ValueError("a(s) must have degree >= 1 (a retarded quasi-polynomial)")
         self.T = check_number("T", T, 0.0, low_open=False, unit="s")
+        self.d = None
+        d = None if delayed is None else real_coefficients(delayed, "delayed")
+        if d is not None and np.any(d):
+            self.d = strip_leading_zeros(d)
+            if len(self.d) >= len(self.a):
+                raise ValueError(f"delayed d(s) must have a lower degree than a(s) (a retarded quasi-polynomial); got degree {len(self.d) - 1}")
         self._a_roots = np.roots(self.a)
+
+    def _b(self, K):
+        """b(s) = d(s) + K, descending."""
+        return np.array([K]) if self.d is None else np.polyadd(self.d, [K])
 
     # ------------------------------------------------------------------ values
     def value(self, s, K: float):
-        """a(s) + K·e^(−sT) at complex `s`."""
-        return np.polyval(self.a, s) + K * np.exp(-s * self.T)
+        """a(s) + (d(s) + K)·e^(−sT) at complex `s`."""
+        b = K if self.d is None else np.polyval(self._b(K), s)
+        return np.polyval(self.a, s) + b * np.exp(-s * self.T)
 
     def _derivative(self, s, K):
-        return _polyval_derivative(self.a, s) - K * self.T * np.exp(-s * self.T)
+        if self.d is None:
+            return _polyval_derivative(self.a, s) - K * self.T * np.exp(-s * self.T)
+        b = self._b(K)
+        return _polyval_derivative(self.a, s) + (_polyval_derivative(b, s) - self.T * np.polyval(b, s)) * np.exp(-s * self.T)
 
     def _delay_free(self, K):
-        return np.polyadd(self.a, [K])
+        return np.polyadd(self.a, self._b(K))
 
     # -------------------------------------------------------- delay crossings
     def _modulus_poly_in_y(self, K):
-        """F(y) = |a(j√y)|² − K² as a polynomial in y = ω² (descending)."""
-        n = len(self.a) - 1
-        # a(jω) conj a(jω) = Σ c_m (jω)^m with c = a * a(−s) coefficients
-        a_minus = self.a * (-1.0) ** np.arange(n, -1, -1)
-        prod = np.polymul(self.a, a_minus)  # a(s)·a(−s): even polynomial in s
-        # a(s)a(−s) at s = jω equals |a(jω)|²; only even powers survive: s^(2i) = (−y)^i
-        deg = len(prod) - 1
-        coeff_y = [prod[idx] * (-1.0) ** ((deg - idx) // 2) for idx in range(0, deg + 1, 2)]
-        return np.polysub(np.array(coeff_y), [K * K])
+        """F(y) = |a(j√y)|² − |b(j√y)|² as a polynomial in y = ω² (descending)."""
+        if self.d is None:
+            return np.polysub(_modulus_in_y(self.a), [K * K])
+        return np.polysub(_modulus_in_y(self.a), _modulus_in_y(self._b(K)))
 
     def crossing_frequencies(self, K: float):
-        """Frequencies ω > 0 with |a(jω)| = |K|, and the crossing direction there.
+        """Frequencies ω > 0 with |a(jω)| = |b(jω)|, and the crossing direction there.
 
         Returns
         -------
@@ -170,8 +196,9 @@ class DelayLoop:
         return sorted(out)
 
     def _first_delay(self, w: float, K: float) -> float:
-        """Smallest T >= 0 with e^(−jωT) = −a(jω)/K, s."""
-        theta = (-np.angle(-np.polyval(self.a, 1j * w) / K)) % _TWO_PI
+        """Smallest T >= 0 with e^(−jωT) = −a(jω)/b(jω), s."""
+        b = K if self.d is None else np.polyval(self._b(K), 1j * w)
+        theta = (-np.angle(-np.polyval(self.a, 1j * w) / b)) % _TWO_PI
         return theta / w
 
     def crossing_delays(self, K: float, T_max: float) -> list[DelayCrossing]:
@@ -201,7 +228,7 @@ class DelayLoop:
         relative 1e-12 in delay) or at s = 0, or a crossing is tangent.
         """
         K = check_number("K", K, -_K_MAX, _K_MAX, low_open=False, high_open=False)
-        if np.polyval(self.a, 0.0) + K == 0.0:
+        if np.polyval(self.a, 0.0) + np.polyval(self._b(K), 0.0) == 0.0:
             return None
         base = routh_array(self._delay_free(K))
         if base.marginal:
@@ -261,8 +288,12 @@ class DelayLoop:
         Raises
         ------
         ValueError
-            If a(s) has a non-zero root on the imaginary axis (the phase jumps).
+            If a(s) has a non-zero root on the imaginary axis (the phase jumps),
+            or d ≠ 0 (the phase argument needs a delayed term without s; KB's
+            loop with a heading gain: `models.heading.kb_heading_interval`).
         """
+        if self.d is not None:
+            raise ValueError("critical_gain needs d = 0 (delayed term K alone); for KB's loop with a heading gain use models.heading.kb_heading_interval")
         if self.T == 0:
             from .crossings import first_stable_interval
 
@@ -303,9 +334,10 @@ class DelayLoop:
         """The `count` roots with largest real part, sorted by decreasing real part.
 
         Pseudospectral collocation (Breda, Maset & Vermiglio 2005) on `nodes`
-        Chebyshev nodes in [−T, 0], then Newton's method on a(s) + K·e^(−sT)
-        from each eigenvalue (to |Δs| < 1e-13·max(1, |s|)). Conjugate pairs are
-        both returned. T = 0 returns the polynomial roots of a(s) + K.
+        Chebyshev nodes in [−T, 0], then Newton's method on
+        a(s) + (d(s) + K)·e^(−sT) from each eigenvalue (to
+        |Δs| < 1e-13·max(1, |s|)). Conjugate pairs are both returned. T = 0
+        returns the polynomial roots of a(s) + d(s) + K.
 
         The discretization resolves roots up to |s|·T of the order of `nodes`;
         where no eigenvalue polishes to a root (a loop with |s|·T in the
@@ -342,6 +374,9 @@ class DelayLoop:
         A0[-1, :] = -self.a[:0:-1] / lead
         A1 = np.zeros((n, n))
         A1[-1, 0] = -K / lead
+        if self.d is not None:  # d(s)·x(t − T): derivatives of the delayed state, ascending powers
+            b = self._b(K)[::-1]
+            A1[-1, : len(b)] = -b / lead
         x = np.cos(math.pi * np.arange(nodes + 1) / nodes)
         c = np.ones(nodes + 1)
         c[0] = c[-1] = 2.0
@@ -461,45 +496,51 @@ def kb_critical_gain(tau, T, k):
     return K_star.reshape(shape), omega_star.reshape(shape)
 
 
-def _cubic_positive_roots(tau, k, K):
-    """Positive roots y of F(y) = τ²y³ + (1 − 2kτ)y² + k²y − K² (up to three; NaN where absent).
+def _cubic_positive_roots(tau, k, K, linear=None):
+    """Positive roots y of F(y) = τ²y³ + (1 − 2kτ)y² + ℓy − K² (up to three; NaN where absent).
 
-    No discriminant (it cancels catastrophically when τ is small): the
+    ℓ = `linear` (k² by default; k²(1 − c²) with a heading gain c). No
+    discriminant (it cancels catastrophically when τ is small): the
     critical points of F (a stable quadratic formula) split (0, ∞) into
     intervals where F is monotone and of one convexity, so each root is reached
     by Newton's method from a start that satisfies Fourier's condition
     F·F″ > 0 — convergence is monotone and needs no safeguard. τ = 0 leaves
-    the quadratic y² + k²y − K² (one positive root, closed form).
+    the quadratic y² + ℓy − K² (one positive root, closed form).
     """
     roots = np.full(tau.shape + (3,), np.nan)
     quadratic = tau == 0
     if quadratic.any():
-        kk, KK = k[quadratic] ** 2, K[quadratic] ** 2
-        roots[quadratic, 0] = 2 * KK / (kk + np.sqrt(kk * kk + 4 * KK))
+        kk = k[quadratic] ** 2 if linear is None else linear[quadratic]
+        KK = K[quadratic] ** 2
+        with np.errstate(invalid="ignore", divide="ignore"):
+            root = np.sqrt(kk * kk + 4 * KK)
+            roots[quadratic, 0] = np.where(kk >= 0, 2 * KK / (kk + root), (root - kk) / 2)
     cubic = ~quadratic
     if cubic.any():
-        roots[cubic] = _newton_cubic_roots(tau[cubic] ** 2, 1 - 2 * k[cubic] * tau[cubic], k[cubic] ** 2, K[cubic] ** 2)
+        lin = k[cubic] ** 2 if linear is None else linear[cubic]
+        roots[cubic] = _newton_cubic_roots(tau[cubic] ** 2, 1 - 2 * k[cubic] * tau[cubic], lin, K[cubic] ** 2)
     return roots
 
 
 def _newton_cubic_roots(a, beta, c, D):
-    """Up to three positive roots of a·y³ + β·y² + c·y − D (a, c, D > 0)."""
+    """Up to three positive roots of a·y³ + β·y² + c·y − D (a, D > 0; c <= 0 for a heading gain |c| >= 1:
+    F falls from −D, then rises, so one root, in the convex stretch: Newton from the right)."""
 
     def F(y):
         return ((a * y + beta) * y + c) * y - D
 
     inflection = -beta / (3 * a)
     disc = beta * beta - 3 * a * c
-    critical = (beta < 0) & (disc > 0)
+    critical = (beta < 0) & (disc > 0) & (c > 0)
     c2 = np.where(critical, (-beta + np.sqrt(np.maximum(disc, 0))) / (3 * a), np.inf)
     c1 = np.where(critical, c / (3 * a * np.where(critical, c2, 1.0)), np.inf)
     F1 = np.where(critical, F(np.where(critical, c1, 0.0)), np.inf)
     F2 = np.where(critical, F(np.where(critical, c2, 0.0)), -np.inf)
-    # a point right of every root: with β >= 0 each term alone bounds the root
-    # (within a factor 3 of it); otherwise Fujiwara's bound
+    # a point right of every root: with β >= 0 and c > 0 each term alone bounds
+    # the root (within a factor 3 of it); otherwise Fujiwara's bound
     with np.errstate(divide="ignore", invalid="ignore"):
         positive_bound = np.minimum.reduce([D / c, np.sqrt(D / np.where(beta > 0, beta, 0.0)), np.cbrt(D / a)])
-    right = np.where(beta >= 0, positive_bound, 2 * np.maximum.reduce([np.abs(beta) / a, np.sqrt(c / a), np.cbrt(D / (2 * a))]))
+    right = np.where((beta >= 0) & (c > 0), positive_bound, 2 * np.maximum.reduce([np.abs(beta) / a, np.sqrt(np.abs(c) / a), np.cbrt(D / (2 * a))]))
     F_inflection = np.where(inflection > 0, F(np.maximum(inflection, 0.0)), -np.inf)
     # smallest root: in the concave stretch left of the inflection (start at 0) or in the convex one (start right)
     left_concave = np.where(critical, F1 > 0, F_inflection >= 0)
@@ -532,19 +573,27 @@ def _newton_cubic_roots(a, beta, c, D):
     return y
 
 
-def delay_verdicts_from_gain(tau, T, k, K):
-    """Crossing-count verdicts for arrays (τ, T, k, K = kNV); returns (stable, Z, delay margin)."""
-    y = _cubic_positive_roots(tau, k, K)
+def delay_verdicts_from_gain(tau, T, k, K, c=None):
+    """Crossing-count verdicts for arrays (τ, T, k, K = kNV[, c]); returns (stable, Z, delay margin).
+
+    τs³ + s² + ks + (kcs + K)·e^(−sT) (c None: KB eq 18): F(y) = τ²y³ + (1 − 2kτ)y² + k²(1 − c²)y − K²,
+    first delays from arg(a(jω)/b(jω)), b = kcjω + K; Z(0), the Routh count of τs³ + s² + k(1 + c)s + K,
+    is 1 for K < 0 (a real root s > 0: N < 0), so K < 0 is always unstable."""
+    linear = None if c is None else k**2 * (1 - c * c)
+    y = _cubic_positive_roots(tau, k, K, linear)
     present = np.isfinite(y) & (y > 0)  # y = 0: K² underflowed to 0, no crossing at ω > 0
     y0 = np.where(present, y, 1.0)
     w = np.sqrt(y0)
     t3, k3 = tau[:, None], k[:, None]
-    slope = 3 * t3**2 * y0**2 + 2 * (1 - 2 * k3 * t3) * y0 + k3**2
+    slope = 3 * t3**2 * y0**2 + 2 * (1 - 2 * k3 * t3) * y0 + (k3**2 if c is None else linear[:, None])
     direction = np.where(present, np.sign(slope), 0.0)
     psi = np.arctan((k3 - t3 * y0) / w)
+    # arg b(jω): 0 for c = 0 and K > 0 (psi untouched), π for K < 0
+    b_phase = np.where(K[:, None] < 0, math.pi, 0.0) if c is None else np.arctan2(k3 * c[:, None] * w, K[:, None])
+    psi = np.where(b_phase == 0, psi, psi + b_phase)
     first = np.where(psi >= 0, psi, psi + _TWO_PI) / w
     passed = np.where(present & (T[:, None] > first), np.floor((T[:, None] - first) * w / _TWO_PI) + 1, 0.0)
-    base = np.where(tau * K > k, 2, 0)
+    base = np.where(K < 0, 1, np.where(tau * K > (k if c is None else k * (1 + c)), 2, 0))
     Z = base + 2 * np.sum(direction * passed, axis=1).astype(np.int64)
     margin = np.where(base == 0, np.min(np.where(present, first, np.inf), axis=1), 0.0)
     return Z == 0, Z, margin

@@ -106,6 +106,8 @@ class GridWallLaw(ForceLaw):
     window_cells: int = 33
     cv: int = DEFAULT_CV
     name = "grid wall (VFF window sum, KB eq 1)"
+    monotone = True  # decreasing on its whole domain (the tail beyond the reach too), no goal part
+    key = "grid"
 
     def __post_init__(self):
         object.__setattr__(self, "ratio", check_number("cell_ratio", self.ratio, 0.0))
@@ -182,6 +184,10 @@ class GridWallLaw(ForceLaw):
     def with_scale(self, scale: float) -> "GridWallLaw":
         """The same wall with cell ratio ρ = `scale`."""
         return GridWallLaw(scale, self.n, self.W, self.cell_size, self.window_cells, self.cv)
+
+    def parameters(self) -> dict:
+        """The grid's parameters by name (`parameters.RANGES` keys), for the report."""
+        return {"cell_ratio": self.ratio, "n": self.n, "W": self.W, "cell_size": self.cell_size, "window_cells": self.window_cells, "cv": self.cv}
 
     def domain(self) -> tuple[float, float]:
         """(1e-9 m, inf): defined for every d > 0 (the tail beyond `reach`)."""

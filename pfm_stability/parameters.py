@@ -41,6 +41,9 @@ __all__ = [
     "GEOMETRIES",
     "ENVIRONMENTS",
     "FORCE_LAWS",
+    "DOOR_OBSTACLES",
+    "LAW_PARAMETERS",
+    "FIELD_DEFAULTS",
     "DERIVATION_LAWS",
     "DEGREES_PER_RADIAN",
     "RADIANS_PER_DEGREE",
@@ -73,8 +76,25 @@ GEOMETRIES = ("corridor", "wall")
 ENVIRONMENTS = ("grid", "analytic")
 """Simulator environments: a histogram grid of cells, or continuous walls with a force law."""
 
-FORCE_LAWS = ("power", "grid")
-"""Lateral force laws by name: KB's lumped power law, the histogram grid's effective law."""
+DOOR_OBSTACLES = ("posts", "wall-ends")
+"""What bounds a door (KB Fig 4; docs/door.md): two posts, or the ends of two walls."""
+
+FORCE_LAWS = ("power", "grid", "khatib", "gnron")
+"""Lateral force laws by name: KB's lumped power law, the histogram grid's effective law, Khatib's
+repulsion and Ge & Cui 2000's goal-aware repulsion (docs/fields.md)."""
+
+LAW_PARAMETERS = {
+    "power": ("f", "n"),
+    "grid": ("f", "n", "cell_ratio", "cell_size", "window_cells"),
+    "khatib": ("xi", "eta", "rho0", "attraction_exponent", "goal_distance"),
+    "gnron": ("xi", "eta", "rho0", "attraction_exponent", "goal_exponent", "goal_distance", "delta"),
+}
+"""The parameters (`RANGES` keys) each law of `FORCE_LAWS` takes beside the robot's width W
+(docs/fields.md, "Command line"); a parameter given to a law that does not take it is an error."""
+
+FIELD_DEFAULTS = {"xi": 1.0, "eta": 0.1, "rho0": 0.8, "attraction_exponent": 2.0, "goal_exponent": 2.0, "delta": 0.0}
+"""Defaults of the Khatib and goal-aware laws: Ge & Cui 2000 Sec VI (ξ = 1, η = 0.1, ρ0 = 0.8 m,
+m = n = 2) and δ = 0 (eq 8, not eq 40). The goal distance has no default."""
 
 DERIVATION_LAWS = ("power", "general")
 """Force laws of the symbolic derivation (`pfm_stability.derivation`, ``pfm-stability derive --law``):
@@ -148,12 +168,22 @@ RANGES = {
     "cell_size": Range(0.01, 1.0, low_open=False, unit="m"),
     "start_jitter": Range(0.0, 100.0, low_open=False, unit="m"),
     "rtol": Range(0.0, 0.5, high_open=True),
+    # potential-field laws (Ge & Cui 2000; docs/fields.md)
+    "xi": Range(1e-6, 1e6, low_open=False),
+    "eta": Range(1e-6, 1e6, low_open=False),
+    "rho0": Range(1e-3, 1e4, low_open=False, unit="m"),
+    "attraction_exponent": Range(1.0, 10.0, low_open=False),
+    "goal_exponent": Range(0.0, 10.0, low_open=False),
+    "goal_distance": Range(1e-3, 1e4, low_open=False, unit="m"),
+    "delta": Range(0.0, 1e3, low_open=False, unit="m"),
     # integers (closed bounds, checked with `checks.check_integer`)
     "compute_delay": Range(0, 1, low_open=False, unit="samples"),
     "pade_order": Range(1, 12, low_open=False),
     "window_cells": Range(3, 1001, low_open=False, unit="cells"),
     "members": Range(3, 1000, low_open=False),
     "resolution": Range(10, 1000, low_open=False, unit="points per side"),
+    "door": Range(0.0, 1e4, unit="m"),
+    "post_radius": Range(0.0, 1e4, low_open=False, unit="m"),
     "sweep": Range(8, 100_000, low_open=False),
     "seed": Range(0, 2**63 - 1, low_open=False),
 }
@@ -182,6 +212,18 @@ Entries beyond the robot, controller and geometry:
     Standard deviation of a random lateral start offset, m, in [0, 100].
 ``rtol``
     Relative width of a bisection's final bracket, in (0, 0.5).
+``xi``, ``eta``
+    Attractive and repulsive scaling factors ξ, η of Ge & Cui 2000 (eq 1, 3, 8),
+    in [10⁻⁶, 10⁶] (docs/fields.md).
+``rho0``
+    Influence distance ρ0 of the repulsion, m, in [10⁻³, 10⁴].
+``attraction_exponent``, ``goal_exponent``
+    m of U_att = ½ξρ_gᵐ, in [1, 10] (Ge & Cui: 1 or 2); n of the goal-aware
+    repulsion U_rep·ρ_gⁿ, in [0, 10] (0 is Khatib's law).
+``goal_distance``
+    ρ_g, the frozen distance to the goal, m, in [10⁻³, 10⁴].
+``delta``
+    The surface offset δ of Ge & Cui's eq (40), m, in [0, 10³].
 ``compute_delay``, ``pade_order``, ``window_cells``, ``members``, ``sweep``, ``seed``
     Integers in closed ranges: samples from measurement to actuation [0, 1];
     Padé order m [1, 12]; grid window side [3, 1001] cells (odd, KB: 33);

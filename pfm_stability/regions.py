@@ -12,6 +12,12 @@ Asked for ``exact_delay``, the maps keep the vectorized crossing count of
 `pfm_stability.vectorized` (one count per point, independent of the boundary
 curves of `pfm_stability.curves`; the tests check that the two agree to the
 grid resolution).
+
+Any `ForceLaw` may be shaded (docs/fields.md). For a law that is not
+`monotone` each point takes its first (nearest) wall equilibrium
+(`force_law.wall_gain_arrays`, one root search per angle) and the middle of the
+corridor; the (V, f) plane scales the law's force, so it needs a law without a
+goal-directed part (a ValueError says so).
 """
 
 from __future__ import annotations

@@ -7,6 +7,11 @@ criterion (Koren & Borenstein 1991 eq 20) is from the sampled loop
 (docs/models.md). The text and Markdown renderings live in
 `pfm_stability.cli.render`; `StabilityReport.to_dict` is the JSON form
 (infinite values become ``"inf"``: "no finite critical value").
+
+Any `ForceLaw` may be given (docs/fields.md): its parameters join the inputs,
+``law`` names it, and a wall lists every equilibrium of the law
+(``environment.wall.equilibria``, each with every model's verdict); the
+top-level ``wall`` verdicts are those of the first (nearest) equilibrium.
 """
 
 from __future__ import annotations
@@ -17,19 +22,23 @@ from dataclasses import dataclass, field
 from .checks import check_type
 from .comparison import relative_error
 from .criteria import CorridorAnalysis, WallAnalysis, analyze_corridor, analyze_wall, loop_of
+from .force_law import ForceLaw, law_in_force
 from .models import KBFirstOrder, Sampled, models_for
-from .parameters import MODEL_NAMES, RANGES, Controller, Corridor, Robot, Wall
-from .serialize import SCHEMA_VERSION, json_number
+from .parameters import LAW_PARAMETERS, MODEL_NAMES, RANGES, Controller, Corridor, Robot, Wall, check_parameter
+from .serialize import SCHEMA_VERSION, json_number, json_ready
 
 __all__ = ["StabilityReport", "KBError", "build_report", "remedies", "kb_error"]
 
-INPUTS = ("V", "tau", "T", "k", "f", "n", "W", "hold", "compute_delay", "pade_order", "alpha_deg", "L")
-"""The report's inputs, in the order it lists them (``alpha_deg`` and ``L`` when given)."""
+LAW_INPUTS = ("cell_ratio", "cell_size", "window_cells", "xi", "eta", "rho0", "attraction_exponent", "goal_exponent", "goal_distance", "delta")
+"""The law's own parameters, listed after W when the law takes them (`parameters.LAW_PARAMETERS`)."""
+
+INPUTS = ("V", "tau", "T", "k", "f", "n", "W", *LAW_INPUTS, "hold", "compute_delay", "pade_order", "alpha_deg", "L")
+"""The report's inputs, in the order it lists them (``alpha_deg`` and ``L`` when given; f and n for KB's laws only)."""
 
 UNITS = {name: RANGES[name].unit if name in RANGES else "" for name in INPUTS}
 """Unit of each input (`parameters.RANGES`; ``hold`` has none)."""
 
-REMEDY_PARAMETERS = ("V", "T", "k", "alpha_deg", "L", "f")
+REMEDY_PARAMETERS = ("V", "T", "k", "alpha_deg", "L", "f", "eta", "rho0", "xi")
 """Parameters a remedy may change (one at a time), in the order they are listed."""
 
 
@@ -101,6 +110,14 @@ class StabilityReport:
     wall : WallAnalysis or None
     corridor : CorridorAnalysis or None
     kb_error : KBError
+    remedies : dict
+        (scenario, model) → `remedies` of the first wall equilibrium or the
+        corridor; ("wall", i, model) → those of wall equilibrium i.
+    law : dict or None
+        The law: ``name`` (`parameters.FORCE_LAWS`, or None for a law built in
+        code), ``description`` and ``parameters``.
+    door : DoorPassage or None
+        KB's problem 2 (Fig 4) for a door of the given width (`door.door_passage`).
     """
 
     inputs: dict
@@ -109,21 +126,37 @@ class StabilityReport:
     corridor: CorridorAnalysis | None = None
     kb_error: KBError | None = None
     remedies: dict = field(default_factory=dict)
+    law: dict | None = None
+    door: object | None = None
 
     def to_dict(self) -> dict:
         """The fields as a JSON-ready dict (SI units; infinities as ``"inf"``, undefined as null)."""
         out = {"schema_version": SCHEMA_VERSION, "command": "report", "inputs": self.inputs, "models": self.model_options}
+        if self.law is not None:
+            out["law"] = self.law
         if self.wall is not None:
             out.setdefault("environment", {})["wall"] = {
                 "alpha_deg": self.wall.alpha_deg,
                 "d0": json_number(self.wall.d0),
                 "N": self.wall.N,
                 "NV": self.wall.NV,
+                "c": self.wall.c,
+                "equilibria": [
+                    {"d0": json_number(e.d0), "N": e.N, "c": e.c, "NV": e.NV,
+                     "models": {name: _verdict_dict(v, self.remedies.get(("wall", i, name))) for name, v in e.models.items()}}
+                    for i, e in enumerate(self.wall.equilibria)
+                ],
             }
             out["wall"] = {name: _verdict_dict(v, self.remedies.get(("wall", name))) for name, v in self.wall.models.items()}
         if self.corridor is not None:
-            out.setdefault("environment", {})["corridor"] = {"L": self.corridor.L, "N": self.corridor.N, "NV": self.corridor.NV}
-            out["corridor"] = {name: _verdict_dict(v, self.remedies.get(("corridor", name))) for name, v in self.corridor.models.items()}
+            c = self.corridor
+            env = {"L": c.L, "N": c.N, "NV": c.NV, "c": c.c, "equilibria": [{"x0": e.x0, "N": e.N, "c": e.c} for e in c.equilibria]}
+            if c.N_finite_goal is not None:
+                env["N_finite_goal"] = c.N_finite_goal
+            out.setdefault("environment", {})["corridor"] = env
+            out["corridor"] = {name: _verdict_dict(v, self.remedies.get(("corridor", name))) for name, v in c.models.items()}
+        if self.door is not None:
+            out["door"] = self.door.to_dict()
         if self.kb_error is not None:
             out["kb_error"] = self.kb_error.to_dict()
         return out
@@ -142,10 +175,12 @@ def _verdict_dict(v, remedy) -> dict:
     }
     out.update({key: json_number(value) for key, value in v.critical.items()})
     out["to_stabilize"] = remedy or {}
+    if v.reason is not None:
+        out["reason"] = v.reason
     return out
 
 
-def remedies(scenario: str, verdict, robot: Robot, controller: Controller) -> dict:
+def remedies(scenario: str, verdict, robot: Robot, controller: Controller, law: ForceLaw | None = None, at: float | None = None) -> dict:
     """Single-parameter changes that make an unstable loop stable.
 
     Parameters
@@ -153,6 +188,14 @@ def remedies(scenario: str, verdict, robot: Robot, controller: Controller) -> di
     scenario : {"wall", "corridor"}
     verdict : criteria.ModelVerdict
     robot, controller : the current parameters
+    law : ForceLaw, optional
+        The law analysed (KB's power law by default). For a law that is not
+        `monotone` the critical values of α, L and of the law's parameters are
+        the nearest values at which the verdict changes (docs/fields.md), so
+        the direction is the one towards them.
+    at : float, optional
+        The current α (deg, wall) or L (m, corridor): the direction towards α*
+        or L* for a law that is not monotone (without it, "raise").
 
     Returns
     -------
@@ -160,23 +203,28 @@ def remedies(scenario: str, verdict, robot: Robot, controller: Controller) -> di
         Parameter → {"to": critical value (SI, α in deg), "direction": "raise"
         or "lower", "change_percent": relative change, %}. Each value leaves
         the loop stable over the whole way from it to 0 (V, T, k) or beyond it
-        (α, L), by the definitions of the critical values. Empty if stable; a
-        parameter is left out when no value of it alone helps (e.g. V, α, L
-        and f when the model is unstable at every NV: then only a shorter T or
-        a lower k can work).
+        (α, L), by the definitions of the critical values (for a law that is
+        not monotone: just past it). Empty if stable; a parameter is left out
+        when no value of it alone helps (e.g. V, α, L and f when the model is
+        unstable at every NV: then only a shorter T or a lower k can work).
     """
     if verdict.verdict == "stable":
         return {}
+    law = law_in_force(robot, controller, law)
     c = verdict.critical
-    current = {"V": robot.V, "f": controller.f, "T": controller.T, "k": robot.k}
-    wanted = [("V", "lower", c.V_critical), ("T", "lower", c.T_critical), ("k", "lower", c.k_critical)]
+    current = {**law.parameters(), "V": robot.V, "f": controller.f if law.monotone else law.scale, "T": controller.T, "k": robot.k}
+    wanted = [("V", "V_critical", "lower"), ("T", "T_critical", "lower"), ("k", "k_critical", "lower")]  # (parameter, critical key, direction)
     if scenario == "wall":
-        wanted += [("alpha_deg", "raise", c.alpha_critical_deg), ("f", "raise", c.f_critical)]
+        wanted.append(("alpha_deg", "alpha_critical_deg", _towards(c.alpha_critical_deg, at, law)))
     else:
-        wanted += [("L", "raise", c.L_critical), ("f", "lower", c.f_critical)]
+        wanted.append(("L", "L_critical", _towards(c.L_critical, at, law)))
+    if "f_critical" in c:
+        wanted.append(("f", "f_critical", ("raise" if scenario == "wall" else "lower") if law.monotone else _towards(c.f_critical, current["f"], law)))
+    wanted += [(name, f"{name}_critical", _towards(c[f"{name}_critical"], current[name], law)) for name in ("eta", "rho0", "xi") if f"{name}_critical" in c]
     out = {}
-    for name, direction, target in wanted:
-        if not math.isfinite(target) or target <= 0 or (name == "alpha_deg" and target >= 90):
+    for name, key, direction in wanted:
+        target = c[key]
+        if direction is None or not math.isfinite(target) or target <= 0 or (name == "alpha_deg" and target >= 90):
             continue
         now = current.get(name)
         if now is not None and (target >= now if direction == "lower" else target <= now):
@@ -186,6 +234,15 @@ def remedies(scenario: str, verdict, robot: Robot, controller: Controller) -> di
             entry["change_percent"] = (target / now - 1.0) * 100
         out[name] = entry
     return out
+
+
+def _towards(target: float, now: float | None, law: ForceLaw) -> str | None:
+    """"raise" or "lower": towards `target` for a law that is not monotone; "raise" (α, L) for one that is."""
+    if law.monotone or now is None:
+        return "raise"
+    if not math.isfinite(target) or target == now:
+        return None
+    return "raise" if target > now else "lower"
 
 
 def kb_error(robot: Robot, controller: Controller) -> KBError:
@@ -207,6 +264,9 @@ def build_report(
     sources: dict | None = None,
     law=None,
     alpha_deg: float | None = None,
+    door: float | None = None,
+    door_obstacle: str = "posts",
+    post_radius: float = 0.0,
 ) -> StabilityReport:
     """Analyze a wall (α) and/or a corridor (L, m) with the chosen models.
 
@@ -226,19 +286,23 @@ def build_report(
     sources : dict, optional
         Provenance of each input (shown in the report).
     law : ForceLaw, optional
-        KB's power law by default.
+        KB's power law by default (`fields.make_law` builds any law of
+        `parameters.FORCE_LAWS`). A law named in `parameters.LAW_PARAMETERS`
+        lists the parameters it takes among the inputs (f and n only where it
+        uses them).
 
     Raises
     ------
     ValueError
-        Neither α nor L given, or any parameter out of range.
+        Neither α nor L given, any parameter out of range, or a wall where the
+        law has no equilibrium.
     """
     if alpha is not None and alpha_deg is not None:
         raise ValueError("give alpha (rad) or alpha_deg, not both")
-    if alpha is None and alpha_deg is None and L is None:
+    if alpha is None and alpha_deg is None and L is None and door is None:
         raise ValueError(
-            f"alpha or L must be given: a wall (--alpha DEG, in {RANGES['alpha_deg'].describe()}) "
-            f"and/or a corridor (--L M, in (W/2, {RANGES['L'].high:g}] m)"
+            f"alpha or L must be given, or a door: a wall (--alpha DEG, in {RANGES['alpha_deg'].describe()}), "
+            f"a corridor (--L M, in (W/2, {RANGES['L'].high:g}] m) and/or a door (--door WIDTH, m)"
         )
     wall = Wall.from_degrees(alpha_deg) if alpha_deg is not None else (Wall(alpha) if alpha is not None else None)
     corridor = Corridor(L) if L is not None else None
@@ -263,6 +327,8 @@ def build_report(
         "compute_delay": controller.compute_delay,
         "pade_order": pade_order,
     }
+    law = law_in_force(robot, controller, law)
+    values = _law_inputs(values, law)
     if wall is not None:
         values["alpha_deg"] = wall.alpha_deg
     if corridor is not None:
@@ -272,8 +338,38 @@ def build_report(
     wall_result = analyze_wall(robot, controller, wall, model_objs, law) if wall else None
     corridor_result = analyze_corridor(robot, controller, corridor, model_objs, law) if corridor else None
     fixes = {}
-    for scenario, result in (("wall", wall_result), ("corridor", corridor_result)):
-        if result is not None:
-            for name, verdict in result.models.items():
-                fixes[(scenario, name)] = remedies(scenario, verdict, robot, controller)
-    return StabilityReport(inputs, options, wall_result, corridor_result, kb_error(robot, controller), fixes)
+    if wall_result is not None:
+        for i, e in enumerate(wall_result.equilibria):
+            for name, verdict in e.models.items():
+                fixes[("wall", i, name)] = remedies("wall", verdict, robot, controller, law, wall.alpha_deg)
+        fixes.update({("wall", name): fixes[("wall", 0, name)] for name in wall_result.models})
+    if corridor_result is not None:
+        for name, verdict in corridor_result.models.items():
+            fixes[("corridor", name)] = remedies("corridor", verdict, robot, controller, law, corridor.L)
+    described = {"name": law.key, "description": law.name, "parameters": json_ready(law.parameters())}
+    passage = None
+    if door is not None:
+        from .door import door_passage
+
+        try:
+            passage = door_passage(law, check_parameter("door", door), obstacle=door_obstacle,
+                                   post_radius=check_parameter("post_radius", post_radius), robot_width=robot.W, find_smallest=True)
+        except ValueError as error:  # door_passage calls the door's width "width"; the report calls it "door"
+            text = str(error)
+            raise ValueError("door" + text[len("width"):] if text.startswith("width") else text) from None
+    return StabilityReport(inputs, options, wall_result, corridor_result, kb_error(robot, controller), fixes, described, passage)
+
+
+def _law_inputs(values: dict, law: ForceLaw) -> dict:
+    """The inputs with the law's own parameters after W, and without f and n where a named law does not use them."""
+    taken = LAW_PARAMETERS.get(law.key)
+    if taken is None:
+        return values
+    own = {k: v for k, v in law.parameters().items() if k in LAW_INPUTS and k in taken}
+    out = {}
+    for name, value in values.items():
+        if name not in ("f", "n") or name in taken:
+            out[name] = value
+        if name == "W":
+            out.update(own)
+    return out

@@ -18,6 +18,11 @@ Stable ⇔ Z = 0. The delay margin (largest T that keeps the point stable, s) is
 the smallest T₀ when Z₀ = 0, and 0 otherwise. Every parameter may vary per
 point; N comes from KB's power law for a wall (eq 11, 23) or a corridor (eq 25).
 Chunks of the arrays are processed on all cores (numpy releases the GIL).
+
+A heading gain c (``c=`` array, default 0; docs/models.md, "The heading
+gain") makes the delayed term kcs + K: F(y) gains −k²c²y, the first delay
+gains arg(kcjω + K), and Z₀ is the Routh count of τs³ + s² + k(1 + c)s + K.
+Without ``c`` (or with c = 0 everywhere) the code and the floats are KB's.
 """
 
 from __future__ import annotations
@@ -30,9 +35,10 @@ import numpy as np
 
 from .delay import delay_verdicts_from_gain
 from .force_law import power_law_corridor_gain, power_law_wall_gain
+from .models.base import HEADING_GAIN_RANGE, check_heading_gain
 from .parameters import RANGES, TAU_RESOLUTION, check_parameter
 
-__all__ = ["VectorVerdicts", "exact_delay_verdicts", "loop_gain_arrays", "delay_verdicts_from_gain"]
+__all__ = ["VectorVerdicts", "exact_delay_verdicts", "heading_gain_array", "loop_gain_arrays", "delay_verdicts_from_gain"]
 
 _CHUNK = 32768
 
@@ -143,7 +149,24 @@ def _run_chunks(func, arrays):
     return [np.concatenate([o[i] for o in outputs]) for i in range(len(outputs[0]))]
 
 
-def exact_delay_verdicts(V, tau, T, k, f, n, W, *, alpha=None, L=None) -> VectorVerdicts:
+def heading_gain_array(c) -> np.ndarray:
+    """c as a float array, every value finite and in `HEADING_GAIN_RANGE`; else `Loop`'s message and the point index."""
+    try:
+        c = np.asarray(c, dtype=float)
+    except (TypeError, ValueError):
+        raise ValueError(f"c must be a real number or an array of real numbers; got {c!r}") from None
+    low, high = HEADING_GAIN_RANGE
+    bad = ~np.isfinite(c) | (c < low) | (c > high)
+    if bad.any():
+        index = int(np.flatnonzero(bad.ravel())[0])
+        try:
+            check_heading_gain(float(c.ravel()[index]))
+        except ValueError as exc:
+            raise ValueError(f"{exc} (point {index})") from None
+    return c
+
+
+def exact_delay_verdicts(V, tau, T, k, f, n, W, *, alpha=None, L=None, c=None) -> VectorVerdicts:
     """`exact_delay` verdicts and delay margins for arrays of parameters.
 
     Parameters
@@ -155,6 +178,9 @@ def exact_delay_verdicts(V, tau, T, k, f, n, W, *, alpha=None, L=None) -> Vector
         Wall target angle, rad, in (0, π/2) (KB eq 9).
     L : array_like, optional
         Corridor half-width, m, > W/2 (KB eq 25).
+    c : array_like, optional
+        Heading gain, dimensionless, in [−0.99, 100] (`models.Loop.c`);
+        default 0 everywhere (KB's loop, KB's code path).
 
     Returns
     -------
@@ -167,7 +193,12 @@ def exact_delay_verdicts(V, tau, T, k, f, n, W, *, alpha=None, L=None) -> Vector
         For the first out-of-range value (parameter, range, point index).
     """
     tau, T, k, NV = loop_gain_arrays(V, tau, T, k, f, n, W, alpha=alpha, L=L)
+    heading = [] if c is None else [heading_gain_array(c)]
+    if heading and not heading[0].any():
+        heading = []  # c = 0 everywhere: KB's code path
+    if heading:
+        tau, T, k, NV, heading[0] = np.broadcast_arrays(tau, T, k, NV, heading[0])
     shape = NV.shape
     K = k * NV
-    stable, Z, margin = _run_chunks(delay_verdicts_from_gain, [tau, T, k, K])
+    stable, Z, margin = _run_chunks(delay_verdicts_from_gain, [tau, T, k, K] + heading)
     return VectorVerdicts(stable.reshape(shape), Z.reshape(shape), margin.reshape(shape), NV, T)

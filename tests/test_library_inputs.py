@@ -41,7 +41,7 @@ CALLS = {
     "make_models": (lambda a: P.make_models(a), "names"),
     "boundary loop": (lambda a: P.ExactDelay().boundary(a), "loop"),
     "is_stable NV": (lambda a: P.Sampled().is_stable(a, LOOP), "NV"),
-    "rightmost_root NV": (lambda a: P.ExactDelay().rightmost_root(a, LOOP), "NV"),
+    "rightmost_root NV": (lambda a: P.ExactDelay().rightmost_root(a, LOOP).real, "NV"),  # NV < 0 is valid (N < 0 diverges): the root is complex-typed
     "critical_delay loop": (lambda a: P.Pade().critical_delay(1.0, a), "loop"),
     "DelayLoop a": (lambda a: P.DelayLoop(a, 0.1), "a"),
     "DelayLoop K": (lambda a: P.DelayLoop([1.0, 1.0, 0.0], 0.1).is_stable(a), "K"),

@@ -10,6 +10,7 @@ run colliding, with the grid boundaries of the sampled model.
 
 import importlib
 import json
+import math
 import sys
 from pathlib import Path
 
@@ -90,3 +91,18 @@ def test_results_table_and_readme(run_all, tmp_path, quick_results):
     assert "| Fig 3 |" in inside and "| Validation |" in inside
     for name in ("fig3.png", "fig5.png", "fig6.png", "fig3.json", "validation_summary.json"):
         assert (EXPERIMENTS / "results" / name).is_file(), name
+
+
+def test_general_field_experiments_write_png_and_json(quick_results):
+    """Ge & Cui 2000's traps (Figs 2–4, 6, Sec VI.B), the goal-aware corridor (crossover ρ_g* = √(1 + 2ηc(L)²/ξ)
+    = 1.1456 m for ξ = 1, η = 0.1, ρ0 = 0.8, L = 0.4) and KB's Fig 4 door are part of `run_all`: each writes
+    its PNG and JSON, and the door's numeric w* equals its closed form (to 1e-9: both are exact to round-off)."""
+    out, rows = quick_results
+    for name in ("gc2000_fig4", "gc2000_corridor", "kb_fig4_door"):
+        assert (out / f"{name}.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n", name
+    corridor = _json(out, "gc2000_corridor.json")
+    assert abs(corridor["crossover"]["rho_g"] / math.sqrt(1 + 2 * 0.1 * (1 / 0.4 - 1 / 0.8) ** 2 / 1.0) - 1) < 1e-9
+    door = _json(out, "kb_fig4_door.json")
+    assert abs(door["relative_error_numeric_vs_closed_form"]) < 1e-9
+    traps = _json(out, "gc2000_traps.json")
+    assert traps["rows"]

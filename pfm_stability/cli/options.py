@@ -10,7 +10,7 @@ import argparse
 from dataclasses import dataclass, fields
 
 from ..checks import check_integer, check_number, check_output_path
-from ..parameters import HOLDS, PRESETS, RANGES, SHOWN_AS, Controller, Preset, Robot, get_preset
+from ..parameters import FIELD_DEFAULTS, FORCE_LAWS, HOLDS, LAW_PARAMETERS, PRESETS, RANGES, SHOWN_AS, Controller, Preset, Robot, get_preset
 
 __all__ = [
     "number",
@@ -21,6 +21,9 @@ __all__ = [
     "add_parameter_options",
     "resolve_parameters",
     "ResolvedParameters",
+    "LAW_OPTIONS",
+    "add_law_options",
+    "resolve_law",
 ]
 
 def _shown(key: str) -> str:
@@ -180,3 +183,65 @@ def resolve_parameters(args) -> ResolvedParameters:
 
 def _fields(obj) -> dict:
     return {f.name: getattr(obj, f.name) for f in fields(obj)}
+
+
+# ------------------------------------------------------------------ force laws
+LAW_OPTIONS = {
+    "cell_ratio": "grid: force ratio F_cr/F_ct per cell (default: calibrated so that f_av = f, KB §4)",
+    "cell_size": "grid: cell size (default 0.1)",
+    "window_cells": "grid: active window side, odd (default 33)",
+    "xi": "khatib/gnron: attractive scaling factor xi (default 1)",
+    "eta": "khatib/gnron: repulsive scaling factor eta (default 0.1)",
+    "rho0": "khatib/gnron: influence distance rho0 (default 0.8)",
+    "attraction_exponent": "khatib/gnron: m of U_att = xi rho_g^m / 2 (default 2)",
+    "goal_exponent": "gnron: n of the goal-aware repulsion U_rep rho_g^n (default 2)",
+    "goal_distance": "khatib/gnron: the frozen distance to the goal rho_g (required)",
+    "delta": "gnron: surface offset delta of Ge & Cui eq (40) (default 0)",
+}
+"""The law options (`parameters.RANGES` keys) and their help, as ``--cell-ratio`` … ``--delta`` (docs/fields.md)."""
+
+_FIELD_SOURCE = "default (Ge & Cui 2000 Sec VI)"
+
+
+def _option(name: str) -> str:
+    return "--" + name.replace("_", "-")
+
+
+def add_law_options(parser: argparse.ArgumentParser) -> None:
+    """--law and the options of the laws (`LAW_OPTIONS`); each applies to the laws of `parameters.LAW_PARAMETERS` only."""
+    group = parser.add_argument_group("force law (docs/fields.md)")
+    group.add_argument("--law", choices=FORCE_LAWS, default="power",
+                       help="lateral force law: KB's power law f(W/d)^n (default), the histogram grid's law, "
+                            "Khatib's repulsion or Ge & Cui's goal-aware repulsion (gnron)")
+    for name, text in LAW_OPTIONS.items():
+        kind = integer(name, odd=True) if name == "window_cells" else number(name)
+        group.add_argument(_option(name), type=kind, help=f"{text}, {describe(name)}")
+
+
+def resolve_law(args, params: ResolvedParameters):
+    """The law of ``--law`` and the sources of its parameters: (law, sources).
+
+    Raises
+    ------
+    ValueError
+        An option the law does not take (``--xi applies to khatib or gnron, not to --law power``),
+        or ``--law khatib``/``gnron`` without ``--goal-distance``.
+    """
+    from ..fields import check_law_parameters, make_law
+
+    given = {name: getattr(args, name) for name in LAW_OPTIONS if getattr(args, name, None) is not None}
+    typed = [name for name in ("f", "n") if params.sources.get(name) == "user"]
+    check_law_parameters(args.law, typed + list(given), _option, f"--law {args.law}")
+    law = make_law(args.law, params.robot, params.controller, **given)
+    sources = {}
+    for name in LAW_PARAMETERS[args.law]:
+        if name in ("f", "n"):
+            continue
+        if name in given:
+            sources[name] = "user"
+        elif name == "cell_ratio":
+            sources[name] = "calibrated so that f_av = f (KB §4)"
+        else:
+            sources[name] = "default (0: Ge & Cui eq 8)" if name == "delta" else _FIELD_SOURCE if name in FIELD_DEFAULTS else "default (KB §2)"
+    return law, sources
+

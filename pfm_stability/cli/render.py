@@ -33,6 +33,7 @@ __all__ = [
     "render_validation_text",
     "render_sweep_text",
     "render_traps_text",
+    "render_door_text",
 ]
 
 
@@ -79,6 +80,16 @@ _LABELS = {
     "pade_order": "Pade order m",
     "alpha_deg": "alpha (target angle to wall normal)",
     "L": "L (corridor half-width)",
+    "cell_ratio": "cell ratio F_cr/F_ct (grid)",
+    "cell_size": "cell size (grid)",
+    "window_cells": "window side (grid)",
+    "xi": "xi (attractive scaling factor)",
+    "eta": "eta (repulsive scaling factor)",
+    "rho0": "rho0 (influence distance)",
+    "attraction_exponent": "m (attraction exponent)",
+    "goal_exponent": "n (goal exponent)",
+    "goal_distance": "rho_g (goal distance, frozen)",
+    "delta": "delta (surface offset, eq 40)",
 }
 
 _REPORT_SCENARIOS = ("wall", "corridor")
@@ -90,6 +101,9 @@ _COLUMNS = {
 }
 """Per geometry: the table's critical-value columns and their JSON keys (`criteria.WallCritical`, `CorridorCritical`)."""
 
+_FIELD_COLUMNS = (["eta*", "rho0* m", "xi*"], ["eta_critical", "rho0_critical", "xi_critical"])
+"""Khatib's and the goal-aware law: the law's parameters in place of f* (docs/fields.md)."""
+
 _FOOTNOTE = (
     "margin = relative distance in NV to the nearest stability boundary (NV*/NV - 1 when the stable set is (0, NV*); "
     "> 0 stable). Starred values are critical with the other inputs fixed: every V below V*, T below T* and k below k* "
@@ -99,32 +113,59 @@ _FOOTNOTE = (
 
 
 def _scenarios(data: dict):
-    """Yield (title, header, rows, remedies) for each geometry of the report's JSON form."""
+    """Yield (title, header, rows, remedies, notes) for each geometry of the report's JSON form (each wall equilibrium when there are several)."""
     for scenario in _REPORT_SCENARIOS:
         if scenario not in data:
             continue
         env = data["environment"][scenario]
-        if scenario == "wall":
-            title = (
-                f"Wall, alpha = {number(env['alpha_deg'])} deg: equilibrium d0 = {number(env['d0'])} m, "
-                f"N = {number(env['N'])} 1/m, NV = {number(env['NV'])} 1/s"
-            )
-        else:
+        if scenario == "corridor":
             title = f"Corridor, L = {number(env['L'])} m: N = {number(env['N'])} 1/m, NV = {number(env['NV'])} 1/s"
-        columns, keys = _COLUMNS[scenario]
-        header = ["model", "verdict", "margin", "NV* 1/s", "omega* rad/s"] + columns
-        rows = []
-        for name, v in data[scenario].items():
-            cells = [name, v["verdict"].upper() if v["verdict"] != "stable" else "stable", percent(v["margin"]), number(v["NV_critical"]), number(v["omega_critical"])]
-            cells += [number(v[k]) for k in keys]
-            rows.append(cells)
-        fixes = {name: v["to_stabilize"] for name, v in data[scenario].items() if v["verdict"] != "stable"}
-        yield title, header, rows, fixes
+            yield (title, *_verdict_table(scenario, data[scenario]), _corridor_notes(env))
+            continue
+        equilibria = env.get("equilibria") or [{"d0": env["d0"], "N": env["N"], "NV": env["NV"], "models": data["wall"]}]
+        for i, e in enumerate(equilibria):
+            which = f", equilibrium {i + 1} of {len(equilibria)}: d0" if len(equilibria) > 1 else ": equilibrium d0"
+            title = (
+                f"Wall, alpha = {number(env['alpha_deg'])} deg{which} = {number(e['d0'])} m, "
+                f"N = {number(e['N'])} 1/m, NV = {number(e['NV'])} 1/s"
+            )
+            reasons = sorted({v["reason"] for v in e["models"].values() if "reason" in v})
+            yield (title, *_verdict_table(scenario, e["models"]), [f"  every model: unstable ({r})" for r in reasons])
 
 
-def _remedy_line(model: str, fix: dict) -> str:
+def _verdict_table(scenario: str, verdicts: dict):
+    """(header, rows, remedies) of one geometry's verdicts."""
+    columns, keys = _COLUMNS[scenario]
+    if verdicts and "f_critical" not in next(iter(verdicts.values())):  # a law with its own parameters in place of f
+        at = keys.index("f_critical")
+        columns = columns[:at] + _FIELD_COLUMNS[0] + columns[at + 1:]
+        keys = keys[:at] + _FIELD_COLUMNS[1] + keys[at + 1:]
+    header = ["model", "verdict", "margin", "NV* 1/s", "omega* rad/s"] + columns
+    rows = []
+    for name, v in verdicts.items():
+        cells = [name, v["verdict"].upper() if v["verdict"] != "stable" else "stable", percent(v["margin"]), number(v["NV_critical"]), number(v["omega_critical"])]
+        cells += [number(v.get(k)) for k in keys]
+        rows.append(cells)
+    fixes = {name: (v["to_stabilize"], "eta_critical" in v) for name, v in verdicts.items() if v["verdict"] != "stable"}
+    return header, rows, fixes
+
+
+def _corridor_notes(env: dict) -> list[str]:
+    """The corridor's lines beyond the table: the finite-goal gain, equilibria off the centre line."""
+    notes = []
+    if "N_finite_goal" in env:
+        notes.append(f"  with a finite goal straight ahead N would be {number(env['N_finite_goal'])} 1/m (N + 1/rho_g; not used: the goal direction is frozen)")
+    others = [e for e in env.get("equilibria", []) if e["x0"] != 0]
+    if others:
+        notes.append("  other lateral equilibria: " + "; ".join(f"x0 = {number(e['x0'])} m, N = {number(e['N'])} 1/m" for e in others))
+    return notes
+
+
+def _remedy_line(model: str, fix) -> str:
+    fix, field = fix if isinstance(fix, tuple) else (fix, False)
     if not fix:
-        return f"  to stabilize ({model}): no change of V, T, k, alpha, L or f alone helps; change tau or several parameters"
+        which = "alpha, L, eta, rho0 or xi" if field else "alpha, L or f"
+        return f"  to stabilize ({model}): no change of V, T, k, {which} alone helps; change tau or several parameters"
     parts = []
     for name, entry in fix.items():
         unit = RANGES[name].unit
@@ -132,6 +173,14 @@ def _remedy_line(model: str, fix: dict) -> str:
         change = f" ({entry['change_percent']:+.0f} %)" if "change_percent" in entry else ""
         parts.append(f"{entry['direction']} {SHOWN_AS.get(name, name)} to {bound} {number(entry['to'])}{(' ' + unit) if unit else ''}{change}")
     return f"  to stabilize ({model}), change one of: " + "; ".join(parts)
+
+
+def _law_line(data: dict) -> list[str]:
+    """The force law, when it is not KB's power law (docs/fields.md)."""
+    law = data.get("law")
+    if not law or law["name"] == "power":
+        return []
+    return ["", f"Force law: {law['description']}" + (f" (--law {law['name']})" if law["name"] else "")]
 
 
 def _kb_error_line(report) -> list[str]:
@@ -149,17 +198,51 @@ def render_text(report) -> str:
         unit = f" {entry['unit']}" if entry["unit"] else ""
         mark = "  <-- " + entry["source"] if entry["source"].startswith("ASSUMED") else f"  ({entry['source']})"
         lines.append(f"  {_LABELS[name]:<38} {number(entry['value'])}{unit}{mark}")
+    lines += _law_line(data)
     lines += ["", "Models"]
     for name, entry in data["models"].items():
         options = ", ".join(f"{k}={v}" for k, v in entry.items() if k != "equation")
         lines.append(f"  {name:<15} {entry['equation']}{'  [' + options + ']' if options else ''}")
-    for title, header, rows, fixes in _scenarios(data):
+    for title, header, rows, fixes, notes in _scenarios(data):
         lines += ["", title]
         lines += ["  " + line for line in table(header, rows)]
+        lines += notes
         for model, fix in fixes.items():
             lines.append(_remedy_line(model, fix))
+    if data.get("door"):
+        lines += ["", *render_door_text(data["door"]).rstrip("\n").splitlines()]
     lines += ["", _FOOTNOTE]
     lines += _kb_error_line(report)
+    return "\n".join(lines) + "\n"
+
+
+def render_door_text(passage) -> str:
+    """The door passage (KB Fig 4; a `door.DoorPassage` or its `to_dict()`): geometry, verdict, stop, lateral stiffness, smallest width."""
+    d = passage.to_dict() if hasattr(passage, "to_dict") else passage
+    g = d["geometry"]
+    kind = "two posts" if g["obstacle"] == "posts" else "two wall ends"
+    radius = "radius" if g["obstacle"] == "posts" else "half-thickness"
+    lines = [
+        f"Door (KB 1991 Fig 4, docs/door.md): {kind} {number(g['width'])} m apart (centre to centre), {radius} {number(g['post_radius'])} m; "
+        f"opening {number(g['opening'])} m, robot {number(g['robot_width'])} m wide",
+        f"  law: {d['law']}" + (" (with a goal-directed part)" if d["goal_force"] else ""),
+        f"  peak push back from the gap: {number(d['peak_repulsion'])} F_a, {number(d['peak_distance'])} m before it; "
+        f"margin (min forward force) {number(d['margin'])} F_a",
+    ]
+    if d["passes"]:
+        lines.append("  verdict: passes (the force along the axis points forward all the way to the gap)")
+    else:
+        what = {
+            "trapped": "trapped on the axis (a local minimum in front of the door)",
+            "turns away": "slides off the axis and turns away (KB Fig 4)",
+            "neutral": "laterally neutral",
+        }[d["at_stop"]]
+        lines.append(f"  verdict: STOPS {number(d['stop_distance'])} m before the gap plane; lateral stiffness "
+                     f"{number(d['lateral_stiffness'])} 1/m there: {what}")
+    if d.get("smallest_passable_width") is not None:
+        lines.append(f"  smallest passable width: {number(d['smallest_passable_width'])} m")
+    lines.append("  static analysis: " + ("the steering loop in the gap (a corridor of half-width opening/2) is not checked" if d["passes"]
+                                           else "a moving robot may still pass by momentum"))
     return "\n".join(lines) + "\n"
 
 
@@ -170,12 +253,16 @@ def render_markdown(report) -> str:
     for name, entry in data["inputs"].items():
         source = f"**{entry['source']}**" if entry["source"].startswith("ASSUMED") else entry["source"]
         lines.append(f"| {_LABELS[name]} | {number(entry['value'])} | {entry['unit']} | {source} |")
-    for title, header, rows, fixes in _scenarios(data):
+    lines += _law_line(data)
+    for title, header, rows, fixes, notes in _scenarios(data):
         lines += ["", f"## {title}", "", "| " + " | ".join(header) + " |", "|" + " --- |" * len(header)]
         lines += ["| " + " | ".join(str(c) for c in r) + " |" for r in rows]
+        lines += ["", *(note.strip() for note in notes)] if notes else []
         for model, fix in fixes.items():
             lines.append("")
             lines.append("-" + _remedy_line(model, fix)[1:])
+    if data.get("door"):
+        lines += ["", "## Door", "", "```", *render_door_text(data["door"]).rstrip("\n").splitlines(), "```"]
     lines += _kb_error_line(report)
     return "\n".join(lines) + "\n"
 

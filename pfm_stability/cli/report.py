@@ -1,9 +1,9 @@
-"""``pfm-stability report``: every model's verdict for a wall and/or a corridor."""
+"""``pfm-stability report``: every model's verdict for a wall and/or a corridor, with any force law (``--law``, docs/fields.md)."""
 
 from __future__ import annotations
 
-from ..parameters import MODEL_NAMES, Wall
-from .options import PADE_ORDER, add_parameter_options, describe, number, resolve_parameters
+from ..parameters import DOOR_OBSTACLES, MODEL_NAMES, Wall
+from .options import PADE_ORDER, add_law_options, add_parameter_options, describe, number, resolve_law, resolve_parameters
 
 FORMATS = ("text", "json", "markdown")
 DEFAULT_PADE_ORDER = 3
@@ -16,8 +16,14 @@ def add_parser(sub) -> None:
         description="Stability of the VFF robot-environment loop (Koren & Borenstein 1991) for every model.",
     )
     add_parameter_options(p)
+    add_law_options(p)
     p.add_argument("--alpha", type=number("alpha_deg"), help=f"wall: target angle from the wall normal, {describe('alpha_deg')}")
     p.add_argument("--L", type=number("L"), help=f"corridor half-width, {describe('L')}, and more than W/2")
+    p.add_argument("--door", type=number("door"), metavar="WIDTH",
+                   help=f"door (KB Fig 4; docs/door.md): distance between the posts' centres or the wall ends, {describe('door')}")
+    p.add_argument("--door-obstacle", choices=DOOR_OBSTACLES, default="posts", help="what bounds the door (default posts)")
+    p.add_argument("--post-radius", type=number("post_radius"), default=0.0,
+                   help=f"post radius, or the walls' half-thickness, {describe('post_radius')} (default 0)")
     p.add_argument("--model", action="append", choices=MODEL_NAMES, help="model to include (repeatable; default: all)")
     p.add_argument(
         "--pade-order", type=PADE_ORDER, default=DEFAULT_PADE_ORDER,
@@ -33,6 +39,7 @@ def run(args) -> int:
     from .render import render_markdown, render_text
 
     params = resolve_parameters(args)
+    law, law_sources = resolve_law(args, params)
     report = build_report(
         params.robot,
         params.controller,
@@ -41,9 +48,13 @@ def run(args) -> int:
         models=tuple(dict.fromkeys(args.model)) if args.model else MODEL_NAMES,
         pade_order=args.pade_order,
         sources={
-            **params.sources, "alpha_deg": "user", "L": "user",
+            **params.sources, **law_sources, "alpha_deg": "user", "L": "user",
             "pade_order": "user" if args.pade_order != DEFAULT_PADE_ORDER else "default",
         },
+        law=law,
+        door=args.door,
+        door_obstacle=args.door_obstacle,
+        post_radius=args.post_radius,
     )
     if args.format == "json":
         print(dumps(report.to_dict()))

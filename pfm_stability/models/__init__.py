@@ -9,13 +9,17 @@ pade               (18) with Padé(m, m) of e^(−sT)                Routh; axis
 exact_delay        τs³ + s² + ks + kNV e^(−sT) = 0 (KB 18)        crossing count, pseudospectral roots
 sampled            det(zI − Φ_cl(kNV)) = 0, ZOH                   eigenvalues, Schur–Cohn
 =================  ============================================  ==========================
+
+A heading gain c (``Loop(tau, T, k, c=…)``, default 0) turns the gain term kNV
+into k(cs + NV) in every model (docs/models.md, "The heading gain"); NV < 0 is
+unstable in every model (`divergent_reason`).
 """
 
 from __future__ import annotations
 
 from ..checks import check_choice
 from ..parameters import MODEL_NAMES, Controller
-from .base import Boundary, Loop, LoopModel, gain_margin, verdict_label
+from .base import DIVERGENT_REASON, HEADING_GAIN_RANGE, Boundary, Loop, LoopModel, divergent_reason, gain_margin, verdict_label
 from .continuous import Continuous
 from .exact_delay import ExactDelay
 from .kb_first_order import KBFirstOrder
@@ -24,6 +28,8 @@ from .sampled import Sampled
 
 __all__ = [
     "MODEL_NAMES",
+    "DIVERGENT_REASON",
+    "HEADING_GAIN_RANGE",
     "Boundary",
     "Loop",
     "LoopModel",
@@ -32,6 +38,7 @@ __all__ = [
     "Pade",
     "ExactDelay",
     "Sampled",
+    "divergent_reason",
     "gain_margin",
     "make_model",
     "make_models",

@@ -11,13 +11,19 @@ K = kNV. A model therefore answers three questions for given (τ, T, k):
   (Routh, Schur–Cohn, a crossing count);
 * `rightmost_root(NV, …)`: the dominant root as a continuous-time rate
   σ + jω (1/s, rad/s); sampled models convert z by s = ln(z)/T.
+
+A heading gain c (`Loop.c`, docs/models.md "The heading gain") adds k·c·s to
+the gain term: τs³ + s² + ks + k(cs + NV)·e^(−sT) = 0. c = 0 (the default)
+is KB's loop and runs exactly the code it always ran. NV < 0 (N < 0: a field
+that pushes the robot away from its equilibrium) is accepted by every query
+and is unstable in every model (`divergent_reason`).
 """
 
 from __future__ import annotations
 
 import functools
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from functools import lru_cache
 
 import numpy as np
@@ -27,13 +33,59 @@ from ..parameters import RANGES, TAU_RESOLUTION, check_parameter
 from ..crossings import first_stable_interval, verdict_at
 from ..serialize import json_number
 
-__all__ = ["Loop", "Boundary", "LoopModel", "AffineGainModel", "verdict_label", "gain_margin", "gain_range", "checked", "UNDECIDED_RTOL", "NV_MAX"]
+__all__ = [
+    "Loop",
+    "Boundary",
+    "LoopModel",
+    "AffineGainModel",
+    "verdict_label",
+    "gain_margin",
+    "gain_range",
+    "checked",
+    "check_heading_gain",
+    "divergent_reason",
+    "DIVERGENT_REASON",
+    "HEADING_GAIN_RANGE",
+    "UNDECIDED_RTOL",
+    "NV_MAX",
+]
 
 _DELAY_RTOL = 1e-7
 """Relative bracket width at which `critical_delay` stops (reports show 4 digits)."""
 
 UNDECIDED_RTOL = 1e-9
 """|NV/NV* − 1| below this is reported as "undecided" (on the boundary)."""
+
+HEADING_GAIN_RANGE = (-0.99, 100.0)
+"""Closed range of the heading gain c (`Loop.c`, dimensionless).
+
+The steering command is k(δ − θ) = −k(N·x + (1 + c)·θ): c <= −1 removes or
+reverses the loop's heading feedback, and the continuous loop
+τs³ + s² + k(1 + c)s + kNV is then unstable at every NV (Routh: its s¹
+coefficient is <= 0). Such a c is refused rather than answered, with that
+reason; −0.99 keeps 1 + c >= 0.01. 100 is a generous cap (a heading term a
+hundred times the steering loop's own)."""
+
+DIVERGENT_REASON = "N < 0: the equilibrium diverges (a real root in the right half-plane) at any speed"
+"""Why every model says "unstable" for NV < 0 (`divergent_reason`)."""
+
+
+def divergent_reason(NV: float) -> str | None:
+    """`DIVERGENT_REASON` when NV < 0, else None.
+
+    With N < 0 the field pushes the robot away from its equilibrium: the
+    characteristic function of every model is kNV < 0 at s = 0 (z = 1 for
+    `sampled`) and positive for large real s (z), so it has a real root
+    s > 0 (a real pole z > 1) whatever V, T, k and c are (the one exception,
+    `kb_first_order` with τ = 0 and kcT > 1, has coefficients of both signs
+    and is unstable at every NV anyway). Every model's `is_stable` is then
+    False, `critical_delay` and `critical_gain_k` are 0 (no T and no k
+    helps), `rightmost_root` is that real root (or an oscillating pair
+    further right, in a loop unstable at every NV anyway), `gain_margin` is
+    −1 and `verdict_label` "unstable". A verdict can show this string as the
+    reason (docs/models.md, "N < 0").
+    """
+    return DIVERGENT_REASON if NV < 0 else None
 
 
 @dataclass(frozen=True)
@@ -49,27 +101,51 @@ class Loop:
         Sampling period / loop delay, s, >= 0 (KB eq 18).
     k : float
         Steering gain, 1/s, > 0 (KB eq 5).
+    c : float, keyword only
+        Heading gain, dimensionless, in `HEADING_GAIN_RANGE` ([−0.99, 100]);
+        default 0 (KB's loop). The linearized reference is
+        δ = −N·(x − x0) − c·θ, so the gain term of every model becomes
+        k(cs + NV) (delayed by e^(−sT) with the rest of the sensor data);
+        docs/models.md, "The heading gain".
     """
 
     tau: float
     T: float
     k: float
+    c: float = field(default=0.0, kw_only=True)
 
     def __post_init__(self):
         for name in ("tau", "T", "k"):
             object.__setattr__(self, name, check_parameter(name, getattr(self, name)))
         if self.tau * self.k < TAU_RESOLUTION:  # a lag 10⁹ times faster than the steering loop: an ideal motor
             object.__setattr__(self, "tau", 0.0)
+        if self.c.__class__ is not float or self.c != 0.0:
+            object.__setattr__(self, "c", check_heading_gain(self.c))
 
     @property
     def plant(self) -> np.ndarray:
         """a(s) = τs³ + s² + ks, descending (KB eq 17 without the gain term)."""
         return np.array([self.tau, 1.0, self.k, 0.0]) if self.tau > 0 else np.array([1.0, self.k, 0.0])
 
+    @property
+    def heading(self) -> float:
+        """kc, 1/s: the s-coefficient of the gain term k(cs + NV) (0 for KB's loop)."""
+        return self.k * self.c
+
+    @property
+    def closed_plant(self) -> np.ndarray:
+        """a(s) + kc·s = τs³ + s² + k(1 + c)s, descending: the loop without delay and without NV.
+
+        ``plant`` itself when c = 0 (the same array, the same floats).
+        """
+        if self.c == 0.0:
+            return self.plant
+        return np.array([self.tau, 1.0, self.k * (1.0 + self.c), 0.0]) if self.tau > 0 else np.array([1.0, self.k * (1.0 + self.c), 0.0])
+
 
 @dataclass(frozen=True)
 class Boundary:
-    """Stability boundary of one model for one (τ, T, k).
+    """Stability boundary of one model for one loop (τ, T, k, c).
 
     Attributes
     ----------
@@ -154,7 +230,22 @@ NV_MAX = 1e12
 
 
 def _check_NV(NV) -> float:
-    return check_number("NV", NV, 0.0, unit="1/s")
+    """NV as a float: finite and non-zero (negative is allowed: N < 0, `divergent_reason`)."""
+    NV = check_number("NV", NV, unit="1/s")
+    if NV == 0.0:
+        raise ValueError("NV must be a finite non-zero number 1/s (NV = 0: no force gradient, a root at s = 0); got 0.0")
+    return NV
+
+
+def check_heading_gain(c) -> float:
+    """c as a float if it is finite and in `HEADING_GAIN_RANGE`, else ValueError (with the reason for c <= −1)."""
+    low, high = HEADING_GAIN_RANGE
+    try:
+        return check_number("c", c, low, high, low_open=False, high_open=False)
+    except ValueError as exc:
+        if isinstance(c, (int, float)) and not isinstance(c, bool) and c <= -1:
+            raise ValueError(f"{exc} (c <= -1 removes the heading feedback: unstable at any NV)") from None
+        raise
 
 
 def _check_loop(loop) -> "Loop":
@@ -166,13 +257,16 @@ def _check_loop(loop) -> "Loop":
 def checked(method):
     """Validate a public model method's (NV, loop) arguments: ValueError naming the bad one.
 
-    NV is capped at `NV_MAX` here only: internal probes (a stable interval
-    checked beyond the last crossing gain) may go further.
+    NV is capped at |NV| <= `NV_MAX` here only: internal probes (a stable
+    interval checked beyond the last crossing gain) may go further. NV < 0
+    is accepted (N < 0, `divergent_reason`); NV = 0 is not (a root at s = 0).
     """
 
     @functools.wraps(method)
     def wrapper(self, NV, loop, *args, **kwargs):
-        NV = check_number("NV", NV, 0.0, NV_MAX, high_open=False, unit="1/s")
+        NV = check_number("NV", NV, -NV_MAX, NV_MAX, low_open=False, high_open=False, unit="1/s")
+        if NV == 0.0:
+            _check_NV(NV)
         return method(self, NV, _check_loop(loop), *args, **kwargs)
 
     return wrapper
@@ -241,11 +335,11 @@ class LoopModel:
         from ..solve import first_crossing
 
         NV = _check_NV(NV)
-        if self.growth_rates(NV, [Loop(loop.tau, 0.0, loop.k)])[0] >= 0:
+        if NV < 0 or self.growth_rates(NV, [Loop(loop.tau, 0.0, loop.k, c=loop.c)])[0] >= 0:
             return 0.0
 
         def measure(Ts):
-            return self.growth_rates(NV, [Loop(loop.tau, float(T), loop.k) for T in Ts])
+            return self.growth_rates(NV, [Loop(loop.tau, float(T), loop.k, c=loop.c) for T in Ts])
 
         scale = _time_scale(loop, NV)
         return first_crossing(measure, scale * 1e-2, RANGES["T"].high, rtol=_DELAY_RTOL, atol=1e-12 * scale)
@@ -262,11 +356,11 @@ class LoopModel:
 
         NV = _check_NV(NV)
         lo, hi = gain_range(loop)
-        if self.growth_rates(NV, [Loop(loop.tau, loop.T, lo)])[0] >= 0:
+        if NV < 0 or self.growth_rates(NV, [Loop(loop.tau, loop.T, lo, c=loop.c)])[0] >= 0:
             return 0.0
 
         def measure(ks):
-            return self.growth_rates(NV, [Loop(loop.tau, loop.T, float(k)) for k in ks])
+            return self.growth_rates(NV, [Loop(loop.tau, loop.T, float(k), c=loop.c) for k in ks])
 
         return first_crossing(measure, lo, hi, start=lo, rtol=_DELAY_RTOL, atol=1e-12 * lo)
 

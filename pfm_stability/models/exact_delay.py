@@ -18,6 +18,15 @@ answers every question without a search bound, by the same array code that
   (`DelayLoop.rightmost_roots`).
 
 T = 0 reduces to `continuous` (eq 17).
+
+With a heading gain c (`Loop.c`, docs/models.md) the equation is
+τs³ + s² + ks + k(cs + NV)·e^(−sT) = 0, the quasi-polynomial
+a(s) + (kcs + K)·e^(−sT). The crossing count and the rightmost roots take the
+delayed kc·s as they take K (`delay_verdicts_from_gain(…, c)`,
+`DelayLoop(…, delayed=[kc, 0])`); the gain crossings no longer all
+destabilize, and `models.heading.kb_heading_interval` finds every one that can bound the
+stable set, from polynomial roots, each stretch decided by the crossing count.
+c = 0 runs exactly KB's code above.
 """
 
 from __future__ import annotations
@@ -28,6 +37,7 @@ import numpy as np
 
 from ..delay import DelayLoop, delay_verdicts_from_gain, kb_critical_gain
 from .base import Boundary, Loop, LoopModel, _check_NV, checked, gain_range
+from .pade import Pade
 
 __all__ = ["ExactDelay"]
 
@@ -44,17 +54,24 @@ class ExactDelay(LoopModel):
 
     @staticmethod
     def quasi_polynomial(loop: Loop) -> DelayLoop:
-        """The quasi-polynomial a(s) + K e^(−sT) with a(s) = τs³ + s² + ks."""
-        return DelayLoop(loop.plant, loop.T)
+        """The quasi-polynomial a(s) + (kcs + K)·e^(−sT) with a(s) = τs³ + s² + ks (c = 0: a(s) + K e^(−sT))."""
+        if loop.c == 0.0:
+            return DelayLoop(loop.plant, loop.T)
+        return DelayLoop(loop.plant, loop.T, delayed=[loop.heading, 0.0])
 
     def compute_boundary(self, loop: Loop) -> Boundary:
+        if loop.c != 0.0:
+            from .heading import kb_heading_interval  # only with a heading gain: KB's reports never compile it
+
+            return Boundary.from_interval(self.name, kb_heading_interval(loop.tau, loop.T, loop.k, loop.c), loop.k)
         K, w = (float(x[0]) for x in kb_critical_gain(_one(loop.tau), _one(loop.T), _one(loop.k)))
         omega = w if math.isfinite(K) else None
         return Boundary(self.name, K / loop.k, omega, K, ((0.0, K / loop.k),))
 
     def _count(self, NV: float, loop: Loop):
         K = loop.k * _check_NV(NV)
-        stable, Z, margin = delay_verdicts_from_gain(_one(loop.tau), _one(loop.T), _one(loop.k), _one(K))
+        heading = () if loop.c == 0.0 else (_one(loop.c),)
+        stable, Z, margin = delay_verdicts_from_gain(_one(loop.tau), _one(loop.T), _one(loop.k), _one(K), *heading)
         return bool(stable[0]), int(Z[0]), float(margin[0])
 
     @checked
@@ -91,18 +108,46 @@ class ExactDelay(LoopModel):
         Stability is NV < NV*(k); NV*(k) → 1/(τ + T) as k → 0 (the roots
         shrink and e^(−sT) ≈ 1 − sT becomes exact: KB's eq 20), so k* = 0
         when NV(τ + T) >= 1. Otherwise the first k with NV*(k) <= NV.
+
+        With c ≠ 0 the k → 0 limit is NV(τ + T) < 1 + c (the loop tends to
+        `kb_first_order`'s), and beyond it `solve.first_crossing` over k on a
+        measure whose sign is the crossing count's (exact, one array call) and
+        whose size is the growth rate of Padé(6) (batched eigenvalues: a
+        stand-in that peaks where a root nears the axis, so the search refines
+        near-misses between grid points). NV < 0: 0.
         """
         from ..solve import first_crossing
 
         NV = _check_NV(NV)
+        if NV < 0:
+            return 0.0
         if loop.T == 0:
             return super().critical_gain_k(NV, loop)
-        if NV * (loop.tau + loop.T) >= 1.0:
+        if NV * (loop.tau + loop.T) >= 1.0 + loop.c:
             return 0.0
+        if loop.c != 0.0:
+            return self._heading_gain_k(NV, loop)
 
         def measure(ks):
             K_star = kb_critical_gain(loop.tau, loop.T, ks)[0]
             return np.log(NV * ks / K_star)
 
         lo, hi = gain_range(loop)
+        return first_crossing(measure, lo, hi, start=lo)
+
+    def _heading_gain_k(self, NV: float, loop: Loop) -> float:
+        """k* for c ≠ 0 (`critical_gain_k`): first sign change of the signed measure over k."""
+        from ..solve import first_crossing
+
+        def measure(ks):
+            loops = [Loop(loop.tau, loop.T, float(k), c=loop.c) for k in ks]
+            arrays = (np.array([getattr(x, name) for x in loops]) for name in ("tau", "T", "k"))
+            tau, T, k = arrays
+            stable = delay_verdicts_from_gain(tau, T, k, k * NV, np.full(k.shape, loop.c))[0]
+            size = np.abs(Pade(6).growth_rates(NV, loops)) + 1e-300
+            return np.where(stable, -size, size)
+
+        lo, hi = gain_range(loop)
+        if measure(np.array([lo]))[0] >= 0:
+            return 0.0
         return first_crossing(measure, lo, hi, start=lo)

@@ -5,6 +5,22 @@ The delay e^(−sT) of (18) replaced by 1 − sT gives (19),
 NV* = 1/(τ + T) — independent of k *only in this approximation*. At NV* the
 s¹ row of the Routh array vanishes and the auxiliary polynomial s² + kNV* gives
 the boundary oscillation ω* = √(k/(τ + T)).
+
+With a heading gain c (`Loop.c`, docs/models.md) the delayed term is
+k(cs + NV)(1 − sT), and (19) becomes
+
+    τs³ + (1 − kcT)s² + k(1 + c − NVT)s + kNV = 0.
+
+Routh: stable ⇔ 1 − kcT > 0, NV > 0 and (1 − kcT)(1 + c − NVT) > τNV
+(which implies 1 + c − NVT > 0), i.e.
+
+    NV* = (1 − kcT)(1 + c) / (τ + T(1 − kcT)),   ω*² = k(1 + c)/(τ + T(1 − kcT)),
+
+and unstable at every NV when kcT >= 1 (τ > 0: the s² coefficient is not
+positive). k no longer cancels (unless c = 0): a heading term makes the
+first-order approximation itself depend on the steering gain. The boundary is
+computed by the generic crossing route (`AffineGainModel`), the closed forms
+above are the tests' reference (derived there with sympy).
 """
 
 from __future__ import annotations
@@ -13,6 +29,7 @@ import math
 
 import numpy as np
 
+from ..parameters import RANGES
 from .base import AffineGainModel, Loop, _check_NV, checked
 
 __all__ = ["KBFirstOrder"]
@@ -25,15 +42,52 @@ class KBFirstOrder(AffineGainModel):
     equation = "tau s^3 + s^2 + k(1 - N V T) s + k N V = 0  (KB eq 19)"
 
     def polynomials(self, loop: Loop):
-        """D = τs³ + s² + ks, E = 1 − sT (descending powers of s)."""
-        return loop.plant, np.array([-loop.T, 1.0])
+        """D = τs³ + (1 − kcT)s² + k(1 + c)s, E = 1 − sT (descending powers of s; c = 0: KB eq 19)."""
+        if loop.c == 0.0:
+            return loop.plant, np.array([-loop.T, 1.0])
+        D = loop.closed_plant.copy()
+        D[-3] -= loop.heading * loop.T  # the s² coefficient: 1 − kcT
+        return D, np.array([-loop.T, 1.0])
 
     @checked
     def critical_delay(self, NV: float, loop: Loop) -> float:
-        """KB eq (20) solved for T: T* = 1/NV − τ (0 if negative), s."""
-        return max(1.0 / _check_NV(NV) - loop.tau, 0.0)
+        """KB eq (20) solved for T: T* = 1/NV − τ (0 if negative), s.
+
+        With c ≠ 0: the smallest T > 0 where (1 − kcT)(1 + c − NVT) = τNV,
+        the root 2C/(B + √(B² − 4AC)) of kcNV·T² − (kc(1 + c) + NV)T + (1 + c − τNV)
+        (0 when τNV >= 1 + c: unstable already at T = 0). NV < 0: 0.
+        """
+        NV = _check_NV(NV)
+        if NV < 0:
+            return 0.0
+        if loop.c == 0.0:
+            return max(1.0 / NV - loop.tau, 0.0)
+        A = loop.heading * NV
+        B = loop.heading * (1.0 + loop.c) + NV
+        C = 1.0 + loop.c - loop.tau * NV
+        if C <= 0:
+            return 0.0
+        return 2.0 * C / (B + math.sqrt(B * B - 4.0 * A * C))
 
     @checked
     def critical_gain_k(self, NV: float, loop: Loop) -> float:
-        """k cancels from eq (20): ``inf`` if NV(τ + T) < 1, else 0 (1/s)."""
-        return math.inf if _check_NV(NV) * (loop.tau + loop.T) < 1.0 else 0.0
+        """k cancels from eq (20): ``inf`` if NV(τ + T) < 1, else 0 (1/s).
+
+        With c ≠ 0: as k → 0 the condition is NV(τ + T) < 1 + c (else 0);
+        for c < 0 or T = 0 a larger k never hurts (``inf``); for c > 0 the
+        loop loses stability where (1 − kcT)(1 + c − NVT) = τNV,
+        k* = (1 + c − NV(τ + T))/(cT(1 + c − NVT)) (``inf`` beyond the largest
+        allowed k, 10⁴ 1/s). NV < 0: 0.
+        """
+        NV = _check_NV(NV)
+        if NV < 0:
+            return 0.0
+        if loop.c == 0.0:
+            return math.inf if NV * (loop.tau + loop.T) < 1.0 else 0.0
+        slack = 1.0 + loop.c - NV * (loop.tau + loop.T)
+        if slack <= 0:
+            return 0.0
+        if loop.c < 0 or loop.T == 0:
+            return math.inf
+        k_star = slack / (loop.c * loop.T * (1.0 + loop.c - NV * loop.T))
+        return k_star if k_star <= RANGES["k"].high else math.inf

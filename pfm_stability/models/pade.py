@@ -3,7 +3,8 @@
 e^(−sT) ≈ P_m(s)/Q_m(s) turns (18) into the polynomial
 (τs³ + s² + ks)·Q_m(s) + kNV·P_m(s) = 0, decided by Routh; K* is the first
 crossing of the imaginary axis (module `crossings`). K* converges to the
-`exact_delay` value as m grows.
+`exact_delay` value as m grows. With a heading gain c (`Loop.c`) the delayed
+term is k(cs + NV)·P_m(s): D = (τs³ + s² + ks)·Q_m + kc·s·P_m, E = P_m.
 
 How `pade` with m = 1 differs from `kb_first_order`: KB's 1 − sT is the
 first-order *Taylor* polynomial of e^(−sT) — its gain grows without bound with
@@ -83,13 +84,14 @@ class Pade(AffineGainModel):
         self.order = check_integer("pade_order", order, 1, MAX_PADE_ORDER)
 
     def polynomials(self, loop: Loop):
-        """D = (τs³ + s² + ks)·Q_m, E = P_m (descending powers of s; Q_m(0) = P_m(0) = 1)."""
+        """D = (τs³ + s² + ks)·Q_m + kc·s·P_m, E = P_m (descending powers of s; Q_m(0) = P_m(0) = 1)."""
         D, E = self.batch_polynomials([loop])
         return np.trim_zeros(D[0], "f"), np.trim_zeros(E[0], "f")
 
     def batch_polynomials(self, loops):
-        """`polynomials` of many loops at once: rows of D = (τs³ + s² + ks)·Q_m and E = P_m."""
+        """`polynomials` of many loops at once: rows of D = (τs³ + s² + ks)·Q_m + kc·s·P_m and E = P_m."""
         tau, T, k = (np.array([getattr(loop, name) for loop in loops]) for name in ("tau", "T", "k"))
+        heading = np.array([loop.heading for loop in loops])
         m = self.order
         c = np.array([_pade_term(m, j) for j in range(m + 1)])
         powers = T[:, None] ** np.arange(m + 1)
@@ -101,6 +103,9 @@ class Pade(AffineGainModel):
             D[:, i:i + m + 1] += plant[:, i, None] * den
         E = np.zeros_like(D)
         E[:, 3:] = num
+        rows = np.flatnonzero(heading)
+        if rows.size:  # kc·s·P_m, only where c ≠ 0 (c = 0 keeps KB's rows untouched)
+            D[rows, 2:m + 3] += heading[rows, None] * num[rows]
         return D, E
 
     def options(self) -> dict:

@@ -13,6 +13,12 @@ Linearized loop (Koren & Borenstein 1991 eq 6, 7, 10, 14): steering motor
 * ``"reference"``: the computer samples δ_k and holds it; the steering servo
   closes u = k(δ_k − θ(t)) continuously.
 
+A heading gain c (`Loop.c`, docs/models.md) makes the computer's reference
+δ_k = −(K/k)·y_k − c·θ_k (θ is sampled with x): the held command becomes
+u_k = −k(1 + c)θ_k − K·y_k, the held reference feeds k·δ_k = −kcθ_k − K·y_k
+to the servo. Only F0 changes (F0 = k(1 + c) or kc on θ), so the
+characteristic polynomial stays affine in K and everything below applies.
+
 ``compute_delay`` = 1 applies the value computed at t_k over [t_k+1, t_k+2)
 (one more state: the stored command). The plant is discretized with a
 zero-order hold, Φ = e^(AT), Γ = ∫₀ᵀ e^(As) ds·B (module
@@ -70,6 +76,7 @@ def continuous_plant(loop: Loop, hold: str):
 
     The held input is v_k = −(F0 + K·F1)·state_k, and ẋ = A x + B v between
     samples. States: (ω, θ, y) for τ > 0, (θ, y) for τ = 0; y = x/V (s).
+    The heading gain c adds kc to F0's θ entry.
 
     Parameters
     ----------
@@ -100,6 +107,8 @@ def continuous_plant(loop: Loop, hold: str):
             F0 = np.zeros(2)
         B = np.array([[1.0], [0.0]])
         F1 = np.array([0.0, 1.0])
+    if loop.c != 0.0:  # δ_k = −(K/k)·y_k − c·θ_k: the sampled θ enters with kc more
+        F0[-2] += loop.heading
     return A, B, F0, F1
 
 

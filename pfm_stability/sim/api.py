@@ -24,7 +24,7 @@ ROBOT_PARAMETERS = ("V", "tau", "k", "W", "max_steering_rate")
 CONTROLLER_PARAMETERS = ("f", "n", "T", "hold", "compute_delay")
 SCENARIO_PARAMETERS = (
     "L", "alpha", "offset", "duration", "cell_ratio", "law", "window_cells", "cell_size",
-    "speed_law", "seed", "start_jitter",
+    "speed_law", "seed", "start_jitter", "damping",
 )
 
 

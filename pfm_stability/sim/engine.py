@@ -81,6 +81,8 @@ class _Batch:
         self.reference = _array(scenarios, lambda s: s.controller.hold == "reference", bool)
         self.delayed = _array(scenarios, lambda s: s.controller.compute_delay == 1, bool)
         self.speed_law = _array(scenarios, lambda s: s.speed_law, bool)
+        self.damping = _array(scenarios, lambda s: s.damping)
+        self.any_damping = bool(np.any(self.damping != 0.0))
         self.any_speed_law = bool(self.speed_law.any())
         self.steps = np.ceil(_array(scenarios, lambda s: s.duration) / self.T - 1e-9).astype(np.int64)
         self.order = (self.tau > 0).astype(int) + 2 + self.delayed.astype(int)
@@ -210,18 +212,27 @@ class _Batch:
         return self.g_scale * fx, self.g_scale * fy
 
     def wall_repulsion(self, x, y):
-        """(fx, fy)/F_ct of the analytic members: Σ law(d)·normal over walls within their extent."""
+        """(fx, fy, goal)/F_ct of the analytic members.
+
+        fx, fy: Σ law(d)·normal over the walls within their extent; goal:
+        Σ law.goal_force(d), the part of the repulsion that points towards the
+        target (Ge & Cui 2000's F_rep2; 0 for KB's and the grid's laws), which
+        adds to the attraction's magnitude.
+        """
         wi, w = self.wall_idx, self.walls
         s, d = wall_coordinates(w, x[wi][:, None], y[wi][:, None])
         acting = w["valid"] & (s >= 0) & (s <= w["length"]) & (d > 0)
         d_eval = np.where(acting, d, 1.0)
         pf, pn, pW, power_rows = self.power
         magnitude = np.zeros_like(d)
+        goal = np.zeros_like(d)
         magnitude[power_rows] = (pf * (pW / d_eval) ** pn)[power_rows]
         for law, rows in self.law_groups.values():
             magnitude[rows] = law.force(d_eval[rows])
+            goal[rows] = law.goal_force(d_eval[rows])
         magnitude = np.where(acting, magnitude, 0.0)
-        return np.sum(magnitude * w["nx"], axis=1), np.sum(magnitude * w["ny"], axis=1)
+        goal = np.where(acting, goal, 0.0)
+        return np.sum(magnitude * w["nx"], axis=1), np.sum(magnitude * w["ny"], axis=1), np.sum(goal, axis=1)
 
     def gaps(self, x, y, rows):
         """Clearance minus W/2 per member (m); +inf where no obstacle is near."""
@@ -391,13 +402,16 @@ def run_batch(scenarios, *, record: str = "trajectory", metrics: bool = True, pr
         if rows is not None:
             rows = b.sensing_rows(rows, running)
         # sense (KB eq 1–4)
-        fx, fy = np.zeros(B), np.zeros(B)
+        fx, fy, pull = np.zeros(B), np.zeros(B), np.ones(B)
         if rows is not None:
             fx[b.grid_idx], fy[b.grid_idx] = b.grid_repulsion(x, y, rows)
         if b.wall_idx.size:
-            fx[b.wall_idx], fy[b.wall_idx] = b.wall_repulsion(x, y)
+            fx[b.wall_idx], fy[b.wall_idx], goal = b.wall_repulsion(x, y)
+            pull[b.wall_idx] += goal
         ax, ay = b.attraction(x, y)
-        delta = direction_of(fx + ax, fy + ay)
+        if b.any_damping:  # a velocity-dependent field: −β·v, v = V(sin θ, cos θ)
+            fx, fy = fx - b.damping * b.V * np.sin(theta), fy - b.damping * b.V * np.cos(theta)
+        delta = direction_of(fx + pull * ax, fy + pull * ay)
         # compute the held value (eq 5) and the speed
         value = np.where(b.reference, theta + wrap_angle(delta - theta), steering_command(delta, theta, b.k, b.max_rate))
         speed = np.where(b.speed_law, vff_speed(b.V, fx, fy, theta), b.V) if b.any_speed_law else b.V

@@ -72,7 +72,7 @@ from functools import lru_cache
 
 from ..checks import check_choice, check_number
 from ..effective_force import GridWallLaw, f_average
-from ..force_law import ForceLaw
+from ..force_law import ForceLaw, wall_equilibrium
 from ..parameters import CARMEL, RANGES, Controller, Robot, Wall
 from ..solve import bisect_batched
 from .environment import AnalyticEnvironment, AnalyticWall
@@ -215,7 +215,7 @@ def _wall(o):
     alpha_deg = math.degrees(alpha)
     env, robot, c = o["env"], o["robot"], o["cell_size"]
     law = o["law_object"] or o["grid_law"]
-    d0 = law.distance_for(math.cos(alpha))
+    d0 = wall_equilibrium(law, alpha)  # the nearest of a non-monotone law's equilibria (docs/fields.md)
     contact = robot.W / 2 + (c / 2 if env == "grid" else 0.0)
     if not (math.isfinite(d0) and d0 > contact):
         raise ValueError(
@@ -357,6 +357,7 @@ def make_scenario(
     speed_law: bool = False,
     seed: int | None = None,
     start_jitter: float = 0.0,
+    damping: float = 0.0,
 ) -> Scenario:
     """Build the named scenario (module docstring) for one robot and controller.
 
@@ -387,6 +388,9 @@ def make_scenario(
         VFF speed law instead of constant speed.
     seed, start_jitter
         Random lateral start offset with standard deviation `start_jitter` m.
+    damping : float
+        β of a velocity-dependent force −β·v (F_ct per m/s, >= 0): a field
+        with a heading gain c = βV/F_y (docs/fields.md).
 
     Raises
     ------
@@ -443,6 +447,7 @@ def make_scenario(
         analysis=spec.get("analysis"),
         seed=seed,
         start_jitter=start_jitter,
+        damping=check_number("damping", damping, 0.0, 1e6, low_open=False, unit="F_ct s/m"),
         notes=notes,
     )
 

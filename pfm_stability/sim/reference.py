@@ -141,12 +141,12 @@ def _grid_sense(s: Scenario, x, y):
             fy += weight * dy
             gx, gy = max(abs(dx) - c / 2, 0.0), max(abs(dy) - c / 2, 0.0)
             gap = min(gap, math.hypot(gx, gy))
-    return fx, fy, gap - s.robot.W / 2
+    return fx, fy, gap - s.robot.W / 2, 0.0
 
 
 def _wall_sense(s: Scenario, x, y):
     law = s.effective_law()
-    fx = fy = 0.0
+    fx = fy = goal = 0.0
     gap = math.inf
     for w in s.environment.walls:
         (ux, uy), (nx, ny) = w.unit, w.normal
@@ -159,9 +159,10 @@ def _wall_sense(s: Scenario, x, y):
                 F = float(law.force(d))
             fx += F * nx
             fy += F * ny
+            goal += float(law.goal_force(d))  # towards the target (Ge & Cui's F_rep2; 0 for KB's laws)
         outside = max(-along, along - w.length, 0.0)
         gap = min(gap, math.hypot(outside, d))
-    return fx, fy, gap - s.robot.W / 2
+    return fx, fy, gap - s.robot.W / 2, goal
 
 
 def simulate_reference(s: Scenario):
@@ -192,7 +193,7 @@ def simulate_reference(s: Scenario):
     event = None
     for step in range(steps + 1):
         t = step * T
-        fx, fy, gap = sense(s, x, y)
+        fx, fy, gap, goal = sense(s, x, y)
         distance = math.hypot(tgt.x - x, tgt.y - y) if tgt.is_point else 0.0
         progress = -distance if tgt.is_point else (x - x0) * math.sin(tgt.angle) + (y - y0) * math.cos(tgt.angle)
         if best is None:
@@ -213,7 +214,9 @@ def simulate_reference(s: Scenario):
             ax, ay = (tgt.x - x) / distance, (tgt.y - y) / distance
         else:
             ax, ay = math.sin(tgt.angle), math.cos(tgt.angle)
-        delta = math.atan2(fx + ax, fy + ay)
+        if s.damping:  # a velocity-dependent field: −β·v
+            fx, fy = fx - s.damping * r.V * math.sin(theta), fy - s.damping * r.V * math.cos(theta)
+        delta = math.atan2(fx + (1.0 + goal) * ax, fy + (1.0 + goal) * ay)
         if c.hold == "command":
             value = min(max(k * _wrap(delta - theta), -wmax), wmax)
         else:

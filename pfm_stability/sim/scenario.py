@@ -220,6 +220,10 @@ class Scenario:
         Seed of the random start jitter (with `start_jitter`).
     start_jitter : float
         Standard deviation of a random lateral start offset, m (0: none).
+    damping : float
+        A velocity-dependent force −β·v added to the sensed field, β in
+        F_ct per m/s (0: none). On a straight path at speed V it gives the
+        heading gain c = βV/F_y of the loop (docs/fields.md, "heading gain").
     notes : dict
         Documented choices (geometry, calibration), reported with the inputs.
     """
@@ -241,6 +245,7 @@ class Scenario:
     analysis: dict | None = None
     seed: int | None = None
     start_jitter: float = 0.0
+    damping: float = 0.0
     notes: dict = field(default_factory=dict)
 
     def __post_init__(self):
@@ -339,6 +344,7 @@ class Scenario:
             "measure": self.measure.to_dict(),
             "seed": self.seed,
             "start_jitter": self.start_jitter,
+            "damping": self.damping,
         }
         if self.env == "grid":
             g = self.environment
