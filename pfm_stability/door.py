@@ -136,7 +136,8 @@ def _check_shape(obstacle, post_radius, robot_width, law) -> tuple[str, float, f
     return obstacle, r, W
 
 
-def door_geometry(law: ForceLaw, width: float, *, obstacle: str = "posts", post_radius: float = 0.0, robot_width: float | None = None) -> DoorGeometry:
+def door_geometry(law: ForceLaw, width: float, *, obstacle: str = "posts", post_radius: float = 0.0, robot_width: float | None = None,
+                  name: str = "width") -> DoorGeometry:
     """The checked geometry of a door.
 
     Parameters
@@ -150,6 +151,8 @@ def door_geometry(law: ForceLaw, width: float, *, obstacle: str = "posts", post_
         r >= 0, m.
     robot_width : float, optional
         W >= 0, m; default the law's ``W`` (KB's power law), else 0 (a point robot).
+    name : str
+        What the caller calls the width in its error messages (``"door"`` for ``report --door``).
 
     Raises
     ------
@@ -158,10 +161,10 @@ def door_geometry(law: ForceLaw, width: float, *, obstacle: str = "posts", post_
         a negative or non-finite number, or a width the robot does not fit through.
     """
     obstacle, r, W = _check_shape(obstacle, post_radius, robot_width, law)
-    w = check_number("width", width, 0.0, math.inf, unit="m")
+    w = check_number(name, width, 0.0, math.inf, unit="m")
     if not w > W + 2.0 * r:
         raise ValueError(
-            f"width must be a finite number in (robot_width + 2*post_radius, inf) m = ({W + 2.0 * r:g}, inf) m "
+            f"{name} must be a finite number in (robot_width + 2*post_radius, inf) m = ({W + 2.0 * r:g}, inf) m "
             f"(the robot must fit through the opening); got {width!r}"
         )
     return DoorGeometry(obstacle, w, r, W)
@@ -434,6 +437,7 @@ def door_passage(
     post_radius: float = 0.0,
     robot_width: float | None = None,
     find_smallest: bool = False,
+    name: str = "width",
 ) -> DoorPassage:
     """Does a robot heading straight through a door pass it, and if not, where does it stop? (KB Fig 4)
 
@@ -448,7 +452,7 @@ def door_passage(
     law : ForceLaw
         F_r(d)/F_a (``force``, ``slope``) and, if it has one, the goal-directed
         part Q(d)/F_a (``goal_force``).
-    width, obstacle, post_radius, robot_width
+    width, obstacle, post_radius, robot_width, name
         As in `door_geometry`.
     find_smallest : bool
         Also solve for `smallest_passable_width` (about 50 more scans).
@@ -462,7 +466,7 @@ def door_passage(
     ValueError
         Naming the argument, for bad input (`door_geometry`).
     """
-    geometry = door_geometry(law, width, obstacle=obstacle, post_radius=post_radius, robot_width=robot_width)
+    geometry = door_geometry(law, width, obstacle=obstacle, post_radius=post_radius, robot_width=robot_width, name=name)
     a, r = geometry.half_width, geometry.post_radius
     ap = _approach(law, a, r)
     stiffness = None if ap.stop is None else _lateral_stiffness(law, a, r, ap.stop)

@@ -42,6 +42,7 @@ __all__ = [
     "ENVIRONMENTS",
     "FORCE_LAWS",
     "DOOR_OBSTACLES",
+    "TRAPS_RESOLUTION",
     "LAW_PARAMETERS",
     "FIELD_DEFAULTS",
     "DERIVATION_LAWS",
@@ -75,6 +76,9 @@ GEOMETRIES = ("corridor", "wall")
 
 ENVIRONMENTS = ("grid", "analytic")
 """Simulator environments: a histogram grid of cells, or continuous walls with a force law."""
+
+TRAPS_RESOLUTION = 81
+"""Default grid points of the stationary-point search along a scene's longer side (`traps`; in ``RANGES["resolution"]``)."""
 
 DOOR_OBSTACLES = ("posts", "wall-ends")
 """What bounds a door (KB Fig 4; docs/door.md): two posts, or the ends of two walls."""

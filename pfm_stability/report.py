@@ -351,12 +351,8 @@ def build_report(
     if door is not None:
         from .door import door_passage
 
-        try:
-            passage = door_passage(law, check_parameter("door", door), obstacle=door_obstacle,
-                                   post_radius=check_parameter("post_radius", post_radius), robot_width=robot.W, find_smallest=True)
-        except ValueError as error:  # door_passage calls the door's width "width"; the report calls it "door"
-            text = str(error)
-            raise ValueError("door" + text[len("width"):] if text.startswith("width") else text) from None
+        passage = door_passage(law, check_parameter("door", door), obstacle=door_obstacle, post_radius=check_parameter("post_radius", post_radius),
+                               robot_width=robot.W, find_smallest=True, name="door")
     return StabilityReport(inputs, options, wall_result, corridor_result, kb_error(robot, controller), fixes, described, passage)
 
 

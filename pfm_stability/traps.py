@@ -18,7 +18,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from .checks import check_integer, check_type
-from .parameters import RANGES
+from .parameters import RANGES, TRAPS_RESOLUTION
 from .potentials import k_conservative, k_exact, repulsion_derivatives
 from .scene import Scene, field
 from .serialize import SCHEMA_VERSION, json_number, json_ready
@@ -29,7 +29,7 @@ KINDS = ("minimum", "saddle", "maximum", "degenerate")
 """Kinds of stationary points (by the signs of the Hessian's eigenvalues; "degenerate": one is ~0)."""
 RESOLUTION_RANGE = (int(RANGES["resolution"].low), int(RANGES["resolution"].high))
 """Grid points along the longer side of the region (`find_stationary_points`)."""
-DEFAULT_RESOLUTION = 81
+DEFAULT_RESOLUTION = TRAPS_RESOLUTION
 
 
 # ------------------------------------------------------------------ results

@@ -17,13 +17,12 @@ the field, exit status 2.
 
 from __future__ import annotations
 
+from ..parameters import TRAPS_RESOLUTION
 from .options import describe, integer, output_path
 
 FORMATS = ("text", "json")
 SHIPPED_SCENES = ("gc2000_fig3", "gc2000_fig4", "gc2000_sec6b_khatib", "gc2000_sec6b_gnron")
 """Scene files in ``pfm_stability/data/scenes`` (without ``.yaml``), usable by name."""
-DEFAULT_RESOLUTION = 81
-"""`pfm_stability.traps.DEFAULT_RESOLUTION`, repeated here so that ``--help`` does not load numpy."""
 
 
 def add_parser(sub) -> None:
@@ -38,9 +37,9 @@ def add_parser(sub) -> None:
     p.add_argument("--format", choices=FORMATS, default="text")
     p.add_argument("--plot", type=output_path("plot"), metavar="PNG",
                    help="write the potential with obstacles and stationary points (a .png file in an existing writable directory)")
-    p.add_argument("--resolution", type=integer("resolution"), default=DEFAULT_RESOLUTION,
+    p.add_argument("--resolution", type=integer("resolution"), default=TRAPS_RESOLUTION,
                    help=f"grid points of the search along the region's longer side, {describe('resolution')} "
-                   f"(default {DEFAULT_RESOLUTION})")
+                   f"(default {TRAPS_RESOLUTION})")
     p.set_defaults(run=run)
 
 
