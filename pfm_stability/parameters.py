@@ -3,7 +3,9 @@
 The one place where names and ranges live: model names, sampled structures,
 geometries, simulator environments and force laws, and `RANGES` (library,
 vectorized code and CLI). This module imports no numpy, so the command line
-can validate input before loading it.
+can validate input before loading it. The presets (``CARMEL``, `PRESETS`) are
+the package's configuration files ``data/presets/*.yaml`` (docs/config.md),
+each read on first use.
 
 All quantities are SI (m, s, rad); degrees exist only at the edges: typed
 angles come in through `Wall.from_degrees` (`to_radians` for arrays), and
@@ -18,7 +20,9 @@ with a one-line message naming the parameter and its allowed range.
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
+from pathlib import Path
 
 from .checks import check_choice, check_integer, check_number
 
@@ -180,6 +184,15 @@ RANGES = {
     "goal_exponent": Range(0.0, 10.0, low_open=False),
     "goal_distance": Range(1e-3, 1e4, low_open=False, unit="m"),
     "delta": Range(0.0, 1e3, low_open=False, unit="m"),
+    # robot loop families (docs/models.md, "Robot loop families")
+    "c_h": Range(-1e6, 1e6, low_open=False, unit="1/s"),
+    "kappa": Range(-1e12, 1e12, low_open=False, unit="1/s^2"),
+    "mass": Range(0.0, 1e6, unit="kg"),
+    "alpha_p": Range(0.0, 1e6, unit="N/m"),
+    "alpha_v": Range(0.0, 1e6, low_open=False, unit="N s/m"),
+    "a_max": Range(0.0, 1e6, unit="m/s^2"),  # GC2002 eq 11 (docs/velocity_and_fuzzy.md)
+    "step": Range(0.0, 1e6, unit="m"),
+    "min_length": Range(0.0, 1e4, unit="m"),  # map: shortest segment analysed
     # integers (closed bounds, checked with `checks.check_integer`)
     "compute_delay": Range(0, 1, low_open=False, unit="samples"),
     "pade_order": Range(1, 12, low_open=False),
@@ -189,7 +202,10 @@ RANGES = {
     "door": Range(0.0, 1e4, unit="m"),
     "post_radius": Range(0.0, 1e4, low_open=False, unit="m"),
     "sweep": Range(8, 100_000, low_open=False),
+    "validate": Range(1, 1000, low_open=False),  # map: segments simulated
     "seed": Range(0, 2**63 - 1, low_open=False),
+    "workers": Range(1, 4096, low_open=False),
+    "chunk_size": Range(1, 100_000_000, low_open=False, unit="points"),
 }
 """The one place where parameter ranges live (library, vectorized code and CLI).
 
@@ -228,11 +244,23 @@ Entries beyond the robot, controller and geometry:
     ρ_g, the frozen distance to the goal, m, in [10⁻³, 10⁴].
 ``delta``
     The surface offset δ of Ge & Cui's eq (40), m, in [0, 10³].
+``c_h``, ``kappa``
+    The holonomic loop s² + (c_h·s + κ)e^(−sT) (docs/models.md, "Robot loop
+    families"): damping c_h in [−10⁶, 10⁶] 1/s, stiffness κ in [−10¹², 10¹²]
+    1/s² (κ = 0 is refused by the models: a root at s = 0).
+``mass``, ``alpha_p``, ``alpha_v``
+    Target tracking of Ge & Cui 2002 eq (33)–(36): mass m in (0, 10⁶] kg,
+    position gain α_p in (0, 10⁶] N/m, velocity gain α_v in [0, 10⁶] N·s/m.
+``step``
+    The gradient-step planner's step h = VT, m, in (0, 10⁶].
 ``compute_delay``, ``pade_order``, ``window_cells``, ``members``, ``sweep``, ``seed``
     Integers in closed ranges: samples from measurement to actuation [0, 1];
     Padé order m [1, 12]; grid window side [3, 1001] cells (odd, KB: 33);
     runs per bisection round [3, 1000]; random parameter sets of a sweep
     [8, 10⁵]; random seeds [0, 2⁶³ − 1].
+``workers``, ``chunk_size``
+    ``pfm-stability sweep`` (docs/sweeps.md): local threads or worker processes
+    [1, 4096]; points per chunk [1, 10⁸].
 """
 
 
@@ -411,27 +439,65 @@ class Preset:
     window_cells: int = 33
 
 
-CARMEL = Preset(
-    name="carmel",
-    robot=Robot(V=0.8, tau=0.3, k=2.0, W=0.8, max_steering_rate=math.radians(120.0)),
-    controller=Controller(f=0.8, n=2.0, T=0.065, hold="command", compute_delay=1),
-    assumed={
-        "k": "KB do not give the steering gain; 2 1/s gives the steering loop "
-        "tau*s^2 + s + k a damping ratio of 0.65 with tau = 0.3 s",
-        "hold": "KB do not say how CARMEL sampled; the VFF computer sends steering-rate "
-        "commands to the Z-80 low-level controller, so the whole command is held",
-        "compute_delay": "KB do not say; one VFF cycle (T = 65 ms on the 386) is the time to "
-        "compute a command, so a command computed from the data of t_k is applied at t_k+1",
-    },
-    source="Koren & Borenstein 1991, §4 and §5.4: V = 0.8 m/s, tau = 0.3 s, T = 0.065 s, "
-    "f_av = 0.8, n = 2, W = 0.8 m (sensor ring diameter), 120 deg/s, 0.1 m cells, 33-cell window",
-)
+PRESET_DIRECTORY = Path(__file__).resolve().parent / "data" / "presets"
+"""The shipped presets, one configuration file each (``carmel.yaml``; docs/config.md)."""
 
-PRESETS = {CARMEL.name: CARMEL}
+
+class _Presets(Mapping):
+    """The shipped presets by name, each read from its YAML file on first use.
+
+    The names come from the file names, so listing them (``--preset`` choices,
+    ``--help``) reads no file and imports no YAML parser.
+    """
+
+    def __init__(self, directory: Path):
+        self._directory = directory
+        self._loaded = {}
+
+    def _names(self) -> tuple:
+        return tuple(sorted(p.stem for p in self._directory.glob("*.yaml")))
+
+    def __getitem__(self, name):
+        if name not in self._loaded:
+            if name not in self._names():
+                raise KeyError(name)
+            self._loaded[name] = _read_preset(self._directory / f"{name}.yaml")
+        return self._loaded[name]
+
+    def __iter__(self):
+        return iter(self._names())
+
+    def __len__(self):
+        return len(self._names())
+
+
+def _read_preset(path: Path) -> Preset:
+    """The `Preset` of a shipped file (docs/config.md: ``name``, ``source``, ``robot``, ``controller``, ``assumed``).
+
+    The file's values are checked by `Robot` and `Controller`; a key they do not
+    take is an error. (User files go through the stricter `pfm_stability.config`.)
+    """
+    import yaml
+
+    data = yaml.safe_load(path.read_text(encoding="utf-8"))
+    robot = dict(data["robot"])
+    if "max_steering_rate" in robot:  # deg/s in the file, as angles everywhere at the edges
+        robot["max_steering_rate"] = math.radians(robot["max_steering_rate"])
+    try:
+        return Preset(
+            name=data.get("name", path.stem), robot=Robot(**robot), controller=Controller(**data["controller"]),
+            assumed=dict(data.get("assumed") or {}), source=data.get("source", ""),
+        )
+    except TypeError as exc:  # an unknown key
+        raise ValueError(f"preset {path.name}: {exc}") from None
+
+
+PRESETS = _Presets(PRESET_DIRECTORY)
+"""The shipped presets by name (a read-only mapping; each file is read on first use)."""
 
 
 def get_preset(name: str) -> Preset:
-    """Return the preset called `name` (``"carmel"``).
+    """Return the preset called `name` (``"carmel"``), read from ``data/presets/<name>.yaml``.
 
     Raises
     ------
@@ -440,3 +506,10 @@ def get_preset(name: str) -> Preset:
     """
     check_choice("preset", name, tuple(PRESETS))
     return PRESETS[name]
+
+
+def __getattr__(name):
+    """``CARMEL``: the shipped preset ``carmel.yaml``, read when first asked for (PEP 562)."""
+    if name == "CARMEL":
+        return get_preset("carmel")
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

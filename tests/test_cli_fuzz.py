@@ -177,7 +177,7 @@ def command_lines(draw, command, outdir):
             value, ok = draw(_number_values(command, action.type.range_key))
         elif kind == "integer":
             value, ok = draw(_integer_values(command, action.type.range_key, action.type.odd))
-        elif kind == "path":
+        elif kind in ("path", "directory"):  # a directory option gets the same paths: new, existing, empty, bad
             value, ok = _path(draw(_mostly(st.just("ok"), st.sampled_from(PATH_KINDS))), outdir), False
         else:
             raise AssertionError(f"{command} {name}: an option without a range (type {action.type!r}); give it one in RANGES")
@@ -321,7 +321,7 @@ def test_every_option_is_fuzzed():
     for command in SUBPARSERS:
         options, _ = _options(command)
         for name, action in options.items():
-            assert action.nargs == 0 or action.choices is not None or getattr(action.type, "kind", None) in ("number", "integer", "path"), (command, name)
+            assert action.nargs == 0 or action.choices is not None or getattr(action.type, "kind", None) in ("number", "integer", "path", "directory", "address"), (command, name)
 
 
 # -------------------------------------------- once tracebacks, now defined answers

@@ -24,7 +24,7 @@ import sys
 
 __all__ = ["main", "build_parser", "UsageError"]
 
-SUBCOMMANDS = ("report", "derive", "simulate", "validate", "plot", "traps")
+SUBCOMMANDS = ("report", "derive", "simulate", "validate", "plot", "traps", "map", "sweep")
 
 
 class UsageError(Exception):

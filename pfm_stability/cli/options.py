@@ -1,26 +1,35 @@
-"""Command-line options shared by the subcommands: robot, controller, preset.
+"""Command-line options shared by the subcommands: robot, controller, preset, configuration file.
 
-A value typed by the user overrides the preset's; `resolve_parameters` records
+A value typed by the user overrides the configuration file's (``--config``,
+docs/config.md), which overrides its preset's; `resolve_parameters` records
 where every value came from so reports can mark the assumed ones.
 """
 
 from __future__ import annotations
 
 import argparse
+import sys
 from dataclasses import dataclass, fields
+from typing import TYPE_CHECKING
 
 from ..checks import check_integer, check_number, check_output_path
 from ..parameters import FIELD_DEFAULTS, FORCE_LAWS, HOLDS, LAW_PARAMETERS, PRESETS, RANGES, SHOWN_AS, Controller, Preset, Robot, get_preset
+
+if TYPE_CHECKING:
+    from ..config import Config
 
 __all__ = [
     "number",
     "check",
     "integer",
     "output_path",
+    "input_file",
     "describe",
     "add_parameter_options",
     "resolve_parameters",
     "ResolvedParameters",
+    "Default",
+    "typed",
     "LAW_OPTIONS",
     "add_law_options",
     "resolve_law",
@@ -108,18 +117,50 @@ def output_path(name: str, suffix: str = ".png"):
     return parse
 
 
+class Default(str):
+    """An option's default value (a `str`, equal to the text), marking that the user did not type it.
+
+    argparse cannot tell a typed ``--preset carmel`` from the default; a
+    configuration file's value must beat only the default (`typed`).
+    """
+
+
+def typed(args, name: str) -> bool:
+    """Whether the user gave option `name` (not None and not a `Default`)."""
+    value = getattr(args, name, None)
+    return value is not None and not isinstance(value, Default)
+
+
+def input_file(name: str):
+    """An argparse ``type=`` for a file to read: non-empty text; whether it can be read is the reader's to say
+    (`pfm_stability.config.load_config`: ``config FILE: cannot read the file (…)``)."""
+
+    def parse(text: str) -> str:
+        if not text.strip() or "\0" in text:
+            raise argparse.ArgumentTypeError(f"{name} must be the path of a readable file; got {text!r}")
+        return text
+
+    parse.__name__ = name
+    parse.kind = "path"  # generated like the output paths by the command-line fuzzer: none of them is a config file
+    return parse
+
+
 PADE_ORDER = integer("pade_order")
 """``--pade-order`` values: Padé order m of the ``pade`` model."""
 
 
 def add_parameter_options(parser: argparse.ArgumentParser, *, sampled: bool = False) -> None:
-    """--preset, --V, --tau, --T, --k, --f, --n, --W, --hold, --compute-delay.
+    """--config, --preset, --V, --tau, --T, --k, --f, --n, --W, --hold, --compute-delay.
 
     With ``sampled=True`` (the simulator and the validation, which sample),
     ``--T`` takes ``RANGES["T_sampled"]``: (0, 100] s.
     """
-    group = parser.add_argument_group("robot and controller (override the preset)")
-    group.add_argument("--preset", choices=sorted(PRESETS), default="carmel", help="parameter preset (default: carmel)")
+    group = parser.add_argument_group("robot and controller (override the configuration file and the preset)")
+    group.add_argument("--config", metavar="FILE", type=input_file("config"),
+                       help="configuration file (YAML: robot, controller, law, scenario; or a Nav2 parameters file), "
+                            "docs/config.md; options typed here override it")
+    group.add_argument("--preset", choices=sorted(PRESETS), default=Default("carmel"),
+                       help="parameter preset (default: the configuration file's, else carmel)")
     helps = {
         "V": "speed",
         "tau": "steering time constant",
@@ -149,21 +190,52 @@ class ResolvedParameters:
     Attributes
     ----------
     preset : Preset
+        The preset in force: ``--preset``, or the configuration file over its preset
+        (`pfm_stability.config.Config.preset`: its grid and assumptions).
     robot : Robot
     controller : Controller
     sources : dict[str, str]
-        Parameter name → "user", "preset <name>" or "ASSUMED (preset <name>): why".
+        Parameter name → "user", "preset <name>", "ASSUMED (preset <name>): why",
+        "config <file>", "ASSUMED (config <file>): why" or "Nav2 <file>: key = value";
+        with a configuration file's scenario also ``alpha_deg`` and ``L``.
+    config : Config or None
+        The ``--config`` file, if any.
     """
 
     preset: Preset
     robot: Robot
     controller: Controller
     sources: dict
+    config: "Config | None" = None
 
 
-def resolve_parameters(args) -> ResolvedParameters:
-    """Apply the user's overrides to the preset (validated by the dataclasses)."""
-    preset = get_preset(args.preset)
+SCENARIO_OPTIONS = {"alpha": ("wall", "alpha", "alpha_deg"), "L": ("corridor", "L", "L")}
+"""Options a configuration file's ``scenario`` fills when a command takes them and the user did not type them:
+option → (geometry, key, name in the sources)."""
+
+
+def resolve_parameters(args, *, fill=None) -> ResolvedParameters:
+    """Apply the user's overrides to the configuration file and the preset (validated by the dataclasses).
+
+    Precedence: an option typed > ``--config FILE`` > the file's ``preset`` (or a
+    typed ``--preset``) > carmel. A configuration file's ``scenario`` fills
+    ``args.alpha`` / ``args.L`` where the command has them and the user typed
+    none (only the options of `fill`, if given: a command whose scenario takes
+    no L says so); its notes (Nav2 keys not found) go to stderr.
+    """
+    config = None
+    if getattr(args, "config", None) is not None:
+        from ..config import load_config
+
+        config = load_config(args.config, preset=args.preset if typed(args, "preset") else None)
+        preset = config.preset
+        base_sources = config.sources
+    else:
+        preset = get_preset(getattr(args, "preset", "carmel"))
+        base_sources = {
+            name: f"ASSUMED (preset {preset.name}): {preset.assumed[name]}" if name in preset.assumed else f"preset {preset.name}"
+            for name in _ROBOT_FIELDS + _CONTROLLER_FIELDS
+        }
     sources = {}
     robot_changes, controller_changes = {}, {}
     for name in _ROBOT_FIELDS + _CONTROLLER_FIELDS:
@@ -172,13 +244,27 @@ def resolve_parameters(args) -> ResolvedParameters:
         if value is not None:
             target[name] = value
             sources[name] = "user"
-        elif name in preset.assumed:
-            sources[name] = f"ASSUMED (preset {preset.name}): {preset.assumed[name]}"
         else:
-            sources[name] = f"preset {preset.name}"
+            sources[name] = base_sources[name]
     robot = Robot(**{**_fields(preset.robot), **robot_changes})
     controller = Controller(**{**_fields(preset.controller), **controller_changes})
-    return ResolvedParameters(preset, robot, controller, sources)
+    if config is not None:
+        sources.update(_fill_scenario(args, config, SCENARIO_OPTIONS if fill is None else fill))
+        for note in config.notes:
+            print(f"pfm-stability: note: {note}", file=sys.stderr)
+    return ResolvedParameters(preset, robot, controller, sources, config)
+
+
+def _fill_scenario(args, config, options) -> dict:
+    """Set ``args.alpha`` / ``args.L`` (those of `options`) from the file's scenario where the command has them and none was typed."""
+    sources = {}
+    for option in options:
+        geometry, key, shown = SCENARIO_OPTIONS[option]
+        value = config.scenario.get(geometry, {}).get(key)
+        if value is not None and hasattr(args, option) and getattr(args, option) is None:
+            setattr(args, option, value)
+            sources[shown] = config.sources[shown]
+    return sources
 
 
 def _fields(obj) -> dict:
@@ -210,16 +296,19 @@ def _option(name: str) -> str:
 def add_law_options(parser: argparse.ArgumentParser) -> None:
     """--law and the options of the laws (`LAW_OPTIONS`); each applies to the laws of `parameters.LAW_PARAMETERS` only."""
     group = parser.add_argument_group("force law (docs/fields.md)")
-    group.add_argument("--law", choices=FORCE_LAWS, default="power",
-                       help="lateral force law: KB's power law f(W/d)^n (default), the histogram grid's law, "
-                            "Khatib's repulsion or Ge & Cui's goal-aware repulsion (gnron)")
+    group.add_argument("--law", choices=FORCE_LAWS, default=Default("power"),
+                       help="lateral force law: KB's power law f(W/d)^n (default, unless the configuration file names one), "
+                            "the histogram grid's law, Khatib's repulsion or Ge & Cui's goal-aware repulsion (gnron)")
     for name, text in LAW_OPTIONS.items():
         kind = integer(name, odd=True) if name == "window_cells" else number(name)
         group.add_argument(_option(name), type=kind, help=f"{text}, {describe(name)}")
 
 
 def resolve_law(args, params: ResolvedParameters):
-    """The law of ``--law`` and the sources of its parameters: (law, sources).
+    """The law of ``--law`` (else the configuration file's) and the sources of its parameters: (law, sources).
+
+    A configuration file's law parameters apply when its law is the one in force;
+    an option typed beats them.
 
     Raises
     ------
@@ -229,16 +318,22 @@ def resolve_law(args, params: ResolvedParameters):
     """
     from ..fields import check_law_parameters, make_law
 
-    given = {name: getattr(args, name) for name in LAW_OPTIONS if getattr(args, name, None) is not None}
-    typed = [name for name in ("f", "n") if params.sources.get(name) == "user"]
-    check_law_parameters(args.law, typed + list(given), _option, f"--law {args.law}")
-    law = make_law(args.law, params.robot, params.controller, **given)
+    from_file = (params.config.law if params.config is not None else None) or {}
+    law_name = args.law if typed(args, "law") or not from_file else from_file["name"]
+    given = {key: getattr(args, key) for key in LAW_OPTIONS if getattr(args, key, None) is not None}
+    filed = {k: v for k, v in from_file.items() if k != "name" and k not in given} if from_file.get("name") == law_name else {}
+    typed_fn = [key for key in ("f", "n") if params.sources.get(key) == "user"]
+    shown = f"--law {law_name}" if typed(args, "law") or not from_file else f"law {law_name} of --config {params.config.path}"
+    check_law_parameters(law_name, typed_fn + list(given) + list(filed), _option, shown)
+    law = make_law(law_name, params.robot, params.controller, **given, **filed)
     sources = {}
-    for name in LAW_PARAMETERS[args.law]:
+    for name in LAW_PARAMETERS[law_name]:
         if name in ("f", "n"):
             continue
         if name in given:
             sources[name] = "user"
+        elif name in filed:
+            sources[name] = params.config.sources[name]
         elif name == "cell_ratio":
             sources[name] = "calibrated so that f_av = f (KB §4)"
         else:

@@ -33,7 +33,9 @@ __all__ = [
     "render_validation_text",
     "render_sweep_text",
     "render_traps_text",
+    "render_map_text",
     "render_door_text",
+    "render_parameter_sweep_text",
 ]
 
 
@@ -466,3 +468,80 @@ def render_traps_text(analysis) -> str:
         lines.append(f"no obstacle within rho0 = {scene.law.rho0:g} m of the goal: Ge & Cui's bound puts no condition on xi/eta")
     lines += ["", f"conclusion: {analysis.conclusion}"]
     return "\n".join(lines) + "\n"
+
+
+# ------------------------------------------------------------------ sweep (pfm-stability sweep)
+def _share(x) -> str:
+    """A fraction as a percentage with one decimal ("-" when undefined)."""
+    return "-" if x is None or (isinstance(x, float) and math.isnan(x)) else f"{100 * x:.1f} %"
+
+
+def render_parameter_sweep_text(summary, plot=None) -> str:
+    """``pfm-stability sweep``'s summary: points, time, rate, each model's stable fraction, the agreement matrix, where the output went."""
+    s = summary.statistics
+    spec = summary.spec
+    models = list(s.agreement)
+    varying = ", ".join(spec.varying)
+    lines = [
+        f"sweep {spec.path or ''}: {summary.points} points ({varying} vary; {spec.geometry}, law {spec.law}), "
+        f"{summary.chunks} chunk(s) of <= {summary.chunk_size} on {summary.scheduler}"
+        + (f", {summary.reused_chunks} reused from an interrupted run" if summary.reused_chunks else ""),
+        f"  {summary.seconds:.2f} s, {summary.rate:,.0f} points/s",
+        "",
+        "stable fraction (verdict \"stable\"; undecided = within 1e-9 of a boundary):",
+    ]
+    rows = [[m, _share(s.stable_fraction[m]), str(s.undecided[m])] for m in models]
+    if s.simulation_agreement is not None:
+        rows.append(["simulation", _share(s.stable_fraction.get("sim")), "-"])
+    lines += ["  " + line for line in table(["model", "stable", "undecided"], rows)]
+    if len(models) > 1:
+        lines += ["", "agreement of the verdicts (fraction of points):"]
+        lines += ["  " + line for line in table(["", *models], [[a, *(_share(s.agreement[a][b]) for b in models)] for a in models])]
+    if s.simulation_agreement is not None:
+        lines += ["", "simulated verdict (sign of sigma) agrees with:"]
+        lines += ["  " + line for line in table(["model", "agreement"], [[m, _share(v)] for m, v in s.simulation_agreement.items()])]
+    if s.without_verdict:
+        lines += ["", f"{s.without_verdict} point(s) without a verdict: see the reason column"]
+    lines += [f"note: {note}" for note in summary.notes]
+    lines += ["", f"table: {summary.out} ({summary.format}, one row per point)"]
+    if plot:
+        lines.append(f"plot: {plot}")
+    return "\n".join(lines) + "\n"
+
+
+MAP_ROWS = 15
+"""Segments listed by ``pfm-stability map`` (the worst first)."""
+
+
+def render_map_text(data: dict) -> str:
+    """``pfm-stability map``: the map, the robot, the worst segments (lowest margin first), a summary, validation, outputs."""
+    m, i, s = data["map"], data["inputs"], data["summary"]
+    lines = [
+        f"map {m['name']}: {m['width']} x {m['height']} cells of {m['resolution']:g} m, origin {m['origin'][:2]}; "
+        f"histogram grid {i['grid_cells'][0]} x {i['grid_cells'][1]} cells of {i['cell_size']:g} m (unknown = {i['unknown']})",
+        f"robot V = {i['V']:g} m/s, W = {i['W']:g} m, tau = {i['tau']:g} s, k = {i['k']:g} 1/s, T = {i['T']:g} s; "
+        f"law {i['law']}; model {i['model']} (hold {i['hold']}, compute delay {i['compute_delay']}): NV* = {number(data['NV_critical'])} 1/s",
+        "",
+    ]
+    decided = [g for g in data["segments"] if g["margin"] is not None]
+    decided.sort(key=lambda g: (g["margin"] if not isinstance(g["margin"], str) else math.inf))
+    rows = [[f"({g['x0']:.1f}, {g['y0']:.1f}) -> ({g['x1']:.1f}, {g['y1']:.1f})", f"{g['length']:.1f}", number(g["N"]),
+             number(g["V_critical"]), percent(g["margin"]), g["verdict"]] for g in decided[:MAP_ROWS]]
+    if rows:
+        lines.append(f"worst {len(rows)} of {len(decided)} segments with a verdict (margin = NV*/NV - 1):")
+        lines += ["  " + line for line in table(["segment (m)", "length m", "N 1/m", "V* m/s", "margin", "verdict"], rows)]
+    counts = ", ".join(f"{n} {v}" for v, n in s["verdicts"].items() if n)
+    worst = s["V_critical_min"]
+    lines += [
+        "",
+        f"{s['segments']} segments, {s['route_length_m']:.1f} m of routes: {counts}",
+        f"unstable: {s['unstable_length_m']:.1f} m; slowest V* = {number(worst)} m/s"
+        + (f" -> the robot oscillates somewhere at V = {i['V']:g} m/s" if s["unstable_length_m"] > 0 else f" -> stable everywhere at V = {i['V']:g} m/s"),
+    ]
+    v = data.get("validation")
+    if v is not None:
+        lines.append(f"validation: {v.get('agreed')} of {v.get('measured')} simulated segments agree (agreement {percent(v.get('agreement'))[1:] if v.get('agreement') is not None else '-'})")
+    for name, path in (data.get("outputs") or {}).items():
+        lines.append(f"{name}: {path}")
+    return "\n".join(lines) + "\n"
+

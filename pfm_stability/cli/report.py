@@ -48,7 +48,7 @@ def run(args) -> int:
         models=tuple(dict.fromkeys(args.model)) if args.model else MODEL_NAMES,
         pade_order=args.pade_order,
         sources={
-            **params.sources, **law_sources, "alpha_deg": "user", "L": "user",
+            "alpha_deg": "user", "L": "user", **params.sources, **law_sources,  # a --config scenario names its file
             "pade_order": "user" if args.pade_order != DEFAULT_PADE_ORDER else "default",
         },
         law=law,

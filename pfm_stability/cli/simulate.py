@@ -45,9 +45,9 @@ def add_parser(sub) -> None:
     g.add_argument("--duration", type=number("duration"), help=f"simulated time, {describe('duration')} (default per scenario)")
     g.add_argument("--cell-ratio", type=number("cell_ratio"), help=f"grid: F_cr/F_ct per cell, {describe('cell_ratio')} (default: calibrated to f_av = f)")
     g.add_argument("--law", choices=("power", "grid"), help="analytic: KB's lumped power law (default) or the grid's effective law")
-    g.add_argument("--window-cells", type=integer("window_cells", odd=True), default=33,
-                   help=f"grid: active window side, odd, {describe('window_cells')} (default 33)")
-    g.add_argument("--cell-size", type=number("cell_size"), default=0.1, help=f"grid: cell size, {describe('cell_size')} (default 0.1)")
+    g.add_argument("--window-cells", type=integer("window_cells", odd=True),
+                   help=f"grid: active window side, odd, {describe('window_cells')} (default: the preset's, 33)")
+    g.add_argument("--cell-size", type=number("cell_size"), help=f"grid: cell size, {describe('cell_size')} (default: the preset's, 0.1)")
     g.add_argument("--speed-law", action="store_true", help="use the VFF speed law V(1 - |cos phi|)")
     g.add_argument("--seed", type=integer("seed"), help=f"seed of the random start jitter, {describe('seed')}")
     g.add_argument("--jitter", type=number("start_jitter"), default=0.0,
@@ -59,6 +59,22 @@ def add_parser(sub) -> None:
     out.add_argument("--trajectory", action="store_true", help="json: include every sample of the trajectory")
     out.add_argument("--quiet", action="store_true", help="no progress bar on stderr (shown only when stderr is a terminal)")
     p.set_defaults(run=run)
+
+
+def _law_options(args, params) -> dict:
+    """--law, --cell-ratio, --window-cells, --cell-size: typed, else a --config file's grid or power law, else the preset's grid."""
+    law = (params.config.law if params.config is not None else None) or {}
+    if law.get("name") not in ("power", "grid"):  # khatib and gnron are analysed by `report` only
+        law = {}
+    out = {
+        "law": args.law if args.law is not None else (law.get("name") if law and args.env == "analytic" else None),
+        "cell_ratio": args.cell_ratio,
+        "window_cells": args.window_cells if args.window_cells is not None else params.preset.window_cells,
+        "cell_size": args.cell_size if args.cell_size is not None else params.preset.cell_size,
+    }
+    if out["cell_ratio"] is None and law.get("name") == "grid" and (args.env == "grid" or out["law"] == "grid"):
+        out["cell_ratio"] = law.get("cell_ratio")
+    return out
 
 
 def _build(args, params):
@@ -74,10 +90,7 @@ def _build(args, params):
         alpha=Wall.from_degrees(args.alpha).alpha if args.alpha is not None else None,  # rad, inside RANGES['alpha']
         offset=args.offset,
         duration=args.duration,
-        cell_ratio=args.cell_ratio,
-        law=args.law,
-        window_cells=args.window_cells,
-        cell_size=args.cell_size,
+        **_law_options(args, params),
         speed_law=args.speed_law,
         seed=args.seed,
         start_jitter=args.jitter,
@@ -111,7 +124,7 @@ def run(args) -> int:
     from ..sim.api import simulate
     from ..validation.predict import predict
 
-    params = resolve_parameters(args)
+    params = resolve_parameters(args, fill={"corridor": ("L",), "wall": ("alpha",)}.get(args.scenario, ()))
     if args.scenario == "corridor" and args.L is not None:  # the report's words for a robot wider than the corridor
         check_corridor_fits(Corridor(args.L), params.robot)
     scenario = _build(args, params)

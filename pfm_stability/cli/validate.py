@@ -92,7 +92,8 @@ def run(args) -> int:
         raise ValueError("sweep-plot needs --sweep N")
     if args.no_map and not args.plot:
         raise ValueError("no-map applies to --plot only")
-    params = resolve_parameters(args)
+    fill = ({"corridor": "L", "wall": "alpha"}[args.scenario],) if args.parameter in ("V", "f") else ()  # the fixed geometry
+    params = resolve_parameters(args, fill=fill)
     if args.scenario == "corridor" and args.L is not None and args.parameter in ("V", "f"):  # the report's words
         from ..parameters import Corridor, check_corridor_fits
 

@@ -50,7 +50,7 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-__all__ = ["OscillationMetrics", "oscillation_metrics", "turning_points", "LINEAR_RESIDUAL", "PEAKS_AGREEMENT", "HYSTERESIS"]
+__all__ = ["OscillationMetrics", "oscillation_metrics", "linear_prediction", "turning_points", "LINEAR_RESIDUAL", "PEAKS_AGREEMENT", "HYSTERESIS"]
 
 LINEAR_RESIDUAL = 1e-6
 """Largest relative residual of the linear-prediction fit for the run to count as linear."""
@@ -166,8 +166,29 @@ def _peaks(t, x, extrema):
     return sigma, omega, amplitudes, mid
 
 
-def _linear_prediction(x, order: int, T: float):
-    """(σ, ω, relative residual) of the dominant root of an order-`order` fit, or None."""
+def linear_prediction(x, order: int, T: float):
+    """Dominant root of a linear-prediction (Prony-type) fit to a sampled record.
+
+    Fits x_k = Σ a_i x_(k−i) + b (least squares, `order` lags plus an offset)
+    and takes the recurrence's root of largest modulus z (the one with
+    positive imaginary part of a pair).
+
+    Parameters
+    ----------
+    x : ndarray
+        Samples taken every `T` seconds; at least 4·(order + 1) of them.
+    order : int
+        Number of lags (4: an oscillating pair, one real mode, margin).
+    T : float
+        Sampling period, s.
+
+    Returns
+    -------
+    tuple of (float, float, float) or None
+        (σ = ln|z|/T in 1/s, ω = |arg z|/T in rad/s, the fit's relative
+        residual), or None when the record is too short, constant or its
+        dominant root is 0.
+    """
     n = x.size
     if n < 4 * (order + 1):
         return None
@@ -238,7 +259,7 @@ def oscillation_metrics(t, x, T: float, *, order: int = 4, collision_time: float
     amplitudes = mid = np.array([])
     if extrema.size >= 1:
         sigma_p, omega_p, amplitudes, mid = _peaks(t, x, extrema)
-    fit = _linear_prediction(x, order, T)
+    fit = linear_prediction(x, order, T)
     residual = fit[2] if fit is not None else None
     rel, floor = PEAKS_AGREEMENT
     linear = (

@@ -6,7 +6,7 @@ the geometry (corridor half-width L or wall angle α) — with W = 0.8 m and
 n = 2 (CARMEL, KB §4). Members take the geometries and the sampled structures
 in turn: member i is a corridor when ⌊i/4⌋ is even and a wall otherwise,
 with (hold, compute_delay) = `STRUCTURES`[i mod 4], so every combination is
-covered equally. Each geometry is simulated in one batch (`simulate_batch`),
+covered equally. Each geometry is simulated in one batch (`simulate_members`),
 starting `offset` from equilibrium for long enough to measure σ (8 periods
 of the sampled model's boundary oscillation, 20–150 s, at most 4000 samples).
 
@@ -32,15 +32,26 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..checks import check_choice, check_integer, check_number
-from ..models import Loop, MODEL_NAMES, make_model
+from ..models import MODEL_NAMES, Loop, make_model
 from ..parameters import CARMEL, Controller, Robot
 from ..serialize import json_number, json_ready
-from ..sim.api import simulate_batch
+from ..sim.api import batch_scenarios
+from ..sim.engine import run_batch
 from ..sim.verdict import simulated_verdict
 from .common import SCENARIOS, parameter_domain, scenario_law
 from .predict import environment_gain, model_answer
 
-__all__ = ["SWEEP_RANGES", "STRUCTURES", "SweepPoint", "SweepResult", "verdict_sweep", "sweep_parameters"]
+__all__ = [
+    "STRUCTURES",
+    "SWEEP_RANGES",
+    "MemberVerdict",
+    "SweepPoint",
+    "SweepResult",
+    "simulate_members",
+    "simulation_duration",
+    "sweep_parameters",
+    "verdict_sweep",
+]
 
 SWEEP_RANGES = {
     "V": (0.3, 1.5),
@@ -255,8 +266,12 @@ _MAX_SAMPLES = 4000
 """A batch steps until its longest member: cap each member's samples (T = 0.01 s: 40 s)."""
 
 
-def _duration(loop: Loop, hold: str, delay: int, env: str) -> float:
-    """s: 8 periods of the sampled boundary oscillation, in [20 s (grid 30 s), 150 s], at most `_MAX_SAMPLES` samples."""
+def simulation_duration(loop: Loop, hold: str, delay: int, env: str) -> float:
+    """How long to simulate a member to measure its σ, s.
+
+    8 periods of the sampled model's boundary oscillation (hold, compute
+    delay), in [20 s (grid 30 s), 150 s], and at most `_MAX_SAMPLES` samples.
+    """
     b = make_model("sampled", hold=hold, compute_delay=delay).boundary(loop)
     period = 2 * math.pi / b.omega_critical if b.omega_critical else 0.0
     shortest = 20.0 if env == "analytic" else 30.0
@@ -337,7 +352,7 @@ def verdict_sweep(
                 lo, hi = max(lo, dom[0]), min(hi, dom[1])
             geometry = lo + (hi - lo) * u
         loop = Loop(r.tau, c.T, r.k)
-        members.append((i, s["scenario"][i], r, c, geometry, _duration(loop, c.hold, c.compute_delay, env)))
+        members.append((i, s["scenario"][i], r, c, geometry, simulation_duration(loop, c.hold, c.compute_delay, env)))
 
     models = {name: make_model(name, pade_order=pade_order) for name in COMPARED_MODELS if name != "sampled"}
     points = []
@@ -353,11 +368,13 @@ def verdict_sweep(
         }
         geometry = np.array([m[4] for m in group])
         arrays["L" if kind == "corridor" else "alpha"] = geometry if kind == "corridor" else np.radians(geometry)
-        batch = simulate_batch(kind, env=env, robot=robot, controller=controller, offset=offset, record="offset", metrics=True, **arrays)
+        runs = simulate_members(kind, env=env, robot=robot, controller=controller, offset=offset, **arrays)
         if progress:
             progress(f"sweep: simulated {len(group)} {kind} members ({env})")
-        for (i, _, r, c, _, _), run in zip(group, batch.runs):
-            points.append(_assess(i, kind, r, c, run, models, exclude))
+        for (i, _, r, c, _, _), member in zip(group, runs):
+            if member.run is None:  # the members are drawn inside the simulator's domain
+                raise ValueError(f"sweep member {i}: {member.reason}")
+            points.append(_assess(i, kind, r, c, member.run, models, exclude))
     points.sort(key=lambda p: p.index)
 
     included = [p for p in points if not p.excluded]
@@ -424,3 +441,91 @@ def _assess(index, kind, robot, controller, run, models, exclude) -> SweepPoint:
         method=m.method,
         excluded=bool(math.isfinite(NV_star) and NV_star > 0 and abs(NV / NV_star - 1) < exclude),
     )
+
+
+@dataclass(frozen=True)
+class MemberVerdict:
+    """The simulated answer for one member of a batch (`simulate_members`).
+
+    Attributes
+    ----------
+    verdict : str or None
+        "stable" or "unstable" in the linear sense (`sim.verdict.simulated_verdict`);
+        None when the member could not be simulated (`reason`).
+    basis : str
+        "growth_rate", "collision", "metrics", or "not simulated".
+    growth_rate : float or None
+        Measured σ, 1/s (None: undefined, see `basis` and `method`).
+    method : str
+        Estimator of σ ("linear_prediction", "peaks", "none"), or "none".
+    collided : bool
+    reason : str or None
+        Why the member was not simulated (the scenario's error message).
+    run : RunResult or None
+        The run itself.
+    """
+
+    verdict: str | None
+    basis: str
+    growth_rate: float | None
+    method: str
+    collided: bool
+    reason: str | None = None
+    run: object = None
+
+
+def simulate_members(kind: str, *, env: str, robot: Robot, controller: Controller, offset: float, progress=None, **members) -> list:
+    """Simulate one batch of corridor or wall members and give each one's verdict (the per-point step of every sweep).
+
+    Each member's scenario is built on its own (`sim.api.batch_scenarios`)
+    so that one impossible member (a robot that does not fit, a wall angle
+    beyond the grid's reach) is reported with its reason instead of failing
+    the batch; the others are simulated together (`sim.engine.run_batch`,
+    record="offset", metrics on) and judged by `simulated_verdict`.
+
+    Parameters
+    ----------
+    kind : {"corridor", "wall"}
+    env : {"analytic", "grid"}
+    robot, controller : Robot, Controller
+        Base values; the members override any field.
+    offset : float
+        Start offset, m.
+    progress : callable, optional
+        ``progress(step, total)`` of the batch (`run_batch`).
+    **members
+        Equal-length 1-D arrays (or scalars) of `simulate_batch`'s parameters:
+        ``V, tau, k, W, f, n, T, hold, compute_delay``, ``L`` or ``alpha``
+        (rad), ``duration``, ``law``, ….
+
+    Returns
+    -------
+    list of MemberVerdict
+        In member order.
+    """
+    check_choice("kind", kind, SCENARIOS)
+    sizes = {np.size(v) for v in members.values() if np.ndim(v) > 0}
+    if len(sizes) > 1:
+        raise ValueError(f"member arrays must have one length; got {sorted(sizes)}")
+    count = sizes.pop() if sizes else 1
+    scenarios, reasons = [], []
+    for m in range(count):
+        one = {name: (v[m] if np.ndim(v) > 0 else v) for name, v in members.items()}
+        try:
+            scenarios.append(batch_scenarios(kind, env=env, robot=robot, controller=controller, offset=offset, **one)[0])
+            reasons.append(None)
+        except ValueError as exc:
+            scenarios.append(None)
+            reasons.append(str(exc))
+    valid = [s for s in scenarios if s is not None]
+    runs = iter(run_batch(valid, record="offset", metrics=True, progress=progress).runs if valid else ())
+    out = []
+    for scenario, reason in zip(scenarios, reasons):
+        if scenario is None:
+            out.append(MemberVerdict(None, "not simulated", None, "none", False, reason))
+            continue
+        run = next(runs)
+        verdict, basis = simulated_verdict(run)
+        m = run.metrics
+        out.append(MemberVerdict(verdict, basis, m.growth_rate, m.method, bool(run.collided), None, run))
+    return out

@@ -2,12 +2,14 @@
 
 For KB eq (18), a(s) + K e^(−sT) with a(s) = τs³ + s² + ks and K = kNV, the
 crossing count of `pfm_stability.delay` (Cooke & van den Driessche 1986) needs
-no iteration at all:
+no search over T:
 
 1. crossing frequencies: the positive roots y = ω² of
-   F(y) = |a(jω)|² − K² = τ²y³ + (1 − 2kτ)y² + k²y − K² (closed-form cubic,
-   polished by two Newton steps); there are three when kτ > 2 + √3 (the
-   steering loop resonates), else one;
+   F(y) = |a(jω)|² − K² = τ²y³ + (1 − 2kτ)y² + k²y − K² (Newton's method
+   from starts that satisfy Fourier's condition, `delay._cubic_positive_roots`;
+   the verdict-only path of `loop_verdicts` takes the one root of the
+   non-resonant case in closed form, `delay_verdicts`); there are three when
+   kτ > 2 + √3 (the steering loop resonates) and K² lies in the dip, else one;
 2. direction of each crossing as T grows: sign F′(y);
 3. first crossing delay: T₀ = (ψ mod 2π)/ω with ψ = atan((k − τω²)/ω);
    the crossings repeat every 2π/ω;
@@ -33,10 +35,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .delay import delay_verdicts_from_gain
-from .force_law import power_law_corridor_gain, power_law_wall_gain
-from .models.base import HEADING_GAIN_RANGE, check_heading_gain
-from .parameters import RANGES, TAU_RESOLUTION, check_parameter
+from ..delay import delay_verdicts_from_gain
+from ..force_law import power_law_corridor_gain, power_law_wall_gain
+from ..models.base import HEADING_GAIN_RANGE, check_heading_gain
+from ..parameters import RANGES, TAU_RESOLUTION, check_parameter
 
 __all__ = ["VectorVerdicts", "exact_delay_verdicts", "heading_gain_array", "loop_gain_arrays", "delay_verdicts_from_gain"]
 

@@ -1,0 +1,128 @@
+"""Points per second of `vectorized.loop_verdicts` for every loop model, on one core.
+
+Each model decides the same random points (τ, T, k, NV, seeded; c = 0) in one call,
+(a) verdict only (``columns="verdict"``: `stable` and `verdict`) and (b) all columns
+(verdict, NV*, margin, ω*); then (c) the time of a 200,000-point random sweep of
+`sampled` (CARMEL's structure: command hold, compute delay 1) plus `exact_delay`, all
+columns, in one process (import, evaluation, Parquet writing — the sweep's budget is 2 s). One core: the BLAS/OpenMP thread counts are pinned
+to 1 in the environment before numpy loads (OPENBLAS_NUM_THREADS, OMP_NUM_THREADS,
+MKL_NUM_THREADS) and `threadpoolctl.threadpool_limits(1)` holds around the calls;
+`loop_verdicts` itself starts no threads. Run:
+
+    python benchmarks/bench_models.py [--points 1000000] [--models sampled,pade] [--sweep-points 200000]
+
+Targets stated by the project (verdict only): ``sampled`` >= 10⁶ points/s,
+``exact_delay`` >= 5·10⁶ points/s; all columns >= 3·10⁵ points/s; the sweep <= 2 s.
+The script prints them and exits 1 when one is missed (the machine's load counts:
+compare rates measured in the same run).
+"""
+
+from __future__ import annotations
+
+import os
+
+for _name in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ[_name] = "1"
+
+import argparse  # noqa: E402
+import sys  # noqa: E402
+import time  # noqa: E402
+
+import numpy as np  # noqa: E402
+from threadpoolctl import threadpool_limits  # noqa: E402
+
+from pfm_stability.parameters import MODEL_NAMES, SAMPLED_STRUCTURES  # noqa: E402
+from pfm_stability.vectorized import loop_verdicts  # noqa: E402
+
+TARGETS = {"sampled": 1e6, "exact_delay": 5e6}
+"""Verdict-only targets, points/s."""
+
+ALL_COLUMNS_TARGET = 3e5
+SWEEP_BUDGET = 2.0
+
+
+def random_points(count: int, seed: int) -> dict:
+    """Uniform random loops around CARMEL's (SI units), seeded: τ in [0, 1] s, T in [0, 0.3] s,
+    k in [0.2, 10] 1/s, NV in [0.1, 5] 1/s."""
+    rng = np.random.default_rng(seed)
+    return dict(tau=rng.uniform(0.0, 1.0, count), T=rng.uniform(0.0, 0.3, count), k=rng.uniform(0.2, 10.0, count), NV=rng.uniform(0.1, 5.0, count))
+
+
+def cases(models):
+    """(label, model, options) for each model; ``sampled`` once per (hold, compute delay)."""
+    for model in models:
+        if model == "sampled":
+            for hold, delay in SAMPLED_STRUCTURES:
+                yield f"sampled {hold}/{delay}", model, {"hold": hold, "compute_delay": delay}
+        else:
+            yield model, model, {}
+
+
+def _rate(model, data, options, columns):
+    """(points/s, result) of one call; a warm-up call on 1000 points first."""
+    loop_verdicts(model, **{key: value[:1000] for key, value in data.items()}, columns=columns, **options)
+    start = time.perf_counter()
+    result = loop_verdicts(model, **data, columns=columns, **options)
+    return data["NV"].size / (time.perf_counter() - start), result
+
+
+_SWEEP = """
+import time, sys
+start = time.perf_counter()
+import numpy as np, pyarrow as pa, pyarrow.parquet as pq
+from pfm_stability.vectorized import loop_verdicts
+n = int(sys.argv[1]); path = sys.argv[2]
+rng = np.random.default_rng(3)
+tau, T, k, NV = rng.uniform(0, 1, n), rng.uniform(0, 0.3, n), rng.uniform(0.2, 10, n), rng.uniform(0.1, 5, n)
+table = {"tau": tau, "T": T, "k": k, "NV": NV}
+for model, options in (("sampled", {"hold": "command", "compute_delay": 1}), ("exact_delay", {})):
+    v = loop_verdicts(model, tau, T, k, NV, **options)
+    for field in ("stable", "verdict", "NV_critical", "margin"):
+        table[f"{model}_{field}"] = getattr(v, field)
+pq.write_table(pa.table(table), path)
+print(time.perf_counter() - start)
+"""
+
+
+def sweep_seconds(points: int) -> float:
+    """Wall time of a fresh process that imports, evaluates `sampled` + `exact_delay` (all columns) on
+    `points` random points and writes them to Parquet, s."""
+    import subprocess
+    import tempfile
+
+    with tempfile.TemporaryDirectory() as folder:
+        start = time.perf_counter()
+        subprocess.run([sys.executable, "-c", _SWEEP, str(points), os.path.join(folder, "sweep.parquet")], check=True, capture_output=True)
+        return time.perf_counter() - start
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--points", type=int, default=1_000_000)
+    parser.add_argument("--models", default=",".join(MODEL_NAMES))
+    parser.add_argument("--sweep-points", type=int, default=200_000)
+    args = parser.parse_args(argv)
+    data = random_points(args.points, seed=1)
+    ok = True
+    with threadpool_limits(1):
+        for label, model, options in cases(args.models.split(",")):
+            verdict_rate, fast = _rate(model, data, options, "verdict")
+            all_rate, full = _rate(model, data, options, "all")
+            assert np.array_equal(fast.stable, full.stable) and np.array_equal(fast.verdict, full.verdict)
+            target = TARGETS.get(model)
+            met = target is None or verdict_rate >= target
+            ok &= met and all_rate >= ALL_COLUMNS_TARGET
+            goal = "" if target is None else f" (target {target:,.0f}: {'met' if met else 'MISSED'})"
+            print(
+                f"{label:20s} verdict {verdict_rate:12,.0f} points/s{goal:28s} all columns {all_rate:10,.0f} points/s"
+                f" ({'met' if all_rate >= ALL_COLUMNS_TARGET else 'MISSED'}), {float(np.mean(full.stable)):.1%} stable"
+            )
+    if args.sweep_points:
+        seconds = sweep_seconds(args.sweep_points)
+        ok &= seconds <= SWEEP_BUDGET
+        print(f"sweep: {args.sweep_points:,} random points, sampled + exact_delay, all columns, Parquet: {seconds:.2f} s (budget {SWEEP_BUDGET:g} s: {'met' if seconds <= SWEEP_BUDGET else 'MISSED'})")
+    return 0 if ok else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,158 @@
+"""``pfm-stability map``: where along a building's corridors the robot oscillates, from a ROS occupancy map.
+
+    pfm-stability map MAP.yaml [--V 0.8 ...] [--out-dir DIR] [--validate N] [--format text|json]
+    pfm-stability map depot                     # a map shipped with the package
+
+MAP is a ROS ``map_server`` YAML file (its image beside it) or the name of a shipped
+map (`SHIPPED_MAPS`). The analysis (docs/maps.md) reduces the map onto the robot's
+histogram grid, finds the corridors (the medial axis of the free space) as straight
+segments and decides each with the chosen loop model (default: ``sampled`` with the
+controller's hold and compute delay): N, V*, margin, verdict. The text output is a
+table of the worst segments and a summary; ``--format json`` prints ``map``,
+``inputs``, ``segments``, ``summary``, ``validation`` (null without ``--validate``),
+``outputs``, ``timing``. ``--out-dir DIR`` writes ``stability.png``, ``segments.csv``,
+``speed_mask.pgm`` and ``speed_mask.yaml`` (a Nav2 Speed Filter mask), all or none.
+A bad map is one line naming the file and the problem, exit status 2.
+"""
+
+from __future__ import annotations
+
+import argparse
+
+from ..parameters import MODEL_NAMES
+from .options import (
+    Default,
+    add_law_options,
+    add_parameter_options,
+    describe,
+    integer,
+    number,
+    resolve_law,
+    resolve_parameters,
+)
+
+FORMATS = ("text", "json")
+SHIPPED_MAPS = ("depot", "warehouse", "tb3_sandbox")
+"""Maps in ``pfm_stability/data/maps`` (Nav2's ``nav2_bringup``, Apache-2.0), usable by name."""
+UNKNOWN_CHOICES = ("occupied", "free")
+
+
+def _out_dir(text: str) -> str:
+    from ..maps.outputs import check_output_dir
+
+    try:
+        return check_output_dir(text)
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+
+
+_out_dir.kind = "directory"  # for the command-line fuzzer (tests/test_cli_fuzz.py)
+
+
+def add_parser(sub) -> None:
+    p = sub.add_parser(
+        "map",
+        help="stability along every corridor of a ROS occupancy map; a Nav2 speed mask",
+        description="Reads a ROS map_server map (YAML + image), computes the VFF repulsion of its histogram grid, finds "
+        "the corridors (medial axis of the free space) and says along each straight segment whether the robot oscillates "
+        "at its speed V and the fastest stable speed V* (docs/maps.md).",
+    )
+    p.add_argument("map", metavar="MAP", help=f"map_server YAML file, or a shipped map: {', '.join(SHIPPED_MAPS)}")
+    add_parameter_options(p)
+    add_law_options(p)
+    p.set_defaults(law=Default("grid"))  # a Default: a --config FILE's law beats it (`options.typed`)
+    p.add_argument("--model", choices=MODEL_NAMES, default="sampled",
+                   help="loop model of the verdicts (default sampled, with the controller's hold and compute delay)")
+    p.add_argument("--out-dir", type=_out_dir, metavar="DIR",
+                   help="write stability.png, segments.csv, speed_mask.pgm and speed_mask.yaml here (created if missing)")
+    p.add_argument("--validate", type=integer("validate"), metavar="N",
+                   help=f"simulate the robot along N segments and compare with the verdicts, {describe('validate')}")
+    p.add_argument("--unknown", choices=UNKNOWN_CHOICES, default="occupied", help="how unknown map cells count (default occupied)")
+    p.add_argument("--min-length", type=number("min_length"), metavar="M",
+                   help=f"shortest segment analysed, {describe('min_length')} (default the larger of 1 m and 1.25 W)")
+    p.add_argument("--seed", type=integer("seed"), default=0, help=f"seed of the --validate selection, {describe('seed')} (default 0)")
+    p.add_argument("--format", choices=FORMATS, default="text")
+    p.add_argument("--quiet", action="store_true", help="no progress on stderr")
+    p.set_defaults(run=run)
+
+
+def map_path(name: str):
+    """The YAML file of `name`: a shipped map's (by name) or `name` itself."""
+    if name in SHIPPED_MAPS:
+        from importlib import resources
+
+        return str(resources.files("pfm_stability").joinpath("data", "maps", f"{name}.yaml"))
+    return name
+
+
+def _validate(analysis, count: int, seed: int, progress):
+    from ..effective_force import GridWallLaw
+
+    if not isinstance(analysis.law, GridWallLaw):
+        raise ValueError("validate needs --law grid: the simulator senses the map through its histogram grid")
+    from ..validation.maps import simulator_grid, validate_map_segments
+
+    law = analysis.law
+    return validate_map_segments(simulator_grid(analysis.grid), analysis.segments, analysis.robot, analysis.controller,
+                                 cell_ratio=law.ratio, window_cells=law.window_cells, count=count, seed=seed, progress=progress)
+
+
+def _write_outputs(analysis, out_dir: str) -> dict:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from ..maps.outputs import atomic_outputs, write_speed_mask
+    from ..plots.map import plot_map_stability
+
+    with atomic_outputs(out_dir) as paths:
+        fig = plot_map_stability(analysis)
+        fig.savefig(paths["stability.png"], dpi=110)
+        plt.close(fig)
+        from ..maps.outputs import segments_csv
+
+        with open(paths["segments.csv"], "w", encoding="utf-8") as fh:
+            fh.write(segments_csv(analysis))
+        write_speed_mask(analysis, paths["speed_mask.pgm"], paths["speed_mask.yaml"])
+    import os
+
+    return {name: os.path.join(out_dir, name) for name in paths}
+
+
+def run(args) -> int:
+    import time
+
+    from ..maps.analysis import analyze_map, check_map_law
+    from ..maps.occupancy import load_map
+    from ..serialize import dumps
+    from .progress import line_progress
+    from .render import render_map_text
+
+    started = time.perf_counter()
+    params = resolve_parameters(args)
+    law, _ = resolve_law(args, params)
+    check_map_law(law)  # the law resolved: typed, or named by --config FILE
+    occupancy = load_map(map_path(args.map))
+    with line_progress("map", quiet=args.quiet) as progress:
+        analysis = analyze_map(occupancy, params.robot, params.controller, law, model=args.model, unknown=args.unknown,
+                               cell_size=args.cell_size, min_length=args.min_length, progress=progress)
+        validation = _validate(analysis, args.validate, args.seed, progress) if args.validate else None
+        outputs = _write_outputs(analysis, args.out_dir) if args.out_dir else None
+    data = {
+        **analysis.to_dict(),
+        "validation": validation.to_dict() if validation is not None else None,
+        "outputs": outputs,
+        "timing": {"seconds": time.perf_counter() - started, **{f"{k}_seconds": v for k, v in analysis.timing.items()}},
+    }
+    if args.format == "json":
+        print(dumps({"schema_version": _schema_version(), "command": "map", **data}))
+    else:
+        print(render_map_text(data), end="")
+    return 0
+
+
+def _schema_version() -> str:
+    from ..serialize import SCHEMA_VERSION
+
+    return SCHEMA_VERSION

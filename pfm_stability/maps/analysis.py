@@ -1,0 +1,408 @@
+"""Stability along every corridor of a map: per-sample N and V*, per-segment verdicts, the `MapAnalysis`.
+
+`analyze_map` runs the chain (docs/maps.md): the map onto the robot's histogram grid
+(`field.histogram_of`), the routes (`routes.find_routes`), the lateral equilibrium
+and N at samples every cell along each segment (`equilibria`), then the loop model.
+NV* of a model depends only on (τ, T, k, c) and its structure (hold, compute delay),
+so its `Boundary` is computed once per distinct heading gain c (c = 0 for the static
+VFF field) and every sample is decided from it:
+
+* N > 0: V* = NV*/N, stable when N·V lies in the stable set, margin
+  `models.base.gain_margin` (NV*/NV − 1 for the usual set (0, NV*)), label
+  `models.base.verdict_label`;
+* N < 0 (the field pushes away from the equilibrium): unstable at any speed,
+  V* = 0, margin −1 (`models.base.divergent_reason`).
+
+A segment is decided by its mean growth rate (`verdicts`): over its judged part the
+lateral deviation grows by exp(σ̄·duration), σ̄ the mean of the samples' σ(N_i·V)
+(the model's rightmost-root real part, tabulated once per analysis: `verdicts.GrowthRate`);
+stable when σ̄ < 0. Its N is N_eff, the uniform gain with the same growth
+(σ(N_eff·V) = σ̄; negative, unstable at any speed, when the mean N is), its V* the
+smallest V with σ̄(V) = 0, its margin NV*/(N_eff·V) − 1; a segment whose
+lateral deviation changes by less than one e-fold over its judged part (|σ̄|·length/V < 1)
+is "weak" (no verdict). Only the segment's judged part counts: its longest run of samples where the
+repulsion along the travel direction is at most `verdicts.END_FRACTION` of the
+attraction (near a wall ahead the robot turns instead of oscillating); a segment
+with less than one wavelength λ = 2πV/ω* of it left gets no verdict ("end effect").
+The per-sample worst is kept (`N_max`, `V_critical_local`) for the picture and
+the CSV. A segment with no equilibrium at any sample gets no verdict: "open" when no
+repulsion acts on its axis (an open area, wider than the window sees), "no
+equilibrium" otherwise (a single wall, a dead end, a junction, an aisle whose middle
+no wall reaches).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..effective_force import GridWallLaw
+from ..force_law import ForceLaw, PowerLaw
+from ..models import Loop, divergent_reason, gain_margin, models_for, verdict_label
+from ..parameters import Controller, Robot
+from ..serialize import json_number
+from .equilibria import Samples, grid_equilibria, power_equilibria
+from .field import UNKNOWN_AS, HistogramMap, histogram_of
+from .occupancy import OccupancyMap
+from .routes import Route, default_min_length, find_routes
+from .verdicts import END_FRACTION, TAPER_SLOPE, GrowthRate, drift_slope, critical_speed, is_weak, judged_run, segment_gain, wavelength
+
+__all__ = ["DIRECTIONS", "MAP_LAWS", "NO_VERDICT", "MapAnalysis", "MapSegment", "analyze_map", "sample_verdict"]
+
+MAP_LAWS = ("grid", "power")
+"""Force laws a map analysis supports: the histogram grid's window sum (default) and KB's power law."""
+DIRECTIONS = ("forward", "reverse")
+"""Travel directions of a segment: from (x0, y0) to (x1, y1), and back."""
+NO_VERDICT = ("open", "no equilibrium", "weak", "end effect", "tapering")
+"""Verdicts of a segment without a verdict: no lateral equilibrium, a field too weak to show (`verdicts.is_weak`), or
+too little of it where the corridor model holds (`verdicts.judged_run`: a wall ahead or behind), or an equilibrium
+path turned from the segment (`verdicts.drift_slope` > `verdicts.TAPER_SLOPE`: a tapering space)."""
+
+
+@dataclass(frozen=True)
+class MapSegment:
+    """One straight corridor segment and its verdict.
+
+    Attributes
+    ----------
+    x0, y0, x1, y1 : float
+        End points in map coordinates, m (travel from 0 to 1; the verdict holds both ways).
+    length : float
+        m.
+    N : float or None
+        Effective gain N_eff at the robot's V, 1/m: the uniform gain with the segment's mean growth rate
+        (`verdicts.segment_gain`; None without an equilibrium).
+    c : float
+        Heading gain (0 for the VFF field).
+    V_critical : float or None
+        V* of the segment, m/s: the smallest V whose mean growth rate σ̄(V) is 0 (0: unstable at any speed;
+        inf: stable at any speed; None: no verdict).
+    margin : float or None
+        Gain margin NV*/(N_eff·V) − 1 (−1 for N_eff < 0).
+    stable : bool or None
+        N_eff·V in the model's stable set (None: no verdict).
+    verdict : str
+        "stable", "unstable", "undecided", "weak", "end effect", "tapering", "open" or "no equilibrium".
+    offset : float or None
+        Mean lateral equilibrium offset s0, m, along the left normal of (x1 − x0, y1 − y0).
+    samples : int
+        Samples along the segment.
+    analysed : int
+        Samples with an equilibrium.
+    roots : int
+        Most roots of F_n found in one sample's band.
+    samples_offset : tuple of float
+        s0 of each sample with an equilibrium, m.
+    reason : str or None
+        Why it is unstable at any speed (N < 0), if so.
+    N_max : float or None
+        Largest N of a single sample, 1/m (the local worst; not the verdict's).
+    V_critical_local : float or None
+        NV*/N of the worst single sample, m/s (0 if a sample has N < 0): the old, local bound.
+    wavelength : float or None
+        λ = 2πV/ω* at the robot's V, m (inf: the model has no oscillation frequency).
+    stretch : int
+        Samples averaged into σ̄ (the judged part's samples with an equilibrium).
+    growth_rate : float or None
+        σ̄, the mean growth rate over the judged part at the robot's V, 1/s (`verdicts.mean_growth`).
+    direction : str or None
+        The travel direction deciding the verdict ("forward": from (x0, y0) to (x1, y1); "reverse"):
+        the one with the smaller V* (the forward force, and so N, differ between the two where a
+        wall lies ahead). None without a verdict.
+    judged_from, judged_to : float or None
+        The judged part, m from (x0, y0) along the segment (`verdicts.judged_run`: where
+        |F_r·t| <= `verdicts.END_FRACTION`); None without an equilibrium.
+    """
+
+    x0: float
+    y0: float
+    x1: float
+    y1: float
+    length: float
+    N: float | None
+    c: float
+    V_critical: float | None
+    margin: float | None
+    stable: bool | None
+    verdict: str
+    offset: float | None
+    samples: int
+    analysed: int
+    roots: int
+    samples_offset: tuple = ()
+    reason: str | None = None
+    N_max: float | None = None
+    V_critical_local: float | None = None
+    wavelength: float | None = None
+    stretch: int = 0
+    direction: str | None = None
+    judged_from: float | None = None
+    judged_to: float | None = None
+    growth_rate: float | None = None
+
+    def to_dict(self) -> dict:
+        """JSON-ready (infinities as "inf", undefined as null)."""
+        return {
+            "x0": self.x0, "y0": self.y0, "x1": self.x1, "y1": self.y1, "length": self.length,
+            "N": self.N, "c": self.c, "V_critical": json_number(self.V_critical) if self.V_critical is not None else None,
+            "margin": json_number(self.margin) if self.margin is not None else None, "stable": self.stable,
+            "verdict": self.verdict, "offset": self.offset, "samples": self.samples, "analysed": self.analysed,
+            "roots": self.roots, "reason": self.reason, "N_max": self.N_max,
+            "V_critical_local": json_number(self.V_critical_local) if self.V_critical_local is not None else None,
+            "wavelength": json_number(self.wavelength) if self.wavelength is not None else None, "stretch": self.stretch,
+            "direction": self.direction, "judged_from": self.judged_from, "judged_to": self.judged_to,
+            "growth_rate": self.growth_rate,
+        }
+
+
+@dataclass(frozen=True)
+class MapAnalysis:
+    """The whole map's answer.
+
+    Attributes
+    ----------
+    occupancy : OccupancyMap
+    grid : HistogramMap
+        The robot's histogram grid of the map.
+    law : ForceLaw
+    robot, controller : Robot, Controller
+    model : str
+        The loop model deciding the verdicts.
+    NV_critical : float
+        NV* of that model for c = 0, 1/s.
+    segments : tuple of MapSegment
+    samples : Samples
+    skeleton, clearance : ndarray, shape (nx, ny)
+        The medial axis where the robot fits, and each cell's clearance (m).
+    unknown : str
+        How unknown cells counted ("occupied" or "free").
+    timing : dict
+        Seconds per stage (read, grid, routes, equilibria, verdicts).
+    """
+
+    occupancy: OccupancyMap
+    grid: HistogramMap
+    law: ForceLaw
+    robot: Robot
+    controller: Controller
+    model: str
+    NV_critical: float
+    segments: tuple
+    samples: Samples
+    skeleton: np.ndarray
+    clearance: np.ndarray
+    unknown: str
+    timing: dict = field(default_factory=dict)
+
+    @property
+    def unstable_length(self) -> float:
+        """Total length of the unstable segments, m."""
+        return float(sum(s.length for s in self.segments if s.stable is False))
+
+    @property
+    def V_critical_min(self) -> float | None:
+        """Smallest V* of any segment, m/s (None when no segment has a verdict)."""
+        values = [s.V_critical for s in self.segments if s.V_critical is not None]
+        return min(values) if values else None
+
+    def summary(self) -> dict:
+        """``unstable_length_m``, ``V_critical_min``, segment counts by verdict, total length."""
+        counts = {v: sum(s.verdict == v for s in self.segments) for v in ("stable", "unstable", "undecided", *NO_VERDICT)}
+        return {
+            "segments": len(self.segments),
+            "route_length_m": float(sum(s.length for s in self.segments)),
+            "unstable_length_m": self.unstable_length,
+            "V_critical_min": json_number(self.V_critical_min) if self.V_critical_min is not None else None,
+            "verdicts": counts,
+        }
+
+    def to_dict(self) -> dict:
+        """``map``, ``inputs``, ``segments``, ``summary`` (the JSON of ``pfm-stability map``, without validation)."""
+        g = self.grid
+        return {
+            "map": self.occupancy.to_dict(),
+            "inputs": {
+                "V": self.robot.V, "tau": self.robot.tau, "k": self.robot.k, "W": self.robot.W,
+                "T": self.controller.T, "f": self.controller.f, "n": self.controller.n,
+                "hold": self.controller.hold, "compute_delay": self.controller.compute_delay,
+                "law": getattr(self.law, "key", "power"), "law_parameters": _law_parameters(self.law),
+                "model": self.model, "unknown": self.unknown, "cell_size": g.cell_size,
+                "grid_cells": [int(g.shape[0]), int(g.shape[1])],
+            },
+            "NV_critical": json_number(self.NV_critical),
+            "segments": [s.to_dict() for s in self.segments],
+            "summary": self.summary(),
+        }
+
+
+def _law_parameters(law) -> dict:
+    return {k: v for k, v in law.parameters().items()} if hasattr(law, "parameters") else {}
+
+
+def check_map_law(law) -> None:
+    """ValueError unless `law` is one a map analysis supports (`MAP_LAWS`): the grid's window sum or KB's power law."""
+    if not isinstance(law, (GridWallLaw, PowerLaw)):
+        name = getattr(law, "key", type(law).__name__)
+        raise ValueError(f"law must be one of {', '.join(MAP_LAWS)} for a map (a distance-based goal-aware field needs the goal, "
+                         f"which a map does not give); got {name!r}")
+
+
+def analyze_map(occupancy: OccupancyMap, robot: Robot, controller: Controller, law: ForceLaw, *, model: str = "sampled",
+                unknown: str = "occupied", cell_size: float | None = None, min_length: float | None = None,
+                progress=None, end_fraction: float = END_FRACTION, taper_slope: float = TAPER_SLOPE) -> MapAnalysis:
+    """Every corridor segment of a map, decided (module docstring).
+
+    Parameters
+    ----------
+    occupancy : OccupancyMap
+    robot, controller : Robot, Controller
+        The robot's V is the speed judged; W its width.
+    law : GridWallLaw or PowerLaw
+        The field (`fields.make_law("grid" | "power", ...)`); the grid law's cell size
+        and window are the histogram grid's.
+    model : str
+        Loop model name (`parameters.MODEL_NAMES`); ``sampled`` takes the controller's structure.
+    unknown : {"occupied", "free"}
+        How unknown map cells count.
+    cell_size : float, optional
+        Histogram cell size for the power law's routes, m (default 0.1; the grid law uses its own).
+    min_length : float, optional
+        Shortest segment, m (default `routes.default_min_length`).
+    progress : callable, optional
+        ``progress(line)`` after each stage.
+    end_fraction : float
+        Largest |F_r·t| (units of F_ct) of a judged sample, in (0, 1] (`verdicts.END_FRACTION`).
+    taper_slope : float
+        Largest |ds0/ds| of the judged part's equilibrium offset with a verdict, > 0 (`verdicts.TAPER_SLOPE`;
+        inf: no tapering rule).
+
+    Raises
+    ------
+    ValueError
+        A law other than grid or power, an unknown model, or a map with no free
+        space or no route long enough.
+    """
+    check_map_law(law)
+    if not (isinstance(end_fraction, (int, float)) and 0 < end_fraction <= 1):
+        raise ValueError(f"end_fraction must be a number in (0, 1] (of the attraction); got {end_fraction!r}")
+    if not (isinstance(taper_slope, (int, float)) and not isinstance(taper_slope, bool) and taper_slope > 0):
+        raise ValueError(f"taper_slope must be a number > 0 (|ds0/ds|; inf: no tapering rule); got {taper_slope!r}")
+    if unknown not in UNKNOWN_AS:
+        raise ValueError(f"unknown must be one of {', '.join(UNKNOWN_AS)}; got {unknown!r}")
+    say = progress or (lambda line: None)
+    timing, clock = {}, time.perf_counter()
+
+    def stage(name):
+        nonlocal clock
+        now = time.perf_counter()
+        timing[name] = now - clock
+        clock = now
+        say(f"{name} done ({timing[name]:.2f} s)")
+
+    (loop_model,) = models_for(controller, [model])
+    is_grid = isinstance(law, GridWallLaw)
+    grid = histogram_of(occupancy, law.cell_size if is_grid else (cell_size or 0.1), unknown)
+    if not (~grid.occupied).any():
+        raise ValueError(f"map {occupancy.name!r} has no free space (every cell is occupied{'' if unknown == 'free' else ' or unknown'})")
+    stage("grid")
+    routes, skeleton, clearance = find_routes(grid, robot.W, min_length)
+    if not routes:
+        raise ValueError(f"map {occupancy.name!r} has no route long enough: no straight corridor of at least "
+                         f"{min_length if min_length is not None else default_min_length(robot.W):g} m where a robot of width W = {robot.W:g} m fits")
+    stage("routes")
+    if is_grid:
+        samples = grid_equilibria(grid, law, routes, clearance, robot.W)
+    else:
+        blocked = occupancy.occupied | (occupancy.unknown if unknown == "occupied" else False)
+        samples = power_equilibria(grid, law, routes, clearance, robot.W, blocked, occupancy.resolution, occupancy.origin)
+    stage("equilibria")
+    c = 0.0  # the static VFF field and KB's law have no goal part
+    loop = Loop(robot.tau, controller.T, robot.k, c=c)
+    boundary = loop_model.boundary(loop)
+    growth = GrowthRate(lambda NV: loop_model.rightmost_root(NV, loop), boundary.NV_critical)
+    segments = tuple(_segment(r, samples, k, boundary, robot, c, growth, end_fraction, taper_slope) for k, r in enumerate(routes))
+    stage("verdicts")
+    return MapAnalysis(occupancy, grid, law, robot, controller, loop_model.name, boundary.NV_critical, segments, samples,
+                       skeleton, clearance, unknown, timing)
+
+
+def _stable(NV: float, boundary) -> bool:
+    if boundary.stable_set:
+        return boundary.contains(NV)
+    return 0 < NV < boundary.NV_critical
+
+
+def sample_verdict(N: float, V: float, boundary) -> tuple:
+    """(V*, margin, stable, label, reason) of one sample with gain N (1/m) at speed V."""
+    if N < 0:
+        return 0.0, -1.0, False, "unstable", divergent_reason(N * V)
+    if N == 0:
+        return math.inf, math.inf, True, "stable", None
+    NV = N * V
+    stable = _stable(NV, boundary)
+    V_critical = boundary.NV_critical / N
+    return V_critical, gain_margin(NV, boundary, stable), stable, verdict_label(NV, boundary, stable), None
+
+
+def _direction(N: np.ndarray, length: float, boundary, V: float, growth: GrowthRate) -> dict | None:
+    """The verdict of one travel direction from the N (1/m) of its judged samples, `length` m: None without an
+    equilibrium (`verdicts`: the sign of the mean growth rate σ̄)."""
+    gain = segment_gain(N, V, boundary.omega_critical, growth, boundary.NV_critical)
+    if gain.N_eff is None:
+        return None
+    out = dict(N=gain.N_eff, wavelength=gain.wavelength, stretch=gain.stretch, growth_rate=gain.sigma)
+    if is_weak(gain.sigma, length, V):
+        return dict(out, V_critical=None, margin=None, stable=None, verdict="weak", reason=None)
+    if gain.N_eff < 0:  # the mean N is negative and σ̄ > 0: unstable at any speed
+        V_star, margin, stable, label, reason = sample_verdict(gain.N_eff, V, boundary)
+        return dict(out, V_critical=V_star, margin=margin, stable=stable, verdict=label, reason=reason)
+    stable = bool(gain.sigma < 0)
+    NV = gain.N_eff * V
+    if NV == 0:
+        return dict(out, V_critical=math.inf, margin=math.inf, stable=True, verdict="stable", reason=None)
+    V_star = critical_speed(N, growth, boundary.NV_critical)
+    return dict(out, V_critical=float(V_star), margin=float(gain_margin(NV, boundary, stable)), stable=stable,
+                verdict=verdict_label(NV, boundary, stable), reason=None)
+
+
+def _segment(route: Route, samples: Samples, k: int, boundary, robot: Robot, c: float, growth: GrowthRate,
+             end_fraction: float = END_FRACTION, taper_slope: float = TAPER_SLOPE) -> MapSegment:
+    """The verdict of one segment: the worse of its two travel directions, each from its mean growth rate over the
+    judged part (`verdicts`)."""
+    V = robot.V
+    mine = np.flatnonzero(samples.segment == k)
+    ok = mine[np.isfinite(samples.N[mine])]
+    base = dict(x0=route.x0, y0=route.y0, x1=route.x1, y1=route.y1, length=route.length, c=c, samples=int(mine.size),
+                analysed=int(ok.size), roots=int(samples.roots[mine].max()) if mine.size else 0)
+    spacing = route.length / max(mine.size, 1)
+    if ok.size == 0:
+        verdict = "no equilibrium" if samples.field[mine].any() else "open"
+        return MapSegment(N=None, V_critical=None, margin=None, stable=None, verdict=verdict, offset=None, **base)
+    first, stop = judged_run(samples.along[mine], end_fraction) if samples.along is not None else (0, mine.size)
+    judged = (stop - first) * spacing
+    local = [sample_verdict(float(n), V, boundary) for n in samples.N[ok]]
+    detail = dict(offset=float(np.mean(samples.offset[ok])), samples_offset=tuple(float(v) for v in samples.offset[ok]),
+                  N_max=float(np.max(samples.N[ok])), V_critical_local=float(min(a[0] for a in local)),
+                  judged_from=float(first * spacing), judged_to=float(stop * spacing), **base)
+    lam = wavelength(V, boundary.omega_critical)
+    if stop - first < mine.size and judged < (lam if math.isfinite(lam) else route.length / 2):
+        return MapSegment(N=None, V_critical=None, margin=None, stable=None, verdict="end effect", wavelength=lam,
+                          reason=f"the corridor model holds over {judged:.2f} m only (|F_r.t| > {end_fraction:g} F_ct elsewhere), "
+                          f"less than one wavelength {lam:.2f} m", **detail)
+    part = mine[first:stop]
+    slope = drift_slope((np.arange(first, stop) + 0.5) * spacing, samples.offset[part])
+    if slope > taper_slope:
+        return MapSegment(N=None, V_critical=None, margin=None, stable=None, verdict="tapering", wavelength=lam,
+                          reason=f"the equilibrium path turns from the segment: |ds0/ds| = {slope:.2f} over the judged part "
+                          f"(> {taper_slope:g}, {math.degrees(math.atan(taper_slope)):.0f} deg)", **detail)
+    ways = {name: _direction(N, judged, boundary, V, growth) for name, N in zip(DIRECTIONS, samples.directional(part))}
+    ways = {name: w for name, w in ways.items() if w is not None}
+    if not ways:
+        verdict = "no equilibrium" if samples.field[mine].any() else "open"
+        return MapSegment(N=None, V_critical=None, margin=None, stable=None, verdict=verdict, offset=None, **base)
+    decided = [name for name in ways if ways[name]["margin"] is not None]
+    name = min(decided, key=lambda d: (ways[d]["V_critical"], ways[d]["margin"])) if decided else DIRECTIONS[0] if DIRECTIONS[0] in ways else DIRECTIONS[1]
+    return MapSegment(direction=name if decided else None, **ways[name], **detail)

@@ -1,0 +1,182 @@
+"""The files of ``pfm-stability map --out-dir``: segments.csv and a Nav2 Speed Filter mask, written atomically.
+
+The speed mask (docs/maps.md, "The speed mask") has the input map's size, resolution
+and origin. Each cell holds a speed limit as a percentage of the robot's V, for the
+Nav2 speed filter with ``type: 1`` (percentage), ``base: 0``, ``multiplier: 1``:
+
+* cells within W/2 of a segment whose V* is below V: 100·V*/V rounded down (never
+  above what is stable), at least 1 (the filter reads 0 as "no limit");
+* every other cell — free, occupied or unknown — 100: the robot may drive at V.
+  Occupied cells are never driven through, and 100 % is the filter's "no
+  reduction"; no cell is written as unknown (−1), which the filter ignores
+  without resetting a previous limit.
+
+The PGM is read in ``mode: scale`` with ``negate: 0``, ``free_thresh: 0``,
+``occupied_thresh: 1``: Nav2 turns a pixel value v into
+rint(100·(255 − v)/255). Writing v = 255 − round(2.55·q) for a percentage q gives
+back q exactly (the rounding error 0.5/2.55 ≈ 0.2 % stays below the 0.5 of rint):
+`percent_to_pixel` and `pixel_to_percent`.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import math
+import os
+import shutil
+import tempfile
+
+import numpy as np
+
+__all__ = [
+    "OUTPUT_FILES",
+    "atomic_outputs",
+    "check_output_dir",
+    "percent_to_pixel",
+    "pixel_to_percent",
+    "segments_csv",
+    "speed_limits",
+    "speed_mask_yaml",
+    "write_speed_mask",
+]
+
+OUTPUT_FILES = ("stability.png", "segments.csv", "speed_mask.pgm", "speed_mask.yaml")
+"""What ``--out-dir`` receives."""
+CSV_COLUMNS = ("x0", "y0", "x1", "y1", "length", "N", "c", "V_critical", "margin", "stable", "verdict", "offset", "samples", "analysed",
+               "N_max", "V_critical_local", "wavelength")
+MIN_PERCENT = 1
+"""Lowest limit written (the speed filter reads a mask value of 0 as "no limit")."""
+
+
+def _csv_value(v) -> str:
+    if v is None:
+        return ""
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, float):
+        return "inf" if v == math.inf else f"{v:.6g}"
+    return str(v)
+
+
+def segments_csv(analysis) -> str:
+    """One row per segment: end points (m, map coordinates), length, N (N_eff), c, V*, margin, stable, verdict, offset,
+    samples, and the local worst (N_max, V_critical_local) with the averaging wavelength (m)."""
+    lines = [",".join(CSV_COLUMNS)]
+    for s in analysis.segments:
+        lines.append(",".join(_csv_value(getattr(s, k)) for k in CSV_COLUMNS))
+    return "\n".join(lines) + "\n"
+
+
+def percent_to_pixel(percent) -> np.ndarray:
+    """PGM value (uint8) of a percentage 0 … 100 in the mask's scale mode (module docstring)."""
+    q = np.asarray(percent, dtype=float)
+    return (255 - np.round(2.55 * q)).astype(np.uint8)
+
+
+def pixel_to_percent(value) -> np.ndarray:
+    """Nav2's reading of a PGM value in the mask's scale mode: rint(100·(255 − v)/255)."""
+    return np.rint(100.0 * (255.0 - np.asarray(value, dtype=float)) / 255.0).astype(np.int64)
+
+
+def speed_limits(analysis) -> np.ndarray:
+    """Speed limit per map cell, % of V (int, shape (height, width), row 0 at y = origin)."""
+    occupancy = analysis.occupancy
+    V, half = analysis.robot.V, analysis.robot.W / 2
+    limits = np.full(occupancy.values.shape, 100, dtype=np.int64)
+    r = occupancy.resolution
+    ox, oy = occupancy.origin[0], occupancy.origin[1]
+    for s in analysis.segments:
+        if s.V_critical is None or not s.V_critical < V:
+            continue
+        percent = max(MIN_PERCENT, min(100, math.floor(100.0 * s.V_critical / V)))
+        i0, j0 = occupancy.cell_of(min(s.x0, s.x1) - half, min(s.y0, s.y1) - half)
+        i1, j1 = occupancy.cell_of(max(s.x0, s.x1) + half, max(s.y0, s.y1) + half)
+        i0, j0 = max(int(i0), 0), max(int(j0), 0)
+        i1, j1 = min(int(i1), occupancy.width - 1), min(int(j1), occupancy.height - 1)
+        if i1 < i0 or j1 < j0:
+            continue
+        jj, ii = np.mgrid[j0:j1 + 1, i0:i1 + 1]
+        px, py = ox + (ii + 0.5) * r, oy + (jj + 0.5) * r
+        near = _distance_to_segment(px, py, s) <= half
+        block = limits[j0:j1 + 1, i0:i1 + 1]
+        block[near] = np.minimum(block[near], percent)
+    return limits
+
+
+def _distance_to_segment(px, py, s):
+    dx, dy = s.x1 - s.x0, s.y1 - s.y0
+    t = np.clip(((px - s.x0) * dx + (py - s.y0) * dy) / (dx * dx + dy * dy), 0.0, 1.0)
+    return np.hypot(px - s.x0 - t * dx, py - s.y0 - t * dy)
+
+
+def speed_mask_yaml(occupancy, image: str = "speed_mask.pgm") -> str:
+    """The mask's map_server YAML: the map's resolution and origin, scale mode, thresholds that make the mapping exact."""
+    origin = ", ".join(f"{v:.12g}" for v in occupancy.origin)
+    return (f"image: {image}\nmode: scale\nresolution: {occupancy.resolution:.12g}\norigin: [{origin}]\nnegate: 0\n"
+            "occupied_thresh: 1.0\nfree_thresh: 0.0\n")
+
+
+def write_speed_mask(analysis, pgm_path, yaml_path, image_name: str = "speed_mask.pgm") -> None:
+    """Write the mask image (binary PGM, row 0 at the top) and its YAML."""
+    from PIL import Image
+
+    pixels = percent_to_pixel(speed_limits(analysis))[::-1]
+    Image.fromarray(np.ascontiguousarray(pixels), mode="L").save(pgm_path, format="PPM")
+    with open(yaml_path, "w", encoding="utf-8") as fh:
+        fh.write(speed_mask_yaml(analysis.occupancy, image_name))
+
+
+def check_output_dir(path) -> str:
+    """`path` after checking the outputs can be written there, before any work (nothing is created).
+
+    An existing directory must be writable; a missing one must have a writable parent
+    (it is created when the outputs are written).
+
+    Raises
+    ------
+    ValueError
+        ``"out-dir must be a writable directory; got 'x' (an existing file)"``.
+    """
+    text = os.fspath(path) if isinstance(path, (str, os.PathLike)) else None
+
+    def fail(why):
+        raise ValueError(f"out-dir must be a writable directory; got {path!r} ({why})")
+
+    if text is None or not text.strip():
+        fail("empty")
+    if os.path.exists(text):
+        if not os.path.isdir(text):
+            fail("an existing file")
+        if not os.access(text, os.W_OK | os.X_OK):
+            fail("not writable")
+        return text
+    parent = os.path.dirname(os.path.abspath(text))
+    if not os.path.isdir(parent):
+        fail(f"its parent {parent} does not exist")
+    if not os.access(parent, os.W_OK | os.X_OK):
+        fail(f"its parent {parent} is not writable")
+    return text
+
+
+@contextlib.contextmanager
+def atomic_outputs(out_dir, names=OUTPUT_FILES):
+    """Temporary paths for `names` in `out_dir`, renamed to their names only if the block succeeds.
+
+    Yields a dict name → temporary path (in the same directory, so the rename is
+    atomic per file). On an exception every temporary file is removed, and a
+    directory created here is removed again: a failure leaves nothing behind.
+    """
+    created = not os.path.exists(out_dir)
+    if created:
+        os.makedirs(out_dir)
+    staging = tempfile.mkdtemp(prefix=".map-outputs-", dir=out_dir)
+    paths = {name: os.path.join(staging, name) for name in names}
+    try:
+        yield paths
+        for name, tmp in paths.items():
+            if os.path.exists(tmp):
+                os.replace(tmp, os.path.join(out_dir, name))
+    finally:
+        shutil.rmtree(staging, ignore_errors=True)
+        if created and not os.listdir(out_dir):
+            os.rmdir(out_dir)

@@ -1,0 +1,180 @@
+"""``pfm-stability map`` (docs/maps.md): outputs on the shipped maps, the JSON schema, and bad maps.
+
+The shipped maps are analysed with robots that fit them (the TurtleBot3 sandbox with
+a 0.2 m robot); the outputs are checked by reading them back the way their users do:
+the PNG and the PGM with Pillow, the mask's YAML with PyYAML and its values with
+Nav2's scale-mode formula (`pfm_stability.maps.outputs.pixel_to_percent`). A bad map
+must give exit status 2, one line naming the problem, and nothing in the output
+directory.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import csv
+import io
+import json
+import math
+import shutil
+from importlib import resources
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+from jsonschema import Draft202012Validator
+from PIL import Image
+
+from pfm_stability.cli import main
+from pfm_stability.maps.outputs import pixel_to_percent
+from pfm_stability.schema import load_schema
+
+MAPS = Path(str(resources.files("pfm_stability").joinpath("data", "maps")))
+VALIDATOR = Draft202012Validator(load_schema())
+
+
+def run(argv):
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        code = main(argv)
+    return code, out.getvalue(), err.getvalue()
+
+
+ROBOTS = {"depot": ["--W", "0.4", "--tau", "0.2", "--k", "10", "--T", "0.05", "--f", "2", "--V", "0.3"], "tb3_sandbox": ["--W", "0.2", "--tau", "0.1", "--k", "20", "--T", "0.025", "--f", "2", "--V", "0.4", "--min-length", "0.5"]}
+
+
+@pytest.mark.parametrize("name", list(ROBOTS))
+def test_shipped_map_outputs(tmp_path, name):
+    """Every output is written and readable: the PNG; the CSV (one row per segment, as in the JSON); the mask PGM with
+    the map's size, its YAML with the map's resolution and origin; and the mask's values decode to 100 % off the
+    unstable segments and to floor(100 V*/V) (>= 1) within W/2 of each unstable segment."""
+    out = tmp_path / "out"
+    code, stdout, err = run(["map", name, *ROBOTS[name], "--out-dir", str(out), "--format", "json", "--quiet"])
+    assert code == 0, err
+    data = json.loads(stdout)
+    assert sorted(p.name for p in out.iterdir()) == ["segments.csv", "speed_mask.pgm", "speed_mask.yaml", "stability.png"]
+    with Image.open(out / "stability.png") as im:
+        assert im.format == "PNG" and im.width > 500
+    rows = list(csv.DictReader((out / "segments.csv").open()))
+    assert len(rows) == len(data["segments"]) and [float(r["length"]) for r in rows] == pytest.approx([s["length"] for s in data["segments"]], rel=1e-5)
+    source = yaml.safe_load((MAPS / f"{name}.yaml").read_text())
+    mask_yaml = yaml.safe_load((out / "speed_mask.yaml").read_text())
+    assert mask_yaml["resolution"] == pytest.approx(source["resolution"]) and mask_yaml["origin"] == pytest.approx(source["origin"])
+    assert mask_yaml["mode"] == "scale" and (mask_yaml["free_thresh"], mask_yaml["occupied_thresh"], mask_yaml["negate"]) == (0.0, 1.0, 0)
+    with Image.open(out / "speed_mask.pgm") as im:
+        assert im.format == "PPM" and im.mode == "L" and im.size == (data["map"]["width"], data["map"]["height"])
+        percent = pixel_to_percent(np.array(im))[::-1]  # row 0 at y = origin
+    V, W = data["inputs"]["V"], data["inputs"]["W"]
+    r, (ox, oy) = data["map"]["resolution"], data["map"]["origin"][:2]
+    limited = [s for s in data["segments"] if s["V_critical"] is not None and not isinstance(s["V_critical"], str) and s["V_critical"] < V]
+    expected = np.full(percent.shape, 100)
+    jj, ii = np.mgrid[0:percent.shape[0], 0:percent.shape[1]]
+    px, py = ox + (ii + 0.5) * r, oy + (jj + 0.5) * r
+    for s in limited:
+        dx, dy = s["x1"] - s["x0"], s["y1"] - s["y0"]
+        t = np.clip(((px - s["x0"]) * dx + (py - s["y0"]) * dy) / (dx * dx + dy * dy), 0, 1)
+        near = np.hypot(px - s["x0"] - t * dx, py - s["y0"] - t * dy) <= W / 2
+        expected[near] = np.minimum(expected[near], max(1, math.floor(100 * s["V_critical"] / V)))
+    assert np.array_equal(percent, expected)
+    assert limited and (percent < 100).any()
+    assert VALIDATOR.is_valid(data), [e.message for e in VALIDATOR.iter_errors(data)][:3]
+
+
+def test_text_output_lists_the_worst_segments():
+    """The text output names the map, the robot, the worst segments (lowest margin first) and the summary."""
+    code, stdout, err = run(["map", "depot", *ROBOTS["depot"], "--quiet"])
+    assert code == 0, err
+    assert stdout.startswith("map depot: 604 x 307 cells of 0.05 m") and "worst" in stdout and "unstable:" in stdout
+    margins = [float(line.split()[-2].rstrip("%")) for line in stdout.splitlines() if line.strip().startswith("(") and "%" in line]
+    assert margins == sorted(margins) and len(margins) >= 3
+
+
+def test_json_is_deterministic():
+    """Two runs print the same JSON once the wall-clock timing is dropped (seeded thinning and selection)."""
+    outs = []
+    for _ in range(2):
+        code, stdout, _ = run(["map", "tb3_sandbox", *ROBOTS["tb3_sandbox"], "--format", "json", "--quiet"])
+        assert code == 0
+        data = json.loads(stdout)
+        data.pop("timing")
+        outs.append(json.dumps(data))
+    assert outs[0] == outs[1]
+
+
+def _copy_map(tmp_path: Path, name="depot") -> Path:
+    for suffix in ("yaml", "pgm"):
+        shutil.copy(MAPS / f"{name}.{suffix}", tmp_path / f"{name}.{suffix}")
+    return tmp_path / f"{name}.yaml"
+
+
+def _edit(path: Path, **changes) -> None:
+    data = yaml.safe_load(path.read_text())
+    for key, value in changes.items():
+        if value is None:
+            data.pop(key)
+        else:
+            data[key] = value
+    path.write_text(yaml.safe_dump(data))
+
+
+BAD_MAPS = {
+    "missing image": (lambda p: _edit(p, image="nothing.pgm"), "does not exist"),
+    "image not an image": (lambda p: (p.parent / "depot.pgm").write_text("P5 not really"), "not a readable image"),
+    "unreadable YAML": (lambda p: p.write_text("image: [unclosed\n"), "is not YAML"),
+    "missing key": (lambda p: _edit(p, resolution=None), "key 'resolution' is missing"),
+    "resolution <= 0": (lambda p: _edit(p, resolution=0), "resolution must be"),
+    "threshold above 1": (lambda p: _edit(p, occupied_thresh=1.5), "occupied_thresh must be"),
+    "free >= occupied": (lambda p: _edit(p, free_thresh=0.7), "free_thresh must be below occupied_thresh"),
+    "unknown mode": (lambda p: _edit(p, mode="fancy"), "mode must be one of"),
+    "no free space": (lambda p: Image.new("L", (40, 30), 0).save(p.parent / "depot.pgm", format="PPM"), "no free space"),
+    "no route long enough": (lambda p: Image.new("L", (30, 30), 254).save(p.parent / "depot.pgm", format="PPM"), "no route long enough"),
+    "image of the wrong format": (lambda p: Image.new("CMYK", (40, 30)).save(p.parent / "depot.pgm", format="TIFF"), "pixel mode CMYK"),
+}
+
+
+@pytest.mark.parametrize("case", list(BAD_MAPS))
+def test_bad_map_exits_2_and_writes_nothing(tmp_path, case):
+    """Each bad map: exit 2, one line "pfm-stability: error: map '...': <problem>" (or the analysis' message), no traceback,
+    and the output directory (created on success only) does not exist afterwards."""
+    spoil, message = BAD_MAPS[case]
+    path = _copy_map(tmp_path)
+    spoil(path)
+    out = tmp_path / "out"
+    code, stdout, err = run(["map", str(path), "--out-dir", str(out), "--quiet"])
+    assert code == 2 and stdout == ""
+    assert err.startswith("pfm-stability: error: ") and message in err and len(err.strip().splitlines()) == 1
+    assert not out.exists()
+
+
+def test_existing_output_directory_is_untouched_on_failure(tmp_path):
+    """An existing --out-dir keeps exactly what it had when the analysis fails (no temporary files left)."""
+    path = _copy_map(tmp_path)
+    _edit(path, resolution=-1)
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "keep.txt").write_text("x")
+    assert run(["map", str(path), "--out-dir", str(out), "--quiet"])[0] == 2
+    assert [p.name for p in out.iterdir()] == ["keep.txt"]
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["map", "depot", "--law", "khatib", "--goal-distance", "3"], "law must be one of grid, power"),
+    (["map", "depot", "--out-dir", "/nonexistent-dir/x"], "out-dir must be a writable directory"),
+    (["map", "depot", "--validate", "0"], "validate must be an integer"),
+    (["map", "depot", "--min-length", "-1"], "min_length must be a finite number in (0, 10000] m"),
+])
+def test_bad_options(argv, message):
+    """Options are checked before any work: exit 2 with the option named."""
+    code, _, err = run([*argv, "--quiet"])
+    assert code == 2 and message in err
+
+
+@pytest.mark.parametrize("law", ["khatib", "gnron"])
+def test_law_named_by_a_config_file_is_checked_too(tmp_path, law):
+    """A law `map` does not support is refused when a --config file names it (not only when typed): the resolved
+    law is checked, before the map is read (the map here does not exist, so a later check would name the map)."""
+    config = tmp_path / "robot.yaml"
+    config.write_text(f"law: {{name: {law}, goal_distance: 3.0}}\n")
+    code, stdout, err = run(["map", str(tmp_path / "missing.yaml"), "--config", str(config), "--quiet"])
+    assert code == 2 and stdout == ""
+    assert err.startswith("pfm-stability: error: law must be one of grid, power") and law in err
