@@ -55,6 +55,7 @@ __all__ = [
     "to_degrees",
     "to_radians",
     "TAU_RESOLUTION",
+    "T_RESOLUTION",
     "check_corridor_fits",
 ]
 
@@ -62,6 +63,12 @@ TAU_RESOLUTION = 1e-9
 """τ with τ·k below this is taken as 0, an ideal steering motor, by the models and the simulator
 alike: the lag is 10⁹ times faster than the steering loop, below the resolution of either, and its
 pole at −1/τ would leave floating point."""
+
+T_RESOLUTION = 1e-12
+"""A loop delay / sampling period T (s) below this is taken as 0, a continuous controller, by the
+loop models: no digital controller samples faster than a picosecond, and below ~1e-100 s the
+models' crossing frequencies (√(k/T), π/T) leave floating point. Without it a period such as
+1e-300 s gave overflow warnings instead of the continuous loop's answer."""
 
 MODEL_NAMES = ("continuous", "kb_first_order", "pade", "exact_delay", "sampled")
 """The loop models, in order of fidelity (docs/models.md)."""

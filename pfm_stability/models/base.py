@@ -29,7 +29,7 @@ from functools import lru_cache
 import numpy as np
 
 from ..checks import check_number
-from ..parameters import RANGES, TAU_RESOLUTION, check_parameter
+from ..parameters import RANGES, T_RESOLUTION, TAU_RESOLUTION, check_parameter
 from ..crossings import first_stable_interval, verdict_at
 from ..serialize import json_number
 
@@ -98,7 +98,8 @@ class Loop:
         Steering time constant τ, s, >= 0 (KB eq 6); τ with τk < 10⁻⁹ is
         stored as 0 (`TAU_RESOLUTION`).
     T : float
-        Sampling period / loop delay, s, >= 0 (KB eq 18).
+        Sampling period / loop delay, s, >= 0 (KB eq 18); T < 10⁻¹² s is
+        stored as 0, a continuous controller (`T_RESOLUTION`).
     k : float
         Steering gain, 1/s, > 0 (KB eq 5).
     c : float, keyword only
@@ -119,6 +120,8 @@ class Loop:
             object.__setattr__(self, name, check_parameter(name, getattr(self, name)))
         if self.tau * self.k < TAU_RESOLUTION:  # a lag 10⁹ times faster than the steering loop: an ideal motor
             object.__setattr__(self, "tau", 0.0)
+        if self.T < T_RESOLUTION:  # faster than a picosecond: a continuous controller
+            object.__setattr__(self, "T", 0.0)
         if self.c.__class__ is not float or self.c != 0.0:
             object.__setattr__(self, "c", check_heading_gain(self.c))
 

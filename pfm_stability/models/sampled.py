@@ -296,7 +296,8 @@ class Sampled(AffineGainModel):
         if loop.T == 0:
             return Continuous()._stable(NV, loop)
         lam = self._delta_eigenvalues(NV, loop)
-        return bool(np.all(2.0 * lam.real + loop.T * np.abs(lam) ** 2 < 0.0))
+        size = np.abs(lam)
+        return bool(np.all(2.0 * lam.real + (loop.T * size) * size < 0.0))  # T|λ|·|λ|: no overflow of |λ|² at tiny T
 
     @checked
     def jury_stable(self, NV: float, loop: Loop) -> bool:

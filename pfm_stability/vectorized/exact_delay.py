@@ -38,7 +38,7 @@ import numpy as np
 from ..delay import delay_verdicts_from_gain
 from ..force_law import power_law_corridor_gain, power_law_wall_gain
 from ..models.base import HEADING_GAIN_RANGE, check_heading_gain
-from ..parameters import RANGES, TAU_RESOLUTION, check_parameter
+from ..parameters import RANGES, T_RESOLUTION, TAU_RESOLUTION, check_parameter
 
 __all__ = ["VectorVerdicts", "exact_delay_verdicts", "heading_gain_array", "loop_gain_arrays", "delay_verdicts_from_gain"]
 
@@ -126,6 +126,7 @@ def loop_gain_arrays(V, tau, T, k, f, n, W, *, alpha=None, L=None):
         N = power_law_corridor_gain(f, n, W, L)
     tau, T, k, NV = np.broadcast_arrays(tau, T, k, N * V)
     tau = np.where(tau * k < TAU_RESOLUTION, 0.0, tau)  # an ideal motor, as `models.Loop` takes it
+    T = np.where(T < T_RESOLUTION, 0.0, T)  # a continuous controller, as `models.Loop` takes it
     return tau, T, k, NV
 
 

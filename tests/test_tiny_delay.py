@@ -1,0 +1,80 @@
+"""A loop delay below `parameters.T_RESOLUTION` (1e-12 s) is a continuous controller, everywhere.
+
+Regression: `plot rlocus --T 9.2e-252`, `plot gain-vs-k --T 2.2e-309` and
+`report --T 1e-300` raised overflow warnings in the sampled model
+(|λ|² of the δ-form poles) and in the exact-delay critical gain (the level
+band π/T, the level frequency √(k/T)) instead of answering. The answer must
+be the T = 0 answer exactly (same floats: the models see T = 0), from the
+scalar models, the vectorized verdicts and the command line, with every
+warning an error.
+"""
+
+from __future__ import annotations
+
+import json
+import warnings
+
+import numpy as np
+import pytest
+
+from pfm_stability.cli import main
+from pfm_stability.models import Loop, make_model
+from pfm_stability.parameters import MODEL_NAMES, T_RESOLUTION
+from pfm_stability.vectorized import loop_verdicts
+
+TINY = [5e-324, 2.2250738585072014e-309, 9.226837874867525e-252, 1e-100, 1e-13]
+
+
+@pytest.mark.parametrize("T", TINY)
+def test_loop_stores_a_tiny_delay_as_zero(T):
+    """Loop(τ, T, k) with T < 1e-12 s has T = 0; at the resolution itself T is kept."""
+    assert Loop(0.3, T, 2.0).T == 0.0
+    assert Loop(0.3, T_RESOLUTION, 2.0).T == T_RESOLUTION
+
+
+@pytest.mark.parametrize("T", TINY)
+@pytest.mark.parametrize("name", MODEL_NAMES)
+def test_every_model_answers_a_tiny_delay_as_the_continuous_loop(name, T):
+    """NV* and the verdict at NV = 2 equal those at T = 0 (same floats), with warnings as errors."""
+    model = make_model(name, hold="command", compute_delay=1)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        tiny, zero = model.boundary(Loop(0.3, T, 2.0)), model.boundary(Loop(0.3, 0.0, 2.0))
+        assert tiny.NV_critical == zero.NV_critical
+        assert model.is_stable(2.0, Loop(0.3, T, 2.0)) == model.is_stable(2.0, Loop(0.3, 0.0, 2.0))
+
+
+@pytest.mark.parametrize("name", MODEL_NAMES)
+def test_vectorized_verdicts_take_a_tiny_delay_as_zero(name):
+    """`loop_verdicts` at tiny T equals `loop_verdicts` at T = 0 (all columns), with warnings as errors."""
+    NV = np.array([0.5, 2.0, 3.0, 5.0])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        tiny = loop_verdicts(name, 0.3, np.array(TINY[:4]), 2.0, NV)
+        zero = loop_verdicts(name, 0.3, 0.0, 2.0, NV)
+    assert np.array_equal(tiny.stable, zero.stable) and np.array_equal(tiny.verdict, zero.verdict)
+    assert np.array_equal(tiny.NV_critical, zero.NV_critical) and np.array_equal(tiny.margin, zero.margin)
+
+
+@pytest.mark.parametrize("argv", [["plot", "rlocus"], ["plot", "gain-vs-k"]])
+def test_plots_at_a_tiny_delay(tmp_path, capsys, argv):
+    """The two command lines hypothesis found: exit 0 and a PNG, no warning."""
+    out = tmp_path / "p.png"
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        code = main([*argv, "--out", str(out), "--T", "9.226837874867525e-252"])
+    assert code == 0, capsys.readouterr().err
+    assert out.stat().st_size > 0
+
+
+def test_report_at_a_tiny_delay_is_the_continuous_report(capsys):
+    """`report --T 1e-300` gives every model's verdict and NV* of `report --T 0`."""
+    answers = []
+    for T in ("1e-300", "0"):
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            assert main(["report", "--alpha", "20", "--L", "0.9", "--T", T, "--format", "json"]) == 0
+        answers.append(json.loads(capsys.readouterr().out))
+    for env in ("wall", "corridor"):
+        tiny, zero = (json.dumps(a[env], sort_keys=True) for a in answers)
+        assert tiny == zero
