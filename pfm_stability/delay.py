@@ -475,19 +475,7 @@ def kb_critical_gain(tau, T, k):
     K_star[still] = k[still] / tau[still]
     omega_star[still] = np.sqrt(k[still] / tau[still])
     delayed = T > 0
-    if delayed.any():
-        return _kb_delayed_critical_gain(tau, T, k, delayed, K_star, omega_star, shape)
-    return K_star.reshape(shape), omega_star.reshape(shape)
-
-
-def _kb_delayed_critical_gain(tau, T, k, delayed, K_star, omega_star, shape):
-    """`kb_critical_gain` for the points with T > 0 (filled into K_star, omega_star).
-
-    Overflow is expected and harmless for T far below the loop's time scale
-    (e.g. a subnormal T: the band π/T and the level frequency √(k/T) exceed
-    the floats): the level frequency and K* then come out ``inf``, the
-    answer of the undelayed loop with τ = 0 ("stable for every gain").
-    """
+    # overflow (π/T, √(k/T) beyond the floats at a tiny T) gives K* = inf, the undelayed answer
     with np.errstate(over="ignore"):
         t, d, g = tau[delayed], T[delayed], k[delayed]
         kt = g * t
