@@ -29,6 +29,7 @@ from .options import (
     number,
     resolve_law,
     resolve_parameters,
+    shipped_or_given,
 )
 
 FORMATS = ("text", "json")
@@ -76,13 +77,9 @@ def add_parser(sub) -> None:
     p.set_defaults(run=run)
 
 
-def map_path(name: str):
+def map_path(name: str) -> str:
     """The YAML file of `name`: a shipped map's (by name) or `name` itself."""
-    if name in SHIPPED_MAPS:
-        from importlib import resources
-
-        return str(resources.files("pfm_stability").joinpath("data", "maps", f"{name}.yaml"))
-    return name
+    return shipped_or_given(name, "maps", SHIPPED_MAPS)
 
 
 def _validate(analysis, count: int, seed: int, progress):

@@ -33,6 +33,7 @@ __all__ = [
     "LAW_OPTIONS",
     "add_law_options",
     "resolve_law",
+    "shipped_or_given",
 ]
 
 def _shown(key: str) -> str:
@@ -143,6 +144,18 @@ def input_file(name: str):
     parse.__name__ = name
     parse.kind = "path"  # generated like the output paths by the command-line fuzzer: none of them is a config file
     return parse
+
+
+def shipped_or_given(name: str, folder: str, shipped) -> str:
+    """The YAML file of `name`: ``pfm_stability/data/<folder>/<name>.yaml`` when `name` is in `shipped`, else `name` itself.
+
+    Used by ``map`` (shipped maps) and ``traps`` (shipped scenes).
+    """
+    if name in shipped:
+        from importlib import resources
+
+        return str(resources.files("pfm_stability").joinpath("data", folder, f"{name}.yaml"))
+    return name
 
 
 PADE_ORDER = integer("pade_order")

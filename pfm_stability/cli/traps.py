@@ -18,7 +18,7 @@ the field, exit status 2.
 from __future__ import annotations
 
 from ..parameters import TRAPS_RESOLUTION
-from .options import describe, integer, output_path
+from .options import describe, integer, output_path, shipped_or_given
 
 FORMATS = ("text", "json")
 SHIPPED_SCENES = ("gc2000_fig3", "gc2000_fig4", "gc2000_sec6b_khatib", "gc2000_sec6b_gnron")
@@ -43,13 +43,9 @@ def add_parser(sub) -> None:
     p.set_defaults(run=run)
 
 
-def scene_path(name: str):
+def scene_path(name: str) -> str:
     """The file of `name`: a shipped scene's (by name) or `name` itself."""
-    if name in SHIPPED_SCENES:
-        from importlib import resources
-
-        return resources.files("pfm_stability").joinpath("data", "scenes", f"{name}.yaml")
-    return name
+    return shipped_or_given(name, "scenes", SHIPPED_SCENES)
 
 
 def run(args) -> int:

@@ -47,7 +47,7 @@ from ..force_law import (
     wall_gain,
 )
 from ..models.base import DIVERGENT_REASON, NV_MAX
-from ..parameters import RADIANS_PER_DEGREE, TAU_RESOLUTION, Controller, Robot
+from ..parameters import RADIANS_PER_DEGREE, Controller, Robot
 from .points import chunk_points
 from .spec import LAW_SWEPT, SweepSpec
 
@@ -200,7 +200,9 @@ def model_answers(model: str, tau, T, k, NV, *, groups=None, **options) -> tuple
 
 def _verdict_columns(spec: SweepSpec, inputs: dict, NV: np.ndarray, reasons: np.ndarray) -> tuple[list, list, np.ndarray]:
     """Every model's four columns; the report's answers where NV is not a gain the models take."""
-    tau = np.where(inputs["tau"] * inputs["k"] < TAU_RESOLUTION, 0.0, inputs["tau"])
+    from ..vectorized import resolved_lag_and_delay
+
+    tau, T = resolved_lag_and_delay(inputs["tau"], inputs["T"], inputs["k"])  # as the models take them, before grouping
     negative = NV < 0
     zero = NV == 0
     beyond = ~np.isfinite(NV) | (np.abs(NV) > NV_MAX)
@@ -214,10 +216,10 @@ def _verdict_columns(spec: SweepSpec, inputs: dict, NV: np.ndarray, reasons: np.
                       "choose a less extreme force law (f, n), angle or width")
     safe = np.where(negative | zero | beyond, 1.0, NV)  # NV* does not depend on NV; the answer there is overwritten
     names, arrays = [], []
-    groups = distinct_rows(tau, inputs["T"], inputs["k"])
+    groups = distinct_rows(tau, T, inputs["k"])
     for model in spec.models:
         stable, verdict, critical, margin = model_answers(
-            model, tau, inputs["T"], inputs["k"], safe, groups=groups,
+            model, tau, T, inputs["k"], safe, groups=groups,
             hold=spec.controller.hold, compute_delay=spec.controller.compute_delay, pade_order=spec.pade_order)
         stable[negative], verdict[negative], margin[negative] = False, "unstable", -1.0
         stable[zero], verdict[zero], margin[zero] = True, "stable", math.inf

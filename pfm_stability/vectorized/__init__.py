@@ -14,7 +14,7 @@
   frequency, for ``loop_verdicts(..., columns="verdict")``.
 """
 
-from .exact_delay import VectorVerdicts, delay_verdicts_from_gain, exact_delay_verdicts, heading_gain_array, loop_gain_arrays
+from .exact_delay import VectorVerdicts, delay_verdicts_from_gain, exact_delay_verdicts, heading_gain_array, loop_gain_arrays, resolved_lag_and_delay
 from .loops import LoopVerdicts, loop_verdicts
 
 __all__ = [
@@ -25,4 +25,5 @@ __all__ = [
     "heading_gain_array",
     "loop_gain_arrays",
     "loop_verdicts",
+    "resolved_lag_and_delay",
 ]

@@ -40,7 +40,7 @@ from ..force_law import power_law_corridor_gain, power_law_wall_gain
 from ..models.base import HEADING_GAIN_RANGE, check_heading_gain
 from ..parameters import RANGES, T_RESOLUTION, TAU_RESOLUTION, check_parameter
 
-__all__ = ["VectorVerdicts", "exact_delay_verdicts", "heading_gain_array", "loop_gain_arrays", "delay_verdicts_from_gain"]
+__all__ = ["VectorVerdicts", "exact_delay_verdicts", "heading_gain_array", "loop_gain_arrays", "delay_verdicts_from_gain", "resolved_lag_and_delay"]
 
 _CHUNK = 32768
 
@@ -125,9 +125,27 @@ def loop_gain_arrays(V, tau, T, k, f, n, W, *, alpha=None, L=None):
             raise ValueError(f"L must be a finite number in (W/2, {high:g}] m = ({W_all[i] / 2:g}, {high:g}] m; got {float(L_all[i])!r} (point {i})")
         N = power_law_corridor_gain(f, n, W, L)
     tau, T, k, NV = np.broadcast_arrays(tau, T, k, N * V)
-    tau = np.where(tau * k < TAU_RESOLUTION, 0.0, tau)  # an ideal motor, as `models.Loop` takes it
-    T = np.where(T < T_RESOLUTION, 0.0, T)  # a continuous controller, as `models.Loop` takes it
+    tau, T = resolved_lag_and_delay(tau, T, k)
     return tau, T, k, NV
+
+
+def resolved_lag_and_delay(tau, T, k):
+    """(τ, T) as the loop models take them, for arrays: the one array twin of `models.Loop`'s rule.
+
+    τ with τk below `parameters.TAU_RESOLUTION` is 0 (an ideal steering motor) and
+    T below `parameters.T_RESOLUTION` is 0 (a continuous controller).
+
+    Parameters
+    ----------
+    tau, T, k : ndarray
+        s, s, 1/s; broadcast together.
+
+    Returns
+    -------
+    tau, T : ndarray
+        New arrays, s.
+    """
+    return np.where(tau * k < TAU_RESOLUTION, 0.0, tau), np.where(T < T_RESOLUTION, 0.0, T)
 
 
 def _run_chunks(func, arrays):

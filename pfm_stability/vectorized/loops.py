@@ -35,9 +35,9 @@ import numpy as np
 from ..checks import check_choice, check_integer, check_number
 from ..models import Loop, make_model
 from ..models.base import NV_MAX, UNDECIDED_RTOL, _check_NV, gain_margin, verdict_label
-from ..parameters import HOLDS, MODEL_NAMES, T_RESOLUTION, TAU_RESOLUTION
+from ..parameters import HOLDS, MODEL_NAMES
 from . import routes
-from .exact_delay import _check, heading_gain_array
+from .exact_delay import _check, heading_gain_array, resolved_lag_and_delay
 from .routes import Answers as _Answers
 
 __all__ = ["COLUMNS", "LoopVerdicts", "loop_verdicts"]
@@ -112,9 +112,8 @@ def _options(model, hold, compute_delay, pade_order):
 def loop_arrays(tau, T, k, NV, c=None):
     """Checked, broadcast, flattened (τ, T, k, c, NV) and their common shape.
 
-    τ with τk below `parameters.TAU_RESOLUTION` and T below
-    `parameters.T_RESOLUTION` become 0, as `models.Loop` stores them; c
-    defaults to 0.
+    τ and T below their resolutions become 0, as `models.Loop` stores them
+    (`resolved_lag_and_delay`); c defaults to 0.
 
     Raises
     ------
@@ -127,8 +126,7 @@ def loop_arrays(tau, T, k, NV, c=None):
     tau, T, k, c, NV = np.broadcast_arrays(tau, T, k, c, NV)
     shape = NV.shape
     tau, T, k, c, NV = (np.array(x, dtype=float).ravel() for x in (tau, T, k, c, NV))
-    tau[tau * k < TAU_RESOLUTION] = 0.0
-    T[T < T_RESOLUTION] = 0.0
+    tau, T = resolved_lag_and_delay(tau, T, k)
     return (tau, T, k, c, NV), shape
 
 
