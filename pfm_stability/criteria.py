@@ -55,6 +55,8 @@ __all__ = [
     "kb_critical_f_wall",
     "kb_critical_L",
     "loop_of",
+    "model_verdicts",
+    "check_loop_gain",
 ]
 
 
@@ -210,7 +212,7 @@ NV_MAX = 1e12
 """Largest loop gain NV (1/s) the loop models represent; a geometry beyond it is refused."""
 
 
-def _check_gain(NV: float, where: str) -> float:
+def check_loop_gain(NV: float, where: str) -> float:
     """NV after checking it is finite and <= NV_MAX; otherwise a message that names the geometry."""
     if not (math.isfinite(NV) and abs(NV) <= NV_MAX):
         raise ValueError(
@@ -350,7 +352,7 @@ def critical_f_corridor(law: ForceLaw, L: float, V: float, NV_critical: float) -
 
 
 # ------------------------------------------------------------------ analyses
-def _verdicts(controller: Controller, models, loop: Loop, N: float, NV: float, critical_values, geometric) -> dict:
+def model_verdicts(controller: Controller, models, loop: Loop, N: float, NV: float, critical_values, geometric) -> dict:
     """Model name → `ModelVerdict` for every model of the analysis.
 
     `geometric(NV*)` gives the geometry's own critical values (α* and f*, or
@@ -457,7 +459,7 @@ def analyze_wall(robot: Robot, controller: Controller, wall: Wall, models=None, 
 
 def _wall_equilibrium(robot: Robot, controller: Controller, wall: Wall, models, loop: Loop, law: ForceLaw, e: Equilibrium) -> WallEquilibrium:
     """Every model's verdict at one wall equilibrium."""
-    NV = _check_gain(e.N * robot.V, f"wall equilibrium d0 = {e.x0:g} m (alpha = {wall.alpha_deg:g} deg)")
+    NV = check_loop_gain(e.N * robot.V, f"wall equilibrium d0 = {e.x0:g} m (alpha = {wall.alpha_deg:g} deg)")
     if law.monotone:
 
         def geometric(NV_critical):
@@ -468,7 +470,7 @@ def _wall_equilibrium(robot: Robot, controller: Controller, wall: Wall, models, 
 
     else:
         geometric = WallBranches(law, wall.alpha, e, robot.V).critical
-    return WallEquilibrium(e.x0, e.N, e.c, NV, _verdicts(controller, models, loop, e.N, NV, WallCritical, geometric))
+    return WallEquilibrium(e.x0, e.N, e.c, NV, model_verdicts(controller, models, loop, e.N, NV, WallCritical, geometric))
 
 
 def analyze_corridor(robot: Robot, controller: Controller, corridor: Corridor, models=None, law: ForceLaw | None = None) -> CorridorAnalysis:
@@ -501,7 +503,7 @@ def analyze_corridor(robot: Robot, controller: Controller, corridor: Corridor, m
     check_corridor_fits(corridor, robot)
     loop = loop_of(robot, controller)
     N = corridor_gain(law, corridor.L)
-    NV = _check_gain(N * robot.V, f"corridor middle (L = {corridor.L:g} m)")
+    NV = check_loop_gain(N * robot.V, f"corridor middle (L = {corridor.L:g} m)")
     branches = None if law.monotone else CorridorBranches(law, corridor.L, robot.W, N, robot.V)
 
     def geometric(NV_critical):
@@ -510,6 +512,6 @@ def analyze_corridor(robot: Robot, controller: Controller, corridor: Corridor, m
             return {"L_critical": L_critical, **branches.law_parameters(NV_critical)}
         return {"L_critical": L_critical, "f_critical": critical_f_corridor(law, corridor.L, robot.V, NV_critical)}
 
-    verdicts = _verdicts(controller, models, loop, N, NV, CorridorCritical, geometric)
+    verdicts = model_verdicts(controller, models, loop, N, NV, CorridorCritical, geometric)
     equilibria = corridor_equilibria(law, corridor.L, robot.W)
     return CorridorAnalysis(corridor.L, N, NV, verdicts, 0.0, equilibria, finite_goal_gain(law, N))

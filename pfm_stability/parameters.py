@@ -49,6 +49,10 @@ __all__ = [
     "TRAPS_RESOLUTION",
     "LAW_PARAMETERS",
     "FIELD_DEFAULTS",
+    "ROBOT_FAMILIES",
+    "FAMILY_LAWS",
+    "FAMILY_LAW_PARAMETERS",
+    "FAMILY_DEFAULTS",
     "DERIVATION_LAWS",
     "DEGREES_PER_RADIAN",
     "RADIANS_PER_DEGREE",
@@ -110,6 +114,27 @@ LAW_PARAMETERS = {
 FIELD_DEFAULTS = {"xi": 1.0, "eta": 0.1, "rho0": 0.8, "attraction_exponent": 2.0, "goal_exponent": 2.0, "delta": 0.0}
 """Defaults of the Khatib and goal-aware laws: Ge & Cui 2000 Sec VI (ξ = 1, η = 0.1, ρ0 = 0.8 m,
 m = n = 2) and δ = 0 (eq 8, not eq 40). The goal distance has no default."""
+
+ROBOT_FAMILIES = ("steering", "kinematic", "holonomic")
+"""Robot loop families of ``report --robot`` (docs/models.md, "Robot loop families"): KB's steering
+robot, Ge & Cui 2002's kinematic steering (τ = 0, k = K_s) and the holonomic robot (force = acceleration)."""
+
+FAMILY_LAWS = ("velocity", "velocity-gated", "fuzzy")
+"""Laws of ``report --law`` beyond `FORCE_LAWS` (docs/velocity_and_fuzzy.md): Ge & Cui 2002's velocity
+attraction with Khatib's repulsion, its velocity-gated repulsion, and the DFAPF fuzzy-scheduled repulsion."""
+
+FAMILY_LAW_PARAMETERS = {
+    "velocity": ("alpha_p", "alpha_v", "attraction_exponent", "velocity_exponent", "eta", "rho0", "goal_distance"),
+    "velocity-gated": ("alpha_p", "attraction_exponent", "eta", "rho0", "a_max", "goal_distance"),
+    "fuzzy": ("alpha_p", "attraction_exponent", "rho0", "goal_exponent", "goal_distance"),
+}
+"""The parameters (`RANGES` keys) each law of `FAMILY_LAWS` takes; the attraction F_a = mα_p ρ_g^(m−1) (N)."""
+
+FAMILY_DEFAULTS = {"alpha_p": 0.5, "alpha_v": 0.1, "attraction_exponent": 2.0, "velocity_exponent": 2.0, "eta": 0.1, "rho0": 0.8,
+                   "a_max": 1.0, "goal_distance": 1.0, "goal_exponent": 0.0, "mass": 1.0}
+"""Defaults of the `FAMILY_LAWS` (docs/velocity_and_fuzzy.md): F_a = 1 N (α_p = 0.5, m = 2, ρ_g = 1 m),
+α_v = 0.1 and n = 2 (Ge & Cui 2002 §6), η and ρ0 as `FIELD_DEFAULTS`, a_max = 1 m/s², no goal factor
+(the fuzzy law's ρ_gⁿ with n = 0), a robot of 1 kg."""
 
 DERIVATION_LAWS = ("power", "general")
 """Force laws of the symbolic derivation (`pfm_stability.derivation`, ``pfm-stability derive --law``):
@@ -198,6 +223,7 @@ RANGES = {
     "alpha_p": Range(0.0, 1e6, unit="N/m"),
     "alpha_v": Range(0.0, 1e6, low_open=False, unit="N s/m"),
     "a_max": Range(0.0, 1e6, unit="m/s^2"),  # GC2002 eq 11 (docs/velocity_and_fuzzy.md)
+    "velocity_exponent": Range(0.0, 10.0, unit=""),  # n of GC2002's α_v‖ė‖ⁿ (docs/velocity_and_fuzzy.md)
     "step": Range(0.0, 1e6, unit="m"),
     "min_length": Range(0.0, 1e4, unit="m"),  # map: shortest segment analysed
     # integers (closed bounds, checked with `checks.check_integer`)
@@ -257,7 +283,8 @@ Entries beyond the robot, controller and geometry:
     1/s² (κ = 0 is refused by the models: a root at s = 0).
 ``mass``, ``alpha_p``, ``alpha_v``
     Target tracking of Ge & Cui 2002 eq (33)–(36): mass m in (0, 10⁶] kg,
-    position gain α_p in (0, 10⁶] N/m, velocity gain α_v in [0, 10⁶] N·s/m.
+    position gain α_p in (0, 10⁶] N/m, velocity gain α_v in [0, 10⁶] N·s/m;
+    ``velocity_exponent`` n of α_v‖ė‖ⁿ in (0, 10] (Ge & Cui 2002 eq 1).
 ``step``
     The gradient-step planner's step h = VT, m, in (0, 10⁶].
 ``compute_delay``, ``pade_order``, ``window_cells``, ``members``, ``sweep``, ``seed``

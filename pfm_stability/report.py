@@ -118,6 +118,11 @@ class StabilityReport:
         code), ``description`` and ``parameters``.
     door : DoorPassage or None
         KB's problem 2 (Fig 4) for a door of the given width (`door.door_passage`).
+    extras : dict
+        What the other robot families and laws add (`family_report.build_family_report`):
+        ``scenes`` (geometry → a holonomic or non-smooth scene with ``to_dicts()``),
+        ``environment`` (geometry → keys merged into the environment entry, and
+        per-equilibrium keys under ``equilibria``), ``tracking``. Empty for KB's report.
     """
 
     inputs: dict
@@ -128,6 +133,7 @@ class StabilityReport:
     remedies: dict = field(default_factory=dict)
     law: dict | None = None
     door: object | None = None
+    extras: dict = field(default_factory=dict)
 
     def to_dict(self) -> dict:
         """The fields as a JSON-ready dict (SI units; infinities as ``"inf"``, undefined as null)."""
@@ -155,11 +161,32 @@ class StabilityReport:
                 env["N_finite_goal"] = c.N_finite_goal
             out.setdefault("environment", {})["corridor"] = env
             out["corridor"] = {name: _verdict_dict(v, self.remedies.get(("corridor", name))) for name, v in c.models.items()}
+        if self.extras:
+            _merge_extras(out, self.extras)
         if self.door is not None:
             out["door"] = self.door.to_dict()
         if self.kb_error is not None:
             out["kb_error"] = self.kb_error.to_dict()
         return out
+
+
+def _merge_extras(out: dict, extras: dict) -> None:
+    """Add `StabilityReport.extras` to its JSON form `out` (in place)."""
+    for geometry, scene in extras.get("scenes", {}).items():
+        env, verdicts = scene.to_dicts()
+        out.setdefault("environment", {})[geometry] = env
+        if verdicts is not None:
+            out[geometry] = verdicts
+    for geometry, added in extras.get("environment", {}).items():
+        entry = out["environment"][geometry]
+        for key, value in added.items():
+            if key == "equilibria":
+                for item, more in zip(entry["equilibria"], value):
+                    item.update({k: json_number(v) for k, v in more.items()})
+            else:
+                entry[key] = json_ready(value)
+    if "tracking" in extras:
+        out["tracking"] = json_ready(extras["tracking"])
 
 
 def _verdict_dict(v, remedy) -> dict:

@@ -295,6 +295,25 @@ def test_resume_after_interruption_and_retry_give_the_same_table(tmp_path):
     assert read(whole).column("point").to_pylist() == list(range(45))
 
 
+@pytest.mark.parametrize("count, size", [(2000, 50), (45, 10), (7, 10), (1, 1), (101, 3), (100, 50)])
+def test_chunk_plan_covers_every_point_once_with_a_fine_tail(count, size):
+    """plan_chunks: consecutive ranges covering 0..count once, at most `size` each; with fine_tail (simulation
+    sweeps) the last TAIL_CHUNKS·size points are in chunks of ceil(size/4) (so 2 workers finish within a small
+    chunk of each other), the rest unchanged. Exact integers: no tolerance."""
+    from pfm_stability.sweeps.engine import TAIL_CHUNKS, plan_chunks
+
+    for fine in (False, True):
+        plan = plan_chunks(count, size, fine_tail=fine)
+        assert [c[0] for c in plan] == list(range(len(plan)))
+        assert plan[0][1] == 0 and plan[-1][2] == count
+        assert all(a[2] == b[1] for a, b in zip(plan, plan[1:])) and all(0 < stop - start <= size for _, start, stop in plan)
+    coarse, fine = plan_chunks(count, size), plan_chunks(count, size, fine_tail=True)
+    tail = min(count, TAIL_CHUNKS * size)
+    small = -(-size // 4)
+    assert all(stop - start <= small for _, start, stop in fine if start >= count - tail)
+    assert [c for c in fine if c[2] <= count - tail] == [c for c in coarse if c[2] <= count - tail]
+
+
 def test_failing_chunk_is_named_and_parts_are_kept(tmp_path, monkeypatch):
     """A chunk that fails on every attempt: SweepError naming it and the error; the other chunks stay for --resume."""
     from pfm_stability.sweeps import engine

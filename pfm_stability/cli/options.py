@@ -13,7 +13,8 @@ from dataclasses import dataclass, fields
 from typing import TYPE_CHECKING
 
 from ..checks import check_integer, check_number, check_output_path
-from ..parameters import FIELD_DEFAULTS, FORCE_LAWS, HOLDS, LAW_PARAMETERS, PRESETS, RANGES, SHOWN_AS, Controller, Preset, Robot, get_preset
+from ..parameters import (FAMILY_LAW_PARAMETERS, FAMILY_LAWS, FIELD_DEFAULTS, FORCE_LAWS, HOLDS, LAW_PARAMETERS, PRESETS, RANGES,
+                          ROBOT_FAMILIES, SHOWN_AS, Controller, Preset, Robot, get_preset)
 
 if TYPE_CHECKING:
     from ..config import Config
@@ -34,6 +35,10 @@ __all__ = [
     "add_law_options",
     "resolve_law",
     "shipped_or_given",
+    "FAMILY_OPTIONS",
+    "add_family_options",
+    "resolve_family",
+    "ResolvedFamily",
 ]
 
 def _shown(key: str) -> str:
@@ -262,6 +267,9 @@ def resolve_parameters(args, *, fill=None) -> ResolvedParameters:
     robot = Robot(**{**_fields(preset.robot), **robot_changes})
     controller = Controller(**{**_fields(preset.controller), **controller_changes})
     if config is not None:
+        if config.family not in (None, "steering") and not hasattr(args, "robot"):
+            raise ValueError(f"robot.family {config.family} of --config {config.path} is read by report only (--robot, "
+                             "docs/velocity_and_fuzzy.md); this command analyses KB's steering robot: give robot.family steering or none")
         sources.update(_fill_scenario(args, config, SCENARIO_OPTIONS if fill is None else fill))
         for note in config.notes:
             print(f"pfm-stability: note: {note}", file=sys.stderr)
@@ -306,12 +314,13 @@ def _option(name: str) -> str:
     return "--" + name.replace("_", "-")
 
 
-def add_law_options(parser: argparse.ArgumentParser) -> None:
-    """--law and the options of the laws (`LAW_OPTIONS`); each applies to the laws of `parameters.LAW_PARAMETERS` only."""
+def add_law_options(parser: argparse.ArgumentParser, laws=FORCE_LAWS) -> None:
+    """--law (one of `laws`) and the options of the laws (`LAW_OPTIONS`); each applies to the laws of `parameters.LAW_PARAMETERS` only."""
     group = parser.add_argument_group("force law (docs/fields.md)")
-    group.add_argument("--law", choices=FORCE_LAWS, default=Default("power"),
+    extra = "; velocity, velocity-gated, fuzzy: docs/velocity_and_fuzzy.md" if len(laws) > len(FORCE_LAWS) else ""
+    group.add_argument("--law", choices=laws, default=Default("power"),
                        help="lateral force law: KB's power law f(W/d)^n (default, unless the configuration file names one), "
-                            "the histogram grid's law, Khatib's repulsion or Ge & Cui's goal-aware repulsion (gnron)")
+                            f"the histogram grid's law, Khatib's repulsion or Ge & Cui's goal-aware repulsion (gnron){extra}")
     for name, text in LAW_OPTIONS.items():
         kind = integer(name, odd=True) if name == "window_cells" else number(name)
         group.add_argument(_option(name), type=kind, help=f"{text}, {describe(name)}")
@@ -333,6 +342,9 @@ def resolve_law(args, params: ResolvedParameters):
 
     from_file = (params.config.law if params.config is not None else None) or {}
     law_name = args.law if typed(args, "law") or not from_file else from_file["name"]
+    if law_name in FAMILY_LAWS:
+        raise ValueError(f"law {law_name} of --config {params.config.path} is analysed by report only (docs/velocity_and_fuzzy.md); "
+                         f"this command takes --law {', '.join(FORCE_LAWS)}")
     given = {key: getattr(args, key) for key in LAW_OPTIONS if getattr(args, key, None) is not None}
     filed = {k: v for k, v in from_file.items() if k != "name" and k not in given} if from_file.get("name") == law_name else {}
     typed_fn = [key for key in ("f", "n") if params.sources.get(key) == "user"]
@@ -353,3 +365,113 @@ def resolve_law(args, params: ResolvedParameters):
             sources[name] = "default (0: Ge & Cui eq 8)" if name == "delta" else _FIELD_SOURCE if name in FIELD_DEFAULTS else "default (KB §2)"
     return law, sources
 
+
+
+# ------------------------------------------------------------------ robot families (report)
+FAMILY_OPTIONS = {
+    "alpha_p": "velocity, velocity-gated, fuzzy: position gain alpha_p; F_a = m alpha_p rho_g^(m-1) (default 0.5)",
+    "alpha_v": "velocity: velocity gain alpha_v of GC2002 eq 1 (default 0.1)",
+    "velocity_exponent": "velocity: n of alpha_v |de/dt|^n (default 2)",
+    "a_max": "velocity-gated: braking deceleration a_max of GC2002 eq 11 (default 1)",
+}
+"""The new laws' own options (`parameters.RANGES` keys), as ``--alpha-p`` … ``--a-max`` (docs/velocity_and_fuzzy.md)."""
+
+_FAMILY_SOURCE = "default (docs/velocity_and_fuzzy.md)"
+
+
+def add_family_options(parser: argparse.ArgumentParser) -> None:
+    """--robot, --mass, --side, --no-simulate and the options of `FAMILY_OPTIONS` (``report`` only)."""
+    group = parser.add_argument_group("robot family and velocity/fuzzy laws (docs/velocity_and_fuzzy.md)")
+    group.add_argument("--robot", choices=ROBOT_FAMILIES, default=Default("steering"),
+                       help="loop family: KB's steering robot (default), kinematic steering (tau = 0, --k is K_s) "
+                            "or holonomic (force = acceleration; --law velocity or velocity-gated)")
+    group.add_argument("--mass", type=number("mass"), help=f"holonomic robot mass, {describe('mass')} (default 1)")
+    for name, text in FAMILY_OPTIONS.items():
+        group.add_argument(_option(name), type=number(name), help=f"{text}, {describe(name)}")
+    group.add_argument("--side", choices=("left", "right"), help="fuzzy: the wall's side (the DFAPF tables are asymmetric; default left)")
+    group.add_argument("--no-simulate", action="store_true",
+                       help="velocity-gated: do not simulate the wall's limit cycle (the report gives the rest band only)")
+
+
+@dataclass(frozen=True)
+class ResolvedFamily:
+    """The report's robot family and law after the options.
+
+    Attributes
+    ----------
+    family : str
+        `parameters.ROBOT_FAMILIES`.
+    law : ForceLaw or family_report.FamilyLaw
+    mass : float
+        kg: ``--mass``, else the ``--config`` file's ``robot.mass`` (holonomic), else 1.
+    sources : dict
+        Provenance of the law's parameters, the robot family and the mass.
+    """
+
+    family: str
+    law: object
+    mass: float
+    sources: dict
+
+
+def resolve_family(args, params: ResolvedParameters) -> ResolvedFamily:
+    """``--robot``, ``--law`` and their options: a static law through `resolve_law`, a law of `FAMILY_LAWS` here.
+
+    Precedence as `resolve_parameters`: an option typed > the ``--config`` file's
+    ``robot.family``, ``robot.mass`` and ``law`` (docs/config.md) > the defaults.
+    The file's mass applies when its family (holonomic) is the one in force, its
+    law's parameters and ``side`` when its law is the one in force.
+
+    Raises
+    ------
+    ValueError
+        An option the law or the robot family does not take (``--alpha-p applies to
+        --law velocity, velocity-gated or fuzzy, not to --law power``, ``--mass applies
+        to --robot holonomic``), or a value out of range.
+    """
+    config = params.config
+    filed_family = config.family if config is not None else None
+    from_file = (config.law if config is not None else None) or {}
+    by_user = typed(args, "robot") or filed_family is None
+    family = str(args.robot) if by_user else filed_family
+    robot_shown = f"--robot {family}" if by_user else f"robot family {family} of --config {config.path}"
+    sources = {"robot": "user" if typed(args, "robot") else config.sources["robot"] if filed_family is not None else "default"}
+    if args.mass is not None and family != "holonomic":
+        raise ValueError(f"--mass applies to --robot holonomic, not to {robot_shown}")
+    filed_mass = config.mass if config is not None and family == "holonomic" and args.mass is None else None
+    mass = args.mass if args.mass is not None else filed_mass if filed_mass is not None else 1.0
+    sources["mass"] = "user" if args.mass is not None else config.sources["mass"] if filed_mass is not None else "default (1 kg)"
+    law_by_user = typed(args, "law") or not from_file
+    law_name = str(args.law) if law_by_user else from_file["name"]
+    law_shown = f"--law {law_name}" if law_by_user else f"law {law_name} of --config {config.path}"
+    if family == "holonomic" and law_name not in ("velocity", "velocity-gated"):
+        raise ValueError(f"{robot_shown} takes --law velocity or velocity-gated (a force in newtons on a mass, Ge & Cui 2002 Sec 6); got {law_shown}")
+    typed_family = [k for k in FAMILY_OPTIONS if getattr(args, k, None) is not None]
+    if law_name not in FAMILY_LAWS:
+        if typed_family:
+            takers = [k for k in FAMILY_LAWS if typed_family[0] in FAMILY_LAW_PARAMETERS[k]]
+            raise ValueError(f"{_option(typed_family[0])} applies to --law {' or '.join(takers)}, not to {law_shown}")
+        if args.side is not None:
+            raise ValueError(f"--side applies to --law fuzzy, not to {law_shown}")
+        law, law_sources = resolve_law(args, params)
+        return ResolvedFamily(family, law, mass, {**sources, **law_sources})
+    from ..family_report import make_family_law
+
+    taken = FAMILY_LAW_PARAMETERS[law_name]
+    given = {k: getattr(args, k) for k in (*LAW_OPTIONS, *FAMILY_OPTIONS) if getattr(args, k, None) is not None}
+    typed_fn = [key for key in ("f", "n") if params.sources.get(key) == "user"]
+    for key in typed_fn + list(given):
+        if key not in taken:
+            takers = [k for k in (*FORCE_LAWS, *FAMILY_LAWS) if key in {**LAW_PARAMETERS, **FAMILY_LAW_PARAMETERS}[k]]
+            raise ValueError(f"{_option(key)} applies to --law {' or '.join(takers)}, not to {law_shown}")
+    if args.side is not None and law_name != "fuzzy":
+        raise ValueError(f"--side applies to --law fuzzy, not to {law_shown}")
+    # the file's law parameters (checked against the law by `config`) where it is the law in force and no option is typed
+    filed = {k: v for k, v in from_file.items() if k not in ("name", "side") and k not in given} if from_file.get("name") == law_name else {}
+    filed_side = from_file.get("side") if from_file.get("name") == law_name and args.side is None else None
+    side = args.side or filed_side or "left"
+    law = make_family_law(law_name, side, **given, **filed)
+    sources.update({key: "user" if key in given else config.sources[key] if key in filed else _FAMILY_SOURCE for key in taken})
+    if law_name == "fuzzy":
+        sources["side"] = "user" if args.side is not None else config.sources["side"] if filed_side is not None else "default (left)"
+    return ResolvedFamily(family, law, mass, sources)

@@ -20,6 +20,7 @@ import math
 import textwrap
 
 from ..parameters import RANGES, SHOWN_AS
+from .formatting import number, percent, table
 
 __all__ = [
     "number",
@@ -37,35 +38,6 @@ __all__ = [
     "render_door_text",
     "render_parameter_sweep_text",
 ]
-
-
-# ------------------------------------------------------------------ numbers
-def number(x, digits: int = 4) -> str:
-    """A JSON number as text: ``digits`` significant digits, "-" undefined (None), "inf"/"-inf", strings as they are."""
-    if x is None:
-        return "-"
-    if isinstance(x, str):
-        return x
-    if math.isinf(x):
-        return "inf" if x > 0 else "-inf"
-    return f"{x:.{digits}g}"
-
-
-def percent(x) -> str:
-    """A JSON ratio as a signed percentage with one decimal ("-" undefined, "inf" infinite)."""
-    if x is None or isinstance(x, str):
-        return number(x)
-    return f"{x * 100:+.1f}%"
-
-
-def table(header, rows, sep: str = "  ") -> list[str]:
-    """Aligned text table: the first column left-aligned, the others right-aligned; one string per line."""
-    widths = [max(len(str(r[i])) for r in [header] + rows) for i in range(len(header))]
-
-    def line(cells):
-        return sep.join(str(c).ljust(w) if i == 0 else str(c).rjust(w) for i, (c, w) in enumerate(zip(cells, widths)))
-
-    return [line(header)] + [line(r) for r in rows]
 
 
 # ------------------------------------------------------------------ report
@@ -117,9 +89,14 @@ _FOOTNOTE = (
 def _scenarios(data: dict):
     """Yield (title, header, rows, remedies, notes) for each geometry of the report's JSON form (each wall equilibrium when there are several)."""
     for scenario in _REPORT_SCENARIOS:
-        if scenario not in data:
+        if scenario not in data.get("environment", {}):
             continue
         env = data["environment"][scenario]
+        if "kappa" in env or env.get("verdict") == "non-smooth":  # a holonomic robot or a non-smooth law (cli/render_families.py)
+            from .render_families import family_scenario
+
+            yield from family_scenario(scenario, env, data.get(scenario))
+            continue
         if scenario == "corridor":
             title = f"Corridor, L = {number(env['L'])} m: N = {number(env['N'])} 1/m, NV = {number(env['NV'])} 1/s"
             yield (title, *_verdict_table(scenario, data[scenario]), _corridor_notes(env))
@@ -132,16 +109,18 @@ def _scenarios(data: dict):
                 f"N = {number(e['N'])} 1/m, NV = {number(e['NV'])} 1/s"
             )
             reasons = sorted({v["reason"] for v in e["models"].values() if "reason" in v})
-            yield (title, *_verdict_table(scenario, e["models"]), [f"  every model: unstable ({r})" for r in reasons])
+            yield (title, *_verdict_table(scenario, e["models"]), [f"  every model: unstable ({r})" for r in reasons] + _equilibrium_notes(e))
 
 
 def _verdict_table(scenario: str, verdicts: dict):
     """(header, rows, remedies) of one geometry's verdicts."""
     columns, keys = _COLUMNS[scenario]
-    if verdicts and "f_critical" not in next(iter(verdicts.values())):  # a law with its own parameters in place of f
+    first = next(iter(verdicts.values()), {})
+    if verdicts and "f_critical" not in first:  # a law with its own parameters in place of f (none: velocity, fuzzy)
         at = keys.index("f_critical")
-        columns = columns[:at] + _FIELD_COLUMNS[0] + columns[at + 1:]
-        keys = keys[:at] + _FIELD_COLUMNS[1] + keys[at + 1:]
+        own = _FIELD_COLUMNS if "eta_critical" in first else ([], [])
+        columns = columns[:at] + own[0] + columns[at + 1:]
+        keys = keys[:at] + own[1] + keys[at + 1:]
     header = ["model", "verdict", "margin", "NV* 1/s", "omega* rad/s"] + columns
     rows = []
     for name, v in verdicts.items():
@@ -150,6 +129,33 @@ def _verdict_table(scenario: str, verdicts: dict):
         rows.append(cells)
     fixes = {name: (v["to_stabilize"], "eta_critical" in v) for name, v in verdicts.items() if v["verdict"] != "stable"}
     return header, rows, fixes
+
+
+def _equilibrium_notes(e: dict) -> list[str]:
+    """The fuzzy law's frozen gains at one equilibrium (cli/render_families.py); none for other laws."""
+    if "N_frozen" not in e:
+        return []
+    from .render_families import equilibrium_notes
+
+    return equilibrium_notes(e)
+
+
+def _label(name: str) -> str:
+    """An input's label (`_LABELS`, or the robot families' `render_families.FAMILY_LABELS`)."""
+    if name in _LABELS:
+        return _LABELS[name]
+    from .render_families import FAMILY_LABELS
+
+    return FAMILY_LABELS.get(name, name)
+
+
+def _tail(data: dict) -> list[str]:
+    """The families' closing lines (robust bracket, target tracking), when the report has them."""
+    if "tracking" not in data and "robust_bracket" not in data.get("environment", {}).get("wall", {}):
+        return []
+    from .render_families import family_tail
+
+    return family_tail(data)
 
 
 def _corridor_notes(env: dict) -> list[str]:
@@ -182,7 +188,18 @@ def _law_line(data: dict) -> list[str]:
     law = data.get("law")
     if not law or law["name"] == "power":
         return []
-    return ["", f"Force law: {law['description']}" + (f" (--law {law['name']})" if law["name"] else "")]
+    return ["", f"Force law: {law['description']}" + (f" (law {law['name']})" if law["name"] else "")]
+
+
+def _footnote(data: dict) -> list[str]:
+    """What margin and the starred values mean: in NV (steering robots) or in kappa (holonomic); none without a model."""
+    if not data["models"]:
+        return []
+    if any("kappa" in env for env in data.get("environment", {}).values() if isinstance(env, dict)):
+        from .render_families import HOLONOMIC_FOOTNOTE
+
+        return ["", HOLONOMIC_FOOTNOTE]
+    return ["", _FOOTNOTE]
 
 
 def _kb_error_line(report) -> list[str]:
@@ -199,9 +216,9 @@ def render_text(report) -> str:
     for name, entry in data["inputs"].items():
         unit = f" {entry['unit']}" if entry["unit"] else ""
         mark = "  <-- " + entry["source"] if entry["source"].startswith("ASSUMED") else f"  ({entry['source']})"
-        lines.append(f"  {_LABELS[name]:<38} {number(entry['value'])}{unit}{mark}")
+        lines.append(f"  {_label(name):<38} {number(entry['value'])}{unit}{mark}")
     lines += _law_line(data)
-    lines += ["", "Models"]
+    lines += ["", "Models"] + ([] if data["models"] else ["  none: the law has no smooth equilibrium, so no linear model applies"])
     for name, entry in data["models"].items():
         options = ", ".join(f"{k}={v}" for k, v in entry.items() if k != "equation")
         lines.append(f"  {name:<15} {entry['equation']}{'  [' + options + ']' if options else ''}")
@@ -211,9 +228,10 @@ def render_text(report) -> str:
         lines += notes
         for model, fix in fixes.items():
             lines.append(_remedy_line(model, fix))
+    lines += _tail(data)
     if data.get("door"):
         lines += ["", *render_door_text(data["door"]).rstrip("\n").splitlines()]
-    lines += ["", _FOOTNOTE]
+    lines += _footnote(data)
     lines += _kb_error_line(report)
     return "\n".join(lines) + "\n"
 
@@ -254,7 +272,7 @@ def render_markdown(report) -> str:
     lines = ["# pfm-stability report", "", "| input | value | unit | source |", "| --- | --- | --- | --- |"]
     for name, entry in data["inputs"].items():
         source = f"**{entry['source']}**" if entry["source"].startswith("ASSUMED") else entry["source"]
-        lines.append(f"| {_LABELS[name]} | {number(entry['value'])} | {entry['unit']} | {source} |")
+        lines.append(f"| {_label(name)} | {number(entry['value'])} | {entry['unit']} | {source} |")
     lines += _law_line(data)
     for title, header, rows, fixes, notes in _scenarios(data):
         lines += ["", f"## {title}", "", "| " + " | ".join(header) + " |", "|" + " --- |" * len(header)]
@@ -263,6 +281,7 @@ def render_markdown(report) -> str:
         for model, fix in fixes.items():
             lines.append("")
             lines.append("-" + _remedy_line(model, fix)[1:])
+    lines += _tail(data)
     if data.get("door"):
         lines += ["", "## Door", "", "```", *render_door_text(data["door"]).rstrip("\n").splitlines(), "```"]
     lines += _kb_error_line(report)

@@ -130,7 +130,7 @@ class ExactDelay(LoopModel):
 
         def measure(ks):
             K_star = kb_critical_gain(loop.tau, loop.T, ks)[0]
-            return np.log(NV * ks / K_star)
+            return math.log(NV) + np.log(ks) - np.log(K_star)  # a sum of logs: NV·k underflows for subnormal NV
 
         lo, hi = gain_range(loop)
         return first_crossing(measure, lo, hi, start=lo)

@@ -57,7 +57,7 @@ from .holonomic import (
     PolynomialHolonomicModel,
     checked,
 )
-from .sampled import _bilinear
+from .sampled import bilinear_polynomial
 
 __all__ = ["BEST_CURVATURE_PRODUCT", "HolonomicExactDelay", "HolonomicSampled", "make_holonomic_model"]
 
@@ -167,7 +167,7 @@ class HolonomicSampled(PolynomialHolonomicModel):
             return HolonomicContinuous().parts(loop)
         parts = self.delta_parts(loop)
         degree = len(parts[0]) - 1
-        return tuple(_bilinear(p, degree, loop.T) for p in parts)
+        return tuple(bilinear_polynomial(p, degree, loop.T) for p in parts)
 
     def z_polynomial(self, kappa: float, loop: HolonomicLoop) -> np.ndarray:
         """det(zI − Φ_cl) = z^d(z − 1)² + c_hT(z − 1) + κT²(z + 1)/2, descending in z (T > 0)."""
@@ -214,7 +214,7 @@ class HolonomicSampled(PolynomialHolonomicModel):
         sampled = T[:, 0] > 0
         out = lam.real.max(axis=1)
         with np.errstate(divide="ignore"):
-            radius = 0.5 * np.log1p(2.0 * T * lam.real + T * T * np.abs(lam) ** 2) / np.where(T > 0, T, 1.0)
+            radius = 0.5 * np.log1p(np.maximum(2.0 * T * lam.real + T * T * np.abs(lam) ** 2, -1.0)) / np.where(T > 0, T, 1.0)  # |z|² >= 0
         out[sampled] = radius[sampled].max(axis=1)
         return out
 

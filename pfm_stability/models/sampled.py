@@ -68,7 +68,7 @@ from ..routh import schur_cohn_stable
 from .base import AffineGainModel, Boundary, Loop, _check_NV, checked
 from .continuous import Continuous
 
-__all__ = ["Sampled", "continuous_plant", "discretize", "closed_loop_matrix", "delta_plant"]
+__all__ = ["Sampled", "continuous_plant", "discretize", "closed_loop_matrix", "delta_plant", "bilinear_polynomial"]
 
 
 def continuous_plant(loop: Loop, hold: str):
@@ -175,7 +175,7 @@ def _delta_matrix(loop: Loop, K: float, hold: str, compute_delay: int) -> np.nda
     return np.block([[Psi, G], [-F / loop.T, np.full((1, 1), -1.0 / loop.T)]])
 
 
-def _bilinear(p_w, degree: int, T: float) -> np.ndarray:
+def bilinear_polynomial(p_w, degree: int, T: float) -> np.ndarray:
     """Q(μ) = (1 − Tμ/2)^degree · P(μ/(1 − Tμ/2)) for P(w) given descending (degree >= deg P)."""
     p = np.asarray(p_w, dtype=float)[::-1]  # ascending: p_i w^i
     factor = np.array([-T / 2, 1.0])  # 1 − Tμ/2, descending
@@ -239,7 +239,7 @@ class Sampled(AffineGainModel):
         """(D, E) in μ (z = (1 + Tμ/2)/(1 − Tμ/2)): stable ⇔ D + K·E is Hurwitz, descending, one length."""
         d, e = self.delta_polynomials(loop)
         degree = len(np.trim_zeros(d, "f")) - 1
-        return _bilinear(d, degree, loop.T), _bilinear(e, degree, loop.T)
+        return bilinear_polynomial(d, degree, loop.T), bilinear_polynomial(e, degree, loop.T)
 
     def polynomials(self, loop: Loop):
         """(D(z), E(z)): det(zI − Φ_cl(K)) = D + K·E, descending in z (T > 0).

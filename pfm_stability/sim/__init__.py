@@ -41,6 +41,14 @@ Library API
 ``simulate_reference(scenario) -> (Trajectory, Event | None)``
     The same model in a plain per-robot Python loop (baseline, cross-check).
 
+``simulate_planar(robot, field, world, *, T, compute_delay, duration, start) -> PlanarRun``
+    Ge & Cui 2002's robots — `PointMass` (holonomic, a = F/m saturated at
+    a_max), `Steering` (KB's robot) and `DiffDrive` (GC2002 §7) — in a
+    velocity-aware field with fixed or moving targets and obstacles (`sim.movers`),
+    events at v_RO = 0, D = ρ0 and D ≤ 0 (docs/simulator.md, "Planar robots").
+``wall_cycle(repulsion, attraction, alpha, robot, *, T, …) -> WallCycle``
+    The limit cycle (or rest) of a robot beside a wall with velocity-gated repulsion.
+
 Predictions for a scenario (`predict`) and the simulated stability boundary
 (`boundary_by_bisection`) join simulations with the models: they are in
 `pfm_stability.validation`.
@@ -56,7 +64,8 @@ of the active windows), `vff` (KB eq 1–5, the measured wall force), `robot`
 (exact steering solution, quadrature of the motion), `environment` (analytic
 walls), `scenario` (and `scenario_law`), `presets`, `engine` (batched
 stepping), `events`, `metrics` (docs/simulator.md, measuring oscillation),
-`verdict`, `results`, `api`, `reference`.
+`verdict`, `results`, `api`, `reference`; the planar simulator: `planar`,
+`planar_robots`, `movers`, `cycles`.
 """
 
 from .api import simulate, simulate_batch
@@ -65,6 +74,15 @@ from .environment import AnalyticEnvironment, AnalyticWall
 from .events import Event
 from .grid import HistogramGrid
 from .metrics import OscillationMetrics, oscillation_metrics
+from .planar import (
+    DiffDrive,
+    PlanarRun,
+    PointMass,
+    Steering,
+    WallCycle,
+    simulate_planar,
+    wall_cycle,
+)
 from .presets import SCENARIO_NAMES, barely_avoiding_ratio, make_scenario
 from .reference import simulate_reference
 from .results import BatchResult, RunResult, Trajectory
@@ -73,19 +91,24 @@ from .verdict import linearly_stable, simulated_verdict
 from .vff import measured_wall_force
 
 __all__ = [
+    "SCENARIO_NAMES",
     "AnalyticEnvironment",
     "AnalyticWall",
     "BatchResult",
+    "DiffDrive",
     "Event",
     "HistogramGrid",
     "MeasureAxis",
     "OscillationMetrics",
+    "PlanarRun",
+    "PointMass",
     "Pose",
     "RunResult",
-    "SCENARIO_NAMES",
     "Scenario",
+    "Steering",
     "Target",
     "Trajectory",
+    "WallCycle",
     "barely_avoiding_ratio",
     "linearly_stable",
     "make_scenario",
@@ -95,6 +118,8 @@ __all__ = [
     "scenario_law",
     "simulate",
     "simulate_batch",
+    "simulate_planar",
     "simulate_reference",
     "simulated_verdict",
+    "wall_cycle",
 ]

@@ -64,6 +64,7 @@ __all__ = [
     "CONNECT_TIMEOUT",
     "RETRIES",
     "SIMULATION_CHUNK",
+    "TAIL_CHUNKS",
     "VECTOR_CHUNK",
     "SweepError",
     "SweepInterrupted",
@@ -83,6 +84,9 @@ VECTOR_CHUNK = 250_000
 
 SIMULATION_CHUNK = 50
 """Default points per chunk of a simulation sweep (one simulated batch each, ~seconds of work)."""
+
+TAIL_CHUNKS = 2
+"""A simulation sweep's last TAIL_CHUNKS·chunk_size points go in quarter-size chunks (`plan_chunks`)."""
 
 CONNECT_TIMEOUT = 5.0
 """Seconds to wait for a ``tcp://`` scheduler before giving up (before any work)."""
@@ -168,9 +172,26 @@ def default_chunk_size(spec: SweepSpec) -> int:
     return SIMULATION_CHUNK if spec.simulate else VECTOR_CHUNK
 
 
-def plan_chunks(count: int, chunk_size: int) -> list:
-    """[(index, start, stop), …]: consecutive point ranges of at most `chunk_size`."""
-    return [(i, start, min(start + chunk_size, count)) for i, start in enumerate(range(0, count, chunk_size))]
+def plan_chunks(count: int, chunk_size: int, *, fine_tail: bool = False) -> list:
+    """[(index, start, stop), …]: consecutive point ranges of at most `chunk_size`.
+
+    With ``fine_tail`` (simulation sweeps, whose chunks take seconds) the last
+    ``TAIL_CHUNKS * chunk_size`` points go in chunks a quarter as large, so that
+    the workers finish together instead of one waiting for the other's last
+    full chunk. The plan depends on `count` and `chunk_size` only (never on the
+    number of workers): resumed and re-run sweeps see the same chunks.
+    """
+    sizes, left = [], count
+    small = max(1, -(-chunk_size // 4))
+    while left > 0:
+        size = chunk_size if not fine_tail or left > TAIL_CHUNKS * chunk_size else small
+        sizes.append(min(size, left))
+        left -= sizes[-1]
+    chunks, start = [], 0
+    for index, size in enumerate(sizes):
+        chunks.append((index, start, start + size))
+        start += size
+    return chunks
 
 
 def parts_directory(out: str) -> str:
@@ -369,7 +390,7 @@ def run_sweep(
     sample = all_points(spec)
     check_points(spec, sample)
     chunk_size, manifest = _prepare_parts(spec, out, chunk_size, resume)
-    chunks = plan_chunks(spec.count, chunk_size)
+    chunks = plan_chunks(spec.count, chunk_size, fine_tail=spec.simulate)
     parts = parts_directory(out)
     paths = {index: _part_path(parts, index, len(chunks)) for index, _, _ in chunks}
     use_cluster = scheduler is not None or spec.simulate

@@ -363,10 +363,22 @@ def _base(where: _Where, data: dict, base_dir):
             config = where.wrap("config", load_config, path)
         else:
             where.fail(f"config must be a file name or a mapping; got {given!r}")
+        _steering_only(where, config, "law" in data)
         return config.robot, config.controller, config.law, dict(config.scenario or {}), dict(config.sources)
     preset = where.wrap("preset", get_preset, data.get("preset", "carmel"))
     sources = {name: f"preset {preset.name}" for name in ("V", "tau", "k", "W", "f", "n", "T", "hold", "compute_delay")}
     return preset.robot, preset.controller, None, {}, sources
+
+
+def _steering_only(where: _Where, config, own_law: bool) -> None:
+    """Refuse a config's robot family other than steering, and its law of `parameters.FAMILY_LAWS` unless the spec's
+    own ``law`` replaces it: sweeps analyse KB's steering robot with the static laws (docs/config.md)."""
+    why = "sweeps analyse KB's steering robot with the laws power, grid, khatib, gnron; robot families and the laws " \
+          "velocity, velocity-gated, fuzzy are report's (docs/velocity_and_fuzzy.md)"
+    if config.family not in (None, "steering"):
+        where.fail(f"config: robot.family {config.family} is not supported: {why}")
+    if config.law is not None and config.law["name"] not in LAW_PARAMETERS and not own_law:
+        where.fail(f"config: law.name {config.law['name']} is not supported: {why}")
 
 
 def _models(where: _Where, models) -> tuple:

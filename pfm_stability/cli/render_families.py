@@ -1,0 +1,102 @@
+"""Text of the report's robot families and velocity/fuzzy laws (docs/velocity_and_fuzzy.md): holonomic
+verdicts, the non-smooth verdict and its cycle, the fuzzy law's frozen gains and bracket, target tracking.
+
+`cli.render` calls these for the parts of a `report.StabilityReport` that KB's report does not have.
+"""
+
+from __future__ import annotations
+
+from .formatting import number, percent
+
+__all__ = ["FAMILY_LABELS", "HOLONOMIC_FOOTNOTE", "family_scenario", "equilibrium_notes", "family_tail"]
+
+FAMILY_LABELS = {
+    "robot": "robot family",
+    "mass": "mass (robot mass)",
+    "alpha_p": "alpha_p (position gain)",
+    "alpha_v": "alpha_v (velocity gain)",
+    "velocity_exponent": "n (velocity exponent)",
+    "a_max": "a_max (braking deceleration)",
+    "side": "wall side (fuzzy tables)",
+}
+"""Labels of the inputs that only the families and the new laws have."""
+
+HOLONOMIC_FOOTNOTE = (
+    "margin = relative distance in kappa to the nearest stability boundary (kappa*/kappa - 1; > 0 stable). "
+    "kappa* and omega*: the stiffness at which this loop (T, c_h fixed) loses stability and the frequency there; "
+    "T*: the largest stable loop delay at this kappa and c_h; c_h range: the damping values stable at this kappa and T; "
+    "inf = no limit; - = undefined."
+)
+"""The footnote of a holonomic robot's report (docs/models.md, "Robot loop families")."""
+
+_CYCLE = (("mean_distance", "mean distance", "m"), ("peak_to_peak", "peak-to-peak", "m"), ("heading_amplitude", "heading amplitude", "rad"),
+          ("period", "period", "s"), ("min_distance", "closest", "m"), ("duration", "measured over", "s"))
+
+
+def family_scenario(scenario: str, env: dict, verdicts: dict | None):
+    """Yield (title, header, rows, remedies, notes) of a holonomic or non-smooth geometry."""
+    where = f"alpha = {number(env['alpha_deg'])} deg" if scenario == "wall" else f"L = {number(env['L'])} m"
+    name = "Wall" if scenario == "wall" else "Corridor"
+    if env.get("verdict") == "non-smooth":
+        yield (f"{name}, {where}: NON-SMOOTH (velocity-gated repulsion: no smooth equilibrium, no N, no linear verdict)",
+               *_non_smooth_table(scenario, env))
+        return
+    x = "d0" if scenario == "wall" else "x0"
+    first = env["equilibria"][0] if scenario == "wall" else min(env["equilibria"], key=lambda e: abs(e["x0"]))
+    title = f"{name}, {where}, holonomic robot: {x} = {number(first[x])} m, kappa = {number(env['kappa'])} 1/s^2, c_h = {number(env['c_h'])} 1/s"
+    header = ["model", "verdict", "margin", "kappa* 1/s^2", "omega* rad/s", "T* s", "c_h range 1/s"]
+    rows, fixes = [], {}
+    for model, v in verdicts.items():
+        ranges = ", ".join(f"({number(lo)}, {number(hi)})" for lo, hi in v["damping_range"]) or "none"
+        rows.append([model, v["verdict"] if v["verdict"] == "stable" else v["verdict"].upper(), percent(v["margin"]),
+                     number(v["kappa_critical"]), number(v["omega_critical"]), number(v["T_critical"]), ranges])
+        if v["verdict"] != "stable" and v["to_stabilize"]:
+            fixes[model] = v["to_stabilize"]
+    others = [e for e in env["equilibria"] if e is not first]
+    notes = ["  other equilibria: " + "; ".join(f"{x} = {number(e[x])} m, kappa = {number(e['kappa'])} 1/s^2" for e in others)] if others else []
+    yield title, header, rows, fixes, notes
+
+
+def _non_smooth_table(scenario: str, env: dict):
+    """(header, rows, remedies, notes) of a non-smooth geometry: the rest band and the simulated cycle."""
+    if scenario == "wall":
+        rows = [["rest band of a holonomic robot (Filippov)", f"d <= {number(env['d_s'])} m"],
+                ["pull F_a cos(alpha) the repulsion at rest must match", f"{number(env['friction'])} N"]]
+        notes = []
+    else:
+        mid = env["offsets"].index(min(env["offsets"], key=abs))
+        rows = [["lateral position", "neutral (both walls act as Coulomb friction)"],
+                ["friction in the middle, left / right", f"{number(env['friction_left'][mid])} / {number(env['friction_right'][mid])} N"]]
+        notes = ["  no cycle is simulated in a corridor"]
+    cycle = env.get("cycle")
+    if cycle is None:
+        if scenario == "wall":
+            notes.append("  simulated cycle: not run (--no-simulate, or no planar simulator)")
+        return ["quantity", "value"], rows, {}, notes
+    rows += [[f"simulated cycle: {label}", f"{number(cycle[key])} {unit}"] for key, label, unit in _CYCLE]
+    rows += [["simulated cycle: at rest", "yes" if cycle["at_rest"] else "no"], ["simulated cycle: touches the wall", "yes" if cycle["touches_wall"] else "no"]]
+    return ["quantity", "value"], rows, {}, notes
+
+
+def equilibrium_notes(e: dict) -> list[str]:
+    """The fuzzy law's frozen-gain N and the one-sided heading gains at one equilibrium."""
+    if "N_frozen" not in e:
+        return []
+    line = f"  fuzzy-scheduled gains: N total {number(e['N'])} 1/m (used), N frozen {number(e['N_frozen'])} 1/m"
+    if "c_plus" in e:
+        line += f"; c = {number(e['c'])} (c- {number(e['c_minus'])}, c+ {number(e['c_plus'])}); eta = {number(e['eta'])}, d eta/dd = {number(e['eta_d'])} 1/m"
+    return [line]
+
+
+def family_tail(data: dict) -> list[str]:
+    """Lines after the geometries: the fuzzy law's robust bracket and the tracking error's dynamics."""
+    lines = []
+    bracket = data.get("environment", {}).get("wall", {}).get("robust_bracket")
+    if bracket:
+        lines += ["", f"Robust bracket (eta in [{number(bracket['eta'][0])}, {number(bracket['eta'][1])}], frozen): "
+                      f"N in [{number(bracket['N'][0])}, {number(bracket['N'][1])}] 1/m, d0 in [{number(bracket['d0'][0])}, {number(bracket['d0'][1])}] m"]
+    t = data.get("tracking")
+    if t:
+        lines += ["", f"Target tracking (Ge & Cui 2002 eq 34-36): zeta = {number(t['damping_ratio'])}, "
+                      f"omega_n = {number(t['natural_frequency'])} rad/s ({t['regime']})"]
+    return lines

@@ -1,0 +1,535 @@
+"""The report for the robot loop families and the velocity-aware and fuzzy laws.
+
+`pfm_stability.report.build_report` answers KB's steering robot with a static
+lateral law. `build_family_report` answers the rest of ``report --robot`` and
+``report --law`` (docs/velocity_and_fuzzy.md, docs/models.md "Robot loop families"):
+
+* ``--robot kinematic`` (Ge & Cui 2002 §7: ω = K_s(θ_f − θ), no motor lag): KB's loop
+  with τ = 0 and k = K_s, any law;
+* ``--law velocity`` (GC2002's velocity attraction with Khatib's repulsion): on a
+  steering robot every equilibrium's N and heading gain c (N = N_static/(1 − q),
+  c = q/(1 − q)) enter the five steering models; on a holonomic robot (force =
+  acceleration, GC2002 §6) every equilibrium's κ and c_h enter the five holonomic
+  models, and the tracking error's ζ and ω_n (GC2002 eq 34–36) are added;
+* ``--law fuzzy`` (the DFAPF paper's fuzzy-scheduled repulsion): the total N and c
+  enter the steering models; N_frozen and the robust bracket are reported beside them;
+* ``--law velocity-gated`` (GC2002 eq 10–12): no smooth equilibrium, the verdict is
+  ``"non-smooth"`` with the Filippov rest band; the simulated limit cycle is added
+  above this level (`pfm_stability.validation.non_smooth`, which the CLI calls).
+
+The result is a `report.StabilityReport`, so the JSON (`to_dict`) and the text keep
+the static report's shape wherever it applies; what is new goes in its ``extras``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+
+from .checks import check_choice
+from .critical import CorridorCritical, WallCritical
+from .criteria import CorridorAnalysis, WallAnalysis, WallEquilibrium, check_loop_gain, model_verdicts
+from .fields import KhatibLaw
+from .fuzzy_law import FuzzyScheduledLaw
+from .models import Loop, models_for
+from .models.holonomic import HolonomicLoop
+from .models.holonomic_delay import make_holonomic_model
+from .parameters import (FAMILY_DEFAULTS, FAMILY_LAW_PARAMETERS, FAMILY_LAWS, MODEL_NAMES, RANGES, ROBOT_FAMILIES, Controller, Corridor,
+                         Robot, Wall, check_parameter)
+from .report import UNITS, StabilityReport, build_report, kb_error, remedies
+from .serialize import json_number
+from .tracking import tracking_dynamics
+from .velocity_laws import HolonomicGains, VelocityAttraction, VelocityGatedRepulsion
+
+__all__ = ["FamilyLaw", "HolonomicVerdict", "make_family_law", "build_family_report", "holonomic_verdict", "KINEMATIC_TAU_SOURCE"]
+
+KINEMATIC_TAU_SOURCE = "not used (kinematic robot: no motor lag, tau = 0; --k is K_s)"
+"""The source the report gives τ for ``--robot kinematic``."""
+
+HOLONOMIC_UNUSED = "not used (holonomic robot)"
+"""The source the report gives τ, k (and f, n, W) for ``--robot holonomic``."""
+
+SIDES = ("left", "right")
+"""The wall's side for the fuzzy law (its tables are left–right asymmetric)."""
+
+_DESCRIPTIONS = {
+    "velocity": "Ge & Cui 2002 velocity attraction (eq 1, 7-9) with Khatib's repulsion (GC2000 eq 3-4)",
+    "velocity-gated": "Ge & Cui 2002 velocity-gated repulsion (eq 10-12, 19-20): non-smooth",
+    "fuzzy": "DFAPF fuzzy-scheduled repulsion (controller 1, tables as printed)",
+}
+
+
+@dataclass(frozen=True)
+class FamilyLaw:
+    """A law of `parameters.FAMILY_LAWS` with every parameter it takes (docs/velocity_and_fuzzy.md).
+
+    Attributes
+    ----------
+    name : str
+        ``"velocity"``, ``"velocity-gated"`` or ``"fuzzy"``.
+    parameters : dict
+        Every key of ``FAMILY_LAW_PARAMETERS[name]`` → value (SI units).
+    side : str
+        The wall's side (``"left"`` or ``"right"``; the fuzzy law only).
+    """
+
+    name: str
+    parameters: dict
+    side: str = "left"
+
+    @property
+    def attraction(self) -> float:
+        """F_a = mα_p ρ_g^(m−1), N: the attraction's position part at the goal distance."""
+        p = self.parameters
+        return p["attraction_exponent"] * p["alpha_p"] * p["goal_distance"] ** (p["attraction_exponent"] - 1.0)
+
+    def velocity_attraction(self) -> VelocityAttraction:
+        """GC2002's attraction (α_v = 0 for the laws without one)."""
+        p = self.parameters
+        return VelocityAttraction(p["alpha_p"], p.get("alpha_v", 0.0), p["attraction_exponent"], p.get("velocity_exponent", 2.0))
+
+    def repulsion(self) -> KhatibLaw:
+        """Khatib's repulsion in units of F_a: ξ = 2α_p makes its attraction (m/2)ξρ_g^(m−1) equal F_a."""
+        p = self.parameters
+        return KhatibLaw(2.0 * p["alpha_p"], p["eta"], p["rho0"], p["attraction_exponent"], p["goal_distance"])
+
+    def gated(self) -> VelocityGatedRepulsion:
+        """GC2002's velocity-gated repulsion (`gradient` variant)."""
+        p = self.parameters
+        return VelocityGatedRepulsion(p["eta"], p["rho0"], p["a_max"])
+
+    def fuzzy(self) -> FuzzyScheduledLaw:
+        """The fuzzy-scheduled law with attraction F_a."""
+        p = self.parameters
+        return FuzzyScheduledLaw(p["rho0"], self.attraction, p["goal_exponent"], p["goal_distance"])
+
+    def described(self) -> dict:
+        """``law`` of the report: name, description, parameters (and the fuzzy law's side)."""
+        params = {**self.parameters, "attraction": self.attraction}
+        return {"name": self.name, "description": _DESCRIPTIONS[self.name] + (f", wall on the {self.side}" if self.name == "fuzzy" else ""),
+                "parameters": {k: json_number(v) for k, v in params.items()}}
+
+
+def make_family_law(name: str, side: str = "left", **parameters) -> FamilyLaw:
+    """The law `name` of `parameters.FAMILY_LAWS` with `parameters` over `parameters.FAMILY_DEFAULTS`.
+
+    Raises
+    ------
+    ValueError
+        An unknown law or side, a parameter the law does not take, or a value out of range.
+    """
+    check_choice("law", name, FAMILY_LAWS)
+    check_choice("side", side, SIDES)
+    taken = FAMILY_LAW_PARAMETERS[name]
+    given = {k: v for k, v in parameters.items() if v is not None}
+    for key in given:
+        if key not in taken:
+            raise ValueError(f"{key} is not a parameter of law {name} (it takes {', '.join(taken)})")
+    values = {key: check_parameter(key, given.get(key, FAMILY_DEFAULTS[key])) for key in taken}
+    return FamilyLaw(name, values, side)
+
+
+# ------------------------------------------------------------------ holonomic verdicts
+@dataclass(frozen=True)
+class HolonomicVerdict:
+    """One holonomic model's answer at one equilibrium: s² + (c_h s + κ)e^(−sT) (docs/models.md).
+
+    Attributes
+    ----------
+    model : str
+    kappa : float
+        κ, 1/s².
+    kappa_critical : float
+        κ*, 1/s²: stable for 0 < κ < κ* (``inf``: every κ > 0; 0: none).
+    omega_critical : float or None
+        rad/s at κ*.
+    margin : float
+        κ_edge/κ − 1 (as the steering gain margin, docs/models.md): > 0 stable, < 0 unstable.
+    verdict : str
+        "stable", "unstable" or "undecided" (within 1e-9 of an edge of the stable set).
+    T_critical : float
+        T*, s: stable for every delay / period in [0, T*) (0: unstable already at T = 0).
+    damping_range : tuple of (float, float)
+        Every interval of c_h (1/s) that makes this κ stable at the loop's T.
+    rightmost_root : complex or None
+    """
+
+    model: str
+    kappa: float
+    kappa_critical: float
+    omega_critical: float | None
+    margin: float
+    verdict: str
+    T_critical: float
+    damping_range: tuple
+    rightmost_root: complex | None
+
+    @property
+    def stable(self) -> bool:
+        """True only when the verdict is "stable"."""
+        return self.verdict == "stable"
+
+    def to_dict(self, T: float) -> dict:
+        """JSON-ready (SI units); ``to_stabilize`` names the period T* when a shorter period helps."""
+        root = self.rightmost_root
+        fix = {}
+        if not self.stable and 0 < self.T_critical < T:
+            fix["T"] = {"to": self.T_critical, "direction": "lower", "change_percent": (self.T_critical / T - 1.0) * 100}
+        return {
+            "stable": self.stable,
+            "verdict": self.verdict,
+            "kappa": self.kappa,
+            "kappa_critical": json_number(self.kappa_critical),
+            "margin": json_number(self.margin),
+            "omega_critical": json_number(self.omega_critical),
+            "rightmost_root": {"sigma": json_number(root.real), "omega": json_number(abs(root.imag))} if root is not None else {"sigma": None, "omega": None},
+            "T_critical": json_number(self.T_critical),
+            "damping_range": [[json_number(lo), json_number(hi)] for lo, hi in self.damping_range],
+            "to_stabilize": fix,
+        }
+
+
+def _kappa_margin(kappa: float, stable_set, stable: bool) -> tuple:
+    """(margin, verdict) of κ against the stable set (the steering `gain_margin`/`verdict_label` in κ)."""
+    edges = [e for lo, hi in stable_set for e in (lo, hi) if 0 < e < math.inf]
+    if kappa > 0 and any(abs(kappa / e - 1.0) <= 1e-9 for e in edges):
+        return 0.0, "undecided"
+    if kappa <= 0:
+        return -1.0, "stable" if stable else "unstable"
+    if stable:
+        holding = [hi for lo, hi in stable_set if lo <= kappa <= hi]
+        return (holding[0] / kappa - 1.0 if holding else math.inf), "stable"
+    below = [hi for lo, hi in stable_set if hi <= kappa]
+    return (max(below) / kappa - 1.0 if below else -1.0), "unstable"
+
+
+def holonomic_verdict(name: str, kappa: float, c_h: float, controller: Controller, pade_order: int = 3) -> HolonomicVerdict:
+    """The holonomic model `name` at κ (1/s²) and c_h (1/s) with the controller's T and compute delay."""
+    model = make_holonomic_model(name, pade_order=pade_order, compute_delay=controller.compute_delay)
+    loop = HolonomicLoop(controller.T, c_h)
+    boundary = model.boundary(loop)
+    stable = model.is_stable(kappa, loop)
+    margin, verdict = _kappa_margin(kappa, boundary.stable_set, stable)
+    return HolonomicVerdict(name, kappa, boundary.kappa_critical, boundary.omega_critical, margin, verdict,
+                            model.critical_delay(kappa, loop), model.damping_range(kappa, loop), model.rightmost_root(kappa, loop))
+
+
+@dataclass(frozen=True)
+class HolonomicEquilibrium(HolonomicGains):
+    """Every holonomic model's verdict at one equilibrium, with its gains (`velocity_laws.HolonomicGains`: x0 m, κ 1/s², c_h 1/s).
+
+    Attributes
+    ----------
+    models : dict[str, HolonomicVerdict]
+    """
+
+    models: dict
+
+    def models_dict(self, T: float) -> dict:
+        return {name: v.to_dict(T) for name, v in self.models.items()}
+
+
+@dataclass(frozen=True)
+class HolonomicScene:
+    """A wall or corridor for a holonomic robot: every equilibrium, the verdicts at the first (wall) or the middle (corridor).
+
+    Attributes
+    ----------
+    geometry : str
+        ``"wall"`` or ``"corridor"``.
+    value : float
+        α (deg) or L (m).
+    equilibria : tuple of HolonomicEquilibrium
+    main : int
+        Index of the equilibrium whose verdicts are the top-level ones.
+    T : float
+        The loop's period, s.
+    """
+
+    geometry: str
+    value: float
+    equilibria: tuple
+    main: int
+    T: float
+
+    def to_dicts(self) -> tuple:
+        """(environment entry, top-level verdicts), JSON-ready."""
+        first = self.equilibria[self.main]
+        key, where = ("alpha_deg", "d0") if self.geometry == "wall" else ("L", "x0")
+        env = {key: self.value, "N": None, "NV": None, "kappa": first.kappa, "c_h": first.c_h}
+        if self.geometry == "wall":
+            env["d0"] = json_number(first.x0)
+        env["equilibria"] = [{where: json_number(e.x0), "N": None, "c": None, "kappa": e.kappa, "c_h": e.c_h,
+                              **({"NV": None, "models": e.models_dict(self.T)} if self.geometry == "wall" else {})}
+                             for e in self.equilibria]
+        return env, first.models_dict(self.T)
+
+
+@dataclass(frozen=True)
+class NonSmoothScene:
+    """The velocity-gated repulsion's non-smooth verdict at a wall or in a corridor (`velocity_laws`).
+
+    Attributes
+    ----------
+    geometry : str
+    value : float
+        α (deg) or L (m).
+    result : NonSmoothWall or NonSmoothCorridor
+    cycle : dict or None
+        The simulated cycle (`validation.non_smooth.simulated_cycle`), filled above this level.
+    """
+
+    geometry: str
+    value: float
+    result: object
+    cycle: dict | None = None
+
+    def to_dicts(self) -> tuple:
+        """(environment entry, top-level verdicts = {}): the verdict, the band and the cycle."""
+        key = "alpha_deg" if self.geometry == "wall" else "L"
+        env = {key: self.value, "N": None, "NV": None, "verdict": "non-smooth"}
+        r = self.result
+        if self.geometry == "wall":
+            env.update(d0=None, rest_band=[r.rest_band[0], r.rest_band[1]], d_s=r.d_s, friction=r.friction)
+        else:
+            env.update(rest_band=[-self.value, self.value], offsets=[float(x) for x in r.offsets],
+                       friction_left=[float(x) for x in r.friction_left], friction_right=[float(x) for x in r.friction_right])
+        env["cycle"] = self.cycle
+        return env, None
+
+
+# ------------------------------------------------------------------ steering with a heading gain
+def _steering_wall(robot: Robot, controller: Controller, wall: Wall, models, equilibria, fixed_V: bool) -> WallAnalysis:
+    """Every steering model at each (d0, N, c): the loop k(cs + NV)e^(−sT); α* is not followed (NaN)."""
+    analyses = []
+    for e in equilibria:
+        NV = check_loop_gain(e.N * robot.V, f"wall equilibrium d0 = {e.x0:g} m (alpha = {wall.alpha_deg:g} deg)")
+        loop = Loop(robot.tau, controller.T, robot.k, c=e.c)
+        verdicts = model_verdicts(controller, models, loop, e.N, NV, WallCritical, lambda _: {"alpha_critical": math.nan})
+        analyses.append(WallEquilibrium(e.x0, e.N, e.c, NV, _speed_free(verdicts, fixed_V)))
+    if not analyses:
+        raise ValueError(f"alpha = {wall.alpha_deg:g} deg: the law has no equilibrium beside the wall (it never balances the pull)")
+    first = analyses[0]
+    return WallAnalysis(wall.alpha, first.d0, first.N, first.NV, first.models, first.c, tuple(analyses))
+
+
+def _steering_corridor(robot: Robot, controller: Controller, corridor: Corridor, models, equilibria, fixed_V: bool) -> CorridorAnalysis:
+    """Every steering model at the equilibrium nearest the centre line; L* is not followed (NaN)."""
+    if not equilibria:
+        raise ValueError(f"L = {corridor.L:g} m: the law has no lateral equilibrium in this corridor")
+    e = min(equilibria, key=lambda q: abs(q.x0))
+    NV = check_loop_gain(e.N * robot.V, f"corridor equilibrium x0 = {e.x0:g} m (L = {corridor.L:g} m)")
+    loop = Loop(robot.tau, controller.T, robot.k, c=e.c)
+    verdicts = model_verdicts(controller, models, loop, e.N, NV, CorridorCritical, lambda _: {"L_critical": math.nan})
+    return CorridorAnalysis(corridor.L, e.N, NV, _speed_free(verdicts, fixed_V), e.c, tuple(equilibria))
+
+
+def _speed_free(verdicts: dict, fixed_V: bool) -> dict:
+    """The verdicts; with N and c moving with V (the velocity law) V* = NV*/N does not hold: NaN (null)."""
+    if fixed_V:
+        return verdicts
+    return {name: replace(v, critical=replace(v.critical, V_critical=math.nan)) for name, v in verdicts.items()}
+
+
+def _holonomic_scene(geometry, value, gains, controller, models, pade_order, main) -> HolonomicScene:
+    if not gains:
+        raise ValueError(f"{'alpha' if geometry == 'wall' else 'L'} = {value:g}: the law has no equilibrium here (it never balances the pull)")
+    flat = [g.x0 for g in gains if g.kappa == 0.0]
+    if flat:
+        raise ValueError(f"{'alpha' if geometry == 'wall' else 'L'} = {value:g}: no lateral stiffness at x0 = {flat[0]:g} m (kappa = 0: "
+                         f"the repulsion does not reach there, rho0 too short); raise --rho0")
+    equilibria = tuple(
+        HolonomicEquilibrium(g.x0, g.kappa, g.c_h, {name: holonomic_verdict(name, g.kappa, g.c_h, controller, pade_order) for name in models})
+        for g in gains
+    )
+    index = 0 if main == "first" else min(range(len(gains)), key=lambda i: abs(gains[i].x0))
+    return HolonomicScene(geometry, value, equilibria, index, controller.T)
+
+
+# ------------------------------------------------------------------ the report
+def build_family_report(
+    robot: Robot,
+    controller: Controller,
+    *,
+    family: str = "steering",
+    law=None,
+    alpha_deg: float | None = None,
+    L: float | None = None,
+    models=MODEL_NAMES,
+    pade_order: int = 3,
+    mass: float = 1.0,
+    sources: dict | None = None,
+) -> StabilityReport:
+    """The report of any robot family and law (module docstring; docs/velocity_and_fuzzy.md).
+
+    Parameters
+    ----------
+    robot, controller : Robot, Controller
+        ``--robot kinematic`` uses k as K_s and ignores τ; ``holonomic`` uses T, the
+        compute delay and V (which enters only through a velocity exponent n ≠ 2).
+    family : {"steering", "kinematic", "holonomic"}
+    law : ForceLaw or FamilyLaw, optional
+        A static law (`fields.make_law`; KB's power law by default) or a `FamilyLaw`
+        (`make_family_law`). A holonomic robot takes ``velocity`` or ``velocity-gated`` only.
+    alpha_deg : float, optional
+        Wall target angle, deg.
+    L : float, optional
+        Corridor half-width, m.
+    models, pade_order
+        As `report.build_report`.
+    mass : float
+        The holonomic robot's mass, kg (κ = −F_x′/m, c_h = nα_v V^(n−2)/m).
+    sources : dict, optional
+        Provenance of each input.
+
+    Returns
+    -------
+    StabilityReport
+        With ``extras``: ``tracking`` (holonomic ``velocity``, m = n = 2), the
+        holonomic scenes and the non-smooth scenes (filled by `to_dict`).
+
+    Raises
+    ------
+    ValueError
+        An unknown family, a law the family does not take, no geometry, or any parameter out of range.
+    """
+    check_choice("robot", family, ROBOT_FAMILIES)
+    if alpha_deg is None and L is None:
+        raise ValueError(f"alpha or L must be given: a wall (--alpha DEG, in {RANGES['alpha_deg'].describe()}) and/or a corridor (--L M)")
+    sources = dict(sources or {})
+    mass = check_parameter("mass", mass)
+    family_law = law if isinstance(law, FamilyLaw) else None
+    if family == "holonomic" and (family_law is None or family_law.name == "fuzzy"):
+        shown = family_law.name if family_law is not None else getattr(law, "key", None) or "power"
+        raise ValueError(f"--robot holonomic takes --law velocity or velocity-gated (a force in newtons on a mass, Ge & Cui 2002 Sec 6); got --law {shown}")
+    if family == "kinematic":
+        robot = robot.replace(tau=0.0)
+        sources["tau"] = KINEMATIC_TAU_SOURCE
+    if family_law is None:
+        report = build_report(robot, controller, alpha_deg=alpha_deg, L=L, models=models, pade_order=pade_order, sources=sources, law=law)
+        return _with_family(report, family, sources)
+    models = tuple(dict.fromkeys(models))
+    for name in models:
+        check_choice("model", name, MODEL_NAMES)
+    model_objs = _model_objects(controller, models, pade_order, family)
+    wall = Wall.from_degrees(alpha_deg) if alpha_deg is not None else None
+    corridor = Corridor(L) if L is not None else None
+    inputs = _inputs(robot, controller, family, family_law, mass, pade_order, wall, corridor, sources)
+    extras = {}
+    if family_law.name == "velocity-gated":
+        return _non_smooth(inputs, family_law, wall, corridor, family)
+    if family == "holonomic":
+        return _holonomic(inputs, family_law, controller, robot, wall, corridor, models, pade_order, mass)
+    if family_law.name == "velocity":
+        att, rep, rho_g = family_law.velocity_attraction(), family_law.repulsion(), family_law.parameters["goal_distance"]
+        wall_eq = att.steering_wall_equilibria(rep, wall.alpha, robot.V, rho_g) if wall else None
+        corr_eq = att.steering_corridor_equilibria(rep, corridor.L, robot.V, rho_g) if corridor else None
+    else:
+        fuzzy = family_law.fuzzy()
+        wall_eq = fuzzy.wall_equilibria(wall.alpha, family_law.side) if wall else None
+        corr_eq = fuzzy.corridor_equilibria(corridor.L) if corridor else None
+        if wall:
+            bracket = fuzzy.robust_bracket(wall.alpha)
+            extras["environment"] = {"wall": {
+                "equilibria": [{"N_frozen": e.N_frozen, "eta": e.eta, "eta_d": e.eta_d, "c_plus": e.c_plus, "c_minus": e.c_minus} for e in wall_eq],
+                "robust_bracket": {"eta": list(bracket.eta), "N": list(bracket.N), "d0": list(bracket.d0)},
+            }}
+    fixed_V = family_law.name == "fuzzy"
+    wall_result = _steering_wall(robot, controller, wall, model_objs, wall_eq, fixed_V) if wall else None
+    corridor_result = _steering_corridor(robot, controller, corridor, model_objs, corr_eq, fixed_V) if corridor else None
+    if corridor and family_law.name == "fuzzy":
+        extras.setdefault("environment", {})["corridor"] = {"equilibria": [{"N_frozen": e.N_frozen} for e in corridor_result.equilibria]}
+    fixes = {}
+    static = family_law.repulsion() if family_law.name == "velocity" else None
+    if wall_result is not None:
+        for i, e in enumerate(wall_result.equilibria):
+            for name, verdict in e.models.items():
+                fixes[("wall", i, name)] = _loop_remedies(verdict, robot, controller, static)
+        fixes.update({("wall", name): fixes[("wall", 0, name)] for name in wall_result.models})
+    if corridor_result is not None:
+        for name, verdict in corridor_result.models.items():
+            fixes[("corridor", name)] = _loop_remedies(verdict, robot, controller, static)
+    options = {m.name: {"equation": m.equation, **m.options()} for m in model_objs}
+    return StabilityReport(inputs, options, wall_result, corridor_result, kb_error(robot, controller), fixes, family_law.described(), None, extras)
+
+
+def _loop_remedies(verdict, robot: Robot, controller: Controller, static) -> dict:
+    """`report.remedies` limited to what the verdict's critical values support (V, T, k)."""
+    from .force_law import PowerLaw
+
+    law = static if static is not None else PowerLaw(controller.f, controller.n, robot.W)
+    fix = remedies("corridor" if "L_critical" in verdict.critical else "wall", verdict, robot, controller, law)
+    return {k: v for k, v in fix.items() if k in ("V", "T", "k")}
+
+
+def _model_objects(controller: Controller, models, pade_order: int, family: str) -> tuple:
+    """The steering models (`models.models_for`, ``sampled`` as the controller samples) or the holonomic ones."""
+    if family == "holonomic":
+        return tuple(make_holonomic_model(name, pade_order=pade_order, compute_delay=controller.compute_delay) for name in models)
+    return tuple(models_for(controller, models, pade_order=pade_order))
+
+
+def _inputs(robot, controller, family, family_law, mass, pade_order, wall, corridor, sources) -> dict:
+    """The report's inputs: the robot family, the robot and controller, the law's parameters, the geometry."""
+    holonomic = family == "holonomic"
+    values = {"robot": family, "V": robot.V, "tau": robot.tau, "T": controller.T, "k": robot.k}
+    if holonomic:
+        values["mass"] = mass
+    values.update(family_law.parameters)
+    if family_law.name == "fuzzy":
+        values["side"] = family_law.side
+    values.update({"hold": controller.hold, "compute_delay": controller.compute_delay, "pade_order": pade_order})
+    if wall is not None:
+        values["alpha_deg"] = wall.alpha_deg
+    if corridor is not None:
+        values["L"] = corridor.L
+    out = {}
+    for name, value in values.items():
+        source = sources.get(name, "default" if name in FAMILY_DEFAULTS else "user")
+        if holonomic and name in ("tau", "k", "hold"):
+            source = HOLONOMIC_UNUSED
+        out[name] = {"value": value, "unit": _unit(name), "source": source}
+    return out
+
+
+def _unit(name: str) -> str:
+    if name in UNITS:
+        return UNITS[name]
+    return RANGES[name].unit if name in RANGES else ""
+
+
+def _with_family(report: StabilityReport, family: str, sources: dict) -> StabilityReport:
+    """A static law's report with the robot family among its inputs (nothing added for KB's steering robot)."""
+    if family == "steering":
+        return report
+    inputs = {"robot": {"value": family, "unit": "", "source": sources.get("robot", "user")}, **report.inputs}
+    return replace(report, inputs=inputs)
+
+
+def _holonomic(inputs, family_law, controller, robot, wall, corridor, models, pade_order, mass) -> StabilityReport:
+    """κ, c_h and every holonomic model at each equilibrium; the tracking error's ζ, ω_n for m = n = 2."""
+    att, rep, rho_g = family_law.velocity_attraction(), family_law.repulsion(), family_law.parameters["goal_distance"]
+    scenes = {}
+    if wall is not None:
+        gains = att.holonomic_wall_gains(rep, wall.alpha, rho_g, mass, robot.V)
+        scenes["wall"] = _holonomic_scene("wall", wall.alpha_deg, gains, controller, models, pade_order, "first")
+    if corridor is not None:
+        gains = att.holonomic_corridor_gains(rep, corridor.L, rho_g, mass, robot.V)
+        scenes["corridor"] = _holonomic_scene("corridor", corridor.L, gains, controller, models, pade_order, "middle")
+    extras = {"scenes": scenes}
+    if att.m == 2.0 and att.n == 2.0:
+        t = tracking_dynamics(att.alpha_p, att.alpha_v, mass)
+        extras["tracking"] = {"damping_ratio": t.damping_ratio, "natural_frequency": t.natural_frequency, "regime": t.regime}
+    options = {m.name: {"equation": m.equation, **m.options()} for m in _model_objects(controller, models, pade_order, "holonomic")}
+    return StabilityReport(inputs, options, None, None, None, {}, family_law.described(), None, extras)
+
+
+def _non_smooth(inputs, family_law, wall, corridor, family) -> StabilityReport:
+    """The non-smooth verdict: the rest band at a wall, the friction levels in a corridor; the cycle is filled above."""
+    gated = family_law.gated()
+    scenes = {}
+    if wall is not None:
+        scenes["wall"] = NonSmoothScene("wall", wall.alpha_deg, gated.non_smooth_wall(family_law.attraction, wall.alpha))
+    if corridor is not None:
+        scenes["corridor"] = NonSmoothScene("corridor", corridor.L, gated.non_smooth_corridor(corridor.L))
+    return StabilityReport(inputs, {}, None, None, None, {}, family_law.described(), None, {"scenes": scenes})

@@ -1,0 +1,154 @@
+"""`pfm-stability report --law velocity|fuzzy|velocity-gated` on a steering robot (docs/velocity_and_fuzzy.md).
+
+The velocity attraction and the fuzzy-scheduled law reach the KB loop through N and the
+heading gain c: the report's gains are checked against `velocity_laws`/`fuzzy_law` and an
+independent reconstruction (N_static from Khatib's law, q from the forces), and its
+verdicts against the steering models run with `Loop(τ, T, k, c=c)`. The velocity-gated
+law gives the non-smooth verdict with its rest band and, from the planar simulator, its cycle.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from cli_helpers import report_json, run
+
+from pfm_stability import CARMEL
+from pfm_stability.force_law import wall_equilibria
+from pfm_stability.fuzzy_law import FuzzyScheduledLaw
+from pfm_stability.models import ExactDelay, Loop, make_model
+
+FUZZY_WALL = ["--law", "fuzzy", "--alpha-p", "50", "--rho0", "0.5", "--alpha", "60"]  # F_a = 2·50·1 = 100 N (docs/velocity_and_fuzzy.md)
+
+
+def check_verdicts(models: dict, N: float, c: float, V: float):
+    """Each model's NV*, stability and margin from the model itself with the heading gain c (rel 1e-9: the same boundary route)."""
+    loop = Loop(CARMEL.robot.tau, CARMEL.controller.T, CARMEL.robot.k, c=c)
+    for name, v in models.items():
+        model = make_model(name, hold=CARMEL.controller.hold, compute_delay=CARMEL.controller.compute_delay) if name == "sampled" else make_model(name)
+        NV_star = model.boundary(loop).NV_critical
+        assert v["NV"] == pytest.approx(N * V, rel=1e-12)
+        assert v["NV_critical"] == pytest.approx(NV_star, rel=1e-9), name
+        assert v["stable"] == model.is_stable(N * V, loop), name
+        assert v["margin"] == pytest.approx(NV_star / (N * V) - 1, rel=1e-9), name
+
+
+def test_fuzzy_wall_gains_per_equilibrium_and_verdicts_use_total_N_and_c():
+    """Left wall, ρ0 0.5, F_a 100, α 60°: N frozen 13.459, N total 13.499, c 0.168 (docs/velocity_and_fuzzy.md table,
+    3–5 digits); every equilibrium's N, N_frozen, c equal `FuzzyScheduledLaw.wall_equilibria` exactly; the verdicts
+    are the models' at N total and c (not N frozen)."""
+    d = report_json(FUZZY_WALL)
+    law = FuzzyScheduledLaw(0.5, 100.0)
+    expected = law.wall_equilibria(math.radians(60), "left")
+    eqs = d["environment"]["wall"]["equilibria"]
+    assert [(e["d0"], e["N"], e["N_frozen"], e["c"]) for e in eqs] == [(q.x0, q.N, q.N_frozen, q.c) for q in expected]
+    first = eqs[0]
+    assert first["N_frozen"] == pytest.approx(13.459, abs=5e-4) and first["N"] == pytest.approx(13.499, abs=5e-4)
+    assert first["c"] == pytest.approx(0.168, abs=5e-4)
+    check_verdicts(first["models"], first["N"], first["c"], CARMEL.robot.V)
+    bracket = d["environment"]["wall"]["robust_bracket"]
+    assert bracket["N"] == pytest.approx([9.147, 23.175], abs=1e-3)
+
+
+def test_fuzzy_right_wall_and_corridor():
+    """The right wall (tables asymmetric): N total 13.256, c 0.403 (docs table, 3 decimals); the corridor's verdicts
+    are at the equilibrium nearest the centre line, with its N total and c."""
+    d = report_json([*FUZZY_WALL, "--side", "right", "--L", "0.4", "--model", "exact_delay"])
+    e = d["environment"]["wall"]["equilibria"][0]
+    assert e["N"] == pytest.approx(13.256, abs=1e-3) and e["c"] == pytest.approx(0.403, abs=1e-3)
+    corridor = d["environment"]["corridor"]
+    mid = min(corridor["equilibria"], key=lambda q: abs(q["x0"]))
+    assert corridor["N"] == mid["N"] and corridor["c"] == mid["c"]
+    check_verdicts(d["corridor"], mid["N"], mid["c"], CARMEL.robot.V)
+
+
+def test_velocity_law_steering_gains_against_static_law_and_q():
+    """N = N_static/(1 − q), c = q/(1 − q), q = 2α_v V/(F_a sin α) (GC2002 §7, n = 2): N_static from Khatib's law
+    (`force_law.wall_equilibria`), on random α_v, α, V; and the models at that c. rel 1e-12 on the gains (same algebra)."""
+    rng = np.random.default_rng(7)
+    for _ in range(4):
+        alpha, V = rng.uniform(30, 80), rng.uniform(0.2, 1.5)
+        Fa = 1.0  # defaults: α_p 0.5, m 2, ρ_g 1
+        alpha_v = rng.uniform(0.05, 0.6) * Fa * math.sin(math.radians(alpha)) / (2 * V)  # q in (0.05, 0.6)
+        d = report_json(["--law", "velocity", "--alpha-v", repr(alpha_v), "--alpha", repr(alpha), "--V", repr(V), "--model", "exact_delay"])
+        from pfm_stability.family_report import make_family_law
+
+        static = wall_equilibria(make_family_law("velocity").repulsion(), math.radians(alpha))
+        q = 2 * alpha_v * V / (Fa * math.sin(math.radians(alpha)))
+        eqs = d["environment"]["wall"]["equilibria"]
+        assert len(eqs) == len(static)
+        for e, s in zip(eqs, static):
+            assert e["d0"] == s.x0 and e["N"] == pytest.approx(s.N / (1 - q), rel=1e-12) and e["c"] == pytest.approx(q / (1 - q), rel=1e-12)
+        V_check = eqs[0]["models"]["exact_delay"]
+        assert V_check["V_critical"] is None  # N and c move with V: no V* = NV*/N
+        check_verdicts(eqs[0]["models"], eqs[0]["N"], eqs[0]["c"], V)
+
+
+def test_velocity_law_exact_delay_NV_star_for_c_one_half():
+    """docs/models.md: CARMEL's exact-delay NV* for c = 0.5 is 3.92682 (5 digits). q = 1/3 gives c = 0.5:
+    α_v = F_a sin α/(6V) with F_a = 1, α = 60°, V = 0.8."""
+    alpha_v = math.sin(math.radians(60)) / (6 * 0.8)
+    d = report_json(["--law", "velocity", "--alpha-v", repr(alpha_v), "--alpha", "60", "--model", "exact_delay"])
+    assert d["environment"]["wall"]["c"] == pytest.approx(0.5, rel=1e-12)
+    assert d["wall"]["exact_delay"]["NV_critical"] == pytest.approx(3.92682, abs=1e-5)
+    assert ExactDelay().boundary(Loop(0.3, 0.065, 2.0, c=0.5)).NV_critical == pytest.approx(3.92682, abs=1e-5)
+
+
+def test_velocity_gated_is_non_smooth_with_its_band():
+    """η 0.1, F_a 1, α 60°: verdict "non-smooth", rest band [0, d_s], d_s = √(η/(F_a cos α)) = 0.4472 m;
+    a corridor: non-smooth, friction η/(L ± x)² inside ρ0 (docs/velocity_and_fuzzy.md). No linear verdicts."""
+    d = report_json(["--law", "velocity-gated", "--eta", "0.1", "--alpha", "60", "--L", "0.5", "--no-simulate"])
+    wall, corridor = d["environment"]["wall"], d["environment"]["corridor"]
+    assert wall["verdict"] == "non-smooth" and corridor["verdict"] == "non-smooth"
+    d_s = math.sqrt(0.1 / math.cos(math.radians(60)))
+    assert wall["d_s"] == pytest.approx(d_s, rel=1e-12) and wall["rest_band"] == [0.0, pytest.approx(d_s, rel=1e-12)]
+    assert wall["cycle"] is None and "wall" not in d and "corridor" not in d
+    x = np.array(corridor["offsets"])
+    inside = (0.5 + x) < 0.8
+    assert np.allclose(np.array(corridor["friction_left"])[inside], 0.1 / (0.5 + x[inside]) ** 2, rtol=1e-12)
+
+
+@pytest.mark.parametrize("family", ["steering", "kinematic", "holonomic"])
+def test_velocity_gated_cycle_from_the_planar_simulator(family):
+    """With the simulator: η 0.1, a_max 1, F_a 1, α 60°, CARMEL's V 0.8, τ 0.3, k 2, hold, T 0.065, compute delay 1.
+    The report's cycle is `sim.cycles.wall_cycle` of the family's robot (KB's steering robot, τ = 0 for kinematic,
+    a point mass for holonomic), exactly: the wiring is checked against a direct call with the parameters written
+    out here; and it lies where the band says (mean and closest distance inside the rest band (0, d_s])."""
+    from pfm_stability.sim.cycles import wall_cycle
+    from pfm_stability.sim.planar import PointMass, Steering
+    from pfm_stability.velocity_laws import VelocityGatedRepulsion
+
+    d = report_json(["--law", "velocity-gated", "--eta", "0.1", "--a-max", "1", "--alpha", "60", "--robot", family])
+    cycle = d["environment"]["wall"]["cycle"]
+    robot = PointMass(1.0, 1.0) if family == "holonomic" else Steering(0.8, 0.0 if family == "kinematic" else 0.3, 2.0, hold="command")
+    direct = wall_cycle(VelocityGatedRepulsion(0.1, 0.8, 1.0), 1.0, math.radians(60), robot, T=0.065, compute_delay=1).to_dict()
+    assert cycle == direct  # JSON keeps floats exactly (repr round trip)
+    d_s = d["environment"]["wall"]["d_s"]
+    assert 0 < cycle["min_distance"] <= cycle["mean_distance"] <= d_s and not cycle["touches_wall"]
+    code, out, _ = run(["report", "--law", "velocity-gated", "--eta", "0.1", "--alpha", "60", "--robot", family])
+    assert code == 0 and "NON-SMOOTH" in out and "simulated cycle: mean distance" in out
+
+
+def test_velocity_gated_with_a_continuous_controller_has_no_cycle():
+    """T = 0: nothing sampled to simulate; the band alone, exit 0."""
+    d = report_json(["--law", "velocity-gated", "--alpha", "60", "--T", "0"])
+    assert d["environment"]["wall"]["cycle"] is None
+
+
+@pytest.mark.parametrize("argv,message", [
+    (["--alpha-v", "-1", "--law", "velocity", "--L", "1"], "argument --alpha-v: alpha_v must be a finite number in [0, 1000000] N s/m"),
+    (["--alpha-p", "1", "--L", "1"], "--alpha-p applies to --law velocity or velocity-gated or fuzzy, not to --law power"),
+    (["--law", "velocity", "--xi", "1", "--L", "1"], "--xi applies to --law khatib or gnron, not to --law velocity"),
+    (["--law", "fuzzy", "--alpha-v", "1", "--alpha", "60"], "--alpha-v applies to --law velocity, not to --law fuzzy"),
+    (["--law", "velocity", "--f", "2", "--alpha", "60"], "--f applies to --law power or grid, not to --law velocity"),
+    (["--law", "velocity", "--side", "left", "--alpha", "60"], "--side applies to --law fuzzy"),
+    (["--a-max", "0", "--law", "velocity-gated", "--alpha", "60"], "argument --a-max: a_max must be a finite number in (0, 1000000] m/s^2"),
+    (["--law", "velocity", "--alpha-v", "10", "--alpha", "60"], "V must be below the speed at which the velocity attraction cancels"),
+])
+def test_bad_input_exits_2_naming_the_option(argv, message):
+    """Bad input: exit 2, nothing on stdout, one line naming the option and its range or the law it applies to."""
+    code, out, err = run(["report", *argv])
+    assert code == 2 and out == "", err
+    assert err.startswith("pfm-stability: error: ") and message in err and len(err.splitlines()) == 1, err
