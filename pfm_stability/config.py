@@ -10,10 +10,10 @@
     assumed: {k: "why this value is an assumption"}
 
 ``robot.family`` and ``robot.mass`` (`parameters.ROBOT_FAMILIES`) and the laws of
-`parameters.FAMILY_LAWS` (their parameters `parameters.FAMILY_LAW_PARAMETERS` and
-``side``) are read by ``report`` only (``--robot``, ``--mass``, ``--law velocity`` …,
-docs/velocity_and_fuzzy.md); the braking deceleration ``a_max`` is a parameter of the law
-``velocity-gated``, as ``--a-max`` is.
+`parameters.FAMILY_LAWS` (their parameters `parameters.FAMILY_LAW_PARAMETERS` and their
+choices `parameters.FAMILY_LAW_CHOICES`: ``variant``, ``side``, ``symmetrize``) are read by
+``report`` only (``--robot``, ``--mass``, ``--law velocity`` …, docs/velocity_and_fuzzy.md);
+the braking deceleration ``a_max`` is a parameter of the law ``velocity-gated``, as ``--a-max`` is.
 
 Keys are the command-line option names with underscores (``compute_delay``,
 ``cell_size``); units are SI, angles (α) in degrees and the steering rate in
@@ -38,8 +38,8 @@ from pathlib import Path
 
 from .checks import check_choice, check_integer, check_number
 from .nav2 import is_nav2, read_nav2
-from .parameters import (FAMILY_LAW_PARAMETERS, FAMILY_LAWS, FORCE_LAWS, HOLDS, LAW_PARAMETERS, RANGES, ROBOT_FAMILIES, Controller,
-                         Preset, Robot, get_preset)
+from .parameters import (FAMILY_LAW_CHOICES, FAMILY_LAW_PARAMETERS, FAMILY_LAWS, FORCE_LAWS, HOLDS, LAW_PARAMETERS, RANGES, ROBOT_FAMILIES,
+                         Controller, Preset, Robot, get_preset)
 
 __all__ = [
     "Config",
@@ -66,11 +66,11 @@ FAMILY_ROBOT_KEYS = ("family", "mass")
 """Keys of ``robot:`` beyond `ROBOT_KEYS`, read by ``report`` only: the loop family
 (`parameters.ROBOT_FAMILIES`, ``--robot``) and the holonomic robot's mass in kg (``--mass``)."""
 
-SIDES = ("left", "right")
+SIDES = FAMILY_LAW_CHOICES["fuzzy"]["side"]
 """Values of ``law.side`` (the fuzzy law's wall side, ``--side``)."""
 
 _ALL_LAWS = FORCE_LAWS + FAMILY_LAWS
-_ALL_LAW_PARAMETERS = {**LAW_PARAMETERS, **{name: (*keys, "side") if name == "fuzzy" else keys for name, keys in FAMILY_LAW_PARAMETERS.items()}}
+_ALL_LAW_PARAMETERS = {**LAW_PARAMETERS, **{name: (*keys, *FAMILY_LAW_CHOICES[name]) for name, keys in FAMILY_LAW_PARAMETERS.items()}}
 
 CONTROLLER_KEYS = ("T", "f", "n", "hold", "compute_delay")
 """Keys of ``controller:`` (`parameters.Controller`)."""
@@ -78,7 +78,7 @@ CONTROLLER_KEYS = ("T", "f", "n", "hold", "compute_delay")
 LAW_KEYS = ("name",) + tuple(dict.fromkeys(k for names in _ALL_LAW_PARAMETERS.values() for k in names if k not in ("f", "n")))
 """Keys of ``law:``: the law's name (`parameters.FORCE_LAWS`, `parameters.FAMILY_LAWS`) and the parameters of
 `parameters.LAW_PARAMETERS` beyond f and n (those are the controller's), of `parameters.FAMILY_LAW_PARAMETERS`
-and the fuzzy law's ``side``."""
+and of `parameters.FAMILY_LAW_CHOICES` (``variant``; ``side``, ``symmetrize``)."""
 
 SCENARIO_KEYS = {"wall": ("alpha",), "corridor": ("L",)}
 """Keys of ``scenario:``: ``wall: {alpha: deg}`` fills ``--alpha``, ``corridor: {L: m}`` fills ``--L``."""
@@ -325,8 +325,8 @@ def _law(origin, values) -> dict:
         if key not in _ALL_LAW_PARAMETERS[name]:
             takers = _either([k for k in _ALL_LAWS if key in _ALL_LAW_PARAMETERS[k]])
             raise ValueError(f"{origin}: law.{key} applies to {takers}, not to law {name}")
-        if key == "side":
-            law[key] = _in_range(origin, lambda: check_choice("law.side", value, SIDES))
+        if key in FAMILY_LAW_CHOICES.get(name, {}):
+            law[key] = _in_range(origin, lambda: check_choice(f"law.{key}", value, FAMILY_LAW_CHOICES[name][key]))
         elif key == "window_cells":
             r = RANGES[key]
             message = f"{origin}: law.window_cells must be an odd integer in [{int(r.low)}, {int(r.high)}]; got {value!r}"

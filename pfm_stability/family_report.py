@@ -24,18 +24,20 @@ the static report's shape wherever it applies; what is new goes in its ``extras`
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
+from functools import lru_cache
 
 from .checks import check_choice
 from .critical import CorridorCritical, WallCritical
 from .criteria import CorridorAnalysis, WallAnalysis, WallEquilibrium, check_loop_gain, model_verdicts
 from .fields import KhatibLaw
+from .fuzzy import DfapfControllers, load_dfapf
 from .fuzzy_law import FuzzyScheduledLaw
 from .models import Loop, models_for
 from .models.holonomic import HolonomicLoop
 from .models.holonomic_delay import make_holonomic_model
-from .parameters import (FAMILY_DEFAULTS, FAMILY_LAW_PARAMETERS, FAMILY_LAWS, MODEL_NAMES, RANGES, ROBOT_FAMILIES, Controller, Corridor,
-                         Robot, Wall, check_parameter)
+from .parameters import (FAMILY_CHOICE_DEFAULTS, FAMILY_DEFAULTS, FAMILY_LAW_CHOICES, FAMILY_LAW_PARAMETERS, FAMILY_LAWS, MODEL_NAMES, RANGES,
+                         ROBOT_FAMILIES, Controller, Corridor, Robot, Wall, check_parameter)
 from .report import UNITS, StabilityReport, build_report, kb_error, remedies
 from .serialize import json_number
 from .tracking import tracking_dynamics
@@ -49,13 +51,28 @@ KINEMATIC_TAU_SOURCE = "not used (kinematic robot: no motor lag, tau = 0; --k is
 HOLONOMIC_UNUSED = "not used (holonomic robot)"
 """The source the report gives τ, k (and f, n, W) for ``--robot holonomic``."""
 
-SIDES = ("left", "right")
-"""The wall's side for the fuzzy law (its tables are left–right asymmetric)."""
+_LIBRARY_VALUES = {"variant": {"paper-eq23": "paper_eq23"}, "symmetrize": {"none": False}}
+"""The one place where a user-facing choice (`parameters.FAMILY_LAW_CHOICES`) is spelt as the library spells it:
+``--variant paper-eq23`` is `velocity_laws.VelocityGatedRepulsion`'s ``"paper_eq23"``, ``--symmetrize none``
+is `fuzzy.load_dfapf`'s ``False``; every other value is passed as it is."""
+
+_VARIANT_TEXT = {
+    "gradient": "gradient variant, magnitude eta/D^2 (eq 12, 19)",
+    "squared": "squared variant, magnitude eta(1/D - 1/rho0)^2",
+    "paper-eq23": "paper-eq23 variant, magnitude eta^3(1/D - 1/rho0)^2 (eq 23 as printed)",
+}
+"""How the law's description names the velocity-gated repulsion's variant."""
+
+
+@lru_cache(maxsize=None)
+def _dfapf(symmetrize: str) -> DfapfControllers:
+    """The DFAPF controllers for ``--symmetrize`` (read once per value: the tables do not change)."""
+    return load_dfapf(symmetrize=_LIBRARY_VALUES["symmetrize"].get(symmetrize, symmetrize))
 
 _DESCRIPTIONS = {
     "velocity": "Ge & Cui 2002 velocity attraction (eq 1, 7-9) with Khatib's repulsion (GC2000 eq 3-4)",
     "velocity-gated": "Ge & Cui 2002 velocity-gated repulsion (eq 10-12, 19-20): non-smooth",
-    "fuzzy": "DFAPF fuzzy-scheduled repulsion (controller 1, tables as printed)",
+    "fuzzy": "DFAPF fuzzy-scheduled repulsion (controller 1, {tables})",
 }
 
 
@@ -69,13 +86,23 @@ class FamilyLaw:
         ``"velocity"``, ``"velocity-gated"`` or ``"fuzzy"``.
     parameters : dict
         Every key of ``FAMILY_LAW_PARAMETERS[name]`` → value (SI units).
-    side : str
-        The wall's side (``"left"`` or ``"right"``; the fuzzy law only).
+    choices : dict
+        Every key of ``FAMILY_LAW_CHOICES[name]`` → value as the user spells it
+        (velocity-gated: ``variant``; fuzzy: ``side``, ``symmetrize``); empty for ``velocity``.
     """
 
     name: str
     parameters: dict
-    side: str = "left"
+    choices: dict = field(default_factory=dict)
+
+    def choice(self, key: str) -> str:
+        """The value of the choice `key` (`parameters.FAMILY_CHOICE_DEFAULTS` when not given)."""
+        return self.choices.get(key, FAMILY_CHOICE_DEFAULTS[key])
+
+    @property
+    def side(self) -> str:
+        """The wall's side of the fuzzy law (``"left"`` for the laws without one)."""
+        return self.choice("side")
 
     @property
     def attraction(self) -> float:
@@ -94,39 +121,67 @@ class FamilyLaw:
         return KhatibLaw(2.0 * p["alpha_p"], p["eta"], p["rho0"], p["attraction_exponent"], p["goal_distance"])
 
     def gated(self) -> VelocityGatedRepulsion:
-        """GC2002's velocity-gated repulsion (`gradient` variant)."""
+        """GC2002's velocity-gated repulsion in the law's ``variant`` (`velocity_laws.VARIANTS`)."""
         p = self.parameters
-        return VelocityGatedRepulsion(p["eta"], p["rho0"], p["a_max"])
+        variant = self.choice("variant")
+        return VelocityGatedRepulsion(p["eta"], p["rho0"], p["a_max"], variant=_LIBRARY_VALUES["variant"].get(variant, variant))
 
     def fuzzy(self) -> FuzzyScheduledLaw:
-        """The fuzzy-scheduled law with attraction F_a."""
+        """The fuzzy-scheduled law with attraction F_a and the DFAPF tables as ``symmetrize`` says (`fuzzy.load_dfapf`)."""
         p = self.parameters
-        return FuzzyScheduledLaw(p["rho0"], self.attraction, p["goal_exponent"], p["goal_distance"])
+        controllers = _dfapf(self.choice("symmetrize"))
+        return FuzzyScheduledLaw(p["rho0"], self.attraction, p["goal_exponent"], p["goal_distance"], controllers=controllers)
 
     def described(self) -> dict:
-        """``law`` of the report: name, description, parameters (and the fuzzy law's side)."""
+        """``law`` of the report: name, description (naming the law's choices), parameters."""
         params = {**self.parameters, "attraction": self.attraction}
-        return {"name": self.name, "description": _DESCRIPTIONS[self.name] + (f", wall on the {self.side}" if self.name == "fuzzy" else ""),
+        return {"name": self.name, "description": _DESCRIPTIONS[self.name].format(tables=self._tables()) + self._choices_text(),
                 "parameters": {k: json_number(v) for k, v in params.items()}}
 
+    def _tables(self) -> str:
+        """How the fuzzy law's description names its tables (``symmetrize``)."""
+        mirrored = self.choice("symmetrize")
+        return "tables as printed" if mirrored == "none" else f"tables made left-right symmetric: {mirrored}-bearing rows mirrored"
 
-def make_family_law(name: str, side: str = "left", **parameters) -> FamilyLaw:
+    def _choices_text(self) -> str:
+        """The description's tail naming the law's choices (nothing for ``velocity``)."""
+        if self.name == "velocity-gated":
+            return ", " + _VARIANT_TEXT[self.choice("variant")]
+        if self.name == "fuzzy":
+            return f", wall on the {self.side}"
+        return ""
+
+
+def make_family_law(name: str, choices: dict | None = None, **parameters) -> FamilyLaw:
     """The law `name` of `parameters.FAMILY_LAWS` with `parameters` over `parameters.FAMILY_DEFAULTS`.
+
+    `choices` (`parameters.FAMILY_LAW_CHOICES`, e.g. ``{"side": "right"}``) go over
+    `parameters.FAMILY_CHOICE_DEFAULTS`; a choice may also be a keyword (``symmetrize="negative"``).
 
     Raises
     ------
     ValueError
-        An unknown law or side, a parameter the law does not take, or a value out of range.
+        An unknown law, a parameter or choice the law does not take, a value out of range,
+        or a choice value not allowed (naming the choice and its values).
     """
     check_choice("law", name, FAMILY_LAWS)
-    check_choice("side", side, SIDES)
+    allowed = FAMILY_LAW_CHOICES[name]
+    named = {k: v for k, v in parameters.items() if k in FAMILY_CHOICE_DEFAULTS and v is not None}
+    picked = {**{k: v for k, v in (choices or {}).items() if v is not None}, **named}
+    for key, value in picked.items():
+        if key not in allowed:
+            takers = [law for law in FAMILY_LAWS if key in FAMILY_LAW_CHOICES[law]]
+            if not takers:
+                raise ValueError(f"{key} is not a choice of law {name} (it takes {', '.join(allowed) or 'none'})")
+            raise ValueError(f"{key} applies to law {' or '.join(takers)}, not to law {name}")
+        check_choice(key, value, allowed[key])
     taken = FAMILY_LAW_PARAMETERS[name]
-    given = {k: v for k, v in parameters.items() if v is not None}
+    given = {k: v for k, v in parameters.items() if v is not None and k not in FAMILY_CHOICE_DEFAULTS}
     for key in given:
         if key not in taken:
             raise ValueError(f"{key} is not a parameter of law {name} (it takes {', '.join(taken)})")
     values = {key: check_parameter(key, given.get(key, FAMILY_DEFAULTS[key])) for key in taken}
-    return FamilyLaw(name, values, side)
+    return FamilyLaw(name, values, {key: picked.get(key, FAMILY_CHOICE_DEFAULTS[key]) for key in allowed})
 
 
 # ------------------------------------------------------------------ holonomic verdicts
@@ -476,8 +531,7 @@ def _inputs(robot, controller, family, family_law, mass, pade_order, wall, corri
     if holonomic:
         values["mass"] = mass
     values.update(family_law.parameters)
-    if family_law.name == "fuzzy":
-        values["side"] = family_law.side
+    values.update(family_law.choices)
     values.update({"hold": controller.hold, "compute_delay": controller.compute_delay, "pade_order": pade_order})
     if wall is not None:
         values["alpha_deg"] = wall.alpha_deg
@@ -485,7 +539,7 @@ def _inputs(robot, controller, family, family_law, mass, pade_order, wall, corri
         values["L"] = corridor.L
     out = {}
     for name, value in values.items():
-        source = sources.get(name, "default" if name in FAMILY_DEFAULTS else "user")
+        source = sources.get(name, "default" if name in FAMILY_DEFAULTS or name in FAMILY_CHOICE_DEFAULTS else "user")
         if holonomic and name in ("tau", "k", "hold"):
             source = HOLONOMIC_UNUSED
         out[name] = {"value": value, "unit": _unit(name), "source": source}

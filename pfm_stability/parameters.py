@@ -53,6 +53,8 @@ __all__ = [
     "FAMILY_LAWS",
     "FAMILY_LAW_PARAMETERS",
     "FAMILY_DEFAULTS",
+    "FAMILY_LAW_CHOICES",
+    "FAMILY_CHOICE_DEFAULTS",
     "DERIVATION_LAWS",
     "DEGREES_PER_RADIAN",
     "RADIANS_PER_DEGREE",
@@ -135,6 +137,19 @@ FAMILY_DEFAULTS = {"alpha_p": 0.5, "alpha_v": 0.1, "attraction_exponent": 2.0, "
 """Defaults of the `FAMILY_LAWS` (docs/velocity_and_fuzzy.md): F_a = 1 N (α_p = 0.5, m = 2, ρ_g = 1 m),
 α_v = 0.1 and n = 2 (Ge & Cui 2002 §6), η and ρ0 as `FIELD_DEFAULTS`, a_max = 1 m/s², no goal factor
 (the fuzzy law's ρ_gⁿ with n = 0), a robot of 1 kg."""
+
+FAMILY_LAW_CHOICES = {
+    "velocity": {},
+    "velocity-gated": {"variant": ("gradient", "squared", "paper-eq23")},
+    "fuzzy": {"side": ("left", "right"), "symmetrize": ("none", "negative", "positive")},
+}
+"""The choice-valued parameters of each law of `FAMILY_LAWS` and their values (docs/velocity_and_fuzzy.md):
+the velocity-gated repulsion's magnitude (Ge & Cui 2002 eq 12/19 gradient η/D², its square η(1/D − 1/ρ0)²,
+or eq 23 as printed η³(1/D − 1/ρ0)²), the fuzzy law's wall side and which half of the DFAPF tables is
+mirrored onto the other (none: the tables as printed)."""
+
+FAMILY_CHOICE_DEFAULTS = {"variant": "gradient", "side": "left", "symmetrize": "none"}
+"""Defaults of `FAMILY_LAW_CHOICES`: the gradient variant, a wall on the left, the tables as printed."""
 
 DERIVATION_LAWS = ("power", "general")
 """Force laws of the symbolic derivation (`pfm_stability.derivation`, ``pfm-stability derive --law``):

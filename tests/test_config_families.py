@@ -275,3 +275,18 @@ def test_sweep_refuses_families_and_family_laws(tmp_path, config, key):
         own = write(tmp_path, "config: robot.yaml\nlaw: {name: power}\nscenario: {corridor: {L: 1}}\ngrid: {V: {from: 0.2, to: 1.0, num: 3}}\n",
                     "own.yaml")
         assert load_spec(own).law == "power"
+
+
+@pytest.mark.parametrize("law", [
+    {"name": "fuzzy", "alpha_p": 50, "rho0": 0.5, "symmetrize": "negative"},
+    {"name": "velocity-gated", "eta": 0.2, "variant": "squared"},
+    {"name": "velocity", "eta": 0.05, "alpha_v": 0.3},
+])
+def test_a_files_family_law_is_in_force_without_typing_law(tmp_path, capsys, law):
+    """A steering robot's file naming a family law gives that law's report with no --law typed, equal (sources aside)
+    to the same values typed: the report follows the law resolved from the file, not the --law default. Exact JSON."""
+    path = write(tmp_path, {"law": law})
+    typed = ["--law", law["name"]] + [item for key, value in law.items() if key != "name" for item in (option(key), str(value))]
+    from_file = report_json(capsys, "--config", str(path), "--alpha", "60", "--no-simulate")
+    assert from_file["law"]["name"] == law["name"]
+    assert without_sources(from_file) == without_sources(report_json(capsys, *typed, "--alpha", "60", "--no-simulate"))

@@ -17,6 +17,8 @@ from pathlib import Path
 import pytest
 
 EXPERIMENTS = Path(__file__).resolve().parents[1] / "experiments"
+CHECKED_HERE = ("fig3_calibration", "fig5_wall", "fig6_corridor", "validation_summary", "gc2000_traps", "gc2000_corridor", "kb_fig4_door")
+"""The scripts this file runs and checks; Ge & Cui 2002's and the DFAPF paper's run in tests/test_experiments_gc2002.py."""
 
 
 @pytest.fixture(scope="module")
@@ -31,7 +33,7 @@ def run_all():
 @pytest.fixture(scope="module")
 def quick_results(run_all, tmp_path_factory):
     out = tmp_path_factory.mktemp("experiments")
-    rows = run_all.run_all(out, quick=True)
+    rows = run_all.run_all(out, quick=True, only=CHECKED_HERE)
     return out, rows
 
 
@@ -75,6 +77,13 @@ def test_fig6_wide_settles_narrow_collides(quick_results):
     assert d["runs"]["narrow"]["collided"] and d["runs"]["narrow"]["measured"]["growth_rate"] > 0
     L = d["L_critical_m"]
     assert 0.6 < L["simulated"] < 0.9 and abs(L["relative_error_grid_law"]["sampled"]) < 0.05
+
+
+def test_every_script_is_run_by_one_test_file(run_all):
+    """Every script of `run_all.EXPERIMENTS` runs in the suite: here, or in tests/test_experiments_gc2002.py."""
+    from test_experiments_gc2002 import SCRIPTS
+
+    assert set(run_all.EXPERIMENTS) == set(CHECKED_HERE) | set(SCRIPTS)
 
 
 def test_results_table_and_readme(run_all, tmp_path, quick_results):

@@ -13,8 +13,8 @@ from dataclasses import dataclass, fields
 from typing import TYPE_CHECKING
 
 from ..checks import check_integer, check_number, check_output_path
-from ..parameters import (FAMILY_LAW_PARAMETERS, FAMILY_LAWS, FIELD_DEFAULTS, FORCE_LAWS, HOLDS, LAW_PARAMETERS, PRESETS, RANGES,
-                          ROBOT_FAMILIES, SHOWN_AS, Controller, Preset, Robot, get_preset)
+from ..parameters import (FAMILY_CHOICE_DEFAULTS, FAMILY_LAW_CHOICES, FAMILY_LAW_PARAMETERS, FAMILY_LAWS, FIELD_DEFAULTS, FORCE_LAWS, HOLDS,
+                          LAW_PARAMETERS, PRESETS, RANGES, ROBOT_FAMILIES, SHOWN_AS, Controller, Preset, Robot, get_preset)
 
 if TYPE_CHECKING:
     from ..config import Config
@@ -36,6 +36,7 @@ __all__ = [
     "resolve_law",
     "shipped_or_given",
     "FAMILY_OPTIONS",
+    "FAMILY_CHOICE_OPTIONS",
     "add_family_options",
     "resolve_family",
     "ResolvedFamily",
@@ -376,11 +377,20 @@ FAMILY_OPTIONS = {
 }
 """The new laws' own options (`parameters.RANGES` keys), as ``--alpha-p`` … ``--a-max`` (docs/velocity_and_fuzzy.md)."""
 
+FAMILY_CHOICE_OPTIONS = {
+    "variant": "velocity-gated: the repulsion's magnitude: gradient eta/D^2 (Ge & Cui 2002 eq 12, 19; default), "
+               "squared eta(1/D - 1/rho0)^2, or paper-eq23 eta^3(1/D - 1/rho0)^2 (eq 23 as printed)",
+    "side": "fuzzy: the wall's side (the DFAPF tables are asymmetric; default left)",
+    "symmetrize": "fuzzy: make the DFAPF tables left-right symmetric by copying the rows of negative (obstacle on the right) "
+                  "or positive bearings onto the others (default none: the tables as printed)",
+}
+"""Help of the laws' choice-valued options (`parameters.FAMILY_LAW_CHOICES`), as ``--variant``, ``--side``, ``--symmetrize``."""
+
 _FAMILY_SOURCE = "default (docs/velocity_and_fuzzy.md)"
 
 
 def add_family_options(parser: argparse.ArgumentParser) -> None:
-    """--robot, --mass, --side, --no-simulate and the options of `FAMILY_OPTIONS` (``report`` only)."""
+    """--robot, --mass, --no-simulate and the options of `FAMILY_OPTIONS` and `FAMILY_CHOICE_OPTIONS` (``report`` only)."""
     group = parser.add_argument_group("robot family and velocity/fuzzy laws (docs/velocity_and_fuzzy.md)")
     group.add_argument("--robot", choices=ROBOT_FAMILIES, default=Default("steering"),
                        help="loop family: KB's steering robot (default), kinematic steering (tau = 0, --k is K_s) "
@@ -388,7 +398,9 @@ def add_family_options(parser: argparse.ArgumentParser) -> None:
     group.add_argument("--mass", type=number("mass"), help=f"holonomic robot mass, {describe('mass')} (default 1)")
     for name, text in FAMILY_OPTIONS.items():
         group.add_argument(_option(name), type=number(name), help=f"{text}, {describe(name)}")
-    group.add_argument("--side", choices=("left", "right"), help="fuzzy: the wall's side (the DFAPF tables are asymmetric; default left)")
+    for name, text in FAMILY_CHOICE_OPTIONS.items():
+        values = next(choices[name] for choices in FAMILY_LAW_CHOICES.values() if name in choices)
+        group.add_argument(_option(name), choices=values, help=text)
     group.add_argument("--no-simulate", action="store_true",
                        help="velocity-gated: do not simulate the wall's limit cycle (the report gives the rest band only)")
 
@@ -420,7 +432,7 @@ def resolve_family(args, params: ResolvedParameters) -> ResolvedFamily:
     Precedence as `resolve_parameters`: an option typed > the ``--config`` file's
     ``robot.family``, ``robot.mass`` and ``law`` (docs/config.md) > the defaults.
     The file's mass applies when its family (holonomic) is the one in force, its
-    law's parameters and ``side`` when its law is the one in force.
+    law's parameters and choices (``variant``, ``side``, ``symmetrize``) when its law is the one in force.
 
     Raises
     ------
@@ -451,8 +463,7 @@ def resolve_family(args, params: ResolvedParameters) -> ResolvedFamily:
         if typed_family:
             takers = [k for k in FAMILY_LAWS if typed_family[0] in FAMILY_LAW_PARAMETERS[k]]
             raise ValueError(f"{_option(typed_family[0])} applies to --law {' or '.join(takers)}, not to {law_shown}")
-        if args.side is not None:
-            raise ValueError(f"--side applies to --law fuzzy, not to {law_shown}")
+        _check_choices_taken(args, None, law_shown)
         law, law_sources = resolve_law(args, params)
         return ResolvedFamily(family, law, mass, {**sources, **law_sources})
     from ..family_report import make_family_law
@@ -464,14 +475,26 @@ def resolve_family(args, params: ResolvedParameters) -> ResolvedFamily:
         if key not in taken:
             takers = [k for k in (*FORCE_LAWS, *FAMILY_LAWS) if key in {**LAW_PARAMETERS, **FAMILY_LAW_PARAMETERS}[k]]
             raise ValueError(f"{_option(key)} applies to --law {' or '.join(takers)}, not to {law_shown}")
-    if args.side is not None and law_name != "fuzzy":
-        raise ValueError(f"--side applies to --law fuzzy, not to {law_shown}")
-    # the file's law parameters (checked against the law by `config`) where it is the law in force and no option is typed
-    filed = {k: v for k, v in from_file.items() if k not in ("name", "side") and k not in given} if from_file.get("name") == law_name else {}
-    filed_side = from_file.get("side") if from_file.get("name") == law_name and args.side is None else None
-    side = args.side or filed_side or "left"
-    law = make_family_law(law_name, side, **given, **filed)
+    _check_choices_taken(args, law_name, law_shown)
+    # the file's law parameters and choices (checked against the law by `config`) where it is the law in force and no option is typed
+    filed_law = from_file if from_file.get("name") == law_name else {}
+    filed = {k: v for k, v in filed_law.items() if k != "name" and k not in FAMILY_CHOICE_DEFAULTS and k not in given}
+    choices = {}
+    for key in FAMILY_LAW_CHOICES[law_name]:
+        if getattr(args, key, None) is not None:
+            choices[key], sources[key] = getattr(args, key), "user"
+        elif key in filed_law:
+            choices[key], sources[key] = filed_law[key], config.sources[key]
+        else:
+            sources[key] = f"default ({FAMILY_CHOICE_DEFAULTS[key]})"
+    law = make_family_law(law_name, choices, **given, **filed)
     sources.update({key: "user" if key in given else config.sources[key] if key in filed else _FAMILY_SOURCE for key in taken})
-    if law_name == "fuzzy":
-        sources["side"] = "user" if args.side is not None else config.sources["side"] if filed_side is not None else "default (left)"
     return ResolvedFamily(family, law, mass, sources)
+
+
+def _check_choices_taken(args, law_name, law_shown) -> None:
+    """ValueError for a choice option (``--variant``, ``--side``, ``--symmetrize``) the law in force does not take."""
+    for key in FAMILY_CHOICE_OPTIONS:
+        if getattr(args, key, None) is not None and key not in FAMILY_LAW_CHOICES.get(law_name, {}):
+            takers = [k for k in FAMILY_LAWS if key in FAMILY_LAW_CHOICES[k]]
+            raise ValueError(f"{_option(key)} applies to --law {' or '.join(takers)}, not to {law_shown}")

@@ -18,6 +18,8 @@ FAMILY_LABELS = {
     "velocity_exponent": "n (velocity exponent)",
     "a_max": "a_max (braking deceleration)",
     "side": "wall side (fuzzy tables)",
+    "symmetrize": "symmetrize (fuzzy tables mirrored)",
+    "variant": "variant (gated repulsion magnitude)",
 }
 """Labels of the inputs that only the families and the new laws have."""
 

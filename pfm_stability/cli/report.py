@@ -56,7 +56,7 @@ def run(args) -> int:
 
 def _family(args, chosen) -> bool:
     """Whether the report is another robot family's or a law of `parameters.FAMILY_LAWS` (else KB's report, unchanged)."""
-    return chosen.family != "steering" or str(args.law) in FAMILY_LAWS
+    return chosen.family != "steering" or getattr(chosen.law, "name", None) in FAMILY_LAWS  # the law in force: typed or the file's
 
 
 def _family_report(args, params, chosen):
@@ -64,7 +64,8 @@ def _family_report(args, params, chosen):
     from ..family_report import FamilyLaw, build_family_report
 
     if args.door is not None:
-        raise ValueError(f"--door applies to --robot steering with a static law (power, grid, khatib, gnron), not to --robot {chosen.family} --law {args.law}")
+        raise ValueError(f"--door applies to --robot steering with a static law (power, grid, khatib, gnron), "
+                         f"not to --robot {chosen.family} --law {getattr(chosen.law, 'name', None) or args.law}")
     sources = {"alpha_deg": "user", "L": "user", **params.sources, **chosen.sources,
                "pade_order": "user" if args.pade_order != DEFAULT_PADE_ORDER else "default"}
     report = build_family_report(
