@@ -232,7 +232,7 @@ RANGES = {
     "goal_distance": Range(1e-3, 1e4, low_open=False, unit="m"),
     "delta": Range(0.0, 1e3, low_open=False, unit="m"),
     # robot loop families (docs/models.md, "Robot loop families")
-    "c_h": Range(-1e6, 1e6, low_open=False, unit="1/s"),
+    "c_h": Range(-1e15, 1e15, low_open=False, unit="1/s"),
     "kappa": Range(-1e12, 1e12, low_open=False, unit="1/s^2"),
     "mass": Range(0.0, 1e6, unit="kg"),
     "alpha_p": Range(0.0, 1e6, unit="N/m"),
@@ -294,8 +294,9 @@ Entries beyond the robot, controller and geometry:
     The surface offset δ of Ge & Cui's eq (40), m, in [0, 10³].
 ``c_h``, ``kappa``
     The holonomic loop s² + (c_h·s + κ)e^(−sT) (docs/models.md, "Robot loop
-    families"): damping c_h in [−10⁶, 10⁶] 1/s, stiffness κ in [−10¹², 10¹²]
-    1/s² (κ = 0 is refused by the models: a root at s = 0).
+    families"): damping c_h in [−10¹⁵, 10¹⁵] 1/s (the damping ranges' ends reach
+    about 31/T for the Padé model, 3·10¹³ 1/s at the shortest delay, `T_RESOLUTION`), stiffness κ in
+    [−10¹², 10¹²] 1/s² (κ = 0 is refused by the models: a root at s = 0).
 ``mass``, ``alpha_p``, ``alpha_v``
     Target tracking of Ge & Cui 2002 eq (33)–(36): mass m in (0, 10⁶] kg,
     position gain α_p in (0, 10⁶] N/m, velocity gain α_v in [0, 10⁶] N·s/m;

@@ -78,3 +78,62 @@ def test_report_at_a_tiny_delay_is_the_continuous_report(capsys):
     for env in ("wall", "corridor"):
         tiny, zero = (json.dumps(a[env], sort_keys=True) for a in answers)
         assert tiny == zero
+
+
+@pytest.mark.parametrize("T", TINY)
+def test_holonomic_loop_stores_a_tiny_delay_as_zero(T):
+    """HolonomicLoop(T, c_h) follows `Loop`: T < 1e-12 s is a continuous controller (T = 0), the resolution itself is kept."""
+    from pfm_stability.models.holonomic import HolonomicLoop
+
+    assert HolonomicLoop(T, 0.2).T == 0.0
+    assert HolonomicLoop(T_RESOLUTION, 0.2).T == T_RESOLUTION
+
+
+@pytest.mark.parametrize("T", [1e-12, 3e-12, 1e-9, 1e-6, 1e-3, 0.1])
+def test_holonomic_damping_ranges_down_to_the_shortest_delay(T):
+    """Every holonomic model's damping range at κ = 24 1/s² exists down to T = 1e-12 s (regression: Padé's ends, ~31/T,
+    left the c_h range, and the exact-delay upper end failed to bracket where cos(π/2) rounds to 6e-17).
+
+    Exact delay against an independent route: the ends are c = ω sin(ωT) at the two roots of ω² cos(ωT) = κ; for
+    ωT well inside (0, π/2) scipy's brentq on that equation gives them (rel 1e-9), and for κT² < 1e-6 the asymptotes
+    κT (1 + O(κT²)) and π/(2T) (1 + O(κT²)) hold (rel 1e-5)."""
+    import math
+
+    from scipy.optimize import brentq
+
+    from pfm_stability.models.holonomic import HolonomicLoop
+    from pfm_stability.models.holonomic_delay import make_holonomic_model
+
+    kappa = 24.0
+    loop = HolonomicLoop(T, 0.2)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        for name in ("continuous", "kb_first_order", "pade", "exact_delay", "sampled"):
+            (lo, hi), = make_holonomic_model(name, pade_order=3, compute_delay=1).damping_range(kappa, loop)
+            assert 0 <= lo < hi and (lo > 0 or name == "continuous"), name
+        (lo, hi), = make_holonomic_model("exact_delay").damping_range(kappa, loop)
+    if kappa * T * T < 1e-6:
+        assert lo == pytest.approx(kappa * T, rel=1e-5) and hi == pytest.approx(math.pi / (2 * T), rel=1e-5)
+    else:
+        g = lambda w: w * w * math.cos(w * T) - kappa  # noqa: E731
+        peak = 1.0768739863118038 / T  # maximiser of u² cos u, u = ωT
+        ends = [w * math.sin(w * T) for w in (brentq(g, 1e-12, peak, xtol=1e-300, rtol=1e-15),
+                                              brentq(g, peak, 0.999999 * math.pi / (2 * T), xtol=1e-300, rtol=1e-15))]
+        assert (lo, hi) == pytest.approx(tuple(ends), rel=1e-9)
+
+
+@pytest.mark.parametrize("T", ["1e-12", "1e-9", "1e-6"])
+def test_holonomic_report_at_tiny_delays(capsys, T):
+    """report --robot holonomic at a delay of a picosecond to a microsecond answers (exit 0, no warning) with the
+    pure-delay T* of the closed form atan2(c_h ω, κ)/ω, ω² = (c_h² + √(c_h⁴ + 4κ²))/2 (rel 1e-6: bisection tolerance)."""
+    import math
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        code = main(["report", "--robot", "holonomic", "--law", "velocity", "--L", "0.5", "--eta", "0.3", "--rho0", "2",
+                     "--alpha-v", "0.1", "--T", T, "--format", "json"])
+    data = json.loads(capsys.readouterr().out)
+    assert code == 0
+    kappa, c_h = data["environment"]["corridor"]["kappa"], data["environment"]["corridor"]["c_h"]
+    w = math.sqrt((c_h**2 + math.sqrt(c_h**4 + 4 * kappa**2)) / 2)
+    assert data["corridor"]["exact_delay"]["T_critical"] == pytest.approx(math.atan2(c_h * w, kappa) / w, rel=1e-6)

@@ -52,7 +52,7 @@ from ..crossings import (
     stable_set,
     verdict_at,
 )
-from ..parameters import RANGES, check_parameter
+from ..parameters import RANGES, T_RESOLUTION, check_parameter
 from ..serialize import json_number
 from .base import Loop, LoopModel
 from .pade import MAX_PADE_ORDER, pade_coefficients
@@ -77,9 +77,9 @@ class HolonomicLoop:
     Parameters
     ----------
     T : float
-        Loop delay / sampling period, s, in [0, 100] (``RANGES["T"]``).
+        Loop delay / sampling period, s, in [0, 100] (``RANGES["T"]``); below `T_RESOLUTION` (10⁻¹² s) stored as 0.
     c_h : float
-        Damping c_h = −∂F_x/∂v_x / m, 1/s, in [−10⁶, 10⁶] (``RANGES["c_h"]``).
+        Damping c_h = −∂F_x/∂v_x / m, 1/s, in [−10¹⁵, 10¹⁵] (``RANGES["c_h"]``).
         c_h <= 0 is accepted and unstable in every model.
     """
 
@@ -88,6 +88,8 @@ class HolonomicLoop:
 
     def __post_init__(self):
         object.__setattr__(self, "T", check_parameter("T", self.T))
+        if self.T < T_RESOLUTION:  # faster than a picosecond: a continuous controller, as `Loop`
+            object.__setattr__(self, "T", 0.0)
         object.__setattr__(self, "c_h", check_parameter("c_h", self.c_h))
 
 

@@ -126,8 +126,10 @@ class HolonomicExactDelay(HolonomicModel):
         if kappa * T * T >= BEST_CURVATURE_PRODUCT:
             return ()
         g = lambda x: x * x * math.cos(x * T) - kappa
-        peak = _X0 / T
-        ends = [bisect_root(g, 0.0, peak, rtol=1e-15), bisect_root(g, peak, math.pi / (2 * T), rtol=1e-15)]
+        # the second root near ωT = π/2 in v = π/2 − ωT: cos(ωT) = sin(v) keeps its digits where cos(π/2) rounds to 6e-17
+        h = lambda v: ((0.5 * math.pi - v) / T) ** 2 * math.sin(v) - kappa
+        v = bisect_root(h, 0.0, 0.5 * math.pi - _X0, rtol=1e-15)
+        ends = [bisect_root(g, 0.0, _X0 / T, rtol=1e-15), (0.5 * math.pi - v) / T]
         crossings = [Crossing(w * math.sin(w * T), w) for w in ends]
         return stable_set(crossings, lambda c: self._stable(kappa, replace(loop, c_h=c)))
 
