@@ -33,7 +33,7 @@ from .criteria import CorridorAnalysis, WallAnalysis, WallEquilibrium, check_loo
 from .fields import KhatibLaw
 from .fuzzy import DfapfControllers, load_dfapf
 from .fuzzy_law import FuzzyScheduledLaw
-from .models import Loop, models_for
+from .models import Loop, interval_margin, interval_verdict, models_for
 from .models.holonomic import HolonomicLoop
 from .models.holonomic_delay import make_holonomic_model
 from .parameters import (FAMILY_CHOICE_DEFAULTS, FAMILY_DEFAULTS, FAMILY_LAW_CHOICES, FAMILY_LAW_PARAMETERS, FAMILY_LAWS, MODEL_NAMES, RANGES,
@@ -244,18 +244,17 @@ class HolonomicVerdict:
         }
 
 
-def _kappa_margin(kappa: float, stable_set, stable: bool) -> tuple:
-    """(margin, verdict) of κ against the stable set (the steering `gain_margin`/`verdict_label` in κ)."""
-    edges = [e for lo, hi in stable_set for e in (lo, hi) if 0 < e < math.inf]
-    if kappa > 0 and any(abs(kappa / e - 1.0) <= 1e-9 for e in edges):
-        return 0.0, "undecided"
+def _kappa_margin(kappa: float, boundary, stable: bool) -> tuple:
+    """(margin, verdict) of κ against the model's stable set: the steering report's `interval_margin`/`interval_verdict` in κ.
+
+    κ <= 0 (no restoring force) has margin −1; within 1e-9 of an edge the verdict is "undecided" with margin 0.
+    """
     if kappa <= 0:
         return -1.0, "stable" if stable else "unstable"
-    if stable:
-        holding = [hi for lo, hi in stable_set if lo <= kappa <= hi]
-        return (holding[0] / kappa - 1.0 if holding else math.inf), "stable"
-    below = [hi for lo, hi in stable_set if hi <= kappa]
-    return (max(below) / kappa - 1.0 if below else -1.0), "unstable"
+    verdict = interval_verdict(kappa, boundary.stable_set, boundary.kappa_critical, stable)
+    if verdict == "undecided":
+        return 0.0, verdict
+    return interval_margin(kappa, boundary.stable_set, boundary.kappa_critical, stable), verdict
 
 
 def holonomic_verdict(name: str, kappa: float, c_h: float, controller: Controller, pade_order: int = 3) -> HolonomicVerdict:
@@ -264,7 +263,7 @@ def holonomic_verdict(name: str, kappa: float, c_h: float, controller: Controlle
     loop = HolonomicLoop(controller.T, c_h)
     boundary = model.boundary(loop)
     stable = model.is_stable(kappa, loop)
-    margin, verdict = _kappa_margin(kappa, boundary.stable_set, stable)
+    margin, verdict = _kappa_margin(kappa, boundary, stable)
     return HolonomicVerdict(name, kappa, boundary.kappa_critical, boundary.omega_critical, margin, verdict,
                             model.critical_delay(kappa, loop), model.damping_range(kappa, loop), model.rightmost_root(kappa, loop))
 

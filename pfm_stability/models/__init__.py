@@ -19,7 +19,8 @@ from __future__ import annotations
 
 from ..checks import check_choice
 from ..parameters import MODEL_NAMES, Controller
-from .base import DIVERGENT_REASON, HEADING_GAIN_RANGE, Boundary, Loop, LoopModel, divergent_reason, gain_margin, verdict_label
+from .base import (DIVERGENT_REASON, HEADING_GAIN_RANGE, Boundary, Loop, LoopModel, divergent_reason, gain_margin, interval_margin,
+                   interval_verdict, verdict_label)
 from .continuous import Continuous
 from .exact_delay import ExactDelay
 from .kb_first_order import KBFirstOrder
@@ -40,6 +41,8 @@ __all__ = [
     "Sampled",
     "divergent_reason",
     "gain_margin",
+    "interval_margin",
+    "interval_verdict",
     "make_model",
     "make_models",
     "models_for",

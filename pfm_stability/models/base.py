@@ -40,6 +40,8 @@ __all__ = [
     "AffineGainModel",
     "verdict_label",
     "gain_margin",
+    "interval_verdict",
+    "interval_margin",
     "gain_range",
     "checked",
     "check_heading_gain",
@@ -195,37 +197,47 @@ class Boundary:
         }
 
 
-def _edges(boundary: Boundary):
-    """Finite positive edges of the stable set (NV* alone if the set is unknown)."""
-    if boundary.stable_set:
-        return [x for pair in boundary.stable_set for x in pair if 0 < x < math.inf]
-    return [boundary.NV_critical] if 0 < boundary.NV_critical < math.inf else []
+def _edges(stable_set, critical: float):
+    """Finite positive edges of the stable set (the critical value alone if the set is unknown)."""
+    if stable_set:
+        return [x for pair in stable_set for x in pair if 0 < x < math.inf]
+    return [critical] if 0 < critical < math.inf else []
 
 
-def verdict_label(NV: float, boundary: Boundary, stable: bool, rtol: float = UNDECIDED_RTOL) -> str:
-    """"stable", "unstable" or "undecided" (within `rtol` of an edge of the stable set)."""
-    if any(abs(NV / edge - 1.0) <= rtol for edge in _edges(boundary)):
+def interval_verdict(gain: float, stable_set, critical: float, stable: bool, rtol: float = UNDECIDED_RTOL) -> str:
+    """"stable", "unstable" or "undecided" (within `rtol` of an edge of `stable_set`) for any loop gain (NV, κ)."""
+    if any(abs(gain / edge - 1.0) <= rtol for edge in _edges(stable_set, critical)):
         return "undecided"
     return "stable" if stable else "unstable"
 
 
-def gain_margin(NV: float, boundary: Boundary, stable: bool) -> float:
-    """Relative distance to the nearest boundary below or above, NV_edge/NV − 1.
+def interval_margin(gain: float, stable_set, critical: float, stable: bool) -> float:
+    """Relative distance to the nearest boundary below or above, gain_edge/gain − 1, for any loop gain (NV, κ).
 
-    Stable: NV_edge is the upper end of the stable interval that holds NV
-    (``inf`` if unbounded), so the margin is how much NV may grow. Unstable:
-    the upper end of the nearest stable interval below NV, so the (negative)
-    margin is how much NV must shrink; −1 when no smaller NV is stable. With
-    the usual stable set (0, NV*) both are NV*/NV − 1.
+    Stable: the edge is the upper end of the stable interval that holds the
+    gain (``inf`` if unbounded), so the margin is how much the gain may grow.
+    Unstable: the upper end of the nearest stable interval below, so the
+    (negative) margin is how much it must shrink; −1 when no smaller gain is
+    stable. With the usual stable set (0, critical) both are critical/gain − 1.
     """
-    intervals = boundary.stable_set or (((0.0, boundary.NV_critical),) if boundary.NV_critical > 0 else ())
+    intervals = stable_set or (((0.0, critical),) if critical > 0 else ())
     if stable:
-        holding = [hi for lo, hi in intervals if lo <= NV <= hi]
-        edge = holding[0] if holding else boundary.NV_critical
+        holding = [hi for lo, hi in intervals if lo <= gain <= hi]
+        edge = holding[0] if holding else critical
     else:
-        below = [hi for lo, hi in intervals if hi <= NV * (1 + UNDECIDED_RTOL)]
+        below = [hi for lo, hi in intervals if hi <= gain * (1 + UNDECIDED_RTOL)]
         edge = max(below) if below else 0.0
-    return edge / NV - 1.0
+    return edge / gain - 1.0
+
+
+def verdict_label(NV: float, boundary: Boundary, stable: bool, rtol: float = UNDECIDED_RTOL) -> str:
+    """"stable", "unstable" or "undecided" (within `rtol` of an edge of the stable set): `interval_verdict` in NV."""
+    return interval_verdict(NV, boundary.stable_set, boundary.NV_critical, stable, rtol)
+
+
+def gain_margin(NV: float, boundary: Boundary, stable: bool) -> float:
+    """NV_edge/NV − 1 (`interval_margin` in NV): with the usual stable set (0, NV*), NV*/NV − 1."""
+    return interval_margin(NV, boundary.stable_set, boundary.NV_critical, stable)
 
 
 NV_MAX = 1e12
