@@ -259,7 +259,12 @@ def _kappa_margin(kappa: float, boundary, stable: bool) -> tuple:
 
 def holonomic_verdict(name: str, kappa: float, c_h: float, controller: Controller, pade_order: int = 3) -> HolonomicVerdict:
     """The holonomic model `name` at κ (1/s²) and c_h (1/s) with the controller's T and compute delay."""
-    model = make_holonomic_model(name, pade_order=pade_order, compute_delay=controller.compute_delay)
+    return _verdict_of(make_holonomic_model(name, pade_order=pade_order, compute_delay=controller.compute_delay), kappa, c_h, controller)
+
+
+def _verdict_of(model, kappa: float, c_h: float, controller: Controller) -> HolonomicVerdict:
+    """`holonomic_verdict` for a model object (the report builds each model once)."""
+    name = model.name
     loop = HolonomicLoop(controller.T, c_h)
     boundary = model.boundary(loop)
     stable = model.is_stable(kappa, loop)
@@ -385,7 +390,7 @@ def _speed_free(verdicts: dict, fixed_V: bool) -> dict:
     return {name: replace(v, critical=replace(v.critical, V_critical=math.nan)) for name, v in verdicts.items()}
 
 
-def _holonomic_scene(geometry, value, gains, controller, models, pade_order, main) -> HolonomicScene:
+def _holonomic_scene(geometry, value, gains, controller, model_objs, main) -> HolonomicScene:
     if not gains:
         raise ValueError(f"{'alpha' if geometry == 'wall' else 'L'} = {value:g}: the law has no equilibrium here (it never balances the pull)")
     flat = [g.x0 for g in gains if g.kappa == 0.0]
@@ -393,7 +398,7 @@ def _holonomic_scene(geometry, value, gains, controller, models, pade_order, mai
         raise ValueError(f"{'alpha' if geometry == 'wall' else 'L'} = {value:g}: no lateral stiffness at x0 = {flat[0]:g} m (kappa = 0: "
                          f"the repulsion does not reach there, rho0 too short); raise --rho0")
     equilibria = tuple(
-        HolonomicEquilibrium(g.x0, g.kappa, g.c_h, {name: holonomic_verdict(name, g.kappa, g.c_h, controller, pade_order) for name in models})
+        HolonomicEquilibrium(g.x0, g.kappa, g.c_h, {m.name: _verdict_of(m, g.kappa, g.c_h, controller) for m in model_objs})
         for g in gains
     )
     index = 0 if main == "first" else min(range(len(gains)), key=lambda i: abs(gains[i].x0))
@@ -465,15 +470,15 @@ def build_family_report(
     models = tuple(dict.fromkeys(models))
     for name in models:
         check_choice("model", name, MODEL_NAMES)
-    model_objs = _model_objects(controller, models, pade_order, family)
     wall = Wall.from_degrees(alpha_deg) if alpha_deg is not None else None
     corridor = Corridor(L) if L is not None else None
     inputs = _inputs(robot, controller, family, family_law, mass, pade_order, wall, corridor, sources)
-    extras = {}
     if family_law.name == "velocity-gated":
-        return _non_smooth(inputs, family_law, wall, corridor, family)
+        return _non_smooth(inputs, family_law, wall, corridor)
+    model_objs = _model_objects(controller, models, pade_order, family)
     if family == "holonomic":
-        return _holonomic(inputs, family_law, controller, robot, wall, corridor, models, pade_order, mass)
+        return _holonomic(inputs, family_law, controller, robot, wall, corridor, model_objs, mass)
+    extras = {}
     if family_law.name == "velocity":
         att, rep, rho_g = family_law.velocity_attraction(), family_law.repulsion(), family_law.parameters["goal_distance"]
         wall_eq = att.steering_wall_equilibria(rep, wall.alpha, robot.V, rho_g) if wall else None
@@ -559,25 +564,25 @@ def _with_family(report: StabilityReport, family: str, sources: dict) -> Stabili
     return replace(report, inputs=inputs)
 
 
-def _holonomic(inputs, family_law, controller, robot, wall, corridor, models, pade_order, mass) -> StabilityReport:
+def _holonomic(inputs, family_law, controller, robot, wall, corridor, model_objs, mass) -> StabilityReport:
     """κ, c_h and every holonomic model at each equilibrium; the tracking error's ζ, ω_n for m = n = 2."""
     att, rep, rho_g = family_law.velocity_attraction(), family_law.repulsion(), family_law.parameters["goal_distance"]
     scenes = {}
     if wall is not None:
         gains = att.holonomic_wall_gains(rep, wall.alpha, rho_g, mass, robot.V)
-        scenes["wall"] = _holonomic_scene("wall", wall.alpha_deg, gains, controller, models, pade_order, "first")
+        scenes["wall"] = _holonomic_scene("wall", wall.alpha_deg, gains, controller, model_objs, "first")
     if corridor is not None:
         gains = att.holonomic_corridor_gains(rep, corridor.L, rho_g, mass, robot.V)
-        scenes["corridor"] = _holonomic_scene("corridor", corridor.L, gains, controller, models, pade_order, "middle")
+        scenes["corridor"] = _holonomic_scene("corridor", corridor.L, gains, controller, model_objs, "middle")
     extras = {"scenes": scenes}
     if att.m == 2.0 and att.n == 2.0:
         t = tracking_dynamics(att.alpha_p, att.alpha_v, mass)
         extras["tracking"] = {"damping_ratio": t.damping_ratio, "natural_frequency": t.natural_frequency, "regime": t.regime}
-    options = {m.name: {"equation": m.equation, **m.options()} for m in _model_objects(controller, models, pade_order, "holonomic")}
+    options = {m.name: {"equation": m.equation, **m.options()} for m in model_objs}
     return StabilityReport(inputs, options, None, None, None, {}, family_law.described(), None, extras)
 
 
-def _non_smooth(inputs, family_law, wall, corridor, family) -> StabilityReport:
+def _non_smooth(inputs, family_law, wall, corridor) -> StabilityReport:
     """The non-smooth verdict: the rest band at a wall, the friction levels in a corridor; the cycle is filled above."""
     gated = family_law.gated()
     scenes = {}
