@@ -461,8 +461,7 @@ def resolve_family(args, params: ResolvedParameters) -> ResolvedFamily:
     typed_family = [k for k in FAMILY_OPTIONS if getattr(args, k, None) is not None]
     if law_name not in FAMILY_LAWS:
         if typed_family:
-            takers = [k for k in FAMILY_LAWS if typed_family[0] in FAMILY_LAW_PARAMETERS[k]]
-            raise ValueError(f"{_option(typed_family[0])} applies to --law {' or '.join(takers)}, not to {law_shown}")
+            _refuse(typed_family[0], FAMILY_LAW_PARAMETERS, law_shown)
         _check_choices_taken(args, None, law_shown)
         law, law_sources = resolve_law(args, params)
         return ResolvedFamily(family, law, mass, {**sources, **law_sources})
@@ -473,8 +472,7 @@ def resolve_family(args, params: ResolvedParameters) -> ResolvedFamily:
     typed_fn = [key for key in ("f", "n") if params.sources.get(key) == "user"]
     for key in typed_fn + list(given):
         if key not in taken:
-            takers = [k for k in (*FORCE_LAWS, *FAMILY_LAWS) if key in {**LAW_PARAMETERS, **FAMILY_LAW_PARAMETERS}[k]]
-            raise ValueError(f"{_option(key)} applies to --law {' or '.join(takers)}, not to {law_shown}")
+            _refuse(key, {**LAW_PARAMETERS, **FAMILY_LAW_PARAMETERS}, law_shown)
     _check_choices_taken(args, law_name, law_shown)
     # the file's law parameters and choices (checked against the law by `config`) where it is the law in force and no option is typed
     filed_law = from_file if from_file.get("name") == law_name else {}
@@ -496,5 +494,10 @@ def _check_choices_taken(args, law_name, law_shown) -> None:
     """ValueError for a choice option (``--variant``, ``--side``, ``--symmetrize``) the law in force does not take."""
     for key in FAMILY_CHOICE_OPTIONS:
         if getattr(args, key, None) is not None and key not in FAMILY_LAW_CHOICES.get(law_name, {}):
-            takers = [k for k in FAMILY_LAWS if key in FAMILY_LAW_CHOICES[k]]
-            raise ValueError(f"{_option(key)} applies to --law {' or '.join(takers)}, not to {law_shown}")
+            _refuse(key, FAMILY_LAW_CHOICES, law_shown)
+
+
+def _refuse(key: str, taken_by: dict, law_shown: str) -> None:
+    """ValueError: option `key` applies to the laws of `taken_by` (law → the keys it takes) that take it, not to `law_shown`."""
+    takers = [law for law, keys in taken_by.items() if key in keys]
+    raise ValueError(f"{_option(key)} applies to --law {' or '.join(takers)}, not to {law_shown}")
