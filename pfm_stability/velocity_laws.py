@@ -367,6 +367,13 @@ class VelocityGatedRepulsion:
         check_choice("variant", self.variant, VARIANTS)
         object.__setattr__(self, "robot_radius", check_number("robot_radius", self.robot_radius, 0.0, 1e4, low_open=False, unit="m"))
 
+    def braked_clearance(self, distance, closing_speed):
+        """D = (distance − ρ_rob) − v_RO²/(2a_max), m: the clearance left after braking at a_max (eq 11, 12, 12′).
+
+        `distance` is to the obstacle's surface (m), `closing_speed` v_RO (m/s, > 0 approaching).
+        """
+        return distance - self.robot_radius - closing_speed * closing_speed / (2.0 * self.a_max)
+
     def magnitude(self, D):
         """The repulsion's magnitude factor at braked clearance D (m): η/D², η(1/D − 1/ρ0)² or η³(1/D − 1/ρ0)²."""
         D = np.asarray(D, dtype=float)
@@ -415,7 +422,7 @@ class VelocityGatedRepulsion:
         rho_s = dist - self.robot_radius
         rel = v - v_obs
         v_ro = float(rel @ n_ro)
-        D = rho_s - v_ro * v_ro / (2.0 * self.a_max)
+        D = self.braked_clearance(dist, v_ro)
         if v_ro > 0 and D <= 0:
             return RepulsionResult("collision", None, None, rho_s, v_ro, D)
         if not v_ro > 0 or D >= self.rho0:

@@ -265,7 +265,7 @@ def _sense(field: Field, world: World, p, v, t, gated: VelocityGatedRepulsion | 
         if gated is not None:
             rel = v - np.array(o.velocity)
             v_ro = float(-(rel @ away))
-            D = clearance - gated.robot_radius - v_ro * v_ro / (2.0 * gated.a_max)
+            D = gated.braked_clearance(clearance, v_ro)
         else:
             v_ro = D = math.nan
         info.append([clearance, v_ro, D, "inactive", away, where])
