@@ -38,7 +38,7 @@ from pathlib import Path
 
 from .checks import check_choice, check_integer, check_number
 from .nav2 import is_nav2, read_nav2
-from .parameters import (FAMILY_LAW_CHOICES, FAMILY_LAW_PARAMETERS, FAMILY_LAWS, FORCE_LAWS, HOLDS, LAW_PARAMETERS, RANGES, ROBOT_FAMILIES,
+from .parameters import (FAMILY_LAW_CHOICES, FAMILY_LAW_PARAMETERS, FAMILY_LAWS, FORCE_LAWS, HOLDS, HOLONOMIC_LAWS, LAW_PARAMETERS, RANGES, ROBOT_FAMILIES,
                          Controller, Preset, Robot, get_preset)
 
 __all__ = [
@@ -344,7 +344,7 @@ def _check_family(origin, family_values, law) -> None:
     family = family_values.get("family", "steering")
     if "mass" in family_values and family != "holonomic":
         raise ValueError(f"{origin}: robot.mass applies to robot family holonomic (robot.family: holonomic), not to family {family}")
-    if family == "holonomic" and law is not None and law["name"] not in ("velocity", "velocity-gated"):
+    if family == "holonomic" and law is not None and law["name"] not in HOLONOMIC_LAWS:
         raise ValueError(f"{origin}: robot.family holonomic takes law velocity or velocity-gated "
                          f"(a force in newtons on a mass, Ge & Cui 2002 Sec 6); got law {law['name']}")
 

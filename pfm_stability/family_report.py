@@ -36,7 +36,7 @@ from .fuzzy_law import FuzzyScheduledLaw
 from .models import Loop, interval_margin, interval_verdict, models_for
 from .models.holonomic import HolonomicLoop
 from .models.holonomic_delay import make_holonomic_model
-from .parameters import (FAMILY_CHOICE_DEFAULTS, FAMILY_DEFAULTS, FAMILY_LAW_CHOICES, FAMILY_LAW_PARAMETERS, FAMILY_LAWS, MODEL_NAMES, RANGES,
+from .parameters import (FAMILY_CHOICE_DEFAULTS, FAMILY_DEFAULTS, FAMILY_LAW_CHOICES, FAMILY_LAW_PARAMETERS, FAMILY_LAWS, HOLONOMIC_LAWS, MODEL_NAMES, RANGES,
                          ROBOT_FAMILIES, Controller, Corridor, Robot, Wall, check_parameter)
 from .report import UNITS, StabilityReport, build_report, kb_error, remedies
 from .serialize import json_number
@@ -458,7 +458,7 @@ def build_family_report(
     sources = dict(sources or {})
     mass = check_parameter("mass", mass)
     family_law = law if isinstance(law, FamilyLaw) else None
-    if family == "holonomic" and (family_law is None or family_law.name == "fuzzy"):
+    if family == "holonomic" and (family_law is None or family_law.name not in HOLONOMIC_LAWS):
         shown = family_law.name if family_law is not None else getattr(law, "key", None) or "power"
         raise ValueError(f"--robot holonomic takes --law velocity or velocity-gated (a force in newtons on a mass, Ge & Cui 2002 Sec 6); got --law {shown}")
     if family == "kinematic":

@@ -51,6 +51,7 @@ __all__ = [
     "FIELD_DEFAULTS",
     "ROBOT_FAMILIES",
     "FAMILY_LAWS",
+    "HOLONOMIC_LAWS",
     "FAMILY_LAW_PARAMETERS",
     "FAMILY_DEFAULTS",
     "FAMILY_LAW_CHOICES",
@@ -124,6 +125,9 @@ robot, Ge & Cui 2002's kinematic steering (τ = 0, k = K_s) and the holonomic ro
 FAMILY_LAWS = ("velocity", "velocity-gated", "fuzzy")
 """Laws of ``report --law`` beyond `FORCE_LAWS` (docs/velocity_and_fuzzy.md): Ge & Cui 2002's velocity
 attraction with Khatib's repulsion, its velocity-gated repulsion, and the DFAPF fuzzy-scheduled repulsion."""
+
+HOLONOMIC_LAWS = ("velocity", "velocity-gated")
+"""The laws a holonomic robot (``--robot holonomic``) takes: forces in newtons on a mass (Ge & Cui 2002 §6)."""
 
 FAMILY_LAW_PARAMETERS = {
     "velocity": ("alpha_p", "alpha_v", "attraction_exponent", "velocity_exponent", "eta", "rho0", "goal_distance"),

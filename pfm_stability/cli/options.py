@@ -13,7 +13,7 @@ from dataclasses import dataclass, fields
 from typing import TYPE_CHECKING
 
 from ..checks import check_integer, check_number, check_output_path
-from ..parameters import (FAMILY_CHOICE_DEFAULTS, FAMILY_LAW_CHOICES, FAMILY_LAW_PARAMETERS, FAMILY_LAWS, FIELD_DEFAULTS, FORCE_LAWS, HOLDS,
+from ..parameters import (FAMILY_CHOICE_DEFAULTS, FAMILY_LAW_CHOICES, FAMILY_LAW_PARAMETERS, FAMILY_LAWS, FIELD_DEFAULTS, FORCE_LAWS, HOLDS, HOLONOMIC_LAWS,
                           LAW_PARAMETERS, PRESETS, RANGES, ROBOT_FAMILIES, SHOWN_AS, Controller, Preset, Robot, get_preset)
 
 if TYPE_CHECKING:
@@ -456,7 +456,7 @@ def resolve_family(args, params: ResolvedParameters) -> ResolvedFamily:
     law_by_user = typed(args, "law") or not from_file
     law_name = str(args.law) if law_by_user else from_file["name"]
     law_shown = f"--law {law_name}" if law_by_user else f"law {law_name} of --config {config.path}"
-    if family == "holonomic" and law_name not in ("velocity", "velocity-gated"):
+    if family == "holonomic" and law_name not in HOLONOMIC_LAWS:
         raise ValueError(f"{robot_shown} takes --law velocity or velocity-gated (a force in newtons on a mass, Ge & Cui 2002 Sec 6); got {law_shown}")
     typed_family = [k for k in FAMILY_OPTIONS if getattr(args, k, None) is not None]
     if law_name not in FAMILY_LAWS:
