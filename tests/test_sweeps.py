@@ -13,6 +13,7 @@ from __future__ import annotations
 import json
 import math
 import os
+from itertools import pairwise
 
 import numpy as np
 import pyarrow.parquet as pq
@@ -306,7 +307,7 @@ def test_chunk_plan_covers_every_point_once_with_a_fine_tail(count, size):
         plan = plan_chunks(count, size, fine_tail=fine)
         assert [c[0] for c in plan] == list(range(len(plan)))
         assert plan[0][1] == 0 and plan[-1][2] == count
-        assert all(a[2] == b[1] for a, b in zip(plan, plan[1:])) and all(0 < stop - start <= size for _, start, stop in plan)
+        assert all(a[2] == b[1] for a, b in pairwise(plan)) and all(0 < stop - start <= size for _, start, stop in plan)
     coarse, fine = plan_chunks(count, size), plan_chunks(count, size, fine_tail=True)
     tail = min(count, TAIL_CHUNKS * size)
     small = -(-size // 4)
@@ -391,3 +392,19 @@ def test_simulation_on_cluster_with_retry_agrees_with_sampled(tmp_path, cluster)
     assert all(r["sim_verdict"] in ("stable", "unstable") and (not math.isnan(r["sim_sigma"]) or r["sim_basis"] != "growth_rate") for r in rows)
     far = [r for r in rows if abs(r["sampled_margin"]) > 0.05]
     assert far and all(r["sim_verdict"] == r["sampled_verdict"] for r in far)
+
+
+def test_simulation_on_local_processes_equals_cluster_and_in_process(tmp_path, cluster):
+    """simulate: true without a scheduler runs on Dask's local worker processes (no cluster): the table equals the
+    cluster's and the in-process evaluation (pyarrow equality), a chunk failing once in a worker process is retried
+    there, and the progress callback sees every point once, in this process."""
+    s = spec(simulate=True, models=["sampled"], scenario={"wall": {"alpha": 40}}, grid=None,
+             sample={"method": "latin-hypercube", "n": 6, "seed": 1, "ranges": {"V": [0.3, 1.5], "T": [0.02, 0.15]}})
+    seen = []
+    local = run_sweep(s, tmp_path / "local.parquet", chunk_size=3, workers=2, fail_once=(0,),
+                      progress=lambda points, total, chunks, total_chunks: seen.append((points, chunks)))
+    run_sweep(s, tmp_path / "cluster.parquet", chunk_size=3, scheduler=cluster.scheduler_address)
+    assert local.scheduler == "local processes (2)" and local.chunks == 6  # the fine tail: chunks of ceil(3/4) = 1
+    assert seen[0] == (0, 0) and seen[-1] == (6, 6) and [c for _, c in seen] == list(range(7))
+    assert same(read(tmp_path / "local.parquet"), read(tmp_path / "cluster.parquet"))
+    assert same(read(tmp_path / "local.parquet"), to_arrow(evaluate_chunk(s, 0, 6, sample_points(s))))

@@ -51,7 +51,7 @@ def add_parser(sub) -> None:
         help="parameter study: every model's verdict (and the simulator's) over a grid or a sample, to Parquet",
         description="Evaluate a sweep spec (docs/sweeps.md): a full factorial grid or a seeded Latin-hypercube/Sobol sample "
         "of V, tau, T, k, f, n, W, alpha or L and the law's parameters; every model's verdict, NV* and margin per point "
-        "and, with simulate: true, the simulator's growth rate and verdict. Runs on local threads, a local cluster of "
+        "and, with simulate: true, the simulator's growth rate and verdict. Runs on local threads, local worker "
         "processes (simulation), or a running dask.distributed scheduler; resumable.",
     )
     p.add_argument("spec", metavar="SPEC", help="sweep spec, a YAML file (docs/sweeps.md)")

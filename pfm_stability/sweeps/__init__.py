@@ -4,13 +4,13 @@
   specification (YAML) before any work: the fixed values (preset or config),
   the geometry, the law, the models, and a grid or a seeded sample;
 * `points` — the points: a full factorial grid, or a Latin hypercube / Sobol
-  sample (`scipy.stats.qmc`, seeded);
+  sample (seeded; the draws of `scipy.stats.qmc`, `sampling`);
 * `evaluate_chunk` (module `evaluate`) — one chunk of points → its columns:
   N and NV, every model's verdict, NV* and margin (`vectorized.loop_verdicts`)
   and, when asked, the simulator's σ and verdict (`validation.sweep.simulate_members`);
 * `run_sweep` (module `engine`) — the chunks as Dask tasks, written as they
-  finish, retried, resumable; local threads, a local cluster of processes,
-  or a running ``dask.distributed`` scheduler;
+  finish, retried, resumable; local threads, local worker processes
+  (simulation), or a running ``dask.distributed`` scheduler;
 * `table` — Parquet parts, the output (Parquet or CSV) and its statistics;
 * `summary_map` (module `summary`) — the data of the summary figure
   (`pfm_stability.plots.sweep`).

@@ -14,14 +14,15 @@
 4. concatenates the parts in point order into ``OUT`` (atomically) and
    removes ``OUT.parts``.
 
-Schedulers: without ``scheduler`` and without simulation, Dask's threaded
-scheduler in this process (no cluster to start: a vectorized sweep is
-dominated by its arithmetic); without ``scheduler`` and with ``simulate``,
-a `distributed.LocalCluster` of ``workers`` single-threaded processes (the
-simulator holds the GIL); with ``scheduler="tcp://HOST:PORT"``, that
-cluster (its workers need this version of pfm-stability). On a cluster the
-workers return each chunk's table and this process writes it, so the
-workers need no shared file system.
+Schedulers: without ``scheduler``, Dask's local scheduler on this machine:
+``workers`` threads of this process without simulation (a vectorized sweep
+is dominated by its arithmetic, which releases the GIL), ``workers`` worker
+processes with ``simulate`` (the simulator holds the GIL); either way there
+is no cluster to start and the chunks write their own parts. With
+``scheduler="tcp://HOST:PORT"``, that ``dask.distributed`` cluster (its
+workers need this version of pfm-stability): the workers return each
+chunk's table and this process writes it, so the workers need no shared
+file system.
 
 Resume: with ``resume=True`` finished chunks whose manifest has this spec's
 digest are kept (a different spec is a ValueError: nothing is overwritten);
@@ -115,7 +116,7 @@ class SweepSummary:
     reused_chunks : int
         Chunks taken from an earlier, interrupted run (``resume``).
     scheduler : str
-        ``"threads (N)"``, ``"local cluster (N processes)"`` or the address.
+        ``"threads (N)"``, ``"local processes (N)"`` or the address.
     statistics : SweepStatistics
     seconds : float
         Wall clock of `run_sweep`, s.
@@ -256,8 +257,8 @@ def _chunk_error(index: int, start: int, stop: int, exc: BaseException) -> Sweep
                       f"{type(exc).__name__}: {exc}; the finished chunks are kept, rerun with --resume")
 
 
-def _local_task(spec, index, start, stop, sample, path, marker, report):
-    """Evaluate, retry, write: one chunk in a thread of this process; its `SweepError` (returned, so the other chunks still finish) or None."""
+def _local_task(spec, index, start, stop, sample, path, marker):
+    """Evaluate, retry, write: one chunk in a thread or worker process of this machine; its `SweepError` (returned, so the other chunks still finish) or None."""
     error = None
     for _ in range(RETRIES + 1):
         try:
@@ -268,21 +269,39 @@ def _local_task(spec, index, start, stop, sample, path, marker, report):
     else:
         return _chunk_error(index, start, stop, error)
     write_part(table, path)
-    report(stop - start)
     return None
 
 
-def _run_threads(todo, spec, sample, paths, parts, fail_once, workers, report):
-    from dask.threaded import get
+def _run_local(todo, spec, sample, paths, parts, fail_once, workers, processes, report):
+    """Every chunk of `todo` on Dask's local scheduler: `workers` threads, or (``processes``) worker processes.
+
+    The chunks write their own parts (this machine's file system); `report` is
+    called here, in this process, as each chunk finishes (a Dask callback).
+    """
+    from dask.callbacks import Callback
 
     from ..vectorized import loop_verdicts  # noqa: F401 - imported here once: threads importing it together race
 
-    graph = {}
+    graph, sizes = {}, {}
     for index, start, stop in todo:
-        task = partial(_local_task, spec, index, start, stop, _slice(spec, sample, start, stop), paths[index],
-                       _fail_marker(parts, index, fail_once), report)
-        graph[("chunk", index)] = (task,)
-    errors = [e for e in get(graph, list(graph), num_workers=workers) if e is not None]
+        graph[("chunk", index)] = (partial(_local_task, spec, index, start, stop, _slice(spec, sample, start, stop), paths[index],
+                                           _fail_marker(parts, index, fail_once)),)
+        sizes[("chunk", index)] = stop - start
+
+    def finished(key, result, dsk, state, worker_id) -> None:
+        if result is None:
+            report(sizes[key])
+
+    with Callback(posttask=finished):
+        if processes:
+            from dask.multiprocessing import get
+
+            results = get(graph, list(graph), num_workers=workers, chunksize=1)  # one chunk per dispatch: both workers to the end
+        else:
+            from dask.threaded import get
+
+            results = get(graph, list(graph), num_workers=workers)
+    errors = [e for e in results if e is not None]
     if errors:
         raise errors[0]
 
@@ -291,20 +310,14 @@ def _slice(spec: SweepSpec, sample, start: int, stop: int):
     return chunk_points(spec, start, stop, sample) if sample is not None else None
 
 
-def _connect(scheduler: str | None, workers: int, timeout: float):
-    """A distributed Client: to `scheduler`, or to a new LocalCluster of `workers` processes (then also the cluster)."""
-    import logging
+def _connect(scheduler: str, timeout: float):
+    """A distributed Client of the running scheduler at `scheduler` (ValueError if it cannot be reached within `timeout` s)."""
+    from distributed import Client
 
-    from distributed import Client, LocalCluster
-
-    if scheduler is not None:
-        try:
-            return Client(scheduler, timeout=timeout), None
-        except (OSError, TimeoutError, ValueError) as exc:
-            raise ValueError(f"scheduler: cannot connect to {scheduler} within {timeout:g} s ({type(exc).__name__}: {exc})") from None
-    # dashboard on a free port: the default 8787 may belong to another cluster (distributed then warns)
-    cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=":0", silence_logs=logging.ERROR)
-    return Client(cluster), cluster
+    try:
+        return Client(scheduler, timeout=timeout)
+    except (OSError, TimeoutError, ValueError) as exc:
+        raise ValueError(f"scheduler: cannot connect to {scheduler} within {timeout:g} s ({type(exc).__name__}: {exc})") from None
 
 
 def _run_cluster(client, todo, spec, sample, paths, parts, fail_once, stop_after, report):
@@ -393,10 +406,9 @@ def run_sweep(
     chunks = plan_chunks(spec.count, chunk_size, fine_tail=spec.simulate)
     parts = parts_directory(out)
     paths = {index: _part_path(parts, index, len(chunks)) for index, _, _ in chunks}
-    use_cluster = scheduler is not None or spec.simulate
-    client = cluster = None
-    if use_cluster:
-        client, cluster = _connect(scheduler, workers, CONNECT_TIMEOUT if connect_timeout is None else connect_timeout)
+    client = None
+    if scheduler is not None:
+        client = _connect(scheduler, CONNECT_TIMEOUT if connect_timeout is None else connect_timeout)
     try:
         if manifest is None:
             shutil.rmtree(parts, ignore_errors=True)
@@ -420,21 +432,19 @@ def run_sweep(
             progress(state["points"], spec.count, state["chunks"], len(chunks))
         if client is not None:
             _run_cluster(client, todo, spec, sample, paths, parts, set(fail_once), stop_after_chunks, report)
-            where = scheduler if scheduler is not None else f"local cluster ({workers} processes)"
+            where = scheduler
         else:
             if stop_after_chunks is not None:
                 todo, stopped = todo[:stop_after_chunks], True
             else:
                 stopped = False
-            _run_threads(todo, spec, sample, paths, parts, set(fail_once), workers, report)
+            _run_local(todo, spec, sample, paths, parts, set(fail_once), workers, spec.simulate, report)
             if stopped:
                 raise SweepInterrupted(f"stopped after {len(todo)} chunks (stop_after_chunks)")
-            where = f"threads ({workers})"
+            where = f"local processes ({workers})" if spec.simulate else f"threads ({workers})"
     finally:
         if client is not None:
             client.close()
-        if cluster is not None:
-            cluster.close()
     concatenate_parts([paths[i] for i, _, _ in chunks], out, spec)
     shutil.rmtree(parts, ignore_errors=True)
     columns = [f"{m}_verdict" for m in spec.models] + (["sim_verdict"] if spec.simulate else [])

@@ -4,10 +4,11 @@ Point ``i`` of a grid is the C-order (row-major) element ``i`` of the
 product of its axes in the spec's order: the first axis varies slowest,
 the last fastest (`numpy.unravel_index`). A chunk of a grid is therefore
 computed from its index range alone (`grid_points`), without the other
-points. A sample is drawn once, whole, by `scipy.stats.qmc`
+points. A sample is drawn once, whole, as `scipy.stats.qmc` draws it
 (``LatinHypercube(d, seed=seed)`` or ``Sobol(d, scramble=True,
-seed=seed)``) and scaled to its ranges (`sample_points`): the same seed
-gives the same points on every machine. Sobol points are balanced only for
+seed=seed)``; `sampling.latin_hypercube`, `sampling.sobol`) and scaled to
+its ranges (`sample_points`): the same seed gives the same points on every
+machine. Sobol points are balanced only for
 n a power of two; another n is accepted, with a note (`sobol_note`) in the
 summary, instead of scipy's warning.
 
@@ -17,10 +18,10 @@ summary, instead of scipy's warning.
 from __future__ import annotations
 
 import math
-import warnings
 
 import numpy as np
 
+from ..sampling import latin_hypercube, sobol
 from .spec import Axis, SweepSpec
 
 __all__ = ["all_points", "axis_values", "check_points", "chunk_points", "grid_points", "sample_points", "sobol_note"]
@@ -44,17 +45,9 @@ def grid_points(axes, start: int, stop: int) -> dict:
 
 def sample_points(spec: SweepSpec) -> dict:
     """Every point of the spec's sample: parameter → array of ``n`` values (seeded, reproducible)."""
-    from scipy.stats import qmc
-
     s = spec.sample
-    d = len(s.ranges)
-    if s.method == "sobol":
-        engine = qmc.Sobol(d, scramble=True, seed=s.seed)
-        with warnings.catch_warnings():  # the balance note is `sobol_note`'s
-            warnings.simplefilter("ignore", UserWarning)
-            unit = engine.random(s.n)
-    else:
-        unit = qmc.LatinHypercube(d, seed=s.seed).random(s.n)
+    draw = sobol if s.method == "sobol" else latin_hypercube  # sobol: the balance note is `sobol_note`'s
+    unit = draw(s.n, len(s.ranges), s.seed)
     lows = np.array([lo for _, lo, _ in s.ranges])
     highs = np.array([hi for _, _, hi in s.ranges])
     scaled = lows + (highs - lows) * unit

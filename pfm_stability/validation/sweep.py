@@ -1,7 +1,8 @@
 """Random parameter sets: does the sign of the simulated growth rate agree with each model? (docs/validation.md)
 
 `verdict_sweep` draws `count` parameter sets from a seeded Latin hypercube
-(`scipy.stats.qmc.LatinHypercube`) over `SWEEP_RANGES` — V, τ, T, k, f and
+(`sampling.latin_hypercube`: the draws of SciPy's `qmc.LatinHypercube`) over
+`SWEEP_RANGES` — V, τ, T, k, f and
 the geometry (corridor half-width L or wall angle α) — with W = 0.8 m and
 n = 2 (CARMEL, KB §4). Members take the geometries and the sampled structures
 in turn: member i is a corridor when ⌊i/4⌋ is even and a wall otherwise,
@@ -34,6 +35,7 @@ import numpy as np
 from ..checks import check_choice, check_integer, check_number
 from ..models import MODEL_NAMES, Loop, make_model
 from ..parameters import CARMEL, Controller, Robot
+from ..sampling import latin_hypercube
 from ..serialize import json_number, json_ready
 from ..sim.api import batch_scenarios
 from ..sim.engine import run_batch
@@ -246,10 +248,8 @@ def sweep_parameters(count: int, seed: int = 0, ranges: dict | None = None) -> d
         ``V, tau, T, k, f, u`` (arrays), ``scenario`` (list of str),
         ``hold`` (list), ``compute_delay`` (array).
     """
-    from scipy.stats import qmc
-
     ranges = dict(SWEEP_RANGES if ranges is None else ranges)
-    sample = qmc.LatinHypercube(d=len(_DIMENSIONS), seed=seed).random(count)
+    sample = latin_hypercube(count, len(_DIMENSIONS), seed)
     out = {}
     for j, name in enumerate(_DIMENSIONS[:-1]):
         lo, hi = ranges[name]
