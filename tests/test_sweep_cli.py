@@ -14,6 +14,7 @@ import numpy as np
 import pyarrow.parquet as pq
 import pytest
 from jsonschema import Draft202012Validator
+from table_helpers import read, same
 
 from pfm_stability.cli import main
 from pfm_stability.schema import load_schema
@@ -161,3 +162,57 @@ def test_config_option_replaces_the_specs_preset(tmp_path, capsys):
     assert tables["option"]["sampled_verdict"] != tables["preset"]["sampled_verdict"]
     code, _, err = run(capsys, [spec, "--config", str(tmp_path / "missing.yaml"), "--out", str(tmp_path / "m.parquet"), "--quiet"])
     assert code == 2 and "config" in err and not (tmp_path / "m.parquet").exists()
+
+
+SIM_SPEC = """\
+preset: carmel
+scenario: {wall: {alpha: 40}}
+models: [sampled]
+simulate: true
+sample: {method: latin-hypercube, n: 60, seed: 3, ranges: {V: [0.3, 1.5], T: [0.02, 0.15]}}
+"""
+
+
+@pytest.mark.parametrize("signal_name", ["SIGINT", "SIGKILL"])
+def test_a_really_interrupted_simulation_sweep_resumes_to_the_same_table(tmp_path, signal_name):
+    """The command in a process of its own, interrupted once 3 of its parts are written — its whole process group
+    signalled, as Ctrl-C in a terminal (SIGINT: exit 130 and the --resume hint) or a crash / ``kill -9`` (SIGKILL)
+    would. ``--resume`` then reuses the written parts, and the table equals the uninterrupted in-process evaluation
+    (pyarrow equality: the same floats, no tolerance)."""
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    from pfm_stability.sweeps import evaluate_chunk, load_spec
+    from pfm_stability.sweeps.engine import plan_chunks
+    from pfm_stability.sweeps.points import sample_points
+    from pfm_stability.sweeps.table import to_arrow
+
+    spec, out = write(tmp_path, SIM_SPEC), tmp_path / "t.parquet"
+    argv = [sys.executable, "-m", "pfm_stability", "sweep", spec, "--out", str(out), "--workers", "2", "--chunk-size", "3", "--quiet"]
+    # SIGINT back to its default before exec (a background job may inherit it ignored); its own session: a process group
+    launch = ("import os, signal, sys; signal.signal(signal.SIGINT, signal.SIG_DFL); os.execv(sys.executable, sys.argv[1:])")
+    process = subprocess.Popen([sys.executable, "-c", launch, *argv], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                               start_new_session=True)
+    parts, deadline = f"{out}.parts", time.monotonic() + 120
+    while time.monotonic() < deadline and process.poll() is None:
+        if os.path.isdir(parts) and sum(name.endswith(".parquet") for name in os.listdir(parts)) >= 3:
+            break
+        time.sleep(0.005)
+    assert process.poll() is None, "the sweep ended before it could be interrupted"
+    os.killpg(process.pid, getattr(signal, signal_name))
+    _, err = process.communicate(timeout=60)
+    assert not out.exists()
+    if signal_name == "SIGINT":
+        assert process.returncode == 130 and "rerun with --resume" in err, err
+    else:
+        assert process.returncode == -signal.SIGKILL
+    kept = sum(name.endswith(".parquet") for name in os.listdir(parts))
+    resumed = subprocess.run([*argv, "--resume", "--format", "json"], capture_output=True, text=True, timeout=300, check=False)
+    assert resumed.returncode == 0, resumed.stderr
+    summary = json.loads(resumed.stdout)
+    chunks = len(plan_chunks(60, 3, fine_tail=True))
+    assert summary["chunks"] == chunks and 3 <= summary["reused_chunks"] == kept < chunks
+    s = load_spec(spec)
+    assert same(read(out), to_arrow(evaluate_chunk(s, 0, 60, sample_points(s))))

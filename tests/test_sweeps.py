@@ -16,8 +16,8 @@ import os
 from itertools import pairwise
 
 import numpy as np
-import pyarrow.parquet as pq
 import pytest
+from table_helpers import read, same
 
 from pfm_stability.cli import main
 from pfm_stability.parameters import MODEL_NAMES
@@ -257,24 +257,6 @@ def test_config_file_gives_the_fixed_values(tmp_path):
 
 
 # ------------------------------------------------------------------ engine
-def read(path):
-    return pq.read_table(path).replace_schema_metadata(None)
-
-
-def same(a, b) -> bool:
-    """pyarrow table equality, with NaN equal to NaN (Table.equals calls a table holding a NaN unequal to itself)."""
-    if a.schema != b.schema:
-        return False
-    for name in a.column_names:
-        x, y = a.column(name), b.column(name)
-        if x.type == "double":
-            if not np.array_equal(x.to_numpy(), y.to_numpy(), equal_nan=True):
-                return False
-        elif not x.equals(y):
-            return False
-    return True
-
-
 def test_resume_after_interruption_and_retry_give_the_same_table(tmp_path):
     """Interrupted after 2 of 5 chunks and resumed (2 reused), or with a chunk failing once: the table of an uninterrupted run."""
     s = spec(grid={"V": {"from": 0.2, "to": 1.6, "num": 9}, "k": {"from": 0.5, "to": 6, "num": 5}}, models=["sampled", "pade"])
