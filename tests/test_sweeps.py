@@ -224,6 +224,33 @@ def test_once_per_loop_equals_loop_verdicts_at_every_point(model):
         assert np.allclose(got[3], direct.margin, rtol=1e-15, atol=0, equal_nan=True)  # the same division
 
 
+def test_loop_groups_skip_grouping_only_where_most_loops_are_distinct():
+    """`loop_groups`: None (no grouping: every point to `loop_verdicts`) exactly when more than half the points
+    have a loop of their own — a random sample of T, or of τ and k with T fixed; otherwise `distinct_rows`' groups.
+    The count of distinct loops is checked independently with numpy.unique over the rows. Exact integers."""
+    from pfm_stability.sweeps.evaluate import distinct_rows, loop_groups
+
+    rng = np.random.default_rng(11)
+    n = 1000
+    grid_T = np.repeat(rng.uniform(0.01, 0.2, 40), n // 40)
+    fixed = np.full(n, 0.5)
+    cases = {
+        "random T": (fixed, rng.uniform(0.01, 0.2, n), np.full(n, 2.0)),
+        "random tau and k": (rng.uniform(0, 1, n), np.full(n, 0.05), rng.uniform(0.2, 10, n)),
+        "grid of 40 T": (fixed, grid_T, np.full(n, 2.0)),
+        "501 loops of pairs": (np.r_[np.repeat(rng.uniform(0, 1, 499), 2), 0.1, 0.2], np.full(n, 0.05), np.full(n, 2.0)),
+        "500 loops of pairs": (np.repeat(rng.uniform(0, 1, 500), 2), np.full(n, 0.05), np.full(n, 2.0)),
+    }
+    for name, (tau, T, k) in cases.items():
+        distinct = len(np.unique(np.column_stack([tau, T, k]), axis=0))
+        groups = loop_groups(tau, T, k)
+        assert (groups is None) == (2 * distinct > n), name
+        if groups is not None:
+            first, inverse = groups
+            want_first, want_inverse = distinct_rows(tau, T, k)
+            assert np.array_equal(first, want_first) and np.array_equal(inverse, want_inverse) and len(first) == distinct, name
+
+
 def test_goal_aware_wall_rows_agree_with_report(capsys):
     """Ge & Cui's goal-aware law at a wall with three equilibria (the report's JSON-schema case): the nearest one's verdicts."""
     s = spec(law={"name": "gnron", "goal_distance": 0.02, "goal_exponent": 0.5, "eta": 1.0}, models=["sampled", "exact_delay"],
@@ -295,6 +322,24 @@ def test_chunk_plan_covers_every_point_once_with_a_fine_tail(count, size):
     small = -(-size // 4)
     assert all(stop - start <= small for _, start, stop in fine if start >= count - tail)
     assert [c for c in fine if c[2] <= count - tail] == [c for c in coarse if c[2] <= count - tail]
+
+
+def test_default_chunk_size_shares_a_vectorized_sweep_over_the_workers():
+    """Without simulation ⌈points/workers⌉ within [VECTOR_MIN_CHUNK, VECTOR_CHUNK] (every thread gets work), with
+    simulation SIMULATION_CHUNK (that the table does not depend on the chunks: the resume test). Exact integers."""
+    from pfm_stability.sweeps.engine import (
+        SIMULATION_CHUNK,
+        VECTOR_CHUNK,
+        VECTOR_MIN_CHUNK,
+        default_chunk_size,
+    )
+
+    def sized(n, simulate=False):
+        return spec(grid=None, simulate=simulate, sample={"method": "sobol", "n": n, "seed": 0, "ranges": {"T": [0.01, 0.2]}})
+
+    assert default_chunk_size(sized(200_000), 2) == 100_000 and default_chunk_size(sized(200_001), 2) == 100_001
+    assert default_chunk_size(sized(5_000_000), 2) == VECTOR_CHUNK and default_chunk_size(sized(900), 2) == VECTOR_MIN_CHUNK
+    assert default_chunk_size(sized(200_000, simulate=True), 2) == SIMULATION_CHUNK
 
 
 def test_failing_chunk_is_named_and_parts_are_kept(tmp_path, monkeypatch):

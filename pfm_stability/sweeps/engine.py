@@ -67,6 +67,7 @@ __all__ = [
     "SIMULATION_CHUNK",
     "TAIL_CHUNKS",
     "VECTOR_CHUNK",
+    "VECTOR_MIN_CHUNK",
     "SweepError",
     "SweepInterrupted",
     "SweepSummary",
@@ -81,7 +82,10 @@ RETRIES = 2
 """Retries of a failed chunk before the sweep fails."""
 
 VECTOR_CHUNK = 250_000
-"""Default points per chunk of a sweep without simulation (vectorized: large chunks, few tasks)."""
+"""Most points per chunk of a sweep without simulation by default (vectorized: large chunks, few tasks; `default_chunk_size`)."""
+
+VECTOR_MIN_CHUNK = 10_000
+"""Fewest points per chunk of a sweep without simulation by default (`default_chunk_size`)."""
 
 SIMULATION_CHUNK = 50
 """Default points per chunk of a simulation sweep (one simulated batch each, ~seconds of work)."""
@@ -168,9 +172,16 @@ class SweepSummary:
         })
 
 
-def default_chunk_size(spec: SweepSpec) -> int:
-    """`SIMULATION_CHUNK` when simulating, else `VECTOR_CHUNK`."""
-    return SIMULATION_CHUNK if spec.simulate else VECTOR_CHUNK
+def default_chunk_size(spec: SweepSpec, workers: int) -> int:
+    """`SIMULATION_CHUNK` when simulating; else the points shared over the `workers` threads,
+    ⌈count/workers⌉, within [`VECTOR_MIN_CHUNK`, `VECTOR_CHUNK`] (one chunk would keep one core busy).
+
+    The table does not depend on it (every point is evaluated on its own), and a
+    resumed sweep takes the chunk size of the interrupted run.
+    """
+    if spec.simulate:
+        return SIMULATION_CHUNK
+    return min(VECTOR_CHUNK, max(VECTOR_MIN_CHUNK, -(-spec.count // workers)))
 
 
 def plan_chunks(count: int, chunk_size: int, *, fine_tail: bool = False) -> list:
@@ -218,7 +229,7 @@ def _manifest(spec: SweepSpec, chunk_size: int) -> dict:
     return {"digest": spec.digest, "chunk_size": chunk_size, "points": spec.count, "version": __version__}
 
 
-def _prepare_parts(spec: SweepSpec, out: str, chunk_size: int | None, resume: bool) -> tuple[int, dict | None]:
+def _prepare_parts(spec: SweepSpec, out: str, chunk_size: int | None, resume: bool, workers: int) -> tuple[int, dict | None]:
     """(chunk size, the manifest to keep or None): checks a resumed run's manifest before anything is written."""
     parts = parts_directory(out)
     path = os.path.join(parts, "manifest.json")
@@ -236,7 +247,7 @@ def _prepare_parts(spec: SweepSpec, out: str, chunk_size: int | None, resume: bo
             raise ValueError(f"chunk-size: the interrupted sweep in {parts} used chunks of {old.get('chunk_size')} points; "
                              f"resume with that size (or omit --chunk-size)")
         chunk_size = int(old["chunk_size"])
-    return (chunk_size if chunk_size is not None else default_chunk_size(spec)), old
+    return (chunk_size if chunk_size is not None else default_chunk_size(spec, workers)), old
 
 
 def _fail_marker(parts: str, index: int, fail_once) -> str | None:
@@ -402,7 +413,7 @@ def run_sweep(
         raise ValueError(f"scheduler must be an address tcp://HOST:PORT; got {scheduler!r}")
     sample = all_points(spec)
     check_points(spec, sample)
-    chunk_size, manifest = _prepare_parts(spec, out, chunk_size, resume)
+    chunk_size, manifest = _prepare_parts(spec, out, chunk_size, resume, workers)
     chunks = plan_chunks(spec.count, chunk_size, fine_tail=spec.simulate)
     parts = parts_directory(out)
     paths = {index: _part_path(parts, index, len(chunks)) for index, _, _ in chunks}

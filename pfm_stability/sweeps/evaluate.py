@@ -51,7 +51,7 @@ from ..parameters import RADIANS_PER_DEGREE, Controller, Robot
 from .points import chunk_points
 from .spec import LAW_SWEPT, SweepSpec
 
-__all__ = ["NO_GRADIENT_REASON", "SIM_COLUMNS", "ChunkColumns", "distinct_rows", "evaluate_chunk", "model_answers", "model_columns"]
+__all__ = ["NO_GRADIENT_REASON", "SIM_COLUMNS", "ChunkColumns", "distinct_rows", "evaluate_chunk", "loop_groups", "model_answers", "model_columns"]
 
 NO_GRADIENT_REASON = "N = 0: no force gradient at the equilibrium (the law never balances the pull there): nothing to oscillate"
 """The reason written where N = 0: every model "stable", margin inf (as the report answers)."""
@@ -163,7 +163,28 @@ def distinct_rows(*columns) -> tuple[np.ndarray, np.ndarray]:
     return order[changed], inverse
 
 
-def model_answers(model: str, tau, T, k, NV, *, groups=None, **options) -> tuple:
+def loop_groups(tau, T, k):
+    """`distinct_rows(tau, T, k)`, or None where grouping the points by loop would save nothing.
+
+    None when more than half the points have a loop of their own — seen first
+    on each column alone (one sort each: a column with more than n/2 distinct
+    values makes as many distinct loops), which spares random samples of τ, T
+    or k the sort of all three columns together.
+    """
+    n = len(tau)
+    for column in (T, tau, k):
+        ordered = np.sort(column)
+        if 2 * (1 + np.count_nonzero(ordered[1:] != ordered[:-1])) > n:
+            return None
+    groups = distinct_rows(tau, T, k)
+    return None if 2 * len(groups[0]) > n else groups
+
+
+_GROUP = object()
+"""`model_answers`' default: group the points itself (`loop_groups`)."""
+
+
+def model_answers(model: str, tau, T, k, NV, *, groups=_GROUP, **options) -> tuple:
     """(stable, verdict, NV*, margin) arrays of one model: `vectorized.loop_verdicts`, once per distinct loop.
 
     A model's boundary depends on the loop (τ, T, k) and not on NV
@@ -174,14 +195,15 @@ def model_answers(model: str, tau, T, k, NV, *, groups=None, **options) -> tuple
     within `SHORTCUT_BAND` of NV* and every point of a loop with another stable
     set are decided by `loop_verdicts` at their own NV. With more than half as
     many distinct loops as points, every point goes to `loop_verdicts` directly.
-    `groups` is `distinct_rows(tau, T, k)` when the caller has it already.
+    `groups` is `loop_groups(tau, T, k)` when the caller has it already.
     """
     from ..vectorized import loop_verdicts
 
-    first, inverse = groups if groups is not None else distinct_rows(tau, T, k)
-    if 2 * len(first) > len(NV):
+    groups = loop_groups(tau, T, k) if groups is _GROUP else groups
+    if groups is None:
         v = loop_verdicts(model, tau, T, k, NV, **options)
         return np.array(v.stable, dtype=bool), np.array(v.verdict, dtype=object), np.array(v.NV_critical, dtype=float), np.array(v.margin, dtype=float)
+    first, inverse = groups
     per_loop = loop_verdicts(model, tau[first], T[first], k[first], 1.0, **options)
     critical = np.asarray(per_loop.NV_critical, dtype=float)[inverse]
     regular = np.asarray(per_loop.regular, dtype=bool)[inverse]
@@ -216,7 +238,7 @@ def _verdict_columns(spec: SweepSpec, inputs: dict, NV: np.ndarray, reasons: np.
                       "choose a less extreme force law (f, n), angle or width")
     safe = np.where(negative | zero | beyond, 1.0, NV)  # NV* does not depend on NV; the answer there is overwritten
     names, arrays = [], []
-    groups = distinct_rows(tau, T, inputs["k"])
+    groups = loop_groups(tau, T, inputs["k"])
     for model in spec.models:
         stable, verdict, critical, margin = model_answers(
             model, tau, T, inputs["k"], safe, groups=groups,

@@ -23,7 +23,7 @@ import numpy as np
 from ..version import __version__
 from .evaluate import ChunkColumns
 
-__all__ = ["SweepStatistics", "concatenate_parts", "metadata", "read_columns", "read_part", "statistics", "to_arrow", "write_part", "write_table"]
+__all__ = ["SweepStatistics", "concatenate_parts", "dictionary_columns", "metadata", "read_columns", "read_part", "statistics", "to_arrow", "write_part", "write_table"]
 
 
 def to_arrow(columns: ChunkColumns, metadata: dict | None = None):
@@ -45,12 +45,24 @@ def metadata(spec) -> dict:
     return {"pfm_stability.spec": json.dumps(spec.to_dict(), sort_keys=True), "pfm_stability.version": __version__}
 
 
+def dictionary_columns(schema) -> list:
+    """The columns worth Parquet's dictionary encoding: the strings (verdicts, reasons: a few distinct values).
+
+    Numbers are stored plainly: trying a dictionary on a column of distinct
+    floats (a sample's inputs, NV*, margins) and giving up costs three times
+    the rest of the write (0.18 of 0.26 s for 200,000 rows).
+    """
+    import pyarrow as pa
+
+    return [field.name for field in schema if pa.types.is_string(field.type)]
+
+
 def write_part(table, path: str) -> None:
     """Write one chunk's table as Parquet, atomically (temporary name, then rename)."""
     import pyarrow.parquet as pq
 
     tmp = f"{path}.tmp-{os.getpid()}"
-    pq.write_table(table, tmp)
+    pq.write_table(table, tmp, use_dictionary=dictionary_columns(table.schema))
     os.replace(tmp, path)
 
 
@@ -88,7 +100,7 @@ def concatenate_parts(paths, out: str, spec) -> None:
                 writer.close()
         else:
             schema = pq.read_schema(paths[0]).with_metadata(meta) if paths else None
-            with pq.ParquetWriter(tmp, schema) as writer:
+            with pq.ParquetWriter(tmp, schema, use_dictionary=dictionary_columns(schema)) as writer:
                 for path in paths:
                     writer.write_table(pa.Table.from_batches(pq.ParquetFile(path).read().to_batches(), schema=schema))
         os.replace(tmp, out)
@@ -102,7 +114,7 @@ def write_table(table, out: str, spec) -> None:
     import pyarrow.parquet as pq
 
     tmp_part = f"{out}.part-{os.getpid()}.parquet"
-    pq.write_table(table, tmp_part)
+    pq.write_table(table, tmp_part, use_dictionary=dictionary_columns(table.schema))
     try:
         concatenate_parts([tmp_part], out, spec)
     finally:

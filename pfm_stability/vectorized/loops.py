@@ -256,8 +256,10 @@ def _verdicts_only(name, points, shape, options) -> LoopVerdicts:
     edge there would flip the test between two of the three gains. Its label
     is then "stable" or "unstable" by the test at NV — exactly what
     `verdict_label` returns, since no |NV/edge − 1| <= 10⁻⁹ exists. Only the
-    points where the three tests differ (about 2ε of random points) go
-    through `_all_columns`. Two assumptions, both stated: the array test
+    points where the three tests differ (about 2ε of random points), and
+    those a model's test leaves open (`exact_delay`: three crossing
+    frequencies, about 0.6 % of random points), go through `_all_columns`,
+    in one call. Two assumptions, both stated: the array test
     and the array boundary agree to better than ε − 10⁻⁹ in NV (they come
     from the same polynomials: 10⁻¹² for closed forms, ~10⁻⁸ for the
     stiffest sampled loops), and no two edges of a stable set lie within
@@ -293,7 +295,8 @@ _STABILITY = {
     "sampled": routes.sampled_stable,
 }
 """Model name → ``test(points, options, K, ε) -> (stable, near)`` (verdict-only path): `stable` at
-the gains K, and `near` where an edge of the stable set may lie within a relative step ε of K."""
+the gains K, and `near` where an edge of the stable set may lie within a relative step ε of K (or where
+the test does not decide: those points are decided with the boundary too)."""
 
 _ROUTES = {
     "continuous": routes.continuous,

@@ -216,16 +216,17 @@ def pade_stable(points, options, K, eps):
 
 
 def exact_delay_stable(points, options, K, eps):
-    """(stable, near) of KB eq (18) (with c) at gains K: one crossing by `single_crossing_verdicts`,
-    heading gains and three crossings by the crossing count at K and K(1 ± ε)."""
+    """(stable, near) of KB eq (18) (with c) at gains K: one crossing by `single_crossing_verdicts`;
+    three crossings flagged `near` (the caller decides them with the boundary, all chunks' in one
+    call: a few per thousand random points); heading gains by the crossing count at K and K(1 ± ε)."""
     tau, T, k, c, NV = points
     stable, near, three = single_crossing_verdicts(tau, T, k, K, eps)
-    rest = np.flatnonzero(three | (c != 0))
+    near |= three
+    rest = np.flatnonzero(c != 0)
     if rest.size:
-        heading = None if not c[rest].any() else c[rest]
         gain = K[rest]
         # one call for the three gains K, K(1 − ε), K(1 + ε) (few points: the call's overhead dominates)
-        t, d, g = (np.tile(x[rest], 3) for x in (tau, T, k))
-        tests = delay_verdicts_from_gain(t, d, g, np.concatenate([gain, gain * (1.0 - eps), gain * (1.0 + eps)]), None if heading is None else np.tile(heading, 3))[0]
+        t, d, g, h = (np.tile(x[rest], 3) for x in (tau, T, k, c))
+        tests = delay_verdicts_from_gain(t, d, g, np.concatenate([gain, gain * (1.0 - eps), gain * (1.0 + eps)]), h)[0]
         stable[rest], near[rest] = _bracketed(tests.reshape(3, rest.size))
     return stable, near
