@@ -342,6 +342,42 @@ def test_default_chunk_size_shares_a_vectorized_sweep_over_the_workers():
     assert default_chunk_size(sized(200_000, simulate=True), 2) == SIMULATION_CHUNK
 
 
+def test_local_schedulers_start_the_chunks_in_index_order(tmp_path, monkeypatch):
+    """Dask's local schedulers start chunk 0 first and the last chunk last (`engine._local_key`), so that a
+    simulation sweep's full chunks run before its fine tail: on one thread the chunks run in exactly that order.
+    (Plain keys ("chunk", i) ran 9, 8, …, 2, 11, 10, 1, 0 for 12 chunks: `dask.order` sorts them as text.)"""
+    from pfm_stability.sweeps import engine
+
+    started, real = [], engine.evaluate_task
+
+    def recording(spec, index, *args):
+        started.append(index)
+        return real(spec, index, *args)
+
+    monkeypatch.setattr(engine, "evaluate_task", recording)
+    s = spec(grid={"V": {"from": 0.2, "to": 1.6, "num": 5}, "T": {"from": 0.01, "to": 0.2, "num": 23}})
+    summary = run_sweep(s, tmp_path / "t.parquet", chunk_size=5, workers=1)
+    assert summary.chunks == 23 and started == list(range(23))
+
+
+def test_a_worker_process_that_dies_is_a_sweep_error(tmp_path, monkeypatch):
+    """A simulation sweep's worker process that ends without an answer (as one killed for memory would) gives
+    `SweepError` saying so and how to go on (the CLI: exit 1 and that line), not the pool's traceback."""
+    from pfm_stability.sweeps import engine
+
+    def die(*args):  # pickled by value (cloudpickle): runs in the worker process
+        import os
+
+        os._exit(9)
+
+    monkeypatch.setattr(engine, "_local_task", die)
+    s = spec(simulate=True, models=["sampled"], scenario={"wall": {"alpha": 40}}, grid=None,
+             sample={"method": "latin-hypercube", "n": 2, "seed": 1, "ranges": {"V": [0.3, 1.5]}})
+    with pytest.raises(SweepError, match="a worker process died without an answer .* rerun with --resume"):
+        run_sweep(s, tmp_path / "t.parquet", chunk_size=1, workers=1)
+    assert not (tmp_path / "t.parquet").exists()
+
+
 def test_failing_chunk_is_named_and_parts_are_kept(tmp_path, monkeypatch):
     """A chunk that fails on every attempt: SweepError naming it and the error; the other chunks stay for --resume."""
     from pfm_stability.sweeps import engine

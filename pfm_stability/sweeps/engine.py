@@ -283,6 +283,18 @@ def _local_task(spec, index, start, stop, sample, path, marker):
     return None
 
 
+def _local_key(index: int) -> tuple:
+    """The Dask key of chunk `index` on the local schedulers, named so that they start the chunks in index order.
+
+    They start independent tasks in the order of `dask.order`, which for such
+    tasks is the descending order of the keys' text (dask 2026.8; tested:
+    `tests/test_sweeps.py`): ``("chunk", "1000000000000000")`` for chunk 0
+    comes first, so the full chunks run before the fine tail (`plan_chunks`)
+    and the workers finish together.
+    """
+    return ("chunk", f"{10**15 - index:016d}")
+
+
 def _run_local(todo, spec, sample, paths, parts, fail_once, workers, processes, report):
     """Every chunk of `todo` on Dask's local scheduler: `workers` threads, or (``processes``) worker processes.
 
@@ -295,9 +307,10 @@ def _run_local(todo, spec, sample, paths, parts, fail_once, workers, processes, 
 
     graph, sizes = {}, {}
     for index, start, stop in todo:
-        graph[("chunk", index)] = (partial(_local_task, spec, index, start, stop, _slice(spec, sample, start, stop), paths[index],
-                                           _fail_marker(parts, index, fail_once)),)
-        sizes[("chunk", index)] = stop - start
+        key = _local_key(index)
+        graph[key] = (partial(_local_task, spec, index, start, stop, _slice(spec, sample, start, stop), paths[index],
+                              _fail_marker(parts, index, fail_once)),)
+        sizes[key] = stop - start
 
     def finished(key, result, dsk, state, worker_id) -> None:
         if result is None:
@@ -305,9 +318,15 @@ def _run_local(todo, spec, sample, paths, parts, fail_once, workers, processes, 
 
     with Callback(posttask=finished):
         if processes:
+            from concurrent.futures.process import BrokenProcessPool
+
             from dask.multiprocessing import get
 
-            results = get(graph, list(graph), num_workers=workers, chunksize=1)  # one chunk per dispatch: both workers to the end
+            try:
+                results = get(graph, list(graph), num_workers=workers, chunksize=1)  # one chunk per dispatch: both workers to the end
+            except BrokenProcessPool:
+                raise SweepError("a worker process died without an answer (killed: out of memory, kill -9?); "
+                                 "the finished chunks are kept, rerun with --resume") from None
         else:
             from dask.threaded import get
 
