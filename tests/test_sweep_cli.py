@@ -173,16 +173,38 @@ sample: {method: latin-hypercube, n: 60, seed: 3, ranges: {V: [0.3, 1.5], T: [0.
 """
 
 
-@pytest.mark.parametrize("signal_name", ["SIGINT", "SIGKILL"])
-def test_a_really_interrupted_simulation_sweep_resumes_to_the_same_table(tmp_path, signal_name):
-    """The command in a process of its own, interrupted once 3 of its parts are written — its whole process group
-    signalled, as Ctrl-C in a terminal (SIGINT: exit 130 and the --resume hint) or a crash / ``kill -9`` (SIGKILL)
-    would. ``--resume`` then reuses the written parts, and the table equals the uninterrupted in-process evaluation
-    (pyarrow equality: the same floats, no tolerance)."""
-    import signal
+def _interrupt_when(argv, parts, count, signal_number):
+    """Run `argv` in a session of its own; once `parts` holds `count` finished parts, signal its process group.
+    Returns (exit status, stderr, finished parts then)."""
     import subprocess
     import sys
     import time
+
+    # SIGINT back to its default before exec (a background job may inherit it ignored); its own session: a process group
+    launch = "import os, signal, sys; signal.signal(signal.SIGINT, signal.SIG_DFL); os.execv(sys.executable, sys.argv[1:])"
+    process = subprocess.Popen([sys.executable, "-c", launch, *argv], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                               start_new_session=True)
+
+    def finished():
+        return sum(name.endswith(".parquet") for name in os.listdir(parts)) if os.path.isdir(parts) else 0
+
+    deadline = time.monotonic() + 120
+    while time.monotonic() < deadline and process.poll() is None and finished() < count:
+        time.sleep(0.005)
+    assert process.poll() is None, "the sweep ended before it could be interrupted"
+    os.killpg(process.pid, signal_number)
+    _, err = process.communicate(timeout=60)
+    return process.returncode, err, finished()
+
+
+def test_a_really_interrupted_simulation_sweep_resumes_to_the_same_table(tmp_path):
+    """The command in a process of its own, interrupted twice by a signal to its whole process group: SIGINT once 2
+    parts are written (as Ctrl-C in a terminal: exit 130 and the --resume hint), then, resumed, SIGKILL once 2 more
+    are (a crash, ``kill -9``). The last ``--resume`` reuses exactly the parts written, and the table equals the
+    uninterrupted in-process evaluation (pyarrow equality: the same floats, no tolerance)."""
+    import signal
+    import subprocess
+    import sys
 
     from pfm_stability.sweeps import evaluate_chunk, load_spec
     from pfm_stability.sweeps.engine import plan_chunks
@@ -190,29 +212,16 @@ def test_a_really_interrupted_simulation_sweep_resumes_to_the_same_table(tmp_pat
     from pfm_stability.sweeps.table import to_arrow
 
     spec, out = write(tmp_path, SIM_SPEC), tmp_path / "t.parquet"
-    argv = [sys.executable, "-m", "pfm_stability", "sweep", spec, "--out", str(out), "--workers", "2", "--chunk-size", "3", "--quiet"]
-    # SIGINT back to its default before exec (a background job may inherit it ignored); its own session: a process group
-    launch = ("import os, signal, sys; signal.signal(signal.SIGINT, signal.SIG_DFL); os.execv(sys.executable, sys.argv[1:])")
-    process = subprocess.Popen([sys.executable, "-c", launch, *argv], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                               start_new_session=True)
-    parts, deadline = f"{out}.parts", time.monotonic() + 120
-    while time.monotonic() < deadline and process.poll() is None:
-        if os.path.isdir(parts) and sum(name.endswith(".parquet") for name in os.listdir(parts)) >= 3:
-            break
-        time.sleep(0.005)
-    assert process.poll() is None, "the sweep ended before it could be interrupted"
-    os.killpg(process.pid, getattr(signal, signal_name))
-    _, err = process.communicate(timeout=60)
-    assert not out.exists()
-    if signal_name == "SIGINT":
-        assert process.returncode == 130 and "rerun with --resume" in err, err
-    else:
-        assert process.returncode == -signal.SIGKILL
-    kept = sum(name.endswith(".parquet") for name in os.listdir(parts))
+    parts = f"{out}.parts"
+    argv = [sys.executable, "-m", "pfm_stability", "sweep", spec, "--out", str(out), "--workers", "1", "--chunk-size", "6", "--quiet"]
+    code, err, first = _interrupt_when(argv, parts, 2, signal.SIGINT)
+    assert code == 130 and "rerun with --resume" in err and first >= 2 and not out.exists(), err
+    code, err, second = _interrupt_when([*argv, "--resume"], parts, first + 2, signal.SIGKILL)
+    assert code == -signal.SIGKILL and second >= first + 2 and not out.exists(), err
     resumed = subprocess.run([*argv, "--resume", "--format", "json"], capture_output=True, text=True, timeout=300, check=False)
     assert resumed.returncode == 0, resumed.stderr
     summary = json.loads(resumed.stdout)
-    chunks = len(plan_chunks(60, 3, fine_tail=True))
-    assert summary["chunks"] == chunks and 3 <= summary["reused_chunks"] == kept < chunks
+    chunks = len(plan_chunks(60, 6, fine_tail=True))
+    assert summary["chunks"] == chunks and summary["reused_chunks"] == second < chunks
     s = load_spec(spec)
     assert same(read(out), to_arrow(evaluate_chunk(s, 0, 60, sample_points(s))))

@@ -326,7 +326,7 @@ def test_chunk_plan_covers_every_point_once_with_a_fine_tail(count, size):
 
 def test_default_chunk_size_shares_a_vectorized_sweep_over_the_workers():
     """Without simulation ⌈points/workers⌉ within [VECTOR_MIN_CHUNK, VECTOR_CHUNK] (every thread gets work), with
-    simulation SIMULATION_CHUNK (that the table does not depend on the chunks: the resume test). Exact integers."""
+    simulation SIMULATION_CHUNK of the environment (that the table does not depend on the chunks: the resume test). Exact integers."""
     from pfm_stability.sweeps.engine import (
         SIMULATION_CHUNK,
         VECTOR_CHUNK,
@@ -339,7 +339,10 @@ def test_default_chunk_size_shares_a_vectorized_sweep_over_the_workers():
 
     assert default_chunk_size(sized(200_000), 2) == 100_000 and default_chunk_size(sized(200_001), 2) == 100_001
     assert default_chunk_size(sized(5_000_000), 2) == VECTOR_CHUNK and default_chunk_size(sized(900), 2) == VECTOR_MIN_CHUNK
-    assert default_chunk_size(sized(200_000, simulate=True), 2) == SIMULATION_CHUNK
+    assert default_chunk_size(sized(200_000, simulate=True), 2) == SIMULATION_CHUNK["analytic"] == 200
+    grid_env = spec(grid=None, simulate=True, env="grid", law={"name": "grid"}, scenario={"wall": {"alpha": 40}},
+                    sample={"method": "sobol", "n": 64, "seed": 0, "ranges": {"T": [0.01, 0.2]}})
+    assert default_chunk_size(grid_env, 2) == SIMULATION_CHUNK["grid"] == 50
 
 
 def test_local_schedulers_start_the_chunks_in_index_order(tmp_path, monkeypatch):

@@ -65,7 +65,7 @@ def add_parser(sub) -> None:
     p.add_argument("--workers", type=integer("workers"),
                    help=f"local threads, or worker processes when simulating, {describe('workers')} (default: the number of cores)")
     p.add_argument("--chunk-size", type=integer("chunk_size"),
-                   help=f"points per task, {describe('chunk_size')} (default: without simulation the points shared over the workers, 10000 to 250000; with, 50; "
+                   help=f"points per task, {describe('chunk_size')} (default: without simulation the points shared over the workers, 10000 to 250000; with, 200, or 50 for env grid; "
                    "on --resume the interrupted run's)")
     p.add_argument("--resume", action="store_true", help="keep the finished chunks of an interrupted run of the same spec")
     p.add_argument("--plot", type=output_path("plot"), metavar="PNG",

@@ -13,7 +13,15 @@ from .common import MODEL_STYLE, figure_and_axes
 
 __all__ = ["plot_sweep_summary"]
 
-_CMAP = "RdYlGn"
+_FRACTION_COLOURS = ("#a50026", "#e8a317", "#006837")
+"""Red (no model says stable) through amber (half) to green (all): the middle stays visible on white,
+where RdYlGn's pale yellow vanished among scattered points."""
+
+
+def _fraction_colormap():
+    from matplotlib.colors import LinearSegmentedColormap
+
+    return LinearSegmentedColormap.from_list("stable_fraction", _FRACTION_COLOURS)
 
 
 def plot_sweep_summary(data, ax=None):
@@ -27,7 +35,7 @@ def _map(data, ax):
     fig, ax = figure_and_axes(ax, size=(7.6, 5.4))
     levels = len(data.models)
     if data.gridded:
-        mesh = ax.pcolormesh(data.x_values, data.y_values, data.fraction, cmap=_CMAP, vmin=0.0, vmax=1.0, shading="nearest")
+        mesh = ax.pcolormesh(data.x_values, data.y_values, data.fraction, cmap=_fraction_colormap(), vmin=0.0, vmax=1.0, shading="nearest")
         handles = []
         if data.x_values.size > 1 and data.y_values.size > 1:
             for model, share in data.model_fraction.items():
@@ -37,7 +45,7 @@ def _map(data, ax):
                 handles.append(ax.plot([], [], label=f"{model} boundary", **style)[0])
     else:
         size = float(np.clip(20000.0 / max(data.x_values.size, 1), 6.0, 70.0))  # few points: large dots
-        mesh = ax.scatter(data.x_values, data.y_values, c=data.fraction, cmap=_CMAP, vmin=0.0, vmax=1.0, s=size, linewidths=0)
+        mesh = ax.scatter(data.x_values, data.y_values, c=data.fraction, cmap=_fraction_colormap(), vmin=0.0, vmax=1.0, s=size, linewidths=0)
         handles = []
     if data.sim_x is not None and data.sim_x.size:
         ok = data.sim_stable

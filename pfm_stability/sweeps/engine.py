@@ -87,8 +87,12 @@ VECTOR_CHUNK = 250_000
 VECTOR_MIN_CHUNK = 10_000
 """Fewest points per chunk of a sweep without simulation by default (`default_chunk_size`)."""
 
-SIMULATION_CHUNK = 50
-"""Default points per chunk of a simulation sweep (one simulated batch each, ~seconds of work)."""
+SIMULATION_CHUNK = {"analytic": 200, "grid": 50}
+"""Default points per chunk of a simulation sweep, per simulator environment: one batch each
+(`validation.sweep.simulate_members` steps a chunk's members together, so larger chunks share the
+per-step cost: a 2,000-point sweep took 30 s in chunks of 50 and 22 s in chunks of 200, one worker;
+`benchmarks/bench_sweep.py`). The grid environment keeps 50: each member carries a histogram grid
+(a worker then held 1.4 GB)."""
 
 TAIL_CHUNKS = 2
 """A simulation sweep's last TAIL_CHUNKS·chunk_size points go in quarter-size chunks (`plan_chunks`)."""
@@ -173,14 +177,14 @@ class SweepSummary:
 
 
 def default_chunk_size(spec: SweepSpec, workers: int) -> int:
-    """`SIMULATION_CHUNK` when simulating; else the points shared over the `workers` threads,
+    """`SIMULATION_CHUNK` of the spec's environment when simulating; else the points shared over the `workers` threads,
     ⌈count/workers⌉, within [`VECTOR_MIN_CHUNK`, `VECTOR_CHUNK`] (one chunk would keep one core busy).
 
     The table does not depend on it (every point is evaluated on its own), and a
     resumed sweep takes the chunk size of the interrupted run.
     """
     if spec.simulate:
-        return SIMULATION_CHUNK
+        return SIMULATION_CHUNK[spec.env]
     return min(VECTOR_CHUNK, max(VECTOR_MIN_CHUNK, -(-spec.count // workers)))
 
 
