@@ -33,23 +33,22 @@ import sys
 import tempfile
 import time
 
-VECTOR_SPEC = """\
+VECTOR_FIXED = """\
 preset: carmel
 scenario: {{corridor: {{L: 0.9}}}}
 models: [sampled, exact_delay]
 hold: command
 compute_delay: 1
+"""
+"""What both (a) specs fix: the robot, the corridor, the models and the loop structure."""
+
+VECTOR_SPEC = VECTOR_FIXED + """\
 grid:
   V: {{from: 0.2, to: 1.6, num: {nv}}}
   T: {{from: 0.005, to: 0.2, num: {nt}, scale: log}}
 """
 
-SAMPLE_SPEC = """\
-preset: carmel
-scenario: {{corridor: {{L: 0.9}}}}
-models: [sampled, exact_delay]
-hold: command
-compute_delay: 1
+SAMPLE_SPEC = VECTOR_FIXED + """\
 sample: {{method: latin-hypercube, n: {n}, seed: 0, ranges: {{V: [0.2, 1.6], T: [0.005, 0.2], tau: [0.05, 1.0], k: [0.5, 6.0]}}}}
 """
 

@@ -92,7 +92,7 @@ SIMULATION_CHUNK = {"analytic": 200, "grid": 50}
 (`validation.sweep.simulate_members` steps a chunk's members together, so larger chunks share the
 per-step cost: a 2,000-point sweep took 30 s in chunks of 50 and 22 s in chunks of 200, one worker;
 `benchmarks/bench_sweep.py`). The grid environment keeps 50: each member carries a histogram grid
-(a worker then held 1.4 GB)."""
+(at 50 a worker already held 1.4 GB)."""
 
 TAIL_CHUNKS = 2
 """A simulation sweep's last TAIL_CHUNKS·chunk_size points go in quarter-size chunks (`plan_chunks`)."""
@@ -299,15 +299,13 @@ def _local_key(index: int) -> tuple:
     return ("chunk", f"{10**15 - index:016d}")
 
 
-def _run_local(todo, spec, sample, paths, parts, fail_once, workers, processes, report):
-    """Every chunk of `todo` on Dask's local scheduler: `workers` threads, or (``processes``) worker processes.
+def _run_local(todo, spec, sample, paths, parts, fail_once, workers, report):
+    """Every chunk of `todo` on Dask's local scheduler: `workers` threads, or worker processes when the spec simulates.
 
     The chunks write their own parts (this machine's file system); `report` is
     called here, in this process, as each chunk finishes (a Dask callback).
     """
     from dask.callbacks import Callback
-
-    from ..vectorized import loop_verdicts  # noqa: F401 - imported here once: threads importing it together race
 
     graph, sizes = {}, {}
     for index, start, stop in todo:
@@ -321,7 +319,7 @@ def _run_local(todo, spec, sample, paths, parts, fail_once, workers, processes, 
             report(sizes[key])
 
     with Callback(posttask=finished):
-        if processes:
+        if spec.simulate:
             from concurrent.futures.process import BrokenProcessPool
 
             from dask.multiprocessing import get
@@ -333,6 +331,8 @@ def _run_local(todo, spec, sample, paths, parts, fail_once, workers, processes, 
                                  "the finished chunks are kept, rerun with --resume") from None
         else:
             from dask.threaded import get
+
+            from ..vectorized import loop_verdicts  # noqa: F401 - imported here once: threads importing it together race
 
             results = get(graph, list(graph), num_workers=workers)
     errors = [e for e in results if e is not None]
@@ -472,7 +472,7 @@ def run_sweep(
                 todo, stopped = todo[:stop_after_chunks], True
             else:
                 stopped = False
-            _run_local(todo, spec, sample, paths, parts, set(fail_once), workers, spec.simulate, report)
+            _run_local(todo, spec, sample, paths, parts, set(fail_once), workers, report)
             if stopped:
                 raise SweepInterrupted(f"stopped after {len(todo)} chunks (stop_after_chunks)")
             where = f"local processes ({workers})" if spec.simulate else f"threads ({workers})"
