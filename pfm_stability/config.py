@@ -426,22 +426,28 @@ def _did_you_mean(key, allowed) -> str:
 
 
 # ------------------------------------------------------------------ Nav2
+NAV2_ASSUMED = {
+    "tau": "a Nav2 file does not give the steering lag; this is the preset's robot's (measure yours: docs/config.md)",
+    "f": "a Nav2 file has no VFF force ratio; this is the preset's",
+    "n": "a Nav2 file has no repulsion exponent; this is the preset's",
+}
+"""Why a loop parameter a Nav2 file cannot give is an assumption (marked ASSUMED in the report)."""
+
 def _from_nav2(data, origin, path, preset) -> Config:
     """A `Config` from a Nav2 parameters file: T, V and W where found, everything else from the preset."""
     base = _base(origin, {}, preset)
     found = read_nav2(data, origin)
     robot = _build(origin, Robot, base.robot, {k: v.value for k, v in found.values.items() if k in ROBOT_KEYS})
     controller = _build(origin, Controller, base.controller, {k: v.value for k, v in found.values.items() if k in CONTROLLER_KEYS})
-    sources = {}
+    sources, assumed = {}, {}
     for name in PARAMETER_KEYS:
         if name in found.values:
             sources[name] = f"{origin}: {found.values[name].describe()}"
-        elif name in base.assumed:
-            sources[name] = f"ASSUMED (preset {base.name}): {base.assumed[name]}"
-        else:
-            sources[name] = f"preset {base.name}"
+            continue
+        assumed[name] = base.assumed.get(name) or NAV2_ASSUMED.get(name, f"not found in the Nav2 file: the preset {base.name}'s value")
+        sources[name] = f"ASSUMED (preset {base.name}): {assumed[name]}"
     merged = Preset(
-        name=origin, robot=robot, controller=controller, assumed=dict(base.assumed),
+        name=origin, robot=robot, controller=controller, assumed=assumed,
         source=f"{origin} over preset {base.name}", cell_size=base.cell_size, window_cells=base.window_cells,
     )
     return Config(robot, controller, None, {}, sources, path, merged, notes=found.notes)

@@ -146,6 +146,32 @@ def test_negative_numbers_in_scientific_notation_are_values(capsys):
     assert json.loads(out)["inputs"]["start"]["x"] == -1e-3
 
 
+def test_options_are_not_abbreviated(capsys):
+    """Options are the paper's case-sensitive symbols, so no prefix stands for an option: `--t` is not `--tau`
+    (argparse's abbreviations took it silently, though the user meant T), `--l` is not `--law` (it meant L).
+    Every subcommand's parser refuses prefixes; `report --t 0.1` is refused, not read as τ = 0.1."""
+    from pfm_stability.cli import build_parser
+
+    parser = build_parser()
+    assert parser.allow_abbrev is False and all(sub.allow_abbrev is False for sub in parser.subcommands.values())
+    for prefix in ("--t", "--l", "--compute"):
+        code, _, err = run(capsys, "report", "--L", "1", prefix, "1")
+        assert code == 2 and err.startswith(f"pfm-stability: error: unrecognized arguments: {prefix} 1"), err
+
+
+@pytest.mark.parametrize("argv, hint", [
+    (["--v", "0.5"], "; did you mean --V? (options are case-sensitive)"),
+    (["--t", "0.1"], "; did you mean --T? (options are case-sensitive)"),
+    (["--tua", "0.3"], "; did you mean --tau?"),
+    (["--tua", "0.3", "--l", "2"], "; did you mean --tau (for --tua), --L (for --l)? (options are case-sensitive)"),
+    (["--zzz", "1"], ""),
+])
+def test_unknown_options_name_the_option_meant(capsys, argv, hint):
+    """An option that differs from a real one only in case, or is close to one, is named; nothing is guessed otherwise."""
+    code, _, err = run(capsys, "report", "--L", "1", *argv)
+    assert code == 2 and err.strip() == f"pfm-stability: error: unrecognized arguments: {' '.join(argv)}{hint}"
+
+
 # ----------------------------------------------------------------- progress
 @pytest.fixture
 def terminal(monkeypatch):

@@ -359,6 +359,11 @@ def test_nav2_example(capsys):
     assert inputs["V"]["source"] == f"{origin}: controller_server.FollowPath.max_vel_x = 0.26 m/s"
     assert inputs["W"]["source"] == f"{origin}: local_costmap.local_costmap.robot_radius = 0.22 m"
     assert inputs["k"]["source"].startswith("ASSUMED (preset carmel)")
+    # a Nav2 file gives no steering lag, force ratio or exponent: the preset's values are assumptions, said so
+    for name in ("tau", "f", "n", "hold", "compute_delay"):
+        assert inputs[name]["source"].startswith("ASSUMED (preset carmel): "), name
+    assert "Nav2 file does not give the steering lag" in inputs["tau"]["source"]
+    assert "no VFF force ratio" in inputs["f"]["source"]
 
 
 @pytest.mark.parametrize("seed", range(4))
@@ -388,7 +393,7 @@ def test_nav2_missing_keys_are_notes(tmp_path, capsys):
     assert config.controller.T == 0.1 and config.robot.V == 0.8 and len(config.notes) == 2
     assert "V is the preset's" in config.notes[0] and "max_vel_x, max_speed_xy, desired_linear_vel, vx_max" in config.notes[0]
     code, out, err = run(capsys, "report", "--config", path, "--L", "1", "--model", "sampled", "--format", "json")
-    assert code == 0 and json.loads(out)["inputs"]["V"]["source"] == "preset carmel"
+    assert code == 0 and json.loads(out)["inputs"]["V"]["source"] == "ASSUMED (preset carmel): not found in the Nav2 file: the preset carmel's value"
     assert err.count("pfm-stability: note: Nav2 ") == 2 and "W is the preset's" in err
 
 

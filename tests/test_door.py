@@ -247,12 +247,13 @@ def test_field_on_the_axis(obstacle):
 
 
 def test_wall_ends_differ_from_posts_only_beside_the_opening():
-    """For |x| < w/2 a wall end's nearest point is its end, so the fields agree exactly; in front of the wall
-    (|x| > w/2) the wall's nearest point is straight ahead and the fields differ."""
+    """For |x| < w/2 a wall end's nearest point is its end, so the fields agree (to 4 ULP: the two obstacles
+    take different code paths to the same distances); in front of the wall (|x| > w/2) the wall's nearest
+    point is straight ahead and the fields differ."""
     law, w = CARMEL_LAW, 1.2
     x, y = np.meshgrid(np.linspace(-0.59, 0.59, 13), np.linspace(-2.0, 2.0, 17))
     for a, b in zip(door_field(law, w, x, y, obstacle="posts"), door_field(law, w, x, y, obstacle="wall-ends")):
-        np.testing.assert_array_equal(a, b)
+        np.testing.assert_allclose(a, b, rtol=4 * np.finfo(float).eps, atol=0)
     posts = door_field(law, w, 1.0, -0.5, obstacle="posts")
     wall = door_field(law, w, 1.0, -0.5, obstacle="wall-ends")
     d = math.hypot(0.4, 0.5)  # robot at (1, −0.5): right post at distance d; the right wall's nearest point (1, 0) is 0.5 ahead

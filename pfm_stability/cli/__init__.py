@@ -17,12 +17,13 @@ ends with exit status 2 and one line on stderr::
 from __future__ import annotations
 
 import argparse
+import difflib
 import importlib
 import os
 import re
 import sys
 
-__all__ = ["main", "build_parser", "UsageError"]
+__all__ = ["main", "build_parser", "UsageError", "unknown_options"]
 
 SUBCOMMANDS = ("report", "derive", "simulate", "validate", "plot", "traps", "map", "sweep")
 
@@ -43,6 +44,7 @@ class _Parser(argparse.ArgumentParser):
     """
 
     def __init__(self, *args, **kwargs):
+        kwargs.setdefault("allow_abbrev", False)  # --t is not --tau, --l not --law: options are the paper's case-sensitive symbols
         super().__init__(*args, **kwargs)
         self._negative_number_matcher = _NEGATIVE_NUMBER
 
@@ -62,6 +64,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--version", action="version", version=f"pfm-stability {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     sub.required = True
+    parser.subcommands = sub.choices  # name → its parser: `unknown_options` names the options of the one used
     for name in SUBCOMMANDS:
         try:
             module = importlib.import_module(f".{name}", __name__)
@@ -71,6 +74,31 @@ def build_parser() -> argparse.ArgumentParser:
             continue
         module.add_parser(sub)
     return parser
+
+
+def unknown_options(extras, parser) -> str:
+    """The message for arguments no option of `parser` takes, with a suggestion per unknown option.
+
+    Options are case-sensitive (``--V`` speed, ``--v`` nothing); an option that differs from a real one
+    only in case, or is close to one, is named (``--v`` → ``--V``, ``--tua`` → ``--tau``).
+    """
+    options = [o for o in parser._option_string_actions if o.startswith("--")]
+    hints, case = [], False
+    for token in extras:
+        name = token.split("=", 1)[0]
+        if not name.startswith("--"):
+            continue
+        same_letters = [o for o in options if o.lower() == name.lower()]
+        close = same_letters or difflib.get_close_matches(name, options, n=1, cutoff=0.75)
+        if close:
+            hints.append((name, close[0]))
+            case = case or bool(same_letters)
+    message = f"unrecognized arguments: {' '.join(extras)}"
+    if len(hints) == 1:
+        message += f"; did you mean {hints[0][1]}?"
+    elif hints:
+        message += "; did you mean " + ", ".join(f"{real} (for {given})" for given, real in hints) + "?"
+    return message + (" (options are case-sensitive)" if case else "")
 
 
 def _fail(message: str) -> int:
@@ -90,7 +118,9 @@ def main(argv=None) -> int:
         os.environ.setdefault(variable, "1")
     parser = build_parser()
     try:
-        args = parser.parse_args(argv)
+        args, extras = parser.parse_known_args(argv)
+        if extras:
+            raise UsageError(unknown_options(extras, parser.subcommands.get(args.command, parser)))
         return int(args.run(args) or 0)
     except UsageError as exc:
         return _fail(str(exc))
