@@ -15,7 +15,9 @@ import math
 import numbers
 import os
 
-__all__ = ["check_number", "check_choice", "check_integer", "check_output_path", "check_type", "check_positive_axis", "describe_range"]
+from .files import check_writable
+
+__all__ = ["check_number", "check_choice", "check_integer", "check_output_path", "check_output_dir", "check_type", "check_positive_axis", "describe_range"]
 
 
 def describe_range(low: float, high: float, low_open: bool, high_open: bool) -> str:
@@ -119,7 +121,10 @@ def check_output_path(name: str, path, suffix: str = ".png") -> str:
 
     The path must be non-empty, end in `suffix` (case-insensitive), not be an
     existing directory, and name a file whose directory exists and is
-    writable (an existing file must be writable too). Nothing is created.
+    writable: a temporary file is created there and removed (`files.check_writable`:
+    root passes `os.access` in ``/proc``, where nothing can be created). An existing
+    file is replaced, not written into (`files.atomic_file`), so only the
+    directory must take new files.
 
     Parameters
     ----------
@@ -160,10 +165,44 @@ def check_output_path(name: str, path, suffix: str = ".png") -> str:
     parent = os.path.dirname(os.path.abspath(text))
     if not os.path.isdir(parent):
         fail(f"directory {parent} does not exist")
-    if not os.access(parent, os.W_OK | os.X_OK):
-        fail(f"directory {parent} is not writable")
-    if os.path.exists(text) and not (os.path.isfile(text) and os.access(text, os.W_OK)):
+    reason = check_writable(parent)
+    if reason is not None:
+        fail(f"nothing can be created in {parent}: {reason}")
+    if os.path.exists(text) and not os.path.isfile(text):
         fail("an existing file that cannot be overwritten")
+    return text
+
+
+def check_output_dir(name: str, path) -> str:
+    """Return `path` after checking output files can be created in it, before any work.
+
+    An existing directory must take new files; a missing one is created when the
+    outputs are written (`files.atomic_directory`), so its parent must exist and
+    take new entries. A temporary file is created there and removed
+    (`files.check_writable`).
+
+    Raises
+    ------
+    ValueError
+        ``"out-dir must be a writable directory; got '/proc/x' (nothing can be created in /proc: No such file or directory)"``.
+    """
+    text = os.fspath(path) if isinstance(path, (str, os.PathLike)) else None
+
+    def fail(why):
+        raise ValueError(f"{name} must be a writable directory; got {path!r} ({why})")
+
+    if text is None or not text.strip():
+        fail("empty")
+    if "\0" in text:
+        fail("contains a NUL character")
+    if os.path.exists(text) and not os.path.isdir(text):
+        fail("an existing file")
+    existing = os.path.abspath(text) if os.path.isdir(text) else os.path.dirname(os.path.abspath(text))
+    if not os.path.isdir(existing):
+        fail(f"its parent {existing} does not exist")
+    reason = check_writable(existing)
+    if reason is not None:
+        fail(f"nothing can be created in {existing}: {reason}")
     return text
 
 

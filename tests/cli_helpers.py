@@ -30,3 +30,41 @@ def report_json(argv) -> dict:
     errors = [f"{list(e.absolute_path)}: {e.message[:200]}" for e in VALIDATOR.iter_errors(data)]
     assert not errors, errors[:3]
     return data
+
+
+class DiskFull(io.FileIO):
+    """A new file on a disk with `room` bytes left: writes beyond it write what fits, then fail with ENOSPC."""
+
+    def __init__(self, path, room: int):
+        super().__init__(path, "wb")
+        self.room = room
+
+    def write(self, data):
+        view = memoryview(data).cast("B")
+        if len(view) > self.room:
+            if self.room:
+                super().write(view[: self.room])
+                self.room = 0
+            import errno
+            import os
+
+            raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+        self.room -= len(view)
+        return super().write(view)
+
+
+@contextlib.contextmanager
+def disk_full(room: int):
+    """Every file the package writes (`pfm_stability.files.open_new`, the one place it opens one) lands on a full disk."""
+    import pfm_stability.files as files
+
+    def open_new(path, mode):
+        raw = DiskFull(path, room)
+        return raw if "b" in mode else io.TextIOWrapper(raw, encoding="utf-8")
+
+    saved = files.open_new
+    files.open_new = open_new
+    try:
+        yield
+    finally:
+        files.open_new = saved

@@ -2,13 +2,19 @@
 
 Whatever is typed — values inside and outside each option's range
 (`pfm_stability.parameters.RANGES`), NaN, inf, huge and tiny numbers, empty
-strings, text, output paths that are directories, lack ``.png`` or lie in
-missing directories, unknown options, ``--help`` — `main` returns 0 or 2 and
+strings, text, output paths that are directories, lack ``.png``, lie in
+missing directories or where nothing can be created (``/proc``, ``/sys``),
+unknown options, ``--help``, a full disk (every file the package writes goes
+through `pfm_stability.files.open_new`, which the fuzz replaces by a disk with
+0, 1 or 4096 bytes left now and then) — `main` returns 0 or 2 and
 never raises. An exit 2 prints exactly one error line (after any progress
 lines) and nothing on stdout, and never blames a value drawn inside its
 option's stated range. An exit 0 with ``--format json`` prints strict JSON
 (NaN and Infinity tokens rejected) that validates against the shipped schema,
-and a reported success wrote the PNG it named.
+and a reported success wrote the PNG it named; a full disk leaves neither the
+output nor a temporary file behind. `map` and `sweep`, too slow to fuzz, are
+checked on a full disk and on uncreatable paths by
+`test_every_writing_command_on_a_full_disk_and_an_uncreatable_path`.
 
 Examples run in-process (`pfm_stability.cli.main`). Their number follows the
 hypothesis profile (``HYPOTHESIS_PROFILE``, tests/conftest.py: ``ci`` by
@@ -42,6 +48,7 @@ from pfm_stability.cli.options import describe
 from pfm_stability.cli.traps import SHIPPED_SCENES
 from pfm_stability.parameters import RANGES, SHOWN_AS
 from pfm_stability.schema import load_schema
+from cli_helpers import disk_full
 
 pytestmark = pytest.mark.filterwarnings("error::RuntimeWarning")  # a numpy warning is a silent NaN or overflow
 
@@ -78,7 +85,7 @@ ADDED = {
 BAD_NUMBERS = ["nan", "NaN", "-nan", "inf", "-inf", "Infinity", "1e309", "-1e309", "1e308", "-1e308", "", " ", "fast",
                "0x10", "1,5", "None", "true", "1e", "--", "-", "1_000", "٣", "1e-320", "-0", "-1e-300"]
 BAD_INTEGERS = ["", " ", "x", "1.5", "1e3", "nan", "inf", "0x3", "-", "--", "3.0", "٣", "9" * 5000]
-PATH_KINDS = ["ok", "upper", "directory", "empty", "blank", "no_suffix", "missing_dir", "only_suffix", "nul"]
+PATH_KINDS = ["ok", "upper", "directory", "empty", "blank", "no_suffix", "missing_dir", "only_suffix", "nul", "proc", "sys"]
 _COUNTER = itertools.count()
 
 def _options(command):
@@ -150,6 +157,8 @@ def _path(kind, outdir) -> str:
         "missing_dir": os.path.join(outdir, "missing", f"out{n}.png"),
         "only_suffix": os.path.join(outdir, ".png"),
         "nul": os.path.join(outdir, "a\0b.png"),
+        "proc": f"/proc/out{n}.png",  # a directory root may "write" (os.access) where nothing can be created
+        "sys": f"/sys/kernel/out{n}.png",
     }[kind]
 
 
@@ -210,10 +219,18 @@ def run_cli(argv):
     return code, out.getvalue(), err.getvalue()
 
 
-def check_run(command, argv, inside):
-    """Every property of one command line (module docstring)."""
-    note(f"argv = {argv!r}")
-    code, out, err = run_cli(argv)  # any exception is a traceback: a failure
+OUTPUT_OPTIONS = ("--out", "--plot", "--sweep-plot")
+
+
+def check_run(command, argv, inside, room=None):
+    """Every property of one command line (module docstring); `room`: bytes left on a full disk (None: not full)."""
+    note(f"argv = {argv!r}; disk room {room!r}")
+    if room is None:
+        code, out, err = run_cli(argv)  # any exception is a traceback: a failure
+    else:
+        with disk_full(room):
+            code, out, err = run_cli(argv)
+        _nothing_left_behind(argv)
     note(f"exit {code}; stderr = {err!r}")
     event(f"exit {code}")
     assert code in (0, 2)
@@ -233,7 +250,7 @@ def check_run(command, argv, inside):
         assert out.startswith("usage:")
         return
     assert others == [] and out
-    for name in ("--out", "--plot", "--sweep-plot"):
+    for name in OUTPUT_OPTIONS:
         if name in argv:
             path = argv[argv.index(name) + 1]
             assert path.lower().endswith(".png") and os.path.isfile(path), f"{name} {path!r}: success without the file"
@@ -244,6 +261,19 @@ def check_run(command, argv, inside):
         errors = sorted(VALIDATOR.iter_errors(data), key=lambda e: list(e.absolute_path))
         assert not errors, [f"{list(e.absolute_path)}: {e.message[:200]}" for e in errors[:5]]
         assert data["command"] == command
+
+
+def _nothing_left_behind(argv) -> None:
+    """After a run on a full disk: no output file (none existed: the names are new) and no temporary file beside it."""
+    for name in OUTPUT_OPTIONS:
+        if name in argv:
+            path = argv[argv.index(name) + 1]
+            if not path.strip() or "\0" in path or os.path.isdir(path):
+                continue
+            assert not os.path.exists(path), f"{name} {path!r} written on a full disk"
+            folder = os.path.dirname(os.path.abspath(path))
+            if os.path.isdir(folder) and os.access(folder, os.R_OK):
+                assert not [f for f in os.listdir(folder) if f.startswith(f".{os.path.basename(path)}.")], "a temporary file left"
 
 
 @pytest.fixture(scope="module")
@@ -258,7 +288,8 @@ def _fuzz_test(command):
     @given(data=st.data())
     def test(outdir, data):
         argv, inside = data.draw(command_lines(command, outdir), label="argv")
-        check_run(command, argv, inside)
+        room = data.draw(_mostly(st.none(), st.sampled_from([0, 1, 4096])), label="disk room")  # now and then the disk is full
+        check_run(command, argv, inside, room)
 
     test.__name__ = f"test_fuzz_{command}"
     test.__doc__ = f"Random `pfm-stability {command}` command lines: exit 0 or 2, one error line, strict JSON, files written ({examples} examples)."
@@ -353,3 +384,57 @@ def test_once_a_traceback_exact_delay_without_roots():
 def test_once_a_traceback_alpha_at_the_end_of_its_range_in_simulate():
     code, out, err = run_cli(["simulate", "--scenario", "wall", "--env", "analytic", "--alpha", "89.999999", "--duration", "2"])
     assert code == 0, err
+
+
+# ------------------------------------------- full disk, uncreatable paths: every writer
+SWEEP_SPEC = "preset: carmel\nscenario: {corridor: {L: 0.9}}\nmodels: [sampled]\ngrid:\n  V: {from: 0.2, to: 1.6, num: 30}\n"
+
+WRITERS = {
+    "plot": (["plot", "force-law", "--out", "{target}.png"], "{target}.png"),
+    "simulate": (["simulate", "--scenario", "corridor", "--env", "analytic", "--duration", "0.5", "--plot", "{target}.png"], "{target}.png"),
+    "validate": (["validate", "--scenario", "corridor", "--env", "analytic", "--quiet", "--duration", "3", "--rtol", "0.3",
+                  "--members", "3", "--plot", "{target}.png"], "{target}.png"),
+    "traps": (["traps", "gc2000_fig3", "--plot", "{target}.png"], "{target}.png"),
+    "map": (["map", "depot", "--quiet", "--out-dir", "{target}"], "{target}/stability.png"),
+    "sweep": (["sweep", "{spec}", "--quiet", "--workers", "1", "--out", "{target}.parquet"], "{target}.parquet"),
+    "sweep-plot": (["sweep", "{spec}", "--quiet", "--workers", "1", "--out", "{other}.parquet", "--plot", "{target}.png"], "{target}.png"),
+}
+"""Every command that writes a file: its argv (with the output at {target}) and the file it writes."""
+
+
+def _writer_argv(name, target, tmp_path):
+    spec = tmp_path / "spec.yaml"
+    spec.write_text(SWEEP_SPEC)
+    argv, written = WRITERS[name]
+    fill = {"target": str(target), "spec": str(spec), "other": str(tmp_path / "other")}
+    return [a.format(**fill) for a in argv], written.format(**fill)
+
+
+@pytest.mark.parametrize("room", [0, 3000])
+@pytest.mark.parametrize("name", sorted(WRITERS))
+def test_every_writing_command_on_a_full_disk_and_an_uncreatable_path(tmp_path, name, room):
+    """A full disk (0 or 3000 bytes left): exit 2, one line "could not write … No space left on device", no output, no
+    temporary file, and a file already at the output path untouched (the write is atomic: a rename once complete).
+    An output where nothing can be created (/proc, /sys: root passes os.access there) is refused before any work."""
+    argv, written = _writer_argv(name, tmp_path / "out", tmp_path)
+    if name != "map":
+        with open(written, "wb") as fh:
+            fh.write(b"the user's old file")
+    before = sorted(p.name for p in tmp_path.rglob("*"))
+    with disk_full(room):
+        code, out, err = run_cli(argv)
+    assert code == 2 and out == "", err
+    assert err.splitlines()[-1].startswith("pfm-stability: error: could not write ") and err.endswith("No space left on device\n") or \
+        "No space left on device; the finished chunks are kept in" in err, err
+    if name == "map":
+        assert not os.path.exists(tmp_path / "out"), "a map directory created on a full disk is removed again"
+    else:
+        with open(written, "rb") as fh:
+            assert fh.read() == b"the user's old file"
+    after = sorted(p.name for p in tmp_path.rglob("*") if not p.name.endswith(".parts") and ".parts" not in str(p))
+    assert after == before, "temporary files left behind"
+    for place in ("/proc/nope", "/sys/kernel/nope"):
+        argv, _ = _writer_argv(name, place, tmp_path)
+        code, out, err = run_cli(argv)
+        assert code == 2 and out == "" and len(err.splitlines()) == 1, err
+        assert "nothing can be created in /" in err, err

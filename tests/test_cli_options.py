@@ -73,11 +73,21 @@ def test_bad_output_paths_exit_2_before_any_work(tmp_path, capsys, no_work, argv
 
 
 def test_unwritable_directory_is_found_before_the_work(tmp_path, capsys, no_work, monkeypatch):
+    """The check creates a file where the output will go (root passes os.access anywhere): a directory that refuses
+    it is named before any work. Simulated by a file system that refuses new files in `locked`."""
+    import tempfile
+
     locked = str(tmp_path)
-    real_access = os.access
-    monkeypatch.setattr(os, "access", lambda p, mode: False if os.fspath(p) == locked else real_access(p, mode))
+    real_mkstemp = tempfile.mkstemp
+
+    def mkstemp(*args, dir=None, **kwargs):
+        if dir is not None and os.path.abspath(dir) == locked:
+            raise PermissionError(13, "Permission denied", dir)
+        return real_mkstemp(*args, dir=dir, **kwargs)
+
+    monkeypatch.setattr(tempfile, "mkstemp", mkstemp)
     code, _, err = run(capsys, "simulate", "--scenario", "corridor", "--plot", str(tmp_path / "x.png"))
-    assert code == 2 and f"(directory {locked} is not writable)" in err
+    assert code == 2 and f"(nothing can be created in {locked}: Permission denied)" in err
 
 
 def test_check_output_path_messages(tmp_path):

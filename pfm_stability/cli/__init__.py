@@ -8,8 +8,9 @@ imports here are light (no numpy, scipy, sympy or matplotlib) so that
 start-up stays fast; the heavy libraries are imported by the subcommand that
 needs them.
 
-Every user error — a bad value, an unknown option, an impossible scenario —
-ends with exit status 2 and one line on stderr::
+Every user error — a bad value, an unknown option, an impossible scenario, a
+file that cannot be written (a full disk: `files.OutputError`) — ends with exit
+status 2 and one line on stderr::
 
     pfm-stability: error: V must be a finite number in (0, 100] m/s; got -1.0
 """
@@ -128,6 +129,9 @@ def main(argv=None) -> int:
         return _fail(str(exc))
     except BrokenPipeError:
         return 0
+    except OSError as exc:  # the environment, not the code: a full disk, a vanished file, a device error
+        where = f" ({exc.filename})" if getattr(exc, "filename", None) else ""
+        return _fail(f"{exc.strerror or exc}{where}")
 
 
 def entry_point() -> None:  # pragma: no cover - thin wrapper

@@ -39,10 +39,10 @@ UNKNOWN_CHOICES = ("occupied", "free")
 
 
 def _out_dir(text: str) -> str:
-    from ..maps.outputs import check_output_dir
+    from ..checks import check_output_dir
 
     try:
-        return check_output_dir(text)
+        return check_output_dir("out-dir", text)
     except ValueError as exc:
         raise argparse.ArgumentTypeError(str(exc)) from None
 
@@ -95,26 +95,30 @@ def _validate(analysis, count: int, seed: int, progress):
 
 
 def _write_outputs(analysis, out_dir: str) -> dict:
+    """The four files of ``--out-dir``, all or none (`files.atomic_directory`)."""
+    import os
+
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from ..maps.outputs import atomic_outputs, write_speed_mask
+    from ..files import atomic_directory, open_new
+    from ..maps.outputs import OUTPUT_FILES, segments_csv, speed_mask_pgm, speed_mask_yaml
     from ..plots.map import plot_map_stability
 
-    with atomic_outputs(out_dir) as paths:
+    with atomic_directory(out_dir, OUTPUT_FILES, what="map outputs") as paths:
         fig = plot_map_stability(analysis)
-        fig.savefig(paths["stability.png"], dpi=110)
-        plt.close(fig)
-        from ..maps.outputs import segments_csv
-
-        with open(paths["segments.csv"], "w", encoding="utf-8") as fh:
-            fh.write(segments_csv(analysis))
-        write_speed_mask(analysis, paths["speed_mask.pgm"], paths["speed_mask.yaml"])
-    import os
-
-    return {name: os.path.join(out_dir, name) for name in paths}
+        try:
+            with open_new(paths["stability.png"], "wb") as fh:
+                fig.savefig(fh, format="png", dpi=110)
+        finally:
+            plt.close(fig)
+        for name, content in (("segments.csv", segments_csv(analysis).encode("utf-8")), ("speed_mask.pgm", speed_mask_pgm(analysis)),
+                              ("speed_mask.yaml", speed_mask_yaml(analysis.occupancy).encode("utf-8"))):
+            with open_new(paths[name], "wb") as fh:
+                fh.write(content)
+    return {name: os.path.join(out_dir, name) for name in OUTPUT_FILES}
 
 
 def run(args) -> int:

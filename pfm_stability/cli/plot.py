@@ -50,14 +50,9 @@ def run(args) -> int:
     import matplotlib
 
     matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
 
-    fig = _draw(args.kind, params, args.pade_order)
-    try:
-        fig.savefig(args.out, dpi=130)
-    except OSError as exc:  # checked before the work; this is a race or a full disk
-        raise ValueError(f"out must be a writable file path ending in .png; got {args.out!r} ({exc.strerror or exc})") from None
-    finally:
-        plt.close(fig)
+    from ..files import save_figure
+
+    save_figure(_draw(args.kind, params, args.pade_order), args.out, dpi=130, what="plot")
     print(f"wrote {args.out}")
     return 0

@@ -101,17 +101,11 @@ def _plot(result, path: str) -> None:
     import matplotlib
 
     matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
 
+    from ..files import save_figure
     from ..plots.trajectory import plot_trajectory
 
-    fig = plot_trajectory(result)
-    try:
-        fig.savefig(path, dpi=120)
-    except OSError as exc:  # checked before the work; this is a race or a full disk
-        raise ValueError(f"plot must be a writable file path ending in .png; got {path!r} ({exc.strerror or exc})") from None
-    finally:
-        plt.close(fig)
+    save_figure(plot_trajectory(result), path, dpi=120, what="plot")
 
 
 def run(args) -> int:

@@ -130,11 +130,10 @@ def _plot(summary, path: str) -> None:
     import matplotlib
 
     matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
 
     from ..plots.sweep import plot_sweep_summary
     from ..sweeps.summary import summary_figure_data
 
-    fig = plot_sweep_summary(summary_figure_data(summary))
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    from ..files import save_figure
+
+    save_figure(plot_sweep_summary(summary_figure_data(summary)), path, dpi=110, what="plot")

@@ -60,13 +60,11 @@ def run(args) -> int:
         import matplotlib
 
         matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
 
+        from ..files import save_figure
         from ..plots.traps import plot_traps
 
-        fig = plot_traps(analysis)
-        fig.savefig(args.plot, dpi=110)
-        plt.close(fig)
+        save_figure(plot_traps(analysis), args.plot, dpi=110, what="plot")
     if args.format == "json":
         print(dumps({**analysis.to_dict(), "plot": args.plot}))
     else:

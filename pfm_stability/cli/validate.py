@@ -75,14 +75,9 @@ def add_parser(sub) -> None:
 
 
 def _save(fig, path: str, what: str) -> None:
-    import matplotlib.pyplot as plt
+    from ..files import save_figure
 
-    try:
-        fig.savefig(path, dpi=120)
-    except OSError as exc:  # checked before the work; this is a race or a full disk
-        raise ValueError(f"{what} must be a writable file path ending in .png; got {path!r} ({exc.strerror or exc})") from None
-    finally:
-        plt.close(fig)
+    save_figure(fig, path, dpi=120, what=what)
 
 
 def run(args) -> int:

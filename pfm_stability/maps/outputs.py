@@ -1,4 +1,4 @@
-"""The files of ``pfm-stability map --out-dir``: segments.csv and a Nav2 Speed Filter mask, written atomically.
+"""The files of ``pfm-stability map --out-dir``: segments.csv and a Nav2 Speed Filter mask (their contents; the CLI writes them atomically with `files.atomic_directory`).
 
 The speed mask (docs/maps.md, "The speed mask") has the input map's size, resolution
 and origin. Each cell holds a speed limit as a percentage of the robot's V, for the
@@ -20,24 +20,18 @@ back q exactly (the rounding error 0.5/2.55 ≈ 0.2 % stays below the 0.5 of rin
 
 from __future__ import annotations
 
-import contextlib
 import math
-import os
-import shutil
-import tempfile
 
 import numpy as np
 
 __all__ = [
     "OUTPUT_FILES",
-    "atomic_outputs",
-    "check_output_dir",
     "percent_to_pixel",
     "pixel_to_percent",
     "segments_csv",
     "speed_limits",
     "speed_mask_yaml",
-    "write_speed_mask",
+    "speed_mask_pgm",
 ]
 
 OUTPUT_FILES = ("stability.png", "segments.csv", "speed_mask.pgm", "speed_mask.yaml")
@@ -116,67 +110,8 @@ def speed_mask_yaml(occupancy, image: str = "speed_mask.pgm") -> str:
             "occupied_thresh: 1.0\nfree_thresh: 0.0\n")
 
 
-def write_speed_mask(analysis, pgm_path, yaml_path, image_name: str = "speed_mask.pgm") -> None:
-    """Write the mask image (binary PGM, row 0 at the top) and its YAML."""
-    from PIL import Image
-
+def speed_mask_pgm(analysis) -> bytes:
+    """The mask image as a binary PGM (P5, 8 bits, row 0 at the top, as map_server reads it)."""
     pixels = percent_to_pixel(speed_limits(analysis))[::-1]
-    Image.fromarray(np.ascontiguousarray(pixels), mode="L").save(pgm_path, format="PPM")
-    with open(yaml_path, "w", encoding="utf-8") as fh:
-        fh.write(speed_mask_yaml(analysis.occupancy, image_name))
-
-
-def check_output_dir(path) -> str:
-    """`path` after checking the outputs can be written there, before any work (nothing is created).
-
-    An existing directory must be writable; a missing one must have a writable parent
-    (it is created when the outputs are written).
-
-    Raises
-    ------
-    ValueError
-        ``"out-dir must be a writable directory; got 'x' (an existing file)"``.
-    """
-    text = os.fspath(path) if isinstance(path, (str, os.PathLike)) else None
-
-    def fail(why):
-        raise ValueError(f"out-dir must be a writable directory; got {path!r} ({why})")
-
-    if text is None or not text.strip():
-        fail("empty")
-    if os.path.exists(text):
-        if not os.path.isdir(text):
-            fail("an existing file")
-        if not os.access(text, os.W_OK | os.X_OK):
-            fail("not writable")
-        return text
-    parent = os.path.dirname(os.path.abspath(text))
-    if not os.path.isdir(parent):
-        fail(f"its parent {parent} does not exist")
-    if not os.access(parent, os.W_OK | os.X_OK):
-        fail(f"its parent {parent} is not writable")
-    return text
-
-
-@contextlib.contextmanager
-def atomic_outputs(out_dir, names=OUTPUT_FILES):
-    """Temporary paths for `names` in `out_dir`, renamed to their names only if the block succeeds.
-
-    Yields a dict name → temporary path (in the same directory, so the rename is
-    atomic per file). On an exception every temporary file is removed, and a
-    directory created here is removed again: a failure leaves nothing behind.
-    """
-    created = not os.path.exists(out_dir)
-    if created:
-        os.makedirs(out_dir)
-    staging = tempfile.mkdtemp(prefix=".map-outputs-", dir=out_dir)
-    paths = {name: os.path.join(staging, name) for name in names}
-    try:
-        yield paths
-        for name, tmp in paths.items():
-            if os.path.exists(tmp):
-                os.replace(tmp, os.path.join(out_dir, name))
-    finally:
-        shutil.rmtree(staging, ignore_errors=True)
-        if created and not os.listdir(out_dir):
-            os.rmdir(out_dir)
+    height, width = pixels.shape
+    return f"P5\n{width} {height}\n255\n".encode("ascii") + np.ascontiguousarray(pixels).tobytes()

@@ -47,6 +47,7 @@ from dataclasses import dataclass, field
 from functools import partial
 
 from ..checks import check_integer, check_output_path
+from ..files import OutputError, write_text
 from ..version import __version__
 from .evaluate import evaluate_chunk
 from .points import all_points, check_points, chunk_points, sobol_note
@@ -446,9 +447,11 @@ def run_sweep(
     try:
         if manifest is None:
             shutil.rmtree(parts, ignore_errors=True)
-            os.makedirs(parts)
-            with open(os.path.join(parts, "manifest.json"), "w", encoding="utf-8") as handle:
-                json.dump(_manifest(spec, chunk_size), handle, indent=2)
+            try:
+                os.makedirs(parts)
+            except OSError as exc:
+                raise OutputError(f"could not create {parts}: {exc.strerror or exc}") from None
+            write_text(os.path.join(parts, "manifest.json"), json.dumps(_manifest(spec, chunk_size), indent=2), what="sweep manifest")
         todo = [c for c in chunks if not os.path.isfile(paths[c[0]])]
         reused = len(chunks) - len(todo)
         pending = {c[0] for c in todo}
@@ -476,10 +479,13 @@ def run_sweep(
             if stopped:
                 raise SweepInterrupted(f"stopped after {len(todo)} chunks (stop_after_chunks)")
             where = f"local processes ({workers})" if spec.simulate else f"threads ({workers})"
+        concatenate_parts([paths[i] for i, _, _ in chunks], out, spec)
+    except OutputError as exc:  # a full disk: what is finished stays for --resume
+        kept = f"; the finished chunks are kept in {parts}: rerun with --resume" if os.path.isdir(parts) else ""
+        raise OutputError(f"{exc}{kept}") from None
     finally:
         if client is not None:
             client.close()
-    concatenate_parts([paths[i] for i, _, _ in chunks], out, spec)
     shutil.rmtree(parts, ignore_errors=True)
     columns = [f"{m}_verdict" for m in spec.models] + (["sim_verdict"] if spec.simulate else [])
     stats = statistics(read_columns(out, columns), spec.models, spec.simulate)

@@ -8,8 +8,9 @@ Column types: ``point`` int64; inputs, N, NV, NV*, margins and σ float64
 ``pfm_stability.version``. A CSV writes the same columns (``inf``, empty for
 null) and has no metadata.
 
-`write_table` writes to a temporary name beside the target and renames it:
-an interrupted write leaves no half-written output.
+Every file is written to a temporary name beside the target and renamed
+(`files.atomic_file`): an interrupted write or a full disk leaves no
+half-written output.
 """
 
 from __future__ import annotations
@@ -20,6 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..files import atomic_file
 from ..version import __version__
 from .evaluate import ChunkColumns
 
@@ -58,12 +60,11 @@ def dictionary_columns(schema) -> list:
 
 
 def write_part(table, path: str) -> None:
-    """Write one chunk's table as Parquet, atomically (temporary name, then rename)."""
+    """Write one chunk's table as Parquet, atomically (`files.atomic_file`)."""
     import pyarrow.parquet as pq
 
-    tmp = f"{path}.tmp-{os.getpid()}"
-    pq.write_table(table, tmp, use_dictionary=dictionary_columns(table.schema))
-    os.replace(tmp, path)
+    with atomic_file(path, what="sweep chunk") as handle:
+        pq.write_table(table, handle, use_dictionary=dictionary_columns(table.schema))
 
 
 def read_part(path: str):
@@ -84,9 +85,8 @@ def concatenate_parts(paths, out: str, spec) -> None:
     if len(paths) == 1 and not out.lower().endswith(".csv") and pq.read_schema(paths[0]).metadata == {k.encode(): v.encode() for k, v in metadata(spec).items()}:
         os.replace(paths[0], out)  # one part with the output's metadata is the output: moved, not rewritten
         return
-    tmp = f"{out}.tmp-{os.getpid()}"
     meta = metadata(spec)
-    try:
+    with atomic_file(out, what="table") as handle:
         if out.lower().endswith(".csv"):
             import pyarrow.csv as pcsv
 
@@ -94,19 +94,15 @@ def concatenate_parts(paths, out: str, spec) -> None:
             for path in paths:
                 table = pq.ParquetFile(path).read()
                 if writer is None:
-                    writer = pcsv.CSVWriter(tmp, table.schema)
+                    writer = pcsv.CSVWriter(handle, table.schema)
                 writer.write_table(table)
             if writer is not None:
                 writer.close()
         else:
             schema = pq.read_schema(paths[0]).with_metadata(meta) if paths else None
-            with pq.ParquetWriter(tmp, schema, use_dictionary=dictionary_columns(schema)) as writer:
+            with pq.ParquetWriter(handle, schema, use_dictionary=dictionary_columns(schema)) as writer:
                 for path in paths:
                     writer.write_table(pa.Table.from_batches(pq.ParquetFile(path).read().to_batches(), schema=schema))
-        os.replace(tmp, out)
-    finally:
-        if os.path.exists(tmp):
-            os.remove(tmp)
 
 
 def write_table(table, out: str, spec) -> None:
