@@ -242,3 +242,38 @@ def test_start_up_imports_nothing_heavy():
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     lines = done.stdout.strip().splitlines()
     assert lines[0] == "[]" and lines[-1] == "[]", done.stdout
+
+
+# ----------------------------------------------------------------- optional extras
+@pytest.mark.parametrize("argv, extra, module, package", [
+    (["map", "depot"], "maps", "skimage", "scikit-image"),
+    (["map", "depot"], "maps", "PIL", "Pillow"),
+    (["sweep", "spec.yaml", "--out", "t.parquet"], "sweep", "pyarrow", "pyarrow"),
+    (["sweep", "spec.yaml", "--out", "t.parquet"], "sweep", "dask", "dask[distributed]"),
+])
+def test_a_command_without_its_extra_says_so_in_one_line(capsys, monkeypatch, tmp_path, argv, extra, module, package):
+    """Without the extra's package (its import fails, as on a plain `pip install .`): exit 2, one line naming the command,
+    the extra, the missing package and the pip command, before any work."""
+    (tmp_path / "spec.yaml").write_text("preset: carmel\nscenario: {corridor: {L: 0.9}}\ngrid: {V: {from: 0.2, to: 1, num: 3}}\n")
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setitem(sys.modules, module, None)  # `import module` now raises ImportError
+    code, out, err = run(capsys, *argv)
+    assert code == 2 and out == ""
+    assert err == (f"pfm-stability: error: pfm-stability {argv[0]} needs the optional extra '{extra}' (missing: {package}): "
+                   f"pip install 'pfm-stability[{extra}]'\n")
+
+
+def test_the_report_needs_no_extra():
+    """The main job's dependencies are the documented seven (and threadpoolctl); what one command needs is an extra
+    (pfm_stability.extras names the same packages as pyproject.toml)."""
+    import tomllib
+
+    from pfm_stability.extras import EXTRAS
+
+    with open(os.path.join(os.path.dirname(__file__), "..", "pyproject.toml"), "rb") as fh:
+        project = tomllib.load(fh)["project"]
+    names = {dep.split(">")[0].split("[")[0].split("=")[0].strip().lower() for dep in project["dependencies"]}
+    assert names == {"numpy", "scipy", "sympy", "control", "matplotlib", "tqdm", "pyyaml", "threadpoolctl"}
+    for extra, packages in EXTRAS.items():
+        declared = {dep.split(">")[0].strip() for dep in project["optional-dependencies"][extra]}
+        assert declared == set(packages.values()), extra

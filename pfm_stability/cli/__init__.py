@@ -24,6 +24,8 @@ import os
 import re
 import sys
 
+from ..extras import MissingExtra
+
 __all__ = ["main", "build_parser", "UsageError", "unknown_options"]
 
 SUBCOMMANDS = ("report", "derive", "simulate", "validate", "plot", "traps", "map", "sweep")
@@ -126,6 +128,8 @@ def main(argv=None) -> int:
     except UsageError as exc:
         return _fail(str(exc))
     except ValueError as exc:
+        return _fail(str(exc))
+    except MissingExtra as exc:
         return _fail(str(exc))
     except BrokenPipeError:
         return 0

@@ -124,6 +124,10 @@ def _write_outputs(analysis, out_dir: str) -> dict:
 def run(args) -> int:
     import time
 
+    from ..extras import require
+
+    require("maps", "pfm-stability map")
+
     from ..maps.analysis import analyze_map, check_map_law
     from ..maps.occupancy import load_map
     from ..serialize import dumps

@@ -99,6 +99,9 @@ def _progress(quiet: bool):
 
 
 def run(args) -> int:
+    from ..extras import require
+
+    require("sweep", "pfm-stability sweep")
     from ..serialize import SCHEMA_VERSION, dumps
     from ..sweeps import SweepError, load_spec, run_sweep
     from .render import render_parameter_sweep_text

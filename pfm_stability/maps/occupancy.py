@@ -44,6 +44,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..checks import check_number
+from ..extras import require
 
 __all__ = ["MAP_KEYS", "MAX_PIXELS", "MODES", "OccupancyMap", "load_map", "occupancy_values"]
 
@@ -218,6 +219,7 @@ def _parameters(path, data: dict) -> dict:
 
 def _read_image(path, image_path: str):
     """`_channels` of the image file, rows as in the file (row 0 = top)."""
+    require("maps", "reading a map image")
     from PIL import Image, UnidentifiedImageError
 
     if not os.path.isfile(image_path):

@@ -31,6 +31,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..extras import require
 from .field import HistogramMap
 
 __all__ = ["JUNCTION_CUT", "MIN_LENGTH", "TOLERANCE_CELLS", "Route", "default_min_length", "find_routes", "prune_spurs", "skeleton_of"]
@@ -71,6 +72,7 @@ class Route:
 
 def skeleton_of(grid: HistogramMap, W: float):
     """(skeleton, clearance): the medial axis of the free space where a robot of width W fits, and the clearance (m)."""
+    require("maps", "finding a map's corridors")
     from skimage.morphology import skeletonize
 
     clearance = grid.clearance()
