@@ -19,7 +19,9 @@ code) is analysed at every one of its wall equilibria, and its α*, L* and the
 critical values of its own parameters (f*, or η*, ρ0*, ξ*) are found on each
 equilibrium by following it (`pfm_stability.critical`, docs/fields.md).
 An equilibrium with N < 0 is unstable in the field itself: every model's
-verdict is "unstable", with the reason.
+verdict is "unstable", with the reason. At N = 0 (no restoring force) each
+model judges its heading loop, the roots other than the neutral lateral one
+(docs/models.md, "N = 0"), with the reason.
 """
 
 from __future__ import annotations
@@ -34,7 +36,7 @@ from .checks import check_number, check_type
 from .critical import CorridorBranches, CorridorCritical, CriticalValues, WallBranches, WallCritical, is_field_law
 from .fields import finite_goal_gain
 from .force_law import Equilibrium, ForceLaw, PowerLaw, corridor_equilibria, corridor_gain, law_in_force, wall_equilibria, wall_gain
-from .models import Loop, LoopModel, gain_margin, models_for, verdict_label
+from .models import Loop, LoopModel, gain_margin, models_for, neutral_reason, verdict_label
 from .parameters import RANGES, Controller, Corridor, Robot, Wall, check_corridor_fits, check_parameter, to_degrees
 from .solve import bisect_root, expand_bracket
 
@@ -87,7 +89,8 @@ class ModelVerdict:
         the model cannot resolve it; the verdict does not depend on it).
     reason : str or None
         Why the verdict does not come from the model (N < 0: an unstable
-        equilibrium of the field); None otherwise.
+        equilibrium of the field), or at N = 0 that it is the heading loop's
+        (`models.neutral_reason`); None otherwise.
     """
 
     model: str
@@ -361,8 +364,7 @@ def model_verdicts(controller: Controller, models, loop: Loop, N: float, NV: flo
     out = {}
     for model in models_for(controller, models):
         boundary = model.boundary(loop)
-        V_critical = boundary.NV_critical / N if N > 0 else (0.0 if N < 0 else math.inf)
-        out[model.name] = _verdict(model, loop, NV, boundary, critical_values, V_critical=V_critical, **geometric(boundary.NV_critical))
+        out[model.name] = _verdict(model, loop, NV, boundary, critical_values, N, **geometric(boundary.NV_critical))
     return out
 
 
@@ -381,21 +383,24 @@ def _negative_gain_root(model: LoopModel, NV: float, loop: Loop):
         return None
 
 
-def _verdict(model: LoopModel, loop: Loop, NV: float, boundary, critical_values, **geometry) -> ModelVerdict:
-    """The verdict; `critical_values` (WallCritical or CorridorCritical) built from `geometry` plus T*, k*."""
+def _verdict(model: LoopModel, loop: Loop, NV: float, boundary, critical_values, N: float, **geometry) -> ModelVerdict:
+    """The verdict; `critical_values` (WallCritical or CorridorCritical) built from `geometry` plus V*, T*, k*.
+
+    N = 0 is judged by the model like any other point: its heading loop (the neutral lateral
+    root left out, `models.neutral_reason`, docs/models.md "N = 0"), with that reason; V* is
+    then ``inf`` or 0 (NV = 0 at every speed).
+    """
     if NV < 0:  # an unstable equilibrium of the field: no T or k helps, margin −1
-        critical = critical_values(**geometry, T_critical=0.0, k_critical=0.0)
+        critical = critical_values(**geometry, V_critical=0.0, T_critical=0.0, k_critical=0.0)
         root = _negative_gain_root(model, NV, loop)
         return ModelVerdict(model.name, NV, boundary.NV_critical, boundary.omega_critical, -1.0, "unstable", critical, root, NEGATIVE_N)
-    if NV == 0:  # no equilibrium force gradient: nothing to oscillate
-        critical = critical_values(**geometry, T_critical=math.inf, k_critical=math.inf)
-        return ModelVerdict(model.name, NV, boundary.NV_critical, boundary.omega_critical, math.inf, "stable", critical, 0j)
     stable = model.is_stable(NV, loop)
     critical = critical_values(
         **geometry,
+        V_critical=boundary.NV_critical / N if N > 0 else (math.inf if stable else 0.0),
         T_critical=model.critical_delay(NV, loop),
         k_critical=model.critical_gain_k(NV, loop),
-        tau_plus_T_critical=1.0 / NV if model.name == "kb_first_order" else None,
+        tau_plus_T_critical=(1.0 / NV if NV > 0 else math.inf) if model.name == "kb_first_order" else None,
     )
     return ModelVerdict(
         model=model.name,
@@ -406,6 +411,7 @@ def _verdict(model: LoopModel, loop: Loop, NV: float, boundary, critical_values,
         verdict=verdict_label(NV, boundary, stable),
         critical=critical,
         rightmost_root=model.rightmost_root(NV, loop),
+        reason=neutral_reason(NV, stable),
     )
 
 

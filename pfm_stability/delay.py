@@ -506,20 +506,21 @@ def _cubic_positive_roots(tau, k, K, linear=None):
     intervals where F is monotone and of one convexity, so each root is reached
     by Newton's method from a start that satisfies Fourier's condition
     F·F″ > 0 — convergence is monotone and needs no safeguard. τ = 0 leaves
-    the quadratic y² + ℓy − K² (one positive root, closed form).
+    the quadratic y² + ℓy − K² (one positive root, closed form); K = 0 (N = 0: the heading loop's crossings)
+    leaves y·(τ²y² + (1 − 2kτ)y + ℓ), the quadratic's positive roots (closed form).
     """
     roots = np.full(tau.shape + (3,), np.nan)
-    quadratic = tau == 0
-    if quadratic.any():
-        kk = k[quadratic] ** 2 if linear is None else linear[quadratic]
-        KK = K[quadratic] ** 2
-        with np.errstate(invalid="ignore", divide="ignore"):
-            root = np.sqrt(kk * kk + 4 * KK)
-            roots[quadratic, 0] = np.where(kk >= 0, 2 * KK / (kk + root), (root - kk) / 2)
-    cubic = ~quadratic
+    lin = k**2 if linear is None else linear
+    quadratic, neutral, cubic = tau == 0, (tau > 0) & (K == 0), (tau > 0) & (K != 0)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        root = np.sqrt(lin[quadratic] ** 2 + 4 * K[quadratic] ** 2)
+        roots[quadratic, 0] = np.where(lin[quadratic] >= 0, 2 * K[quadratic] ** 2 / (lin[quadratic] + root), (root - lin[quadratic]) / 2)
+        a, b, c = tau[neutral] ** 2, 1 - 2 * k[neutral] * tau[neutral], lin[neutral]
+        q = -0.5 * (b + np.copysign(np.sqrt(b * b - 4 * a * c), b))  # the stable quadratic formula: roots c/q, q/a
+        pair = np.stack([c / q, q / a], axis=-1)
+        roots[neutral, :2] = np.where(pair > 0, pair, np.nan)
     if cubic.any():
-        lin = k[cubic] ** 2 if linear is None else linear[cubic]
-        roots[cubic] = _newton_cubic_roots(tau[cubic] ** 2, 1 - 2 * k[cubic] * tau[cubic], lin, K[cubic] ** 2)
+        roots[cubic] = _newton_cubic_roots(tau[cubic] ** 2, 1 - 2 * k[cubic] * tau[cubic], lin[cubic], K[cubic] ** 2)
     return roots
 
 
@@ -570,8 +571,7 @@ def _newton_cubic_roots(a, beta, c, D):
             break
     out = np.full(starts.shape, np.nan)
     out[used] = y
-    y = out
-    return y
+    return out
 
 
 def delay_verdicts_from_gain(tau, T, k, K, c=None):
@@ -579,7 +579,7 @@ def delay_verdicts_from_gain(tau, T, k, K, c=None):
 
     τs³ + s² + ks + (kcs + K)·e^(−sT) (c None: KB eq 18): F(y) = τ²y³ + (1 − 2kτ)y² + k²(1 − c²)y − K²,
     first delays from arg(a(jω)/b(jω)), b = kcjω + K; Z(0), the Routh count of τs³ + s² + k(1 + c)s + K,
-    is 1 for K < 0 (a real root s > 0: N < 0), so K < 0 is always unstable."""
+    is 1 for K < 0 (a real root s > 0: N < 0, always unstable); K = 0 (N = 0) counts the heading loop (s = 0 left out)."""
     linear = None if c is None else k**2 * (1 - c * c)
     y = _cubic_positive_roots(tau, k, K, linear)
     present = np.isfinite(y) & (y > 0)  # y = 0: K² underflowed to 0, no crossing at ω > 0

@@ -157,7 +157,7 @@ def test_shapes_broadcast_and_scalars():
         (dict(tau=[0.1, -1.0]), "tau"),
         (dict(T=np.nan), "T"),
         (dict(k=0.0), "k"),
-        (dict(NV=[1.0, 0.0]), "NV"),
+        (dict(NV=[1.0, np.nan]), r"NV.*\(point 1\)"),
         (dict(NV=np.inf), "NV"),
         (dict(NV=2e12), "NV"),
         (dict(c=-1.5), "c"),

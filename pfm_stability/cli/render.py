@@ -99,7 +99,7 @@ def _scenarios(data: dict):
             continue
         if scenario == "corridor":
             title = f"Corridor, L = {number(env['L'])} m: N = {number(env['N'])} 1/m, NV = {number(env['NV'])} 1/s"
-            yield (title, *_verdict_table(scenario, data[scenario]), _corridor_notes(env))
+            yield (title, *_verdict_table(scenario, data[scenario]), _reason_lines(data[scenario]) + _corridor_notes(env))
             continue
         equilibria = env.get("equilibria") or [{"d0": env["d0"], "N": env["N"], "NV": env["NV"], "models": data["wall"]}]
         for i, e in enumerate(equilibria):
@@ -108,8 +108,17 @@ def _scenarios(data: dict):
                 f"Wall, alpha = {number(env['alpha_deg'])} deg{which} = {number(e['d0'])} m, "
                 f"N = {number(e['N'])} 1/m, NV = {number(e['NV'])} 1/s"
             )
-            reasons = sorted({v["reason"] for v in e["models"].values() if "reason" in v})
-            yield (title, *_verdict_table(scenario, e["models"]), [f"  every model: unstable ({r})" for r in reasons] + _equilibrium_notes(e))
+            yield (title, *_verdict_table(scenario, e["models"]), _reason_lines(e["models"]) + _equilibrium_notes(e))
+
+
+def _reason_lines(verdicts: dict) -> list[str]:
+    """One line per distinct reason (N < 0, N = 0): the models giving it ("every model") and their verdict."""
+    lines = []
+    for reason in sorted({v["reason"] for v in verdicts.values() if "reason" in v}):
+        names = [name for name, v in verdicts.items() if v.get("reason") == reason]
+        labels = "/".join(sorted({verdicts[name]["verdict"] for name in names}))
+        lines.append(f"  {'every model' if len(names) == len(verdicts) else ', '.join(names)}: {labels} ({reason})")
+    return lines
 
 
 def _verdict_table(scenario: str, verdicts: dict):

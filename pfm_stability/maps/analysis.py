@@ -11,7 +11,11 @@ VFF field) and every sample is decided from it:
   `models.base.gain_margin` (NV*/NV − 1 for the usual set (0, NV*)), label
   `models.base.verdict_label`;
 * N < 0 (the field pushes away from the equilibrium): unstable at any speed,
-  V* = 0, margin −1 (`models.base.divergent_reason`).
+  V* = 0, margin −1 (`models.base.divergent_reason`);
+* N = 0 (no restoring force): the model's own verdict at NV = 0, its heading
+  loop (`is_stable(0, loop)`, asked once per analysis; docs/models.md "N = 0"):
+  stable, V* = inf, margin inf, or unstable, V* = 0, margin −1, with
+  `models.neutral_reason`.
 
 A segment is decided by its mean growth rate (`verdicts`): over its judged part the
 lateral deviation grows by exp(σ̄·duration), σ̄ the mean of the samples' σ(N_i·V)
@@ -41,7 +45,7 @@ import numpy as np
 
 from ..effective_force import GridWallLaw
 from ..force_law import ForceLaw, PowerLaw
-from ..models import Loop, divergent_reason, gain_margin, models_for, verdict_label
+from ..models import Loop, divergent_reason, gain_margin, models_for, neutral_reason, verdict_label
 from ..parameters import Controller, Robot
 from ..serialize import json_number
 from .equilibria import Samples, grid_equilibria, power_equilibria
@@ -97,7 +101,7 @@ class MapSegment:
     samples_offset : tuple of float
         s0 of each sample with an equilibrium, m.
     reason : str or None
-        Why it is unstable at any speed (N < 0), if so.
+        Why it is unstable at any speed (N < 0), if so, or why N = 0 has its verdict (`models.neutral_reason`).
     N_max : float or None
         Largest N of a single sample, 1/m (the local worst; not the verdict's).
     V_critical_local : float or None
@@ -323,7 +327,9 @@ def analyze_map(occupancy: OccupancyMap, robot: Robot, controller: Controller, l
     loop = Loop(robot.tau, controller.T, robot.k, c=c)
     boundary = loop_model.boundary(loop)
     growth = GrowthRate(lambda NV: loop_model.rightmost_root(NV, loop), boundary.NV_critical)
-    segments = tuple(_segment(r, samples, k, boundary, robot, c, growth, end_fraction, taper_slope) for k, r in enumerate(routes))
+    heading_stable = loop_model.is_stable(0.0, loop)  # decides the samples with N = 0
+    segments = tuple(_segment(r, samples, k, boundary, robot, c, growth, heading_stable, end_fraction, taper_slope)
+                     for k, r in enumerate(routes))
     stage("verdicts")
     return MapAnalysis(occupancy, grid, law, robot, controller, loop_model.name, boundary.NV_critical, segments, samples,
                        skeleton, clearance, unknown, timing)
@@ -335,40 +341,40 @@ def _stable(NV: float, boundary) -> bool:
     return 0 < NV < boundary.NV_critical
 
 
-def sample_verdict(N: float, V: float, boundary) -> tuple:
-    """(V*, margin, stable, label, reason) of one sample with gain N (1/m) at speed V."""
+def sample_verdict(N: float, V: float, boundary, heading_stable: bool) -> tuple:
+    """(V*, margin, stable, label, reason) of one sample with gain N (1/m) at speed V (m/s).
+
+    `heading_stable` is the model's verdict at NV = 0 (``model.is_stable(0.0, loop)``: its
+    heading loop), which decides a sample with N = 0 (module docstring).
+    """
     if N < 0:
         return 0.0, -1.0, False, "unstable", divergent_reason(N * V)
-    if N == 0:
-        return math.inf, math.inf, True, "stable", None
     NV = N * V
-    stable = _stable(NV, boundary)
-    V_critical = boundary.NV_critical / N
-    return V_critical, gain_margin(NV, boundary, stable), stable, verdict_label(NV, boundary, stable), None
+    stable = bool(heading_stable) if N == 0 else _stable(NV, boundary)
+    V_critical = boundary.NV_critical / N if N > 0 else (math.inf if stable else 0.0)
+    return V_critical, gain_margin(NV, boundary, stable), stable, verdict_label(NV, boundary, stable), neutral_reason(NV, stable)
 
 
-def _direction(N: np.ndarray, length: float, boundary, V: float, growth: GrowthRate) -> dict | None:
+def _direction(N: np.ndarray, length: float, boundary, V: float, growth: GrowthRate, heading_stable: bool) -> dict | None:
     """The verdict of one travel direction from the N (1/m) of its judged samples, `length` m: None without an
-    equilibrium (`verdicts`: the sign of the mean growth rate σ̄)."""
+    equilibrium (`verdicts`: the sign of the mean growth rate σ̄; N_eff = 0: `sample_verdict`'s N = 0)."""
     gain = segment_gain(N, V, boundary.omega_critical, growth, boundary.NV_critical)
     if gain.N_eff is None:
         return None
     out = dict(N=gain.N_eff, wavelength=gain.wavelength, stretch=gain.stretch, growth_rate=gain.sigma)
     if is_weak(gain.sigma, length, V):
         return dict(out, V_critical=None, margin=None, stable=None, verdict="weak", reason=None)
-    if gain.N_eff < 0:  # the mean N is negative and σ̄ > 0: unstable at any speed
-        V_star, margin, stable, label, reason = sample_verdict(gain.N_eff, V, boundary)
+    if gain.N_eff <= 0:  # the mean N is negative and σ̄ > 0: unstable at any speed; or no restoring force
+        V_star, margin, stable, label, reason = sample_verdict(gain.N_eff, V, boundary, heading_stable)
         return dict(out, V_critical=V_star, margin=margin, stable=stable, verdict=label, reason=reason)
     stable = bool(gain.sigma < 0)
     NV = gain.N_eff * V
-    if NV == 0:
-        return dict(out, V_critical=math.inf, margin=math.inf, stable=True, verdict="stable", reason=None)
     V_star = critical_speed(N, growth, boundary.NV_critical)
     return dict(out, V_critical=float(V_star), margin=float(gain_margin(NV, boundary, stable)), stable=stable,
                 verdict=verdict_label(NV, boundary, stable), reason=None)
 
 
-def _segment(route: Route, samples: Samples, k: int, boundary, robot: Robot, c: float, growth: GrowthRate,
+def _segment(route: Route, samples: Samples, k: int, boundary, robot: Robot, c: float, growth: GrowthRate, heading_stable: bool,
              end_fraction: float = END_FRACTION, taper_slope: float = TAPER_SLOPE) -> MapSegment:
     """The verdict of one segment: the worse of its two travel directions, each from its mean growth rate over the
     judged part (`verdicts`)."""
@@ -383,7 +389,7 @@ def _segment(route: Route, samples: Samples, k: int, boundary, robot: Robot, c: 
         return MapSegment(N=None, V_critical=None, margin=None, stable=None, verdict=verdict, offset=None, **base)
     first, stop = judged_run(samples.along[mine], end_fraction) if samples.along is not None else (0, mine.size)
     judged = (stop - first) * spacing
-    local = [sample_verdict(float(n), V, boundary) for n in samples.N[ok]]
+    local = [sample_verdict(float(n), V, boundary, heading_stable) for n in samples.N[ok]]
     detail = dict(offset=float(np.mean(samples.offset[ok])), samples_offset=tuple(float(v) for v in samples.offset[ok]),
                   N_max=float(np.max(samples.N[ok])), V_critical_local=float(min(a[0] for a in local)),
                   judged_from=float(first * spacing), judged_to=float(stop * spacing), **base)
@@ -398,7 +404,7 @@ def _segment(route: Route, samples: Samples, k: int, boundary, robot: Robot, c: 
         return MapSegment(N=None, V_critical=None, margin=None, stable=None, verdict="tapering", wavelength=lam,
                           reason=f"the equilibrium path turns from the segment: |ds0/ds| = {slope:.2f} over the judged part "
                           f"(> {taper_slope:g}, {math.degrees(math.atan(taper_slope)):.0f} deg)", **detail)
-    ways = {name: _direction(N, judged, boundary, V, growth) for name, N in zip(DIRECTIONS, samples.directional(part))}
+    ways = {name: _direction(N, judged, boundary, V, growth, heading_stable) for name, N in zip(DIRECTIONS, samples.directional(part))}
     ways = {name: w for name, w in ways.items() if w is not None}
     if not ways:
         verdict = "no equilibrium" if samples.field[mine].any() else "open"

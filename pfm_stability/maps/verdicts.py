@@ -31,8 +31,11 @@ over the samples with an equilibrium: a gap is not a gain):
 
 σ(NV) is tabulated once per analysis (`GrowthRate`): the model's rightmost root on a
 geometric grid of |NV| around NV* (both signs, NV* itself a node), interpolated by a
-shape-preserving cubic (PCHIP) in log |NV|; linear in NV below the grid (σ → 0 like
-the slow real root −NV as NV → 0), exact above it.
+shape-preserving cubic (PCHIP) in log |NV|; linear in NV below the grid, exact above it.
+At NV = 0 σ is the growth of the lateral deviation with no restoring force: 0 (the neutral
+lateral root) when the model's heading loop is stable, its dominant root's real part when
+that grows (`models.neutral_reason`); below the grid σ runs linearly from there (the slow
+real root −NV/(1 + c) → 0 as NV → 0).
 
 A spike, a gap or a negative sample counts by the growth it causes while the robot
 crosses it: a sample ten times the median over one cell adds its σ over the number of
@@ -162,6 +165,8 @@ class GrowthRate:
         The grid's ends, 1/s.
     NV_least : float
         The positive grid NV with the most negative σ (the most damped uniform gain), 1/s.
+    zero : float
+        σ at NV = 0, 1/s: max(0, the heading loop's growth rate ``root_of(0).real``) (module docstring).
     """
 
     def __init__(self, root_of, NV_critical: float, decades: float = 4.0, per_decade: int = 40):
@@ -174,19 +179,20 @@ class GrowthRate:
         self._pos = PchipInterpolator(np.log(grid), self.positive)
         self._neg = PchipInterpolator(np.log(grid), self.negative)
         self.NV_least = float(grid[int(np.argmin(self.positive))])
+        self.zero = max(0.0, float(root_of(0.0).real))
 
     def __call__(self, NV):
-        """σ at every NV (array or float), 1/s; 0 at NV = 0."""
+        """σ at every NV (array or float), 1/s; `zero` at NV = 0."""
         shape = np.shape(NV)
         NV = np.atleast_1d(np.asarray(NV, dtype=float))
         x = np.abs(NV)
         inside = (x >= self.lo) & (x <= self.hi)
         log_x = np.log(np.where(inside, x, 1.0))
-        out = np.where(inside & (NV > 0), self._pos(log_x), 0.0)
+        out = np.where(inside & (NV > 0), self._pos(log_x), self.zero)
         out = np.where(inside & (NV < 0), self._neg(log_x), out)
         below = (x > 0) & (x < self.lo)
-        out = np.where(below & (NV > 0), self.positive[0] * x / self.lo, out)
-        out = np.where(below & (NV < 0), self.negative[0] * x / self.lo, out)
+        out = np.where(below & (NV > 0), self.zero + (self.positive[0] - self.zero) * x / self.lo, out)
+        out = np.where(below & (NV < 0), self.zero + (self.negative[0] - self.zero) * x / self.lo, out)
         out = np.array(out, dtype=float)
         for i in zip(*np.nonzero(x > self.hi)):
             out[i] = self.root_of(float(NV[i])).real

@@ -12,15 +12,16 @@ sampled            det(zI − Φ_cl(kNV)) = 0, ZOH                   eigenvalues
 
 A heading gain c (``Loop(tau, T, k, c=…)``, default 0) turns the gain term kNV
 into k(cs + NV) in every model (docs/models.md, "The heading gain"); NV < 0 is
-unstable in every model (`divergent_reason`).
+unstable in every model (`divergent_reason`); at NV = 0 every model judges its
+heading loop, the roots other than the neutral lateral one (`neutral_reason`).
 """
 
 from __future__ import annotations
 
 from ..checks import check_choice
 from ..parameters import MODEL_NAMES, Controller
-from .base import (DIVERGENT_REASON, HEADING_GAIN_RANGE, Boundary, Loop, LoopModel, divergent_reason, gain_margin, interval_margin,
-                   interval_verdict, verdict_label)
+from .base import (DIVERGENT_REASON, HEADING_GAIN_RANGE, NEUTRAL_REASON, Boundary, Loop, LoopModel, divergent_reason, gain_margin,
+                   interval_margin, interval_verdict, neutral_reason, verdict_label)
 from .continuous import Continuous
 from .exact_delay import ExactDelay
 from .kb_first_order import KBFirstOrder
@@ -31,6 +32,7 @@ __all__ = [
     "MODEL_NAMES",
     "DIVERGENT_REASON",
     "HEADING_GAIN_RANGE",
+    "NEUTRAL_REASON",
     "Boundary",
     "Loop",
     "LoopModel",
@@ -46,6 +48,7 @@ __all__ = [
     "make_model",
     "make_models",
     "models_for",
+    "neutral_reason",
     "pade_coefficients",
     "verdict_label",
 ]

@@ -16,7 +16,10 @@ A heading gain c (`Loop.c`, docs/models.md "The heading gain") adds k·c·s to
 the gain term: τs³ + s² + ks + k(cs + NV)·e^(−sT) = 0. c = 0 (the default)
 is KB's loop and runs exactly the code it always ran. NV < 0 (N < 0: a field
 that pushes the robot away from its equilibrium) is accepted by every query
-and is unstable in every model (`divergent_reason`).
+and is unstable in every model (`divergent_reason`). NV = 0 (N = 0: no
+restoring force) leaves a neutral lateral root at s = 0 (z = 1); every query
+judges the other roots, the heading loop (`neutral_reason`, docs/models.md
+"N = 0").
 """
 
 from __future__ import annotations
@@ -46,7 +49,10 @@ __all__ = [
     "checked",
     "check_heading_gain",
     "divergent_reason",
+    "neutral_reason",
+    "neutral_quotient",
     "DIVERGENT_REASON",
+    "NEUTRAL_REASON",
     "HEADING_GAIN_RANGE",
     "UNDECIDED_RTOL",
     "NV_MAX",
@@ -70,6 +76,56 @@ hundred times the steering loop's own)."""
 
 DIVERGENT_REASON = "N < 0: the equilibrium diverges (a real root in the right half-plane) at any speed"
 """Why every model says "unstable" for NV < 0 (`divergent_reason`)."""
+
+
+NEUTRAL_REASON = "N = 0: the lateral mode is neutral (no restoring force); the verdict is the heading loop's"
+"""Why a verdict at NV = 0 is the heading loop's, when it is not told which (`neutral_reason`; a sweep's reason column)."""
+
+_NEUTRAL_REASONS = {
+    True: "N = 0: the lateral mode is neutral (no restoring force); the heading loop is stable",
+    False: "N = 0: the lateral mode is neutral (no restoring force) and the heading loop is unstable by itself",
+}
+
+
+def neutral_reason(NV: float, stable: bool | None = None) -> str | None:
+    """Why the verdict at NV = 0 is what it is; None for NV != 0.
+
+    At N = 0 the field exerts no restoring force: the characteristic
+    function of every model is s·D1(s) (a root at z = 1 for `sampled`),
+    and the lateral root stays at s = 0 whatever V, T, k and c are — the
+    robot drifts sideways, it does not oscillate. Every model then judges
+    the other roots, D1 — the heading loop: τs² + s + k(1 + c) for
+    `continuous`, τs² + s + k + kc·e^(−sT) for `exact_delay`, the sampled
+    loop without its lateral state (the whole command k(δ − θ) held can
+    make it unstable even with c = 0). `is_stable` is the heading loop's
+    verdict, `rightmost_root` its dominant root, `critical_delay` and
+    `critical_gain_k` its T* and k*; the margin is ``inf`` when it is
+    stable and −1 when it is not (`interval_margin`), never "undecided".
+
+    Parameters
+    ----------
+    NV : float
+        Loop gain, 1/s.
+    stable : bool, optional
+        The model's verdict at NV = 0 (`LoopModel.is_stable`); None:
+        `NEUTRAL_REASON`, which does not say it (several models in one row).
+    """
+    if NV != 0:
+        return None
+    return NEUTRAL_REASON if stable is None else _NEUTRAL_REASONS[bool(stable)]
+
+
+def neutral_quotient(p, domain: str = "s") -> np.ndarray:
+    """p(s)/s (``domain="s"``) or p(z)/(z − 1) (``"z"``): a characteristic polynomial at NV = 0 without its
+    neutral lateral root (descending in and out; the quotient of the exact division).
+
+    Every affine model's D has the root there exactly (D(0) = 0: the s⁰ coefficient is a product with
+    the plant's zero constant term), so the s quotient drops that coefficient without arithmetic.
+    """
+    p = np.trim_zeros(np.asarray(p, dtype=float), "f")
+    if domain == "s":
+        return p[:-1]
+    return np.polydiv(p, [1.0, -1.0])[0]
 
 
 def divergent_reason(NV: float) -> str | None:
@@ -219,7 +275,12 @@ def interval_margin(gain: float, stable_set, critical: float, stable: bool) -> f
     Unstable: the upper end of the nearest stable interval below, so the
     (negative) margin is how much it must shrink; −1 when no smaller gain is
     stable. With the usual stable set (0, critical) both are critical/gain − 1.
+
+    Gain 0 (N = 0, `neutral_reason`): ``inf`` when stable, −1 when not — the
+    limits of critical/gain − 1 as the gain → 0+ (no gain below 0 exists).
     """
+    if gain == 0:
+        return math.inf if stable else -1.0
     intervals = stable_set or (((0.0, critical),) if critical > 0 else ())
     if stable:
         holding = [hi for lo, hi in intervals if lo <= gain <= hi]
@@ -245,11 +306,8 @@ NV_MAX = 1e12
 
 
 def _check_NV(NV) -> float:
-    """NV as a float: finite and non-zero (negative is allowed: N < 0, `divergent_reason`)."""
-    NV = check_number("NV", NV, unit="1/s")
-    if NV == 0.0:
-        raise ValueError("NV must be a finite non-zero number 1/s (NV = 0: no force gradient, a root at s = 0); got 0.0")
-    return NV
+    """NV as a float: finite (negative: N < 0, `divergent_reason`; 0: N = 0, `neutral_reason`; −0.0 becomes 0.0)."""
+    return check_number("NV", NV, unit="1/s") + 0.0
 
 
 def check_heading_gain(c) -> float:
@@ -274,14 +332,13 @@ def checked(method):
 
     NV is capped at |NV| <= `NV_MAX` here only: internal probes (a stable
     interval checked beyond the last crossing gain) may go further. NV < 0
-    is accepted (N < 0, `divergent_reason`); NV = 0 is not (a root at s = 0).
+    is accepted (N < 0, `divergent_reason`), and NV = 0 (N = 0: the heading
+    loop is judged, `neutral_reason`).
     """
 
     @functools.wraps(method)
     def wrapper(self, NV, loop, *args, **kwargs):
-        NV = check_number("NV", NV, -NV_MAX, NV_MAX, low_open=False, high_open=False, unit="1/s")
-        if NV == 0.0:
-            _check_NV(NV)
+        NV = check_number("NV", NV, -NV_MAX, NV_MAX, low_open=False, high_open=False, unit="1/s") + 0.0
         return method(self, NV, _check_loop(loop), *args, **kwargs)
 
     return wrapper
@@ -331,7 +388,9 @@ class LoopModel:
     def growth_rates(self, NV: float, loops) -> np.ndarray:
         """Real part of the dominant root, 1/s, at NV for each loop of a sequence.
 
-        Models override this with a vectorized version where they can.
+        At NV = 0 the heading loop's (`neutral_reason`: the neutral lateral
+        root left out), as `rightmost_root`. Models override this with a
+        vectorized version where they can.
         """
         NV = _check_NV(NV)
         return np.array([self.rightmost_root(NV, loop).real for loop in loops])
@@ -390,8 +449,8 @@ class LoopModel:
 
 
 def _time_scale(loop: Loop, NV: float) -> float:
-    """The loop's fastest time scale, s: min(τ, 1/k, 1/NV) (τ counts when > 0)."""
-    scales = [1.0 / loop.k, 1.0 / NV] + ([loop.tau] if loop.tau > 0 else [])
+    """The loop's fastest time scale, s: min(τ, 1/k, 1/NV) (τ counts when > 0, 1/NV when NV != 0)."""
+    scales = [1.0 / loop.k] + ([1.0 / abs(NV)] if NV != 0 else []) + ([loop.tau] if loop.tau > 0 else [])
     return min(scales)
 
 
@@ -438,8 +497,10 @@ class AffineGainModel(LoopModel):
         return self._stable(NV, loop)
 
     def _stable(self, NV: float, loop: Loop) -> bool:
-        """`is_stable` without the public argument checks (internal probes)."""
+        """`is_stable` without the public argument checks (internal probes); NV = 0: D's quotient by its neutral root."""
         d, e = self.polynomials(loop)
+        if NV == 0:
+            return verdict_at(neutral_quotient(d, self.domain), [0.0], 0.0, self.domain)
         return verdict_at(d, e, loop.k * NV, self.domain)
 
     @checked
@@ -456,10 +517,13 @@ class AffineGainModel(LoopModel):
         return D, E
 
     def growth_rates(self, NV: float, loops) -> np.ndarray:
-        """max Re s (1/s) at NV for each loop: eigenvalues of the companion matrices, batched by degree."""
+        """max Re s (1/s) at NV for each loop: eigenvalues of the companion matrices, batched by degree
+        (NV = 0: of D/s, the heading loop; −inf for a constant)."""
         loops = list(loops)
         D, E = self.batch_polynomials(loops)
         P = D + (np.array([loop.k for loop in loops]) * _check_NV(NV))[:, None] * E
+        if NV == 0:  # D(0) = 0 exactly: drop the neutral lateral root
+            P = P[:, :-1]
         polys = [row[np.flatnonzero(row)[0]:] for row in P]
         out = np.empty(len(polys))
         for degree in {len(p) - 1 for p in polys}:
@@ -476,7 +540,13 @@ class AffineGainModel(LoopModel):
 
     @checked
     def rightmost_root(self, NV: float, loop: Loop) -> complex:
-        roots = self.roots(NV, loop)
+        """Dominant root σ + jω (1/s, rad/s); NV = 0: the heading loop's (−inf when only the neutral root is left)."""
+        if NV == 0:
+            roots = np.roots(neutral_quotient(self.characteristic(NV, loop), self.domain))
+            if roots.size == 0:
+                return complex(-math.inf, 0.0)
+        else:
+            roots = self.roots(NV, loop)
         if self.domain == "z":
             z = roots[np.argmax(np.abs(roots))]
             return complex(np.log(z) / loop.T)

@@ -8,7 +8,8 @@ the generic crossing computation in the tests.
 With a heading gain c (`Loop.c`, docs/models.md) the equation is
 τs³ + s² + k(1 + c)s + kNV = 0: Routh gives τNV < 1 + c, so NV* = (1 + c)/τ
 and ω* = √(k(1 + c)/τ); k still cancels. NV < 0 leaves a sign change in the
-coefficients: unstable.
+coefficients: unstable. NV = 0 leaves s·(τs² + s + k(1 + c)): the heading loop
+is stable (docs/models.md, "N = 0"), so T* = k* = ``inf``.
 """
 
 from __future__ import annotations
@@ -34,10 +35,10 @@ class Continuous(AffineGainModel):
 
     @checked
     def critical_delay(self, NV: float, loop: Loop) -> float:
-        """T does not enter (17): ``inf`` if τNV < 1 + c (and NV > 0), else 0 (s)."""
+        """T does not enter (17): ``inf`` if τNV < 1 + c (and NV >= 0: `is_stable`), else 0 (s)."""
         return math.inf if self.is_stable(NV, loop) else 0.0
 
     @checked
     def critical_gain_k(self, NV: float, loop: Loop) -> float:
-        """k cancels from Routh's condition 0 < τNV < 1 + c: ``inf`` if it holds, else 0 (1/s)."""
+        """k cancels from Routh's condition 0 <= τNV < 1 + c (`is_stable`): ``inf`` if it holds, else 0 (1/s)."""
         return math.inf if self.is_stable(NV, loop) else 0.0

@@ -19,6 +19,14 @@ answers every question without a search bound, by the same array code that
 
 T = 0 reduces to `continuous` (eq 17).
 
+NV = 0 (N = 0, `models.base.neutral_reason`): the quasi-polynomial is
+s·(τs² + s + k + kc·e^(−sT)); every query judges the heading loop
+τs² + s + k + kc·e^(−sT) (`heading_quasi_polynomial`). The crossing count at
+K = 0 is that loop's (`delay.delay_verdicts_from_gain`: the crossing
+frequencies and delays of s·h(s) are those of h), so verdict and delay
+margin come from the same call; with c = 0 it is τs² + s + k, stable at every
+T and k.
+
 With a heading gain c (`Loop.c`, docs/models.md) the equation is
 τs³ + s² + ks + k(cs + NV)·e^(−sT) = 0, the quasi-polynomial
 a(s) + (kcs + K)·e^(−sT). The crossing count and the rightmost roots take the
@@ -59,6 +67,15 @@ class ExactDelay(LoopModel):
             return DelayLoop(loop.plant, loop.T)
         return DelayLoop(loop.plant, loop.T, delayed=[loop.heading, 0.0])
 
+    @staticmethod
+    def heading_quasi_polynomial(loop: Loop) -> DelayLoop:
+        """N = 0: the quasi-polynomial divided by s, τs² + s + k + kc·e^(−sT) (its gain K is kc)."""
+        return DelayLoop(loop.plant[:-1], loop.T)
+
+    def _quasi(self, NV: float, loop: Loop):
+        """(quasi-polynomial, gain) of the roots the verdict judges: the loop's at kNV, the heading loop's at NV = 0."""
+        return (self.heading_quasi_polynomial(loop), loop.heading) if NV == 0 else (self.quasi_polynomial(loop), loop.k * NV)
+
     def compute_boundary(self, loop: Loop) -> Boundary:
         if loop.c != 0.0:
             from .heading import kb_heading_interval  # only with a heading gain: KB's reports never compile it
@@ -81,16 +98,18 @@ class ExactDelay(LoopModel):
 
     @checked
     def unstable_root_count(self, NV: float, loop: Loop) -> int | None:
-        """Roots with Re s > 0 (None when a root is on the imaginary axis)."""
-        return self.quasi_polynomial(loop).unstable_root_count(loop.k * _check_NV(NV))
+        """Roots with Re s > 0 (None when a root is on the imaginary axis; NV = 0: the heading loop's)."""
+        q, K = self._quasi(NV, loop)
+        return q.unstable_root_count(K)
 
     @checked
     def rightmost_root(self, NV: float, loop: Loop) -> complex | None:
         """Dominant root σ + jω (1/s, rad/s); None where the pseudospectral method cannot resolve
-        it (|s|·T in the thousands: `DelayLoop.rightmost_roots`). The verdict does not need it."""
-        q = self.quasi_polynomial(loop)
+        it (|s|·T in the thousands: `DelayLoop.rightmost_roots`). The verdict does not need it.
+        NV = 0: the heading loop's (`heading_quasi_polynomial`)."""
+        q, K = self._quasi(NV, loop)
         for nodes in (40, 160):
-            roots = q.rightmost_roots(loop.k * NV, count=2, nodes=nodes)
+            roots = q.rightmost_roots(K, count=2, nodes=nodes)
             if roots.size:
                 top = roots[roots.real >= roots[0].real - 1e-9 * max(1.0, abs(roots[0]))]
                 return complex(top[top.imag.argmax()])
@@ -114,13 +133,16 @@ class ExactDelay(LoopModel):
         measure whose sign is the crossing count's (exact, one array call) and
         whose size is the growth rate of Padé(6) (batched eigenvalues: a
         stand-in that peaks where a root nears the axis, so the search refines
-        near-misses between grid points). NV < 0: 0.
+        near-misses between grid points). NV < 0: 0. NV = 0: the heading
+        loop's k* (c = 0: τs² + s + k, ``inf``).
         """
         from ..solve import first_crossing
 
         NV = _check_NV(NV)
         if NV < 0:
             return 0.0
+        if NV == 0 and loop.c == 0.0:
+            return math.inf
         if loop.T == 0:
             return super().critical_gain_k(NV, loop)
         if NV * (loop.tau + loop.T) >= 1.0 + loop.c:

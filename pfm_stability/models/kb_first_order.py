@@ -55,19 +55,22 @@ class KBFirstOrder(AffineGainModel):
 
         With c ≠ 0: the smallest T > 0 where (1 − kcT)(1 + c − NVT) = τNV,
         the root 2C/(B + √(B² − 4AC)) of kcNV·T² − (kc(1 + c) + NV)T + (1 + c − τNV)
-        (0 when τNV >= 1 + c: unstable already at T = 0). NV < 0: 0.
+        (0 when τNV >= 1 + c: unstable already at T = 0). NV < 0: 0. NV = 0
+        (the heading loop τs² + (1 − kcT)s + k(1 + c), `neutral_reason`): the
+        same root, 1/(kc) for c > 0, ``inf`` for c <= 0.
         """
         NV = _check_NV(NV)
         if NV < 0:
             return 0.0
         if loop.c == 0.0:
-            return max(1.0 / NV - loop.tau, 0.0)
+            return max(1.0 / NV - loop.tau, 0.0) if NV > 0 else math.inf
         A = loop.heading * NV
         B = loop.heading * (1.0 + loop.c) + NV
         C = 1.0 + loop.c - loop.tau * NV
         if C <= 0:
             return 0.0
-        return 2.0 * C / (B + math.sqrt(B * B - 4.0 * A * C))
+        denominator = B + math.sqrt(B * B - 4.0 * A * C)
+        return 2.0 * C / denominator if denominator > 0 else math.inf  # 0 only at NV = 0 with c < 0
 
     @checked
     def critical_gain_k(self, NV: float, loop: Loop) -> float:
@@ -77,7 +80,8 @@ class KBFirstOrder(AffineGainModel):
         for c < 0 or T = 0 a larger k never hurts (``inf``); for c > 0 the
         loop loses stability where (1 − kcT)(1 + c − NVT) = τNV,
         k* = (1 + c − NV(τ + T))/(cT(1 + c − NVT)) (``inf`` beyond the largest
-        allowed k, 10⁴ 1/s). NV < 0: 0.
+        allowed k, 10⁴ 1/s). NV < 0: 0. NV = 0: the same rules, the heading
+        loop's (k* = 1/(cT) for c > 0).
         """
         NV = _check_NV(NV)
         if NV < 0:

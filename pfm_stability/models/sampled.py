@@ -51,6 +51,12 @@ independent route; the dominant pole is σ = ln|1 + Tλ|/T (log1p),
 ω = arg(1 + Tλ)/T (atan2: π/T for a real negative z).
 
 T = 0 is the continuous loop of KB eq (17) (`continuous`).
+
+NV = 0 (N = 0, `models.base.neutral_reason`): y feeds nothing back, so the
+closed-loop matrix's y column is zero and z = 1 (λ = 0) is a pole at every T,
+k and c. The verdict and the dominant pole are those of the matrix without
+y's row and column, the heading loop (`_judged_eigenvalues`): with the whole
+command k(δ − θ) held it can be unstable on its own, even with c = 0.
 """
 
 from __future__ import annotations
@@ -277,6 +283,14 @@ class Sampled(AffineGainModel):
     def _delta_eigenvalues(self, NV: float, loop: Loop) -> np.ndarray:
         return np.linalg.eigvals(_delta_matrix(loop, loop.k * NV, self.hold, self.compute_delay))
 
+    def _judged_eigenvalues(self, NV: float, loop: Loop) -> np.ndarray:
+        """The λ the verdict judges: every one, or at NV = 0 those of the heading loop (y's row and column removed)."""
+        if NV != 0:
+            return self._delta_eigenvalues(NV, loop)
+        y = delta_plant(loop, self.hold)[0].shape[0] - 1  # the lateral state: the plant's last
+        matrix = _delta_matrix(loop, 0.0, self.hold, self.compute_delay)
+        return np.linalg.eigvals(np.delete(np.delete(matrix, y, axis=0), y, axis=1))
+
     @checked
     def closed_loop(self, NV: float, loop: Loop) -> np.ndarray:
         """Φ_cl for NV (1/s)."""
@@ -289,13 +303,14 @@ class Sampled(AffineGainModel):
 
     @checked
     def is_stable(self, NV: float, loop: Loop) -> bool:
-        """Every pole strictly inside the unit circle: 2 Re λ + T|λ|² < 0 (T = 0: KB eq 17 by Routh)."""
+        """Every pole strictly inside the unit circle: 2 Re λ + T|λ|² < 0 (T = 0: KB eq 17 by Routh;
+        NV = 0: every pole but the neutral z = 1, `_judged_eigenvalues`)."""
         return self._stable(NV, loop)
 
     def _stable(self, NV: float, loop: Loop) -> bool:
         if loop.T == 0:
             return Continuous()._stable(NV, loop)
-        lam = self._delta_eigenvalues(NV, loop)
+        lam = self._judged_eigenvalues(NV, loop)
         size = np.abs(lam)
         return bool(np.all(2.0 * lam.real + (loop.T * size) * size < 0.0))  # T|λ|·|λ|: no overflow of |λ|² at tiny T
 
@@ -306,10 +321,10 @@ class Sampled(AffineGainModel):
 
     @checked
     def rightmost_root(self, NV: float, loop: Loop) -> complex:
-        """Dominant pole as s = ln(z)/T: σ = ln|z|/T (1/s), ω = arg(z)/T in [0, π/T] (rad/s)."""
+        """Dominant pole as s = ln(z)/T: σ = ln|z|/T (1/s), ω = arg(z)/T in [0, π/T] (rad/s); NV = 0: the heading loop's."""
         if loop.T == 0:
             return Continuous().rightmost_root(NV, loop)
-        lam = self._delta_eigenvalues(NV, loop)
+        lam = self._judged_eigenvalues(NV, loop)
         T = loop.T
         sigma = _log_radius(lam, T) / T
         omega = np.abs(np.arctan2(T * lam.imag, 1.0 + T * lam.real)) / T
@@ -339,17 +354,20 @@ class Sampled(AffineGainModel):
             G[sampled] = integral @ B[sampled] / t
         F = (F0 + K[:, None] * F1)[:, None, :]
         closed = Psi - G @ F
+        keep = np.arange(n + self.compute_delay)  # the states judged: at NV = 0 not y, the plant's last (`_judged_eigenvalues`)
+        keep = keep[keep != n - 1] if NV == 0 else keep
+        judged, plant = np.ix_(keep, keep), np.ix_(keep[keep < n], keep[keep < n])
         if self.compute_delay and sampled.any():
             t = T[sampled, None, None]
             top = np.concatenate([Psi[sampled], G[sampled]], axis=2)
             bottom = np.concatenate([-F[sampled] / t, -np.ones((int(sampled.sum()), 1, 1)) / t], axis=2)
-            lam = np.linalg.eigvals(np.concatenate([top, bottom], axis=1))
+            lam = np.linalg.eigvals(np.concatenate([top, bottom], axis=1)[(slice(None),) + judged])
         else:
-            lam = np.linalg.eigvals(closed[sampled]) if sampled.any() else np.empty((0, n))
+            lam = np.linalg.eigvals(closed[sampled][(slice(None),) + plant]) if sampled.any() else np.empty((0, n))
         sigma = np.empty(len(loops))
         sigma[sampled] = np.max(_log_radius(lam, T[sampled, None]), axis=1) / T[sampled]
         if (~sampled).any():
-            sigma[~sampled] = np.linalg.eigvals(closed[~sampled]).real.max(axis=1)
+            sigma[~sampled] = np.linalg.eigvals(closed[~sampled][(slice(None),) + plant]).real.max(axis=1)
         return sigma
 
 

@@ -17,9 +17,10 @@ For each point (docs/sweeps.md, "Columns"):
   `pfm-stability report` gives for the same point. Where NV is not a loop gain
   the models take, the report's documented answers are written instead, with
   a ``reason``: N < 0 unstable in every model, margin −1
-  (`models.base.divergent_reason`); N = 0 (no equilibrium force gradient)
-  stable, margin inf; no equilibrium at all, or NV beyond `models.base.NV_MAX` (the report's limit too),
-  no verdict (null, NaN margins) and the report's error message as reason.
+  (`models.base.divergent_reason`); no equilibrium at all, or NV beyond `models.base.NV_MAX` (the report's limit too),
+  no verdict (null, NaN margins) and the report's error message as reason. N = 0 (no restoring
+  force) is each model's own verdict at NV = 0, its heading loop (docs/models.md "N = 0"), with
+  `models.base.NEUTRAL_REASON`.
 * **simulation** (``simulate: true``) — `validation.sweep.simulate_members`
   (the one implementation behind ``validate --sweep``): ``sim_sigma`` (σ,
   1/s; NaN only with a ``sim_basis`` saying why), ``sim_stable``,
@@ -46,15 +47,12 @@ from ..force_law import (
     wall_equilibria,
     wall_gain,
 )
-from ..models.base import DIVERGENT_REASON, NV_MAX
+from ..models.base import DIVERGENT_REASON, NEUTRAL_REASON, NV_MAX
 from ..parameters import RADIANS_PER_DEGREE, Controller, Robot
 from .points import chunk_points
 from .spec import LAW_SWEPT, SweepSpec
 
-__all__ = ["NO_GRADIENT_REASON", "SIM_COLUMNS", "ChunkColumns", "distinct_rows", "evaluate_chunk", "loop_groups", "model_answers", "model_columns"]
-
-NO_GRADIENT_REASON = "N = 0: no force gradient at the equilibrium (the law never balances the pull there): nothing to oscillate"
-"""The reason written where N = 0: every model "stable", margin inf (as the report answers)."""
+__all__ = ["SIM_COLUMNS", "ChunkColumns", "distinct_rows", "evaluate_chunk", "loop_groups", "model_answers", "model_columns"]
 
 SIM_COLUMNS = ("sim_sigma", "sim_stable", "sim_verdict", "sim_basis", "sim_method", "sim_collided", "sim_reason")
 """Simulation columns (``simulate: true``), in order."""
@@ -192,7 +190,8 @@ def model_answers(model: str, tau, T, k, NV, *, groups=_GROUP, **options) -> tup
     and T has one per T). So `loop_verdicts` is asked once per distinct loop
     for NV* and whether the stable set is the usual (0, NV*); there a point is
     stable iff NV < NV*, with margin NV*/NV − 1 (`models.gain_margin`). Points
-    within `SHORTCUT_BAND` of NV* and every point of a loop with another stable
+    within `SHORTCUT_BAND` of NV*, points with NV = 0 (the heading loop decides:
+    docs/models.md, "N = 0") and every point of a loop with another stable
     set are decided by `loop_verdicts` at their own NV. With more than half as
     many distinct loops as points, every point goes to `loop_verdicts` directly.
     `groups` is `loop_groups(tau, T, k)` when the caller has it already.
@@ -209,7 +208,7 @@ def model_answers(model: str, tau, T, k, NV, *, groups=_GROUP, **options) -> tup
     regular = np.asarray(per_loop.regular, dtype=bool)[inverse]
     with np.errstate(divide="ignore", invalid="ignore"):
         edge = (critical > 0) & np.isfinite(critical)
-        near = ~regular | (edge & (np.abs(NV / np.where(edge, critical, 1.0) - 1.0) <= SHORTCUT_BAND))
+        near = ~regular | (NV == 0) | (edge & (np.abs(NV / np.where(edge, critical, 1.0) - 1.0) <= SHORTCUT_BAND))
         stable = NV < critical
         margin = critical / NV - 1.0
     verdict = np.where(stable, "stable", "unstable").astype(object)
@@ -231,12 +230,12 @@ def _verdict_columns(spec: SweepSpec, inputs: dict, NV: np.ndarray, reasons: np.
     reasons = reasons.copy()
     given = ~np.equal(reasons, None)  # elementwise: the points whose N already has a reason (no equilibrium)
     reasons[negative & ~given] = DIVERGENT_REASON
-    reasons[zero & ~given] = NO_GRADIENT_REASON
+    reasons[zero & ~given] = NEUTRAL_REASON  # the verdict is each model's own at NV = 0: its heading loop's
     undefined = beyond | given & ~negative & ~zero
     for i in np.flatnonzero(beyond & ~given):
         reasons[i] = (f"N*V = {NV[i]:g} 1/s exceeds what the loop models represent (<= {NV_MAX:g} 1/s); "
                       "choose a less extreme force law (f, n), angle or width")
-    safe = np.where(negative | zero | beyond, 1.0, NV)  # NV* does not depend on NV; the answer there is overwritten
+    safe = np.where(negative | beyond, 1.0, NV)  # NV* does not depend on NV; the answer there is overwritten
     names, arrays = [], []
     groups = loop_groups(tau, T, inputs["k"])
     for model in spec.models:
@@ -244,7 +243,6 @@ def _verdict_columns(spec: SweepSpec, inputs: dict, NV: np.ndarray, reasons: np.
             model, tau, T, inputs["k"], safe, groups=groups,
             hold=spec.controller.hold, compute_delay=spec.controller.compute_delay, pade_order=spec.pade_order)
         stable[negative], verdict[negative], margin[negative] = False, "unstable", -1.0
-        stable[zero], verdict[zero], margin[zero] = True, "stable", math.inf
         stable[undefined], verdict[undefined], margin[undefined] = False, None, math.nan
         names += list(model_columns(model))
         arrays += [stable, verdict, critical, margin]

@@ -84,14 +84,12 @@ def model_answer(model: LoopModel, loop: Loop, NV: float | None = None, *, root:
     """Ask `model` for its boundary on `loop` and, given NV, its verdict (and dominant root if `root`).
 
     The verdict is `models.verdict_label` (within `UNDECIDED_RTOL` of an edge
-    of the stable set: "undecided"); NV = 0 (no force gradient: nothing to
-    oscillate) is "stable" with root 0, as in `pfm_stability.criteria`.
+    of the stable set: "undecided"); at NV = 0 the model judges its heading
+    loop, as in `pfm_stability.criteria` (docs/models.md, "N = 0").
     """
     boundary = model.boundary(loop)
     if NV is None:
         return ModelAnswer(model.name, boundary.NV_critical, boundary.omega_critical)
-    if NV == 0:
-        return ModelAnswer(model.name, boundary.NV_critical, boundary.omega_critical, NV, "stable", 0j if root else None)
     verdict = verdict_label(NV, boundary, model.is_stable(NV, loop))
     dominant = model.rightmost_root(NV, loop) if root else None
     return ModelAnswer(model.name, boundary.NV_critical, boundary.omega_critical, NV, verdict, dominant)

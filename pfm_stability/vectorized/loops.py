@@ -84,12 +84,12 @@ class LoopVerdicts:
 
 
 def _NV_array(NV) -> np.ndarray:
-    """NV as a float array: finite, |NV| <= `NV_MAX`, non-zero (the scalar models' check, with the point index)."""
+    """NV as a float array: finite, |NV| <= `NV_MAX` (the scalar models' check, with the point index); −0.0 becomes 0.0."""
     try:
         NV = np.asarray(NV, dtype=float)
     except (TypeError, ValueError):
         raise ValueError(f"NV must be a real number or an array of real numbers; got {NV!r}") from None
-    bad = ~np.isfinite(NV) | (np.abs(NV) > NV_MAX) | (NV == 0)
+    bad = ~np.isfinite(NV) | (np.abs(NV) > NV_MAX)
     if bad.any():
         index = int(np.flatnonzero(bad.ravel())[0])
         value = float(NV.ravel()[index])
@@ -97,7 +97,7 @@ def _NV_array(NV) -> np.ndarray:
             _check_NV(check_number("NV", value, -NV_MAX, NV_MAX, low_open=False, high_open=False, unit="1/s"))
         except ValueError as exc:
             raise ValueError(f"{exc} (point {index})") from None
-    return NV
+    return NV + 0.0
 
 
 def _options(model, hold, compute_delay, pade_order):
@@ -154,13 +154,14 @@ def _regular_set(boundary) -> bool:
 
 
 def _labels(NV, NV_critical, stable):
-    """`verdict_label` and `gain_margin` for stable sets (0, NV*) (or empty), in arrays."""
+    """`verdict_label` and `gain_margin` for stable sets (0, NV*) (or empty), in arrays (NV = 0: margin inf or −1)."""
     edge = (NV_critical > 0) & np.isfinite(NV_critical)
     with np.errstate(divide="ignore", invalid="ignore"):
         undecided = edge & (np.abs(NV / np.where(edge, NV_critical, 1.0) - 1.0) <= UNDECIDED_RTOL)
         verdict = np.where(undecided, "undecided", np.where(stable, "stable", "unstable"))
         below = (NV_critical > 0) & (NV_critical <= NV * (1 + UNDECIDED_RTOL))
         margin = np.where(stable | below, NV_critical, 0.0) / NV - 1.0
+    margin[NV == 0] = np.where(stable[NV == 0], np.inf, -1.0)
     return verdict, margin
 
 
@@ -181,8 +182,10 @@ def loop_verdicts(model, tau, T, k, NV, *, c=None, hold="command", compute_delay
         Steering time constant τ (s, [0, 100]), sampling period / delay T
         (s, [0, 100]), steering gain k (1/s, [10⁻⁶, 10⁴]).
     NV : array_like
-        Loop gain NV, 1/s: finite, non-zero, |NV| <= 10¹² (NV < 0 is
-        unstable in every model: `models.divergent_reason`).
+        Loop gain NV, 1/s: finite, |NV| <= 10¹² (NV < 0 is unstable in
+        every model: `models.divergent_reason`; NV = 0 is each model's
+        heading loop, the neutral lateral root left out: `models.neutral_reason`,
+        margin ``inf`` or −1).
     c : array_like, optional
         Heading gain (dimensionless, [−0.99, 100]; default 0, KB's loop).
     hold : {"command", "reference"}

@@ -6,7 +6,10 @@ the points whose boundary the scalar model must give (a stable set that is
 not (0, NV*), or a case the closed forms leave out), and whether the scalar
 model's `is_stable` is also needed there. Every closed form below is the one
 the scalar model's docstring states (docs/models.md); the tests hold each
-route to the scalar model point by point.
+route to the scalar model point by point. At NV = 0 every route judges the
+heading loop, the roots other than the neutral lateral one (docs/models.md,
+"N = 0"): the Routh conditions with K >= 0, D/s (D/μ for `sampled`: z = 1 is
+μ = 0), the crossing count at K = 0.
 """
 
 from __future__ import annotations
@@ -42,13 +45,31 @@ def _regular(n):
     return np.ones(n, dtype=bool)
 
 
+def _neutral_stable(D, E, K):
+    """Hurwitz test of the rows D + K·E (descending); at K = 0 of D/s, D's last coefficient being 0 (N = 0)."""
+    stable = hurwitz_stable(D + K[:, None] * E)
+    zero = np.flatnonzero(K == 0)
+    if zero.size:
+        stable[zero] = hurwitz_stable(D[zero, :-1])
+    return stable
+
+
+def _neutral_columns(D, E, K):
+    """`_neutral_stable` for coefficient columns (`polynomial.hurwitz_columns`): at K = 0 D/μ (z = 1 left out)."""
+    stable = hurwitz_columns([d + K * e for d, e in zip(D, E)])
+    zero = np.flatnonzero(K == 0)
+    if zero.size:
+        stable[zero] = hurwitz_columns([d[zero] for d in D[:-1]])
+    return stable
+
+
 def continuous(points, options):
-    """KB eq (17) with c: τs³ + s² + k(1 + c)s + K. Routh: stable ⇔ 0 < τK < k(1 + c);
-    NV* = (1 + c)/τ, ω* = √(k(1 + c)/τ) (τ = 0: stable for every NV > 0)."""
+    """KB eq (17) with c: τs³ + s² + k(1 + c)s + K. Routh: stable ⇔ 0 < τK < k(1 + c) (K = 0: the heading
+    loop τs² + s + k(1 + c), stable); NV* = (1 + c)/τ, ω* = √(k(1 + c)/τ) (τ = 0: stable for every NV > 0)."""
     tau, T, k, c, NV = points
     kc = k * (1.0 + c)
     K = k * NV
-    stable = (K > 0) & (kc - tau * K > 0)
+    stable = (K >= 0) & (kc - tau * K > 0)
     lag = tau > 0
     with np.errstate(divide="ignore", invalid="ignore"):
         NV_star = np.where(lag, (1.0 + c) / np.where(lag, tau, 1.0), np.inf)
@@ -59,7 +80,8 @@ def continuous(points, options):
 def kb_first_order(points, options):
     """KB eq (19) with c: τs³ + a₁s² + (k(1 + c) − KT)s + K, a₁ = 1 − kcT.
 
-    Routh (τ > 0): stable ⇔ a₁ > 0, K > 0 and a₁(k(1 + c) − KT) > τK;
+    Routh (τ > 0): stable ⇔ a₁ > 0, K > 0 and a₁(k(1 + c) − KT) > τK (K = 0:
+    the heading loop τs² + a₁s + k(1 + c), stable ⇔ a₁ > 0, the same conditions);
     NV* = a₁(1 + c)/(τ + a₁T), ω*² = k(1 + c)/(τ + a₁T) (KB eq 20 for c = 0);
     a₁ <= 0: unstable at every NV. τ = 0: the quadratic a₁s² + … is stable
     for 0 < K < k(1 + c)/T when a₁ > 0. a₁ = 0 exactly (a degree drop) goes to
@@ -69,7 +91,7 @@ def kb_first_order(points, options):
     K = k * NV
     a1 = 1.0 - (k * c) * T
     a2 = k * (1.0 + c) - K * T
-    stable = (a1 > 0) & (K > 0) & (a2 > 0) & (a1 * a2 - tau * K > 0)
+    stable = (a1 > 0) & (K >= 0) & (a2 > 0) & (a1 * a2 - tau * K > 0)
     denominator = tau + a1 * T
     live = (a1 > 0) & (denominator > 0)
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -83,26 +105,23 @@ def exact_delay(points, options):
 
     With c ≠ 0 the stable set may be several intervals (`models.heading`):
     the boundary of those loops comes from the scalar model (cached per loop),
-    the verdict still from the crossing count.
+    the verdict still from the crossing count, which also decides K = 0 (the
+    heading loop τs² + s + k + kc·e^(−sT)).
     """
     tau, T, k, c, NV = points
     K = k * NV
     heading = c != 0
-    if heading.any():
-        stable = np.empty(tau.size, dtype=bool)
-        plain = np.flatnonzero(~heading)
-        rows = np.flatnonzero(heading)
-        stable[rows] = delay_verdicts_from_gain(tau[rows], T[rows], k[rows], K[rows], c[rows])[0]
-    else:
-        plain = slice(None)
-        rows = _NONE
-        stable = np.empty(tau.size, dtype=bool)
+    stable = np.empty(tau.size, dtype=bool)
+    counted = np.flatnonzero(heading | (K == 0))
+    if counted.size:
+        stable[counted] = delay_verdicts_from_gain(tau[counted], T[counted], k[counted], K[counted], c[counted])[0]
+    plain, rows = (np.flatnonzero(~heading), np.flatnonzero(heading)) if heading.any() else (slice(None), _NONE)
     NV_star = np.zeros(tau.size)
     omega = np.full(tau.size, math.nan)
     K_star, w = _kb_critical_gain(tau[plain], T[plain], k[plain])
     # c = 0: the stable set is (0, K*) (every crossing destabilizing, `delay.kb_critical_gain`), so the
     # crossing count and K < K* agree except within round-off of K*, where the verdict is "undecided"
-    stable[plain] = (K[plain] > 0) & (K[plain] < K_star)
+    stable[plain] = np.where(K[plain] == 0, stable[plain], (K[plain] > 0) & (K[plain] < K_star))
     NV_star[plain] = K_star / k[plain]
     omega[plain] = np.where(np.isfinite(K_star), w, math.nan)
     return Answers(stable, NV_star, omega, _regular(tau.size)), rows, False
@@ -148,7 +167,7 @@ def pade(points, options):
     """KB eq (18) with Padé(m, m): Routh on D + K·E for the verdict, the crossing route for K*."""
     tau, T, k, c, NV = points
     D, E = pade_polynomials(tau, T, k, c, options["pade_order"])
-    stable = hurwitz_stable(D + (k * NV)[:, None] * E)
+    stable = _neutral_stable(D, E, k * NV)
     sets = affine_stable_sets(D, E)
     return Answers(stable, sets.K_critical / k, sets.frequency, sets.regular), np.flatnonzero(~sets.regular), False
 
@@ -169,8 +188,7 @@ def sampled(points, options):
     for group in _sampled_groups(tau, T):
         t = T[group]
         Dc, Ec = bilinear_columns(tau[group], t, k[group], c[group], options["hold"], options["compute_delay"])
-        K = k[group] * NV[group]
-        answers.stable[group] = hurwitz_columns([d + K * e for d, e in zip(Dc, Ec)])
+        answers.stable[group] = _neutral_columns(Dc, Ec, k[group] * NV[group])
         sets, unsure = hurwitz_gain_sets(Dc, Ec, math.pi / t, lambda w: 2.0 * np.arctan(w * t[:, None] / 2.0) / t[:, None])
         K_star, frequency, regular = sets.K_critical, sets.frequency, sets.regular
         rows = np.flatnonzero(unsure)
@@ -199,12 +217,11 @@ def sampled_stable(points, options, K, eps):
     (one polynomial per point, tested at three gains; T = 0: KB eq 17 by Routh)."""
     tau, T, k, c, NV = points
     gains = (K, K * (1.0 - eps), K * (1.0 + eps))
-    out = [(g > 0) & (k * (1.0 + c) - tau * g > 0) for g in gains]
+    out = [(g >= 0) & (k * (1.0 + c) - tau * g > 0) for g in gains]
     for group in _sampled_groups(tau, T):
         D, E = bilinear_columns(tau[group], T[group], k[group], c[group], options["hold"], options["compute_delay"])
         for verdicts, g in zip(out, gains):
-            gain = g[group]
-            verdicts[group] = hurwitz_columns([d + gain * e for d, e in zip(D, E)])
+            verdicts[group] = _neutral_columns(D, E, g[group])
     return _bracketed(out)
 
 
@@ -212,17 +229,18 @@ def pade_stable(points, options, K, eps):
     """(stable, near) of the Padé loop at gains K (Routh at K and K(1 ± ε))."""
     tau, T, k, c, NV = points
     D, E = pade_polynomials(tau, T, k, c, options["pade_order"])
-    return _bracketed([hurwitz_stable(D + g[:, None] * E) for g in (K, K * (1.0 - eps), K * (1.0 + eps))])
+    return _bracketed([_neutral_stable(D, E, g) for g in (K, K * (1.0 - eps), K * (1.0 + eps))])
 
 
 def exact_delay_stable(points, options, K, eps):
     """(stable, near) of KB eq (18) (with c) at gains K: one crossing by `single_crossing_verdicts`;
     three crossings flagged `near` (the caller decides them with the boundary, all chunks' in one
-    call: a few per thousand random points); heading gains by the crossing count at K and K(1 ± ε)."""
+    call: a few per thousand random points); heading gains and K = 0 (the heading loop) by the crossing
+    count at K and K(1 ± ε)."""
     tau, T, k, c, NV = points
     stable, near, three = single_crossing_verdicts(tau, T, k, K, eps)
     near |= three
-    rest = np.flatnonzero(c != 0)
+    rest = np.flatnonzero((c != 0) | (K == 0))
     if rest.size:
         gain = K[rest]
         # one call for the three gains K, K(1 − ε), K(1 + ε) (few points: the call's overhead dominates)
