@@ -225,7 +225,7 @@ class HolonomicVerdict:
         return self.verdict == "stable"
 
     def to_dict(self, T: float) -> dict:
-        """JSON-ready (SI units); ``to_stabilize`` names the period T* when a shorter period helps."""
+        """JSON-ready (SI units); ``stable_side`` of κ* and T* (below), ``to_stabilize`` the period T* when a shorter one helps."""
         root = self.rightmost_root
         fix = {}
         if not self.stable and 0 < self.T_critical < T:
@@ -240,6 +240,7 @@ class HolonomicVerdict:
             "rightmost_root": {"sigma": json_number(root.real), "omega": json_number(abs(root.imag))} if root is not None else {"sigma": None, "omega": None},
             "T_critical": json_number(self.T_critical),
             "damping_range": [[json_number(lo), json_number(hi)] for lo, hi in self.damping_range],
+            "stable_side": {"kappa_critical": "below", "T_critical": "below"},  # stable for 0 < κ < κ*, for T in [0, T*)
             "to_stabilize": fix,
         }
 

@@ -201,6 +201,7 @@ def _verdict_dict(v, remedy) -> dict:
         "rightmost_root": {"sigma": json_number(root.real), "omega": json_number(abs(root.imag))} if root is not None else {"sigma": None, "omega": None},
     }
     out.update({key: json_number(value) for key, value in v.critical.items()})
+    out["stable_side"] = {"NV_critical": None if math.isnan(v.NV_critical) else "below", **v.critical.stable_sides()}
     out["to_stabilize"] = remedy or {}
     if v.reason is not None:
         out["reason"] = v.reason
@@ -227,8 +228,9 @@ def remedies(scenario: str, verdict, robot: Robot, controller: Controller, law: 
     Returns
     -------
     dict
-        Parameter → {"to": critical value (SI, α in deg), "direction": "raise"
-        or "lower", "change_percent": relative change, %}. Each value leaves
+        Parameter → {"to": critical value (SI, α in deg; f in the user's f,
+        a grid law's f_av: `ForceLaw.lumped_f`), "direction": "raise" or
+        "lower", "change_percent": relative change, %}. Each value leaves
         the loop stable over the whole way from it to 0 (V, T, k) or beyond it
         (α, L), by the definitions of the critical values (for a law that is
         not monotone: just past it). Empty if stable; a parameter is left out
@@ -239,7 +241,7 @@ def remedies(scenario: str, verdict, robot: Robot, controller: Controller, law: 
         return {}
     law = law_in_force(robot, controller, law)
     c = verdict.critical
-    current = {**law.parameters(), "V": robot.V, "f": controller.f if law.monotone else law.scale, "T": controller.T, "k": robot.k}
+    current = {**law.parameters(), "V": robot.V, "f": law.lumped_f(), "T": controller.T, "k": robot.k}  # f: the user's (a grid's f_av)
     wanted = [("V", "V_critical", "lower"), ("T", "T_critical", "lower"), ("k", "k_critical", "lower")]  # (parameter, critical key, direction)
     if scenario == "wall":
         wanted.append(("alpha_deg", "alpha_critical_deg", _towards(c.alpha_critical_deg, at, law)))
