@@ -111,7 +111,7 @@ def _scenarios(data: dict):
             continue
         if scenario == "corridor":
             title = f"Corridor, L = {number(env['L'])} m: N = {number(env['N'])} 1/m, NV = {number(env['NV'])} 1/s"
-            yield (title, *_verdict_table(scenario, data[scenario]), _corridor_notes(env))
+            yield (title, *_verdict_table(scenario, data[scenario]), _reasons(data[scenario]) + _corridor_notes(env))
             continue
         equilibria = env.get("equilibria") or [{"d0": env["d0"], "N": env["N"], "NV": env["NV"], "models": data["wall"]}]
         for i, e in enumerate(equilibria):
@@ -120,8 +120,13 @@ def _scenarios(data: dict):
                 f"Wall, alpha = {number(env['alpha_deg'])} deg{which} = {number(e['d0'])} m, "
                 f"N = {number(e['N'])} 1/m, NV = {number(e['NV'])} 1/s"
             )
-            reasons = sorted({v["reason"] for v in e["models"].values() if "reason" in v})
-            yield (title, *_verdict_table(scenario, e["models"]), [f"  every model: unstable ({r})" for r in reasons] + _equilibrium_notes(e))
+            yield (title, *_verdict_table(scenario, e["models"]), _reasons(e["models"]) + _equilibrium_notes(e))
+
+
+def _reasons(verdicts: dict) -> list[str]:
+    """One line per reason a verdict does not come from the models (N < 0; a heading gain beyond them)."""
+    reasons = dict.fromkeys((v["verdict"], v["reason"]) for v in verdicts.values() if "reason" in v)
+    return [f"  every model: {verdict} ({reason})" for verdict, reason in sorted(reasons)]
 
 
 def _verdict_table(scenario: str, verdicts: dict):
@@ -141,7 +146,8 @@ def _verdict_table(scenario: str, verdicts: dict):
         cells = [name, v["verdict"].upper() if v["verdict"] != "stable" else "stable", percent(v["margin"])]
         cells += [_starred(v, k, k in marked) for k in ["NV_critical", "omega_critical", *keys]]
         rows.append(cells)
-    fixes = {name: (v["to_stabilize"], "eta_critical" in v) for name, v in verdicts.items() if v["verdict"] != "stable"}
+    fixes = {name: (v["to_stabilize"], "eta_critical" in v) for name, v in verdicts.items()
+             if v["verdict"] != "stable" and not (v["verdict"] == "undecided" and "reason" in v)}  # no model decides it: the reason says so
     return header, rows, fixes
 
 
@@ -225,10 +231,9 @@ def _footnote(data: dict) -> list[str]:
 
 
 def _kb_error_line(report) -> list[str]:
-    if report.kb_error is None:
-        return []
-    e = report.kb_error
-    return ["", f"{e.sentence()}: NV* = {number(e.NV_kb)} vs {number(e.NV_sampled)} 1/s."]
+    """KB's error: one line per loop the tables decide (`report.kb_errors`: a heading gain that differs between the geometries)."""
+    errors = report.kb_errors or ((report.kb_error,) if report.kb_error is not None else ())
+    return ([""] if errors else []) + [f"{e.sentence()}: NV* = {number(e.NV_kb)} vs {number(e.NV_sampled)} 1/s." for e in errors]
 
 
 def render_text(report) -> str:
