@@ -33,7 +33,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .checks import check_number, check_type
-from .critical import CorridorBranches, CorridorCritical, CriticalValues, WallBranches, WallCritical, is_field_law
+from .critical import CorridorBranches, CorridorCritical, CriticalValues, WallBranches, WallCritical, in_user_f, is_field_law
 from .fields import finite_goal_gain
 from .force_law import Equilibrium, ForceLaw, PowerLaw, corridor_equilibria, corridor_gain, law_in_force, wall_equilibria, wall_gain
 from .models import Loop, LoopModel, gain_margin, models_for, neutral_reason, verdict_label
@@ -471,7 +471,7 @@ def _wall_equilibrium(robot: Robot, controller: Controller, wall: Wall, models, 
         def geometric(NV_critical):
             return {
                 "alpha_critical": critical_alpha(law, robot.V, NV_critical),
-                "f_critical": critical_f_wall(law, wall.alpha, robot.V, NV_critical),
+                "f_critical": in_user_f(law, critical_f_wall(law, wall.alpha, robot.V, NV_critical)),
             }
 
     else:
@@ -513,10 +513,14 @@ def analyze_corridor(robot: Robot, controller: Controller, corridor: Corridor, m
     branches = None if law.monotone else CorridorBranches(law, corridor.L, robot.W, N, robot.V)
 
     def geometric(NV_critical):
-        L_critical = critical_L(law, robot.V, NV_critical) if branches is None else branches.critical_L(NV_critical)
+        L_critical, side = (critical_L(law, robot.V, NV_critical), "above") if branches is None else branches.critical_L(NV_critical)
+        if L_critical <= robot.W / 2:  # no corridor the robot fits in is on the other side: stable at every L (docs/models.md)
+            L_critical, side = 0.0, "above"
         if branches is not None and is_field_law(law):
-            return {"L_critical": L_critical, **branches.law_parameters(NV_critical)}
-        return {"L_critical": L_critical, "f_critical": critical_f_corridor(law, corridor.L, robot.V, NV_critical)}
+            own = branches.law_parameters(NV_critical)
+            return {"L_critical": L_critical, **own, "sides": (("L_critical", side), *own["sides"])}
+        return {"L_critical": L_critical, "f_critical": in_user_f(law, critical_f_corridor(law, corridor.L, robot.V, NV_critical)),
+                "sides": (("L_critical", side),)}
 
     verdicts = model_verdicts(controller, models, loop, N, NV, CorridorCritical, geometric)
     equilibria = corridor_equilibria(law, corridor.L, robot.W)

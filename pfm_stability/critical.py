@@ -24,6 +24,15 @@ unstable throughout gives α* = 90°, L* = inf and NaN for the others (JSON
 null: no value of that parameter alone helps). An equilibrium with N < 0 is
 unstable throughout: N keeps its sign along a branch until the branch ends
 at a fold.
+
+N jumps where the law changes form (`ForceLaw.breakpoints`: ρ0, where the
+repulsion's support ends), so a band of one verdict can be far narrower than
+the scan's step: the middle of a corridor is followed in L onto each
+breakpoint, and in a law parameter onto the value at which a breakpoint
+reaches L (`_passing`). Every critical value carries its stable side
+(`CriticalValues.stable_side`): the side on which the verdict is stable just
+past it. A critical strength is reported in the user's f (`in_user_f`: a grid
+law's cell ratio as f_av).
 """
 
 from __future__ import annotations
@@ -36,24 +45,43 @@ from dataclasses import dataclass, field, fields
 from .fields import Branch, GnronLaw, KhatibLaw
 from .force_law import Equilibrium, ForceLaw, corridor_gain, wall_equilibria
 from .parameters import RANGES, to_degrees
+from .solve import bisect_root
 
-__all__ = ["CriticalValues", "WallCritical", "CorridorCritical", "is_field_law", "WallBranches", "CorridorBranches"]
+__all__ = ["CriticalValues", "WallCritical", "CorridorCritical", "is_field_law", "in_user_f", "WallBranches", "CorridorBranches"]
 
 
 class CriticalValues(Mapping):
     """Critical values of one model in one geometry: named fields, read-only mapping too.
 
     Subclasses are frozen dataclasses. As a `Mapping` they hold their fields
-    in declaration order, leaving out those that are None (``critical["L_critical"]``,
-    ``.items()``, ``in``, ``len``, iteration): the keys and the order of the
-    report's JSON. Equality is the mapping's (so a plain dict of the same
-    items compares equal).
+    in declaration order, leaving out those that are None and `sides`
+    (``critical["L_critical"]``, ``.items()``, ``in``, ``len``, iteration):
+    the keys and the order of the report's JSON. Equality is the mapping's (so
+    a plain dict of the same items compares equal).
+
+    Every value has a stable side (`stable_side`, docs/models.md "Critical
+    values"): "below" (stable for values below it: V*, T*, k*), "above" (α*,
+    L*; a wall's f*) or, for a value found as the nearest change of verdict
+    (a law that is not `monotone`, docs/fields.md), the side on which the
+    verdict is stable just past it, given in `sides`.
     """
 
     __slots__ = ()
+    _SIDES: dict = {}
 
     def _keys(self) -> tuple:
-        return tuple(f.name for f in fields(self) if getattr(self, f.name) is not None)
+        return tuple(f.name for f in fields(self) if f.name != "sides" and getattr(self, f.name) is not None)
+
+    def stable_side(self, key: str) -> str | None:
+        """"below" or "above": on which side of the critical value `key` the loop is stable; None when the value is undefined (NaN)."""
+        value = self[key]
+        if isinstance(value, float) and math.isnan(value):
+            return None
+        return dict(self.sides).get(key, self._SIDES.get(key))
+
+    def stable_sides(self) -> dict:
+        """Key → `stable_side` for every value."""
+        return {key: self.stable_side(key) for key in self}
 
     def __getitem__(self, key: str):
         if isinstance(key, str) and key in self._keys():
@@ -100,7 +128,14 @@ class WallCritical(CriticalValues):
         Khatib's and the goal-aware law: the nearest η, ρ0 (m) and ξ at which
         the verdict of this equilibrium changes (docs/fields.md; ``inf``: no
         limit, NaN: no value helps). None (no key) for other laws.
+    sides : tuple of (str, str)
+        (key, "below" or "above") for the values whose stable side is not
+        the default (`stable_side`): those found as the nearest change of
+        verdict. Not a key of the mapping.
     """
+
+    _SIDES = {"alpha_critical": "above", "alpha_critical_deg": "above", "f_critical": "above", "V_critical": "below", "T_critical": "below",
+              "k_critical": "below", "tau_plus_T_critical": "below"}
 
     alpha_critical: float
     alpha_critical_deg: float = field(init=False)
@@ -112,6 +147,7 @@ class WallCritical(CriticalValues):
     eta_critical: float | None = None
     rho0_critical: float | None = None
     xi_critical: float | None = None
+    sides: tuple = ()
 
     def __post_init__(self):
         object.__setattr__(self, "alpha_critical_deg", to_degrees(self.alpha_critical))
@@ -140,7 +176,12 @@ class CorridorCritical(CriticalValues):
         (τ + T)* = 1/NV, s (``kb_first_order`` only; None, and no key, otherwise).
     eta_critical, rho0_critical, xi_critical : float or None
         As in `WallCritical`, for the middle of the corridor.
+    sides : tuple of (str, str)
+        As in `WallCritical`.
     """
+
+    _SIDES = {"L_critical": "above", "f_critical": "below", "V_critical": "below", "T_critical": "below", "k_critical": "below",
+              "tau_plus_T_critical": "below"}
 
     L_critical: float
     V_critical: float
@@ -151,6 +192,7 @@ class CorridorCritical(CriticalValues):
     eta_critical: float | None = None
     rho0_critical: float | None = None
     xi_critical: float | None = None
+    sides: tuple = ()
 
 
 _ALPHA_STEPS = 120
@@ -160,6 +202,18 @@ _ALPHA_STEPS = 120
 def is_field_law(law: ForceLaw) -> bool:
     """True for Khatib's and the goal-aware law: critical values of η, ρ0 and ξ instead of f."""
     return isinstance(law, (KhatibLaw, GnronLaw))
+
+
+def in_user_f(law: ForceLaw, strength: float) -> float:
+    """A strength (`scale`) of `law` in the user's f: KB's lumped f the law stands for there (`ForceLaw.lumped_f`).
+
+    The force is ∝ the strength, so f = strength·lumped_f/scale: the power law's f
+    itself, a grid law's cell ratio ρ as f_av = ρ·f_av(ρ0)/ρ0 (KB §4). ``inf``, 0
+    and NaN keep their meaning.
+    """
+    if not math.isfinite(strength) or strength == 0:
+        return strength
+    return strength * (law.lumped_f() / law.scale)
 
 
 def _range(name: str) -> tuple[float, float]:
@@ -182,25 +236,37 @@ class _Branches:
     def _make(self, name: str) -> Branch:  # pragma: no cover - interface
         raise NotImplementedError
 
-    def _critical(self, name: str, NV_critical: float, stable_end: float, unstable_end: float) -> float:
-        """p* on the branch of `name`; `stable_end` / `unstable_end` when N·V never crosses NV*."""
+    def _critical(self, name: str, NV_critical: float, stable_end: float, unstable_end: float, end_side: str) -> tuple:
+        """(p*, stable side) on the branch of `name`; `stable_end` / `unstable_end` (side `end_side`) when N·V never crosses NV*.
+
+        The side is where the verdict is stable just past p*: towards p0 when
+        the operating point is stable, away from it when it is not.
+        """
         N = self.start.N
         if N < 0 or NV_critical <= 0:
-            return unstable_end
+            return unstable_end, end_side
         if math.isinf(NV_critical):
-            return stable_end
-        root, _ = self._branch(name).nearest_crossing(NV_critical / self.V)
+            return stable_end, end_side
+        branch = self._branch(name)
+        root, _ = branch.nearest_crossing(NV_critical / self.V)
         if root is not None:
-            return root
-        return stable_end if N * self.V < NV_critical else unstable_end
+            stable_now = N * self.V < NV_critical
+            return root, "below" if (root > branch.p0) == stable_now else "above"
+        return (stable_end if N * self.V < NV_critical else unstable_end), end_side
 
     def law_parameters(self, NV_critical: float) -> dict:
-        """The law's strength (f*, or η* and ξ*) and ρ0* of a field law."""
+        """The law's strength (f*, or η* and ξ*) and ρ0* of a field law, with their stable sides (``sides``)."""
         if not is_field_law(self.law):
-            return {"f_critical": self._critical("scale", NV_critical, math.inf, math.nan)}
-        eta = self._critical("eta", NV_critical, math.inf, math.nan)
-        xi = self.law.xi * self.law.eta / eta if math.isfinite(eta) else eta
-        return {"eta_critical": eta, "rho0_critical": self._critical("rho0", NV_critical, math.inf, math.nan), "xi_critical": xi}
+            f, side = self._critical("scale", NV_critical, math.inf, math.nan, "below")
+            return {"f_critical": in_user_f(self.law, f), "sides": (("f_critical", side),)}
+        eta, eta_side = self._critical("eta", NV_critical, math.inf, math.nan, "below")
+        rho0, rho0_side = self._critical("rho0", NV_critical, math.inf, math.nan, "below")
+        if math.isfinite(eta):  # only η/ξ enters: ξ* = ξη/η*, stable on the other side
+            xi, xi_side = self.law.xi * self.law.eta / eta, {"below": "above", "above": "below"}[eta_side]
+        else:
+            xi, xi_side = eta, eta_side
+        return {"eta_critical": eta, "rho0_critical": rho0, "xi_critical": xi,
+                "sides": (("eta_critical", eta_side), ("rho0_critical", rho0_side), ("xi_critical", xi_side))}
 
 
 class WallBranches(_Branches):
@@ -231,8 +297,10 @@ class WallBranches(_Branches):
                       getattr(self.law, name), self.start, *_range(name))
 
     def critical(self, NV_critical: float) -> dict:
-        """α* (rad) and the law's parameters' critical values for a model with this NV* (1/s)."""
-        return {"alpha_critical": self._critical("alpha", NV_critical, 0.0, math.pi / 2), **self.law_parameters(NV_critical)}
+        """α* (rad) and the law's parameters' critical values for a model with this NV* (1/s), and their stable sides."""
+        alpha, side = self._critical("alpha", NV_critical, 0.0, math.pi / 2, "above")
+        own = self.law_parameters(NV_critical)
+        return {"alpha_critical": alpha, **own, "sides": (("alpha_critical", side), ("alpha_critical_deg", side), *own["sides"])}
 
 
 class CorridorBranches(_Branches):
@@ -260,12 +328,31 @@ class CorridorBranches(_Branches):
 
     def _make(self, name: str) -> Branch:
         if name == "L":
-            return Branch(lambda L, _: self._middle(self.law, L), self.L, self.start, self.W / 2 * (1 + 1e-9), RANGES["L"].high)
-        if name == "scale":
-            return Branch(lambda s, _: self._middle(self.law.with_scale(s), self.L), self.law.scale, self.start, *_range("f"))
-        return Branch(lambda p, _: self._middle(dataclasses.replace(self.law, **{name: p}), self.L), getattr(self.law, name), self.start,
-                      *_range(name))
+            return Branch(lambda L, _: self._middle(self.law, L), self.L, self.start, self.W / 2 * (1 + 1e-9), RANGES["L"].high,
+                          breaks=self.law.breakpoints())
+        make = self.law.with_scale if name == "scale" else (lambda p: dataclasses.replace(self.law, **{name: p}))
+        lo, hi = _range("f" if name == "scale" else name)
+        start = self.law.scale if name == "scale" else getattr(self.law, name)
+        return Branch(lambda p, _: self._middle(make(p), self.L), start, self.start, lo, hi, breaks=_passing(make, lo, hi, self.L))
 
-    def critical_L(self, NV_critical: float) -> float:
-        """L*, m: the nearest half-width at which the middle's verdict changes (0: stable at every L; inf: at none)."""
-        return self._critical("L", NV_critical, 0.0, math.inf)
+    def critical_L(self, NV_critical: float) -> tuple:
+        """(L*, m, stable side): the nearest half-width at which the middle's verdict changes (0: stable at every L; inf: at none)."""
+        return self._critical("L", NV_critical, 0.0, math.inf, "above")
+
+
+def _passing(make, lo: float, hi: float, distance: float) -> tuple:
+    """The values p in (lo, hi) at which a breakpoint of the law ``make(p)`` passes `distance` (m).
+
+    In a corridor of half-width L a law parameter that moves a breakpoint (ρ0:
+    where the repulsion's support ends) makes N jump where the breakpoint
+    reaches L; the branch in that parameter steps onto it (`fields.Branch`).
+    """
+    try:
+        ends = make(lo).breakpoints(), make(hi).breakpoints()
+    except ValueError:  # a law built in code that refuses an end of the range: no breakpoint is followed
+        return ()
+    out = []
+    for i in range(min(len(ends[0]), len(ends[1]))):
+        if (ends[0][i] - distance) * (ends[1][i] - distance) < 0:
+            out.append(bisect_root(lambda p, i=i: make(p).breakpoints()[i] - distance, lo, hi))
+    return tuple(out)

@@ -193,9 +193,16 @@ class GridWallLaw(ForceLaw):
         """(1e-9 m, inf): defined for every d > 0 (the tail beyond `reach`)."""
         return (1e-9, math.inf)
 
+    def lumped_f(self) -> float:
+        """KB's f_av of this grid (`f_average`): the user's f, of which the cell ratio is the calibration (KB §4).
+
+        f_av ∝ ρ, so a critical cell ratio ρ* stands for f* = ρ*·f_av/ρ (docs/simulator.md).
+        """
+        return f_average(self)
+
     def lumped(self, f: float | None = None) -> PowerLaw:
-        """KB's lumped law with this law's n and W and f (default: `f_average`)."""
-        return PowerLaw(f_average(self) if f is None else f, self.n, self.W)
+        """KB's lumped law with this law's n and W and f (default: `lumped_f`, the grid's f_av)."""
+        return PowerLaw(self.lumped_f() if f is None else f, self.n, self.W)
 
 
 def working_range(W: float, cell_size: float = 0.1, window_cells: int = 33) -> tuple[float, float]:

@@ -29,16 +29,16 @@ from functools import lru_cache
 
 from .checks import check_choice
 from .critical import CorridorCritical, WallCritical
-from .criteria import CorridorAnalysis, WallAnalysis, WallEquilibrium, check_loop_gain, model_verdicts
+from .criteria import CorridorAnalysis, ModelVerdict, WallAnalysis, WallEquilibrium, check_loop_gain, model_verdicts
 from .fields import KhatibLaw
 from .fuzzy import DfapfControllers, load_dfapf
 from .fuzzy_law import FuzzyScheduledLaw
-from .models import Loop, interval_margin, interval_verdict, models_for
+from .models import HEADING_GAIN_RANGE, Loop, interval_margin, interval_verdict, models_for
 from .models.holonomic import HolonomicLoop
 from .models.holonomic_delay import make_holonomic_model
 from .parameters import (FAMILY_CHOICE_DEFAULTS, FAMILY_DEFAULTS, FAMILY_LAW_CHOICES, FAMILY_LAW_PARAMETERS, FAMILY_LAWS, HOLONOMIC_LAWS, MODEL_NAMES, RANGES,
                          ROBOT_FAMILIES, Controller, Corridor, Robot, Wall, check_parameter)
-from .report import UNITS, StabilityReport, build_report, kb_error, remedies
+from .report import UNITS, StabilityReport, build_report, kb_errors, remedies, remedies_by_key
 from .serialize import json_number
 from .tracking import tracking_dynamics
 from .velocity_laws import HolonomicGains, VelocityAttraction, VelocityGatedRepulsion
@@ -225,7 +225,7 @@ class HolonomicVerdict:
         return self.verdict == "stable"
 
     def to_dict(self, T: float) -> dict:
-        """JSON-ready (SI units); ``to_stabilize`` names the period T* when a shorter period helps."""
+        """JSON-ready (SI units); ``stable_side`` of κ* and T* (below), ``to_stabilize`` the period T* when a shorter one helps."""
         root = self.rightmost_root
         fix = {}
         if not self.stable and 0 < self.T_critical < T:
@@ -240,6 +240,7 @@ class HolonomicVerdict:
             "rightmost_root": {"sigma": json_number(root.real), "omega": json_number(abs(root.imag))} if root is not None else {"sigma": None, "omega": None},
             "T_critical": json_number(self.T_critical),
             "damping_range": [[json_number(lo), json_number(hi)] for lo, hi in self.damping_range],
+            "stable_side": {"kappa_critical": "below", "T_critical": "below"},  # stable for 0 < κ < κ*, for T in [0, T*)
             "to_stabilize": fix,
         }
 
@@ -358,13 +359,25 @@ class NonSmoothScene:
 
 
 # ------------------------------------------------------------------ steering with a heading gain
-def _steering_wall(robot: Robot, controller: Controller, wall: Wall, models, equilibria, fixed_V: bool) -> WallAnalysis:
+def _steering_verdicts(controller, models, robot: Robot, e, NV: float, critical_values, geometry: dict, where: str, law: str) -> dict:
+    """Every steering model at one (x0, N, c): the loop k(cs + NV)e^(−sT); with c beyond `models.HEADING_GAIN_RANGE` every
+    verdict "undecided", its values null, with the reason (docs/velocity_and_fuzzy.md: no model decides that loop)."""
+    low, high = HEADING_GAIN_RANGE
+    if low <= e.c <= high:
+        return model_verdicts(controller, models, Loop(robot.tau, controller.T, robot.k, c=e.c), e.N, NV, critical_values, lambda _: geometry)
+    reason = (f"c = {e.c:.4g}: the heading gain of --law {law} at the {where} is outside the range the loop models take, "
+              f"[{low:g}, {high:g}]; no model decides this loop (docs/velocity_and_fuzzy.md)")
+    critical = critical_values(**geometry, V_critical=math.nan, T_critical=math.nan, k_critical=math.nan)
+    return {m.name: ModelVerdict(m.name, NV, math.nan, None, math.nan, "undecided", critical, None, reason) for m in models_for(controller, models)}
+
+
+def _steering_wall(robot: Robot, controller: Controller, wall: Wall, models, equilibria, fixed_V: bool, law: str) -> WallAnalysis:
     """Every steering model at each (d0, N, c): the loop k(cs + NV)e^(−sT); α* is not followed (NaN)."""
     analyses = []
     for e in equilibria:
-        NV = check_loop_gain(e.N * robot.V, f"wall equilibrium d0 = {e.x0:g} m (alpha = {wall.alpha_deg:g} deg)")
-        loop = Loop(robot.tau, controller.T, robot.k, c=e.c)
-        verdicts = model_verdicts(controller, models, loop, e.N, NV, WallCritical, lambda _: {"alpha_critical": math.nan})
+        where = f"wall equilibrium d0 = {e.x0:g} m (alpha = {wall.alpha_deg:g} deg)"
+        NV = check_loop_gain(e.N * robot.V, where)
+        verdicts = _steering_verdicts(controller, models, robot, e, NV, WallCritical, {"alpha_critical": math.nan}, where, law)
         analyses.append(WallEquilibrium(e.x0, e.N, e.c, NV, _speed_free(verdicts, fixed_V)))
     if not analyses:
         raise ValueError(f"alpha = {wall.alpha_deg:g} deg: the law has no equilibrium beside the wall (it never balances the pull)")
@@ -372,14 +385,14 @@ def _steering_wall(robot: Robot, controller: Controller, wall: Wall, models, equ
     return WallAnalysis(wall.alpha, first.d0, first.N, first.NV, first.models, first.c, tuple(analyses))
 
 
-def _steering_corridor(robot: Robot, controller: Controller, corridor: Corridor, models, equilibria, fixed_V: bool) -> CorridorAnalysis:
+def _steering_corridor(robot: Robot, controller: Controller, corridor: Corridor, models, equilibria, fixed_V: bool, law: str) -> CorridorAnalysis:
     """Every steering model at the equilibrium nearest the centre line; L* is not followed (NaN)."""
     if not equilibria:
         raise ValueError(f"L = {corridor.L:g} m: the law has no lateral equilibrium in this corridor")
     e = min(equilibria, key=lambda q: abs(q.x0))
-    NV = check_loop_gain(e.N * robot.V, f"corridor equilibrium x0 = {e.x0:g} m (L = {corridor.L:g} m)")
-    loop = Loop(robot.tau, controller.T, robot.k, c=e.c)
-    verdicts = model_verdicts(controller, models, loop, e.N, NV, CorridorCritical, lambda _: {"L_critical": math.nan})
+    where = f"corridor equilibrium x0 = {e.x0:g} m (L = {corridor.L:g} m)"
+    NV = check_loop_gain(e.N * robot.V, where)
+    verdicts = _steering_verdicts(controller, models, robot, e, NV, CorridorCritical, {"L_critical": math.nan}, where, law)
     return CorridorAnalysis(corridor.L, e.N, NV, _speed_free(verdicts, fixed_V), e.c, tuple(equilibria))
 
 
@@ -494,31 +507,24 @@ def build_family_report(
                 "robust_bracket": {"eta": list(bracket.eta), "N": list(bracket.N), "d0": list(bracket.d0)},
             }}
     fixed_V = family_law.name == "fuzzy"
-    wall_result = _steering_wall(robot, controller, wall, model_objs, wall_eq, fixed_V) if wall else None
-    corridor_result = _steering_corridor(robot, controller, corridor, model_objs, corr_eq, fixed_V) if corridor else None
+    wall_result = _steering_wall(robot, controller, wall, model_objs, wall_eq, fixed_V, family_law.name) if wall else None
+    corridor_result = _steering_corridor(robot, controller, corridor, model_objs, corr_eq, fixed_V, family_law.name) if corridor else None
     if corridor and family_law.name == "fuzzy":
         extras.setdefault("environment", {})["corridor"] = {"equilibria": [{"N_frozen": e.N_frozen} for e in corridor_result.equilibria]}
-    fixes = {}
     static = family_law.repulsion() if family_law.name == "velocity" else None
-    if wall_result is not None:
-        for i, e in enumerate(wall_result.equilibria):
-            for name, verdict in e.models.items():
-                fixes[("wall", i, name)] = _loop_remedies(verdict, robot, controller, static)
-        fixes.update({("wall", name): fixes[("wall", 0, name)] for name in wall_result.models})
-    if corridor_result is not None:
-        for name, verdict in corridor_result.models.items():
-            fixes[("corridor", name)] = _loop_remedies(verdict, robot, controller, static)
+    fixes = remedies_by_key(wall_result, corridor_result, lambda scenario, verdict: _loop_remedies(scenario, verdict, robot, controller, static))
     options = {m.name: {"equation": m.equation, **m.options()} for m in model_objs}
-    return StabilityReport(inputs, options, wall_result, corridor_result, kb_error(robot, controller), fixes, family_law.described(), None, extras)
+    errors = kb_errors(robot, controller, wall_result, corridor_result)
+    return StabilityReport(inputs, options, wall_result, corridor_result, errors[0] if errors else None, fixes, family_law.described(), None, extras,
+                           errors if len(errors) > 1 else ())
 
 
-def _loop_remedies(verdict, robot: Robot, controller: Controller, static) -> dict:
+def _loop_remedies(scenario: str, verdict, robot: Robot, controller: Controller, static) -> dict:
     """`report.remedies` limited to what the verdict's critical values support (V, T, k)."""
     from .force_law import PowerLaw
 
     law = static if static is not None else PowerLaw(controller.f, controller.n, robot.W)
-    fix = remedies("corridor" if "L_critical" in verdict.critical else "wall", verdict, robot, controller, law)
-    return {k: v for k, v in fix.items() if k in ("V", "T", "k")}
+    return {k: v for k, v in remedies(scenario, verdict, robot, controller, law).items() if k in ("V", "T", "k")}
 
 
 def _model_objects(controller: Controller, models, pade_order: int, family: str) -> tuple:

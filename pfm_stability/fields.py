@@ -123,6 +123,10 @@ class _FieldLaw(ForceLaw):
         """(1e-9·ρ0, ρ0), m: beyond ρ0 the law is 0."""
         return (_REACH * self.rho0, self.rho0)
 
+    def breakpoints(self) -> tuple:
+        """(ρ0,), m: the repulsion's support ends there (P′ jumps to 0: a corridor's N drops to 0 at L = ρ0)."""
+        return (self.rho0,)
+
 
 @dataclass(frozen=True)
 class KhatibLaw(_FieldLaw):
@@ -302,6 +306,11 @@ class Branch:
         Steps geometric (p > 0) or even.
     steps : int
         Steps per decade (geometric) or over the whole range (even).
+    breaks : sequence of float
+        Values of p where N may jump (the law changes form there,
+        `force_law.ForceLaw.breakpoints`): the scan steps onto each from both
+        sides (a relative 1e-9 away), so a band that ends at one is never
+        stepped over.
 
     The points are scanned lazily and shared by every threshold asked
     (`nearest_crossing`). Where the number of equilibria changes between two
@@ -313,10 +322,15 @@ class Branch:
 
     _FINEST = 2.0**-10
 
-    def __init__(self, equilibria_at, p0: float, start: Equilibrium, lo: float, hi: float, *, log: bool = True, steps: int = 8):
+    _BREAK_GAP = 1e-9
+    """Relative distance from a break at which the scan stops on either side of it."""
+
+    def __init__(self, equilibria_at, p0: float, start: Equilibrium, lo: float, hi: float, *, log: bool = True, steps: int = 8, breaks=()):
         self._at = equilibria_at
         self.p0, self.start, self.log = p0, start, log
         self._nominal = math.log(10.0) / steps if log else (hi - lo) / steps
+        gap = self._BREAK_GAP * (1.0 if log else hi - lo)
+        self._fences = sorted({q for b in breaks for q in ((b * (1 - gap), b * (1 + gap)) if log else (b - gap, b + gap)) if lo < q < hi and q != p0})
         before = self._equilibria(p0, False)
         self._points = {+1: [(p0, start, before)], -1: [(p0, start, before)]}
         self._end = {+1: hi, -1: lo}
@@ -336,7 +350,9 @@ class Branch:
     def _next(self, p: float, side: int) -> float:
         step = side * self._nominal * self._scale[side]
         q = p * math.exp(step) if self.log else p + step
-        return min(q, self._end[side]) if side > 0 else max(q, self._end[side])
+        q = min(q, self._end[side]) if side > 0 else max(q, self._end[side])
+        fences = [f for f in self._fences if (p < f < q if side > 0 else q < f < p)]  # never step over a break
+        return (min(fences) if side > 0 else max(fences)) if fences else q
 
     def _advance(self, side: int) -> None:
         points = self._points[side]

@@ -143,6 +143,22 @@ class ForceLaw:
         """(d_min, d_max), m: where the law is defined (and P > 0)."""
         return (1e-9, math.inf)
 
+    def breakpoints(self) -> tuple:
+        """Distances d (m) where P or Q changes form (e.g. where the repulsion's support ends); none by default.
+
+        N jumps where an equilibrium crosses one, so the searches for critical
+        values step onto each (`pfm_stability.critical`, docs/fields.md).
+        """
+        return ()
+
+    def lumped_f(self) -> float:
+        """KB's lumped f this law stands for (the user's f): its `scale` by default, a grid law's f_av.
+
+        The force is proportional to `scale`, so the law at strength s stands for
+        f = s·lumped_f()/scale: a critical strength is reported in f this way.
+        """
+        return self.scale
+
     def distance_for(self, force: float) -> float:
         """d with F_r(d)/F_a = `force` (m); ``inf`` if the law never gets that weak.
 

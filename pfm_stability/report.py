@@ -23,11 +23,11 @@ from .checks import check_type
 from .comparison import relative_error
 from .criteria import CorridorAnalysis, WallAnalysis, analyze_corridor, analyze_wall, loop_of
 from .force_law import ForceLaw, law_in_force
-from .models import KBFirstOrder, Sampled, models_for
+from .models import HEADING_GAIN_RANGE, KBFirstOrder, Loop, Sampled, models_for
 from .parameters import LAW_PARAMETERS, MODEL_NAMES, RANGES, Controller, Corridor, Robot, Wall, check_parameter
 from .serialize import SCHEMA_VERSION, json_number, json_ready
 
-__all__ = ["StabilityReport", "KBError", "build_report", "remedies", "kb_error"]
+__all__ = ["StabilityReport", "KBError", "build_report", "remedies", "remedies_by_key", "kb_error", "kb_errors"]
 
 LAW_INPUTS = ("cell_ratio", "cell_size", "window_cells", "xi", "eta", "rho0", "attraction_exponent", "goal_exponent", "goal_distance", "delta")
 """The law's own parameters, listed after W when the law takes them (`parameters.LAW_PARAMETERS`)."""
@@ -44,7 +44,7 @@ REMEDY_PARAMETERS = ("V", "T", "k", "alpha_deg", "L", "f", "eta", "rho0", "xi")
 
 @dataclass(frozen=True)
 class KBError:
-    """How far KB's NV* = 1/(τ+T) (eq 20) is from the sampled loop's NV*.
+    """How far KB's criterion (eq 20, `kb_first_order`) is from the sampled loop's NV*, for one loop.
 
     Attributes
     ----------
@@ -54,9 +54,17 @@ class KBError:
         unstable at every NV (NV*_sampled = 0); NaN (undefined) when both are
         infinite.
     NV_kb, NV_sampled : float
-        1/s.
+        1/s: `kb_first_order`'s NV* (1/(τ + T) when c = 0) and `sampled`'s, for
+        the same loop (τ, T, k, c).
     hold : str
     compute_delay : int
+    c : float
+        The loop's heading gain (0: KB's loop). With c ≠ 0 KB's criterion is
+        that of `kb_first_order` with the heading gain (docs/models.md, "The
+        heading gain"): the NV* its table prints.
+    where : tuple of str
+        The geometries whose loop this is ("wall", "wall equilibrium 2",
+        "corridor"); empty for KB's loop (c = 0), which every geometry shares.
     """
 
     relative: float
@@ -64,6 +72,8 @@ class KBError:
     NV_sampled: float
     hold: str
     compute_delay: int
+    c: float = 0.0
+    where: tuple = ()
 
     @property
     def direction(self) -> str | None:
@@ -73,14 +83,17 @@ class KBError:
         return "optimistic" if self.relative > 0 else "conservative"
 
     def sentence(self) -> str:
-        """"KB's criterion is X % optimistic/conservative against `sampled` (…)"."""
+        """"KB's criterion is X % optimistic/conservative against `sampled` (…)" (naming the heading gain when there is one)."""
         against = f"`sampled` (hold={self.hold}, compute_delay={self.compute_delay})"
+        kb = "KB's criterion"
+        if self.c != 0.0:
+            kb += f" with the heading gain c = {self.c:.4g} (kb_first_order{', ' + ', '.join(self.where) if self.where else ''})"
         if math.isnan(self.relative):
-            return f"KB's criterion cannot be compared with {against}: both are stable at every NV"
+            return f"{kb} cannot be compared with {against}: both are stable at every NV"
         if math.isinf(self.relative):
-            return (f"KB's criterion is infinitely optimistic against {against}: the sampled loop is unstable at every NV "
+            return (f"{kb} is infinitely optimistic against {against}: the sampled loop is unstable at every NV "
                     f"(NV* = 0) while KB allows NV < {self.NV_kb:.4g} 1/s")
-        return f"KB's criterion is {abs(self.relative) * 100:.1f} % {self.direction or 'off'} against {against}"
+        return f"{kb} is {abs(self.relative) * 100:.1f} % {self.direction or 'off'} against {against}"
 
     def to_dict(self) -> dict:
         """The fields as a JSON-ready dict (SI units); ``direction`` only with a value."""
@@ -94,6 +107,10 @@ class KBError:
         }
         if self.direction is not None:
             out["direction"] = self.direction
+        if self.c != 0.0:
+            out["c"] = self.c
+        if self.where:
+            out["where"] = list(self.where)
         return out
 
 
@@ -123,6 +140,9 @@ class StabilityReport:
         ``scenes`` (geometry → a holonomic or non-smooth scene with ``to_dicts()``),
         ``environment`` (geometry → keys merged into the environment entry, and
         per-equilibrium keys under ``equilibria``), ``tracking``. Empty for KB's report.
+    kb_errors : tuple of KBError
+        Every loop's KB error when the geometries close different loops (a heading
+        gain that differs between them); empty otherwise (`kb_error` is then the one).
     """
 
     inputs: dict
@@ -134,6 +154,7 @@ class StabilityReport:
     law: dict | None = None
     door: object | None = None
     extras: dict = field(default_factory=dict)
+    kb_errors: tuple = ()
 
     def to_dict(self) -> dict:
         """The fields as a JSON-ready dict (SI units; infinities as ``"inf"``, undefined as null)."""
@@ -167,6 +188,8 @@ class StabilityReport:
             out["door"] = self.door.to_dict()
         if self.kb_error is not None:
             out["kb_error"] = self.kb_error.to_dict()
+        if len(self.kb_errors) > 1:
+            out["kb_errors"] = [e.to_dict() for e in self.kb_errors]
         return out
 
 
@@ -201,6 +224,7 @@ def _verdict_dict(v, remedy) -> dict:
         "rightmost_root": {"sigma": json_number(root.real), "omega": json_number(abs(root.imag))} if root is not None else {"sigma": None, "omega": None},
     }
     out.update({key: json_number(value) for key, value in v.critical.items()})
+    out["stable_side"] = {"NV_critical": None if math.isnan(v.NV_critical) else "below", **v.critical.stable_sides()}
     out["to_stabilize"] = remedy or {}
     if v.reason is not None:
         out["reason"] = v.reason
@@ -227,8 +251,9 @@ def remedies(scenario: str, verdict, robot: Robot, controller: Controller, law: 
     Returns
     -------
     dict
-        Parameter → {"to": critical value (SI, α in deg), "direction": "raise"
-        or "lower", "change_percent": relative change, %}. Each value leaves
+        Parameter → {"to": critical value (SI, α in deg; f in the user's f,
+        a grid law's f_av: `ForceLaw.lumped_f`), "direction": "raise" or
+        "lower", "change_percent": relative change, %}. Each value leaves
         the loop stable over the whole way from it to 0 (V, T, k) or beyond it
         (α, L), by the definitions of the critical values (for a law that is
         not monotone: just past it). Empty if stable; a parameter is left out
@@ -239,7 +264,7 @@ def remedies(scenario: str, verdict, robot: Robot, controller: Controller, law: 
         return {}
     law = law_in_force(robot, controller, law)
     c = verdict.critical
-    current = {**law.parameters(), "V": robot.V, "f": controller.f if law.monotone else law.scale, "T": controller.T, "k": robot.k}
+    current = {**law.parameters(), "V": robot.V, "f": law.lumped_f(), "T": controller.T, "k": robot.k}  # f: the user's (a grid's f_av)
     wanted = [("V", "V_critical", "lower"), ("T", "T_critical", "lower"), ("k", "k_critical", "lower")]  # (parameter, critical key, direction)
     if scenario == "wall":
         wanted.append(("alpha_deg", "alpha_critical_deg", _towards(c.alpha_critical_deg, at, law)))
@@ -263,6 +288,21 @@ def remedies(scenario: str, verdict, robot: Robot, controller: Controller, law: 
     return out
 
 
+def remedies_by_key(wall: WallAnalysis | None, corridor: CorridorAnalysis | None, fix) -> dict:
+    """`StabilityReport.remedies`: ``fix(scenario, verdict)`` for every verdict, under the report's keys.
+
+    ("wall", i, model) for wall equilibrium i, ("wall", model) for the first,
+    ("corridor", model) for the corridor.
+    """
+    out = {}
+    if wall is not None:
+        out.update({("wall", i, name): fix("wall", v) for i, e in enumerate(wall.equilibria) for name, v in e.models.items()})
+        out.update({("wall", name): out[("wall", 0, name)] for name in wall.models})
+    if corridor is not None:
+        out.update({("corridor", name): fix("corridor", v) for name, v in corridor.models.items()})
+    return out
+
+
 def _towards(target: float, now: float | None, law: ForceLaw) -> str | None:
     """"raise" or "lower": towards `target` for a law that is not monotone; "raise" (α, L) for one that is."""
     if law.monotone or now is None:
@@ -272,12 +312,36 @@ def _towards(target: float, now: float | None, law: ForceLaw) -> str | None:
     return "raise" if target > now else "lower"
 
 
-def kb_error(robot: Robot, controller: Controller) -> KBError:
-    """KB's eq (20) against the `sampled` loop with the controller's structure."""
+def kb_error(robot: Robot, controller: Controller, c: float = 0.0, where: tuple = ()) -> KBError:
+    """KB's eq (20) against the `sampled` loop with the controller's structure, for the loop with heading gain `c`.
+
+    With c ≠ 0 (a velocity or fuzzy law) KB's criterion is `kb_first_order`'s
+    with the heading gain, so both sides are the NV* the report's table prints
+    for that loop; `where` names the geometries whose loop it is.
+    """
     loop = loop_of(robot, controller)
+    if c != 0.0:
+        loop = Loop(loop.tau, loop.T, loop.k, c=c)
     kb = KBFirstOrder().boundary(loop).NV_critical
     sampled = Sampled(controller.hold, controller.compute_delay).boundary(loop).NV_critical
-    return KBError(relative_error(kb, sampled), kb, sampled, controller.hold, controller.compute_delay)
+    return KBError(relative_error(kb, sampled), kb, sampled, controller.hold, controller.compute_delay, c, tuple(where))
+
+
+def kb_errors(robot: Robot, controller: Controller, wall: WallAnalysis | None, corridor: CorridorAnalysis | None) -> tuple:
+    """`kb_error` for every loop the report's tables decide: one per heading gain c, naming its geometries, wall first.
+
+    A static law gives one loop (c = 0, KB's own); a velocity or fuzzy law one per
+    heading gain, each compared as its table prints it. A loop whose c is beyond
+    the models (`models.HEADING_GAIN_RANGE`: no table value) has none.
+    """
+    loops = {}
+    if wall is not None:
+        for i, e in enumerate(wall.equilibria):
+            loops.setdefault(e.c, []).append("wall" if len(wall.equilibria) == 1 else f"wall equilibrium {i + 1}")
+    if corridor is not None:
+        loops.setdefault(corridor.c, []).append("corridor")
+    low, high = HEADING_GAIN_RANGE
+    return tuple(kb_error(robot, controller, c, tuple(where) if c != 0.0 else ()) for c, where in (loops or {0.0: []}).items() if low <= c <= high)
 
 
 def build_report(
@@ -364,15 +428,8 @@ def build_report(
     options = {m.name: {"equation": m.equation, **m.options()} for m in model_objs}
     wall_result = analyze_wall(robot, controller, wall, model_objs, law) if wall else None
     corridor_result = analyze_corridor(robot, controller, corridor, model_objs, law) if corridor else None
-    fixes = {}
-    if wall_result is not None:
-        for i, e in enumerate(wall_result.equilibria):
-            for name, verdict in e.models.items():
-                fixes[("wall", i, name)] = remedies("wall", verdict, robot, controller, law, wall.alpha_deg)
-        fixes.update({("wall", name): fixes[("wall", 0, name)] for name in wall_result.models})
-    if corridor_result is not None:
-        for name, verdict in corridor_result.models.items():
-            fixes[("corridor", name)] = remedies("corridor", verdict, robot, controller, law, corridor.L)
+    fixes = remedies_by_key(wall_result, corridor_result,
+                            lambda scenario, verdict: remedies(scenario, verdict, robot, controller, law, wall.alpha_deg if scenario == "wall" else corridor.L))
     described = {"name": law.key, "description": law.name, "parameters": json_ready(law.parameters())}
     passage = None
     if door is not None:

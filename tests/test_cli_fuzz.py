@@ -37,6 +37,7 @@ import itertools
 import json
 import math
 import os
+import re
 
 import pytest
 from hypothesis import event, given, note, settings
@@ -245,6 +246,7 @@ def check_run(command, argv, inside, room=None):
         assert " rad; got" not in message, "a range stated in radians: every option is typed in degrees"
         for name in inside:
             assert not message.startswith(f"pfm-stability: error: argument {name}:"), f"{name}: a value inside the stated range was rejected"
+        _check_blamed_value(command, argv, message)
         return
     if "--help" in argv:
         assert out.startswith("usage:")
@@ -274,6 +276,32 @@ def _nothing_left_behind(argv) -> None:
             folder = os.path.dirname(os.path.abspath(path))
             if os.path.isdir(folder) and os.access(folder, os.R_OK):
                 assert not [f for f in os.listdir(folder) if f.startswith(f".{os.path.basename(path)}.")], "a temporary file left"
+
+
+def _same_value(got: str, typed: str) -> bool:
+    """True when the value a message quotes is the one typed (as a number where both parse, else as text)."""
+    got = got.strip("'\"")
+    try:
+        return float(got) == float(typed) or (math.isnan(float(got)) and math.isnan(float(typed)))
+    except ValueError:
+        return got == typed
+
+
+def _check_blamed_value(command, argv, message):
+    """A message "X must be …; got Y" about an option the user typed quotes the value typed, never an internal one
+    (k* once probed 1e-3·k below k's range and blamed the user's k for it)."""
+    found = re.match(r"pfm-stability: error: (\w+) must be .*; got (.+)$", message)
+    if not found:
+        return
+    options, _ = _options(command)
+    typed = {}
+    for token, value in zip(argv, argv[1:]):
+        action = options.get(token)
+        if action is not None and getattr(action.type, "kind", None) in ("number", "integer"):
+            typed[SHOWN_AS.get(action.type.range_key, action.type.range_key)] = value
+    key, got = found.groups()
+    if key in typed:
+        assert _same_value(got, typed[key]), f"{message!r}: {key} was typed as {typed[key]!r}"
 
 
 @pytest.fixture(scope="module")
@@ -379,6 +407,30 @@ def test_once_a_traceback_exact_delay_with_a_tiny_tau():
 def test_once_a_traceback_exact_delay_without_roots():
     code, out, err = run_cli(["report", "--L", "1", "--tau", "1e-38", "--V", "0.03125"])
     assert code in (0, 2)
+
+
+def test_once_an_internal_value_blamed_on_the_user_k_star_probe():
+    """`report --k 1e-4` (inside k's range) failed with "k must be … got 1e-07": the k* search probed 1e-3·k."""
+    argv = ["report", "--k", "1e-4", "--L", "0.9"]
+    code, out, err = run_cli(argv)
+    assert code == 0 and err == "", err
+
+
+def test_once_an_internal_value_blamed_on_the_user_heading_gain():
+    """`report --law fuzzy --L 0.25 --W 0.18` failed with "c must be … got 942.76", an internal heading gain; now
+    every model's verdict is "undecided" with the reason (docs/velocity_and_fuzzy.md)."""
+    code, out, err = run_cli(["report", "--law", "fuzzy", "--L", "0.25", "--W", "0.18", "--format", "json"])
+    assert code == 0 and err == "", err
+    data = json.loads(out, parse_constant=_reject_constant)
+    assert not list(VALIDATOR.iter_errors(data)) and {v["verdict"] for v in data["corridor"].values()} == {"undecided"}
+
+
+def test_a_message_quotes_the_typed_value():
+    """The property the fuzz checks on every exit 2 (`_check_blamed_value`), on messages it must accept and reject."""
+    _check_blamed_value("report", ["report", "--L", "0.4"], "pfm-stability: error: L must be a finite number in (W/2, 10000] m; got 0.4")
+    _check_blamed_value("report", ["report", "--alpha", "90"], "pfm-stability: error: alpha must be a finite number in [1e-06, 89.999999] deg; got 90.0")
+    with pytest.raises(AssertionError):
+        _check_blamed_value("report", ["report", "--k", "1e-4", "--L", "0.9"], "pfm-stability: error: k must be a finite number in [1e-06, 10000] 1/s; got 1e-07")
 
 
 def test_once_a_traceback_alpha_at_the_end_of_its_range_in_simulate():

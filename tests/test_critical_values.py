@@ -151,3 +151,34 @@ def test_k_star_closed_forms():
     loop = Loop(0.3, 0.065, 2.0)
     assert Continuous().critical_gain_k(3.0, loop) == math.inf and Continuous().critical_gain_k(3.5, loop) == 0.0
     assert KBFirstOrder().critical_gain_k(2.0, loop) == math.inf and KBFirstOrder().critical_gain_k(3.0, loop) == 0.0
+
+
+@pytest.mark.parametrize("k", [1e-4, 5e-6, 1e-6])
+def test_k_star_search_stays_inside_the_range_of_k(k):
+    """A steering gain inside its documented range [1e-6, 1e4] 1/s but below 1e-3 (`report --k 1e-4`): the k* search
+    once probed 1e-3·k, outside the range, and the report failed with "k must be ... got 1e-07", a value the user never
+    typed. Now the search starts at the range's end: the report answers, and k* keeps its definition, checked by the
+    independent oracles (scipy ZOH for sampled, numpy roots for pade, the crossing count for exact_delay): unstable
+    just above a finite k* (1 + 1e-5: above the search's 1e-7), stable on a scan below it down to the range's end;
+    k* = 0 only where the range's smallest k is already unstable."""
+    from pfm_stability.parameters import CARMEL, RANGES
+    from pfm_stability.report import build_report
+
+    robot, controller = CARMEL.robot.replace(k=k), CARMEL.controller
+    report = build_report(robot, controller, L=0.9, alpha_deg=30.0)
+    low = RANGES["k"].low
+    oracles = {"sampled": lambda g, NV: _sampled_oracle_stable(Loop(robot.tau, controller.T, g), controller.hold, controller.compute_delay, NV),
+               "pade": lambda g, NV: _pade_oracle_stable(Loop(robot.tau, controller.T, g), 3, NV),
+               "exact_delay": lambda g, NV: _exact_oracle_stable(Loop(robot.tau, controller.T, g), NV)}
+    for analysis in (report.wall, report.corridor):
+        for name, oracle in oracles.items():
+            v = analysis.models[name]
+            k_star = v.critical["k_critical"]
+            if k_star == 0:
+                assert not oracle(low, v.NV)
+                continue
+            if math.isfinite(k_star):
+                assert not oracle(k_star * (1 + 1e-5), v.NV)
+            top = 0.999 * min(k_star, RANGES["k"].high)
+            for g in np.geomspace(low, top, 25):
+                assert oracle(float(g), v.NV), (name, g, k_star)

@@ -1,10 +1,14 @@
 """The grid's effective force law (docs/simulator.md, grid quantization; KB eq 1–2, 8, §4 f_av)."""
 
+import contextlib
+import io
+import json
 import math
 
 import numpy as np
 import pytest
 
+from pfm_stability.cli import main
 from pfm_stability.criteria import analyze_corridor, analyze_wall, critical_L
 from pfm_stability.effective_force import (
     GridWallLaw,
@@ -14,8 +18,10 @@ from pfm_stability.effective_force import (
     f_average,
     working_range,
 )
+from pfm_stability.fields import make_law
 from pfm_stability.force_law import PowerLaw, corridor_gain
 from pfm_stability.models import Loop, Sampled
+from pfm_stability.report import build_report
 from pfm_stability.parameters import CARMEL, Corridor, Wall
 from pfm_stability.sim.vff import measured_wall_force
 
@@ -148,6 +154,54 @@ def test_criteria_accept_the_grid_law():
     assert wall.models["sampled"].verdict == "stable"
     assert 0.45 < wall.d0 < law.reach
     assert critical_L(law, robot.V, NV_star) == pytest.approx(L_star)
+
+
+def _grid_report(robot, controller, **geometry):
+    """`build_report` with the grid law calibrated from the controller's f (KB §4), as ``--law grid`` builds it."""
+    return build_report(robot, controller, law=make_law("grid", robot, controller), **geometry)
+
+
+@pytest.mark.parametrize("geometry, robot, f", [({"L": 0.4}, CARMEL.robot.replace(W=0.4), 1.5), ({"alpha_deg": 20.0}, CARMEL.robot, 0.8),
+                                                 ({"L": 0.9}, CARMEL.robot, 0.8)], ids=["config corridor", "carmel wall", "carmel corridor"])
+def test_grid_law_f_critical_and_remedy_are_in_f(geometry, robot, f):
+    """With ``--law grid`` the user's f is KB's lumped f_av and the law's scale the cell ratio: f* and "to stabilize f"
+    are in f (docs/fields.md). Oracle, per model: the report rebuilt (library call) at f*·(1 ∓ 1e-6), the cell ratio
+    calibrated from that f, has opposite verdicts, the stable one on f*'s stated side (wall: above, corridor: below);
+    1e-6 is far above the closed form's or bisection's round-off and far below any other change. The remedy's "to"
+    is f*, its percentage against the user's f."""
+    controller = CARMEL.controller.replace(f=f)
+    scenario = "corridor" if "L" in geometry else "wall"
+    report = _grid_report(robot, controller, models=["continuous", "kb_first_order", "sampled"], **geometry)
+    analysis = getattr(report, scenario)
+    for name, verdict in analysis.models.items():
+        f_star = verdict.critical["f_critical"]
+        side = verdict.critical.stable_side("f_critical")
+        assert side == ("below" if scenario == "corridor" else "above") and 1e-3 < f_star < 1e3
+        verdicts = {}
+        for where, x in (("below", f_star * (1 - 1e-6)), ("above", f_star * (1 + 1e-6))):
+            verdicts[where] = getattr(_grid_report(robot, controller.replace(f=x), models=[name], **geometry), scenario).models[name].stable
+        assert verdicts[side] and not verdicts[{"below": "above", "above": "below"}[side]], (name, f_star, verdicts)
+        remedy = report.remedies[(scenario, name)].get("f")
+        if not verdict.stable:
+            assert remedy["to"] == f_star and remedy["change_percent"] == pytest.approx((f_star / f - 1) * 100, rel=1e-9)
+
+
+def test_grid_law_f_critical_of_the_config_example_in_text_and_json():
+    """The reported case (a config file with ``law: grid``, f = 1.5, W = 0.4 m; ``--L 0.4``): f* of sampled is about 1
+    (was printed as the cell ratio 0.0043, "-100 %"); text and JSON show the same f*, and the text's remedy lowers f
+    to it (about −32 %)."""
+    robot, controller = CARMEL.robot.replace(W=0.4), CARMEL.controller.replace(f=1.5)
+    f_star = _grid_report(robot, controller, L=0.4).corridor.models["sampled"].critical["f_critical"]
+    assert 0.9 < f_star < 1.1
+    argv = ["report", "--law", "grid", "--W", "0.4", "--f", "1.5", "--L", "0.4", "--model", "sampled"]
+    out = io.StringIO()
+    with contextlib.redirect_stdout(out):
+        assert main([*argv, "--format", "json"]) == 0
+    assert json.loads(out.getvalue())["corridor"]["sampled"]["f_critical"] == pytest.approx(f_star, rel=1e-12)
+    out = io.StringIO()
+    with contextlib.redirect_stdout(out):
+        assert main(argv) == 0
+    assert f"lower f to <= {f_star:.4g} ({(f_star / 1.5 - 1) * 100:+.0f} %)" in out.getvalue()
 
 
 def test_staircase_wall_pushes_harder():

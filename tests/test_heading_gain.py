@@ -247,6 +247,32 @@ def test_a_stable_band_that_does_not_start_at_zero():
         assert int(np.sum(roots.real > 0)) == expected == _count(tau, T, k, c, k * NV)
 
 
+def test_the_printed_band_example_holds_for_its_printed_values():
+    """docs/models.md ("The heading gain") prints a loop with a stable band away from 0, to 3 digits. Recomputed from
+    the printed, rounded inputs, each edge of the stable set must round to the printed digits (half a unit of the last
+    one), and QPmR's root count (independent of the model) must be 0 one unit inside each printed edge and 2 one unit
+    outside it. The example once printed the band of the unrounded inputs (0.120 < NV < 0.790)."""
+    import re
+    from pathlib import Path
+
+    text = " ".join((Path(__file__).resolve().parents[1] / "docs" / "models.md").read_text().split())
+    found = re.search(r"tested: τ = ([\d.]+) s, T = ([\d.]+) s, k = ([\d.]+) 1/s, c = −([\d.]+): stable for ([\d.]+) < NV < ([\d.]+) only, "
+                      r"NV\\\* = 0", text)
+    assert found, "the example's sentence changed: update this test with it"
+    tau, T, k, c = (float(x) for x in found.groups()[:4])
+    c = -c
+    printed = found.groups()[4:]
+    boundary = ExactDelay().boundary(Loop(tau, T, k, c=c))
+    ((lo, hi),) = boundary.stable_set
+    assert boundary.NV_critical == 0.0
+    for value, shown, below, above in ((lo, printed[0], 2, 0), (hi, printed[1], 0, 2)):  # unstable roots one unit below / above
+        unit = 10.0 ** -len(shown.split(".")[1])
+        assert abs(value - float(shown)) <= 0.5 * unit * (1 + 1e-9), (value, shown)
+        for NV, expected in ((float(shown) - unit, below), (float(shown) + unit, above)):
+            roots = _qpmr_roots(tau, T, k, c, k * NV, -0.5, 5.0)
+            assert int(np.sum(roots.real > 0)) == expected, (NV, expected)
+
+
 def test_heading_route_with_c_zero_equals_kb_critical_gain():
     """The heading machinery (polynomial split points, level equation, crossing count) run at c = 0
     reproduces the c = 0 route's K* (three phase levels) on 150 random loops, resonant ones

@@ -347,3 +347,92 @@ def test_factory_and_json():
     assert make_holonomic_model("pade", pade_order=5).options() == {"order": 5}
     d = HolonomicContinuous().boundary(HolonomicLoop(0.1, 0.2)).to_dict()
     assert d["kappa_critical"] == "inf" and d["stable_set"] == [[0.0, "inf"]]
+
+
+# --------------------------------------------------------------- T* below a microsecond
+SUB_MICROSECOND = [(1e3, 1e12), (1.0, 1e9), (0.1, 1e8), (0.0033677912440780674, 8364626.708573155), (50.0, 3e9)]
+"""(c_h, κ) whose T* lies between 1e-10 and 1e-6 s; the light damping of the middle three (c_h ≪ √κ) left the old
+absolute floor far above 1e-9·T* (the fourth was found 3e-7 relative off)."""
+
+
+def _mp_first_loss(stable, T_hi):
+    """The delay where `stable(T)` (mpmath, 30 digits) turns False, by bisection on [T_hi/64, T_hi], 1e-12 relative."""
+    import mpmath as mp
+
+    lo, hi = mp.mpf(T_hi) / 64, mp.mpf(T_hi)
+    assert stable(lo) and not stable(hi)
+    while hi - lo > mp.mpf("1e-12") * hi:
+        mid = (lo + hi) / 2
+        lo, hi = (mid, hi) if stable(mid) else (lo, mid)
+    return float(hi)
+
+
+def _mp_zoh1_stable(kappa, c_h):
+    """ZOH with one sample of delay, built here in mpmath: Φ = [[1, T], [0, 1]], Γ = [T²/2, T], the held command
+    u_k = −κx_{k−1} − c_h v_{k−1}; stable iff every eigenvalue of [[Φ, Γ], [−F, 0]] has |z| < 1."""
+    import mpmath as mp
+
+    def stable(T):
+        M = mp.matrix([[1, T, T * T / 2], [0, 1, T], [-kappa, -c_h, 0]])
+        return max(abs(z) for z in mp.eig(M, left=False, right=False)) < 1
+
+    return stable
+
+
+def _routh_stable(descending) -> bool:
+    """Every root in Re s < 0: the n + 1 entries of the first column of the Routh array are positive (any zero: not)."""
+    n = len(descending) - 1
+    width = n // 2 + 2
+    rows = [list(descending[0::2]), list(descending[1::2])]
+    rows = [r + [0] * (width - len(r)) for r in rows]
+    for _ in range(n - 1):
+        upper, lower = rows[-2], rows[-1]
+        if lower[0] <= 0:
+            return False
+        rows.append([(lower[0] * upper[i + 1] - upper[0] * lower[i + 1]) / lower[0] for i in range(width - 1)] + [0])
+    return all(row[0] > 0 for row in rows)
+
+
+def _mp_pade_stable(kappa, c_h, m):
+    """s²·Q_m(sT) + (c_h s + κ)·P_m(sT) with Padé's textbook coefficients of e^(−x), P_m(x) = Σ_j (2m − j)! m! /
+    ((2m)! j! (m − j)!) (−x)^j and Q_m(x) = P_m(−x); stable iff the first column of its Routh array (mpmath) is positive."""
+    import mpmath as mp
+
+    a = [mp.factorial(2 * m - j) * mp.factorial(m) / (mp.factorial(2 * m) * mp.factorial(j) * mp.factorial(m - j)) for j in range(m + 1)]
+
+    def stable(T):
+        P = [a[j] * (-T) ** j for j in range(m + 1)]  # ascending powers of s
+        Q = [a[j] * T**j for j in range(m + 1)]
+        coefficients = [mp.mpf(0)] * (m + 3)
+        for j in range(m + 1):
+            coefficients[j + 2] += Q[j]
+            coefficients[j + 1] += c_h * P[j]
+            coefficients[j] += kappa * P[j]
+        return _routh_stable(coefficients[::-1])
+
+    return stable
+
+
+@pytest.mark.parametrize("c_h, kappa", SUB_MICROSECOND)
+def test_T_star_below_a_microsecond_meets_its_promise(c_h, kappa):
+    """`critical_delay` promises 1e-9 relative; where T* <= 1e-6 s its absolute floor (1e-12·min(1/c_h, 1/√κ)) used to
+    stop the bisection first (2e-7 to 3e-6 relative off). Oracles at 1e-9 relative (plus round-off: 2e-9): Routh's
+    min(1/c_h, c_h/κ) for kb_first_order, Jury's min(2/c_h, 2c_h/κ) for the ZOH; the exact delay's crossing solved
+    here with mpmath (s = jω: −ω² + κ cos ωT + c_h ω sin ωT = 0 and c_h ω cos ωT − κ sin ωT = 0, 30 digits); the ZOH
+    with one sample of delay and Padé(4) bisected here in mpmath on their own stability tests."""
+    import mpmath as mp
+
+    loop = HolonomicLoop(0.01, c_h)
+    first_order = min(1 / c_h, c_h / kappa)
+    assert 1e-10 < first_order <= 1e-6
+    assert HolonomicFirstOrder().critical_delay(kappa, loop) == pytest.approx(first_order, rel=2e-9, abs=0)
+    assert ZOH.critical_delay(kappa, loop) == pytest.approx(min(2 / c_h, 2 * c_h / kappa), rel=2e-9, abs=0)
+    with mp.workdps(30):  # abs=0 below: pytest.approx's default absolute 1e-12 would pass anything at T* ~ 1e-9 s
+        w0, T0 = _pure_delay_T_star(c_h, kappa)[1], _pure_delay_T_star(c_h, kappa)[0]
+        w, T = mp.findroot(lambda w, T: (-w * w + kappa * mp.cos(w * T) + c_h * w * mp.sin(w * T), c_h * w * mp.cos(w * T) - kappa * mp.sin(w * T)),
+                           (mp.mpf(w0) * (1 + mp.mpf("1e-6")), mp.mpf(T0) * (1 - mp.mpf("1e-6"))))
+        assert EXACT.critical_delay(kappa, loop) == pytest.approx(float(T), rel=2e-9, abs=0)
+        T_zoh1 = _mp_first_loss(_mp_zoh1_stable(mp.mpf(kappa), mp.mpf(c_h)), 4 * first_order)
+        T_pade = _mp_first_loss(_mp_pade_stable(mp.mpf(kappa), mp.mpf(c_h), 4), 4 * first_order)
+    assert ZOH1.critical_delay(kappa, loop) == pytest.approx(T_zoh1, rel=2e-9, abs=0)
+    assert HolonomicPade(4).critical_delay(kappa, loop) == pytest.approx(T_pade, rel=2e-9, abs=0)

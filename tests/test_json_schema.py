@@ -134,8 +134,11 @@ def test_validate_with_sweep_and_stability_map_validates(tmp_path):
         lambda d: d["corridor"]["sampled"].update(NV_critical="Infinity"),
         lambda d: d["corridor"]["sampled"].update(stable="yes"),
         lambda d: d["kb_error"].update(direction=None),
+        lambda d: d["corridor"]["sampled"]["stable_side"].update(L_critical="sideways"),
+        lambda d: d["wall"]["sampled"].pop("stable_side"),
     ],
-    ids=["wrong command", "no version", "other version", "unknown key", "infinity spelled otherwise", "bool as text", "null direction"],
+    ids=["wrong command", "no version", "other version", "unknown key", "infinity spelled otherwise", "bool as text", "null direction",
+         "a side that is no side", "no stable side"],
 )
 def test_schema_rejects_what_it_should(mutate):
     data = strict_loads(_report_text())

@@ -9,6 +9,7 @@ law gives the non-smooth verdict with its rest band and, from the planar simulat
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -152,3 +153,80 @@ def test_bad_input_exits_2_naming_the_option(argv, message):
     code, out, err = run(["report", *argv])
     assert code == 2 and out == "", err
     assert err.startswith("pfm-stability: error: ") and message in err and len(err.splitlines()) == 1, err
+
+
+# ------------------------------------------------------------------ KB's error with a heading gain
+@functools.lru_cache(maxsize=1)
+def _kb_first_order_routh():
+    """KB's first-order loop with a heading gain, derived here: τs³ + s² + ks + k(cs + NV)(1 − sT) expanded by sympy;
+    Routh–Hurwitz for a cubic (every coefficient > 0 and a2·a1 > a3·a0). Returns the coefficients and the roots in NV of
+    the boundary a2·a1 = a3·a0 (a quadratic), as functions of (τ, T, k, c[, NV])."""
+    import sympy as sp
+
+    s, NV, tau, T, k, c = sp.symbols("s NV tau T k c")
+    coefficients = sp.Poly(sp.expand(tau * s**3 + s**2 + k * s + k * (c * s + NV) * (1 - s * T)), s).all_coeffs()
+    a3, a2, a1, a0 = coefficients
+    roots = sp.solve(sp.Eq(a2 * a1 - a3 * a0, 0), NV)
+    return sp.lambdify((tau, T, k, c, NV), coefficients), [sp.lambdify((tau, T, k, c), r) for r in roots]
+
+
+def _kb_first_order_NV_star(tau: float, T: float, k: float, c: float) -> float:
+    """The smallest positive root of the Routh boundary at which every coefficient is still positive just below it."""
+    coefficients, roots = _kb_first_order_routh()
+    values = [complex(r(tau, T, k, c)) for r in roots]
+    real = [v.real for v in values if abs(v.imag) <= 1e-12 * abs(v) and v.real > 0]
+    return min(x for x in real if all(a > 0 for a in coefficients(tau, T, k, c, x * (1 - 1e-9))))
+
+
+def test_kb_error_compares_the_loop_the_tables_decide():
+    """A small robot with the velocity attraction (W 0.3 m, α 30°, L 0.4 m, ρ0 1 m): wall and corridor have different
+    heading gains c, so KB's error is given per loop (``kb_errors``, wall first). Each compares kb_first_order's NV*
+    with the heading gain against sampled's for that loop: both equal the table's values read back from the same JSON
+    (rel 1e-12: the same computation), and KB's side equals the Routh bound of τs³ + s² + ks + k(cs + NV)(1 − sT)
+    derived here with sympy (rel 1e-9). The text prints those numbers, not KB's c = 0 ones (2.74 vs 2.123)."""
+    argv = ["--law", "velocity", "--alpha", "30", "--L", "0.4", "--rho0", "1.0", "--W", "0.3"]
+    d = report_json(argv)
+    errors = d["kb_errors"]
+    assert [e["where"] for e in errors] == [["wall"], ["corridor"]] and d["kb_error"] == errors[0]
+    r, ctl = CARMEL.robot, CARMEL.controller
+    code, text, _ = run(["report", *argv])
+    assert code == 0
+    for e, geometry in zip(errors, ("wall", "corridor")):
+        c = d["environment"][geometry]["c"]
+        assert e["c"] == c != 0
+        assert e["NV_critical_kb_first_order"] == pytest.approx(d[geometry]["kb_first_order"]["NV_critical"], rel=1e-12)
+        assert e["NV_critical_sampled"] == pytest.approx(d[geometry]["sampled"]["NV_critical"], rel=1e-12)
+        assert e["NV_critical_kb_first_order"] == pytest.approx(_kb_first_order_NV_star(r.tau, ctl.T, r.k, c), rel=1e-9)
+        assert e["relative"] == pytest.approx(e["NV_critical_kb_first_order"] / e["NV_critical_sampled"] - 1, rel=1e-12)
+        line = next(x for x in text.splitlines() if x.startswith("KB's criterion") and f"kb_first_order, {geometry})" in x)
+        assert line.endswith(f"NV* = {e['NV_critical_kb_first_order']:.4g} vs {e['NV_critical_sampled']:.4g} 1/s.")
+    assert "NV* = 2.74 vs 2.123 1/s" not in text
+
+
+def test_kb_error_of_the_fuzzy_law_is_its_wall_loop():
+    """The fuzzy law's wall (docs/velocity_and_fuzzy.md example): one loop, c = 0.1683; KB's error compares the table's
+    kb_first_order and sampled NV*, the former also equal to the sympy Routh bound (rel 1e-9)."""
+    d = report_json([*FUZZY_WALL, "--model", "kb_first_order", "--model", "sampled"])
+    e, c = d["kb_error"], d["environment"]["wall"]["c"]
+    assert "kb_errors" not in d and e["where"] == ["wall"] and e["c"] == c
+    assert e["NV_critical_kb_first_order"] == pytest.approx(d["wall"]["kb_first_order"]["NV_critical"], rel=1e-12)
+    assert e["NV_critical_sampled"] == pytest.approx(d["wall"]["sampled"]["NV_critical"], rel=1e-12)
+    assert e["NV_critical_kb_first_order"] == pytest.approx(_kb_first_order_NV_star(CARMEL.robot.tau, CARMEL.controller.T, CARMEL.robot.k, c), rel=1e-9)
+
+
+def test_a_heading_gain_beyond_the_models_is_answered():
+    """The fuzzy law in a narrow corridor (L 0.25 m, W 0.18 m) has c ≈ 943, beyond the models' [−0.99, 100]: the report
+    answers (exit 0) instead of failing on an internal check ("c must be ... got 942.76", a value never typed). Every
+    verdict is "undecided" with NV*, margin and critical values null and a reason naming c and the corridor; no remedy,
+    no KB error for that loop; a wall in the same report is decided as usual (docs/velocity_and_fuzzy.md)."""
+    d = report_json(["--law", "fuzzy", "--L", "0.25", "--W", "0.18", "--alpha", "60"])
+    c = d["environment"]["corridor"]["c"]
+    assert c > 100
+    for v in d["corridor"].values():
+        assert v["verdict"] == "undecided" and v["stable"] is False and v["NV_critical"] is None and v["margin"] is None
+        assert v["T_critical"] is None and v["to_stabilize"] == {}
+        assert f"c = {c:.4g}" in v["reason"] and "L = 0.25 m" in v["reason"] and "[-0.99, 100]" in v["reason"]
+    assert d["kb_error"]["where"] == ["wall"] and "kb_errors" not in d
+    assert all(v["verdict"] in ("stable", "unstable") for v in d["wall"].values())
+    code, text, err = run(["report", "--law", "fuzzy", "--L", "0.25", "--W", "0.18"])
+    assert code == 0 and err == "" and "every model: undecided (c = " in text and "to stabilize" not in text

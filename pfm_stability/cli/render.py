@@ -78,11 +78,23 @@ _COLUMNS = {
 _FIELD_COLUMNS = (["eta*", "rho0* m", "xi*"], ["eta_critical", "rho0_critical", "xi_critical"])
 """Khatib's and the goal-aware law: the law's parameters in place of f* (docs/fields.md)."""
 
+_SIDES = {
+    "wall": {"NV_critical": "below", "alpha_critical_deg": "above", "f_critical": "above", "V_critical": "below", "T_critical": "below",
+             "k_critical": "below"},
+    "corridor": {"NV_critical": "below", "L_critical": "above", "f_critical": "below", "V_critical": "below", "T_critical": "below",
+                 "k_critical": "below"},
+}
+"""The stable side of each starred column that the footnote names (docs/models.md, "Critical values"); a column whose
+JSON ``stable_side`` differs anywhere (the nearest change of a law that is not monotone; η*, ρ0*, ξ* always) shows
+each value as "<= x" or ">= x" instead."""
+
 _FOOTNOTE = (
     "margin = relative distance in NV to the nearest stability boundary (NV*/NV - 1 when the stable set is (0, NV*); "
-    "> 0 stable). Starred values are critical with the other inputs fixed: every V below V*, T below T* and k below k* "
-    "is stable (T*, k*: where this operating point first loses stability); NV* = 0 and V* = 0 mean unstable at any speed; "
-    "inf = no limit; - = undefined."
+    "> 0 stable). Starred values are critical with the other inputs fixed; the loop is stable below NV*, V*, T* and k* "
+    "(T*, k*: where this operating point first loses stability), above alpha* and L*, above a wall's f* and below a corridor's f*. "
+    "A value shown as <= x or >= x is stable just below or just above x, the nearest value at which the verdict changes "
+    "(a law that is not monotone, docs/fields.md). NV* = 0 and V* = 0 mean unstable at any speed; L* = 0: stable in every "
+    "corridor the robot fits in; inf = no limit; - = undefined."
 )
 
 
@@ -122,7 +134,7 @@ def _reason_lines(verdicts: dict) -> list[str]:
 
 
 def _verdict_table(scenario: str, verdicts: dict):
-    """(header, rows, remedies) of one geometry's verdicts."""
+    """(header, rows, remedies) of one geometry's verdicts; a starred value whose stable side the footnote does not name as "<= x"/">= x"."""
     columns, keys = _COLUMNS[scenario]
     first = next(iter(verdicts.values()), {})
     if verdicts and "f_critical" not in first:  # a law with its own parameters in place of f (none: velocity, fuzzy)
@@ -131,13 +143,24 @@ def _verdict_table(scenario: str, verdicts: dict):
         columns = columns[:at] + own[0] + columns[at + 1:]
         keys = keys[:at] + own[1] + keys[at + 1:]
     header = ["model", "verdict", "margin", "NV* 1/s", "omega* rad/s"] + columns
+    named = _SIDES[scenario]
+    marked = {k for k in ["NV_critical", *keys] if any(v.get("stable_side", {}).get(k) not in (None, named.get(k)) for v in verdicts.values())}
     rows = []
     for name, v in verdicts.items():
-        cells = [name, v["verdict"].upper() if v["verdict"] != "stable" else "stable", percent(v["margin"]), number(v["NV_critical"]), number(v["omega_critical"])]
-        cells += [number(v.get(k)) for k in keys]
+        cells = [name, v["verdict"].upper() if v["verdict"] != "stable" else "stable", percent(v["margin"])]
+        cells += [_starred(v, k, k in marked) for k in ["NV_critical", "omega_critical", *keys]]
         rows.append(cells)
-    fixes = {name: (v["to_stabilize"], "eta_critical" in v) for name, v in verdicts.items() if v["verdict"] != "stable"}
+    fixes = {name: (v["to_stabilize"], "eta_critical" in v) for name, v in verdicts.items()
+             if v["verdict"] != "stable" and not (v["verdict"] == "undecided" and "reason" in v)}  # no model decides it: the reason says so
     return header, rows, fixes
+
+
+def _starred(verdict: dict, key: str, marked: bool) -> str:
+    """A critical value as text; in a `marked` column with its stable side: "<= x" (stable below) or ">= x" (above)."""
+    value, side = verdict.get(key), verdict.get("stable_side", {}).get(key)
+    if not marked or side is None or isinstance(value, str):  # "inf": no limit
+        return number(value)
+    return f"{'<=' if side == 'below' else '>='} {number(value)}"
 
 
 def _equilibrium_notes(e: dict) -> list[str]:
@@ -212,10 +235,9 @@ def _footnote(data: dict) -> list[str]:
 
 
 def _kb_error_line(report) -> list[str]:
-    if report.kb_error is None:
-        return []
-    e = report.kb_error
-    return ["", f"{e.sentence()}: NV* = {number(e.NV_kb)} vs {number(e.NV_sampled)} 1/s."]
+    """KB's error: one line per loop the tables decide (`report.kb_errors`: a heading gain that differs between the geometries)."""
+    errors = report.kb_errors or ((report.kb_error,) if report.kb_error is not None else ())
+    return ([""] if errors else []) + [f"{e.sentence()}: NV* = {number(e.NV_kb)} vs {number(e.NV_sampled)} 1/s." for e in errors]
 
 
 def render_text(report) -> str:
@@ -293,6 +315,7 @@ def render_markdown(report) -> str:
     lines += _tail(data)
     if data.get("door"):
         lines += ["", "## Door", "", "```", *render_door_text(data["door"]).rstrip("\n").splitlines(), "```"]
+    lines += _footnote(data)
     lines += _kb_error_line(report)
     return "\n".join(lines) + "\n"
 

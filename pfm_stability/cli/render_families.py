@@ -25,8 +25,8 @@ FAMILY_LABELS = {
 
 HOLONOMIC_FOOTNOTE = (
     "margin = relative distance in kappa to the nearest stability boundary (kappa*/kappa - 1; > 0 stable). "
-    "kappa* and omega*: the stiffness at which this loop (T, c_h fixed) loses stability and the frequency there; "
-    "T*: the largest stable loop delay at this kappa and c_h; c_h range: the damping values stable at this kappa and T; "
+    "kappa* and omega*: the stiffness at which this loop (T, c_h fixed) loses stability and the frequency there (stable below kappa*); "
+    "T*: the largest stable loop delay at this kappa and c_h (stable below T*); c_h range: the damping values stable at this kappa and T; "
     "inf = no limit; - = undefined."
 )
 """The footnote of a holonomic robot's report (docs/models.md, "Robot loop families")."""

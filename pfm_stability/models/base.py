@@ -455,8 +455,12 @@ def _time_scale(loop: Loop, NV: float) -> float:
 
 
 def gain_range(loop: Loop) -> tuple[float, float]:
-    """(k_lo, k_hi), 1/s: where `critical_gain_k` searches (k_hi = the largest allowed k)."""
-    return 1e-3 * loop.k, RANGES["k"].high
+    """(k_lo, k_hi), 1/s: where `critical_gain_k` searches, inside k's range (`RANGES["k"]`).
+
+    k_lo = 1e-3·k, but never below the smallest allowed k (a loop with a k
+    outside its range cannot be built: the search would fail on its own probe).
+    """
+    return max(1e-3 * loop.k, RANGES["k"].low), RANGES["k"].high
 
 
 class AffineGainModel(LoopModel):

@@ -228,7 +228,9 @@ class HolonomicModel:
 
         0 when the point is unstable already at T = 0 (κ < 0 or c_h <= 0);
         ``inf`` if it stays stable up to 100 s. Found by `solve.first_crossing`
-        on the dominant growth rate over T (bisection to 1e-9 relative);
+        on the dominant growth rate over T (bisection to 1e-9 relative, however
+        small T* is: a delay below `T_RESOLUTION` is T = 0, so T* >= 10⁻¹² s and
+        the bracket's absolute floor, 10⁻⁹·10⁻¹² s, never decides first);
         models with an exact route override it.
         """
         from ..solve import first_crossing
@@ -240,7 +242,7 @@ class HolonomicModel:
             return self._growth_rates(kappa, [replace(loop, T=float(T)) for T in Ts])
 
         scale = min(1.0 / abs(loop.c_h), 1.0 / math.sqrt(abs(kappa)))
-        return first_crossing(measure, scale * 1e-3, RANGES["T"].high, rtol=_DELAY_RTOL, atol=1e-12 * scale)
+        return first_crossing(measure, scale * 1e-3, RANGES["T"].high, rtol=_DELAY_RTOL, atol=_DELAY_RTOL * T_RESOLUTION)
 
     def _growth_rates(self, kappa: float, loops) -> np.ndarray:
         """Real part of the dominant root (1/s) at κ for each loop (models batch this where they can)."""

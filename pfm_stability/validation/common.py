@@ -21,7 +21,7 @@ import math
 from dataclasses import dataclass
 
 from ..criteria import loop_of
-from ..effective_force import GridWallLaw, f_average
+from ..effective_force import GridWallLaw
 from ..force_law import ForceLaw
 from ..models import MODEL_NAMES, make_model
 from ..parameters import CARMEL, Controller, Robot
@@ -161,8 +161,8 @@ def relative_errors(predicted: dict, simulated: float) -> dict:
 
 
 def f_av_of(law: ForceLaw) -> float:
-    """KB's f_av of a grid law (§4), or a power law's f."""
-    return f_average(law) if isinstance(law, GridWallLaw) else law.scale
+    """KB's f_av of a grid law (§4), or a power law's f (`ForceLaw.lumped_f`)."""
+    return law.lumped_f()
 
 
 def parameter_domain(parameter: str, scenario: str, env: str, robot: Robot, controller: Controller, law: ForceLaw, alpha, cell_size: float = 0.1):
