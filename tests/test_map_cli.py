@@ -40,7 +40,7 @@ def run(argv):
     return code, out.getvalue(), err.getvalue()
 
 
-ROBOTS = {"depot": ["--W", "0.4", "--tau", "0.2", "--k", "10", "--T", "0.05", "--f", "2", "--V", "0.3"], "tb3_sandbox": ["--W", "0.2", "--tau", "0.1", "--k", "20", "--T", "0.025", "--f", "2", "--V", "0.4", "--min-length", "0.5"]}
+ROBOTS = {"depot": ["--W", "0.4", "--tau", "0.2", "--k", "10", "--T", "0.05", "--f", "2", "--V", "0.3"], "tb3_sandbox": ["--W", "0.2", "--tau", "0.1", "--k", "20", "--T", "0.025", "--f", "2", "--V", "0.6", "--min-length", "0.5"]}
 
 
 @pytest.mark.parametrize("name", list(ROBOTS))
