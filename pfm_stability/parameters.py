@@ -45,6 +45,7 @@ __all__ = [
     "GEOMETRIES",
     "ENVIRONMENTS",
     "FORCE_LAWS",
+    "MAP_LAWS",
     "DOOR_OBSTACLES",
     "TRAPS_RESOLUTION",
     "LAW_PARAMETERS",
@@ -104,6 +105,10 @@ DOOR_OBSTACLES = ("posts", "wall-ends")
 FORCE_LAWS = ("power", "grid", "khatib", "gnron")
 """Lateral force laws by name: KB's lumped power law, the histogram grid's effective law, Khatib's
 repulsion and Ge & Cui 2000's goal-aware repulsion (docs/fields.md)."""
+
+MAP_LAWS = ("grid", "power")
+"""The `FORCE_LAWS` a map analysis takes (``pfm-stability map``, docs/maps.md): the histogram grid's window sum
+(its default) and KB's power law; Khatib's and the goal-aware laws need the distance to a goal, which a map does not give."""
 
 LAW_PARAMETERS = {
     "power": ("f", "n"),

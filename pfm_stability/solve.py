@@ -99,7 +99,7 @@ def expand_bracket(func, start: float, *, factor: float = 2.0, steps: int = 200,
     return None
 
 
-def newton_increasing(func, lo, hi, *, rtol: float = 4e-16, iterations: int = 200):
+def newton_increasing(func, lo, hi, *, rtol: float = 4e-16, atol: float = 0.0, iterations: int = 200):
     """Roots of strictly increasing functions, one per bracket, for arrays of brackets at once.
 
     Safeguarded Newton (Numerical Recipes' ``rtsafe``): a Newton step that
@@ -114,8 +114,11 @@ def newton_increasing(func, lo, hi, *, rtol: float = 4e-16, iterations: int = 20
         f(lo) <= 0 <= f(hi).
     lo, hi : array_like
         Brackets (finite).
-    rtol : float
-        Stop when every step is below rtol·|x| (or the bracket is that narrow).
+    rtol, atol : float
+        Stop when every step is below rtol·|x| + atol (or the bracket is that narrow); atol (units of x) for roots
+        at or near 0, where rtol·|x| is below f's round-off.
+    iterations : int
+        At most this many steps.
 
     Returns
     -------
@@ -133,12 +136,12 @@ def newton_increasing(func, lo, hi, *, rtol: float = 4e-16, iterations: int = 20
         with np.errstate(divide="ignore", invalid="ignore"):
             correction = f / slope
         newton = x - correction
-        converged = (f == 0) | (np.abs(correction) <= rtol * np.abs(x))
+        converged = (f == 0) | (np.abs(correction) <= rtol * np.abs(x) + atol)
         good = np.isfinite(newton) & (newton > lo) & (newton < hi) & (np.abs(correction) < 0.5 * previous)
         step_to = np.where(converged, x, np.where(good, newton, 0.5 * (lo + hi)))
         previous = np.abs(step_to - x)
         x = step_to
-        if np.all(converged | (hi - lo <= rtol * np.abs(x))):
+        if np.all(converged | (hi - lo <= rtol * np.abs(x) + atol)):
             break
     return x
 

@@ -40,7 +40,7 @@ def run(argv):
     return code, out.getvalue(), err.getvalue()
 
 
-ROBOTS = {"depot": ["--W", "0.4", "--tau", "0.2", "--k", "10", "--T", "0.05", "--f", "2", "--V", "0.3"], "tb3_sandbox": ["--W", "0.2", "--tau", "0.1", "--k", "20", "--T", "0.025", "--f", "2", "--V", "0.4", "--min-length", "0.5"]}
+ROBOTS = {"depot": ["--W", "0.4", "--tau", "0.2", "--k", "10", "--T", "0.05", "--f", "2", "--V", "0.3"], "tb3_sandbox": ["--W", "0.2", "--tau", "0.1", "--k", "20", "--T", "0.025", "--f", "2", "--V", "0.6", "--min-length", "0.5"]}
 
 
 @pytest.mark.parametrize("name", list(ROBOTS))
@@ -158,7 +158,7 @@ def test_existing_output_directory_is_untouched_on_failure(tmp_path):
 
 
 @pytest.mark.parametrize("argv, message", [
-    (["map", "depot", "--law", "khatib", "--goal-distance", "3"], "law must be one of grid, power"),
+    (["map", "depot", "--law", "khatib", "--goal-distance", "3"], "argument --law: invalid choice: 'khatib'"),
     (["map", "depot", "--out-dir", "/nonexistent-dir/x"], "out-dir must be a writable directory"),
     (["map", "depot", "--validate", "0"], "validate must be an integer"),
     (["map", "depot", "--min-length", "-1"], "min_length must be a finite number in (0, 10000] m"),
@@ -178,3 +178,81 @@ def test_law_named_by_a_config_file_is_checked_too(tmp_path, law):
     code, stdout, err = run(["map", str(tmp_path / "missing.yaml"), "--config", str(config), "--quiet"])
     assert code == 2 and stdout == ""
     assert err.startswith("pfm-stability: error: law must be one of grid, power") and law in err
+
+
+def test_help_lists_only_the_laws_map_takes():
+    """``map --help`` offers --law grid and power (`parameters.MAP_LAWS`), grid the default, and none of the options of
+    the laws it refuses (Khatib's and the goal-aware law need a goal a map does not give)."""
+    buffer = io.StringIO()
+    with contextlib.redirect_stdout(buffer), pytest.raises(SystemExit) as exit_:
+        main(["map", "--help"])
+    out = buffer.getvalue()
+    assert exit_.value.code == 0
+    assert "--law {grid,power}" in out and "khatib" not in out and "gnron" not in out
+    for option in ("--xi", "--eta", "--rho0", "--goal-distance", "--goal-exponent", "--attraction-exponent", "--delta"):
+        assert option not in out
+    law_help = " ".join(out.split("--law {grid,power}")[-1].split("--cell-ratio")[0].split())
+    assert law_help.endswith("the histogram grid's law (default, unless the configuration file names one)")
+
+
+@pytest.mark.parametrize("command, name, folder", [("map", "nosuchmap", "maps"), ("traps", "nosuchscene", "scenes")])
+def test_unknown_shipped_name_lists_the_shipped_ones(command, name, folder):
+    """A bare name that is neither a file nor shipped: exit 2, one line listing the shipped names, each of which is a
+    file of pfm_stability/data/<folder> (every scene file there; every map but depot_speed, Nav2's example speed mask,
+    which is not an occupancy map)."""
+    code, out, err = run([command, name])
+    assert code == 2 and out == "" and len(err.strip().splitlines()) == 1
+    assert f"{name!r} is neither a file nor a shipped" in err
+    listed = err.split("(shipped: ")[1].rstrip(")\n").split(", ")
+    files = Path(str(resources.files("pfm_stability").joinpath("data", folder)))
+    assert sorted(listed) == sorted(p.stem for p in files.glob("*.yaml") if p.stem != "depot_speed")
+
+
+@pytest.mark.parametrize("origin", ["[0.0, 0.0]", "[0.0, 0.0, 0.0, 1.0]", "0.0", "[0.0, .nan, 0.0]", "[0.0, 0.0, true]"])
+def test_origin_map_server_refuses_is_refused(tmp_path, origin):
+    """Nav2's map_server takes origin as exactly three numbers [x, y, yaw] ("value of the 'origin' tag should have 3
+    elements"; a bool is not a number to it): two (the yaw left out), four, a scalar or a bool are refused, and NaN too
+    (map_server would read it; no coordinate follows from it): exit 2, one line naming origin."""
+    path = _copy_map(tmp_path)
+    path.write_text(path.read_text().replace("origin: [0.0, 0.0, 0]", f"origin: {origin}"))
+    code, out, err = run(["map", str(path), "--quiet"])
+    assert code == 2 and out == "" and len(err.strip().splitlines()) == 1 and "origin" in err
+
+
+def _open_corridor(tmp_path: Path, resolution: float, gap_pixels: int, length_pixels: int) -> Path:
+    """A map of one straight corridor of `gap_pixels` free pixels between one-pixel walls, `length_pixels` long."""
+    img = np.full((length_pixels, gap_pixels + 2), 254, dtype=np.uint8)
+    img[:, 0] = img[:, -1] = 0
+    Image.fromarray(img).save(tmp_path / "c.pgm")
+    path = tmp_path / "c.yaml"
+    path.write_text(f"image: c.pgm\nresolution: {resolution}\norigin: [0.0, 0.0, 0.0]\nnegate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n")
+    return path
+
+
+def test_a_resolution_typo_is_warned_about(tmp_path):
+    """A corridor of 8 pixels at 0.25 m/pixel (meant: 0.025): the map is analysed with one warning line on stderr
+    (before the analysis' work) and the same line in the JSON's ``warnings``: a pixel (0.25 m) is wider than half the
+    robot (W/2 = 0.2 m; `maps.analysis.MAX_RESOLUTION`). A corridor of 20 pixels at 0.05 m/pixel (1 m, 2.5 W): none."""
+    code, out, err = run(["map", str(_open_corridor(tmp_path, 0.25, 8, 40)), "--W", "0.4", "--format", "json", "--quiet"])
+    assert code == 0, err
+    warnings = [line for line in err.splitlines() if line.startswith("pfm-stability: warning: ")]
+    assert len(warnings) == 1 and "resolution 0.25 m/pixel is implausible" in warnings[0] and "0.2 m" in warnings[0]
+    data = json.loads(out)
+    assert data["warnings"] == [warnings[0].removeprefix("pfm-stability: warning: ")]
+    assert VALIDATOR.is_valid(data)
+    code, out, err = run(["map", str(_open_corridor(tmp_path, 0.05, 20, 200)), "--W", "0.4", "--format", "json", "--quiet"])
+    assert code == 0 and err == "" and json.loads(out)["warnings"] == []
+
+
+def test_corridors_many_robot_widths_wide_are_warned_about(tmp_path):
+    """At a plausible resolution (0.1 m/pixel) a corridor 5 m wide (20 m long) is 12.5 robot widths (W = 0.4 m), more
+    than `maps.analysis.MAX_CORRIDOR_WIDTHS` = 10 (a resolution 10 times too large looks like this): one warning line
+    naming the width (4.9 m: twice the clearance of the skeleton's cells, half a cell beside the axis of an even gap).
+    A 3.8 m corridor (9.5 W) is not warned about."""
+    code, out, err = run(["map", str(_open_corridor(tmp_path, 0.1, 50, 200)), "--W", "0.4", "--format", "json", "--quiet"])
+    assert code == 0, err
+    (line,) = err.splitlines()
+    assert line.startswith("pfm-stability: warning: ") and "narrowest corridor is 4.9 m wide, 12 robot widths" in line
+    assert json.loads(out)["warnings"] == [line.removeprefix("pfm-stability: warning: ")]
+    code, out, err = run(["map", str(_open_corridor(tmp_path, 0.1, 38, 200)), "--W", "0.4", "--format", "json", "--quiet"])
+    assert code == 0 and err == "" and json.loads(out)["warnings"] == []

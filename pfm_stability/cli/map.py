@@ -9,19 +9,22 @@ histogram grid, finds the corridors (the medial axis of the free space) as strai
 segments and decides each with the chosen loop model (default: ``sampled`` with the
 controller's hold and compute delay): N, V*, margin, verdict. The text output is a
 table of the worst segments and a summary; ``--format json`` prints ``map``,
-``inputs``, ``segments``, ``summary``, ``validation`` (null without ``--validate``),
-``outputs``, ``timing``. ``--out-dir DIR`` writes ``stability.png``, ``segments.csv``,
+``inputs``, ``segments``, ``summary``, ``warnings``, ``validation`` (null without
+``--validate``: else ``agreement`` and the counts ``agreed``, ``disagreed``,
+``not_measurable``, ``measured``), ``outputs``, ``timing``. A map whose scale looks
+wrong for the robot (a resolution typo) is analysed with a one-line warning on
+stderr, also in ``warnings``. ``--out-dir DIR`` writes ``stability.png``, ``segments.csv``,
 ``speed_mask.pgm`` and ``speed_mask.yaml`` (a Nav2 Speed Filter mask), all or none.
-A bad map is one line naming the file and the problem, exit status 2.
+A bad map, or a name that is neither a file nor a shipped map, is one line naming the
+file and the problem, exit status 2.
 """
 
 from __future__ import annotations
 
 import argparse
 
-from ..parameters import MODEL_NAMES
+from ..parameters import MAP_LAWS, MODEL_NAMES
 from .options import (
-    Default,
     add_law_options,
     add_parameter_options,
     describe,
@@ -60,8 +63,7 @@ def add_parser(sub) -> None:
     )
     p.add_argument("map", metavar="MAP", help=f"map_server YAML file, or a shipped map: {', '.join(SHIPPED_MAPS)}")
     add_parameter_options(p)
-    add_law_options(p)
-    p.set_defaults(law=Default("grid"))  # a Default: a --config FILE's law beats it (`options.typed`)
+    add_law_options(p, MAP_LAWS, default="grid")  # a Default: a --config FILE's law beats it (`options.typed`)
     p.add_argument("--model", choices=MODEL_NAMES, default="sampled",
                    help="loop model of the verdicts (default sampled, with the controller's hold and compute delay)")
     p.add_argument("--out-dir", type=_out_dir, metavar="DIR",
@@ -78,8 +80,8 @@ def add_parser(sub) -> None:
 
 
 def map_path(name: str) -> str:
-    """The YAML file of `name`: a shipped map's (by name) or `name` itself."""
-    return shipped_or_given(name, "maps", SHIPPED_MAPS)
+    """The YAML file of `name`: a shipped map's (by name) or `name` itself (ValueError naming the shipped maps if neither)."""
+    return shipped_or_given(name, "maps", SHIPPED_MAPS, "map")
 
 
 def _validate(analysis, count: int, seed: int, progress):
@@ -122,6 +124,7 @@ def _write_outputs(analysis, out_dir: str) -> dict:
 
 
 def run(args) -> int:
+    import sys
     import time
 
     from ..extras import require
@@ -141,7 +144,8 @@ def run(args) -> int:
     occupancy = load_map(map_path(args.map))
     with line_progress("map", quiet=args.quiet) as progress:
         analysis = analyze_map(occupancy, params.robot, params.controller, law, model=args.model, unknown=args.unknown,
-                               cell_size=args.cell_size, min_length=args.min_length, progress=progress)
+                               cell_size=args.cell_size, min_length=args.min_length, progress=progress,
+                               warn=lambda line: print(f"pfm-stability: warning: {line}", file=sys.stderr, flush=True))
         validation = _validate(analysis, args.validate, args.seed, progress) if args.validate else None
         outputs = _write_outputs(analysis, args.out_dir) if args.out_dir else None
     data = {

@@ -8,6 +8,7 @@ where every value came from so reports can mark the assumed ones.
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 from dataclasses import dataclass, fields
 from typing import TYPE_CHECKING
@@ -152,15 +153,24 @@ def input_file(name: str):
     return parse
 
 
-def shipped_or_given(name: str, folder: str, shipped) -> str:
+def shipped_or_given(name: str, folder: str, shipped, kind: str) -> str:
     """The YAML file of `name`: ``pfm_stability/data/<folder>/<name>.yaml`` when `name` is in `shipped`, else `name` itself.
 
-    Used by ``map`` (shipped maps) and ``traps`` (shipped scenes).
+    Used by ``map`` (shipped maps) and ``traps`` (shipped scenes); `kind` ("map", "scene") names them in the error.
+    A name with a directory or an extension is a path, left to the file's reader (which names a missing file).
+
+    Raises
+    ------
+    ValueError
+        A bare name (no directory, no extension) that is neither shipped nor an existing file: one line listing the
+        shipped names.
     """
     if name in shipped:
         from importlib import resources
 
         return str(resources.files("pfm_stability").joinpath("data", folder, f"{name}.yaml"))
+    if not (os.path.dirname(name) or os.path.splitext(name)[1] or os.path.exists(name)):
+        raise ValueError(f"{kind} {name!r} is neither a file nor a shipped {kind} (shipped: {', '.join(shipped)})")
     return name
 
 
@@ -315,14 +325,24 @@ def _option(name: str) -> str:
     return "--" + name.replace("_", "-")
 
 
-def add_law_options(parser: argparse.ArgumentParser, laws=FORCE_LAWS) -> None:
-    """--law (one of `laws`) and the options of the laws (`LAW_OPTIONS`); each applies to the laws of `parameters.LAW_PARAMETERS` only."""
+LAW_HELP = {"power": "KB's power law f(W/d)^n", "grid": "the histogram grid's law", "khatib": "Khatib's repulsion",
+            "gnron": "Ge & Cui's goal-aware repulsion (gnron)"}
+"""How ``--law``'s help names each of `parameters.FORCE_LAWS`."""
+
+
+def add_law_options(parser: argparse.ArgumentParser, laws=FORCE_LAWS, default: str = "power") -> None:
+    """--law (one of `laws`, `default` unless a configuration file names one) and the options of those laws (`LAW_OPTIONS`
+    that `parameters.LAW_PARAMETERS` gives them); each applies to its laws only. The help names only `laws`."""
     group = parser.add_argument_group("force law (docs/fields.md)")
     extra = "; velocity, velocity-gated, fuzzy: docs/velocity_and_fuzzy.md" if len(laws) > len(FORCE_LAWS) else ""
-    group.add_argument("--law", choices=laws, default=Default("power"),
-                       help="lateral force law: KB's power law f(W/d)^n (default, unless the configuration file names one), "
-                            f"the histogram grid's law, Khatib's repulsion or Ge & Cui's goal-aware repulsion (gnron){extra}")
+    named = [LAW_HELP[law] + (" (default, unless the configuration file names one)" if law == default else "")
+             for law in FORCE_LAWS if law in laws]
+    group.add_argument("--law", choices=laws, default=Default(default),
+                       help=f"lateral force law: {', '.join(named[:-1])}{' or ' if len(named) > 1 else ''}{named[-1]}{extra}")
+    taken = {name for law in laws for name in LAW_PARAMETERS.get(law, ())}
     for name, text in LAW_OPTIONS.items():
+        if name not in taken:
+            continue
         kind = integer(name, odd=True) if name == "window_cells" else number(name)
         group.add_argument(_option(name), type=kind, help=f"{text}, {describe(name)}")
 

@@ -591,7 +591,9 @@ def render_map_text(data: dict) -> str:
     ]
     v = data.get("validation")
     if v is not None:
-        lines.append(f"validation: {v.get('agreed')} of {v.get('measured')} simulated segments agree (agreement {percent(v.get('agreement'))[1:] if v.get('agreement') is not None else '-'})")
+        share = f"{percent(v['agreement'])[1:]} of the {v['measured']} measured" if v.get("agreement") is not None else "- (none measured)"
+        lines.append(f"validation: {len(v['cases'])} simulated segments: {v['agreed']} agree, {v['disagreed']} disagree, "
+                     f"{v['not_measurable']} not measurable; agreement {share}")
     for name, path in (data.get("outputs") or {}).items():
         lines.append(f"{name}: {path}")
     return "\n".join(lines) + "\n"

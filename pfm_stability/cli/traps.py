@@ -44,8 +44,8 @@ def add_parser(sub) -> None:
 
 
 def scene_path(name: str) -> str:
-    """The file of `name`: a shipped scene's (by name) or `name` itself."""
-    return shipped_or_given(name, "scenes", SHIPPED_SCENES)
+    """The file of `name`: a shipped scene's (by name) or `name` itself (ValueError naming the shipped scenes if neither)."""
+    return shipped_or_given(name, "scenes", SHIPPED_SCENES, "scene")
 
 
 def run(args) -> int:

@@ -46,7 +46,7 @@ import numpy as np
 from ..effective_force import GridWallLaw
 from ..force_law import ForceLaw, PowerLaw
 from ..models import Loop, divergent_reason, gain_margin, models_for, neutral_reason, verdict_label
-from ..parameters import Controller, Robot
+from ..parameters import MAP_LAWS, Controller, Robot
 from ..serialize import json_number
 from .equilibria import Samples, grid_equilibria, power_equilibria
 from .field import UNKNOWN_AS, HistogramMap, histogram_of
@@ -54,12 +54,21 @@ from .occupancy import OccupancyMap
 from .routes import Route, default_min_length, find_routes
 from .verdicts import END_FRACTION, TAPER_SLOPE, GrowthRate, drift_slope, critical_speed, is_weak, judged_run, segment_gain, wavelength
 
-__all__ = ["DIRECTIONS", "MAP_LAWS", "NO_VERDICT", "MapAnalysis", "MapSegment", "analyze_map", "sample_verdict"]
+__all__ = ["DIRECTIONS", "MAP_LAWS", "MAX_CORRIDOR_WIDTHS", "MAX_MAP_SIDE", "MAX_RESOLUTION", "NO_VERDICT", "MapAnalysis", "MapSegment",
+           "analyze_map", "corridor_warnings", "sample_verdict", "scale_warnings"]
 
-MAP_LAWS = ("grid", "power")
-"""Force laws a map analysis supports: the histogram grid's window sum (default) and KB's power law."""
 DIRECTIONS = ("forward", "reverse")
 """Travel directions of a segment: from (x0, y0) to (x1, y1), and back."""
+MAX_MAP_SIDE = 1000.0
+"""Longest side of a plausible map, m: the largest buildings are under 1 km long; a longer map is most often a
+resolution typo (5.0 for 0.05 makes a map 100 times too large, and its analysis minutes long)."""
+MAX_RESOLUTION = 0.5
+"""Coarsest plausible resolution, in robot widths W (m/pixel): a pixel wider than W/2 cannot draw the clearance a
+robot needs (a corridor the robot fits in is then at most a few pixels wide); Nav2's maps use 0.02–0.1 m."""
+MAX_CORRIDOR_WIDTHS = 10.0
+"""Narrowest corridor of a plausible map, in robot widths: when even the narrowest corridor (twice the clearance
+along the route, the median over each segment) is wider than 10 W, the map's scale is most likely wrong (a
+resolution 10 times too large makes 1 m corridors 10 m wide); building corridors are 2–5 robot widths."""
 NO_VERDICT = ("open", "no equilibrium", "weak", "end effect", "tapering")
 """Verdicts of a segment without a verdict: no lateral equilibrium, a field too weak to show (`verdicts.is_weak`), or
 too little of it where the corridor model holds (`verdicts.judged_run`: a wall ahead or behind), or an equilibrium
@@ -185,6 +194,8 @@ class MapAnalysis:
         How unknown cells counted ("occupied" or "free").
     timing : dict
         Seconds per stage (read, grid, routes, equilibria, verdicts).
+    warnings : tuple of str
+        One line each: an implausible scale of the map (`scale_warnings`, `corridor_warnings`).
     """
 
     occupancy: OccupancyMap
@@ -200,6 +211,7 @@ class MapAnalysis:
     clearance: np.ndarray
     unknown: str
     timing: dict = field(default_factory=dict)
+    warnings: tuple = ()
 
     @property
     def unstable_length(self) -> float:
@@ -224,7 +236,7 @@ class MapAnalysis:
         }
 
     def to_dict(self) -> dict:
-        """``map``, ``inputs``, ``segments``, ``summary`` (the JSON of ``pfm-stability map``, without validation)."""
+        """``map``, ``inputs``, ``segments``, ``summary``, ``warnings`` (the JSON of ``pfm-stability map``, without validation)."""
         g = self.grid
         return {
             "map": self.occupancy.to_dict(),
@@ -239,6 +251,7 @@ class MapAnalysis:
             "NV_critical": json_number(self.NV_critical),
             "segments": [s.to_dict() for s in self.segments],
             "summary": self.summary(),
+            "warnings": list(self.warnings),
         }
 
 
@@ -254,9 +267,40 @@ def check_map_law(law) -> None:
                          f"which a map does not give); got {name!r}")
 
 
+def scale_warnings(occupancy: OccupancyMap, W: float) -> tuple:
+    """One line if the map's resolution looks wrong for a robot of width W (m): coarser than `MAX_RESOLUTION`·W per
+    pixel, or a map side longer than `MAX_MAP_SIDE`; () otherwise (docs/maps.md, "Map files")."""
+    r = occupancy.resolution
+    x0, x1, y0, y1 = occupancy.extent
+    reasons = [f"a pixel is wider than {MAX_RESOLUTION:g} W = {MAX_RESOLUTION * W:g} m"] if r > MAX_RESOLUTION * W else []
+    if max(x1 - x0, y1 - y0) > MAX_MAP_SIDE:
+        reasons.append(f"the map is {x1 - x0:.0f} x {y1 - y0:.0f} m, larger than any building ({MAX_MAP_SIDE:g} m)")
+    if not reasons:
+        return ()
+    return (f"map {occupancy.name!r}: resolution {r:g} m/pixel is implausible ({'; '.join(reasons)}): check the map's YAML file "
+            f"(a typo such as 5.0 for 0.05?)",)
+
+
+def corridor_warnings(occupancy: OccupancyMap, grid: HistogramMap, routes, clearance: np.ndarray, W: float) -> tuple:
+    """One line if even the narrowest corridor is wider than `MAX_CORRIDOR_WIDTHS` robot widths W (m): a corridor's
+    width is twice the clearance (m, per histogram cell) along its segment, the median over the segment's cells."""
+    widths = []
+    for r in routes:
+        count = max(2, int(math.ceil(r.length / grid.cell_size)))
+        i, j = grid.cell_index(np.linspace(r.x0, r.x1, count), np.linspace(r.y0, r.y1, count))
+        inside = (i >= 0) & (i < grid.shape[0]) & (j >= 0) & (j < grid.shape[1])
+        if inside.any():
+            widths.append(2.0 * float(np.median(clearance[i[inside], j[inside]])))
+    if not widths or min(widths) <= MAX_CORRIDOR_WIDTHS * W:
+        return ()
+    return (f"map {occupancy.name!r}: its narrowest corridor is {min(widths):.3g} m wide, {min(widths) / W:.0f} robot widths "
+            f"(W = {W:g} m; more than {MAX_CORRIDOR_WIDTHS:g} is implausible): check the resolution ({occupancy.resolution:g} m/pixel) "
+            f"in the map's YAML file",)
+
+
 def analyze_map(occupancy: OccupancyMap, robot: Robot, controller: Controller, law: ForceLaw, *, model: str = "sampled",
                 unknown: str = "occupied", cell_size: float | None = None, min_length: float | None = None,
-                progress=None, end_fraction: float = END_FRACTION, taper_slope: float = TAPER_SLOPE) -> MapAnalysis:
+                progress=None, end_fraction: float = END_FRACTION, taper_slope: float = TAPER_SLOPE, warn=None) -> MapAnalysis:
     """Every corridor segment of a map, decided (module docstring).
 
     Parameters
@@ -282,6 +326,9 @@ def analyze_map(occupancy: OccupancyMap, robot: Robot, controller: Controller, l
     taper_slope : float
         Largest |ds0/ds| of the judged part's equilibrium offset with a verdict, > 0 (`verdicts.TAPER_SLOPE`;
         inf: no tapering rule).
+    warn : callable, optional
+        ``warn(line)`` for each warning as soon as it is known (`scale_warnings` before any work,
+        `corridor_warnings` once the routes are found); the warnings are also in `MapAnalysis.warnings`.
 
     Raises
     ------
@@ -297,6 +344,14 @@ def analyze_map(occupancy: OccupancyMap, robot: Robot, controller: Controller, l
     if unknown not in UNKNOWN_AS:
         raise ValueError(f"unknown must be one of {', '.join(UNKNOWN_AS)}; got {unknown!r}")
     say = progress or (lambda line: None)
+    warnings = []
+
+    def caution(lines):
+        warnings.extend(lines)
+        for line in lines:
+            (warn or (lambda text: None))(line)
+
+    caution(scale_warnings(occupancy, robot.W))
     timing, clock = {}, time.perf_counter()
 
     def stage(name):
@@ -316,6 +371,8 @@ def analyze_map(occupancy: OccupancyMap, robot: Robot, controller: Controller, l
     if not routes:
         raise ValueError(f"map {occupancy.name!r} has no route long enough: no straight corridor of at least "
                          f"{min_length if min_length is not None else default_min_length(robot.W):g} m where a robot of width W = {robot.W:g} m fits")
+    if not warnings:  # one cause, one line: a resolution already flagged makes the corridors wide too
+        caution(corridor_warnings(occupancy, grid, routes, clearance, robot.W))
     stage("routes")
     if is_grid:
         samples = grid_equilibria(grid, law, routes, clearance, robot.W)
@@ -332,7 +389,7 @@ def analyze_map(occupancy: OccupancyMap, robot: Robot, controller: Controller, l
                      for k, r in enumerate(routes))
     stage("verdicts")
     return MapAnalysis(occupancy, grid, law, robot, controller, loop_model.name, boundary.NV_critical, segments, samples,
-                       skeleton, clearance, unknown, timing)
+                       skeleton, clearance, unknown, timing, tuple(warnings))
 
 
 def _stable(NV: float, boundary) -> bool:

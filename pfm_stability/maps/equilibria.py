@@ -3,10 +3,11 @@
 At a sample point p of a segment with unit travel direction t and left normal
 nrm, the robot at p + s·nrm feels the attraction t (F_ct = 1) and the repulsion
 F_r(p + s·nrm). The lateral force is F_n(s) = F_r·nrm, the forward force
-F_t = 1 + F_r·t. An equilibrium is a root s0 of F_n inside the free band (where
-the robot fits: |s| < clearance − W/2, and within the window's reach); with
-several roots the one nearest the medial axis is taken and the count recorded.
-The environment gain is
+F_t = 1 + F_r·t. An equilibrium is a root s0 of F_n inside the free band: the run
+of positions across the segment where the robot fits (clearance > W/2, measured on
+both sides of p, so a sample off the corridor's axis still has the axis in its
+band; `_band`), within the window's reach; with several roots the one nearest the
+sample (on the medial axis) is taken and the count recorded. The environment gain is
 
     N = −(dF_n/ds)(s0) / F_t(s0),   1/m (KB eq 22–25 with the forward force),
 
@@ -18,11 +19,17 @@ F_t <= 0 means the repulsion stops the robot: no equilibrium.
 ``grid`` law: F_r is the exact window sum (`field.window_force`), averaged over the
 robot's position along the segment within one cell (`PHASE_NODES`), as KB's grid law
 is (`effective_force.GridWallLaw`: along a wall the sum varies by a few per cent
-with that position, and a moving robot feels the mean). The band is
-scanned every c/2 for sign changes of F_n, and each root is refined by Newton
-steps with the exact derivative nrm·J·nrm inside its bracket (the field is
-smooth inside a cell; at a cell boundary it may jump, and a root there is kept at
-the jump with the derivative of the cell it lies in).
+with that position, and a moving robot feels the mean). The band is scanned in
+equal steps of at most c/2 from edge to edge (at least two, so a band narrower
+than one step is still searched), and a root is a strict sign change of F_n between
+neighbouring scan points or a scan point where F_n is exactly 0 between neighbours
+of opposite signs (the axis of a symmetric corridor, where the two walls cancel to
+the last bit, whenever it is a scan point); a stretch of exact zeros (no wall in
+the window) is neutral. Each root's bracket is narrowed by safeguarded Newton steps
+with the exact derivative nrm·J·nrm (`solve.newton_increasing`): the field is
+smooth inside a cell; at a cell boundary it may jump (the window gains or loses a
+column), and a root there is located at the jump and takes the derivative of the
+cell it lies in.
 
 ``power`` law (KB's lumped f(W/d)^n, no window): the distances a, b to the first
 blocked map pixel along +nrm and −nrm give a corridor of half-width L = (a + b)/2
@@ -39,12 +46,14 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..effective_force import GridWallLaw
+from ..solve import newton_increasing
 from .field import HistogramMap, window_force
 
 __all__ = ["NEWTON_STEPS", "RAY_LENGTH", "Samples", "grid_equilibria", "power_equilibria"]
 
-NEWTON_STEPS = 8
-"""Newton steps refining a root inside its scan bracket (quadratic convergence: 8 reach round-off)."""
+NEWTON_STEPS = 12
+"""Safeguarded Newton steps narrowing a root's scan bracket (`solve.newton_increasing`): a smooth root reaches
+round-off in a few, a jump of F_n at a cell boundary is located to the bracket / 2^12 (~10 µm)."""
 RAY_LENGTH = 50.0
 """How far a ray looks for a wall, m (`power` law)."""
 RAY_STEP = 0.125
@@ -52,7 +61,12 @@ RAY_STEP = 0.125
 PHASE_NODES = 4
 """Gauss–Legendre nodes of the average over the robot's position along the segment within a cell."""
 SCAN_STEP_CELLS = 0.5
-"""Spacing of the scan for sign changes of F_n, cells."""
+"""Largest spacing of the scan for sign changes of F_n, cells."""
+ROOT_TOLERANCE = 1e-12
+"""Absolute tolerance of a refined equilibrium offset, m (`solve.newton_increasing`: the root of a symmetric corridor
+sits at s = 0, where a relative tolerance is below F_n's round-off)."""
+BAND_STEP_CELLS = 0.125
+"""Spacing of the positions across a segment tested for the robot's fit (`_band`), cells."""
 
 
 @dataclass(frozen=True)
@@ -74,7 +88,7 @@ class Samples:
     roots : ndarray of int
         Roots of F_n found in the band.
     field : ndarray of bool
-        Whether any repulsion acts on the axis (False: an open area, no wall in the window).
+        Whether the window of the sample's cell holds a wall (False: an open area, no repulsion).
     along : ndarray or None
         F_r·t at the equilibrium, units of F_ct (t: the direction from the segment's start to its end;
         nan where there is no equilibrium). The gain of one travel direction is `directional`.
@@ -125,13 +139,50 @@ def sample_points(routes, spacing: float):
     return tuple(np.concatenate(a) for a in (xs, ys, seg, txs, tys))
 
 
-def _band(grid: HistogramMap, clearance: np.ndarray, x, y, W: float, reach: float):
-    """Half-width of the free band at each point: clearance of its cell − W/2, at most `reach`, m."""
-    i, j = grid.cell_index(x, y)
-    nx, ny = grid.shape
-    inside = (i >= 0) & (i < nx) & (j >= 0) & (j < ny)
-    cl = np.where(inside, clearance[np.clip(i, 0, nx - 1), np.clip(j, 0, ny - 1)], 0.0)
-    return np.minimum(cl - W / 2, reach)
+def _clearance_at(grid: HistogramMap, clearance: np.ndarray, x, y) -> np.ndarray:
+    """The clearance (m) at points: bilinear between the cell centres' (`HistogramMap.clearance`), 0 outside the grid.
+
+    Exact across a straight axis-parallel wall (the clearance is linear in the distance from it); between the two
+    middle cells of a corridor whose axis is a cell boundary it is their common value, below the axis' own (a
+    conservative reading, and the band's edges stay exact).
+    """
+    c = grid.cell_size
+    u = (np.asarray(x, dtype=float) - grid.x_min) / c - 0.5
+    v = (np.asarray(y, dtype=float) - grid.y_min) / c - 0.5
+    i0, j0 = np.floor(u).astype(np.int64), np.floor(v).astype(np.int64)
+    fu, fv = u - i0, v - j0
+    nx, ny = clearance.shape
+    out = np.zeros(np.shape(u))
+    for di, dj, weight in ((0, 0, (1 - fu) * (1 - fv)), (1, 0, fu * (1 - fv)), (0, 1, (1 - fu) * fv), (1, 1, fu * fv)):
+        i, j = i0 + di, j0 + dj
+        inside = (i >= 0) & (i < nx) & (j >= 0) & (j < ny)
+        out += weight * np.where(inside, clearance[np.clip(i, 0, nx - 1), np.clip(j, 0, ny - 1)], 0.0)
+    return out
+
+
+def _band(grid: HistogramMap, clearance: np.ndarray, x, y, tx, ty, W: float, reach: float):
+    """(low, high): the free band across the segment at each point, s in [low, high] along nrm = (−ty, tx), m.
+
+    The run of positions where the robot fits (`_clearance_at` > W/2), within the window's `reach` on both sides,
+    that holds the point itself or, when the point does not fit, lies nearest to it; found on a grid of
+    `BAND_STEP_CELLS` (its edges are the last positions on that grid that fit). Both sides are measured, so a point
+    off the corridor's axis (a skeleton half a cell to one side of a symmetric corridor's axis, a polyline within a
+    cell of its skeleton) still has the axis in its band. low > high: the robot fits nowhere across the point.
+    """
+    step = BAND_STEP_CELLS * grid.cell_size
+    half = int(math.floor(reach / step))
+    offsets = np.arange(-half, half + 1) * step
+    fits = _clearance_at(grid, clearance, x[:, None] - ty[:, None] * offsets, y[:, None] + tx[:, None] * offsets) > W / 2
+    # the fitting position nearest to the point, then the run of fitting positions around it
+    distance = np.where(fits, np.abs(offsets), np.inf)
+    centre = np.argmin(distance, axis=1)
+    rows = np.arange(x.size)
+    any_fit = np.isfinite(distance[rows, centre])
+    index = np.arange(offsets.size)
+    gap_below = np.where(~fits & (index <= centre[:, None]), index, -1).max(axis=1)
+    gap_above = np.where(~fits & (index >= centre[:, None]), index, offsets.size).min(axis=1)
+    low, high = offsets[np.minimum(gap_below + 1, offsets.size - 1)], offsets[np.maximum(gap_above - 1, 0)]
+    return np.where(any_fit, low, 1.0), np.where(any_fit, high, -1.0)
 
 
 def _lateral(grid, law, x, y, tx, ty, s, jacobian=False):
@@ -157,43 +208,69 @@ def _lateral(grid, law, x, y, tx, ty, s, jacobian=False):
     return fn, ft, nx_ * nx_ * jxx + 2 * nx_ * ny_ * jxy + ny_ * ny_ * jyy
 
 
+def _walls_in_window(grid: HistogramMap, law: GridWallLaw, x, y) -> np.ndarray:
+    """Whether the window of each point's cell holds an occupied cell (False: an open area, no repulsion)."""
+    h = law.window_cells // 2
+    nx, ny = grid.shape
+    counts = np.zeros((nx + 1, ny + 1), dtype=np.int64)
+    counts[1:, 1:] = np.cumsum(np.cumsum(grid.occupied, axis=0), axis=1)  # summed-area table
+    i, j = grid.cell_index(x, y)
+    i0, i1 = np.clip(i - h, 0, nx), np.clip(i + h + 1, 0, nx)
+    j0, j1 = np.clip(j - h, 0, ny), np.clip(j + h + 1, 0, ny)
+    return (counts[i1, j1] - counts[i0, j1] - counts[i1, j0] + counts[i0, j0]) > 0
+
+
+def _brackets(owner: np.ndarray, s: np.ndarray, fn: np.ndarray):
+    """Roots of F_n on the scans: (sample, low, high, start, F_n(low)) of every bracket (module docstring).
+
+    A bracket is a strict sign change between neighbouring scan points of one sample (start: its secant root), or
+    a scan point where F_n is exactly 0 between neighbours of opposite signs (start: that point, the bracket's
+    middle — the symmetric axis of a corridor lands there whenever the axis is a scan point). A stretch of two or
+    more exact zeros (no wall in the window) is neutral, not an equilibrium.
+    """
+    sign = np.sign(fn)
+    pair = np.flatnonzero((owner[1:] == owner[:-1]) & (sign[1:] * sign[:-1] < 0))
+    lo, hi, flo, fhi = s[pair], s[pair + 1], fn[pair], fn[pair + 1]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        secant = lo - flo * (hi - lo) / (fhi - flo)  # opposite signs: fhi − flo != 0 (nan only beside an infinite F_n)
+    secant = np.clip(np.where(np.isfinite(secant), secant, (lo + hi) / 2), lo, hi)
+    zero = np.flatnonzero((owner[2:] == owner[:-2]) & (sign[1:-1] == 0) & (sign[2:] * sign[:-2] < 0)) + 1
+    return (np.concatenate([owner[pair], owner[zero]]), np.concatenate([lo, s[zero - 1]]), np.concatenate([hi, s[zero + 1]]),
+            np.concatenate([secant, s[zero]]), np.concatenate([flo, fn[zero - 1]]))
+
+
 def grid_equilibria(grid: HistogramMap, law: GridWallLaw, routes, clearance: np.ndarray, W: float) -> Samples:
     """Equilibria and N at samples every cell along `routes` with the exact window sum (module docstring)."""
     c = grid.cell_size
     x, y, seg, tx, ty = sample_points(routes, c)
-    band = _band(grid, clearance, x, y, W, law.reach)
-    step = SCAN_STEP_CELLS * c
-    count = np.maximum(0, np.floor(np.maximum(band, 0) / step).astype(np.int64))
-    # the scan: s = −count·step … +count·step for each sample, flattened
-    lengths = 2 * count + 1
+    low, high = _band(grid, clearance, x, y, tx, ty, W, law.reach)
+    span = np.where(high > low, high - low, 0.0)
+    # the scan: `steps` equal steps of at most c/2 from low to high, both ends included (at least two steps, so a
+    # band narrower than one step still has a middle point), flattened over the samples
+    steps = np.where(span > 0, np.maximum(2, np.ceil(span / (SCAN_STEP_CELLS * c))), 0).astype(np.int64)
+    lengths = np.where(steps > 0, steps + 1, 0)
     owner = np.repeat(np.arange(x.size), lengths)
-    first = np.concatenate([[0], np.cumsum(lengths)[:-1]]) if x.size else np.zeros(0, dtype=np.int64)
-    position = np.arange(owner.size) - first[owner] - count[owner]
-    s = position * step
+    first = np.cumsum(lengths) - lengths
+    position = np.arange(owner.size) - first[owner]
+    s = low[owner] + position * (span / np.maximum(steps, 1))[owner]
     fn, _ = _lateral(grid, law, x[owner], y[owner], tx[owner], ty[owner], s)
-    field = np.zeros(x.size, dtype=bool)
-    field[owner[position == 0]] = fn[position == 0] != 0  # a wall inside the window at the axis
-    # strict sign changes between neighbours of the same sample: a stretch where F_n is exactly 0 (no wall in
-    # the window) is neutral, not an equilibrium
-    same = owner[1:] == owner[:-1]
-    change = same & (fn[1:] * fn[:-1] < 0)
-    pairs = np.flatnonzero(change)
-    roots = np.bincount(owner[pairs], minlength=x.size) if pairs.size else np.zeros(x.size, dtype=np.int64)
-    # the root nearest the axis: smallest |midpoint| of its bracket per sample
-    mid = np.abs(s[pairs] + step / 2)
-    order = np.lexsort((mid, owner[pairs]))
-    chosen = pairs[order]
-    firsts = np.unique(owner[chosen], return_index=True)[1]
-    chosen = chosen[firsts]
-    k = owner[chosen]
-    lo, hi = s[chosen], s[chosen + 1]
-    flo, fhi = fn[chosen], fn[chosen + 1]
-    s0 = np.where(fhi != flo, lo - flo * (hi - lo) / np.where(fhi != flo, fhi - flo, 1.0), lo)
-    for _ in range(NEWTON_STEPS):
-        f, _, df = _lateral(grid, law, x[k], y[k], tx[k], ty[k], s0, jacobian=True)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            proposed = s0 - f / df
-        s0 = np.clip(np.where(np.isfinite(proposed), proposed, s0), lo, hi)
+    field = _walls_in_window(grid, law, x, y)
+    k_all, lo_all, hi_all, start_all, sign_lo = _brackets(owner, s, fn)
+    roots = np.bincount(k_all, minlength=x.size)
+    # the root nearest the sample point (on the medial axis) per sample
+    order = np.lexsort((np.abs(start_all), k_all))
+    chosen = order[np.unique(k_all[order], return_index=True)[1]]
+    k, lo, hi = k_all[chosen], lo_all[chosen], hi_all[chosen]
+    # F_n made increasing on each bracket (F_n(lo) < 0 < F_n(hi) after the sign), narrowed by safeguarded Newton: a
+    # smooth root converges quadratically, a sign change at a cell boundary (where the window, and so F_n, jumps)
+    # to the jump, to the bracket / 2^NEWTON_STEPS
+    sign = np.where(sign_lo[chosen] < 0, 1.0, -1.0)
+
+    def increasing(at):
+        f, _, df = _lateral(grid, law, x[k], y[k], tx[k], ty[k], at, jacobian=True)
+        return sign * f, sign * df
+
+    s0 = newton_increasing(increasing, lo, hi, atol=ROOT_TOLERANCE, iterations=NEWTON_STEPS)
     f, ft, df = _lateral(grid, law, x[k], y[k], tx[k], ty[k], s0, jacobian=True)
     forward = 1.0 - np.abs(ft)
     offset, N, F_t, along = (np.full(x.size, np.nan) for _ in range(4))

@@ -7,8 +7,9 @@ A map is a YAML file (docs/maps.md, "Map files") with the keys
 ``resolution``
     Metres per pixel, > 0.
 ``origin``
-    [x, y, yaw] of the lower-left pixel's lower-left corner (m, m, rad). The yaw is
-    read and kept (written back into a speed mask) but, as in most of Nav2, not applied.
+    [x, y, yaw] of the lower-left pixel's lower-left corner (m, m, rad): three numbers,
+    as Nav2's map_server requires (it refuses any other count). The yaw is read and kept
+    (written back into a speed mask) but, as in most of Nav2, not applied.
 ``negate``
     0 or 1 (also true/false): whether white means occupied.
 ``occupied_thresh``, ``free_thresh``
@@ -197,9 +198,9 @@ def _number(path, key, value, low=-math.inf, high=math.inf, **kw) -> float:
 def _parameters(path, data: dict) -> dict:
     resolution = _number(path, "resolution", data["resolution"], 0.0, 1e3, unit="m")
     origin = data["origin"]
-    if not isinstance(origin, (list, tuple)) or len(origin) not in (2, 3):
-        _fail(path, f"origin must be a list [x, y, yaw] of finite numbers; got {origin!r}")
-    origin = tuple(_number(path, f"origin[{i}]", v, -1e7, 1e7) for i, v in enumerate(origin)) + ((0.0,) if len(origin) == 2 else ())
+    if not isinstance(origin, (list, tuple)) or len(origin) != 3:  # map_server: "should have 3 elements"
+        _fail(path, f"origin must be a list [x, y, yaw] of three finite numbers (m, m, rad), as Nav2's map_server requires; got {origin!r}")
+    origin = tuple(_number(path, f"origin[{i}]", v, -1e7, 1e7) for i, v in enumerate(origin))
     negate = data["negate"]
     if negate not in (0, 1) or isinstance(negate, float):  # True/False and 0/1
         _fail(path, f"negate must be 0 or 1; got {negate!r}")
@@ -273,8 +274,9 @@ def load_map(path, name: str | None = None) -> OccupancyMap:
     ------
     ValueError
         One line naming the file and the problem: unreadable YAML, a missing key,
-        resolution <= 0, thresholds outside [0, 1] or free_thresh >= occupied_thresh,
-        an unknown mode, a missing or unreadable image, an empty map.
+        resolution <= 0, an origin that is not three finite numbers, thresholds outside
+        [0, 1] or free_thresh >= occupied_thresh, an unknown mode, a missing or
+        unreadable image, an empty map.
     """
     path = os.fspath(path)
     data = _read_yaml(path)

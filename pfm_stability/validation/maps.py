@@ -23,9 +23,10 @@ corridor, as large as δ) is common to both and cancels, leaving the free
 oscillation from 2δ, measured by the simulator's own metrics
 (`sim.metrics.oscillation_metrics`) and judged by its rule
 (`sim.verdict.simulated_verdict`: sign of σ, a collision is unstable). A
-stall (the "trapped" event) is reported and not counted, and so is a measured σ
-within the measurement's resolution (`resolved`: |σ| < `SIGMA_RESOLUTION` or less
-than `MIN_EFOLDS` e-fold over the run: "not measurable (σ within resolution)").
+stall (the "trapped" event) is not counted. A σ within the run's `resolution` has no
+sign: it disagrees when the predicted σ̄ differs from it by more than that (`contradicts`),
+else it is "not measurable (σ within resolution)". Each case is "agree", "disagree" or
+"not measurable" (`MapCase.outcome`); the agreement is over the measured ones only.
 A segment is driven over its judged part only (`maps.verdicts.judged_run`). Undefined values are
 None with a reason, never NaN.
 
@@ -58,7 +59,7 @@ from .map_selection import CLEAR_MARGIN, MIN_PERIODS, number, periods_omega, pre
 
 __all__ = [
     "MapCase", "MapValidation", "validate_map_segments", "select_segments", "required_length", "crop_grid", "simulator_grid",
-    "CLEAR_MARGIN", "START_OFFSET", "SIGMA_RESOLUTION", "MIN_EFOLDS", "resolved", "MIN_PERIODS", "LATERAL_SLACK", "TABLE_BUDGET", "LINEAR_FRACTION", "linear_offset",
+    "CLEAR_MARGIN", "START_OFFSET", "SIGMA_RESOLUTION", "MIN_EFOLDS", "resolution", "resolved", "contradicts", "MIN_PERIODS", "LATERAL_SLACK", "TABLE_BUDGET", "LINEAR_FRACTION", "linear_offset",
     "SHORT_RESIDUAL", "FIT_RESOLUTION", "short_record_fit",
 ]
 
@@ -102,14 +103,24 @@ FIT_RESOLUTION = 0.05
 synthetic corridors of tests/test_map_validation.py (1–1.5 periods, straight and 30°) was 0.045 1/s."""
 
 
-def resolved(sigma: float, duration: float, fitted: bool = False) -> bool:
-    """True if a measured growth rate σ (1/s) over a run of `duration` s is outside the measurement's resolution
-    (else "not measurable (σ within resolution)"). From the simulator's metrics: |σ| >= `SIGMA_RESOLUTION` and
-    |σ|·duration >= `MIN_EFOLDS` (the peaks' scatter); `fitted` (σ from `short_record_fit`, which needs no
-    e-fold: it reads the root, not the amplitudes): |σ| >= `FIT_RESOLUTION`."""
+def resolution(duration: float, fitted: bool = False) -> float:
+    """Smallest |σ| (1/s) a run of `duration` s resolves: max(`SIGMA_RESOLUTION`, `MIN_EFOLDS`/duration) (the peaks'
+    scatter); `FIT_RESOLUTION` for σ from `short_record_fit` (it reads the root, not the amplitudes: no e-fold)."""
     if fitted:
-        return abs(sigma) >= FIT_RESOLUTION
-    return abs(sigma) >= SIGMA_RESOLUTION and abs(sigma) * duration >= MIN_EFOLDS
+        return FIT_RESOLUTION
+    return max(SIGMA_RESOLUTION, MIN_EFOLDS / duration) if duration > 0 else math.inf
+
+
+def resolved(sigma: float, duration: float, fitted: bool = False) -> bool:
+    """True if a measured σ (1/s) is outside the run's `resolution` (its sign is read); else σ ≈ 0 (`contradicts`)."""
+    return abs(sigma) >= resolution(duration, fitted)
+
+
+def contradicts(predicted: float | None, sigma: float, duration: float, fitted: bool = False) -> bool:
+    """True if a measured σ within the resolution (no sign) contradicts the predicted σ̄ (1/s): they differ by more than
+    the run's `resolution`, so the run would have shown the predicted growth or decay (a disagreement). False: the
+    prediction is within the resolution too, and the run decides nothing ("not measurable"; docs/maps.md, "Validation")."""
+    return predicted is not None and math.isfinite(predicted) and abs(predicted - sigma) > resolution(duration, fitted)
 
 
 LATERAL_SLACK = 1.0
@@ -144,17 +155,17 @@ class MapCase:
         "forward" (the segment's own start to end) or "reverse": the travel direction that decides
         the segment's verdict (`maps.analysis.MapSegment.direction`), the one simulated.
     measurable : bool
-        The run was made and gave a verdict.
+        The run decides: a measured sign, or a σ within the resolution contradicting the prediction (`contradicts`).
     growth_rate, angular_frequency : float or None
         Measured σ (1/s) and ω (rad/s) (None: undefined, see `reason`).
     method : str or None
         σ's estimator ("linear_prediction", "peaks", "none").
     verdict : str or None
-        Measured "stable"/"unstable" (sign of σ; collision: unstable).
+        Measured "stable"/"unstable" (sign of σ; collision: unstable); None when σ is within the resolution.
     basis : str or None
-        "growth_rate", "collision" or "metrics" (`sim.verdict.simulated_verdict`).
+        "growth_rate", "collision" or "metrics" (`sim.verdict.simulated_verdict`); "resolution" (`contradicts`).
     agree : bool or None
-        Measured verdict == predicted; None when not measurable.
+        Measured verdict == predicted (False for basis "resolution"); None when not measurable.
     event : str or None
         The event that ended the run ("collision", "target_reached", "trapped"), None: ran its duration.
     start_offset : float or None
@@ -164,7 +175,7 @@ class MapCase:
     min_clearance : float or None
         Smallest gap robot–obstacle, m.
     reason : str or None
-        Why the case is not measurable.
+        Why the case is not measurable, or why a σ within the resolution disagrees.
     """
 
     index: int
@@ -200,9 +211,14 @@ class MapCase:
         """"stable" or "unstable"."""
         return "stable" if self.predicted_stable else "unstable"
 
+    @property
+    def outcome(self) -> str:
+        """"agree", "disagree" or "not measurable" (`agree` True, False, None)."""
+        return "not measurable" if self.agree is None else ("agree" if self.agree else "disagree")
+
     def to_dict(self) -> dict:
-        """JSON form (SI units; ``"inf"`` for infinite values, null for undefined)."""
-        return json_ready({**self.__dict__, "predicted_verdict": self.predicted_verdict})
+        """JSON form (SI units; ``"inf"`` for infinite values, null for undefined), with ``outcome``."""
+        return json_ready({**self.__dict__, "predicted_verdict": self.predicted_verdict, "outcome": self.outcome})
 
 
 @dataclass(frozen=True)
@@ -212,12 +228,12 @@ class MapValidation:
     Attributes
     ----------
     agreement : float or None
-        Fraction of the measurable cases whose measured verdict equals the
-        predicted one (None: none measurable).
+        agreed / measured (None: none measured); a case not measurable is in neither.
     cases : tuple of MapCase
         One per chosen segment, in the order of their predicted margins.
-    measured, agreed : int
-        Measurable cases, and those of them that agree.
+    measured, agreed, disagreed, not_measurable : int
+        Measured cases (agreed + disagreed), those that agree and those that do not (`contradicts` too), and the
+        cases without a measurement (`MapCase.outcome`): agreed + disagreed + not_measurable cases in all.
     inputs : dict
         What defined the validation (V, count, seed, end margin, …).
     notes : dict
@@ -230,16 +246,20 @@ class MapValidation:
     cases: tuple
     measured: int
     agreed: int
+    disagreed: int = 0
+    not_measurable: int = 0
     inputs: dict = field(default_factory=dict)
     notes: dict = field(default_factory=dict)
     seconds: float = 0.0
 
     def to_dict(self) -> dict:
-        """JSON form: ``agreement``, ``measured``, ``agreed``, ``cases``, ``inputs``, ``notes``; time under ``timing``."""
+        """JSON form: ``agreement``, the four counts, ``cases``, ``inputs``, ``notes``; time under ``timing``."""
         return {
             "agreement": json_number(self.agreement),
             "measured": int(self.measured),
             "agreed": int(self.agreed),
+            "disagreed": int(self.disagreed),
+            "not_measurable": int(self.not_measurable),
             "cases": [c.to_dict() for c in self.cases],
             "inputs": json_ready(self.inputs),
             "notes": dict(self.notes),
@@ -382,11 +402,17 @@ def _measured(run: _Run, plus, minus) -> MapCase:
     if stalled and not collisions:
         e = stalled[0].event("trapped")
         return _not_measurable(run.case, f"the robot stalled (no progress in {run.scenarios[0].trap_time:g} s) at ({e.x:.2f}, {e.y:.2f}) m", **common)
-    if not collisions and m.growth_rate is not None and n > 1 and not resolved(m.growth_rate, float(t[-1] - t[0]), fitted):
-        return _not_measurable(run.case, f"not measurable (sigma within resolution): |sigma| = {abs(m.growth_rate):.3g} 1/s, "
-                               f"{abs(m.growth_rate) * float(t[-1] - t[0]):.2g} e-folds over the {float(t[-1] - t[0]):.1f} s run "
-                               + (f"(the short-record fit needs >= {FIT_RESOLUTION:g} 1/s)" if fitted else
-                                  f"(needs >= {SIGMA_RESOLUTION:g} 1/s and >= {MIN_EFOLDS:g} e-fold)"), **common)
+    duration = float(t[-1] - t[0]) if n > 1 else 0.0
+    if not collisions and m.growth_rate is not None and n > 1 and not resolved(m.growth_rate, duration, fitted):
+        within = (f"|sigma| = {abs(m.growth_rate):.3g} 1/s, {abs(m.growth_rate) * duration:.2g} e-folds over the {duration:.1f} s run "
+                  f"(resolves {resolution(duration, fitted):.3g} 1/s: " + (f"the short-record fit's {FIT_RESOLUTION:g})" if fitted else
+                  f">= {SIGMA_RESOLUTION:g} 1/s and >= {MIN_EFOLDS:g} e-fold)"))
+        predicted = run.case.predicted_growth_rate
+        if contradicts(predicted, m.growth_rate, duration, fitted):  # the run would have shown the predicted σ̄
+            return _with(run.case, measurable=True, verdict=None, basis="resolution", agree=False, reason=f"predicted sigma "
+                         f"{predicted:+.3g} 1/s not seen: {within}", **common)
+        return _not_measurable(run.case, f"not measurable (sigma within resolution): {within}, predicted sigma "
+                               + (f"{predicted:+.3g} 1/s within it too" if predicted is not None else "undefined"), **common)
     if not collisions and m.growth_rate is None:  # the settled flag of a record this short decides nothing
         return _not_measurable(run.case, f"not measurable (sigma undefined): {m.reason}", **common)
     verdict, basis = simulated_verdict(_Difference(bool(collisions), m))
@@ -554,7 +580,7 @@ def validate_map_segments(
             progress(f"map validation: batch {b}/{len(batches)}: {len(batch)} runs")
 
     out = tuple(results[c.index] for c in chosen)
-    measured = [c for c in out if c.measurable]
+    measured = [c for c in out if c.agree is not None]
     agreed = sum(1 for c in measured if c.agree)
     inputs = {
         "V": robot.V, "count": count, "seed": seed, "cell_ratio": cell_ratio, "window_cells": window_cells,
@@ -569,4 +595,5 @@ def validate_map_segments(
         "selection": f"prefer |margin| > {CLEAR_MARGIN:g} and long enough segments; stable and unstable both represented; margin quantile bins",
     }
     agreement = agreed / len(measured) if measured else None
-    return MapValidation(agreement, out, len(measured), agreed, inputs, notes, time.perf_counter() - started)
+    return MapValidation(agreement, out, len(measured), agreed, len(measured) - agreed, len(out) - len(measured), inputs, notes,
+                         time.perf_counter() - started)
