@@ -29,7 +29,9 @@ One step, for every member still running (the `sampled` model, docs/models.md):
    Positions: the part linear in Δ = θ − θ_k in closed form, the residual by
    a composite Gauss–Legendre rule graded to the steering time scales
    (`pfm_stability.sim.robot`; a member's rule depends on its own (τ, k, T)
-   only, so it advances identically in any batch).
+   only, so it advances the same in any batch to round-off: numpy's SIMD
+   sin/cos/exp may round a member differently in arrays of other lengths, a
+   few ULP per step, carried on by the loop — docs/simulator.md, "Batches").
 
 Everything is numpy on (B,) or (B, K) arrays; the grid's window sums use
 the precompiled occupied-cell lists of `pfm_stability.sim.window`.

@@ -235,7 +235,10 @@ def node_sum(a):
     """Σ over the node axis (axis 1) of a (B, J, …) array, left to right.
 
     Sequential, so a member's zero-weight padding (trailing) leaves its sum
-    unchanged bit for bit: a member advances identically in any batch.
+    unchanged bit for bit: the batch's widest rule adds nothing to a member's
+    position (which still agrees with its run alone to round-off only, as
+    numpy's SIMD sin/cos round arrays of other shapes differently;
+    docs/simulator.md, "Batches").
     """
     return np.cumsum(a, axis=1)[:, -1]
 
