@@ -61,20 +61,37 @@ def add_parser(sub) -> None:
     p.set_defaults(run=run)
 
 
-def _law_options(args, params) -> dict:
-    """--law, --cell-ratio, --window-cells, --cell-size: typed, else a --config file's grid or power law, else the preset's grid."""
+def config_law(args, params) -> dict:
+    """The simulated walls' law options, ``{"law": …, "cell_ratio": …}``: typed, else a --config file's, else None.
+
+    The one rule of `simulate` and `validate`: ``--law`` (where the command has
+    it) beats the file's ``law.name`` when that is ``power`` or ``grid``
+    (``khatib`` and ``gnron`` are analysed by `report` only), which applies to
+    ``--env analytic`` (the grid's law is its cells); a ``grid`` law's
+    ``cell_ratio`` applies to the grid and to ``--env analytic`` with the grid's
+    law, unless ``--cell-ratio`` is typed. `sim.scenario_law` turns them into
+    the law (docs/config.md, precedence).
+    """
     law = (params.config.law if params.config is not None else None) or {}
-    if law.get("name") not in ("power", "grid"):  # khatib and gnron are analysed by `report` only
+    if law.get("name") not in ("power", "grid"):
         law = {}
+    typed_law, typed_ratio = getattr(args, "law", None), getattr(args, "cell_ratio", None)
     out = {
-        "law": args.law if args.law is not None else (law.get("name") if law and args.env == "analytic" else None),
-        "cell_ratio": args.cell_ratio,
-        "window_cells": args.window_cells if args.window_cells is not None else params.preset.window_cells,
-        "cell_size": args.cell_size if args.cell_size is not None else params.preset.cell_size,
+        "law": typed_law if typed_law is not None else (law.get("name") if law and args.env == "analytic" else None),
+        "cell_ratio": typed_ratio,
     }
     if out["cell_ratio"] is None and law.get("name") == "grid" and (args.env == "grid" or out["law"] == "grid"):
         out["cell_ratio"] = law.get("cell_ratio")
     return out
+
+
+def _law_options(args, params) -> dict:
+    """--law, --cell-ratio (`config_law`), --window-cells, --cell-size: typed, else the configuration's grid."""
+    return {
+        **config_law(args, params),
+        "window_cells": args.window_cells if args.window_cells is not None else params.preset.window_cells,
+        "cell_size": args.cell_size if args.cell_size is not None else params.preset.cell_size,
+    }
 
 
 def _build(args, params):

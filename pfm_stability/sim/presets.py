@@ -77,15 +77,15 @@ from ..parameters import CARMEL, RANGES, Controller, Robot, Wall
 from ..solve import bisect_batched
 from .environment import AnalyticEnvironment, AnalyticWall
 from .grid import HistogramGrid
-from .scenario import MeasureAxis, Pose, Scenario, Target, scenario_law
+from .scenario import LAW_NAMES, MeasureAxis, Pose, Scenario, Target, scenario_law
 from .vff import measured_equilibrium
 
 __all__ = ["SCENARIO_NAMES", "ENVS", "LAWS", "make_scenario", "barely_avoiding_ratio"]
 
 SCENARIO_NAMES = ("straight", "corridor", "wall", "kb-fig3", "kb-fig5", "kb-fig6-wide", "kb-fig6-narrow")
 ENVS = ("grid", "analytic")
-LAWS = ("power", "grid")
-"""Analytic-mode lateral laws: KB's lumped power law, or the grid's effective law."""
+LAWS = LAW_NAMES
+"""Analytic-mode lateral laws: KB's lumped power law, or the grid's effective law (`scenario.LAW_NAMES`)."""
 
 _MARGIN = 1.0
 """Grid margin around the scenario's walls, start and target, m."""
@@ -166,9 +166,10 @@ def _law_of(law, env, robot, controller, grid_law):
         if law is not None:
             raise ValueError("law applies to env=analytic only (the grid's law is its cells)")
         return None
-    if law is not None and not isinstance(law, ForceLaw):
+    if isinstance(law, str) and law == "grid":  # the grid's law as drawn for this run (its ratio set by _grid_law)
+        law = grid_law
+    elif law is not None and not isinstance(law, ForceLaw):
         check_choice("law", law, LAWS)
-        law = grid_law if law == "grid" else None  # "power": KB's law, scenario_law's default
     return scenario_law("analytic", robot, controller, law=law)
 
 
