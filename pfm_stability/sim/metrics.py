@@ -41,6 +41,18 @@ oscillation); **stable** (the run *settled*) = no collision, not oscillating,
 and σ < 0 when σ is defined — not the linear-stability verdict (the sign of σ)
 that is compared with the models (`pfm_stability.sim.verdict`). When too few turning points exist and the fit is rejected, σ and ω
 are ``None`` with a `reason`, never NaN.
+
+The answer is explicit where nothing was measured:
+
+* a **collision** (on the path between samples too, `pfm_stability.sim.contact`)
+  — not stable, whatever the offset did before;
+* fewer than 8 samples in the measurement window (a run that ended, or left
+  the window, almost at once: e.g. T = 100 s) — not stable: nothing shows that
+  it settled (σ None, `reason` says why);
+* σ undefined otherwise (no oscillation and a rejected fit: a constant
+  offset, or a monotone drift) — stable only when the offset is at rest, its
+  range over the second half of the window at most `HYSTERESIS` of its range
+  over the window (a constant offset: 0); a robot drifting away is not stable.
 """
 
 from __future__ import annotations
@@ -84,9 +96,10 @@ class OscillationMetrics:
     oscillating : bool
         A growing oscillation or a limit cycle.
     stable : bool
-        The run settled: no collision, not oscillating, σ < 0 when defined.
-        (The linear-stability verdict the loop models predict is the sign of
-        σ alone: `pfm_stability.sim.verdict.simulated_verdict`.)
+        The run settled: no collision, not oscillating, σ < 0 when defined,
+        at rest when not; False when the window holds too few samples to say
+        (module docstring). (The linear-stability verdict the loop models
+        predict is the sign of σ alone: `pfm_stability.sim.verdict.simulated_verdict`.)
     method : {"linear_prediction", "peaks", "none"}
         Estimator that produced σ and ω.
     turning_points : int
@@ -248,10 +261,10 @@ def oscillation_metrics(t, x, T: float, *, order: int = 4, collision_time: float
     if not np.all(np.isfinite(x)):
         raise FloatingPointError("lateral offset has non-finite samples")
     base = dict(time_to_collision=collision_time, window=(float(t[0]), float(t[-1])) if t.size else None)
-    if t.size < _MIN_SAMPLES:
+    if t.size < _MIN_SAMPLES:  # nothing measured: not "stable" (module docstring)
         return OscillationMetrics(
-            None, None, None, False, False, not collided, "none", 0,
-            reason=f"fewer than {_MIN_SAMPLES} samples in the measurement window ({t.size})", **base,
+            None, None, None, False, False, False, "none", 0,
+            reason=f"fewer than {_MIN_SAMPLES} samples in the measurement window ({t.size}): not measurable", **base,
         )
     span = float(np.max(x) - np.min(x))
     extrema = turning_points(x, HYSTERESIS * span) if span > 0 else np.array([], dtype=int)
@@ -278,7 +291,11 @@ def oscillation_metrics(t, x, T: float, *, order: int = 4, collision_time: float
         sigma, omega, method = None, omega_p, "none"
         reason = f"{extrema.size} turning point(s) in the window and the run is not linear (fit residual {residual})"
     oscillating = limit_cycle or (sigma is not None and sigma > 0 and omega is not None and omega > 0)
-    stable = not collided and not oscillating and (sigma is None or sigma < 0)
+    if sigma is None:  # stable only at rest: the second half of the window moves by at most the hysteresis
+        late = x[t >= (t[0] + t[-1]) / 2]
+        at_rest = float(np.max(late) - np.min(late)) <= HYSTERESIS * span
+        reason += "; the offset is at rest" if at_rest else "; the offset is still moving (not at rest)"
+    stable = not collided and not oscillating and (sigma < 0 if sigma is not None else at_rest)
     return OscillationMetrics(
         growth_rate=sigma,
         angular_frequency=omega,

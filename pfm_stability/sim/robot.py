@@ -217,7 +217,7 @@ def graded_rule(h, rates, decays, slow, panels=None) -> Rule:
     inside = j < panels[:, None]
     target = _phase(h[:, None], rates, decays, slow) * np.where(inside, j / panels[:, None], 1.0)
     lo, hi = np.zeros_like(target), np.broadcast_to(h[:, None], target.shape)
-    for _ in range(60):
+    for _ in range(60 if target.size else 0):  # one panel each: no inner breakpoint to place
         mid = 0.5 * (lo + hi)
         below = _phase(mid, rates, decays, slow) < target
         lo, hi = np.where(below, mid, lo), np.where(below, hi, mid)
