@@ -5,9 +5,11 @@
 
 JSON keys (`pfm_stability/schema/output.schema.json`): ``schema_version``,
 ``command`` ("simulate"), ``events`` (list of {type, t, x, y}; type ∈
-collision, target_reached, trapped; t in s), ``metrics`` (growth_rate σ 1/s,
-angular_frequency ω rad/s, oscillating, stable, amplitude, method, …),
-``t_end`` (s), ``steps``, ``min_clearance`` (m), ``prediction`` (the
+collision, target_reached, trapped; t in s: a collision's first touch on the
+path between samples), ``metrics`` (growth_rate σ 1/s, angular_frequency ω
+rad/s, oscillating, stable, amplitude, method, …), ``t_end`` (s, the last
+sample: the duration, or the first sample at or after the event that stopped
+the run), ``steps``, ``min_clearance`` (m), ``prediction`` (the
 `sampled` model with the run's own force law and KB's criterion, for corridor
 and wall geometries; null otherwise), ``inputs`` (every parameter, where it
 came from, and the scenario's documented choices), ``plot``, and ``timing``
@@ -41,7 +43,9 @@ def add_parser(sub) -> None:
     g = p.add_argument_group("scenario")
     g.add_argument("--L", type=number("L"), help=f"corridor: half-width, {describe('L')}, and more than W/2 (default 1)")
     g.add_argument("--alpha", type=number("alpha_deg"), help=f"wall: target angle from the wall normal, {describe('alpha_deg')} (default 45)")
-    g.add_argument("--offset", type=number("offset"), help=f"corridor/wall: start offset from equilibrium, {describe('offset')} (default 0.02)")
+    g.add_argument("--offset", type=number("offset"),
+                   help=f"corridor/wall: start offset from equilibrium, {describe('offset')}, with the robot inside the corridor "
+                   "(|offset| < L - W/2, - c/2 in the grid) or clear of the wall (default 0.02)")
     g.add_argument("--duration", type=number("duration"), help=f"simulated time, {describe('duration')} (default per scenario)")
     g.add_argument("--cell-ratio", type=number("cell_ratio"), help=f"grid: F_cr/F_ct per cell, {describe('cell_ratio')} (default: calibrated to f_av = f)")
     g.add_argument("--law", choices=("power", "grid"), help="analytic: KB's lumped power law (default) or the grid's effective law")
