@@ -181,11 +181,14 @@ def test_a_run_stopped_early_reports_the_time_simulated_and_why(capsys):
 
 
 def test_unmeasurable_and_drifting_runs_are_not_stable():
-    """docs/simulator.md: fewer than 8 samples → not stable ("not measurable"); σ undefined → stable only at rest."""
+    """docs/simulator.md: fewer than 8 samples → not stable ("not measurable"); σ undefined → stable only when settling:
+    a drift 0.01t² moves 3× more over the second half than the first, a steady drift as much, a constant not at all."""
     t = np.arange(200) * 0.065
     short = oscillation_metrics(t[:5], np.zeros(5), 0.065)
     assert not short.stable and "not measurable" in short.reason
     drift = oscillation_metrics(t, 0.01 * t**2, 0.065)
-    assert drift.growth_rate is None and not drift.stable and "not at rest" in drift.reason
+    assert drift.growth_rate is None and not drift.stable and "is not settling" in drift.reason
+    steady = oscillation_metrics(t, 0.01 * t, 0.065)
+    assert not steady.stable
     flat = oscillation_metrics(t, np.zeros(t.size), 0.065)  # a robot that never moves sideways
     assert flat.growth_rate is None and flat.stable

@@ -59,8 +59,8 @@ def test_undefined_cases_give_none_and_a_reason_never_nan():
     """Too few samples, or a growing drift with no oscillation, give σ = None with a reason; JSON has no NaN.
 
     A monotone settling (tanh) is a decay: σ < 0, stable, not oscillating.
-    Too few samples is not stable (nothing measured), nor is a drift (not at
-    rest); a constant offset is (docs/simulator.md, measuring oscillation).
+    Too few samples is not stable (nothing measured), nor is a drift (not
+    settling); a constant offset is (docs/simulator.md, measuring oscillation).
     """
     short = oscillation_metrics(_t()[:5], np.zeros(5), T)
     assert short.growth_rate is None and "fewer than" in short.reason and not short.stable

@@ -20,8 +20,8 @@ Two questions, two names:
 Where σ is undefined (too few turning points and a rejected linear fit) the
 verdict falls back on the settled flag, which is explicit there
 (`pfm_stability.sim.metrics`): a run with fewer than 8 samples in its window
-(unmeasurable) or whose offset is still moving is unstable, one at rest
-stable; a collision (also between samples, `pfm_stability.sim.contact`) is
+(unmeasurable) or whose offset is not settling (a drift) is unstable, a
+constant or decaying one stable; a collision (also between samples, `pfm_stability.sim.contact`) is
 unstable in both senses.
 """
 
