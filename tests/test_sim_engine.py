@@ -8,6 +8,7 @@ import pytest
 
 from pfm_stability.parameters import CARMEL
 from pfm_stability.sim import make_scenario, run_batch, simulate, simulate_batch, simulate_reference
+from trajectory_helpers import assert_same_to_roundoff
 
 REFERENCE = CARMEL.controller.replace(hold="reference")
 CASES = [
@@ -66,7 +67,11 @@ def test_collisions_are_reported_as_events():
 
 
 def test_identical_seeds_give_identical_trajectories():
-    """A random start jitter drawn from the seed: same seed → bit-identical runs, another seed → another run."""
+    """A random start jitter drawn from the seed: same seed → bit-identical runs, another seed → another run.
+
+    Bit for bit is legitimate here: both runs take the same code path on arrays
+    of the same shapes (one member), so every SIMD kernel rounds alike.
+    """
     a = simulate("corridor", L=0.8, seed=7, start_jitter=0.05)
     b = simulate("corridor", L=0.8, seed=7, start_jitter=0.05)
     c = simulate("corridor", L=0.8, seed=8, start_jitter=0.05)
@@ -75,7 +80,15 @@ def test_identical_seeds_give_identical_trajectories():
 
 
 def test_heterogeneous_batch_equals_separate_runs():
-    """Members with different V, k, T, hold, delay and L in one batch advance exactly as when run alone."""
+    """Members with different V, k, T, hold, delay and L in one batch advance as when run alone, to round-off.
+
+    Not bit for bit: numpy's SIMD kernels (sin, cos, exp) round an element of a
+    3-member array and of a 1-member array differently on AVX-512 machines
+    (docs/simulator.md, "Batches"). Tolerance `trajectory_helpers.roundoff_bound`:
+    64 ε per step of the run's scale, times e^(σ⁺t) for the growing member —
+    40× the measured worst, far below the millimetres a mixed-up member
+    (another member's V, T or law) would show.
+    """
     params = dict(
         V=[0.6, 0.8, 1.0], k=[1.5, 2.0, 3.0], T=[0.05, 0.065, 0.1], hold=["command", "reference", "command"],
         compute_delay=[0, 1, 1], L=[0.8, 0.9, 1.1],
@@ -83,7 +96,8 @@ def test_heterogeneous_batch_equals_separate_runs():
     batch = simulate_batch("corridor", env="analytic", record="trajectory", duration=8.0, **params)
     for m in range(3):
         one = simulate_batch("corridor", env="analytic", record="trajectory", duration=8.0, **{k: [v[m]] for k, v in params.items()})
-        assert np.array_equal(batch.runs[m].trajectory.x, one.runs[0].trajectory.x)
+        alone = one.runs[0]
+        assert_same_to_roundoff(batch.runs[m].trajectory, alone.trajectory, alone.metrics.growth_rate, f"member {m}")
     assert batch.runs[2].steps == round(8.0 / 0.1)
 
 

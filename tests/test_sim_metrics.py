@@ -59,12 +59,14 @@ def test_undefined_cases_give_none_and_a_reason_never_nan():
     """Too few samples, or a growing drift with no oscillation, give σ = None with a reason; JSON has no NaN.
 
     A monotone settling (tanh) is a decay: σ < 0, stable, not oscillating.
+    Too few samples is not stable (nothing measured), nor is a drift (not
+    settling); a constant offset is (docs/simulator.md, measuring oscillation).
     """
     short = oscillation_metrics(_t()[:5], np.zeros(5), T)
-    assert short.growth_rate is None and "fewer than" in short.reason and short.stable
+    assert short.growth_rate is None and "fewer than" in short.reason and not short.stable
     t = _t()
     drift = oscillation_metrics(t, 0.01 * t**2, T)
-    assert drift.growth_rate is None and drift.reason and not drift.oscillating
+    assert drift.growth_rate is None and drift.reason and not drift.oscillating and not drift.stable
     settle = oscillation_metrics(t, np.tanh(t / 5.0), T)
     assert settle.growth_rate < 0 and settle.stable and not settle.oscillating
     collided = oscillation_metrics(t, np.tanh(t / 5.0), T, collision_time=3.0)

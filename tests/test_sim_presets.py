@@ -80,7 +80,7 @@ def test_analytic_variants_exist():
         (dict(name="corridor", window_cells=1), "window_cells must be an odd integer"),
         (dict(name="kb-fig3", env="analytic"), "env must be grid for kb-fig3"),
         (dict(name="kb-fig3", L=1.0), "L does not apply"),
-        (dict(name="corridor", offset=0.7), "start must leave the robot"),
+        (dict(name="corridor", offset=0.7), r"offset must be a finite number in \(-0.55, 0.55\) m .*; got 0.7"),
         (dict(name="wall", env="analytic", controller=CARMEL.controller.replace(f=0.1)), "alpha must give an equilibrium"),
         (dict(name="maze"), "scenario must be one of"),
         (dict(name="corridor", env="sky"), "env must be one of"),

@@ -246,6 +246,8 @@ def test_graded_rule():
     counts = panel_count(h, *constant_input_modes(tau), slow_rate(k, WMAX * np.ones(4)))
     assert counts.tolist()[:2] == [1, 1] and 1 < counts[2] < counts[3] <= MAX_PANELS
     frac, weights = gauss_legendre(NODES)
+    # bit for bit is legitimate: one panel is t = 0 + (h − 0)·frac, w = (h − 0)·weights, correctly rounded
+    # products and sums (IEEE 754) whatever the array shape or SIMD kernel
     assert np.array_equal(rule.t[0, :NODES], 0.065 * frac) and np.array_equal(rule.w[0, :NODES], 0.065 * weights)
     assert np.all(rule.w[0, NODES:] == 0) and np.all(rule.t[0, NODES:] == 0.065)
     assert np.sum(rule.w, axis=1) == pytest.approx(h, rel=1e-14)
@@ -255,6 +257,11 @@ def test_graded_rule():
         assert np.sum(rule.w[m] * rule.t[m] ** 7) == pytest.approx(h[m] ** 8 / 8, rel=1e-13)
     first = np.sum(rule.w[2:, :NODES], axis=1)  # width of the first panel
     assert np.all(first < RESOLUTION * tau[2:])
+    # alone vs in a batch of 4: the breakpoints come from expm1 in arrays of other shapes, which numpy's SIMD
+    # kernels may round differently (docs/simulator.md, "Batches"); the bisection then moves them by a few ULP
+    # of h. 64 ε·h allows that and nothing else: another member's rule would differ by a whole panel
     alone = _rule("command", tau[2:3], k[2:3], h[2:3])
     J = alone.t.shape[1]
-    assert np.array_equal(alone.t[0], rule.t[2, :J]) and np.array_equal(alone.w[0], rule.w[2, :J])
+    assert np.allclose(alone.t[0], rule.t[2, :J], rtol=0, atol=64 * np.finfo(float).eps * h[2])
+    assert np.allclose(alone.w[0], rule.w[2, :J], rtol=0, atol=64 * np.finfo(float).eps * h[2])
+    assert np.all(rule.w[2, J:] == 0)

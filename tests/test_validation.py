@@ -235,7 +235,7 @@ def test_sweep_is_seeded_and_to_dict_is_json():
     import json
 
     a, b, c = sweep_parameters(32, 7), sweep_parameters(32, 7), sweep_parameters(32, 8)
-    for key in ("V", "tau", "T", "k", "f", "u"):
+    for key in ("V", "tau", "T", "k", "f", "u"):  # a and b: same code path, same shapes, so bit for bit is legitimate
         assert np.array_equal(a[key], b[key]) and not np.array_equal(a[key], c[key])
         lo, hi = (0.0, 1.0) if key == "u" else SWEEP_RANGES[key]
         assert np.all((a[key] >= lo) & (a[key] <= hi))

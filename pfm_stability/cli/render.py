@@ -373,13 +373,22 @@ def render_simulation_text(result, prediction, plot_path=None) -> str:
     """The human-readable report of one run."""
     s, m = result.scenario, result.metrics
     r, c = s.robot, s.controller
+    simulated = f"{s.duration:g} s simulated"
+    if result.events:  # stopped early: the time really simulated (to the event: a contact between samples), and why
+        e = result.events[0]
+        simulated = f"{e.t:.4g} s simulated of the {s.duration:g} s asked (stopped by the {e.type.replace('_', ' ')} event)"
+    why = {
+        "collision": "the robot disc touched an obstacle",
+        "target_reached": "the target was reached",
+        "trapped": f"less than {s.trap_distance:g} m of progress towards the target in {s.trap_time:g} s",
+    }
     lines = [
-        f"scenario {s.name} ({s.env}), {s.duration:g} s simulated, {result.steps} samples of T = {c.T:g} s",
+        f"scenario {s.name} ({s.env}), {simulated}, {result.steps} samples of T = {c.T:g} s",
         f"  robot: V = {r.V:g} m/s, tau = {r.tau:g} s, k = {r.k:g} 1/s, W = {r.W:g} m; "
         f"controller: f = {c.f:g}, n = {c.n:g}, hold = {c.hold}, compute_delay = {c.compute_delay}",
         "events:",
     ]
-    lines += [f"  {e.type} at t = {e.t:.3f} s (x = {e.x:.3f} m, y = {e.y:.3f} m)" for e in result.events] or [
+    lines += [f"  {e.type} at t = {e.t:.3f} s (x = {e.x:.3f} m, y = {e.y:.3f} m): {why[e.type]}" for e in result.events] or [
         f"  none (ran {result.t_end:.3f} s)"
     ]
     if result.min_clearance is not None:
@@ -387,7 +396,7 @@ def render_simulation_text(result, prediction, plot_path=None) -> str:
     lines += [
         f"metrics ({m.turning_points} turning points, method {m.method}):",
         f"  growth rate sigma = {_quantity(m.growth_rate, '1/s')}, angular frequency omega = {_quantity(m.angular_frequency, 'rad/s')}",
-        f"  oscillating: {'yes' if m.oscillating else 'no'}; stable: {'yes' if m.stable else 'no'}; "
+        f"  oscillating: {'yes' if m.oscillating else 'no'}; stable: {'yes' if m.stable else ('no (collision)' if result.collided else 'no')}; "
         f"limit cycle: {'amplitude %.3g m' % m.amplitude if m.limit_cycle else 'no'}",
     ]
     if m.reason:

@@ -5,9 +5,11 @@
 
 JSON keys (`pfm_stability/schema/output.schema.json`): ``schema_version``,
 ``command`` ("simulate"), ``events`` (list of {type, t, x, y}; type ∈
-collision, target_reached, trapped; t in s), ``metrics`` (growth_rate σ 1/s,
-angular_frequency ω rad/s, oscillating, stable, amplitude, method, …),
-``t_end`` (s), ``steps``, ``min_clearance`` (m), ``prediction`` (the
+collision, target_reached, trapped; t in s: a collision's first touch on the
+path between samples), ``metrics`` (growth_rate σ 1/s, angular_frequency ω
+rad/s, oscillating, stable, amplitude, method, …), ``t_end`` (s, the last
+sample: the duration, or the first sample at or after the event that stopped
+the run), ``steps``, ``min_clearance`` (m), ``prediction`` (the
 `sampled` model with the run's own force law and KB's criterion, for corridor
 and wall geometries; null otherwise), ``inputs`` (every parameter, where it
 came from, and the scenario's documented choices), ``plot``, and ``timing``
@@ -41,7 +43,9 @@ def add_parser(sub) -> None:
     g = p.add_argument_group("scenario")
     g.add_argument("--L", type=number("L"), help=f"corridor: half-width, {describe('L')}, and more than W/2 (default 1)")
     g.add_argument("--alpha", type=number("alpha_deg"), help=f"wall: target angle from the wall normal, {describe('alpha_deg')} (default 45)")
-    g.add_argument("--offset", type=number("offset"), help=f"corridor/wall: start offset from equilibrium, {describe('offset')} (default 0.02)")
+    g.add_argument("--offset", type=number("offset"),
+                   help=f"corridor/wall: start offset from equilibrium, {describe('offset')}, with the robot inside the corridor "
+                   "(|offset| < L - W/2, - c/2 in the grid) or clear of the wall (default 0.02)")
     g.add_argument("--duration", type=number("duration"), help=f"simulated time, {describe('duration')} (default per scenario)")
     g.add_argument("--cell-ratio", type=number("cell_ratio"), help=f"grid: F_cr/F_ct per cell, {describe('cell_ratio')} (default: calibrated to f_av = f)")
     g.add_argument("--law", choices=("power", "grid"), help="analytic: KB's lumped power law (default) or the grid's effective law")
@@ -61,20 +65,37 @@ def add_parser(sub) -> None:
     p.set_defaults(run=run)
 
 
-def _law_options(args, params) -> dict:
-    """--law, --cell-ratio, --window-cells, --cell-size: typed, else a --config file's grid or power law, else the preset's grid."""
+def config_law(args, params) -> dict:
+    """The simulated walls' law options, ``{"law": …, "cell_ratio": …}``: typed, else a --config file's, else None.
+
+    The one rule of `simulate` and `validate`: ``--law`` (where the command has
+    it) beats the file's ``law.name`` when that is ``power`` or ``grid``
+    (``khatib`` and ``gnron`` are analysed by `report` only), which applies to
+    ``--env analytic`` (the grid's law is its cells); a ``grid`` law's
+    ``cell_ratio`` applies to the grid and to ``--env analytic`` with the grid's
+    law, unless ``--cell-ratio`` is typed. `sim.scenario_law` turns them into
+    the law (docs/config.md, precedence).
+    """
     law = (params.config.law if params.config is not None else None) or {}
-    if law.get("name") not in ("power", "grid"):  # khatib and gnron are analysed by `report` only
+    if law.get("name") not in ("power", "grid"):
         law = {}
+    typed_law, typed_ratio = getattr(args, "law", None), getattr(args, "cell_ratio", None)
     out = {
-        "law": args.law if args.law is not None else (law.get("name") if law and args.env == "analytic" else None),
-        "cell_ratio": args.cell_ratio,
-        "window_cells": args.window_cells if args.window_cells is not None else params.preset.window_cells,
-        "cell_size": args.cell_size if args.cell_size is not None else params.preset.cell_size,
+        "law": typed_law if typed_law is not None else (law.get("name") if law and args.env == "analytic" else None),
+        "cell_ratio": typed_ratio,
     }
     if out["cell_ratio"] is None and law.get("name") == "grid" and (args.env == "grid" or out["law"] == "grid"):
         out["cell_ratio"] = law.get("cell_ratio")
     return out
+
+
+def _law_options(args, params) -> dict:
+    """--law, --cell-ratio (`config_law`), --window-cells, --cell-size: typed, else the configuration's grid."""
+    return {
+        **config_law(args, params),
+        "window_cells": args.window_cells if args.window_cells is not None else params.preset.window_cells,
+        "cell_size": args.cell_size if args.cell_size is not None else params.preset.cell_size,
+    }
 
 
 def _build(args, params):

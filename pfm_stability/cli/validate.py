@@ -9,7 +9,10 @@ or f) in the simulator, compares it with each model's prediction (with the
 simulated environment's own force law; in the grid also with KB's lumped law
 at the grid's f_av), and checks σ and ω near it against the matching
 `sampled` model. ``--sweep N`` also simulates N random parameter sets and
-reports how often each model's verdict agrees with the simulation.
+reports how often each model's verdict agrees with the simulation. A
+``--config`` file's ``power`` or ``grid`` law is the walls' law (with
+``--env analytic``; a grid law's cell ratio in either environment), by the
+rule `simulate` follows (`simulate.config_law`, docs/config.md).
 
 JSON keys (`pfm_stability/schema/output.schema.json`): ``schema_version``,
 ``command`` ("validate"), ``parameter`` (the bisected one),
@@ -128,9 +131,16 @@ def run(args) -> int:
 
 
 def _work(args, params, progress):
-    """The bisection (and the sweep): (BoundaryValidation, SweepResult or None)."""
+    """The bisection (and the sweep): (BoundaryValidation, SweepResult or None).
+
+    The walls' law is a --config file's ``power`` or ``grid`` law (and a grid
+    law's cell ratio), by the rule `simulate` follows (`simulate.config_law`).
+    """
     from ..parameters import Wall
     from ..validation import validate_boundary, verdict_sweep
+    from .simulate import config_law
+
+    law = config_law(args, params)
 
     validation = validate_boundary(
         args.scenario,
@@ -147,6 +157,7 @@ def _work(args, params, progress):
         pade_order=args.pade_order,
         window_cells=params.preset.window_cells,
         cell_size=params.preset.cell_size,
+        **law,
         stability_map=(7, 9) if args.plot and not args.no_map else None,
         progress=progress,
     )
@@ -154,6 +165,6 @@ def _work(args, params, progress):
     if args.sweep:
         sweep = verdict_sweep(
             args.sweep, seed=args.seed, env=args.env, robot=params.robot, controller=params.controller,
-            pade_order=args.pade_order, progress=progress,
+            pade_order=args.pade_order, law=law["law"], progress=progress,
         )
     return validation, sweep

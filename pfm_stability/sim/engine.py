@@ -7,8 +7,10 @@ member (member m is at t = k·T_m after k steps).
 
 One step, for every member still running (the `sampled` model, docs/models.md):
 
-1. **Events** at t_k (`pfm_stability.sim.events`): collision, target
-   reached, trapped. A member with an event stops.
+1. **Events** at t_k (`pfm_stability.sim.events`): collision — the first
+   touch of an obstacle on the exact path from t_k−1 to t_k
+   (`pfm_stability.sim.contact`), or an overlap at t_k — target reached,
+   trapped. A member with an event stops.
 2. **Sense** at t_k: repulsion from the active window's occupied cells
    (grid, KB eq 1–2) or the analytic walls' law; attraction (eq 3);
    δ_k = direction of R (eq 4).
@@ -29,7 +31,9 @@ One step, for every member still running (the `sampled` model, docs/models.md):
    Positions: the part linear in Δ = θ − θ_k in closed form, the residual by
    a composite Gauss–Legendre rule graded to the steering time scales
    (`pfm_stability.sim.robot`; a member's rule depends on its own (τ, k, T)
-   only, so it advances identically in any batch).
+   only, so it advances the same in any batch to round-off: numpy's SIMD
+   sin/cos/exp may round a member differently in arrays of other lengths, a
+   few ULP per step, carried on by the loop — docs/simulator.md, "Batches").
 
 Everything is numpy on (B,) or (B, K) arrays; the grid's window sums use
 the precompiled occupied-cell lists of `pfm_stability.sim.window`.
@@ -44,6 +48,7 @@ import numpy as np
 
 from ..force_law import PowerLaw
 from ..parameters import TAU_RESOLUTION
+from .contact import StepPath, chord_cell_gap, chord_wall_gap, first_contact, path_slack, point_cell_gap, point_wall_gap
 from .environment import segment_clearance, wall_coordinates
 from .events import Event
 from .metrics import oscillation_metrics
@@ -151,6 +156,7 @@ class _Batch:
         take = lambda name, dtype=float: np.array([getattr(q, name) for q in geo], dtype=dtype)
         self.g_offset, self.g_nx, self.g_ny, self.g_pad = (take(n, np.int64) for n in ("cell_offset", "nx_padded", "ny_padded", "pad"))
         self.g_xmin, self.g_ymin, self.g_c = take("x_min"), take("y_min"), take("cell_size")
+        self.g_listed = take("listed_within")  # every cell within this of a robot cell's square is in its near list
         self.g_scale = self.ratio[self.grid_idx] * self.W[self.grid_idx] ** self.n[self.grid_idx]
 
     def _compile_walls(self):
@@ -321,7 +327,7 @@ def _advance_command(coef, theta, omega, u, V, x, y):
 
 
 def _advance_reference(b, theta, omega, ref, V, x, y):
-    """Servo members over one period; saturated ones in SUBSTEPS sub-intervals."""
+    """Servo members over one period; saturated ones in SUBSTEPS sub-intervals (returned: which, bool per member)."""
     r = b.reference_idx
     k, wmax = b.k[r], b.max_rate[r]
     delta, correction, theta_end, omega_end = propagate(b.servo_coef, theta, omega, ref)
@@ -341,7 +347,7 @@ def _advance_reference(b, theta, omega, ref, V, x, y):
             xs, ys = advance_position(xs, ys, V[s], lin.rule, th, d, c)
             th, om = np.where(clipped, e2, e1), np.where(clipped, o2, o1)
         x_new[s], y_new[s], theta_end[s], omega_end[s] = xs, ys, th, om
-    return x_new, y_new, theta_end, omega_end
+    return x_new, y_new, theta_end, omega_end, sat
 
 
 def run_batch(scenarios, *, record: str = "trajectory", metrics: bool = True, progress=None) -> BatchResult:
@@ -390,11 +396,19 @@ def run_batch(scenarios, *, record: str = "trajectory", metrics: bool = True, pr
     started = time.perf_counter()
     k = 0
     max_steps = int(b.steps.max())
+    step = None  # the last period's start, for the collision check along the path
     while True:
         due = alive & (k <= b.steps)
         done_steps[due] = k
         rows = b.grid_rows(x, y, due) if b.grid_idx.size else None
-        _check_events(b, k, x, y, x0, y0, rows, due, alive, events, best, best_t, last_gap)
+        gap = b.gaps(x, y, rows) if rows is not None or b.wall_idx.size else np.full(B, math.inf)
+        if step is not None:
+            for m, contact in _swept_contacts(b, step, x, y, gap).items():
+                events[m] = Event("collision", float((k - 1) * b.T[m] + contact.t), contact.x, contact.y)
+                alive[m] = False
+                min_gap[m] = min(min_gap[m], contact.gap)
+            due &= alive
+        _check_events(b, k, x, y, x0, y0, gap, due, alive, events, best, best_t, last_gap)
         np.minimum(min_gap, last_gap, out=min_gap)
         running = due & alive & (k < b.steps)
         if k == max_steps or not running.any():
@@ -421,6 +435,7 @@ def run_batch(scenarios, *, record: str = "trajectory", metrics: bool = True, pr
         applied_V = np.where(b.delayed, pending_V, speed)
         pending, pending_V = value, speed
         # advance over [t_k, t_k+1)
+        substepped = np.zeros(B, dtype=bool)
         if b.all_command:
             x_new, y_new, th_new, om_new = _advance_command(b.command_coef, theta, omega, applied, applied_V, x, y)
         else:
@@ -429,7 +444,8 @@ def run_batch(scenarios, *, record: str = "trajectory", metrics: bool = True, pr
             if c.size:
                 x_new[c], y_new[c], th_new[c], om_new[c] = _advance_command(b.command_coef, theta[c], omega[c], applied[c], applied_V[c], x[c], y[c])
             if r.size:
-                x_new[r], y_new[r], th_new[r], om_new[r] = _advance_reference(b, theta[r], omega[r], applied[r], applied_V[r], x[r], y[r])
+                x_new[r], y_new[r], th_new[r], om_new[r], substepped[r] = _advance_reference(b, theta[r], omega[r], applied[r], applied_V[r], x[r], y[r])
+        step = dict(running=running, x=x, y=y, theta=theta, omega=omega, value=applied, V=applied_V, gap=gap, rows=rows, substepped=substepped)
         x, y = np.where(running, x_new, x), np.where(running, y_new, y)
         theta, omega = np.where(running, th_new, theta), np.where(running, om_new, omega)
         k += 1
@@ -446,10 +462,85 @@ def run_batch(scenarios, *, record: str = "trajectory", metrics: bool = True, pr
     return BatchResult(runs, int(done_steps.sum()), seconds)
 
 
-def _check_events(b, k, x, y, x0, y0, rows, due, alive, events, best, best_t, last_gap):
-    """Collision, target reached, trapped at t_k for the members due a check (in that priority)."""
+def _swept_contacts(b, step, x, y, gap) -> dict:
+    """Members whose disc touched an obstacle on their exact path over the last period: {member: Contact}.
+
+    `step` holds the period's start (positions, heading, rate, held value,
+    speed, gaps, grid rows, sub-stepped servos). A member is cleared by the
+    Lipschitz bound on its gaps at both ends, then by its chord
+    (`pfm_stability.sim.contact`); the rest are searched along the path with
+    `first_contact`. Gaps are lower bounds: a grid member's near list holds
+    every cell within `g_listed` of its cell's square, so farther cells are
+    at least that far.
+    """
+    stepped = step["running"]
+    length = step["V"] * b.T
+    low_start, low_end = step["gap"].copy(), gap.copy()
+    if b.grid_idx.size:
+        gi = b.grid_idx
+        unlisted = b.g_listed - b.W[gi] / 2
+        low_start[gi], low_end[gi] = np.minimum(low_start[gi], unlisted), np.minimum(low_end[gi], unlisted)
+    suspect = stepped & ~(low_start + low_end > length)
+    if not suspect.any():
+        return {}
+    ax, ay = step["x"], step["y"]
+    chord = np.full(b.size, -math.inf)  # the chords' clearance where known (−inf: search the path)
+    if b.wall_idx.size:
+        pick = suspect[b.wall_idx]
+        w = b.wall_idx[pick]
+        walls = {key: value[pick] for key, value in b.walls.items()}
+        chord[w] = chord_wall_gap(walls, *(v[w][:, None] for v in (ax, ay, x, y)))
+    if b.grid_idx.size:
+        listed = b.W[b.grid_idx] / 2 + length[b.grid_idx] < b.g_listed  # the near list holds every reachable cell
+        pick = suspect[b.grid_idx] & listed
+        g = b.grid_idx[pick]
+        cells = b.table.near[step["rows"][pick]]
+        near = chord_cell_gap(b.table.ox[cells], b.table.oy[cells], b.g_c[pick][:, None] / 2, *(v[g][:, None] for v in (ax, ay, x, y)))
+        chord[g] = np.minimum(near, b.g_listed[pick] - length[g])
+    slack = path_slack(length, np.hypot(x - ax, y - ay))
+    contacts = {}
+    for m in np.flatnonzero(suspect & ~(chord - b.W / 2 > slack)):
+        path = StepPath(
+            float(b.tau[m]), float(b.k[m]), float(b.max_rate[m]), float(b.T[m]), bool(b.reference[m]), bool(step["substepped"][m]),
+            SUBSTEPS, float(step["theta"][m]), float(step["omega"][m]), float(step["value"][m]), float(step["V"][m]),
+            float(ax[m]), float(ay[m]),
+        )
+        contact = first_contact(path, (float(x[m]), float(y[m])), *_obstacles(b, step, m, float(length[m])), float(b.W[m]) / 2)
+        if contact is not None:
+            contacts[int(m)] = contact
+    return contacts
+
+
+def _obstacles(b, step, m, length):
+    """(clearance of points, clearance of chords) of member m's obstacles near its last period, as functions of arrays (m).
+
+    Analytic walls: all of them, exactly. Grid: the near list of the cell the
+    period started in when it holds every cell the disc can reach
+    (W/2 + ℓ < `g_listed`; farther cells are then at least g_listed − ℓ
+    away from any point of the path), else every occupied cell of the grid.
+    """
+    if not b.is_grid[m]:
+        row = int(np.searchsorted(b.wall_idx, m))
+        walls = {key: value[row] for key, value in b.walls.items()}
+        return (lambda px, py: point_wall_gap(walls, px[:, None], py[:, None]),
+                lambda ax, ay, bx, by: chord_wall_gap(walls, ax[:, None], ay[:, None], bx[:, None], by[:, None]))
+    g = int(np.searchsorted(b.grid_idx, m))
+    half = float(b.g_c[g]) / 2
+    if b.W[m] / 2 + length < b.g_listed[g]:
+        row = int(step["rows"][g])
+        cells = b.table.near[row][: b.table.near_count[row]]
+        cx, cy, floor = b.table.ox[cells], b.table.oy[cells], float(b.g_listed[g]) - length
+    else:
+        cx, cy, _ = b.scenarios[m].environment.occupied()
+        floor = math.inf
+    return (lambda px, py: np.minimum(point_cell_gap(cx, cy, half, px[:, None], py[:, None]), floor),
+            lambda ax, ay, bx, by: np.minimum(chord_cell_gap(cx, cy, half, ax[:, None], ay[:, None], bx[:, None], by[:, None]), floor))
+
+
+def _check_events(b, k, x, y, x0, y0, gap, due, alive, events, best, best_t, last_gap):
+    """Collision (an overlap at t_k: at the start, or one the path check missed), target reached, trapped at t_k
+    for the members due a check (in that priority)."""
     t = k * b.T
-    gap = b.gaps(x, y, rows) if rows is not None or b.wall_idx.size else np.full(b.size, math.inf)
     hit = due & (gap <= 0)
     distance = b.target_distance(x, y)
     prog = b.progress(x, y, x0, y0, distance)

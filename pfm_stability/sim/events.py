@@ -3,11 +3,13 @@
 Events are checked at every sample instant t_k, before the controller senses:
 
 * ``collision`` — the robot disc (diameter W) touches an occupied cell's
-  square or an analytic wall segment. The reported time is refined by linear
-  interpolation of the clearance between the last two samples, so it is
-  accurate to O(T²) rather than T; a graze that starts and ends between two
-  samples (depth < ~V²T²/(8 × turn radius), well under 1 mm for CARMEL) is
-  not seen.
+  square or an analytic wall segment anywhere on its exact path from t_k−1
+  to t_k (`pfm_stability.sim.contact`: a robot that moves V·T = 80 m per
+  period at T = 100 s cannot pass through a wall between two samples). The
+  time is the first touch, to 1e-12 of the period, and (x, y) the robot
+  centre there; the run ends at t_k, the first sample after it (whose
+  position may lie past the contact). A graze shallower than ~1e-8 m may
+  count or not.
 * ``target_reached`` — within the target radius of a point target, or past
   the finish distance of a direction target.
 * ``trapped`` — no progress of `trap_distance` towards the target within
@@ -31,9 +33,9 @@ class Event:
     ----------
     type : {"collision", "target_reached", "trapped"}
     t : float
-        Time, s.
+        Time, s: a collision's first touch (between samples), else the sample's.
     x, y : float
-        Robot centre at the sample that detected it, m.
+        Robot centre at that time, m.
     """
 
     type: str

@@ -41,6 +41,20 @@ oscillation); **stable** (the run *settled*) = no collision, not oscillating,
 and σ < 0 when σ is defined — not the linear-stability verdict (the sign of σ)
 that is compared with the models (`pfm_stability.sim.verdict`). When too few turning points exist and the fit is rejected, σ and ω
 are ``None`` with a `reason`, never NaN.
+
+The answer is explicit where nothing was measured:
+
+* a **collision** (on the path between samples too, `pfm_stability.sim.contact`)
+  — not stable, whatever the offset did before;
+* fewer than 8 samples in the measurement window (a run that ended, or left
+  the window, almost at once: e.g. T = 100 s) — not stable: nothing shows that
+  it settled (σ None, `reason` says why);
+* σ undefined otherwise (no oscillation and a rejected fit: a constant
+  offset, a monotone decay the grid's ripple keeps from fitting, or a drift)
+  — stable only when the offset is settling: its range over the second half
+  of the window at most `SETTLING` times its range over the first half (a
+  constant offset: 0 against 0; a decay e^(σt): e^(σD/2)); a robot drifting
+  away at a steady or growing rate is not stable.
 """
 
 from __future__ import annotations
@@ -50,7 +64,10 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-__all__ = ["OscillationMetrics", "oscillation_metrics", "linear_prediction", "turning_points", "LINEAR_RESIDUAL", "PEAKS_AGREEMENT", "HYSTERESIS"]
+__all__ = [
+    "OscillationMetrics", "oscillation_metrics", "linear_prediction", "turning_points", "LINEAR_RESIDUAL", "PEAKS_AGREEMENT",
+    "HYSTERESIS", "SETTLING",
+]
 
 LINEAR_RESIDUAL = 1e-6
 """Largest relative residual of the linear-prediction fit for the run to count as linear."""
@@ -64,6 +81,11 @@ L = 1.2 m), narrow enough to reject a fit that left the linear regime."""
 
 HYSTERESIS = 0.01
 """Turning-point hysteresis as a fraction of the window's range of x."""
+
+SETTLING = 0.9
+"""A run without a measurable σ is settling when its offset moves over the second half of the window at most this
+fraction of what it moved over the first half (module docstring): a decay qualifies (measured 0.0002–0.27 for slow
+grid corridors, V = 0.1–0.3 m/s over 20 s), a steady drift (1) or a growing one (> 1) does not."""
 
 _MIN_SAMPLES = 8
 
@@ -84,9 +106,10 @@ class OscillationMetrics:
     oscillating : bool
         A growing oscillation or a limit cycle.
     stable : bool
-        The run settled: no collision, not oscillating, σ < 0 when defined.
-        (The linear-stability verdict the loop models predict is the sign of
-        σ alone: `pfm_stability.sim.verdict.simulated_verdict`.)
+        The run settled: no collision, not oscillating, σ < 0 when defined,
+        settling when not; False when the window holds too few samples to say
+        (module docstring). (The linear-stability verdict the loop models
+        predict is the sign of σ alone: `pfm_stability.sim.verdict.simulated_verdict`.)
     method : {"linear_prediction", "peaks", "none"}
         Estimator that produced σ and ω.
     turning_points : int
@@ -248,10 +271,10 @@ def oscillation_metrics(t, x, T: float, *, order: int = 4, collision_time: float
     if not np.all(np.isfinite(x)):
         raise FloatingPointError("lateral offset has non-finite samples")
     base = dict(time_to_collision=collision_time, window=(float(t[0]), float(t[-1])) if t.size else None)
-    if t.size < _MIN_SAMPLES:
+    if t.size < _MIN_SAMPLES:  # nothing measured: not "stable" (module docstring)
         return OscillationMetrics(
-            None, None, None, False, False, not collided, "none", 0,
-            reason=f"fewer than {_MIN_SAMPLES} samples in the measurement window ({t.size})", **base,
+            None, None, None, False, False, False, "none", 0,
+            reason=f"fewer than {_MIN_SAMPLES} samples in the measurement window ({t.size}): not measurable", **base,
         )
     span = float(np.max(x) - np.min(x))
     extrema = turning_points(x, HYSTERESIS * span) if span > 0 else np.array([], dtype=int)
@@ -278,7 +301,12 @@ def oscillation_metrics(t, x, T: float, *, order: int = 4, collision_time: float
         sigma, omega, method = None, omega_p, "none"
         reason = f"{extrema.size} turning point(s) in the window and the run is not linear (fit residual {residual})"
     oscillating = limit_cycle or (sigma is not None and sigma > 0 and omega is not None and omega > 0)
-    stable = not collided and not oscillating and (sigma is None or sigma < 0)
+    if sigma is None:  # stable only when settling: the second half of the window moves less than the first
+        late = t >= (t[0] + t[-1]) / 2
+        moved = [float(np.ptp(x[~late])) if np.any(~late) else 0.0, float(np.ptp(x[late]))]
+        settling = moved[1] <= SETTLING * moved[0]
+        reason += f"; the offset {'is settling' if settling else 'is not settling'} (it moved {moved[0]:.3g} m, then {moved[1]:.3g} m)"
+    stable = not collided and not oscillating and (sigma < 0 if sigma is not None else settling)
     return OscillationMetrics(
         growth_rate=sigma,
         angular_frequency=omega,

@@ -70,22 +70,22 @@ from __future__ import annotations
 import math
 from functools import lru_cache
 
-from ..checks import check_choice, check_number
+from ..checks import check_choice, check_number, describe_range
 from ..effective_force import GridWallLaw, f_average
 from ..force_law import ForceLaw, wall_equilibrium
 from ..parameters import CARMEL, RANGES, Controller, Robot, Wall
 from ..solve import bisect_batched
 from .environment import AnalyticEnvironment, AnalyticWall
 from .grid import HistogramGrid
-from .scenario import MeasureAxis, Pose, Scenario, Target, scenario_law
+from .scenario import LAW_NAMES, MeasureAxis, Pose, Scenario, Target, scenario_law
 from .vff import measured_equilibrium
 
 __all__ = ["SCENARIO_NAMES", "ENVS", "LAWS", "make_scenario", "barely_avoiding_ratio"]
 
 SCENARIO_NAMES = ("straight", "corridor", "wall", "kb-fig3", "kb-fig5", "kb-fig6-wide", "kb-fig6-narrow")
 ENVS = ("grid", "analytic")
-LAWS = ("power", "grid")
-"""Analytic-mode lateral laws: KB's lumped power law, or the grid's effective law."""
+LAWS = LAW_NAMES
+"""Analytic-mode lateral laws: KB's lumped power law, or the grid's effective law (`scenario.LAW_NAMES`)."""
 
 _MARGIN = 1.0
 """Grid margin around the scenario's walls, start and target, m."""
@@ -166,9 +166,10 @@ def _law_of(law, env, robot, controller, grid_law):
         if law is not None:
             raise ValueError("law applies to env=analytic only (the grid's law is its cells)")
         return None
-    if law is not None and not isinstance(law, ForceLaw):
+    if isinstance(law, str) and law == "grid":  # the grid's law as drawn for this run (its ratio set by _grid_law)
+        law = grid_law
+    elif law is not None and not isinstance(law, ForceLaw):
         check_choice("law", law, LAWS)
-        law = grid_law if law == "grid" else None  # "power": KB's law, scenario_law's default
     return scenario_law("analytic", robot, controller, law=law)
 
 
@@ -191,6 +192,22 @@ def _check_fits(L, robot, env, cell_size, name="L", given=None):
         raise ValueError(f"{name} must be a finite number in ({where}, {high:g}] m = ({low:g}, {high:g}] m (the robot must fit); got {got}")
 
 
+_DEFAULT_OFFSET = 0.02
+"""Start offset from the equilibrium line when none is given, m (``corridor``, ``wall``)."""
+
+
+def _offset(o, low: float, high: float, why: str) -> float:
+    """The start offset, m: the given one, checked to lie in (low, high) — a start where the robot disc fits — or the
+    default (0.02 m, or half the free play of a narrower corridor: never a value outside the range)."""
+    given = o["offset"]
+    if given is None:
+        return min(_DEFAULT_OFFSET, 0.5 * high)
+    try:
+        return check_number("offset", given, low, high, unit="m")
+    except ValueError:
+        raise ValueError(f"offset must be a finite number in {describe_range(low, high, True, True)} m ({why}); got {given!r}") from None
+
+
 def _corridor(o):
     L = check_number("L", o["L"] if o["L"] is not None else 1.0, 0.0, unit="m")
     env, c, robot = o["env"], o["cell_size"], o["robot"]
@@ -200,7 +217,11 @@ def _corridor(o):
         L, centre = _snap_L(L, c)
         notes["L"] = f"{L:g} m (walls on cell centres: L rounded to a multiple of c/2 = {c / 2:g} m from {given:g})"
     _check_fits(L, robot, env, c, given=given)
-    offset = check_number("offset", o["offset"] if o["offset"] is not None else 0.02, unit="m")
+    face = c / 2 if env == "grid" else 0.0
+    play = L - robot.W / 2 - face  # the robot disc touches a wall at |offset| = play
+    drawn = " as drawn on the grid" if env == "grid" else ""
+    offset = _offset(o, -play, play, f"the robot disc must lie inside the corridor, clear of its walls: |offset| < L - W/2"
+                     f"{' - c/2' if face else ''} with L = {L:g} m{drawn}, W = {robot.W:g} m{f', c = {c:g} m' if face else ''}")
     duration = o["duration"] or 20.0
     walls = _corridor_walls(L, -3.0, _length(robot, duration), centre)
     start = Pose(centre + offset, 0.0, 0.0)
@@ -222,7 +243,8 @@ def _wall(o):
             f"alpha must give an equilibrium distance d0 > {contact:g} m (robot clear of the wall); "
             f"alpha = {alpha_deg:g} deg gives d0 = {d0:.3g} m"
         )
-    offset = check_number("offset", o["offset"] if o["offset"] is not None else 0.02, unit="m")
+    offset = _offset(o, contact - d0, math.inf, f"the robot disc must start clear of the wall: d0 + offset > W/2"
+                     f"{' + c/2' if env == 'grid' else ''} = {contact:g} m with d0 = {d0:.4g} m")
     duration = o["duration"] or 20.0
     walls = [([(0.0, -3.0), (0.0, _length(robot, duration))], "left")]
     notes = {
@@ -374,7 +396,11 @@ def make_scenario(
         ``wall``: target angle from the wall normal, rad (default 45°).
     offset : float, optional
         ``corridor``/``wall``: start offset from the equilibrium line, m
-        (default 0.02; positive = right of the corridor centre, away from the wall).
+        (positive = right of the corridor centre, away from the wall). The
+        robot disc must start inside the corridor, clear of both walls:
+        |offset| < L − W/2 (− c/2 in the grid, L as drawn); beside a wall,
+        clear of it: offset > W/2 (+ c/2) − d0. Default 0.02, or half the
+        free play L − W/2 (− c/2) of a narrower corridor.
     duration : float, optional
         s (default per scenario).
     cell_ratio : float, optional

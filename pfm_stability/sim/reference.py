@@ -12,6 +12,13 @@ expm([[A, I], [0, 0]]h) = [[exp(Ah), ∫₀ʰ exp(At) dt], [0, I]] (scipy), not
 from the engine's closed form. It shares no stepping code with the batch
 engine, so the tests compare the two trajectories (`tests/test_sim_engine.py`,
 `tests/test_sim_accuracy.py`), and `benchmarks/bench_simulator.py` times both.
+
+Collisions between samples take their own route too: a period that starts
+within its length V·T of an obstacle (the only ones the disc can touch) is
+walked at `PATH_SAMPLES` instants, each position computed afresh from the
+period's start (a new `_Steering` of that length), and the first instant that
+overlaps is narrowed by `solve.bisect_root` on the clearance (the engine:
+chords and a batched bisection, `pfm_stability.sim.contact`).
 """
 
 from __future__ import annotations
@@ -22,6 +29,7 @@ import numpy as np
 
 from ..force_law import PowerLaw
 from ..parameters import TAU_RESOLUTION
+from ..solve import bisect_root
 from .engine import SUBSTEPS
 from .events import Event
 from .grid import HistogramGrid
@@ -29,7 +37,10 @@ from .results import Trajectory
 from .robot import constant_input_modes, graded_rule, servo_modes, slow_rate
 from .scenario import Scenario
 
-__all__ = ["simulate_reference"]
+__all__ = ["simulate_reference", "PATH_SAMPLES"]
+
+PATH_SAMPLES = 32
+"""Instants at which a period that may touch an obstacle is walked (its end included)."""
 
 
 def _wrap(a: float) -> float:
@@ -165,6 +176,52 @@ def _wall_sense(s: Scenario, x, y):
     return fx, fy, gap - s.robot.W / 2, goal
 
 
+def _position_after(s, tau, t, theta, omega, applied, V, x, y, substepped):
+    """(x, y) t seconds into a period that starts at (x, y, θ, ω) with `applied` held (`simulate_reference`'s motion)."""
+    k, wmax, T = s.robot.k, s.robot.max_steering_rate, s.controller.T
+    if s.controller.hold == "command":
+        one = _Steering(tau, k, t, wmax, ("constant",))
+        nodes, integral, _, _ = one.constant(theta, omega, applied)
+        return one.move(x, y, V, theta, nodes, integral)
+    if not substepped:
+        one = _Steering(tau, k, t, wmax, ("servo",))
+        nodes, integral, _, _ = one.reference(theta, omega, applied)
+        return one.move(x, y, V, theta, nodes, integral)
+    part = T / SUBSTEPS
+    whole = min(int(t // part), SUBSTEPS - 1)
+    for length in [part] * whole + [t - whole * part]:
+        if length <= 0:
+            break
+        one = _Steering(tau, k, length, wmax, ("servo", "constant"))
+        u = k * (applied - theta)
+        if abs(u) > wmax:
+            nodes, integral, theta2, omega2 = one.constant(theta, omega, min(max(u, -wmax), wmax))
+        else:
+            nodes, integral, theta2, omega2 = one.reference(theta, omega, applied)
+        x, y = one.move(x, y, V, theta, nodes, integral)
+        theta, omega = theta2, omega2
+    return x, y
+
+
+def _path_contact(s, sense, tau, start, applied, V, substepped, gap_start):
+    """The first instant (s into the period) and place where the disc touches an obstacle, or None."""
+    x, y, theta, omega = start
+    T = s.controller.T
+    if s.env == "grid":  # the window's cells only: those beyond it are at least h·c away
+        gap_start = min(gap_start, (s.window_cells // 2) * s.environment.cell_size - s.robot.W / 2)
+    if gap_start > V * T:  # the clearance is 1-Lipschitz: no point of a path of length V·T gets closer
+        return None
+    gap_at = lambda t: sense(s, *_position_after(s, tau, t, theta, omega, applied, V, x, y, substepped))[2]
+    before = 0.0
+    for i in range(1, PATH_SAMPLES + 1):
+        t = T * i / PATH_SAMPLES
+        if gap_at(t) <= 0:
+            hit = bisect_root(gap_at, before, t, rtol=1e-14)
+            return (hit, *_position_after(s, tau, hit, theta, omega, applied, V, x, y, substepped))
+        before = t
+    return None
+
+
 def simulate_reference(s: Scenario):
     """Run one scenario in a per-robot Python loop.
 
@@ -231,6 +288,7 @@ def simulate_reference(s: Scenario):
             pending = (value, speed)
         applied, V = pending if c.compute_delay == 1 else (value, speed)
         pending = (value, speed)
+        start, substepped = (x, y, theta, omega), False
         if c.hold == "command":
             nodes, integral, theta_end, omega_end = full.constant(theta, omega, applied)
             x, y = full.move(x, y, V, theta, nodes, integral)
@@ -240,6 +298,7 @@ def simulate_reference(s: Scenario):
             if all(abs(k * (applied - th)) <= wmax for th in checks):
                 x, y = full.move(x, y, V, theta, nodes, integral)
             else:
+                substepped = True
                 theta_end, omega_end = theta, omega
                 for _ in range(SUBSTEPS):
                     u = k * (applied - theta_end)
@@ -251,5 +310,10 @@ def simulate_reference(s: Scenario):
                     theta_end, omega_end = th2, om2
         theta, omega = theta_end, omega_end
         xs.append(x), ys.append(y), ths.append(theta)
+        contact = _path_contact(s, sense, tau, start, applied, V, substepped, gap)
+        if contact is not None:  # the run ends at the sample after the touch, as the engine's does
+            hit, cx, cy = contact
+            event = Event("collision", step * T + hit, cx, cy)
+            break
     n = len(xs)
     return Trajectory(np.arange(n) * T, np.array(xs), np.array(ys), np.array(ths)), event

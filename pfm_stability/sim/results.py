@@ -62,15 +62,18 @@ class RunResult:
     metrics : OscillationMetrics or None
         None when the batch ran with ``metrics=False``.
     t_end : float
-        Last simulated instant, s.
+        Last sample instant, s: the duration, or the sample of the event that
+        stopped the run (a collision's first sample after the contact, whose
+        time is the event's).
     steps : int
         Sampling periods simulated.
     offset_t, offset : ndarray
         Lateral offset (m) at the sample instants of the measurement window.
     min_clearance : float or None
-        Smallest gap between the robot disc and an obstacle over the samples,
-        m (< 0 at a collision); None if no obstacle ever came within W/2 of
-        the robot's cell (grid) — the gap is only computed near obstacles.
+        Smallest gap between the robot disc and an obstacle over the samples
+        (and at a contact between them), m (<= 0 at a collision); None if no
+        obstacle ever came within W/2 + V·T of the robot's cell (grid) — the
+        gap is only computed near obstacles.
     trajectory : Trajectory or None
         Every sample, when recorded.
     """

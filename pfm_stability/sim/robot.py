@@ -217,7 +217,7 @@ def graded_rule(h, rates, decays, slow, panels=None) -> Rule:
     inside = j < panels[:, None]
     target = _phase(h[:, None], rates, decays, slow) * np.where(inside, j / panels[:, None], 1.0)
     lo, hi = np.zeros_like(target), np.broadcast_to(h[:, None], target.shape)
-    for _ in range(60):
+    for _ in range(60 if target.size else 0):  # one panel each: no inner breakpoint to place
         mid = 0.5 * (lo + hi)
         below = _phase(mid, rates, decays, slow) < target
         lo, hi = np.where(below, mid, lo), np.where(below, hi, mid)
@@ -235,7 +235,10 @@ def node_sum(a):
     """Σ over the node axis (axis 1) of a (B, J, …) array, left to right.
 
     Sequential, so a member's zero-weight padding (trailing) leaves its sum
-    unchanged bit for bit: a member advances identically in any batch.
+    unchanged bit for bit: the batch's widest rule adds nothing to a member's
+    position (which still agrees with its run alone to round-off only, as
+    numpy's SIMD sin/cos round arrays of other shapes differently;
+    docs/simulator.md, "Batches").
     """
     return np.cumsum(a, axis=1)[:, -1]
 

@@ -24,14 +24,17 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..checks import check_number
+from ..checks import check_choice, check_number
 from ..effective_force import DEFAULT_CV, GridWallLaw, calibrate_cell_ratio, check_window_cells, working_range
 from ..force_law import ForceLaw, law_in_force
 from ..parameters import Controller, Robot, check_parameter
 from .environment import AnalyticEnvironment
 from .grid import HistogramGrid
 
-__all__ = ["Pose", "Target", "MeasureAxis", "Scenario", "MAX_SAMPLES", "scenario_law"]
+__all__ = ["Pose", "Target", "MeasureAxis", "Scenario", "MAX_SAMPLES", "LAW_NAMES", "scenario_law"]
+
+LAW_NAMES = ("power", "grid")
+"""Lateral laws of analytic walls by name: KB's lumped power law, or the grid's effective law (`scenario_law`)."""
 
 MAX_SAMPLES = 5e7
 """Most samples one run may take (the recorder keeps two float arrays of this length: 800 MB)."""
@@ -44,7 +47,7 @@ def scenario_law(
     window_cells: int = 33,
     cell_size: float = 0.1,
     *,
-    law: ForceLaw | None = None,
+    law: ForceLaw | str | None = None,
     cell_ratio: float | None = None,
     cv: float = DEFAULT_CV,
 ) -> ForceLaw:
@@ -54,8 +57,11 @@ def scenario_law(
     cells and averaged along it; exact for walls along the grid axes) with
     cell ratio ρ = `cell_ratio`, or, when not given, the ρ whose f_av equals
     the controller's f over the window's working range (KB §4,
-    `calibrate_cell_ratio`). ``env="analytic"``: `law`, or KB's power law
-    f(W/d)^n (eq 8, 13).
+    `calibrate_cell_ratio`). ``env="analytic"``: `law` — a `ForceLaw`, or by
+    name ``"grid"`` (that same `GridWallLaw` without its quantization) or
+    ``"power"`` — or, when not given, KB's power law f(W/d)^n (eq 8, 13).
+    `make_scenario`, the validation (`validate_boundary`, `verdict_sweep`) and
+    the command line (a configuration file's ``law``) all ask this function.
 
     Parameters
     ----------
@@ -64,16 +70,28 @@ def scenario_law(
         W; f and n.
     window_cells, cell_size, cv
         Grid window side (odd), cell size (m) and the wall cells' certainty value.
-    law : ForceLaw, optional
+    law : ForceLaw or {"power", "grid"}, optional
         Analytic walls' law (a grid's law is its cells: not allowed with ``env="grid"``).
     cell_ratio : float, optional
-        Grid: ρ = F_cr/F_ct.
+        ρ = F_cr/F_ct of the grid, or of the analytic ``law="grid"``.
+
+    Raises
+    ------
+    ValueError
+        A law with ``env="grid"``, an unknown law name, or a cell ratio the law does not take.
     """
     if env == "grid":
         if law is not None:
             raise ValueError("law applies to env=analytic only; the grid's law is its cells")
         ratio = cell_ratio if cell_ratio is not None else calibrate_cell_ratio(controller.f, controller.n, robot.W, cell_size, window_cells, cv)
         return GridWallLaw(ratio, controller.n, robot.W, cell_size, window_cells, cv)
+    if isinstance(law, str):
+        check_choice("law", law, LAW_NAMES)
+        if law == "grid":
+            return scenario_law("grid", robot, controller, window_cells, cell_size, cell_ratio=cell_ratio, cv=cv)
+        law = None
+    if cell_ratio is not None:
+        raise ValueError("cell_ratio applies to env=grid, or to env=analytic with law=grid")
     return law_in_force(robot, controller, law)
 
 

@@ -18,7 +18,11 @@ Two questions, two names:
   stable side (docs/validation.md).
 
 Where σ is undefined (too few turning points and a rejected linear fit) the
-verdict falls back on the settled flag.
+verdict falls back on the settled flag, which is explicit there
+(`pfm_stability.sim.metrics`): a run with fewer than 8 samples in its window
+(unmeasurable) or whose offset is not settling (a drift) is unstable, a
+constant or decaying one stable; a collision (also between samples, `pfm_stability.sim.contact`) is
+unstable in both senses.
 """
 
 from __future__ import annotations

@@ -11,8 +11,10 @@ every window are listed once per grid:
   with a *sentinel* cell (CV 0, 10⁹ m away) that contributes exactly 0
   (coordinates rather than indices: a step then gathers whole rows, which
   made the whole 1000-robot step 1.3× faster than gathering cell by cell);
-* ``near[row]`` — the occupied cells whose square lies within W_max/2 of the
-  robot cell's square: the only candidates for a collision (docs/simulator.md);
+* ``near[row]`` — the occupied cells of the window whose square lies within
+  W_max/2 + step_max of the robot cell's square: every cell the robot disc
+  can touch at a sample or on its way to the next one (docs/simulator.md,
+  `pfm_stability.sim.contact`);
 * ``row_of_cell`` — row of each robot cell of the grid padded by h cells on
   every side (a window can see the grid from outside it). Robot cells with no
   occupied cell in their window share row 0 (empty). Cells that no robot of
@@ -90,6 +92,13 @@ class GridGeometry:
     nx_padded: int
     ny_padded: int
     pad: int
+    near_radius: float = 0.0
+
+    @property
+    def listed_within(self) -> float:
+        """Every occupied cell whose square lies within this distance (m) of a robot cell's square is in its near list:
+        the near radius, or the window's edge (h·c) if that comes first."""
+        return min(self.near_radius, self.pad * self.cell_size)
 
 
 def _square_gap(di, dj):
@@ -124,9 +133,9 @@ def compile_window_table(
         Window side w_s, odd, >= 3.
     W_min, W_max : float
         Smallest and largest robot width that will use the table, m: the
-        collision lists reach W_max/2, and robot cells are left out (row −1)
-        when every point of them is closer than W_min/2 − step_max to an
-        obstacle.
+        collision lists reach W_max/2 + step_max (inside the window), and
+        robot cells are left out (row −1) when every point of them is closer
+        than W_min/2 − step_max to an obstacle.
     step_max : float
         Longest distance a robot travels in one sampling period, m (V·T).
     """
@@ -164,7 +173,8 @@ def compile_window_table(
     keep = reachable[ri, rj]
     cell_key = ri[keep] * nyp + rj[keep]
     occ_index = occ_index[keep]
-    near_mask = _square_gap(di, dj) * c <= W_max / 2 + 1e-12
+    near_radius = W_max / 2 + step_max
+    near_mask = _square_gap(di, dj) * c <= near_radius + 1e-12
     near_keep = np.tile(near_mask, m)[keep]
 
     # rows: 0 = empty window; then one row per reachable robot cell that sees something
@@ -175,7 +185,7 @@ def compile_window_table(
     row_key = row_key + 1
     table, _ = _pad_lists(row_key, occ_index, rows, sentinel)
     near, near_count = _pad_lists(row_key[near_keep], occ_index[near_keep], rows, sentinel)
-    geometry = GridGeometry(0, grid.x_min, grid.y_min, c, nxp, nyp, h)
+    geometry = GridGeometry(0, grid.x_min, grid.y_min, c, nxp, nyp, h, near_radius)
     return WindowTable(ox, oy, ocv, ox[table], oy[table], ocv[table], near, near_count, row_of_cell, (geometry,))
 
 
@@ -199,7 +209,7 @@ def stack_tables(tables) -> WindowTable:
         # row 0 (the empty window) of every table is all sentinel: keep pointing at the first one
         cells.append(np.where(t.row_of_cell > 0, t.row_of_cell + row_offset, t.row_of_cell))
         for g in t.grids:
-            grids.append(GridGeometry(g.cell_offset + cell_offset, g.x_min, g.y_min, g.cell_size, g.nx_padded, g.ny_padded, g.pad))
+            grids.append(GridGeometry(g.cell_offset + cell_offset, g.x_min, g.y_min, g.cell_size, g.nx_padded, g.ny_padded, g.pad, g.near_radius))
         occ_offset += m
         row_offset += t.rows
         cell_offset += t.row_of_cell.size

@@ -279,6 +279,8 @@ def validate_boundary(
     pade_order: int = 3,
     window_cells: int = 33,
     cell_size: float = 0.1,
+    law: str | None = None,
+    cell_ratio: float | None = None,
     probe: float = 0.03,
     stability_map: tuple | None = None,
     progress=None,
@@ -313,7 +315,17 @@ def validate_boundary(
     pade_order : int
         Order m of the ``pade`` model.
     window_cells, cell_size
-        Grid window (odd, KB: 33) and cell size (m, KB: 0.1).
+        Grid window (odd, KB: 33) and cell size (m, KB: 0.1); also those of
+        the analytic ``law="grid"``.
+    law : {"power", "grid"}, optional
+        ``env="analytic"``: the walls' lateral law, KB's lumped power law
+        (default) or the grid's effective law (`sim.scenario_law`, as
+        `make_scenario` and a configuration file's ``law`` take it). The
+        simulation and every prediction use it.
+    cell_ratio : float, optional
+        ρ = F_cr/F_ct of the grid (``env="grid"``) or of ``law="grid"``;
+        default: calibrated to f_av = f. Not with ``parameter="f"`` (with ρ
+        given, f changes nothing the simulation sees).
     probe : float
         Relative distance of the oscillation checks from the boundary, in (0, 0.5).
     stability_map : (int, int), optional
@@ -366,7 +378,16 @@ def validate_boundary(
     snapped = None
     if env == "grid" and scenario == "corridor" and parameter != "L":  # walls on cell centres, as make_scenario draws them
         snapped, geometry = geometry, round(2 * geometry / cell_size) * cell_size / 2
-    law = scenario_law(env, robot, controller, window_cells, cell_size)
+    if law is not None and env == "grid":
+        raise ValueError(f"law applies to env=analytic only (the grid's law is its cells); got law={law!r} with env=grid")
+    if cell_ratio is not None:
+        cell_ratio = check_number("cell_ratio", cell_ratio, 0.0)
+        if parameter == "f":
+            raise ValueError(
+                f"f cannot be bisected with a given cell_ratio ({cell_ratio:g}): the grid wall's force is set by the cell ratio, "
+                "f only calibrates it; leave cell_ratio out to bisect f"
+            )
+    law = scenario_law(env, robot, controller, window_cells, cell_size, law=law, cell_ratio=cell_ratio)
     models = validation_models(controller, pade_order)
     predicted = predicted_boundaries(scenario, parameter, robot, controller, law, geometry, models)
     p = predicted["sampled"]
@@ -401,8 +422,12 @@ def validate_boundary(
     if parameter != ("L" if scenario == "corridor" else "alpha"):
         fixed["L" if scenario == "corridor" else "alpha"] = geometry
     common = dict(offset=offset, duration=duration)
-    if env == "grid":
+    if isinstance(law, GridWallLaw):  # the grid, or analytic walls with the grid's law: the same ρ, window and cells
         common.update(window_cells=window_cells, cell_size=cell_size)
+        if env == "analytic":
+            common["law"] = "grid"
+        if cell_ratio is not None:
+            common["cell_ratio"] = cell_ratio
     simulate = ParameterRuns(scenario, env, robot, controller, fixed, common)
 
     if progress:
@@ -458,7 +483,7 @@ def validate_boundary(
         "pade_order": pade_order,
         "law": law.name,
     }
-    if env == "grid":
+    if isinstance(law, GridWallLaw):
         inputs.update(cell_ratio=law.ratio, f_av=f_av_of(law), window_cells=window_cells, cell_size=cell_size)
     return BoundaryValidation(
         scenario=scenario,

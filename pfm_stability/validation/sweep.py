@@ -289,6 +289,7 @@ def verdict_sweep(
     controller: Controller | None = None,
     offset: float | None = None,
     pade_order: int = 3,
+    law: str | None = None,
     progress=None,
 ) -> SweepResult:
     """Simulate a Latin hypercube of parameter sets and compare each model's verdict.
@@ -310,6 +311,10 @@ def verdict_sweep(
     offset : float, optional
         Start offset, m (default 1e-7 analytic, 0.01 grid: `boundary.DEFAULT_OFFSET`).
     pade_order : int
+    law : {"power", "grid"}, optional
+        ``env="analytic"``: the walls' lateral law (`sim.scenario_law`; default
+        KB's power law); ``"grid"``: the grid's effective law, its cell ratio
+        calibrated to each member's f.
     progress : callable, optional
         Called with one line of text per batch.
 
@@ -331,7 +336,13 @@ def verdict_sweep(
     robot = robot if robot is not None else CARMEL.robot
     controller = controller if controller is not None else CARMEL.controller
     offset = check_number("offset", offset if offset is not None else DEFAULT_OFFSET[env], unit="m")
+    if law is not None:
+        if env == "grid":
+            raise ValueError(f"law applies to env=analytic only (the grid's law is its cells); got law={law!r} with env=grid")
+        scenario_law(env, robot, controller, law=law)  # checks the name
     s = sweep_parameters(count, seed, ranges)
+    laws = {} if law is None else {"law": law}
+    bounded = env == "grid" or law == "grid"  # the grid's law acts inside the active window only
 
     # per member: robot, controller, geometry, duration
     members = []
@@ -341,14 +352,14 @@ def verdict_sweep(
         u = float(s["u"][i])
         if s["scenario"][i] == "corridor":
             lo, hi = ranges["L"]
-            if env == "grid":
-                dom = parameter_domain("L", "corridor", env, r, c, scenario_law(env, r, c), None)
+            if bounded:
+                dom = parameter_domain("L", "corridor", env, r, c, scenario_law(env, r, c, **laws), None)
                 lo, hi = max(lo, dom[0]), min(hi, dom[1])
             geometry = lo + (hi - lo) * u
         else:
             lo, hi = ranges["alpha_deg"]
-            if env == "grid":
-                dom = parameter_domain("alpha", "wall", env, r, c, scenario_law(env, r, c), None)
+            if bounded:
+                dom = parameter_domain("alpha", "wall", env, r, c, scenario_law(env, r, c, **laws), None)
                 lo, hi = max(lo, dom[0]), min(hi, dom[1])
             geometry = lo + (hi - lo) * u
         loop = Loop(r.tau, c.T, r.k)
@@ -368,7 +379,7 @@ def verdict_sweep(
         }
         geometry = np.array([m[4] for m in group])
         arrays["L" if kind == "corridor" else "alpha"] = geometry if kind == "corridor" else np.radians(geometry)
-        runs = simulate_members(kind, env=env, robot=robot, controller=controller, offset=offset, **arrays)
+        runs = simulate_members(kind, env=env, robot=robot, controller=controller, offset=offset, **laws, **arrays)
         if progress:
             progress(f"sweep: simulated {len(group)} {kind} members ({env})")
         for (i, _, r, c, _, _), member in zip(group, runs):
