@@ -130,7 +130,7 @@ def _plot(result, path: str) -> None:
 
 
 def run(args) -> int:
-    from .render import render_simulation_text
+    from .render_runs import render_simulation_text
 
     import time
 

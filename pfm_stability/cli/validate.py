@@ -84,7 +84,7 @@ def _save(fig, path: str, what: str) -> None:
 
 
 def run(args) -> int:
-    from .render import render_validation_text
+    from .render_runs import render_validation_text
 
     if args.sweep_plot and not args.sweep:
         raise ValueError("sweep-plot needs --sweep N")

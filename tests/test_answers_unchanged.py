@@ -1,0 +1,258 @@
+"""Every public answer stays as it is: recorded answers of `report`, `traps`, `map` and `sweep`, replayed.
+
+A restructuring of the package (docs/architecture.md) must not change what a user
+reads. `data/answers.json.gz` holds the JSON the commands printed (or their exit
+status and error line) for:
+
+* `report` on 240 seeded command lines: every law (power, grid, khatib, gnron,
+  velocity, velocity-gated, fuzzy), every robot family (steering, kinematic,
+  holonomic), both holds and compute delays, walls, corridors and doors,
+  subsets of models and Padé orders, random values over wide ranges (`report_cases`);
+* `traps` on the four shipped scenes at two resolutions;
+* `map` on the three shipped maps, at CARMEL's preset and at a small robot
+  (W = 0.3 m, V = 0.5 m/s);
+* a 500-point Latin-hypercube `sweep` over V, T, k and L (every model), its table.
+
+Recorded with ``python tests/test_answers_unchanged.py --record``. Replayed here
+and compared value by value: strings, booleans, nulls and structure exactly;
+numbers to 1e-12 relative (with an absolute floor of 1e-12 in the quantity's SI
+unit, for values that are zero up to rounding, e.g. a growth rate at the
+boundary). That is far below the 4 significant digits a report prints and above
+the differences between CPUs and BLAS builds (at most 2.3e-12 relative, measured
+on the loop models' answers: tests/test_c_zero_reference.py). Wall-clock timings
+and temporary paths are not answers and are left out.
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import gzip
+import io
+import json
+import math
+import random
+from pathlib import Path
+
+import pytest
+
+from pfm_stability.cli import main
+
+DATA = Path(__file__).parent / "data" / "answers.json.gz"
+VOLATILE = {"timing", "seconds", "out", "plot", "outputs"}
+"""Keys whose values are not answers (wall-clock times, paths of this run)."""
+RTOL = 1e-12
+ATOL = 1e-12
+
+LAWS = ("power", "grid", "khatib", "gnron", "velocity", "velocity-gated", "fuzzy")
+
+
+def _log_uniform(rng: random.Random, low: float, high: float) -> float:
+    return math.exp(rng.uniform(math.log(low), math.log(high)))
+
+
+def _number(x: float) -> str:
+    return repr(float(f"{x:.6g}"))
+
+
+def _law_options(rng: random.Random, law: str) -> list[str]:
+    if law == "power":
+        return ["--f", _number(_log_uniform(rng, 0.2, 5)), "--n", _number(rng.uniform(1, 3))]
+    if law == "grid":
+        options = ["--f", _number(_log_uniform(rng, 0.3, 3))]
+        if rng.random() < 0.3:
+            options += ["--window-cells", str(rng.choice([21, 33, 45])), "--cell-size", _number(rng.choice([0.05, 0.1]))]
+        return options
+    if law in ("khatib", "gnron"):
+        options = ["--eta", _number(_log_uniform(rng, 0.02, 1)), "--rho0", _number(rng.uniform(0.5, 2)),
+                   "--goal-distance", _number(rng.uniform(0.5, 5))]
+        if law == "gnron":
+            options += ["--goal-exponent", _number(rng.uniform(0.5, 3)), "--attraction-exponent", _number(rng.uniform(1, 3))]
+        return options
+    if law == "velocity":
+        return ["--alpha-p", _number(_log_uniform(rng, 0.1, 2)), "--alpha-v", _number(_log_uniform(rng, 0.01, 1)),
+                "--rho0", _number(rng.uniform(0.5, 2))]
+    if law == "velocity-gated":
+        return ["--a-max", _number(rng.uniform(0.5, 3)), "--variant", rng.choice(["gradient", "squared"]),
+                "--rho0", _number(rng.uniform(0.5, 2)), "--no-simulate"]
+    return ["--side", rng.choice(["left", "right"]), "--symmetrize", rng.choice(["none", "negative", "positive"])]
+
+
+def report_cases(count: int = 240, seed: int = 20261126) -> list[list[str]]:
+    """Seeded `report` command lines (module docstring)."""
+    rng = random.Random(seed)
+    cases = []
+    for i in range(count):
+        law = LAWS[i % len(LAWS)]
+        robot = "steering"
+        if law in ("velocity", "velocity-gated") and rng.random() < 0.4:
+            robot = "holonomic"
+        elif law in ("power", "khatib", "velocity") and rng.random() < 0.15:
+            robot = "kinematic"
+        W = rng.uniform(0.2, 1.0)
+        argv = ["report", "--law", law, "--V", _number(_log_uniform(rng, 0.1, 2)), "--T", _number(_log_uniform(rng, 0.01, 0.3)),
+                "--k", _number(_log_uniform(rng, 0.5, 10)), "--W", _number(W),
+                "--hold", rng.choice(["command", "reference"]), "--compute-delay", str(rng.choice([0, 1]))]
+        if robot != "steering":
+            argv += ["--robot", robot]
+        if robot == "steering":
+            argv += ["--tau", _number(0.0 if rng.random() < 0.05 else _log_uniform(rng, 0.05, 1))]
+        argv += _law_options(rng, law)
+        geometry = rng.random()
+        if geometry < 0.4 or law == "fuzzy":
+            argv += ["--alpha", _number(rng.uniform(5, 80))]
+        if geometry > 0.3:
+            argv += ["--L", _number(W / 2 * rng.uniform(1.3, 4))]
+        if law == "power" and rng.random() < 0.2:
+            argv += ["--door", _number(W * rng.uniform(1.1, 4))]
+        if rng.random() < 0.25:
+            for model in rng.sample(["continuous", "kb_first_order", "pade", "exact_delay", "sampled"], rng.randint(1, 3)):
+                argv += ["--model", model]
+        if rng.random() < 0.2:
+            argv += ["--pade-order", str(rng.randint(1, 8))]
+        cases.append(argv + ["--format", "json"])
+    return cases
+
+
+def other_cases() -> list[list[str]]:
+    """`traps` and `map` command lines."""
+    cases = []
+    for scene in ("gc2000_fig3", "gc2000_fig4", "gc2000_sec6b_khatib", "gc2000_sec6b_gnron"):
+        for resolution in ([], ["--resolution", "120"]):
+            cases.append(["traps", scene, *resolution, "--format", "json"])
+    for name in ("depot", "warehouse", "tb3_sandbox"):
+        cases.append(["map", name, "--quiet", "--format", "json"])
+        cases.append(["map", name, "--W", "0.3", "--V", "0.5", "--quiet", "--format", "json"])
+    return cases
+
+
+SWEEP_SPEC = """preset: carmel
+scenario: {corridor: {L: 0.9}}
+sample:
+  method: latin-hypercube
+  n: 500
+  seed: 11
+  ranges: {V: [0.1, 2.0], T: [0.005, 0.3], k: [0.3, 10.0], L: [0.45, 2.5]}
+"""
+
+
+def run(argv) -> dict:
+    """The command's answer: exit status, its JSON (or None) and its error line."""
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        code = main(argv)
+    text = out.getvalue()
+    return {"code": code, "json": _strip(json.loads(text)) if code == 0 and text else None,
+            "error": err.getvalue().strip().splitlines()[-1] if code != 0 and err.getvalue().strip() else None}
+
+
+def sweep_answer(tmp: Path) -> dict:
+    """The sweep's table as columns (point order)."""
+    from table_helpers import read
+
+    spec = tmp / "spec.yaml"
+    spec.write_text(SWEEP_SPEC)
+    answer = run(["sweep", str(spec), "--out", str(tmp / "sweep.parquet"), "--workers", "1", "--quiet", "--format", "json"])
+    assert answer["code"] == 0, answer
+    table = read(tmp / "sweep.parquet")
+    return {name: table.column(name).to_pylist() for name in table.column_names}
+
+
+def _strip(value):
+    if isinstance(value, dict):
+        return {k: _strip(v) for k, v in value.items() if k not in VOLATILE}
+    if isinstance(value, list):
+        return [_strip(v) for v in value]
+    return value
+
+
+def differences(now, then, where="", found=None) -> list[str]:
+    """Where `now` differs from `then` beyond the tolerances (module docstring)."""
+    found = [] if found is None else found
+    if len(found) > 20:
+        return found
+    if isinstance(then, bool) or then is None or isinstance(then, str):
+        if now != then:
+            found.append(f"{where}: {now!r} != {then!r}")
+    elif isinstance(then, (int, float)):
+        if isinstance(now, bool) or not isinstance(now, (int, float)):
+            found.append(f"{where}: {now!r} is not a number like {then!r}")
+        elif not (now == then or (math.isnan(now) and math.isnan(then)) or abs(now - then) <= max(RTOL * max(abs(now), abs(then)), ATOL)):
+            found.append(f"{where}: {now!r} != {then!r}")
+    elif isinstance(then, list):
+        if not isinstance(now, list) or len(now) != len(then):
+            found.append(f"{where}: a list of {len(now) if isinstance(now, list) else type(now).__name__} items, was {len(then)}")
+        else:
+            for i, (a, b) in enumerate(zip(now, then)):
+                differences(a, b, f"{where}[{i}]", found)
+    elif isinstance(then, dict):
+        if not isinstance(now, dict) or set(now) != set(then):
+            keys = set(now) if isinstance(now, dict) else set()
+            found.append(f"{where}: keys {sorted(keys ^ set(then))} differ")
+        else:
+            for key in then:
+                differences(now[key], then[key], f"{where}.{key}", found)
+    return found
+
+
+def record(path: Path) -> None:
+    import tempfile
+
+    answers = {" ".join(argv): run(argv) for argv in report_cases() + other_cases()}
+    with tempfile.TemporaryDirectory() as tmp:
+        answers["sweep"] = sweep_answer(Path(tmp))
+    path.parent.mkdir(exist_ok=True)
+    with gzip.open(path, "wt", encoding="utf-8") as fh:
+        json.dump(answers, fh)
+    codes = [a["code"] for k, a in answers.items() if k != "sweep"]
+    print(f"{len(answers)} answers; exit 0: {codes.count(0)}, exit 2: {codes.count(2)}")
+
+
+@pytest.fixture(scope="module")
+def recorded():
+    with gzip.open(DATA, "rt", encoding="utf-8") as fh:
+        return json.load(fh)
+
+
+def _chunks(cases, size):
+    return [cases[i:i + size] for i in range(0, len(cases), size)]
+
+
+@pytest.mark.parametrize("argvs", _chunks(report_cases(), 20), ids=lambda argvs: f"report-{report_cases().index(argvs[0])}")
+def test_report_answers_are_unchanged(recorded, argvs):
+    """Twenty recorded `report` command lines per test, every value as recorded (module docstring)."""
+    for argv in argvs:
+        found = differences(run(argv), recorded[" ".join(argv)])
+        assert not found, f"{' '.join(argv)}:\n" + "\n".join(found)
+
+
+@pytest.mark.parametrize("argv", other_cases(), ids=lambda argv: "-".join(argv[:2] + argv[2:4]))
+def test_traps_and_map_answers_are_unchanged(recorded, argv):
+    found = differences(run(argv), recorded[" ".join(argv)])
+    assert not found, "\n".join(found)
+
+
+def test_sweep_table_is_unchanged(recorded, tmp_path):
+    found = differences(sweep_answer(tmp_path), recorded["sweep"])
+    assert not found, "\n".join(found)
+
+
+def test_the_record_covers_what_it_claims(recorded):
+    """Most recorded reports ran (an error answer is an answer, but the record must exercise the analyses): every law
+    and family appears with exit 0, and walls, corridors and doors."""
+    ran = [argv for argv in report_cases() if recorded[" ".join(argv)]["code"] == 0]
+    assert len(ran) >= 0.8 * len(report_cases())
+    for law in LAWS:
+        assert any(law == argv[argv.index("--law") + 1] for argv in ran), law
+    for option in ("--alpha", "--L", "--door", "--robot"):
+        assert any(option in argv for argv in ran), option
+    assert any("holonomic" in argv for argv in ran) and any("kinematic" in argv for argv in ran)
+
+
+if __name__ == "__main__":
+    import sys
+
+    sys.path.insert(0, str(Path(__file__).parent))
+    parser = argparse.ArgumentParser(description="Record the answers (see the module docstring).")
+    parser.add_argument("--record", type=Path, default=DATA)
+    record(parser.parse_args().record)
