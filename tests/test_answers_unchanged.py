@@ -15,12 +15,21 @@ status and error line) for:
 
 Recorded with ``python tests/test_answers_unchanged.py --record``. Replayed here
 and compared value by value: strings, booleans, nulls and structure exactly;
-numbers to 1e-12 relative (with an absolute floor of 1e-12 in the quantity's SI
+numbers to 1e-11 relative (with an absolute floor of 1e-12 in the quantity's SI
 unit, for values that are zero up to rounding, e.g. a growth rate at the
 boundary). That is far below the 4 significant digits a report prints and above
-the differences between CPUs and BLAS builds (at most 2.3e-12 relative, measured
-on the loop models' answers: tests/test_c_zero_reference.py). Wall-clock timings
-and temporary paths are not answers and are left out.
+the differences between CPUs and BLAS builds: at most 2.3e-12 relative on the loop
+models' answers (tests/test_c_zero_reference.py) and 1.7e-12 on these (a law
+parameter's critical value found by bisection on NV*, and a remedy's percentage
+from it, between OpenBLAS's Haswell and SkylakeX kernels). On the machine that
+recorded them the answers are checked at 1e-12 with ``ANSWERS_RTOL=1e-12``. A map is compared to
+its method's accuracy instead: an equilibrium where F_n jumps at a cell boundary
+is located to the bracket / 2^12, about 10 µm (`maps.equilibria.NEWTON_STEPS`),
+and where round-off flips F_n's sign near the jump the offset moves by up to that
+(measured: 4e-7 m between numpy's AVX2 and AVX-512 kernels), so offsets compare
+to 1e-5 m and everything else of a map to 1e-9 relative (the gains evaluated at
+the moved offset: 1e-11 measured). Wall-clock timings and temporary paths are not
+answers and are left out.
 """
 
 from __future__ import annotations
@@ -31,6 +40,7 @@ import gzip
 import io
 import json
 import math
+import os
 import random
 from pathlib import Path
 
@@ -41,8 +51,11 @@ from pfm_stability.cli import main
 DATA = Path(__file__).parent / "data" / "answers.json.gz"
 VOLATILE = {"timing", "seconds", "out", "plot", "outputs"}
 """Keys whose values are not answers (wall-clock times, paths of this run)."""
-RTOL = 1e-12
+RTOL = float(os.environ.get("ANSWERS_RTOL", "1e-11"))
 ATOL = 1e-12
+MAP_RTOL = 1e-9
+MAP_ABSOLUTE = {"offset": 1e-5}
+"""A map's tolerances (module docstring): relative, and absolute per key (m)."""
 
 LAWS = ("power", "grid", "khatib", "gnron", "velocity", "velocity-gated", "fuzzy")
 
@@ -166,9 +179,10 @@ def _strip(value):
     return value
 
 
-def differences(now, then, where="", found=None) -> list[str]:
-    """Where `now` differs from `then` beyond the tolerances (module docstring)."""
+def differences(now, then, where="", found=None, rtol=RTOL, absolute=None) -> list[str]:
+    """Where `now` differs from `then` beyond the tolerances: `rtol` relative, `ATOL` absolute, or `absolute[key]`."""
     found = [] if found is None else found
+    absolute = absolute or {}
     if len(found) > 20:
         return found
     if isinstance(then, bool) or then is None or isinstance(then, str):
@@ -177,21 +191,22 @@ def differences(now, then, where="", found=None) -> list[str]:
     elif isinstance(then, (int, float)):
         if isinstance(now, bool) or not isinstance(now, (int, float)):
             found.append(f"{where}: {now!r} is not a number like {then!r}")
-        elif not (now == then or (math.isnan(now) and math.isnan(then)) or abs(now - then) <= max(RTOL * max(abs(now), abs(then)), ATOL)):
+        elif not (now == then or (math.isnan(now) and math.isnan(then))
+                  or abs(now - then) <= max(rtol * max(abs(now), abs(then)), absolute.get(where.rsplit(".", 1)[-1], ATOL))):
             found.append(f"{where}: {now!r} != {then!r}")
     elif isinstance(then, list):
         if not isinstance(now, list) or len(now) != len(then):
             found.append(f"{where}: a list of {len(now) if isinstance(now, list) else type(now).__name__} items, was {len(then)}")
         else:
             for i, (a, b) in enumerate(zip(now, then)):
-                differences(a, b, f"{where}[{i}]", found)
+                differences(a, b, f"{where}[{i}]", found, rtol, absolute)
     elif isinstance(then, dict):
         if not isinstance(now, dict) or set(now) != set(then):
             keys = set(now) if isinstance(now, dict) else set()
             found.append(f"{where}: keys {sorted(keys ^ set(then))} differ")
         else:
             for key in then:
-                differences(now[key], then[key], f"{where}.{key}", found)
+                differences(now[key], then[key], f"{where}.{key}", found, rtol, absolute)
     return found
 
 
@@ -228,7 +243,9 @@ def test_report_answers_are_unchanged(recorded, argvs):
 
 @pytest.mark.parametrize("argv", other_cases(), ids=lambda argv: "-".join(argv[:2] + argv[2:4]))
 def test_traps_and_map_answers_are_unchanged(recorded, argv):
-    found = differences(run(argv), recorded[" ".join(argv)])
+    """Each recorded `traps` and `map` command line, a map to its method's accuracy (module docstring)."""
+    tolerances = {"rtol": MAP_RTOL, "absolute": MAP_ABSOLUTE} if argv[0] == "map" else {}
+    found = differences(run(argv), recorded[" ".join(argv)], **tolerances)
     assert not found, "\n".join(found)
 
 
