@@ -39,7 +39,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from pfm_stability.criteria import loop_of  # noqa: E402
+from pfm_stability.analysis.criteria import loop_of  # noqa: E402
 from pfm_stability.models import ExactDelay  # noqa: E402
 from pfm_stability.parameters import CARMEL  # noqa: E402
 
@@ -67,8 +67,8 @@ def model_comparison():
 
 def kb_error_maps(resolution: int = 40):
     from pfm_stability.plots.comparison import plot_kb_error_maps
-    from pfm_stability.comparison import kb_error_map
-    from pfm_stability.comparison import kb_error_maps as maps_of
+    from pfm_stability.analysis.comparison import kb_error_map
+    from pfm_stability.analysis.comparison import kb_error_maps as maps_of
 
     k_tau = np.geomspace(0.05, 20.0, resolution)
     T_over_tau = np.geomspace(0.01, 3.0, resolution)
@@ -105,7 +105,7 @@ def grid_law():
 def simulation_vs_prediction(points=None):
     from pfm_stability.plots.regions import plot_corridor_region, plot_wall_alpha_critical, region_legend, shading_text
     from pfm_stability.plots.validation import plot_simulated_boundary
-    from pfm_stability.regions import region_model
+    from pfm_stability.analysis.regions import region_model
 
     points = simulated_points() if points is None else points
     law = grid_law()

@@ -23,7 +23,7 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 def run_once(name: str) -> dict:
     from pfm_stability.cli.map import _write_outputs, map_path
-    from pfm_stability.fields import make_law
+    from pfm_stability.laws.fields import make_law
     from pfm_stability.maps.analysis import analyze_map
     from pfm_stability.maps.occupancy import load_map
     from pfm_stability.parameters import CARMEL

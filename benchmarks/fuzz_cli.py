@@ -109,7 +109,7 @@ def _schema_validator():
         from jsonschema import Draft202012Validator
     except ImportError:  # the test extra is not installed: parse only
         return None
-    from pfm_stability.schema import load_schema
+    from pfm_stability.io.schema import load_schema
 
     return Draft202012Validator(load_schema())
 

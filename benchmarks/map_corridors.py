@@ -24,8 +24,8 @@ from pathlib import Path
 import numpy as np
 from PIL import Image
 
-from pfm_stability.criteria import analyze_corridor
-from pfm_stability.fields import make_law
+from pfm_stability.analysis.criteria import analyze_corridor
+from pfm_stability.laws.fields import make_law
 from pfm_stability.maps.analysis import analyze_map
 from pfm_stability.maps.occupancy import load_map
 from pfm_stability.maps.verdicts import GrowthRate, critical_speed

@@ -5,7 +5,7 @@ repulsion gain η with a two-input Mamdani controller (obstacle bearing θ,
 distance d) and the velocity gain K_V with a second one (θ, relative speed
 ΔV). Its display equations are lost; the tables are data and the rest is the
 reconstruction R1–R7 of docs/velocity_and_fuzzy.md. In KB's loop
-(`pfm_stability.fuzzy_law.FuzzyScheduledLaw`, the repulsion Ge & Cui 2000
+(`pfm_stability.laws.fuzzy_law.FuzzyScheduledLaw`, the repulsion Ge & Cui 2000
 eq 8–9 with n = 0):
 
 1. **Output surfaces** of both controllers (the tables as printed).
@@ -45,7 +45,7 @@ PAPER_CORRIDOR = {0.2: (0.65, 955.7), 0.3: (3.46, 154.1), 0.4: (8.24, 35.87), 0.
 
 def speed_limits(N: float, c: float) -> dict:
     """V* (m/s) below which CARMEL's loop with gains N (1/m) and c is stable: NV*(c)/N, exact delay and sampled."""
-    from pfm_stability.criteria import loop_of
+    from pfm_stability.analysis.criteria import loop_of
     from pfm_stability.models import make_model
     from pfm_stability.parameters import CARMEL
 
@@ -144,7 +144,7 @@ def draw(path: Path, surf, wall, corridor, bracket) -> None:
 
 
 def run(out, quick: bool = False) -> dict:
-    from pfm_stability.fuzzy_law import FuzzyScheduledLaw
+    from pfm_stability.laws.fuzzy_law import FuzzyScheduledLaw
 
     out = output_dir(out)
     law = FuzzyScheduledLaw(RHO0, ATTRACTION)

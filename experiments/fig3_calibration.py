@@ -45,7 +45,7 @@ KB_F_AV = 0.8
 def run(out, quick: bool = False) -> dict:
     import matplotlib.pyplot as plt
 
-    from pfm_stability.effective_force import f_average, working_range
+    from pfm_stability.laws.effective_force import f_average, working_range
     from pfm_stability.parameters import CARMEL
     from pfm_stability.plots.trajectory import plot_trajectory
     from pfm_stability.sim import barely_avoiding_ratio, scenario_law, simulate

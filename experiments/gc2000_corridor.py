@@ -38,7 +38,7 @@ TABLE_RHO_G = (0.5, 1.0, 2.0, 5.0, 10.0)
 
 
 def laws(rho_g):
-    from pfm_stability.fields import GnronLaw, KhatibLaw
+    from pfm_stability.laws.fields import GnronLaw, KhatibLaw
 
     xi, eta, rho0, m = SEC6
     return KhatibLaw(xi, eta, rho0, m, rho_g), GnronLaw(xi, eta, rho0, m, 2.0, rho_g)
@@ -47,9 +47,9 @@ def laws(rho_g):
 def run(out, quick: bool = False) -> dict:
     import matplotlib.pyplot as plt
 
-    from pfm_stability.criteria import analyze_wall, loop_of
-    from pfm_stability.fields import GnronLaw, finite_goal_gain
-    from pfm_stability.force_law import corridor_gain, wall_equilibria
+    from pfm_stability.analysis.criteria import analyze_wall, loop_of
+    from pfm_stability.laws.fields import GnronLaw, finite_goal_gain
+    from pfm_stability.laws.force_law import corridor_gain, wall_equilibria
     from pfm_stability.models import Sampled
     from pfm_stability.parameters import CARMEL, Wall
 

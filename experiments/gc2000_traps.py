@@ -8,7 +8,7 @@ planning", IEEE T-RA 16(5), 2000 ("GC2000"; docs/traps.md). Reproduced:
 2. **Fig 3 / Fig 4** (eq 8, m = n = 2): a circle of radius 0.5 about (1, 0),
    goal at the origin, ξ = 1, η = 1 (no local minimum; a saddle at (2.5, 0)) and
    η = 25 (a minimum at (−1.08, 0)), by the 2-D search of every stationary
-   point (`pfm_stability.traps`) on the shipped scenes.
+   point (`pfm_stability.analysis.traps`) on the shipped scenes.
 3. **Fig 6**: the 1-D case with ξ = η = 1, ρ0 = 2 and n = 0.5, 1, 2, 3: a
    minimum at x ≈ −0.355 for n = 0.5 only.
 4. **Sec IV**: k₂ of eq (29) at r = 0.5, ρ0 = 2 (closed form against the
@@ -22,7 +22,7 @@ planning", IEEE T-RA 16(5), 2000 ("GC2000"; docs/traps.md). Reproduced:
 
 The 1-D cases (a point obstacle) are not scenes — a circle of radius → 0 is
 not a valid obstacle — so they use the distance functions of
-`pfm_stability.potentials` directly: `ray_stationary_points` on the ray from
+`pfm_stability.laws.potentials` directly: `ray_stationary_points` on the ray from
 the goal away from the obstacle (ρ = ρ_g + r), and the potential on the whole
 line for the plots.
 
@@ -49,7 +49,7 @@ SCENES = Path(__file__).resolve().parents[1] / "pfm_stability" / "data" / "scene
 
 def line_potential(x, x_obs, xi, eta, rho0, n):
     """U on the 1-D line of GC2000 Fig 1: goal at 0, point obstacle at x_obs > 0, robot at x < x_obs (eq 6–8)."""
-    from pfm_stability.potentials import attraction_potential, gnron_potential
+    from pfm_stability.laws.potentials import attraction_potential, gnron_potential
 
     x = np.asarray(x, dtype=float)
     return attraction_potential(np.abs(x), xi, 2) + gnron_potential(x_obs - x, np.abs(x), eta, rho0, n)
@@ -57,7 +57,7 @@ def line_potential(x, x_obs, xi, eta, rho0, n):
 
 def one_d(x_obs, xi, eta, rho0, n):
     """Stationary points of the 1-D model on both sides of the goal, as x (m) and kind."""
-    from pfm_stability.potentials import ray_stationary_points
+    from pfm_stability.laws.potentials import ray_stationary_points
 
     behind = [{"x": -rg, "kind": kind} for rg, kind in ray_stationary_points(x_obs, xi, eta, rho0, n)]
     x = np.linspace(1e-6, x_obs - 1e-6, 20001)  # between goal and obstacle (GC2000 Sec IV: none there)
@@ -67,8 +67,8 @@ def one_d(x_obs, xi, eta, rho0, n):
 
 
 def _scene(name, resolution):
-    from pfm_stability.scene import Scene
-    from pfm_stability.traps import find_stationary_points
+    from pfm_stability.laws.scene import Scene
+    from pfm_stability.analysis.traps import find_stationary_points
 
     return find_stationary_points(Scene.load(SCENES / f"{name}.yaml"), resolution)
 
@@ -81,7 +81,7 @@ def run(out, quick: bool = False) -> dict:
     import matplotlib.pyplot as plt
 
     from pfm_stability.plots.traps import plot_traps
-    from pfm_stability.potentials import bound_integrand, k2_closed_form, k_conservative, k_exact, ray_force, ray_stationary_points, rho_m
+    from pfm_stability.laws.potentials import bound_integrand, k2_closed_form, k_conservative, k_exact, ray_force, ray_stationary_points, rho_m
 
     out = output_dir(out)
     resolution = 41 if quick else 121

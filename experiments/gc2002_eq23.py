@@ -51,7 +51,7 @@ PAPER_VMIN = {"C": (0.330, 0.324, 0.322), "B": (None, 0.956, 0.781), "A": (None,
 def simulate(variant: str, a_max: float, v0: float, T: float, duration: float):
     from pfm_stability.sim.movers import Ball, Target
     from pfm_stability.sim.planar import Field, PointMass, Start, World, simulate_planar
-    from pfm_stability.velocity_laws import VelocityAttraction, VelocityGatedRepulsion
+    from pfm_stability.laws.velocity_laws import VelocityAttraction, VelocityGatedRepulsion
 
     field = Field(VelocityAttraction(ALPHA_P, ALPHA_V), VelocityGatedRepulsion(ETA, RHO0, a_max, variant))
     world = World(Target((0.0, 0.0)), (Ball((BALL_X, 0.0), BALL_R),))
@@ -87,7 +87,7 @@ def smallest_landing_speed(variant: str, a_max: float, T: float, duration: float
 
 
 def bands() -> dict:
-    from pfm_stability.velocity_laws import VelocityAttraction, VelocityGatedRepulsion, stall_band
+    from pfm_stability.laws.velocity_laws import VelocityAttraction, VelocityGatedRepulsion, stall_band
 
     att = VelocityAttraction(ALPHA_P, ALPHA_V)
     return {name: [list(i) for i in stall_band(VelocityGatedRepulsion(ETA, RHO0, 1.0, variant), att, RHO_TO).intervals]

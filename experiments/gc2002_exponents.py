@@ -56,7 +56,7 @@ PAPER = {  # the papers' claims with the reference numbers of the analysis (docs
 def simulate(alpha_p, alpha_v, m, n, T, duration):
     from pfm_stability.sim.movers import Target
     from pfm_stability.sim.planar import Field, PointMass, Start, World, simulate_planar
-    from pfm_stability.velocity_laws import VelocityAttraction
+    from pfm_stability.laws.velocity_laws import VelocityAttraction
 
     run = simulate_planar(PointMass(1.0), Field(VelocityAttraction(alpha_p, alpha_v, m, n)), World(Target(TARGET_P, TARGET_V)),
                           T=T, duration=duration, start=Start(ROBOT_P))
@@ -88,7 +88,7 @@ def _s(t) -> str:
 def run(out, quick: bool = False) -> dict:
     import matplotlib.pyplot as plt
 
-    from pfm_stability.velocity_laws import VelocityAttraction
+    from pfm_stability.laws.velocity_laws import VelocityAttraction
 
     out = output_dir(out)
     T = 0.04 if quick else 0.01

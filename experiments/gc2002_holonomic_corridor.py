@@ -51,8 +51,8 @@ def models() -> dict:
 
 def corridor_kappa(alpha_v: float) -> tuple:
     """(κ, c_h) of the Khatib corridor (η = 0.3, ρ0 = 2 m, L = 0.5 m) at its centre, m_rob = 1."""
-    from pfm_stability.fields import KhatibLaw
-    from pfm_stability.velocity_laws import VelocityAttraction
+    from pfm_stability.laws.fields import KhatibLaw
+    from pfm_stability.laws.velocity_laws import VelocityAttraction
 
     att = VelocityAttraction(0.005, alpha_v)
     Fa = att.position_force(RHO_G)
@@ -63,7 +63,7 @@ def corridor_kappa(alpha_v: float) -> tuple:
 
 def tstar_table(ms: dict) -> list:
     from pfm_stability.models.holonomic import HolonomicLoop
-    from pfm_stability.velocity_laws import VelocityAttraction
+    from pfm_stability.laws.velocity_laws import VelocityAttraction
 
     cases = []
     for name, alpha_p, alpha_v in (("tracking", 0.005, 0.1), ("conference tracking", 0.0008, 0.04)):
@@ -120,12 +120,12 @@ def simulated_points(ms: dict, quick: bool) -> list:
     The target sits on the centre line at the start's height, so the robot moves only
     across the corridor: m ẍ = F_x(x) − 2α_v ẋ, with the target's pull adding 2α_p to κ.
     """
-    from pfm_stability.fields import KhatibLaw
+    from pfm_stability.laws.fields import KhatibLaw
     from pfm_stability.models.holonomic import HolonomicLoop
     from pfm_stability.sim.cycles import lateral_metrics
     from pfm_stability.sim.movers import Target, Wall
     from pfm_stability.sim.planar import Field, PointMass, Start, World, simulate_planar
-    from pfm_stability.velocity_laws import VelocityAttraction
+    from pfm_stability.laws.velocity_laws import VelocityAttraction
 
     law = KhatibLaw(1.0, ETA, RHO0, 2.0, 1.0)  # η(1/d − 1/ρ0)/d² newtons with repulsion_scale 1
     world = World(Target((0.0, 0.0)), (Wall((-L_HALF, 0.0), (1.0, 0.0)), Wall((L_HALF, 0.0), (-1.0, 0.0))))

@@ -60,16 +60,16 @@ def wall_run(repulsion, period: float, compute_delay: int, duration: float, star
 
 def first_harmonic_period(delay: float) -> float:
     """Period (s) where k e^(−sT_d)/(τs² + s + k) has phase −π: an ideal relay's limit cycle (describing function)."""
-    from pfm_stability.solve import bisect_root
+    from pfm_stability.numerics.solve import bisect_root
 
     phase = lambda w: -w * delay - math.atan2(w, K - TAU * w * w) + math.pi  # noqa: E731
     return 2 * math.pi / bisect_root(phase, 1e-6, 100.0, rtol=1e-12)
 
 
 def khatib(duration: float) -> dict:
-    from pfm_stability.criteria import loop_of
-    from pfm_stability.fields import KhatibLaw
-    from pfm_stability.force_law import wall_equilibria
+    from pfm_stability.analysis.criteria import loop_of
+    from pfm_stability.laws.fields import KhatibLaw
+    from pfm_stability.laws.force_law import wall_equilibria
     from pfm_stability.models import make_model
     from pfm_stability.models.base import Loop
     from pfm_stability.sim.cycles import measure_wall_cycle
@@ -90,7 +90,7 @@ def run(out, quick: bool = False) -> dict:
     import matplotlib.pyplot as plt
 
     from pfm_stability.sim.cycles import wall_cycle
-    from pfm_stability.velocity_laws import VelocityGatedRepulsion
+    from pfm_stability.laws.velocity_laws import VelocityGatedRepulsion
 
     out = output_dir(out)
     duration = 30.0 if quick else 60.0

@@ -85,10 +85,10 @@ def curve(n: int) -> dict:
 
 def corridor_run(q: float, duration: float):
     """The steering robot (CARMEL, command hold, 1-sample delay) in the Khatib corridor with velocity attraction q."""
-    from pfm_stability.fields import KhatibLaw
+    from pfm_stability.laws.fields import KhatibLaw
     from pfm_stability.sim.movers import Target, Wall
     from pfm_stability.sim.planar import Field, Start, Steering, World, simulate_planar
-    from pfm_stability.velocity_laws import VelocityAttraction
+    from pfm_stability.laws.velocity_laws import VelocityAttraction
 
     F_a = 1.0
     attraction = VelocityAttraction(F_a / (2 * SIM_RHO_G), q * F_a / (2 * V))  # F_a = 2α_pρ_g, q = 2α_vV/F_a
@@ -101,8 +101,8 @@ def corridor_run(q: float, duration: float):
 
 
 def simulated(quick: bool) -> list:
-    from pfm_stability.fields import KhatibLaw
-    from pfm_stability.force_law import corridor_gain
+    from pfm_stability.laws.fields import KhatibLaw
+    from pfm_stability.laws.force_law import corridor_gain
     from pfm_stability.models import make_model
     from pfm_stability.models.base import Loop
     from pfm_stability.sim.cycles import lateral_metrics

@@ -4,7 +4,7 @@ S.S. Ge and Y.J. Cui, "Dynamic motion planning for mobile robots using
 potential field method", Autonomous Robots 13, 2002 ("GC2002"): with
 U_att = α_p‖e‖² + α_v‖ė‖² (eq 1, m = n = 2) a point mass tracks a target
 moving at constant velocity with the error dynamics ë + 2α_vė + 2α_pe = 0
-(eq 33), ω_n = √(2α_p), ζ = α_v/√(2α_p) (eq 34–36; `pfm_stability.tracking`).
+(eq 33), ω_n = √(2α_p), ζ = α_v/√(2α_p) (eq 34–36; `pfm_stability.models.tracking`).
 Fig 8: α_p = 0.005 and α_v = 0, 0.02, 0.1, 0.2 (ζ = 0, 0.2, 1, 2); the target
 starts at (10, 10) m moving at (0.1, −0.05) m/s, the robot at (1, 1) m at rest.
 
@@ -39,7 +39,7 @@ PAPER = {"first_within_0.1": {0.2: 145.46, 1.0: 69.46, 2.0: 183.94}, "e50_zeta1"
 
 def closed_form(alpha_v: float, t) -> np.ndarray:
     """e(t) (shape (len(t), 2), m) in closed form (`tracking_dynamics`)."""
-    from pfm_stability.tracking import tracking_dynamics
+    from pfm_stability.models.tracking import tracking_dynamics
 
     dyn = tracking_dynamics(ALPHA_P, alpha_v)
     e0 = np.subtract(TARGET_P, ROBOT_P)
@@ -48,7 +48,7 @@ def closed_form(alpha_v: float, t) -> np.ndarray:
 
 def first_within(alpha_v: float, level: float, t_max: float) -> float | None:
     """First time ‖e‖ ≤ level (s), closed form: a 0.01 s scan refined by bisection (1e-9 s); None if never."""
-    from pfm_stability.solve import bisect_root
+    from pfm_stability.numerics.solve import bisect_root
 
     t = np.linspace(0.0, t_max, int(t_max / 0.01) + 1)
     r = np.hypot(*closed_form(alpha_v, t).T)
@@ -64,7 +64,7 @@ def simulate(alpha_v: float, T: float, duration: float):
     """The Fig 8 run in the planar simulator: (t, e(t), robot positions, target positions)."""
     from pfm_stability.sim.movers import Target
     from pfm_stability.sim.planar import Field, PointMass, Start, World, simulate_planar
-    from pfm_stability.velocity_laws import VelocityAttraction
+    from pfm_stability.laws.velocity_laws import VelocityAttraction
 
     target = Target(TARGET_P, TARGET_V)
     run = simulate_planar(PointMass(1.0), Field(VelocityAttraction(ALPHA_P, alpha_v)), World(target),
@@ -76,7 +76,7 @@ def simulate(alpha_v: float, T: float, duration: float):
 def run(out, quick: bool = False) -> dict:
     import matplotlib.pyplot as plt
 
-    from pfm_stability.tracking import tracking_dynamics
+    from pfm_stability.models.tracking import tracking_dynamics
 
     out = output_dir(out)
     T = 0.05 if quick else 0.01

@@ -43,8 +43,8 @@ POST_RADIUS = 0.1  # m, for the "posts of radius" row
 
 def khatib_law(W: float, f: float):
     """Khatib's repulsion η(1/d − 1/ρ0)/d² in units of a constant attraction, with F_r(W) = f."""
-    from pfm_stability.force_law import ForceLaw
-    from pfm_stability.potentials import khatib_force, repulsion_derivatives
+    from pfm_stability.laws.force_law import ForceLaw
+    from pfm_stability.laws.potentials import khatib_force, repulsion_derivatives
 
     @dataclass(frozen=True)
     class KhatibLaw(ForceLaw):
@@ -66,7 +66,7 @@ def khatib_law(W: float, f: float):
 
 def law_summary(law, name: str, robot_width: float) -> dict:
     """w* for the three obstacle kinds and the passage at each width of `WIDTHS` and at w*·(1 ± 1e-6)."""
-    from pfm_stability.door import door_passage, smallest_passable_width
+    from pfm_stability.analysis.door import door_passage, smallest_passable_width
 
     smallest = {
         "posts": smallest_passable_width(law, robot_width=robot_width),
@@ -85,8 +85,8 @@ def law_summary(law, name: str, robot_width: float) -> dict:
 def run(out, quick: bool = False) -> dict:
     import matplotlib.pyplot as plt
 
-    from pfm_stability.door import approach_force, door_passage, power_law_door_width
-    from pfm_stability.force_law import PowerLaw
+    from pfm_stability.analysis.door import approach_force, door_passage, power_law_door_width
+    from pfm_stability.laws.force_law import PowerLaw
     from pfm_stability.parameters import CARMEL
 
     out = output_dir(out)

@@ -15,7 +15,7 @@ import math
 import numbers
 import os
 
-from .files import check_writable
+from .io.files import check_writable
 
 __all__ = ["check_number", "check_choice", "check_integer", "check_output_path", "check_output_dir", "check_type", "check_positive_axis", "describe_range"]
 

@@ -161,7 +161,7 @@ FAMILY_CHOICE_DEFAULTS = {"variant": "gradient", "side": "left", "symmetrize": "
 """Defaults of `FAMILY_LAW_CHOICES`: the gradient variant, a wall on the left, the tables as printed."""
 
 DERIVATION_LAWS = ("power", "general")
-"""Force laws of the symbolic derivation (`pfm_stability.derivation`, ``pfm-stability derive --law``):
+"""Force laws of the symbolic derivation (`pfm_stability.analysis.derivation`, ``pfm-stability derive --law``):
 KB's power law (eq 8, 13) and a general F_r(d) (docs/theory.md)."""
 
 DEGREES_PER_RADIAN = 180.0 / math.pi
@@ -534,7 +534,7 @@ def _read_preset(path: Path) -> Preset:
     """The `Preset` of a shipped file (docs/config.md: ``name``, ``source``, ``robot``, ``controller``, ``assumed``).
 
     The file's values are checked by `Robot` and `Controller`; a key they do not
-    take is an error. (User files go through the stricter `pfm_stability.config`.)
+    take is an error. (User files go through the stricter `pfm_stability.io.config`.)
     """
     import yaml
 

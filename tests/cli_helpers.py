@@ -9,7 +9,7 @@ import json
 from jsonschema import Draft202012Validator
 
 from pfm_stability.cli import main
-from pfm_stability.schema import load_schema
+from pfm_stability.io.schema import load_schema
 
 VALIDATOR = Draft202012Validator(load_schema())
 
@@ -55,8 +55,8 @@ class DiskFull(io.FileIO):
 
 @contextlib.contextmanager
 def disk_full(room: int):
-    """Every file the package writes (`pfm_stability.files.open_new`, the one place it opens one) lands on a full disk."""
-    import pfm_stability.files as files
+    """Every file the package writes (`pfm_stability.io.files.open_new`, the one place it opens one) lands on a full disk."""
+    import pfm_stability.io.files as files
 
     def open_new(path, mode):
         raw = DiskFull(path, room)

@@ -31,7 +31,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from pfm_stability.delay import delay_verdicts_from_gain
+from pfm_stability.numerics.delay import delay_verdicts_from_gain
 from pfm_stability.models import Loop, make_model
 
 REFERENCE = Path(__file__).parent / "data" / "c_zero_reference.npz"

@@ -5,7 +5,7 @@ Whatever is typed — values inside and outside each option's range
 strings, text, output paths that are directories, lack ``.png``, lie in
 missing directories or where nothing can be created (``/proc``, ``/sys``),
 unknown options, ``--help``, a full disk (every file the package writes goes
-through `pfm_stability.files.open_new`, which the fuzz replaces by a disk with
+through `pfm_stability.io.files.open_new`, which the fuzz replaces by a disk with
 0, 1 or 4096 bytes left now and then) — `main` returns 0 or 2 and
 never raises. An exit 2 prints exactly one error line (after any progress
 lines) and nothing on stdout, and never blames a value drawn inside its
@@ -48,7 +48,7 @@ from pfm_stability.cli import build_parser, main
 from pfm_stability.cli.options import describe
 from pfm_stability.cli.traps import SHIPPED_SCENES
 from pfm_stability.parameters import RANGES, SHOWN_AS
-from pfm_stability.schema import load_schema
+from pfm_stability.io.schema import load_schema
 from cli_helpers import disk_full
 
 pytestmark = pytest.mark.filterwarnings("error::RuntimeWarning")  # a numpy warning is a silent NaN or overflow

@@ -1,6 +1,6 @@
 """Every closed form used numerically agrees with the symbolic derivation (docs/theory.md).
 
-`pfm_stability.derivation` derives KB's eq (5)–(25) with sympy; here each
+`pfm_stability.analysis.derivation` derives KB's eq (5)–(25) with sympy; here each
 numeric shortcut (the models' NV* and ω*, `force_law`, `criteria`) is checked
 against it:
 
@@ -28,10 +28,10 @@ import numpy as np
 import pytest
 import sympy as sp
 
-from pfm_stability import criteria
-from pfm_stability import derivation as D
-from pfm_stability.derivation import F_a, L, NV_star, T, V, W, alpha, d, f, k, n, tau
-from pfm_stability.force_law import ForceLaw, PowerLaw, corridor_gain, wall_equilibrium, wall_gain
+from pfm_stability.analysis import criteria
+from pfm_stability.analysis import derivation as D
+from pfm_stability.analysis.derivation import F_a, L, NV_star, T, V, W, alpha, d, f, k, n, tau
+from pfm_stability.laws.force_law import ForceLaw, PowerLaw, corridor_gain, wall_equilibrium, wall_gain
 from pfm_stability.models import Continuous, KBFirstOrder, Loop
 from pfm_stability.parameters import CARMEL
 

@@ -1,4 +1,4 @@
-"""Configuration files (`pfm_stability.config`, ``--config FILE``; docs/config.md) and Nav2 parameter files.
+"""Configuration files (`pfm_stability.io.config`, ``--config FILE``; docs/config.md) and Nav2 parameter files.
 
 Checked: the shipped CARMEL preset holds Koren & Borenstein's values and notes and reads the same
 through the strict loader; a file reproducing CARMEL gives the report of ``--preset carmel``; the
@@ -24,9 +24,9 @@ from jsonschema import Draft202012Validator
 from pfm_stability import parameters
 from pfm_stability.cli import build_parser, main
 from pfm_stability.cli import options as cli_options
-from pfm_stability.config import Config, config_from_mapping, load_config
+from pfm_stability.io.config import Config, config_from_mapping, load_config
 from pfm_stability.parameters import Controller, Robot, get_preset
-from pfm_stability.schema import load_schema
+from pfm_stability.io.schema import load_schema
 
 VALIDATOR = Draft202012Validator(load_schema())
 

@@ -20,7 +20,7 @@ import pytest
 import yaml
 
 from pfm_stability.cli import main
-from pfm_stability.config import load_config
+from pfm_stability.io.config import load_config
 from pfm_stability.sweeps.spec import load_spec
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -5,8 +5,8 @@ import math
 import numpy as np
 import pytest
 
-from pfm_stability.criteria import analyze_corridor, analyze_wall, critical_alpha, critical_L, kb_critical_L
-from pfm_stability.force_law import ForceLaw, PowerLaw, corridor_gain, wall_gain
+from pfm_stability.analysis.criteria import analyze_corridor, analyze_wall, critical_alpha, critical_L, kb_critical_L
+from pfm_stability.laws.force_law import ForceLaw, PowerLaw, corridor_gain, wall_gain
 from pfm_stability.models import MODEL_NAMES, make_models
 from pfm_stability.parameters import CARMEL, Corridor, Wall
 

@@ -24,9 +24,9 @@ import numpy as np
 import pytest
 
 from cli_helpers import report_json, run
-from pfm_stability.criteria import analyze_corridor, loop_of
-from pfm_stability.fields import GnronLaw
-from pfm_stability.force_law import PowerLaw, corridor_gain
+from pfm_stability.analysis.criteria import analyze_corridor, loop_of
+from pfm_stability.laws.fields import GnronLaw
+from pfm_stability.laws.force_law import PowerLaw, corridor_gain
 from pfm_stability.models import Continuous
 from pfm_stability.parameters import CARMEL, RANGES, Corridor
 

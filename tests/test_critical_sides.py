@@ -18,8 +18,8 @@ import math
 import pytest
 
 from cli_helpers import report_json, run
-from pfm_stability.criteria import analyze_corridor, analyze_wall, loop_of
-from pfm_stability.fields import GnronLaw, make_law
+from pfm_stability.analysis.criteria import analyze_corridor, analyze_wall, loop_of
+from pfm_stability.laws.fields import GnronLaw, make_law
 from pfm_stability.models import models_for
 from pfm_stability.parameters import CARMEL, Corridor, Wall
 

@@ -17,7 +17,7 @@ import pytest
 import scipy.linalg
 
 from conftest import random_loops
-from pfm_stability.delay import DelayLoop
+from pfm_stability.numerics.delay import DelayLoop
 from pfm_stability.models import Continuous, ExactDelay, KBFirstOrder, Loop, Pade, Sampled
 from pfm_stability.models.sampled import continuous_plant
 
@@ -162,7 +162,7 @@ def test_k_star_search_stays_inside_the_range_of_k(k):
     just above a finite k* (1 + 1e-5: above the search's 1e-7), stable on a scan below it down to the range's end;
     k* = 0 only where the range's smallest k is already unstable."""
     from pfm_stability.parameters import CARMEL, RANGES
-    from pfm_stability.report import build_report
+    from pfm_stability.report.stability import build_report
 
     robot, controller = CARMEL.robot.replace(k=k), CARMEL.controller
     report = build_report(robot, controller, L=0.9, alpha_deg=30.0)

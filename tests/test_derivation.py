@@ -18,8 +18,8 @@ import numpy as np
 import pytest
 import sympy as sp
 
-from pfm_stability import derivation as D
-from pfm_stability.derivation import (
+from pfm_stability.analysis import derivation as D
+from pfm_stability.analysis.derivation import (
     F_a,
     F_r,
     M,

@@ -1,4 +1,4 @@
-"""Passage between two closely spaced obstacles (`pfm_stability.door`; KB 1991 §5.2, Fig 4; docs/door.md).
+"""Passage between two closely spaced obstacles (`pfm_stability.analysis.door`; KB 1991 §5.2, Fig 4; docs/door.md).
 
 Independent routes to every number:
 
@@ -26,7 +26,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 import pytest
 
-from pfm_stability.door import (
+from pfm_stability.analysis.door import (
     OBSTACLES,
     DoorPassage,
     approach_force,
@@ -36,15 +36,15 @@ from pfm_stability.door import (
     power_law_door_width,
     smallest_passable_width,
 )
-from pfm_stability.force_law import ForceLaw, PowerLaw
+from pfm_stability.laws.force_law import ForceLaw, PowerLaw
 from pfm_stability.parameters import CARMEL
-from pfm_stability.potentials import (
+from pfm_stability.laws.potentials import (
     attraction_force,
     gnron_forces,
     khatib_force,
     repulsion_derivatives,
 )
-from pfm_stability.serialize import dumps
+from pfm_stability.io.serialize import dumps
 
 CARMEL_LAW = PowerLaw(CARMEL.controller.f, CARMEL.controller.n, CARMEL.robot.W)  # f = 0.8, n = 2, W = 0.8 m
 
@@ -349,8 +349,8 @@ def test_report_door_option_gives_the_library_answer():
     import json
 
     from pfm_stability.cli import main
-    from pfm_stability.door import door_passage
-    from pfm_stability.force_law import PowerLaw
+    from pfm_stability.analysis.door import door_passage
+    from pfm_stability.laws.force_law import PowerLaw
     from pfm_stability.parameters import CARMEL
 
     out = io.StringIO()

@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 
 from pfm_stability.cli import main
-from pfm_stability.criteria import analyze_corridor, analyze_wall, critical_L
-from pfm_stability.effective_force import (
+from pfm_stability.analysis.criteria import analyze_corridor, analyze_wall, critical_L
+from pfm_stability.laws.effective_force import (
     GridWallLaw,
     calibrate_cell_ratio,
     check_window_cells,
@@ -18,10 +18,10 @@ from pfm_stability.effective_force import (
     f_average,
     working_range,
 )
-from pfm_stability.fields import make_law
-from pfm_stability.force_law import PowerLaw, corridor_gain
+from pfm_stability.laws.fields import make_law
+from pfm_stability.laws.force_law import PowerLaw, corridor_gain
 from pfm_stability.models import Loop, Sampled
-from pfm_stability.report import build_report
+from pfm_stability.report.stability import build_report
 from pfm_stability.parameters import CARMEL, Corridor, Wall
 from pfm_stability.sim.vff import measured_wall_force
 

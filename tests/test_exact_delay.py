@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from conftest import random_loops
-from pfm_stability.delay import DelayLoop
+from pfm_stability.numerics.delay import DelayLoop
 from pfm_stability.models import Continuous, ExactDelay, KBFirstOrder, Loop
 
 cxroots = pytest.importorskip("cxroots")
@@ -197,7 +197,7 @@ def test_resonant_critical_gain_by_two_routes_and_the_generic_count(seed):
     the vectorized three-candidate K* equals the generic scalar `DelayLoop.critical_gain`
     (every stretch of |a(jω)|, 1e-12) and the generic crossing count says stable at
     K*(1 − 1e-9) and at 50 geometric gains below, unstable at K*(1 + 1e-9)."""
-    from pfm_stability.delay import kb_critical_gain
+    from pfm_stability.numerics.delay import kb_critical_gain
 
     rng = np.random.default_rng(seed)
     tau = float(rng.uniform(0.05, 4.0))

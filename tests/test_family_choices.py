@@ -22,10 +22,10 @@ import cli_helpers
 from cli_helpers import run
 from scipy.optimize import brentq
 
-from pfm_stability.family_report import make_family_law
-from pfm_stability.fuzzy import load_dfapf
-from pfm_stability.fuzzy_law import FuzzyScheduledLaw
-from pfm_stability.velocity_laws import VelocityGatedRepulsion
+from pfm_stability.report.families import make_family_law
+from pfm_stability.laws.fuzzy import load_dfapf
+from pfm_stability.laws.fuzzy_law import FuzzyScheduledLaw
+from pfm_stability.laws.velocity_laws import VelocityGatedRepulsion
 
 FUZZY_WALL = ["--law", "fuzzy", "--alpha-p", "50", "--rho0", "0.5", "--alpha", "60"]  # F_a = 100 N, as tests/test_report_velocity_fuzzy.py
 MAGNITUDE = {  # the at-rest force of each variant at clearance d < ρ0 (Ge & Cui 2002 eq 12/19 gradient; eq 23 as printed), written here

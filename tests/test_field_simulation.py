@@ -15,8 +15,8 @@ import math
 
 import pytest
 
-from pfm_stability.criteria import analyze_corridor, analyze_wall
-from pfm_stability.fields import GnronLaw, KhatibLaw
+from pfm_stability.analysis.criteria import analyze_corridor, analyze_wall
+from pfm_stability.laws.fields import GnronLaw, KhatibLaw
 from pfm_stability.models import Sampled
 from pfm_stability.parameters import CARMEL, Corridor, Robot, Wall
 from pfm_stability.validation import boundary_by_bisection

@@ -26,11 +26,11 @@ import pytest
 from scipy.optimize import brentq
 
 from pfm_stability.cli import main
-from pfm_stability.criteria import analyze_corridor, analyze_wall
-from pfm_stability.fields import GnronLaw, KhatibLaw, finite_goal_gain, make_law
-from pfm_stability.force_law import PowerLaw, corridor_equilibria, corridor_gain, wall_equilibria, wall_gain
+from pfm_stability.analysis.criteria import analyze_corridor, analyze_wall
+from pfm_stability.laws.fields import GnronLaw, KhatibLaw, finite_goal_gain, make_law
+from pfm_stability.laws.force_law import PowerLaw, corridor_equilibria, corridor_gain, wall_equilibria, wall_gain
 from pfm_stability.parameters import CARMEL, Corridor, Wall
-from pfm_stability.potentials import attraction_force, gnron_forces
+from pfm_stability.laws.potentials import attraction_force, gnron_forces
 
 ROBOT, CONTROLLER = CARMEL.robot, CARMEL.controller
 SEC6 = {"xi": 1.0, "eta": 0.1, "rho0": 0.8, "m": 2.0}
@@ -54,7 +54,7 @@ def field_2d(law, x, y_direction, walls):
     `walls`: (position of the wall's surface on the x axis, sign of its normal n_OR);
     each wall at distance ρ = |x − x_w| repels along n_OR with F_rep1 and pushes
     towards the goal with F_rep2 (GC2000 eq 9–11, 40), the attraction pulls with
-    (m/2)ξρ_g^(m−1) (eq 1). Nothing here uses `pfm_stability.fields`.
+    (m/2)ξρ_g^(m−1) (eq 1). Nothing here uses `pfm_stability.laws.fields`.
     """
     x = np.asarray(x, dtype=float)
     n = getattr(law, "n", 0.0)
@@ -362,7 +362,7 @@ def test_no_value_helps_and_no_limit():
 
 
 def analyze_report_remedy(law):
-    from pfm_stability.report import build_report
+    from pfm_stability.report.stability import build_report
 
     report = build_report(ROBOT, CONTROLLER, alpha_deg=60.0, models=("continuous",), law=law)
     return report.remedies[("wall", "continuous")]
@@ -426,7 +426,7 @@ def test_curves_refuse_what_is_not_one_curve():
     inf, without a numpy warning; α*(V) of a goal-aware law that is monotone there puts N·V on NV* (1e-9)."""
     import warnings
 
-    from pfm_stability.curves import corridor_V_curves, wall_alpha_curves, wall_f_curves
+    from pfm_stability.analysis.curves import corridor_V_curves, wall_alpha_curves, wall_f_curves
 
     with pytest.raises(ValueError, match="is not monotone for goal-aware repulsion"):
         wall_f_curves(ROBOT, CONTROLLER, 1.0, np.array([0.5]), law=gnron(2.0))

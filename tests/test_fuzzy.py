@@ -11,8 +11,8 @@ import math
 import numpy as np
 import pytest
 
-from pfm_stability.fuzzy import FuzzySystem, FuzzyVariable, load_dfapf, symmetrized_rows
-from pfm_stability.fuzzy_law import FuzzyScheduledLaw
+from pfm_stability.laws.fuzzy import FuzzySystem, FuzzyVariable, load_dfapf, symmetrized_rows
+from pfm_stability.laws.fuzzy_law import FuzzyScheduledLaw
 
 TABLE1 = {  # the paper's Table 1 as printed: rows θ, columns d = ZD SD MD FD
     "NH": "NA NA NA NA", "NB": "SA NA NA NA", "NM": "SA NA NA SA", "NS": "MA SA SA SA",

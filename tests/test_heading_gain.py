@@ -23,7 +23,7 @@ import sympy as sp
 from scipy.linalg import expm
 from scipy.optimize import brentq
 
-from pfm_stability.delay import DelayLoop, delay_verdicts_from_gain, kb_critical_gain
+from pfm_stability.numerics.delay import DelayLoop, delay_verdicts_from_gain, kb_critical_gain
 from pfm_stability.models import MODEL_NAMES, Continuous, ExactDelay, KBFirstOrder, Loop, Pade, Sampled, gain_margin, make_model, verdict_label
 from pfm_stability.models.base import DIVERGENT_REASON, divergent_reason
 from pfm_stability.models.heading import kb_heading_interval

@@ -23,8 +23,8 @@ import pytest
 from jsonschema import Draft202012Validator
 
 from pfm_stability.cli import main
-from pfm_stability.schema import SCHEMA_FILE, load_schema
-from pfm_stability.serialize import SCHEMA_VERSION
+from pfm_stability.io.schema import SCHEMA_FILE, load_schema
+from pfm_stability.io.serialize import SCHEMA_VERSION
 
 ROOT = Path(__file__).resolve().parents[1]
 SCHEMA = load_schema()
@@ -85,11 +85,11 @@ def test_schema_is_a_valid_draft_2020_12_schema_of_this_version():
 
 
 def test_schema_ships_as_package_data():
-    """`pip install .` takes the schema along: pyproject lists it as package data of pfm_stability.schema."""
+    """`pip install .` takes the schema along: pyproject lists it as package data of pfm_stability.io.schema."""
     config = tomllib.loads((ROOT / "pyproject.toml").read_text())
-    data = config["tool"]["setuptools"]["package-data"]["pfm_stability.schema"]
+    data = config["tool"]["setuptools"]["package-data"]["pfm_stability.io.schema"]
     assert any(Path(SCHEMA_FILE).match(pattern) for pattern in data)
-    assert (ROOT / "pfm_stability" / "schema" / SCHEMA_FILE).is_file() and (ROOT / "pfm_stability" / "schema" / "__init__.py").is_file()
+    assert (ROOT / "pfm_stability" / "io" / "schema" / SCHEMA_FILE).is_file() and (ROOT / "pfm_stability" / "io" / "schema" / "__init__.py").is_file()
 
 
 def _keys_outside_timing(o):

@@ -27,7 +27,7 @@ from PIL import Image
 
 from pfm_stability.cli import main
 from pfm_stability.maps.outputs import pixel_to_percent
-from pfm_stability.schema import load_schema
+from pfm_stability.io.schema import load_schema
 
 MAPS = Path(str(resources.files("pfm_stability").joinpath("data", "maps")))
 VALIDATOR = Draft202012Validator(load_schema())

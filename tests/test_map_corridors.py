@@ -25,8 +25,8 @@ import pytest
 from PIL import Image
 
 from cli_helpers import report_json, run
-from pfm_stability.fields import make_law
-from pfm_stability.force_law import corridor_gain
+from pfm_stability.laws.fields import make_law
+from pfm_stability.laws.force_law import corridor_gain
 from pfm_stability.models import Loop, models_for
 from pfm_stability.parameters import CARMEL
 

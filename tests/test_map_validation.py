@@ -17,12 +17,12 @@ from dataclasses import dataclass
 import numpy as np
 import pytest
 
-from pfm_stability.criteria import analyze_corridor, loop_of
-from pfm_stability.fields import make_law
+from pfm_stability.analysis.criteria import analyze_corridor, loop_of
+from pfm_stability.laws.fields import make_law
 from pfm_stability.models import Sampled
 from pfm_stability.models.base import gain_margin
 from pfm_stability.parameters import CARMEL, Corridor
-from pfm_stability.serialize import dumps
+from pfm_stability.io.serialize import dumps
 from pfm_stability.sim.engine import run_batch
 from pfm_stability.sim.grid import HistogramGrid
 from pfm_stability.sim.vff import measured_wall_force

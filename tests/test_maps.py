@@ -18,8 +18,8 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from pfm_stability.criteria import analyze_corridor
-from pfm_stability.fields import make_law
+from pfm_stability.analysis.criteria import analyze_corridor
+from pfm_stability.laws.fields import make_law
 from pfm_stability.maps.analysis import analyze_map, sample_verdict
 from pfm_stability.maps.field import (
     HistogramMap,

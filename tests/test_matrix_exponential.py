@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 import scipy.linalg
 
-from pfm_stability.matrix_exponential import expm, zoh_blocks
+from pfm_stability.numerics.matrix_exponential import expm, zoh_blocks
 
 
 @pytest.mark.parametrize("n", [2, 3, 4, 6])

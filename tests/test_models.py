@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from conftest import random_loops
-from pfm_stability.crossings import affine_crossings, first_stable_interval
+from pfm_stability.numerics.crossings import affine_crossings, first_stable_interval
 from pfm_stability.models import MODEL_NAMES, Continuous, ExactDelay, KBFirstOrder, Loop, Pade, make_model, pade_coefficients
 
 control = pytest.importorskip("control")

@@ -42,7 +42,7 @@ from pfm_stability.plots.regions import (  # noqa: E402
     plot_wall_f_region,
     plot_wall_regions,
 )
-from pfm_stability.comparison import kb_error_map, kb_relative_error  # noqa: E402
+from pfm_stability.analysis.comparison import kb_error_map, kb_relative_error  # noqa: E402
 from pfm_stability.plots.validation import plot_simulated_boundary  # noqa: E402
 from pfm_stability.validation import SimulatedBoundary  # noqa: E402
 
@@ -131,7 +131,7 @@ def test_summary_figures_have_one_shared_legend():
 
 def test_grid_law_curves_without_shading():
     """A non-power law (the grid's) draws curves; shading through the general-law verdicts also works."""
-    from pfm_stability.effective_force import GridWallLaw, calibrate_cell_ratio
+    from pfm_stability.laws.effective_force import GridWallLaw, calibrate_cell_ratio
 
     law = GridWallLaw(calibrate_cell_ratio(0.8, 2.0, 0.8), 2.0, 0.8)
     fig = plot_corridor_region(ROBOT, CONTROLLER, law=law, shade=False, resolution=RES)
@@ -231,7 +231,7 @@ def test_region_plot_shades_the_model_asked_for():
     """shaded="exact_delay": the mesh is the exact_delay map (crossing count) and the legend says so."""
     from matplotlib.collections import QuadMesh
 
-    from pfm_stability.regions import corridor_region
+    from pfm_stability.analysis.regions import corridor_region
 
     L, V = np.linspace(0.45, 2.0, 12), np.linspace(0.05, 2.0, 10)
     fig, ax = plt.subplots()

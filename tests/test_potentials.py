@@ -1,4 +1,4 @@
-"""The potentials of Ge & Cui 2000 and their bounds on ξ/η (`pfm_stability.potentials`).
+"""The potentials of Ge & Cui 2000 and their bounds on ξ/η (`pfm_stability.laws.potentials`).
 
 S.S. Ge and Y.J. Cui, IEEE T-RA 16(5), 2000 ("GC2000"; docs/traps.md). Three
 kinds of checks:
@@ -20,7 +20,7 @@ import math
 import numpy as np
 import pytest
 
-from pfm_stability import potentials as P
+from pfm_stability.laws import potentials as P
 
 RNG_SEED = 20000501
 

@@ -1,6 +1,6 @@
 """Which model the region maps shade, and that each map says what its model says point by point.
 
-The dense maps of `pfm_stability.regions` shade, by default, the model the
+The dense maps of `pfm_stability.analysis.regions` shade, by default, the model the
 stability report's verdict uses (``sampled`` with the controller's hold and
 compute delay). Checked here:
 
@@ -37,11 +37,11 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import pytest  # noqa: E402
 
-from pfm_stability.force_law import ForceLaw, PowerLaw, corridor_gain, wall_gain  # noqa: E402
+from pfm_stability.laws.force_law import ForceLaw, PowerLaw, corridor_gain, wall_gain  # noqa: E402
 from pfm_stability.models import ExactDelay, Loop, Sampled, models_for  # noqa: E402
 from pfm_stability.parameters import CARMEL, Controller, Robot  # noqa: E402
 from pfm_stability.plots.regions import plot_corridor_region, plot_wall_alpha_critical  # noqa: E402
-from pfm_stability.regions import (  # noqa: E402
+from pfm_stability.analysis.regions import (  # noqa: E402
     corridor_region,
     region_model,
     stable_set_verdicts,
@@ -49,7 +49,7 @@ from pfm_stability.regions import (  # noqa: E402
     wall_alpha_region,
     wall_f_region,
 )
-from pfm_stability.report import build_report  # noqa: E402
+from pfm_stability.report.stability import build_report  # noqa: E402
 
 ROBOT, CONTROLLER = CARMEL.robot, CARMEL.controller
 

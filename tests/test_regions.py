@@ -1,4 +1,4 @@
-"""Stability regions and boundary curves (`pfm_stability.regions`, `pfm_stability.curves`).
+"""Stability regions and boundary curves (`pfm_stability.analysis.regions`, `pfm_stability.analysis.curves`).
 
 Every curve is checked by routes that do not share its algebra:
 
@@ -25,15 +25,15 @@ import math
 import numpy as np
 import pytest
 
-from pfm_stability.criteria import critical_alpha, critical_L
-from pfm_stability.effective_force import GridWallLaw, calibrate_cell_ratio
-from pfm_stability.force_law import ForceLaw, PowerLaw, corridor_gain, wall_gain
+from pfm_stability.analysis.criteria import critical_alpha, critical_L
+from pfm_stability.laws.effective_force import GridWallLaw, calibrate_cell_ratio
+from pfm_stability.laws.force_law import ForceLaw, PowerLaw, corridor_gain, wall_gain
 from pfm_stability.models import ExactDelay, KBFirstOrder, Loop, Sampled, make_models
 from pfm_stability.parameters import CARMEL
-from pfm_stability.comparison import critical_gain_vs_delay, kb_error_map, kb_relative_error
+from pfm_stability.analysis.comparison import critical_gain_vs_delay, kb_error_map, kb_relative_error
 from pfm_stability.parameters import SAMPLED_STRUCTURES
-from pfm_stability.curves import corridor_L_curves, corridor_V_curves, default_models, wall_alpha_curves, wall_f_curves
-from pfm_stability.regions import corridor_region, wall_alpha_region, wall_f_region
+from pfm_stability.analysis.curves import corridor_L_curves, corridor_V_curves, default_models, wall_alpha_curves, wall_f_curves
+from pfm_stability.analysis.regions import corridor_region, wall_alpha_region, wall_f_region
 
 ROBOT, CONTROLLER = CARMEL.robot, CARMEL.controller
 LOOP = Loop(ROBOT.tau, CONTROLLER.T, ROBOT.k)

@@ -16,7 +16,7 @@ import pytest
 from cli_helpers import report_json, run
 
 from pfm_stability import CARMEL
-from pfm_stability.family_report import build_family_report, make_family_law
+from pfm_stability.report.families import build_family_report, make_family_law
 from pfm_stability.models import ExactDelay
 from pfm_stability.models.holonomic import HolonomicLoop, kinematic_loop
 from pfm_stability.models.holonomic_delay import make_holonomic_model

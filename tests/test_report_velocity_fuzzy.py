@@ -17,8 +17,8 @@ import pytest
 from cli_helpers import report_json, run
 
 from pfm_stability import CARMEL
-from pfm_stability.force_law import wall_equilibria
-from pfm_stability.fuzzy_law import FuzzyScheduledLaw
+from pfm_stability.laws.force_law import wall_equilibria
+from pfm_stability.laws.fuzzy_law import FuzzyScheduledLaw
 from pfm_stability.models import ExactDelay, Loop, make_model
 
 FUZZY_WALL = ["--law", "fuzzy", "--alpha-p", "50", "--rho0", "0.5", "--alpha", "60"]  # F_a = 2·50·1 = 100 N (docs/velocity_and_fuzzy.md)
@@ -74,7 +74,7 @@ def test_velocity_law_steering_gains_against_static_law_and_q():
         Fa = 1.0  # defaults: α_p 0.5, m 2, ρ_g 1
         alpha_v = rng.uniform(0.05, 0.6) * Fa * math.sin(math.radians(alpha)) / (2 * V)  # q in (0.05, 0.6)
         d = report_json(["--law", "velocity", "--alpha-v", repr(alpha_v), "--alpha", repr(alpha), "--V", repr(V), "--model", "exact_delay"])
-        from pfm_stability.family_report import make_family_law
+        from pfm_stability.report.families import make_family_law
 
         static = wall_equilibria(make_family_law("velocity").repulsion(), math.radians(alpha))
         q = 2 * alpha_v * V / (Fa * math.sin(math.radians(alpha)))
@@ -119,7 +119,7 @@ def test_velocity_gated_cycle_from_the_planar_simulator(family):
     out here; and it lies where the band says (mean and closest distance inside the rest band (0, d_s])."""
     from pfm_stability.sim.cycles import wall_cycle
     from pfm_stability.sim.planar import PointMass, Steering
-    from pfm_stability.velocity_laws import VelocityGatedRepulsion
+    from pfm_stability.laws.velocity_laws import VelocityGatedRepulsion
 
     d = report_json(["--law", "velocity-gated", "--eta", "0.1", "--a-max", "1", "--alpha", "60", "--robot", family])
     cycle = d["environment"]["wall"]["cycle"]

@@ -1,4 +1,4 @@
-"""Routh–Hurwitz and Schur–Cohn tests (module `pfm_stability.routh`).
+"""Routh–Hurwitz and Schur–Cohn tests (module `pfm_stability.numerics.routh`).
 
 The Routh count is checked against `numpy.roots` on random polynomials
 (degree 1–8, skip roots within 1e-9 of the axis) and on the textbook
@@ -11,7 +11,7 @@ import sympy as sp
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
-from pfm_stability.routh import routh_array, routh_count, routh_stable, schur_cohn_stable
+from pfm_stability.numerics.routh import routh_array, routh_count, routh_stable, schur_cohn_stable
 
 coefficient = st.floats(min_value=-10, max_value=10, allow_nan=False, allow_infinity=False)
 

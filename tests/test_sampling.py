@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from scipy.stats import qmc
 
-from pfm_stability.sampling import latin_hypercube, sobol
+from pfm_stability.numerics.sampling import latin_hypercube, sobol
 
 RNG = np.random.default_rng(20261123)
 CASES = [(1, 1, 0), (2000, 4, 0), (7, 9, 2**63 - 1)] + [

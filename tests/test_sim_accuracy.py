@@ -13,7 +13,7 @@ T/τ = 30–100 in the runs below.
 import numpy as np
 import pytest
 
-from pfm_stability.force_law import PowerLaw, corridor_gain
+from pfm_stability.laws.force_law import PowerLaw, corridor_gain
 from pfm_stability.models import Loop, Sampled
 from pfm_stability.parameters import CARMEL
 from pfm_stability.sim import make_scenario, run_batch, simulate_batch, simulate_reference

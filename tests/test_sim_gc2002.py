@@ -1,6 +1,6 @@
 """Ge & Cui 2002's simulations (GC2002 Figs 8, 10–12, eq 23 and the velocity-gated wall) with the planar simulator.
 
-Reference numbers are the closed forms of `pfm_stability.tracking` and `velocity_laws`
+Reference numbers are the closed forms of `pfm_stability.models.tracking` and `velocity_laws`
 and figures recomputed independently (docs/velocity_and_fuzzy.md); each tolerance is the
 sampling error of the period used, stated per test.
 """
@@ -22,8 +22,8 @@ from pfm_stability.sim.planar import (
     World,
     simulate_planar,
 )
-from pfm_stability.tracking import tracking_dynamics
-from pfm_stability.velocity_laws import (
+from pfm_stability.models.tracking import tracking_dynamics
+from pfm_stability.laws.velocity_laws import (
     VelocityAttraction,
     VelocityGatedRepulsion,
     stall_band,

@@ -11,8 +11,8 @@ import math
 import numpy as np
 import pytest
 
-from pfm_stability.fields import KhatibLaw
-from pfm_stability.force_law import PowerLaw, wall_equilibria
+from pfm_stability.laws.fields import KhatibLaw
+from pfm_stability.laws.force_law import PowerLaw, wall_equilibria
 from pfm_stability.models.base import Loop
 from pfm_stability.models.holonomic import HolonomicLoop, kinematic_loop
 from pfm_stability.models.holonomic_delay import HolonomicSampled
@@ -29,7 +29,7 @@ from pfm_stability.sim.planar import (
     World,
     simulate_planar,
 )
-from pfm_stability.velocity_laws import VelocityAttraction, VelocityGatedRepulsion
+from pfm_stability.laws.velocity_laws import VelocityAttraction, VelocityGatedRepulsion
 
 L = 0.5
 LAW = KhatibLaw(xi=1.0, eta=0.3, rho0=2.0, m=2.0, rho_g=1.0)

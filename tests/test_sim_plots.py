@@ -6,7 +6,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import pytest  # noqa: E402
 
-from pfm_stability.effective_force import GridWallLaw, calibrate_cell_ratio  # noqa: E402
+from pfm_stability.laws.effective_force import GridWallLaw, calibrate_cell_ratio  # noqa: E402
 from pfm_stability.plots.force import plot_equivalent_f, plot_force_laws, plot_force_summary  # noqa: E402
 from pfm_stability.plots.trajectory import plot_trajectory  # noqa: E402
 from pfm_stability.sim import simulate  # noqa: E402

@@ -4,7 +4,7 @@ import math
 
 import pytest
 
-from pfm_stability.effective_force import GridWallLaw, calibrate_cell_ratio, f_average
+from pfm_stability.laws.effective_force import GridWallLaw, calibrate_cell_ratio, f_average
 from pfm_stability.parameters import CARMEL
 from pfm_stability.sim import SCENARIO_NAMES, make_scenario, simulate
 from pfm_stability.validation import predict

@@ -19,9 +19,9 @@ reach 1e-4 m). Hence x₀ = 1e-7 m and a tolerance of 3e-8 (1/s, rad/s).
 import numpy as np
 import pytest
 
-from pfm_stability.criteria import critical_L, critical_alpha
-from pfm_stability.effective_force import GridWallLaw, calibrate_cell_ratio
-from pfm_stability.force_law import PowerLaw, corridor_gain, wall_gain
+from pfm_stability.analysis.criteria import critical_L, critical_alpha
+from pfm_stability.laws.effective_force import GridWallLaw, calibrate_cell_ratio
+from pfm_stability.laws.force_law import PowerLaw, corridor_gain, wall_gain
 from pfm_stability.models import Loop, Sampled
 from pfm_stability.parameters import CARMEL
 from pfm_stability.sim import simulate_batch

@@ -1,11 +1,11 @@
-"""Bisection (module `pfm_stability.solve`) against scipy's brentq."""
+"""Bisection (module `pfm_stability.numerics.solve`) against scipy's brentq."""
 
 import math
 
 import pytest
 from scipy.optimize import brentq
 
-from pfm_stability.solve import bisect_root, expand_bracket
+from pfm_stability.numerics.solve import bisect_root, expand_bracket
 
 CASES = [
     (lambda x: x**3 - 2, 0.0, 2.0),

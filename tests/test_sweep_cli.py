@@ -17,7 +17,7 @@ from jsonschema import Draft202012Validator
 from table_helpers import read, same
 
 from pfm_stability.cli import main
-from pfm_stability.schema import load_schema
+from pfm_stability.io.schema import load_schema
 
 VALIDATOR = Draft202012Validator(load_schema())
 

@@ -11,9 +11,9 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from pfm_stability.force_law import PowerLaw, corridor_gain, wall_gain
-from pfm_stability.planner import gradient_step
-from pfm_stability.tracking import tracking_dynamics
+from pfm_stability.laws.force_law import PowerLaw, corridor_gain, wall_gain
+from pfm_stability.models.planner import gradient_step
+from pfm_stability.models.tracking import tracking_dynamics
 
 
 @pytest.mark.parametrize("alpha_v, zeta, regime", [(0.0, 0.0, "undamped"), (0.02, 0.2, "underdamped"), (0.1, 1.0, "critically damped"), (0.2, 2.0, "overdamped")])

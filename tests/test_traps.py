@@ -1,4 +1,4 @@
-"""Every stationary point of a 2-D scene (`pfm_stability.traps`) and the ``traps`` command.
+"""Every stationary point of a 2-D scene (`pfm_stability.analysis.traps`) and the ``traps`` command.
 
 Ge & Cui, IEEE T-RA 16(5), 2000 ("GC2000"; docs/traps.md). Checked:
 
@@ -32,9 +32,9 @@ import pytest
 from jsonschema import Draft202012Validator
 
 from pfm_stability.cli import main
-from pfm_stability.schema import load_schema
-from pfm_stability.scene import Scene, field
-from pfm_stability.traps import find_stationary_points
+from pfm_stability.io.schema import load_schema
+from pfm_stability.laws.scene import Scene, field
+from pfm_stability.analysis.traps import find_stationary_points
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENES = ROOT / "pfm_stability" / "data" / "scenes"

@@ -21,8 +21,8 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from pfm_stability.criteria import analyze_corridor, analyze_wall
-from pfm_stability.force_law import PowerLaw, corridor_gain, wall_gain
+from pfm_stability.analysis.criteria import analyze_corridor, analyze_wall
+from pfm_stability.laws.force_law import PowerLaw, corridor_gain, wall_gain
 from pfm_stability.models import Loop, Sampled
 from pfm_stability.parameters import CARMEL, Corridor, Wall
 from pfm_stability.sim import simulate_batch

@@ -141,7 +141,7 @@ def test_validate_sweep_follows_the_config_files_grid_law():
 
     Tolerance 1e-6: the oracle's midpoint rule and central difference are accurate to ~1e-8.
     """
-    from pfm_stability.effective_force import calibrate_cell_ratio
+    from pfm_stability.laws.effective_force import calibrate_cell_ratio
     from pfm_stability.validation import verdict_sweep
 
     sweep = verdict_sweep(8, seed=1, env="analytic", law="grid")

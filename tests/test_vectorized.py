@@ -5,8 +5,8 @@ import math
 import numpy as np
 import pytest
 
-from pfm_stability.criteria import analyze_corridor, analyze_wall
-from pfm_stability.delay import DelayLoop
+from pfm_stability.analysis.criteria import analyze_corridor, analyze_wall
+from pfm_stability.numerics.delay import DelayLoop
 from pfm_stability.models import ExactDelay, Loop
 from pfm_stability.parameters import Controller, Corridor, Robot, Wall
 from pfm_stability.vectorized import delay_verdicts_from_gain, exact_delay_verdicts

@@ -252,7 +252,7 @@ def test_single_crossing_verdicts_equal_the_crossing_count():
     loops included), T 0…20 s, k 0.05…100 1/s, K over eight decades (some negative): equal
     verdicts wherever the point is neither `near` an edge nor has three crossings (those go to
     the full count). Exact: both evaluate the same formula up to round-off far from the edge."""
-    from pfm_stability.delay import delay_verdicts_from_gain
+    from pfm_stability.numerics.delay import delay_verdicts_from_gain
     from pfm_stability.vectorized.delay_verdicts import single_crossing_verdicts
 
     rng = np.random.default_rng(5)
@@ -338,7 +338,7 @@ def test_closed_form_cubic_root_equals_the_newton_iteration():
     a cubic with F(0) < 0 and one sign change of F is simple): relative agreement 10⁻¹²; and the
     closed form itself, not its fallback iteration, must serve at least 99% of these extreme
     points (about 0.06% fall back: the speed of the verdict path rests on that)."""
-    from pfm_stability import delay
+    from pfm_stability.numerics import delay
     from pfm_stability.vectorized import delay_verdicts
 
     rng = np.random.default_rng(20240611)

@@ -14,8 +14,8 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from pfm_stability.fields import GnronLaw, KhatibLaw
-from pfm_stability.velocity_laws import (
+from pfm_stability.laws.fields import GnronLaw, KhatibLaw
+from pfm_stability.laws.velocity_laws import (
     VARIANTS,
     VelocityAttraction,
     VelocityGatedRepulsion,
@@ -110,7 +110,7 @@ def test_steering_q_closed_form_and_no_forward_force():
     rho_g, alpha, V = 2.0, math.radians(60), 0.8
     Fa = att.position_force(rho_g)
     law = _khatib(0.3, 1.5, Fa, rho_g)
-    (static,) = [e for e in __import__("pfm_stability.force_law", fromlist=["x"]).wall_equilibria(law, alpha)]
+    (static,) = [e for e in __import__("pfm_stability.laws.force_law", fromlist=["x"]).wall_equilibria(law, alpha)]
     (e,) = att.steering_wall_equilibria(law, alpha, V, rho_g)
     q = 2 * 0.2 * V / (Fa * math.sin(alpha))
     assert e.N == pytest.approx(static.N / (1 - q), rel=1e-12) and e.c == pytest.approx(q / (1 - q), rel=1e-12)

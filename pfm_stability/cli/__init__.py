@@ -3,7 +3,7 @@
 Subcommands live in their own modules (``report``, ``derive``, ``simulate``,
 ``validate``, ``plot``, ``traps``); each exposes ``add_parser(subparsers)`` and
 ``run(args) -> int``; their text, Markdown and LaTeX renderings are in
-`render`, their JSON is written by `pfm_stability.serialize.dumps`. Module
+`render`, their JSON is written by `pfm_stability.io.serialize.dumps`. Module
 imports here are light (no numpy, scipy, sympy or matplotlib) so that
 start-up stays fast; the heavy libraries are imported by the subcommand that
 needs them.

@@ -1,6 +1,6 @@
 """``pfm-stability derive``: the Koren & Borenstein derivation, eq (5) → (25), step by step.
 
-Prints every step of `pfm_stability.derivation.derivation` as plain text
+Prints every step of `pfm_stability.analysis.derivation.derivation` as plain text
 (sympy's pretty printer) or as LaTeX (one ``equation*`` per step, tagged with
 KB's equation number; renderers in `pfm_stability.cli.render`), for KB's
 power law or a general force law F_r(d) (docs/theory.md). sympy is imported
@@ -34,7 +34,7 @@ def add_parser(sub) -> None:
 
 
 def run(args) -> int:
-    from ..derivation import derivation
+    from ..analysis.derivation import derivation
     from .render import render_derivation_latex, render_derivation_text
 
     steps = derivation(args.law, pade_order=args.pade_order)

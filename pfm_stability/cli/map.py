@@ -24,16 +24,7 @@ from __future__ import annotations
 import argparse
 
 from ..parameters import MAP_LAWS, MODEL_NAMES
-from .options import (
-    add_law_options,
-    add_parameter_options,
-    describe,
-    integer,
-    number,
-    resolve_law,
-    resolve_parameters,
-    shipped_or_given,
-)
+from .options import add_law_options, add_parameter_options, describe, integer, number, resolve_law, resolve_parameters, shipped_or_given
 
 FORMATS = ("text", "json")
 SHIPPED_MAPS = ("depot", "warehouse", "tb3_sandbox")
@@ -85,7 +76,7 @@ def map_path(name: str) -> str:
 
 
 def _validate(analysis, count: int, seed: int, progress):
-    from ..effective_force import GridWallLaw
+    from ..laws.effective_force import GridWallLaw
 
     if not isinstance(analysis.law, GridWallLaw):
         raise ValueError("validate needs --law grid: the simulator senses the map through its histogram grid")
@@ -105,7 +96,7 @@ def _write_outputs(analysis, out_dir: str) -> dict:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from ..files import atomic_directory, open_new
+    from ..io.files import atomic_directory, open_new
     from ..maps.outputs import OUTPUT_FILES, segments_csv, speed_mask_pgm, speed_mask_yaml
     from ..plots.map import plot_map_stability
 
@@ -133,7 +124,7 @@ def run(args) -> int:
 
     from ..maps.analysis import analyze_map, check_map_law
     from ..maps.occupancy import load_map
-    from ..serialize import dumps
+    from ..io.serialize import dumps
     from .progress import line_progress
     from .render import render_map_text
 
@@ -162,6 +153,6 @@ def run(args) -> int:
 
 
 def _schema_version() -> str:
-    from ..serialize import SCHEMA_VERSION
+    from ..io.serialize import SCHEMA_VERSION
 
     return SCHEMA_VERSION

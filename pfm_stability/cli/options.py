@@ -14,11 +14,10 @@ from dataclasses import dataclass, fields
 from typing import TYPE_CHECKING
 
 from ..checks import check_integer, check_number, check_output_path
-from ..parameters import (FAMILY_CHOICE_DEFAULTS, FAMILY_LAW_CHOICES, FAMILY_LAW_PARAMETERS, FAMILY_LAWS, FIELD_DEFAULTS, FORCE_LAWS, HOLDS, HOLONOMIC_LAWS,
-                          LAW_PARAMETERS, PRESETS, RANGES, ROBOT_FAMILIES, SHOWN_AS, Controller, Preset, Robot, get_preset)
+from ..parameters import FAMILY_CHOICE_DEFAULTS, FAMILY_LAW_CHOICES, FAMILY_LAW_PARAMETERS, FAMILY_LAWS, FIELD_DEFAULTS, FORCE_LAWS, HOLDS, HOLONOMIC_LAWS, LAW_PARAMETERS, PRESETS, RANGES, ROBOT_FAMILIES, SHOWN_AS, Controller, Preset, Robot, get_preset
 
 if TYPE_CHECKING:
-    from ..config import Config
+    from ..io.config import Config
 
 __all__ = [
     "number",
@@ -141,7 +140,7 @@ def typed(args, name: str) -> bool:
 
 def input_file(name: str):
     """An argparse ``type=`` for a file to read: non-empty text; whether it can be read is the reader's to say
-    (`pfm_stability.config.load_config`: ``config FILE: cannot read the file (…)``)."""
+    (`pfm_stability.io.config.load_config`: ``config FILE: cannot read the file (…)``)."""
 
     def parse(text: str) -> str:
         if not text.strip() or "\0" in text:
@@ -220,7 +219,7 @@ class ResolvedParameters:
     ----------
     preset : Preset
         The preset in force: ``--preset``, or the configuration file over its preset
-        (`pfm_stability.config.Config.preset`: its grid and assumptions).
+        (`pfm_stability.io.config.Config.preset`: its grid and assumptions).
     robot : Robot
     controller : Controller
     sources : dict[str, str]
@@ -254,7 +253,7 @@ def resolve_parameters(args, *, fill=None) -> ResolvedParameters:
     """
     config = None
     if getattr(args, "config", None) is not None:
-        from ..config import load_config
+        from ..io.config import load_config
 
         config = load_config(args.config, preset=args.preset if typed(args, "preset") else None)
         preset = config.preset
@@ -359,7 +358,7 @@ def resolve_law(args, params: ResolvedParameters):
         An option the law does not take (``--xi applies to khatib or gnron, not to --law power``),
         or ``--law khatib``/``gnron`` without ``--goal-distance``.
     """
-    from ..fields import check_law_parameters, make_law
+    from ..laws.fields import check_law_parameters, make_law
 
     from_file = (params.config.law if params.config is not None else None) or {}
     law_name = args.law if typed(args, "law") or not from_file else from_file["name"]
@@ -485,7 +484,7 @@ def resolve_family(args, params: ResolvedParameters) -> ResolvedFamily:
         _check_choices_taken(args, None, law_shown)
         law, law_sources = resolve_law(args, params)
         return ResolvedFamily(family, law, mass, {**sources, **law_sources})
-    from ..family_report import make_family_law
+    from ..report.families import make_family_law
 
     taken = FAMILY_LAW_PARAMETERS[law_name]
     given = {k: getattr(args, k) for k in (*LAW_OPTIONS, *FAMILY_OPTIONS) if getattr(args, k, None) is not None}

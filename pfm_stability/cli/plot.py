@@ -23,7 +23,7 @@ def add_parser(sub) -> None:
 
 
 def _draw(kind, params, pade_order):
-    from ..criteria import loop_of
+    from ..analysis.criteria import loop_of
 
     robot, controller = params.robot, params.controller
     if kind == "rlocus":
@@ -51,7 +51,7 @@ def run(args) -> int:
 
     matplotlib.use("Agg")
 
-    from ..files import save_figure
+    from ..io.files import save_figure
 
     save_figure(_draw(args.kind, params, args.pade_order), args.out, dpi=130, what="plot")
     print(f"wrote {args.out}")

@@ -8,7 +8,7 @@ they share:
   exactly what the JSON says;
 * ``derive``: `render_derivation_text` (sympy's pretty printer) and
   `render_derivation_latex` (one ``equation*`` per step) of
-  `pfm_stability.derivation.derivation`;
+  `pfm_stability.analysis.derivation.derivation`;
 * ``traps``, ``map``, ``sweep``: their summaries.
 
 The renderings of simulated runs (``simulate``, ``validate``) are in `render_runs`.
@@ -331,7 +331,7 @@ def render_derivation_text(steps, law: str) -> str:
 
     lines = [
         _derivation_heading(law) + ".",
-        "Misprints corrected: see `pydoc pfm_stability.derivation`.",
+        "Misprints corrected: see `pydoc pfm_stability.analysis.derivation`.",
         "",
     ]
     for index, step in enumerate(steps, 1):

@@ -3,8 +3,7 @@
 from __future__ import annotations
 
 from ..parameters import DOOR_OBSTACLES, FAMILY_LAWS, FORCE_LAWS, MODEL_NAMES, Wall
-from .options import (PADE_ORDER, add_family_options, add_law_options, add_parameter_options, describe, number, resolve_family,
-                      resolve_parameters)
+from .options import PADE_ORDER, add_family_options, add_law_options, add_parameter_options, describe, number, resolve_family, resolve_parameters
 
 FORMATS = ("text", "json", "markdown")
 DEFAULT_PADE_ORDER = 3
@@ -36,7 +35,7 @@ def add_parser(sub) -> None:
 
 
 def run(args) -> int:
-    from ..serialize import dumps
+    from ..io.serialize import dumps
     from .render import render_markdown, render_text
 
     params = resolve_parameters(args)
@@ -61,7 +60,7 @@ def _family(args, chosen) -> bool:
 
 def _family_report(args, params, chosen):
     """`family_report.build_family_report` for ``--robot``/``--law``, the non-smooth wall's cycle simulated unless ``--no-simulate``."""
-    from ..family_report import FamilyLaw, build_family_report
+    from ..report.families import FamilyLaw, build_family_report
 
     if args.door is not None:
         raise ValueError(f"--door applies to --robot steering with a static law (power, grid, khatib, gnron), "
@@ -81,7 +80,7 @@ def _family_report(args, params, chosen):
 
 def _steering_report(args, params, law, law_sources):
     """KB's steering robot with a static law: `report.build_report`, exactly as before the robot families."""
-    from ..report import build_report
+    from ..report.stability import build_report
 
     return build_report(
         params.robot,

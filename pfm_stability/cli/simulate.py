@@ -123,7 +123,7 @@ def _plot(result, path: str) -> None:
 
     matplotlib.use("Agg")
 
-    from ..files import save_figure
+    from ..io.files import save_figure
     from ..plots.trajectory import plot_trajectory
 
     save_figure(plot_trajectory(result), path, dpi=120, what="plot")
@@ -135,7 +135,7 @@ def run(args) -> int:
     import time
 
     from ..parameters import Corridor, check_corridor_fits
-    from ..serialize import SCHEMA_VERSION, dumps, json_number
+    from ..io.serialize import SCHEMA_VERSION, dumps, json_number
     from ..sim.api import simulate
     from ..validation.predict import predict
 

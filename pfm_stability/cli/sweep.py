@@ -102,7 +102,7 @@ def run(args) -> int:
     from ..extras import require
 
     require("sweep", "pfm-stability sweep")
-    from ..serialize import SCHEMA_VERSION, dumps
+    from ..io.serialize import SCHEMA_VERSION, dumps
     from ..sweeps import SweepError, load_spec, run_sweep
     from .render import render_parameter_sweep_text
 
@@ -137,6 +137,6 @@ def _plot(summary, path: str) -> None:
     from ..plots.sweep import plot_sweep_summary
     from ..sweeps.summary import summary_figure_data
 
-    from ..files import save_figure
+    from ..io.files import save_figure
 
     save_figure(plot_sweep_summary(summary_figure_data(summary)), path, dpi=110, what="plot")

@@ -51,9 +51,9 @@ def scene_path(name: str) -> str:
 def run(args) -> int:
     from .render import render_traps_text
 
-    from ..serialize import dumps
-    from ..scene import Scene
-    from ..traps import find_stationary_points
+    from ..io.serialize import dumps
+    from ..laws.scene import Scene
+    from ..analysis.traps import find_stationary_points
 
     analysis = find_stationary_points(Scene.load(scene_path(args.scene)), args.resolution)
     if args.plot:
@@ -61,7 +61,7 @@ def run(args) -> int:
 
         matplotlib.use("Agg")
 
-        from ..files import save_figure
+        from ..io.files import save_figure
         from ..plots.traps import plot_traps
 
         save_figure(plot_traps(analysis), args.plot, dpi=110, what="plot")

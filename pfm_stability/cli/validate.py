@@ -78,7 +78,7 @@ def add_parser(sub) -> None:
 
 
 def _save(fig, path: str, what: str) -> None:
-    from ..files import save_figure
+    from ..io.files import save_figure
 
     save_figure(fig, path, dpi=120, what=what)
 
@@ -101,7 +101,7 @@ def run(args) -> int:
 
         matplotlib.use("Agg")
 
-    from ..serialize import SCHEMA_VERSION, dumps
+    from ..io.serialize import SCHEMA_VERSION, dumps
 
     with line_progress("validate", quiet=args.quiet) as progress:
         validation, sweep = _work(args, params, progress)

@@ -43,11 +43,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..effective_force import GridWallLaw
-from ..force_law import ForceLaw, PowerLaw
+from ..laws.effective_force import GridWallLaw
+from ..laws.force_law import ForceLaw, PowerLaw
 from ..models import Loop, divergent_reason, gain_margin, models_for, neutral_reason, verdict_label
 from ..parameters import MAP_LAWS, Controller, Robot
-from ..serialize import json_number
+from ..io.serialize import json_number
 from .equilibria import Samples, grid_equilibria, power_equilibria
 from .field import UNKNOWN_AS, HistogramMap, histogram_of
 from .occupancy import OccupancyMap

@@ -45,8 +45,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..effective_force import GridWallLaw
-from ..solve import newton_increasing
+from ..laws.effective_force import GridWallLaw
+from ..numerics.solve import newton_increasing
 from .field import HistogramMap, window_force
 
 __all__ = ["NEWTON_STEPS", "RAY_LENGTH", "Samples", "grid_equilibria", "power_equilibria"]
@@ -192,7 +192,7 @@ def _lateral(grid, law, x, y, tx, ty, s, jacobian=False):
     convention of the grid's wall law (`effective_force.GridWallLaw`: the robot
     passes every position in its cell many times before the oscillation builds up).
     """
-    from ..solve import gauss_legendre
+    from ..numerics.solve import gauss_legendre
 
     nodes, weights = gauss_legendre(PHASE_NODES)
     u = nodes * grid.cell_size / 2

@@ -30,7 +30,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..effective_force import DEFAULT_CV, GridWallLaw
+from ..laws.effective_force import DEFAULT_CV, GridWallLaw
 from .occupancy import OccupancyMap
 
 __all__ = ["CHUNK_ENTRIES", "UNKNOWN_AS", "HistogramMap", "centre_field", "histogram_of", "window_force"]

@@ -20,8 +20,7 @@ from __future__ import annotations
 
 from ..checks import check_choice
 from ..parameters import MODEL_NAMES, Controller
-from .base import (DIVERGENT_REASON, HEADING_GAIN_RANGE, NEUTRAL_REASON, Boundary, Loop, LoopModel, divergent_reason, gain_margin,
-                   interval_margin, interval_verdict, neutral_reason, verdict_label)
+from .base import DIVERGENT_REASON, HEADING_GAIN_RANGE, NEUTRAL_REASON, Boundary, Loop, LoopModel, divergent_reason, gain_margin, interval_margin, interval_verdict, neutral_reason, verdict_label
 from .continuous import Continuous
 from .exact_delay import ExactDelay
 from .kb_first_order import KBFirstOrder

@@ -33,8 +33,8 @@ import numpy as np
 
 from ..checks import check_number
 from ..parameters import RANGES, T_RESOLUTION, TAU_RESOLUTION, check_parameter
-from ..crossings import first_stable_interval, verdict_at
-from ..serialize import json_number
+from ..numerics.crossings import first_stable_interval, verdict_at
+from ..io.serialize import json_number
 
 __all__ = [
     "Loop",
@@ -406,7 +406,7 @@ class LoopModel:
         over T (a geometric grid with its local maxima refined, then
         bisection to 1e-7 relative); models with an exact route override it.
         """
-        from ..solve import first_crossing
+        from ..numerics.solve import first_crossing
 
         NV = _check_NV(NV)
         if NV < 0 or self.growth_rates(NV, [Loop(loop.tau, 0.0, loop.k, c=loop.c)])[0] >= 0:
@@ -426,7 +426,7 @@ class LoopModel:
         works. 0 if no k is small enough; ``inf`` if NV stays stable up to the
         largest allowed k (10⁴ 1/s). Same search as `critical_delay`, over k.
         """
-        from ..solve import first_crossing
+        from ..numerics.solve import first_crossing
 
         NV = _check_NV(NV)
         lo, hi = gain_range(loop)

@@ -1,6 +1,6 @@
 """`exact_delay`: KB eq (18), τs³ + s² + ks + kNV·e^(−sT) = 0, solved exactly.
 
-The quasi-polynomial has infinitely many roots. Module `pfm_stability.delay`
+The quasi-polynomial has infinitely many roots. Module `pfm_stability.numerics.delay`
 answers every question without a search bound, by the same array code that
 `pfm_stability.vectorized` runs on millions of points:
 
@@ -43,7 +43,7 @@ import math
 
 import numpy as np
 
-from ..delay import DelayLoop, delay_verdicts_from_gain, kb_critical_gain
+from ..numerics.delay import DelayLoop, delay_verdicts_from_gain, kb_critical_gain
 from .base import Boundary, Loop, LoopModel, _check_NV, checked, gain_range
 from .pade import Pade
 
@@ -136,7 +136,7 @@ class ExactDelay(LoopModel):
         near-misses between grid points). NV < 0: 0. NV = 0: the heading
         loop's k* (c = 0: τs² + s + k, ``inf``).
         """
-        from ..solve import first_crossing
+        from ..numerics.solve import first_crossing
 
         NV = _check_NV(NV)
         if NV < 0:
@@ -159,7 +159,7 @@ class ExactDelay(LoopModel):
 
     def _heading_gain_k(self, NV: float, loop: Loop) -> float:
         """k* for c ≠ 0 (`critical_gain_k`): first sign change of the signed measure over k."""
-        from ..solve import first_crossing
+        from ..numerics.solve import first_crossing
 
         def measure(ks):
             loops = [Loop(loop.tau, loop.T, float(k), c=loop.c) for k in ks]

@@ -2,7 +2,7 @@
 
 The heading gain c (`Loop.c`, docs/models.md "The heading gain") adds kc·s to
 the delayed term of KB eq (18). The crossing count and the rightmost roots of
-`pfm_stability.delay` take it directly; the stable set in K = kNV needs more,
+`pfm_stability.numerics.delay` take it directly; the stable set in K = kNV needs more,
 because the gain crossings are no longer all destabilizing (for c = 0 they are,
 and `delay.kb_critical_gain` finds K* among three levels). This module finds
 every crossing that can bound the stable set, from polynomial roots and a
@@ -16,9 +16,9 @@ import math
 
 import numpy as np
 
-from ..crossings import Crossing, StabilityInterval, first_stable_interval, stable_interval
-from ..delay import delay_verdicts_from_gain
-from ..solve import newton_increasing
+from ..numerics.crossings import Crossing, StabilityInterval, first_stable_interval, stable_interval
+from ..numerics.delay import delay_verdicts_from_gain
+from ..numerics.solve import newton_increasing
 
 __all__ = ["kb_heading_crossings", "kb_heading_interval", "heading_level_offset"]
 

@@ -45,15 +45,9 @@ from functools import lru_cache
 import numpy as np
 
 from ..checks import check_number
-from ..crossings import (
-    Crossing,
-    affine_crossings,
-    stable_interval,
-    stable_set,
-    verdict_at,
-)
+from ..numerics.crossings import Crossing, affine_crossings, stable_interval, stable_set, verdict_at
 from ..parameters import RANGES, T_RESOLUTION, check_parameter
-from ..serialize import json_number
+from ..io.serialize import json_number
 from .base import Loop, LoopModel
 from .pade import MAX_PADE_ORDER, pade_coefficients
 
@@ -233,7 +227,7 @@ class HolonomicModel:
         the bracket's absolute floor, 10⁻⁹·10⁻¹² s, never decides first);
         models with an exact route override it.
         """
-        from ..solve import first_crossing
+        from ..numerics.solve import first_crossing
 
         if not self._stable(kappa, replace(loop, T=0.0)):
             return 0.0

@@ -4,7 +4,7 @@ Both models of s² + (c_h·s + κ)·e^(−sT) = 0 (`models.holonomic`) that keep
 the delay whole.
 
 **exact_delay** is the quasi-polynomial a(s) + (d(s) + K)e^(−sT) of module
-`pfm_stability.delay` with a(s) = s², d(s) = c_h·s and K = κ: verdicts by its
+`pfm_stability.numerics.delay` with a(s) = s², d(s) = c_h·s and K = κ: verdicts by its
 crossing count, T* by its delay margin, rightmost roots by its pseudospectral
 method. The crossing polynomial F(y) = y² − c_h²y − κ² (y = ω²) has one
 positive root, ω² = (c_h² + √(c_h⁴ + 4κ²))/2, where F′ > 0: every crossing
@@ -42,21 +42,12 @@ from dataclasses import replace
 import numpy as np
 
 from ..checks import check_choice, check_integer
-from ..crossings import Crossing, StabilityInterval, stable_interval, stable_set
-from ..delay import DelayLoop
+from ..numerics.crossings import Crossing, StabilityInterval, stable_interval, stable_set
+from ..numerics.delay import DelayLoop
 from ..parameters import MODEL_NAMES
-from ..routh import schur_cohn_stable
-from ..solve import bisect_root
-from .holonomic import (
-    HolonomicBoundary,
-    HolonomicContinuous,
-    HolonomicFirstOrder,
-    HolonomicLoop,
-    HolonomicModel,
-    HolonomicPade,
-    PolynomialHolonomicModel,
-    checked,
-)
+from ..numerics.routh import schur_cohn_stable
+from ..numerics.solve import bisect_root
+from .holonomic import HolonomicBoundary, HolonomicContinuous, HolonomicFirstOrder, HolonomicLoop, HolonomicModel, HolonomicPade, PolynomialHolonomicModel, checked
 from .sampled import bilinear_polynomial
 
 __all__ = ["BEST_CURVATURE_PRODUCT", "HolonomicExactDelay", "HolonomicSampled", "make_holonomic_model"]

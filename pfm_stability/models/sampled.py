@@ -42,7 +42,7 @@ whose coefficients stay O(1) as T → 0 and tend to the continuous loop's.
 The unit circle |z| = 1 is mapped to the imaginary axis by the bilinear
 substitution z = (1 + Tμ/2)/(1 − Tμ/2) (Tustin's w-plane), so
 Q(μ) = (1 − Tμ/2)^d·P(μ/(1 − Tμ/2)) is Hurwitz exactly when the sampled
-loop is stable, and the crossing gains are those of `pfm_stability.crossings`
+loop is stable, and the crossing gains are those of `pfm_stability.numerics.crossings`
 in the s domain, plus the gain at which the degree of Q drops (a pole
 passing through z = −1, where Ω → ∞). A crossing at Ω maps back to the
 frequency ω = 2·atan(ΩT/2)/T. Verdicts come from the eigenvalues λ of the
@@ -67,10 +67,10 @@ from functools import lru_cache
 import numpy as np
 
 from ..checks import check_choice, check_integer
-from ..crossings import Crossing, affine_crossings, stable_interval
-from ..matrix_exponential import zoh_blocks
+from ..numerics.crossings import Crossing, affine_crossings, stable_interval
+from ..numerics.matrix_exponential import zoh_blocks
 from ..parameters import HOLDS
-from ..routh import schur_cohn_stable
+from ..numerics.routh import schur_cohn_stable
 from .base import AffineGainModel, Boundary, Loop, _check_NV, checked
 from .continuous import Continuous
 

@@ -23,7 +23,7 @@ import math
 
 import numpy as np
 
-from ..comparison import GainCurve, KBErrorMap, critical_gain_vs_delay
+from ..analysis.comparison import GainCurve, KBErrorMap, critical_gain_vs_delay
 from .common import MODEL_ZORDER, figure_and_axes, model_label, model_style, outside_legend
 
 __all__ = [

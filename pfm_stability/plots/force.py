@@ -13,8 +13,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..effective_force import GridWallLaw, f_average, working_range
-from ..force_law import PowerLaw
+from ..laws.effective_force import GridWallLaw, f_average, working_range
+from ..laws.force_law import PowerLaw
 from .common import figure_and_axes
 
 __all__ = ["plot_force_laws", "plot_equivalent_f", "plot_force_summary"]

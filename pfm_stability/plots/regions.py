@@ -1,13 +1,13 @@
 """Stability-region plots: where the robot is safe near a wall and in a corridor.
 
 Each panel shades one model's verdicts on a dense grid (green stable, red
-unstable; `pfm_stability.regions`) and draws every model's boundary curve in
+unstable; `pfm_stability.analysis.regions`) and draws every model's boundary curve in
 its own style (`plots.common.MODEL_STYLE`), with the operating points of KB's
 CARMEL runs marked (Koren & Borenstein 1991 Figs 5 and 6). The shaded model
 is by default the one the stability report's verdict uses (``sampled`` with
 the controller's hold and compute delay, `regions.verdict_model`); the title
 and the legend name it. Legends sit outside the axes, so they hide no curve,
-operating point or label. Computation lives in `pfm_stability.regions`; these
+operating point or label. Computation lives in `pfm_stability.analysis.regions`; these
 functions only draw.
 
 * `plot_wall_f_region`: (V, f) plane at one α; stable above f*(V) (KB eq 24).
@@ -28,10 +28,10 @@ import weakref
 
 import numpy as np
 
-from ..force_law import ForceLaw, PowerLaw
+from ..laws.force_law import ForceLaw, PowerLaw
 from ..parameters import Controller, Robot
-from ..curves import corridor_L_curves, corridor_V_curves, default_models, wall_alpha_curves, wall_f_curves
-from ..regions import corridor_region, region_model, verdict_model, wall_alpha_region, wall_f_region
+from ..analysis.curves import corridor_L_curves, corridor_V_curves, default_models, wall_alpha_curves, wall_f_curves
+from ..analysis.regions import corridor_region, region_model, verdict_model, wall_alpha_region, wall_f_region
 from .common import MODEL_STYLE, MODEL_ZORDER, figure_and_axes, model_description, model_label, outside_legend
 
 __all__ = [

@@ -16,7 +16,7 @@ import math
 
 import numpy as np
 
-from ..comparison import GainCurve, RootLocus, critical_gain_vs_k, root_locus
+from ..analysis.comparison import GainCurve, RootLocus, critical_gain_vs_k, root_locus
 from ..models import Loop
 from .common import MODEL_STYLE, MODEL_ZORDER, figure_and_axes, model_label, model_style, outside_legend
 

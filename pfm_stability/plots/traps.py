@@ -1,4 +1,4 @@
-"""The total potential of a scene with its obstacles, goal and stationary points (`pfm_stability.traps`)."""
+"""The total potential of a scene with its obstacles, goal and stationary points (`pfm_stability.analysis.traps`)."""
 
 from __future__ import annotations
 
@@ -38,7 +38,7 @@ def plot_traps(analysis, ax=None, *, points: int = 301, title: str | None = None
 
     Parameters
     ----------
-    analysis : pfm_stability.traps.TrapAnalysis
+    analysis : pfm_stability.analysis.traps.TrapAnalysis
         What `find_stationary_points` returned.
     ax : matplotlib Axes, optional
         Draw here; default a new figure.
@@ -53,7 +53,7 @@ def plot_traps(analysis, ax=None, *, points: int = 301, title: str | None = None
     """
     from matplotlib.lines import Line2D
 
-    from ..scene import field
+    from ..laws.scene import field
 
     scene = analysis.scene
     (x0, y0), (x1, y1) = scene.region

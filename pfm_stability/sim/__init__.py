@@ -55,7 +55,7 @@ Predictions for a scenario (`predict`) and the simulated stability boundary
 
 Environments: ``env="grid"`` (cells of CV 15; the cell ratio ρ = F_cr/F_ct is
 calibrated so that the grid's f_av equals the controller's f unless given,
-`pfm_stability.effective_force`) or ``env="analytic"`` (continuous walls with
+`pfm_stability.laws.effective_force`) or ``env="analytic"`` (continuous walls with
 KB's lumped power law, or ``law="grid"`` for the grid's averaged law without
 quantization).
 
@@ -74,15 +74,7 @@ from .environment import AnalyticEnvironment, AnalyticWall
 from .events import Event
 from .grid import HistogramGrid
 from .metrics import OscillationMetrics, oscillation_metrics
-from .planar import (
-    DiffDrive,
-    PlanarRun,
-    PointMass,
-    Steering,
-    WallCycle,
-    simulate_planar,
-    wall_cycle,
-)
+from .planar import DiffDrive, PlanarRun, PointMass, Steering, WallCycle, simulate_planar, wall_cycle
 from .presets import SCENARIO_NAMES, barely_avoiding_ratio, make_scenario
 from .reference import simulate_reference
 from .results import BatchResult, RunResult, Trajectory

@@ -22,7 +22,7 @@ A period that neither test clears is divided into `SCAN` equal parts, the exact
 positions at their ends computed (`StepPath`), and each part tested in turn
 with its own chord, down to parts shorter than `CONTACT_RESOLUTION`
 (`first_contact`). The first end that overlaps an obstacle brackets the
-contact, which `pfm_stability.solve.refine_sign_change` narrows to `TIME_RTOL`
+contact, which `pfm_stability.numerics.solve.refine_sign_change` narrows to `TIME_RTOL`
 of the period. A part shorter than `CONTACT_RESOLUTION` whose chord touches
 while its ends are clear is a graze (depth at most its B, well under
 a micrometre): its contact is put at its end nearer the obstacle.
@@ -35,7 +35,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..solve import refine_sign_change
+from ..numerics.solve import refine_sign_change
 from .robot import constant_input, constant_input_modes, graded_rule, propagate, servo, servo_modes, slow_rate, advance_position
 
 __all__ = [

@@ -21,14 +21,7 @@ import numpy as np
 from ..checks import check_number, check_type
 from .metrics import OscillationMetrics, oscillation_metrics
 from .movers import vector
-from .planar import (
-    REST_TOLERANCE,
-    PlanarRun,
-    Steering,
-    WallCycle,
-    measure_wall_cycle,
-    wall_cycle,
-)
+from .planar import REST_TOLERANCE, PlanarRun, Steering, WallCycle, measure_wall_cycle, wall_cycle
 
 __all__ = ["REST_TOLERANCE", "WallCycle", "lateral_metrics", "loop_order", "measure_wall_cycle", "wall_cycle"]
 

@@ -46,16 +46,14 @@ import time
 
 import numpy as np
 
-from ..force_law import PowerLaw
+from ..laws.force_law import PowerLaw
 from ..parameters import TAU_RESOLUTION
 from .contact import StepPath, chord_cell_gap, chord_wall_gap, first_contact, path_slack, point_cell_gap, point_wall_gap
 from .environment import segment_clearance, wall_coordinates
 from .events import Event
 from .metrics import oscillation_metrics
 from .results import BatchResult, RunResult, Trajectory
-from .robot import (
-    advance_position, constant_input, constant_input_modes, graded_rule, propagate, servo, servo_modes, slow_rate,
-)
+from .robot import advance_position, constant_input, constant_input_modes, graded_rule, propagate, servo, servo_modes, slow_rate
 from .vff import cell_repulsion, direction_of, steering_command, vff_speed, wrap_angle
 from .window import compile_window_table, stack_tables
 

@@ -6,7 +6,7 @@ the same in the simulator, so the analysis can be validated without
 quantization: each wall is a segment p0 → p1 with a free side; while the
 robot's foot point lies on the segment, the wall pushes it along the
 free-side normal with F_r(d)/F_ct = law(d), d the distance robot centre →
-wall line. The law is any `pfm_stability.force_law.ForceLaw` (KB's lumped
+wall line. The law is any `pfm_stability.laws.force_law.ForceLaw` (KB's lumped
 power law f(W/d)^n by default, or the grid's `GridWallLaw` for the grid
 without its quantization). A corridor is two walls:
 F_x = F_r(L + x) − F_r(L − x).

@@ -25,7 +25,7 @@ import math
 import numpy as np
 
 from ..checks import check_integer, check_number
-from ..effective_force import DEFAULT_CV
+from ..laws.effective_force import DEFAULT_CV
 
 __all__ = ["HistogramGrid"]
 

@@ -29,7 +29,7 @@ and applied at once (``compute_delay=0``) or one period later (1), held (ZOH).
 
 Usage
 -----
->>> from pfm_stability.velocity_laws import VelocityAttraction
+>>> from pfm_stability.laws.velocity_laws import VelocityAttraction
 >>> from pfm_stability.sim.planar import PointMass, Field, World, Start, simulate_planar
 >>> from pfm_stability.sim.movers import Target, Ball
 >>> run = simulate_planar(PointMass(mass=1.0), Field(VelocityAttraction(0.005, 0.1)),
@@ -54,8 +54,8 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from ..checks import check_choice, check_integer, check_number, check_type
-from ..force_law import ForceLaw
-from ..velocity_laws import VelocityAttraction, VelocityGatedRepulsion
+from ..laws.force_law import ForceLaw
+from ..laws.velocity_laws import VelocityAttraction, VelocityGatedRepulsion
 from .metrics import HYSTERESIS, turning_points
 from .movers import Obstacle, Pull, Target, Wall, vector
 from .planar_robots import _DYNAMICS, ROBOTS, DiffDrive, PointMass, Steering, positive

@@ -15,16 +15,7 @@ import numpy as np
 
 from ..checks import check_choice, check_number
 from ..parameters import HOLDS, TAU_RESOLUTION
-from .robot import (
-    advance_position,
-    constant_input,
-    constant_input_modes,
-    graded_rule,
-    propagate,
-    servo,
-    servo_modes,
-    slow_rate,
-)
+from .robot import advance_position, constant_input, constant_input_modes, graded_rule, propagate, servo, servo_modes, slow_rate
 
 __all__ = ["ROBOTS", "DiffDrive", "PointMass", "Steering", "positive"]
 

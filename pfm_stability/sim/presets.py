@@ -71,10 +71,10 @@ import math
 from functools import lru_cache
 
 from ..checks import check_choice, check_number, describe_range
-from ..effective_force import GridWallLaw, f_average
-from ..force_law import ForceLaw, wall_equilibrium
+from ..laws.effective_force import GridWallLaw, f_average
+from ..laws.force_law import ForceLaw, wall_equilibrium
 from ..parameters import CARMEL, RANGES, Controller, Robot, Wall
-from ..solve import bisect_batched
+from ..numerics.solve import bisect_batched
 from .environment import AnalyticEnvironment, AnalyticWall
 from .grid import HistogramGrid
 from .scenario import LAW_NAMES, MeasureAxis, Pose, Scenario, Target, scenario_law
@@ -494,7 +494,7 @@ def barely_avoiding_ratio(
 ) -> float:
     """KB's own calibration (their Fig 3): the smallest cell ratio with which the head-on run avoids the obstacle.
 
-    `pfm_stability.solve.bisect_batched` on ρ = F_cr/F_ct in [1e-4, 0.1]
+    `pfm_stability.numerics.solve.bisect_batched` on ρ = F_cr/F_ct in [1e-4, 0.1]
     (geometric), `rounds` rounds: the first simulates `members` ratios across
     the bracket (its ends included) in one batch, each later one the
     `members` − 2 inside the current bracket; each keeps the interval between

@@ -27,9 +27,9 @@ import math
 
 import numpy as np
 
-from ..force_law import PowerLaw
+from ..laws.force_law import PowerLaw
 from ..parameters import TAU_RESOLUTION
-from ..solve import bisect_root
+from ..numerics.solve import bisect_root
 from .engine import SUBSTEPS
 from .events import Event
 from .grid import HistogramGrid

@@ -3,7 +3,7 @@
 JSON form (`to_dict`): ``events`` (list of {type, t, x, y}), ``metrics``
 (`OscillationMetrics.to_dict`: growth_rate σ in 1/s, angular_frequency ω in
 rad/s, oscillating, stable, …) and ``inputs`` (everything that defined the
-run). Numbers are written by `pfm_stability.serialize.json_number`: infinite
+run). Numbers are written by `pfm_stability.io.serialize.json_number`: infinite
 ones as ``"inf"``/``"-inf"``, undefined ones as ``None`` (with a reason in
 the metrics), never NaN. Wall-clock times are under ``timing`` only.
 """
@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..serialize import json_array, json_number, json_ready
+from ..io.serialize import json_array, json_number, json_ready
 from .events import Event
 from .metrics import OscillationMetrics
 from .scenario import Scenario

@@ -82,7 +82,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..solve import gauss_legendre as legendre_nodes
+from ..numerics.solve import gauss_legendre as legendre_nodes
 
 __all__ = [
     "NODES", "RESOLUTION", "MAX_PANELS", "gauss_legendre", "slow_rate", "constant_input_modes", "servo_modes",

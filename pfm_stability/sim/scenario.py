@@ -25,8 +25,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..checks import check_choice, check_number
-from ..effective_force import DEFAULT_CV, GridWallLaw, calibrate_cell_ratio, check_window_cells, working_range
-from ..force_law import ForceLaw, law_in_force
+from ..laws.effective_force import DEFAULT_CV, GridWallLaw, calibrate_cell_ratio, check_window_cells, working_range
+from ..laws.force_law import ForceLaw, law_in_force
 from ..parameters import Controller, Robot, check_parameter
 from .environment import AnalyticEnvironment
 from .grid import HistogramGrid

@@ -17,7 +17,7 @@ resultant R (eq 4). The steering-rate command is u = k·wrap(δ − θ) (eq 5),
 wrap giving the shortest rotational difference in [−π, π).
 
 `measured_wall_force` sums this window over a wall drawn into a grid: the
-check of the closed-form grid law `pfm_stability.effective_force.GridWallLaw`
+check of the closed-form grid law `pfm_stability.laws.effective_force.GridWallLaw`
 (docs/simulator.md, grid quantization), and the force of walls that are not
 along a grid axis (a staircase of cells), whose equilibrium distance
 `measured_equilibrium` finds.
@@ -30,7 +30,7 @@ from functools import lru_cache
 
 import numpy as np
 
-from ..solve import gauss_legendre
+from ..numerics.solve import gauss_legendre
 from .grid import HistogramGrid
 
 __all__ = [

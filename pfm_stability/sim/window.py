@@ -33,7 +33,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..effective_force import check_window_cells
+from ..laws.effective_force import check_window_cells
 from .grid import HistogramGrid
 
 __all__ = ["WindowTable", "compile_window_table", "stack_tables", "SENTINEL_DISTANCE"]

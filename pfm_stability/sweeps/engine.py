@@ -47,20 +47,12 @@ from dataclasses import dataclass, field
 from functools import partial
 
 from ..checks import check_integer, check_output_path
-from ..files import OutputError, write_text
+from ..io.files import OutputError, write_text
 from ..version import __version__
 from .evaluate import evaluate_chunk
 from .points import all_points, check_points, chunk_points, sobol_note
 from .spec import SweepSpec
-from .table import (
-    SweepStatistics,
-    concatenate_parts,
-    metadata,
-    read_columns,
-    statistics,
-    to_arrow,
-    write_part,
-)
+from .table import SweepStatistics, concatenate_parts, metadata, read_columns, statistics, to_arrow, write_part
 
 __all__ = [
     "CONNECT_TIMEOUT",
@@ -152,7 +144,7 @@ class SweepSummary:
 
     def to_dict(self) -> dict:
         """Plain JSON form (`serialize.json_ready` numbers); wall-clock values under ``timing``."""
-        from ..serialize import json_ready
+        from ..io.serialize import json_ready
 
         s = self.statistics
         return json_ready({
@@ -333,7 +325,7 @@ def _run_local(todo, spec, sample, paths, parts, fail_once, workers, report):
         else:
             from dask.threaded import get
 
-            from ..vectorized import loop_verdicts  # noqa: F401 - imported here once: threads importing it together race
+            from ..vectorized import loop_verdicts
 
             results = get(graph, list(graph), num_workers=workers)
     errors = [e for e in results if e is not None]

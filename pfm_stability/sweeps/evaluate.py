@@ -39,14 +39,7 @@ from functools import lru_cache
 
 import numpy as np
 
-from ..force_law import (
-    Equilibrium,
-    corridor_gain,
-    power_law_corridor_gain,
-    power_law_wall_gain,
-    wall_equilibria,
-    wall_gain,
-)
+from ..laws.force_law import Equilibrium, corridor_gain, power_law_corridor_gain, power_law_wall_gain, wall_equilibria, wall_gain
 from ..models.base import DIVERGENT_REASON, NEUTRAL_REASON, NV_MAX
 from ..parameters import RADIANS_PER_DEGREE, Controller, Robot
 from .points import chunk_points
@@ -100,7 +93,7 @@ def _inputs(spec: SweepSpec, values: dict, size: int) -> dict:
 @lru_cache(maxsize=4096)
 def _law_gain(law: str, parameters: tuple, geometry: str, value: float, f: float, n: float, W: float) -> tuple:
     """(N in 1/m, reason) of a law at one geometry, by the report's scalar route; reason for no answer."""
-    from ..fields import make_law
+    from ..laws.fields import make_law
 
     robot = Robot(V=1.0, tau=0.0, k=1.0, W=W)
     controller = Controller(f=f, n=n, T=0.0)
@@ -251,7 +244,7 @@ def _verdict_columns(spec: SweepSpec, inputs: dict, NV: np.ndarray, reasons: np.
 
 def _simulation_columns(spec: SweepSpec, inputs: dict, N_reasons: np.ndarray) -> list:
     """The simulator's σ and verdict for every point (`validation.sweep.simulate_members`)."""
-    from ..fields import make_law
+    from ..laws.fields import make_law
     from ..models import Loop
     from ..validation.sweep import simulate_members, simulation_duration
 

@@ -21,7 +21,7 @@ import math
 
 import numpy as np
 
-from ..sampling import latin_hypercube, sobol
+from ..numerics.sampling import latin_hypercube, sobol
 from .spec import Axis, SweepSpec
 
 __all__ = ["all_points", "axis_values", "check_points", "chunk_points", "grid_points", "sample_points", "sobol_note"]

@@ -30,16 +30,7 @@ import os
 from dataclasses import dataclass, field
 
 from ..checks import check_choice, check_integer
-from ..parameters import (
-    HOLDS,
-    LAW_PARAMETERS,
-    MODEL_NAMES,
-    RANGES,
-    Controller,
-    Robot,
-    check_parameter,
-    get_preset,
-)
+from ..parameters import HOLDS, LAW_PARAMETERS, MODEL_NAMES, RANGES, Controller, Robot, check_parameter, get_preset
 from ..version import __version__
 
 __all__ = [
@@ -353,7 +344,7 @@ def _base(where: _Where, data: dict, base_dir):
     if "preset" in data and "config" in data:
         where.fail("give preset or config, not both")
     if "config" in data:
-        from ..config import config_from_mapping, load_config
+        from ..io.config import config_from_mapping, load_config
 
         given = data["config"]
         if isinstance(given, dict):
@@ -472,7 +463,7 @@ def _sample(where: _Where, sample) -> Sample:
 
 def _law(where: _Where, law, varying) -> tuple[str, dict]:
     """Law name and its fixed parameters; a varying law parameter must be one the law takes."""
-    from ..fields import check_law_parameters
+    from ..laws.fields import check_law_parameters
 
     if law is None:
         law = {"name": "power"}

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..files import atomic_file
+from ..io.files import atomic_file
 from ..version import __version__
 from .evaluate import ChunkColumns
 

@@ -1,6 +1,6 @@
 """The simulated stability boundary in one parameter, by the package's batched bisection.
 
-Both searches here are `pfm_stability.solve.bisect_batched` (docs/validation.md,
+Both searches here are `pfm_stability.numerics.solve.bisect_batched` (docs/validation.md,
 how a boundary is bisected): each round simulates `members` values of one
 parameter spread over the current bracket in one batch (`simulate_batch`) and
 keeps the cell where the verdict changes, so a round divides the bracket by
@@ -25,11 +25,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..checks import check_integer, check_number
-from ..serialize import json_ready
+from ..io.serialize import json_ready
 from ..sim.api import simulate_batch
 from ..sim.verdict import linearly_stable, simulated_verdict
-from ..solve import spread_values
-from ..solve import bisect_batched
+from ..numerics.solve import spread_values
+from ..numerics.solve import bisect_batched
 
 __all__ = [
     "BoundaryEstimate",

@@ -10,7 +10,7 @@ docs/simulator.md). In the grid, the predictions of KB's lumped law with the
 grid's f_av are reported beside them, as KB compared (§4).
 
 Bisection (`bisection.bisect_boundary`, the package's one batched bisection
-`pfm_stability.solve.bisect_batched`): each round simulates `members` values
+`pfm_stability.numerics.solve.bisect_batched`): each round simulates `members` values
 spread over the bracket in one batch (`simulate_batch`), keeps the two
 neighbours where the verdict changes, and stops when the bracket is narrower
 than `rtol` relative. The verdict is the sign of the measured growth rate σ
@@ -37,23 +37,12 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..checks import check_choice, check_integer, check_number
-from ..criteria import loop_of
-from ..effective_force import GridWallLaw
+from ..analysis.criteria import loop_of
+from ..laws.effective_force import GridWallLaw
 from ..parameters import CARMEL, Controller, Robot
-from ..serialize import json_number, json_ready
+from ..io.serialize import json_number, json_ready
 from .bisection import ParameterRuns, SimulatedPoint, bisect_boundary, crossing, run_value
-from .common import (
-    SCENARIOS,
-    default_parameter,
-    f_av_of,
-    lumped_law,
-    parameter_domain,
-    parameter_spec,
-    predicted_boundaries,
-    relative_errors,
-    scenario_law,
-    validation_models,
-)
+from .common import SCENARIOS, default_parameter, f_av_of, lumped_law, parameter_domain, parameter_spec, predicted_boundaries, relative_errors, scenario_law, validation_models
 from .predict import model_answer, predict
 from .region import StabilityMap, stability_map as simulate_stability_map
 

@@ -20,9 +20,9 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from ..criteria import loop_of
-from ..effective_force import GridWallLaw
-from ..force_law import ForceLaw
+from ..analysis.criteria import loop_of
+from ..laws.effective_force import GridWallLaw
+from ..laws.force_law import ForceLaw
 from ..models import MODEL_NAMES, make_model
 from ..parameters import CARMEL, Controller, Robot
 from ..sim.scenario import scenario_law
@@ -122,7 +122,7 @@ def predicted_boundaries(
     """Each model's critical value of `parameter` (reported units), all else fixed.
 
     Each model's NV* (`predict.model_answer`) through `predict.critical_value`
-    (the general-law conditions of `pfm_stability.criteria`, KB eq 20 with
+    (the general-law conditions of `pfm_stability.analysis.criteria`, KB eq 20 with
     1/NV* in place of τ + T): L* (eq 25), α* (eq 24), V* = NV*/N, f*.
 
     Parameters

@@ -20,7 +20,7 @@ import numbers
 
 import numpy as np
 
-from ..criteria import loop_of
+from ..analysis.criteria import loop_of
 from ..models import Loop, Sampled
 from ..parameters import Controller, Robot
 

@@ -46,10 +46,10 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from ..checks import check_integer, check_number, check_type
-from ..effective_force import check_window_cells
+from ..laws.effective_force import check_window_cells
 from ..models import Sampled
 from ..parameters import TAU_RESOLUTION, Controller, Robot
-from ..serialize import json_number, json_ready
+from ..io.serialize import json_number, json_ready
 from ..sim.engine import run_batch
 from ..sim.grid import HistogramGrid
 from ..sim.metrics import linear_prediction, oscillation_metrics

@@ -10,7 +10,7 @@ through them:
   docs/models.md, verdicts and margins), and on request its dominant root;
 * `critical_value(parameter, …)` — a model's NV* turned into the critical
   L, α, V or f of a corridor or wall, all else fixed (KB eq 20 with 1/NV*
-  in place of τ + T, through `pfm_stability.criteria`'s general-law
+  in place of τ + T, through `pfm_stability.analysis.criteria`'s general-law
   conditions: eq 24, 25; docs/models.md, critical values).
 
 Their users: `predict` (one `Scenario` whose measurement window is a
@@ -34,11 +34,11 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from ..criteria import critical_alpha, critical_f_corridor, critical_f_wall, critical_L, loop_of
-from ..effective_force import GridWallLaw
-from ..force_law import ForceLaw, PowerLaw, corridor_gain, wall_gain
+from ..analysis.criteria import critical_alpha, critical_f_corridor, critical_f_wall, critical_L, loop_of
+from ..laws.effective_force import GridWallLaw
+from ..laws.force_law import ForceLaw, PowerLaw, corridor_gain, wall_gain
 from ..models import KBFirstOrder, Loop, LoopModel, Sampled, verdict_label
-from ..serialize import json_number
+from ..io.serialize import json_number
 from ..sim.scenario import Scenario
 
 __all__ = [
@@ -85,7 +85,7 @@ def model_answer(model: LoopModel, loop: Loop, NV: float | None = None, *, root:
 
     The verdict is `models.verdict_label` (within `UNDECIDED_RTOL` of an edge
     of the stable set: "undecided"); at NV = 0 the model judges its heading
-    loop, as in `pfm_stability.criteria` (docs/models.md, "N = 0").
+    loop, as in `pfm_stability.analysis.criteria` (docs/models.md, "N = 0").
     """
     boundary = model.boundary(loop)
     if NV is None:

@@ -13,7 +13,7 @@ Two questions, two results, one set of model curves:
   set beside the predicted curves (`plots.validation.plot_simulated_boundary`).
 
 Both carry every model's boundary curve over their horizontal axis,
-computed by `model_curves` from `pfm_stability.curves` (KB eq 20, 24, 25
+computed by `model_curves` from `pfm_stability.analysis.curves` (KB eq 20, 24, 25
 with each model's NV* in place of 1/(τ + T); docs/models.md, critical
 values) with the lateral law the simulation really has (and, in the grid,
 KB's lumped law at the grid's f_av), so that a plot only draws.
@@ -26,11 +26,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..effective_force import GridWallLaw
-from ..curves import corridor_L_curves, corridor_V_curves, wall_alpha_curves, wall_f_curves, wall_V_curves
-from ..serialize import json_array, json_number, json_ready
+from ..laws.effective_force import GridWallLaw
+from ..analysis.curves import corridor_L_curves, corridor_V_curves, wall_alpha_curves, wall_f_curves, wall_V_curves
+from ..io.serialize import json_array, json_number, json_ready
 from ..sim.api import batch_scenarios
-from ..solve import spread_values
+from ..numerics.solve import spread_values
 from .bisection import boundary_by_bisection, simulated_point
 from .common import lumped_law, parameter_domain, validation_models
 
@@ -45,7 +45,7 @@ _UNITS = {"V": "m/s", "L": "m", "alpha": "deg", "f": ""}
 def model_curves(scenario: str, y_name: str, x_name: str, x, robot, controller, law, geometry: float, models) -> dict:
     """Each model's critical `y_name` at each x, all else fixed (SI units: α in rad).
 
-    From `pfm_stability.curves`: L*(V) `corridor_L_curves`, α*(V)
+    From `pfm_stability.analysis.curves`: L*(V) `corridor_L_curves`, α*(V)
     `wall_alpha_curves`, f*(V) along a wall `wall_f_curves` (a law's critical
     scale, converted to KB's f with f/scale), V*(L) `corridor_V_curves`, and
     f*(V) in a corridor from V*(L) (N ∝ f, so f* = f·V*(L)/V), V*(α) along a

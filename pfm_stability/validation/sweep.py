@@ -35,8 +35,8 @@ import numpy as np
 from ..checks import check_choice, check_integer, check_number
 from ..models import MODEL_NAMES, Loop, make_model
 from ..parameters import CARMEL, Controller, Robot
-from ..sampling import latin_hypercube
-from ..serialize import json_number, json_ready
+from ..numerics.sampling import latin_hypercube
+from ..io.serialize import json_number, json_ready
 from ..sim.api import batch_scenarios
 from ..sim.engine import run_batch
 from ..sim.verdict import simulated_verdict

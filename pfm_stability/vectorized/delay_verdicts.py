@@ -29,7 +29,7 @@ import math
 
 import numpy as np
 
-from ..delay import _newton_cubic_roots
+from ..numerics.delay import _newton_cubic_roots
 
 __all__ = ["single_crossing_verdicts"]
 

@@ -1,7 +1,7 @@
 """Vectorized `exact_delay` verdicts: millions of parameter points per second.
 
 For KB eq (18), a(s) + K e^(−sT) with a(s) = τs³ + s² + ks and K = kNV, the
-crossing count of `pfm_stability.delay` (Cooke & van den Driessche 1986) needs
+crossing count of `pfm_stability.numerics.delay` (Cooke & van den Driessche 1986) needs
 no search over T:
 
 1. crossing frequencies: the positive roots y = ω² of
@@ -35,8 +35,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..delay import delay_verdicts_from_gain
-from ..force_law import power_law_corridor_gain, power_law_wall_gain
+from ..numerics.delay import delay_verdicts_from_gain
+from ..laws.force_law import power_law_corridor_gain, power_law_wall_gain
 from ..models.base import HEADING_GAIN_RANGE, check_heading_gain
 from ..parameters import RANGES, T_RESOLUTION, TAU_RESOLUTION, check_parameter
 

@@ -11,7 +11,7 @@ but in arrays (docs/models.md, "Verdicts and margins"):
 
 * ``continuous``, ``kb_first_order``: Routh's closed forms;
 * ``exact_delay``: the crossing count and KB's three-level K* of
-  `pfm_stability.delay` (c = 0); with a heading gain the stable set in K may
+  `pfm_stability.numerics.delay` (c = 0); with a heading gain the stable set in K may
   be several intervals, and NV* comes from the scalar model, once per
   distinct loop;
 * ``pade``, ``sampled``: the characteristic polynomial D + K·E (K = kNV) in

@@ -23,7 +23,7 @@ import math
 
 import numpy as np
 
-from ..routh import routh_array
+from ..numerics.routh import routh_array
 
 __all__ = ["hurwitz_stable", "hurwitz_columns", "affine_stable_sets", "GainSets", "real_roots", "leading_zeros"]
 

@@ -19,7 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..delay import _RESONANCE, _kb_level_frequency, delay_verdicts_from_gain, kb_critical_gain
+from ..numerics.delay import _RESONANCE, _kb_level_frequency, delay_verdicts_from_gain, kb_critical_gain
 from ..models.pade import _pade_term
 from .delay_verdicts import single_crossing_verdicts
 from .hurwitz_gain import hurwitz_gain_sets

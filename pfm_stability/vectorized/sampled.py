@@ -24,7 +24,7 @@ import math
 
 import numpy as np
 
-from ..matrix_exponential import zoh_blocks
+from ..numerics.matrix_exponential import zoh_blocks
 from .zoh import delta_entries
 
 __all__ = ["continuous_plants", "delta_plants", "delta_columns", "bilinear_columns", "bilinear_polynomials"]

@@ -17,7 +17,7 @@ the goal), in m, as numbers or numpy arrays (broadcast), and returns values of
 the same shape; potentials are in units of ξ·m^m (or η·m^(n−2)), forces their
 derivatives per m. The second derivatives (`attraction_derivatives`,
 `repulsion_derivatives`) give a scene's exact gradient and Hessian by the
-chain rule (`pfm_stability.traps`).
+chain rule (`pfm_stability.analysis.traps`).
 
 The bounds (GC2000 Sec IV): on the ray from the goal directly away from an
 obstacle at distance r < ρ0 (robot, goal and nearest obstacle point collinear,
@@ -36,8 +36,8 @@ import math
 
 import numpy as np
 
-from .checks import check_number
-from .solve import bisect_root
+from ..checks import check_number
+from ..numerics.solve import bisect_root
 
 __all__ = [
     "attraction_potential",

@@ -29,11 +29,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .checks import check_choice, check_number, check_type
+from ..checks import check_choice, check_number, check_type
 from .force_law import Equilibrium
 from .fuzzy import DfapfControllers, load_dfapf
-from .parameters import check_parameter
-from .solve import bisect_root
+from ..parameters import check_parameter
+from ..numerics.solve import bisect_root
 
 __all__ = ["FuzzyScheduledLaw", "RobustBracket", "ScheduledEquilibrium"]
 

@@ -20,7 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .parameters import check_parameter
+from ..parameters import check_parameter
 
 __all__ = ["CRITICAL_RTOL", "REGIMES", "TrackingDynamics", "tracking_dynamics"]
 

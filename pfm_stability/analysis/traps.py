@@ -1,7 +1,7 @@
 """Traps: every stationary point of a 2-D potential field, and Ge & Cui's bounds for it.
 
 Koren & Borenstein's problem 1 (traps due to local minima) and the GNRON problem
-of Ge & Cui, IEEE T-RA 16(5), 2000 (docs/traps.md), for a `pfm_stability.scene.Scene`.
+of Ge & Cui, IEEE T-RA 16(5), 2000 (docs/traps.md), for a `pfm_stability.laws.scene.Scene`.
 `find_stationary_points`: damped Newton on ∇U = 0 (`scene.field`, exact) from
 every grid node and every cell where both components of ∇U change sign,
 polished, de-duplicated, classified by the Hessian's eigenvalues; grid minima
@@ -17,11 +17,11 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from .checks import check_integer, check_type
-from .parameters import RANGES, TRAPS_RESOLUTION
-from .potentials import k_conservative, k_exact, repulsion_derivatives
-from .scene import Scene, field
-from .serialize import SCHEMA_VERSION, json_number, json_ready
+from ..checks import check_integer, check_type
+from ..parameters import RANGES, TRAPS_RESOLUTION
+from ..laws.potentials import k_conservative, k_exact, repulsion_derivatives
+from ..laws.scene import Scene, field
+from ..io.serialize import SCHEMA_VERSION, json_number, json_ready
 
 __all__ = ["KINDS", "RESOLUTION_RANGE", "DEFAULT_RESOLUTION", "StationaryPoint", "GnronBound", "TrapAnalysis", "find_stationary_points", "gnron_bounds"]
 

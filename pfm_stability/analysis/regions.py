@@ -10,7 +10,7 @@ The default model is the one the stability report's verdict uses
 (`verdict_model`: ``sampled`` with the controller's hold and compute delay).
 Asked for ``exact_delay``, the maps keep the vectorized crossing count of
 `pfm_stability.vectorized` (one count per point, independent of the boundary
-curves of `pfm_stability.curves`; the tests check that the two agree to the
+curves of `pfm_stability.analysis.curves`; the tests check that the two agree to the
 grid resolution).
 
 Any `ForceLaw` may be shaded (docs/fields.md). For a law that is not
@@ -26,13 +26,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .checks import check_positive_axis
+from ..checks import check_positive_axis
 from .criteria import loop_of
-from .force_law import ForceLaw, PowerLaw, corridor_gain, wall_gain_arrays
-from .models import ExactDelay, LoopModel, models_for
-from .parameters import Controller, Robot, check_parameter
-from .serialize import json_array, json_number
-from .vectorized import delay_verdicts_from_gain, exact_delay_verdicts, loop_gain_arrays
+from ..laws.force_law import ForceLaw, PowerLaw, corridor_gain, wall_gain_arrays
+from ..models import ExactDelay, LoopModel, models_for
+from ..parameters import Controller, Robot, check_parameter
+from ..io.serialize import json_array, json_number
+from ..vectorized import delay_verdicts_from_gain, exact_delay_verdicts, loop_gain_arrays
 
 __all__ = [
     "RegionGrid",

@@ -1,6 +1,6 @@
 """The stability report: every model's verdict for a wall and/or a corridor.
 
-`build_report` runs the criteria of `pfm_stability.criteria` for the chosen
+`build_report` runs the criteria of `pfm_stability.analysis.criteria` for the chosen
 models and adds what a user acts on: the margin, the critical value of every
 parameter, the change that would make the loop stable, and how far KB's
 criterion (Koren & Borenstein 1991 eq 20) is from the sampled loop
@@ -19,13 +19,13 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
-from .checks import check_type
-from .comparison import relative_error
-from .criteria import CorridorAnalysis, WallAnalysis, analyze_corridor, analyze_wall, loop_of
-from .force_law import ForceLaw, law_in_force
-from .models import HEADING_GAIN_RANGE, KBFirstOrder, Loop, Sampled, models_for
-from .parameters import LAW_PARAMETERS, MODEL_NAMES, RANGES, Controller, Corridor, Robot, Wall, check_parameter
-from .serialize import SCHEMA_VERSION, json_number, json_ready
+from ..checks import check_type
+from ..analysis.comparison import relative_error
+from ..analysis.criteria import CorridorAnalysis, WallAnalysis, analyze_corridor, analyze_wall, loop_of
+from ..laws.force_law import ForceLaw, law_in_force
+from ..models import HEADING_GAIN_RANGE, KBFirstOrder, Loop, Sampled, models_for
+from ..parameters import LAW_PARAMETERS, MODEL_NAMES, RANGES, Controller, Corridor, Robot, Wall, check_parameter
+from ..io.serialize import SCHEMA_VERSION, json_number, json_ready
 
 __all__ = ["StabilityReport", "KBError", "build_report", "remedies", "remedies_by_key", "kb_error", "kb_errors"]
 
@@ -433,7 +433,7 @@ def build_report(
     described = {"name": law.key, "description": law.name, "parameters": json_ready(law.parameters())}
     passage = None
     if door is not None:
-        from .door import door_passage
+        from ..analysis.door import door_passage
 
         passage = door_passage(law, check_parameter("door", door), obstacle=door_obstacle, post_radius=check_parameter("post_radius", post_radius),
                                robot_width=robot.W, find_smallest=True, name="door")

@@ -5,7 +5,7 @@ A `Scene` holds a goal, obstacles (`Circle`, `Segment`, closed `Polygon`), a
 with the attraction ½ξρ_gᵐ) and a search region, read from YAML
 (`Scene.load`; docs/traps.md, "Scene files") with every field checked.
 `field` gives U = ½ξρ_gᵐ + Σ_i U_rep(ρ_i, ρ_g), ρ_i the minimal distance to
-obstacle i (`pfm_stability.potentials`), with the exact gradient and Hessian
+obstacle i (`pfm_stability.laws.potentials`), with the exact gradient and Hessian
 (∇ρ the unit vector from the nearest point, ∇²ρ = κ(I − ∇ρ∇ρᵀ), κ =
 1/distance to a nearest vertex or circle centre, 0 on an edge).
 """
@@ -17,7 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .checks import check_choice, check_number
+from ..checks import check_choice, check_number
 from .potentials import attraction_derivatives, repulsion_derivatives
 
 __all__ = ["LAW_NAMES", "FieldLaw", "Circle", "Segment", "Polygon", "Scene", "field"]

@@ -2,10 +2,10 @@
 
 ``output.schema.json`` (JSON Schema draft 2020-12) describes what
 ``pfm-stability report|simulate|validate --format json`` print: every
-output carries ``schema_version`` (`pfm_stability.serialize.SCHEMA_VERSION`)
+output carries ``schema_version`` (`pfm_stability.io.serialize.SCHEMA_VERSION`)
 and ``command``; a number that may be infinite is written as the string
 ``"inf"`` or ``"-inf"`` and an undefined one as ``null``
-(`pfm_stability.serialize.json_number`); wall-clock times live under
+(`pfm_stability.io.serialize.json_number`); wall-clock times live under
 ``timing`` only, so the rest of an output is the same from run to run.
 """
 

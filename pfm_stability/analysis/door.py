@@ -47,10 +47,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .checks import check_choice, check_number, check_type
-from .force_law import ForceLaw
-from .serialize import json_number, json_ready, parse_json_number
-from .solve import bisect_root, expand_bracket
+from ..checks import check_choice, check_number, check_type
+from ..laws.force_law import ForceLaw
+from ..io.serialize import json_number, json_ready, parse_json_number
+from ..numerics.solve import bisect_root, expand_bracket
 
 __all__ = [
     "OBSTACLES",

@@ -21,7 +21,7 @@ deg/s, as on the command line. Every value is checked against
 `parameters.RANGES` with the command line's message, prefixed by the file and
 the key: ``config robot.yaml: robot.V must be a finite number in (0, 100] m/s;
 got -1``. A Nav2 parameters file (top-level node names with ``ros__parameters``)
-is recognized and read by `pfm_stability.nav2`.
+is recognized and read by `pfm_stability.io.nav2`.
 
 The shipped presets (``data/presets/*.yaml``, `parameters.PRESETS`) are files of
 this format. This module imports no numpy.
@@ -36,10 +36,9 @@ import re
 from dataclasses import dataclass, field, fields
 from pathlib import Path
 
-from .checks import check_choice, check_integer, check_number
+from ..checks import check_choice, check_integer, check_number
 from .nav2 import is_nav2, read_nav2
-from .parameters import (FAMILY_LAW_CHOICES, FAMILY_LAW_PARAMETERS, FAMILY_LAWS, FORCE_LAWS, HOLDS, HOLONOMIC_LAWS, LAW_PARAMETERS, RANGES, ROBOT_FAMILIES,
-                         Controller, Preset, Robot, get_preset)
+from ..parameters import FAMILY_LAW_CHOICES, FAMILY_LAW_PARAMETERS, FAMILY_LAWS, FORCE_LAWS, HOLDS, HOLONOMIC_LAWS, LAW_PARAMETERS, RANGES, ROBOT_FAMILIES, Controller, Preset, Robot, get_preset
 
 __all__ = [
     "Config",

@@ -43,7 +43,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .checks import check_number
+from ..checks import check_number
 from .crossings import Crossing, StabilityInterval
 from .routh import real_coefficients, routh_array, strip_leading_zeros
 from .solve import bisect_root, newton_increasing

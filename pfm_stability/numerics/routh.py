@@ -33,7 +33,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .checks import check_number
+from ..checks import check_number
 
 __all__ = ["RouthResult", "real_coefficients", "routh_array", "routh_count", "routh_stable", "schur_cohn_stable", "strip_leading_zeros"]
 

@@ -11,7 +11,7 @@ in a frozen direction give, in units of the attraction A = (m/2) ξ ρ_g^(m−1)
   Q(d) = F_rep2/A = (n/2) η (1/d − 1/ρ0)² ρ_g^(n−1) / A (eq 11), the part of the
   repulsion that points at the goal; with δ > 0, d → d + δ and ρ0 → ρ0 + δ (eq 40).
 
-The magnitudes come from `pfm_stability.potentials` (P = −U_ρ/A, P′ = −U_ρρ/A,
+The magnitudes come from `pfm_stability.laws.potentials` (P = −U_ρ/A, P′ = −U_ρρ/A,
 Q = U_g/A, Q′ = U_ρg/A). Both laws are 0 beyond ρ0 and neither is assumed
 monotone: R = P/(1 + Q) can rise over part of (0, ρ0), and a wall then has
 three equilibria (docs/fields.md, "Three equilibria"). Only the ratio η/ξ
@@ -23,7 +23,7 @@ and ρ_g enters only the magnitudes; a finite goal straight ahead would add
 controller and the law's own parameters (`parameters.LAW_PARAMETERS`).
 `Branch` follows one equilibrium as a parameter moves (a law parameter, α,
 L) and finds where its gain crosses a threshold: the critical values of
-`pfm_stability.critical` for laws that are not monotone.
+`pfm_stability.analysis.critical` for laws that are not monotone.
 """
 
 from __future__ import annotations
@@ -34,12 +34,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .checks import check_choice
+from ..checks import check_choice
 from .effective_force import GridWallLaw, calibrate_cell_ratio
 from .force_law import Equilibrium, ForceLaw, PowerLaw
-from .parameters import FIELD_DEFAULTS, FORCE_LAWS, LAW_PARAMETERS, RANGES, Controller, Robot, check_parameter
+from ..parameters import FIELD_DEFAULTS, FORCE_LAWS, LAW_PARAMETERS, RANGES, Controller, Robot, check_parameter
 from .potentials import attraction_force, repulsion_derivatives
-from .solve import newton_increasing
+from ..numerics.solve import newton_increasing
 
 __all__ = ["KhatibLaw", "GnronLaw", "make_law", "check_law_parameters", "finite_goal_gain", "Branch"]
 

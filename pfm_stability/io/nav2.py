@@ -28,8 +28,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from .checks import check_number
-from .parameters import RANGES
+from ..checks import check_number
+from ..parameters import RANGES
 
 __all__ = ["SPEED_KEYS", "Nav2Value", "Nav2Values", "is_nav2", "read_nav2"]
 

@@ -1,6 +1,6 @@
 """The report for the robot loop families and the velocity-aware and fuzzy laws.
 
-`pfm_stability.report.build_report` answers KB's steering robot with a static
+`pfm_stability.report.stability.build_report` answers KB's steering robot with a static
 lateral law. `build_family_report` answers the rest of ``report --robot`` and
 ``report --law`` (docs/velocity_and_fuzzy.md, docs/models.md "Robot loop families"):
 
@@ -27,21 +27,20 @@ import math
 from dataclasses import dataclass, field, replace
 from functools import lru_cache
 
-from .checks import check_choice
-from .critical import CorridorCritical, WallCritical
-from .criteria import CorridorAnalysis, ModelVerdict, WallAnalysis, WallEquilibrium, check_loop_gain, model_verdicts
-from .fields import KhatibLaw
-from .fuzzy import DfapfControllers, load_dfapf
-from .fuzzy_law import FuzzyScheduledLaw
-from .models import HEADING_GAIN_RANGE, Loop, interval_margin, interval_verdict, models_for
-from .models.holonomic import HolonomicLoop
-from .models.holonomic_delay import make_holonomic_model
-from .parameters import (FAMILY_CHOICE_DEFAULTS, FAMILY_DEFAULTS, FAMILY_LAW_CHOICES, FAMILY_LAW_PARAMETERS, FAMILY_LAWS, HOLONOMIC_LAWS, MODEL_NAMES, RANGES,
-                         ROBOT_FAMILIES, Controller, Corridor, Robot, Wall, check_parameter)
-from .report import UNITS, StabilityReport, build_report, kb_errors, remedies, remedies_by_key
-from .serialize import json_number
-from .tracking import tracking_dynamics
-from .velocity_laws import HolonomicGains, VelocityAttraction, VelocityGatedRepulsion
+from ..checks import check_choice
+from ..analysis.critical import CorridorCritical, WallCritical
+from ..analysis.criteria import CorridorAnalysis, ModelVerdict, WallAnalysis, WallEquilibrium, check_loop_gain, model_verdicts
+from ..laws.fields import KhatibLaw
+from ..laws.fuzzy import DfapfControllers, load_dfapf
+from ..laws.fuzzy_law import FuzzyScheduledLaw
+from ..models import HEADING_GAIN_RANGE, Loop, interval_margin, interval_verdict, models_for
+from ..models.holonomic import HolonomicLoop
+from ..models.holonomic_delay import make_holonomic_model
+from ..parameters import FAMILY_CHOICE_DEFAULTS, FAMILY_DEFAULTS, FAMILY_LAW_CHOICES, FAMILY_LAW_PARAMETERS, FAMILY_LAWS, HOLONOMIC_LAWS, MODEL_NAMES, RANGES, ROBOT_FAMILIES, Controller, Corridor, Robot, Wall, check_parameter
+from .stability import UNITS, StabilityReport, build_report, kb_errors, remedies, remedies_by_key
+from ..io.serialize import json_number
+from ..models.tracking import tracking_dynamics
+from ..laws.velocity_laws import HolonomicGains, VelocityAttraction, VelocityGatedRepulsion
 
 __all__ = ["FamilyLaw", "HolonomicVerdict", "make_family_law", "build_family_report", "holonomic_verdict", "KINEMATIC_TAU_SOURCE"]
 
@@ -521,7 +520,7 @@ def build_family_report(
 
 def _loop_remedies(scenario: str, verdict, robot: Robot, controller: Controller, static) -> dict:
     """`report.remedies` limited to what the verdict's critical values support (V, T, k)."""
-    from .force_law import PowerLaw
+    from ..laws.force_law import PowerLaw
 
     law = static if static is not None else PowerLaw(controller.f, controller.n, robot.W)
     return {k: v for k, v in remedies(scenario, verdict, robot, controller, law).items() if k in ("V", "T", "k")}

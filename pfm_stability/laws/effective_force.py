@@ -22,7 +22,7 @@ module imports nothing from the simulator).
 
 The window stops seeing the wall at d = (h + ½)c (the wall column leaves the
 window; 1.65 m for CARMEL), where the grid force drops to 0. The general-law
-root finders of `pfm_stability.criteria` need a strictly decreasing law, so
+root finders of `pfm_stability.analysis.criteria` need a strictly decreasing law, so
 beyond this `reach` the law continues as the C¹ power-law tail
 F_r(reach)(reach/d)^p, p the local exponent at `reach`; `window_force` gives
 the grid's true value (0 beyond the reach). Predictions whose d0 or L exceed
@@ -40,9 +40,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .checks import check_integer, check_number
+from ..checks import check_integer, check_number
 from .force_law import ForceLaw, PowerLaw
-from .solve import gauss_legendre
+from ..numerics.solve import gauss_legendre
 
 __all__ = [
     "DEFAULT_CV",

@@ -332,7 +332,7 @@ def invert_decreasing(g, targets, lo: float, hi: float, iterations: int = 200):
     Elementwise bisection on log x (to round-off): each target has its own
     bracket, all narrowed together (`bisect_batched` narrows one bracket with
     many evaluations per round instead). Used for boundary curves in the
-    equilibrium distance (`pfm_stability.curves`).
+    equilibrium distance (`pfm_stability.analysis.curves`).
 
     Parameters
     ----------

@@ -77,8 +77,8 @@ from functools import lru_cache
 
 import sympy as sp
 
-from .parameters import DERIVATION_LAWS
-from .routh import routh_array
+from ..parameters import DERIVATION_LAWS
+from ..numerics.routh import routh_array
 
 __all__ = [
     "KINDS",

@@ -24,10 +24,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .checks import check_number, check_positive_axis
-from .models import Continuous, ExactDelay, KBFirstOrder, Loop, LoopModel, Pade, Sampled
-from .parameters import SAMPLED_STRUCTURES, check_parameter
-from .serialize import json_array
+from ..checks import check_number, check_positive_axis
+from ..models import Continuous, ExactDelay, KBFirstOrder, Loop, LoopModel, Pade, Sampled
+from ..parameters import SAMPLED_STRUCTURES, check_parameter
+from ..io.serialize import json_array
 
 __all__ = [
     "GainCurve",

@@ -16,7 +16,7 @@ plane of (V, f, α, L) through the force law:
 
 For KB's power law these are closed forms (α* by vectorized bisection on the
 closed-form N(α)). For any other decreasing law (e.g. the grid's effective
-law, `pfm_stability.effective_force.GridWallLaw`) the curves are found by a
+law, `pfm_stability.laws.effective_force.GridWallLaw`) the curves are found by a
 vectorized bisection in the equilibrium distance d0, which parametrizes the
 wall exactly: cos α = F_r(d0)/F_a and N = −F_r′(d0)/(F_a sin α) (KB eq 11
 and 23 with the general law in place of f(W/d)ⁿ); this assumes N decreases as d0 grows (a convex
@@ -26,8 +26,8 @@ not monotone (Khatib's law, the goal-aware law: several equilibria, N not monoto
 docs/fields.md) the curve would not be one curve, and a ValueError says so; V*(α) and V*(L)
 need no inversion and take the first equilibrium.
 
-Dense stable/unstable maps of one model are `pfm_stability.regions`; how the
-models differ from one another is `pfm_stability.comparison`; the simulated
+Dense stable/unstable maps of one model are `pfm_stability.analysis.regions`; how the
+models differ from one another is `pfm_stability.analysis.comparison`; the simulated
 boundary set beside these curves is `pfm_stability.validation`.
 """
 
@@ -38,13 +38,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .checks import check_positive_axis
+from ..checks import check_positive_axis
 from .criteria import loop_of
-from .force_law import ForceLaw, PowerLaw, corridor_gain, law_in_force, wall_equilibria, wall_gain_arrays, wall_gain_at_distance
-from .models import Loop, LoopModel, models_for
-from .parameters import RANGES, Controller, Robot, check_parameter
-from .solve import invert_decreasing
-from .serialize import json_array, json_number
+from ..laws.force_law import ForceLaw, PowerLaw, corridor_gain, law_in_force, wall_equilibria, wall_gain_arrays, wall_gain_at_distance
+from ..models import Loop, LoopModel, models_for
+from ..parameters import RANGES, Controller, Robot, check_parameter
+from ..numerics.solve import invert_decreasing
+from ..io.serialize import json_array, json_number
 
 __all__ = [
     "BoundaryCurve",

@@ -1,7 +1,7 @@
 """Named critical values, and those with no closed form: α*, L* and a law's own parameters, per equilibrium.
 
 `WallCritical` and `CorridorCritical` hold one model's critical values in one
-geometry (docs/models.md, "Critical values"); `pfm_stability.criteria` fills them.
+geometry (docs/models.md, "Critical values"); `pfm_stability.analysis.criteria` fills them.
 The rest of this module finds them where no closed form exists (docs/fields.md).
 
 A law that is not `monotone` (Khatib's, Ge & Cui's, any law built in code)
@@ -42,10 +42,10 @@ import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field, fields
 
-from .fields import Branch, GnronLaw, KhatibLaw
-from .force_law import Equilibrium, ForceLaw, corridor_gain, wall_equilibria
-from .parameters import RANGES, to_degrees
-from .solve import bisect_root
+from ..laws.fields import Branch, GnronLaw, KhatibLaw
+from ..laws.force_law import Equilibrium, ForceLaw, corridor_gain, wall_equilibria
+from ..parameters import RANGES, to_degrees
+from ..numerics.solve import bisect_root
 
 __all__ = ["CriticalValues", "WallCritical", "CorridorCritical", "is_field_law", "in_user_f", "WallBranches", "CorridorBranches"]
 

@@ -24,10 +24,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .checks import check_choice, check_number, check_type
+from ..checks import check_choice, check_number, check_type
 from .force_law import Equilibrium, ForceLaw, corridor_equilibria, wall_equilibria
-from .parameters import check_parameter
-from .solve import bisect_root
+from ..parameters import check_parameter
+from ..numerics.solve import bisect_root
 
 __all__ = [
     "OBSTACLE_KINDS",

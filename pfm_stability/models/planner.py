@@ -28,8 +28,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from .checks import check_number
-from .parameters import check_parameter
+from ..checks import check_number
+from ..parameters import check_parameter
 
 __all__ = ["BOUNDARY_RTOL", "PLANNER_REGIMES", "GradientStep", "gradient_step"]
 

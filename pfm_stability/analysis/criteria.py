@@ -17,7 +17,7 @@ For any other force law the same conditions are solved numerically
 that is not `monotone` (Khatib's, Ge & Cui's goal-aware law, a law built in
 code) is analysed at every one of its wall equilibria, and its α*, L* and the
 critical values of its own parameters (f*, or η*, ρ0*, ξ*) are found on each
-equilibrium by following it (`pfm_stability.critical`, docs/fields.md).
+equilibrium by following it (`pfm_stability.analysis.critical`, docs/fields.md).
 An equilibrium with N < 0 is unstable in the field itself: every model's
 verdict is "unstable", with the reason. At N = 0 (no restoring force) each
 model judges its heading loop, the roots other than the neutral lateral one
@@ -32,13 +32,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .checks import check_number, check_type
+from ..checks import check_number, check_type
 from .critical import CorridorBranches, CorridorCritical, CriticalValues, WallBranches, WallCritical, in_user_f, is_field_law
-from .fields import finite_goal_gain
-from .force_law import Equilibrium, ForceLaw, PowerLaw, corridor_equilibria, corridor_gain, law_in_force, wall_equilibria, wall_gain
-from .models import Loop, LoopModel, gain_margin, models_for, neutral_reason, verdict_label
-from .parameters import RANGES, Controller, Corridor, Robot, Wall, check_corridor_fits, check_parameter, to_degrees
-from .solve import bisect_root, expand_bracket
+from ..laws.fields import finite_goal_gain
+from ..laws.force_law import Equilibrium, ForceLaw, PowerLaw, corridor_equilibria, corridor_gain, law_in_force, wall_equilibria, wall_gain
+from ..models import Loop, LoopModel, gain_margin, models_for, neutral_reason, verdict_label
+from ..parameters import RANGES, Controller, Corridor, Robot, Wall, check_corridor_fits, check_parameter, to_degrees
+from ..numerics.solve import bisect_root, expand_bracket
 
 __all__ = [
     "CriticalValues",

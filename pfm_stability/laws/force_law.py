@@ -38,9 +38,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .checks import check_number, check_type
-from .parameters import Controller, Robot, check_parameter, to_degrees
-from .solve import bisect_root, expand_bracket, invert_decreasing, newton_increasing
+from ..checks import check_number, check_type
+from ..parameters import Controller, Robot, check_parameter, to_degrees
+from ..numerics.solve import bisect_root, expand_bracket, invert_decreasing, newton_increasing
 
 __all__ = [
     "law_in_force",
@@ -147,7 +147,7 @@ class ForceLaw:
         """Distances d (m) where P or Q changes form (e.g. where the repulsion's support ends); none by default.
 
         N jumps where an equilibrium crosses one, so the searches for critical
-        values step onto each (`pfm_stability.critical`, docs/fields.md).
+        values step onto each (`pfm_stability.analysis.critical`, docs/fields.md).
         """
         return ()
 

@@ -28,8 +28,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .checks import check_choice, check_integer
-from .config import read_yaml
+from ..checks import check_choice, check_integer
+from ..io.config import read_yaml
 
 __all__ = [
     "DFAPF_FILE",
@@ -48,7 +48,7 @@ FWHM_FRACTION = 0.8
 OUTPUT_POINTS = 1001
 """Points of the output universe on which the centroid is taken (R1)."""
 
-DFAPF_FILE = Path(__file__).resolve().parent / "data" / "fuzzy" / "dfapf.yaml"
+DFAPF_FILE = Path(__file__).resolve().parent.parent / "data" / "fuzzy" / "dfapf.yaml"
 """The universes and rule tables of the DFAPF paper's two controllers."""
 
 _SIGMA_PER_FWHM = 1.0 / (2.0 * math.sqrt(2.0 * math.log(2.0)))
