@@ -25,7 +25,7 @@ from scipy.optimize import brentq
 
 from pfm_stability.numerics.delay import DelayLoop, delay_verdicts_from_gain, kb_critical_gain
 from pfm_stability.models import MODEL_NAMES, Continuous, ExactDelay, KBFirstOrder, Loop, Pade, Sampled, gain_margin, make_model, verdict_label
-from pfm_stability.models.base import DIVERGENT_REASON, divergent_reason
+from pfm_stability.models.verdicts import DIVERGENT_REASON, divergent_reason
 from pfm_stability.models.heading import kb_heading_interval
 
 STRUCTURES = [(h, d) for h in ("command", "reference") for d in (0, 1)]

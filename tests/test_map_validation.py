@@ -20,7 +20,7 @@ import pytest
 from pfm_stability.analysis.criteria import analyze_corridor, loop_of
 from pfm_stability.laws.fields import make_law
 from pfm_stability.models import Sampled
-from pfm_stability.models.base import gain_margin
+from pfm_stability.models.verdicts import gain_margin
 from pfm_stability.parameters import CARMEL, Corridor
 from pfm_stability.io.serialize import dumps
 from pfm_stability.sim.engine import run_batch

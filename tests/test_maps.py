@@ -177,7 +177,7 @@ def test_straight_corridor_matches_the_report(tmp_path, L, n, f):
     ref = analyze_corridor(ROBOT, controller, Corridor(L), ["sampled"], law=law)
     assert np.abs(s.N[middle] / ref.N - 1).max() < 2e-3
     boundary = models_for(controller, ["sampled"])[0].boundary(Loop(ROBOT.tau, controller.T, ROBOT.k))
-    V_star = sample_verdict(float(np.mean(s.N[middle])), ROBOT.V, boundary, True)[0]  # N > 0: the N = 0 verdict is not read
+    V_star = sample_verdict(float(np.mean(s.N[middle])), ROBOT.V, boundary, True).V_critical  # N > 0: the N = 0 verdict is not read
     assert V_star == pytest.approx(ref.models["sampled"].critical["V_critical"], rel=2e-3)
 
 
@@ -249,7 +249,7 @@ def test_corridor_at_30_degrees_drawn_one_cell_per_cell_length_matches_the_repor
     assert middle.sum() > 50
     assert np.mean(s.N[middle]) == pytest.approx(ref.N, rel=0.03)
     boundary = models_for(CONTROLLER, ["sampled"])[0].boundary(Loop(ROBOT.tau, CONTROLLER.T, ROBOT.k))
-    assert sample_verdict(float(np.mean(s.N[middle])), ROBOT.V, boundary, True)[0] == pytest.approx(V_ref, rel=0.03)
+    assert sample_verdict(float(np.mean(s.N[middle])), ROBOT.V, boundary, True).V_critical == pytest.approx(V_ref, rel=0.03)
     (segment,) = [g for g in analysis.segments if g.N is not None and g.length > 15]
     assert abs(math.atan2(segment.x1 - segment.x0, segment.y1 - segment.y0) % math.pi - angle) < math.radians(2)
     assert segment.V_critical == pytest.approx(V_ref, rel=0.03)
@@ -265,10 +265,12 @@ def test_sample_verdicts_agree_with_the_models_own_stability_test():
         loop = Loop(ROBOT.tau, controller.T, ROBOT.k)
         boundary = model.boundary(loop)
         for N in rng.uniform(0.05, 3 * boundary.NV_critical / ROBOT.V, 12):
-            V_star, margin, stable, label, _ = sample_verdict(N, ROBOT.V, boundary, model.is_stable(0.0, loop))
+            j = sample_verdict(N, ROBOT.V, boundary, model.is_stable(0.0, loop))
+            V_star, margin, stable, label = j.V_critical, j.margin, j.stable, j.verdict
             assert stable == model.is_stable(N * ROBOT.V, loop) and (margin > 0) == stable
             assert V_star == pytest.approx(boundary.NV_critical / N)
-    assert sample_verdict(-0.5, 0.8, boundary, True)[:4] == (0.0, -1.0, False, "unstable")
+    j = sample_verdict(-0.5, 0.8, boundary, True)
+    assert (j.V_critical, j.margin, j.stable, j.verdict) == (0.0, -1.0, False, "unstable")
 
 
 def test_power_law_on_a_corridor(tmp_path):
@@ -369,7 +371,7 @@ def test_uniform_segment_is_decided_like_a_single_sample():
         g = segment_gain(N, ROBOT.V, boundary.omega_critical, growth, boundary.NV_critical)
         assert g.N_eff == pytest.approx(N0, rel=1e-7)
         assert (g.sigma < 0) == boundary.contains(N0 * ROBOT.V)
-        assert critical_speed(N, growth, boundary.NV_critical) == pytest.approx(sample_verdict(N0, ROBOT.V, boundary, True)[0], rel=1e-7)
+        assert critical_speed(N, growth, boundary.NV_critical) == pytest.approx(sample_verdict(N0, ROBOT.V, boundary, True).V_critical, rel=1e-7)
 
 
 def test_a_one_sample_spike_counts_by_its_growth_not_its_gain():

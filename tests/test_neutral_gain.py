@@ -443,12 +443,14 @@ def test_map_sample_with_N0_is_the_models_verdict_at_zero():
     loop = Loop(*ISSUE)
     heading = _heading_poles(*ISSUE, 0.0, "command", 1)
     assert np.max(np.abs(heading)) > 1
-    assert sample_verdict(0.0, 0.8, model.boundary(loop), model.is_stable(0.0, loop)) == (0.0, -1.0, False, "unstable", neutral_reason(0.0, False))
+    j = sample_verdict(0.0, 0.8, model.boundary(loop), model.is_stable(0.0, loop))
+    assert (j.V_critical, j.margin, j.stable, j.verdict, j.reason) == (0.0, -1.0, False, "unstable", neutral_reason(0.0, False))
     growth = GrowthRate(lambda NV: model.rightmost_root(NV, loop), model.boundary(loop).NV_critical)
     assert float(growth(0.0)) == pytest.approx(math.log(np.max(np.abs(heading))) / ISSUE[1], rel=1e-9)
     stable_model, stable_loop = make_model("sampled", hold="reference"), Loop(0.3, 0.065, 2.0)
     assert np.max(np.abs(_heading_poles(0.3, 0.065, 2.0, 0.0, "reference", 0))) < 1
     boundary = stable_model.boundary(stable_loop)
-    assert sample_verdict(0.0, 0.8, boundary, stable_model.is_stable(0.0, stable_loop))[:4] == (math.inf, math.inf, True, "stable")
+    j = sample_verdict(0.0, 0.8, boundary, stable_model.is_stable(0.0, stable_loop))
+    assert (j.V_critical, j.margin, j.stable, j.verdict) == (math.inf, math.inf, True, "stable")
     assert float(GrowthRate(lambda NV: stable_model.rightmost_root(NV, stable_loop), boundary.NV_critical)(0.0)) == 0.0
 

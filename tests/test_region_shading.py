@@ -39,12 +39,12 @@ import pytest  # noqa: E402
 
 from pfm_stability.laws.force_law import ForceLaw, PowerLaw, corridor_gain, wall_gain  # noqa: E402
 from pfm_stability.models import ExactDelay, Loop, Sampled, models_for  # noqa: E402
+from pfm_stability.models.verdicts import in_stable_set  # noqa: E402
 from pfm_stability.parameters import CARMEL, Controller, Robot  # noqa: E402
 from pfm_stability.plots.regions import plot_corridor_region, plot_wall_alpha_critical  # noqa: E402
 from pfm_stability.analysis.regions import (  # noqa: E402
     corridor_region,
     region_model,
-    stable_set_verdicts,
     verdict_model,
     wall_alpha_region,
     wall_f_region,
@@ -163,7 +163,7 @@ def test_maps_flip_at_every_edge_of_the_stable_set(case):
     assert all(expected[2 * i] != expected[2 * i + 1] for i in range(len(edges)))  # each probe pair straddles an edge
     for stable in maps:
         assert stable.tolist() == expected
-    assert stable_set_verdicts(model.boundary(loop).stable_set, NV).tolist() == expected
+    assert in_stable_set(model.boundary(loop).stable_set, NV).tolist() == expected
 
 
 def test_hold_gap_map_is_unstable_at_low_speed():
@@ -186,7 +186,7 @@ def test_exact_delay_map_keeps_the_crossing_count():
     assert region.stable_set is None
     b = ExactDelay().boundary(loop)
     far = np.abs(region.NV / b.NV_critical - 1) > EDGE_SKIP
-    assert np.array_equal(region.stable[far], stable_set_verdicts(b.stable_set, region.NV)[far])
+    assert np.array_equal(region.stable[far], in_stable_set(b.stable_set, region.NV)[far])
     assert _check_points(ExactDelay(), loop, region.NV.ravel()[::97], region.stable.ravel()[::97]) >= 20
     alpha = np.radians([15.0, 35.0, 60.0])
     general = wall_alpha_region(ROBOT, CONTROLLER, V, alpha, law=_Opaque(PowerLaw(CONTROLLER.f, CONTROLLER.n, ROBOT.W)), model="exact_delay")

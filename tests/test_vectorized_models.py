@@ -19,7 +19,7 @@ import numpy as np
 import pytest
 
 from pfm_stability.models import Loop, gain_margin, make_model, verdict_label
-from pfm_stability.models.base import UNDECIDED_RTOL
+from pfm_stability.models.verdicts import UNDECIDED_RTOL
 from pfm_stability.vectorized import LoopVerdicts, loop_verdicts
 
 NV_RTOL = {"continuous": 1e-12, "kb_first_order": 1e-12, "exact_delay": 1e-12, "pade": 1e-9, "sampled": 1e-7}

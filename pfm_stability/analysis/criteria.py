@@ -36,7 +36,7 @@ from ..checks import check_number, check_type
 from .critical import CorridorBranches, CorridorCritical, CriticalValues, WallBranches, WallCritical, in_user_f, is_field_law
 from ..laws.fields import finite_goal_gain
 from ..laws.force_law import Equilibrium, ForceLaw, PowerLaw, corridor_equilibria, corridor_gain, law_in_force, wall_equilibria, wall_gain
-from ..models import Loop, LoopModel, gain_margin, models_for, neutral_reason, verdict_label
+from ..models import Loop, LoopModel, check_loop_gain, judge, models_for
 from ..parameters import RANGES, Controller, Corridor, Robot, Wall, check_corridor_fits, check_parameter, to_degrees
 from ..numerics.solve import bisect_root, expand_bracket
 
@@ -58,7 +58,6 @@ __all__ = [
     "kb_critical_L",
     "loop_of",
     "model_verdicts",
-    "check_loop_gain",
 ]
 
 
@@ -211,20 +210,6 @@ def loop_of(robot: Robot, controller: Controller) -> Loop:
     return Loop(robot.tau, controller.T, robot.k)
 
 
-NV_MAX = 1e12
-"""Largest loop gain NV (1/s) the loop models represent; a geometry beyond it is refused."""
-
-
-def check_loop_gain(NV: float, where: str) -> float:
-    """NV after checking it is finite and <= NV_MAX; otherwise a message that names the geometry."""
-    if not (math.isfinite(NV) and abs(NV) <= NV_MAX):
-        raise ValueError(
-            f"N*V = {NV:g} 1/s at the {where} exceeds what the loop models represent (<= {NV_MAX:g} 1/s); "
-            f"choose a less extreme force law (f, n), angle or width"
-        )
-    return NV
-
-
 # --------------------------------------------------------------- root finding
 def _solve_decreasing(func, x0: float) -> float:
     """Root in (0, inf) of a decreasing function, bracketed geometrically from x0.
@@ -368,13 +353,6 @@ def model_verdicts(controller: Controller, models, loop: Loop, N: float, NV: flo
     return out
 
 
-NEGATIVE_N = (
-    "N < 0: this equilibrium is unstable in the field itself (the lateral force pushes away from it); "
-    "k*N*V < 0 gives a positive real root in every model, at every speed, delay and gain"
-)
-"""The reason every model's verdict is "unstable" at an equilibrium with N < 0 (docs/fields.md)."""
-
-
 def _negative_gain_root(model: LoopModel, NV: float, loop: Loop):
     """The dominant root at NV < 0, or None where the model does not take a negative gain."""
     try:
@@ -386,18 +364,19 @@ def _negative_gain_root(model: LoopModel, NV: float, loop: Loop):
 def _verdict(model: LoopModel, loop: Loop, NV: float, boundary, critical_values, N: float, **geometry) -> ModelVerdict:
     """The verdict; `critical_values` (WallCritical or CorridorCritical) built from `geometry` plus V*, T*, k*.
 
-    N = 0 is judged by the model like any other point: its heading loop (the neutral lateral
-    root left out, `models.neutral_reason`, docs/models.md "N = 0"), with that reason; V* is
-    then ``inf`` or 0 (NV = 0 at every speed).
+    Verdict, margin, V* and reason follow the one verdict rule (`models.verdicts.judge`): N < 0 diverges
+    in every model (no T or k helps: T* = k* = 0); N = 0 is judged by the model like any other point,
+    its heading loop (docs/models.md "N = 0").
     """
-    if NV < 0:  # an unstable equilibrium of the field: no T or k helps, margin −1
-        critical = critical_values(**geometry, V_critical=0.0, T_critical=0.0, k_critical=0.0)
-        root = _negative_gain_root(model, NV, loop)
-        return ModelVerdict(model.name, NV, boundary.NV_critical, boundary.omega_critical, -1.0, "unstable", critical, root, NEGATIVE_N)
-    stable = model.is_stable(NV, loop)
+    if N < 0:
+        judgement = judge(NV, N, boundary, False)
+        critical = critical_values(**geometry, V_critical=judgement.V_critical, T_critical=0.0, k_critical=0.0)
+        return ModelVerdict(model.name, NV, boundary.NV_critical, boundary.omega_critical, judgement.margin, judgement.verdict, critical,
+                            _negative_gain_root(model, NV, loop), judgement.reason)
+    judgement = judge(NV, N, boundary, model.is_stable(NV, loop))
     critical = critical_values(
         **geometry,
-        V_critical=boundary.NV_critical / N if N > 0 else (math.inf if stable else 0.0),
+        V_critical=judgement.V_critical,
         T_critical=model.critical_delay(NV, loop),
         k_critical=model.critical_gain_k(NV, loop),
         tau_plus_T_critical=(1.0 / NV if NV > 0 else math.inf) if model.name == "kb_first_order" else None,
@@ -407,11 +386,11 @@ def _verdict(model: LoopModel, loop: Loop, NV: float, boundary, critical_values,
         NV=NV,
         NV_critical=boundary.NV_critical,
         omega_critical=boundary.omega_critical,
-        margin=gain_margin(NV, boundary, stable),
-        verdict=verdict_label(NV, boundary, stable),
+        margin=judgement.margin,
+        verdict=judgement.verdict,
         critical=critical,
         rightmost_root=model.rightmost_root(NV, loop),
-        reason=neutral_reason(NV, stable),
+        reason=judgement.reason,
     )
 
 

@@ -30,6 +30,7 @@ from ..checks import check_positive_axis
 from .criteria import loop_of
 from ..laws.force_law import ForceLaw, PowerLaw, corridor_gain, wall_gain_arrays
 from ..models import ExactDelay, LoopModel, models_for
+from ..models.verdicts import in_stable_set
 from ..parameters import Controller, Robot, check_parameter
 from ..io.serialize import json_array, json_number
 from ..vectorized import delay_verdicts_from_gain, exact_delay_verdicts, loop_gain_arrays
@@ -38,7 +39,6 @@ __all__ = [
     "RegionGrid",
     "verdict_model",
     "region_model",
-    "stable_set_verdicts",
     "wall_f_region",
     "wall_alpha_region",
     "corridor_region",
@@ -137,28 +137,6 @@ def region_model(controller: Controller, model: LoopModel | str | None = None) -
     return verdict_model(controller) if model is None else models_for(controller, (model,))[0]
 
 
-def stable_set_verdicts(stable_set, NV) -> np.ndarray:
-    """True where NV lies strictly inside one of the intervals (`Boundary.contains` for arrays).
-
-    Parameters
-    ----------
-    stable_set : sequence of (float, float)
-        NV intervals (lo, hi), 1/s (`Boundary.stable_set`).
-    NV : array_like
-        Loop gains, 1/s.
-
-    Returns
-    -------
-    ndarray of bool
-        Shaped like `NV`.
-    """
-    NV = np.asarray(NV, dtype=float)
-    stable = np.zeros(NV.shape, dtype=bool)
-    for lo, hi in stable_set:
-        stable |= (NV > lo) & (NV < hi)
-    return stable
-
-
 # ------------------------------------------------------- dense region maps
 def _general_verdicts(robot: Robot, controller: Controller, NV):
     """`exact_delay` crossing-count verdicts for an array of NV (any force law)."""
@@ -178,7 +156,7 @@ def _region(robot: Robot, controller: Controller, model: LoopModel, axes, NV, st
         else:
             b = model.boundary(loop_of(robot, controller))
             stable_set = tuple(b.stable_set) or (((0.0, b.NV_critical),) if b.NV_critical > 0 else ())
-            stable = stable_set_verdicts(stable_set, NV)
+            stable = in_stable_set(stable_set, NV)
     return RegionGrid(*axes, stable, NV, model.name, model.options(), stable_set)
 
 

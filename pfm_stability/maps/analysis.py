@@ -45,7 +45,8 @@ import numpy as np
 
 from ..laws.effective_force import GridWallLaw
 from ..laws.force_law import ForceLaw, PowerLaw
-from ..models import Loop, divergent_reason, gain_margin, models_for, neutral_reason, verdict_label
+from ..models import Loop, gain_margin, models_for, verdict_label
+from ..models.verdicts import Judgement, inside, judge
 from ..parameters import MAP_LAWS, Controller, Robot
 from ..io.serialize import json_number
 from .equilibria import Samples, grid_equilibria, power_equilibria
@@ -392,24 +393,11 @@ def analyze_map(occupancy: OccupancyMap, robot: Robot, controller: Controller, l
                        skeleton, clearance, unknown, timing, tuple(warnings))
 
 
-def _stable(NV: float, boundary) -> bool:
-    if boundary.stable_set:
-        return boundary.contains(NV)
-    return 0 < NV < boundary.NV_critical
-
-
-def sample_verdict(N: float, V: float, boundary, heading_stable: bool) -> tuple:
-    """(V*, margin, stable, label, reason) of one sample with gain N (1/m) at speed V (m/s).
-
-    `heading_stable` is the model's verdict at NV = 0 (``model.is_stable(0.0, loop)``: its
-    heading loop), which decides a sample with N = 0 (module docstring).
-    """
-    if N < 0:
-        return 0.0, -1.0, False, "unstable", divergent_reason(N * V)
-    NV = N * V
-    stable = bool(heading_stable) if N == 0 else _stable(NV, boundary)
-    V_critical = boundary.NV_critical / N if N > 0 else (math.inf if stable else 0.0)
-    return V_critical, gain_margin(NV, boundary, stable), stable, verdict_label(NV, boundary, stable), neutral_reason(NV, stable)
+def sample_verdict(N: float, V: float, boundary, heading_stable: bool) -> Judgement:
+    """The verdict of one sample with gain N (1/m) at speed V (m/s): `models.verdicts.judge`, stable inside the
+    model's stable set, or at N = 0 by `heading_stable`, the model's verdict at NV = 0 (``model.is_stable(0.0, loop)``:
+    its heading loop; module docstring)."""
+    return judge(N * V, N, boundary, bool(heading_stable) if N == 0 else (lambda NV: inside(boundary, NV)))
 
 
 def _direction(N: np.ndarray, length: float, boundary, V: float, growth: GrowthRate, heading_stable: bool) -> dict | None:
@@ -422,8 +410,8 @@ def _direction(N: np.ndarray, length: float, boundary, V: float, growth: GrowthR
     if is_weak(gain.sigma, length, V):
         return dict(out, V_critical=None, margin=None, stable=None, verdict="weak", reason=None)
     if gain.N_eff <= 0:  # the mean N is negative and σ̄ > 0: unstable at any speed; or no restoring force
-        V_star, margin, stable, label, reason = sample_verdict(gain.N_eff, V, boundary, heading_stable)
-        return dict(out, V_critical=V_star, margin=margin, stable=stable, verdict=label, reason=reason)
+        j = sample_verdict(gain.N_eff, V, boundary, heading_stable)
+        return dict(out, V_critical=j.V_critical, margin=j.margin, stable=j.stable, verdict=j.verdict, reason=j.reason)
     stable = bool(gain.sigma < 0)
     NV = gain.N_eff * V
     V_star = critical_speed(N, growth, boundary.NV_critical)
@@ -448,7 +436,7 @@ def _segment(route: Route, samples: Samples, k: int, boundary, robot: Robot, c: 
     judged = (stop - first) * spacing
     local = [sample_verdict(float(n), V, boundary, heading_stable) for n in samples.N[ok]]
     detail = dict(offset=float(np.mean(samples.offset[ok])), samples_offset=tuple(float(v) for v in samples.offset[ok]),
-                  N_max=float(np.max(samples.N[ok])), V_critical_local=float(min(a[0] for a in local)),
+                  N_max=float(np.max(samples.N[ok])), V_critical_local=float(min(j.V_critical for j in local)),
                   judged_from=float(first * spacing), judged_to=float(stop * spacing), **base)
     lam = wavelength(V, boundary.omega_critical)
     if stop - first < mine.size and judged < (lam if math.isfinite(lam) else route.length / 2):

@@ -20,12 +20,14 @@ from __future__ import annotations
 
 from ..checks import check_choice
 from ..parameters import MODEL_NAMES, Controller
-from .base import DIVERGENT_REASON, HEADING_GAIN_RANGE, NEUTRAL_REASON, Boundary, Loop, LoopModel, divergent_reason, gain_margin, interval_margin, interval_verdict, neutral_reason, verdict_label
+from .base import HEADING_GAIN_RANGE, Boundary, Loop, LoopModel
 from .continuous import Continuous
 from .exact_delay import ExactDelay
 from .kb_first_order import KBFirstOrder
 from .pade import Pade, pade_coefficients
 from .sampled import Sampled
+from .verdicts import (DIVERGENT_REASON, NEUTRAL_REASON, check_loop_gain, critical_speed, divergent_reason, gain_margin, interval_margin,
+                       interval_verdict, judge, judge_arrays, neutral_reason, verdict_label)
 
 __all__ = [
     "MODEL_NAMES",
@@ -40,7 +42,11 @@ __all__ = [
     "Pade",
     "ExactDelay",
     "Sampled",
+    "check_loop_gain",
+    "critical_speed",
     "divergent_reason",
+    "judge",
+    "judge_arrays",
     "gain_margin",
     "interval_margin",
     "interval_verdict",

@@ -35,34 +35,22 @@ from ..checks import check_number
 from ..parameters import RANGES, T_RESOLUTION, TAU_RESOLUTION, check_parameter
 from ..numerics.crossings import first_stable_interval, verdict_at
 from ..io.serialize import json_number
+from .verdicts import NV_MAX
 
 __all__ = [
     "Loop",
     "Boundary",
     "LoopModel",
     "AffineGainModel",
-    "verdict_label",
-    "gain_margin",
-    "interval_verdict",
-    "interval_margin",
     "gain_range",
     "checked",
     "check_heading_gain",
-    "divergent_reason",
-    "neutral_reason",
     "neutral_quotient",
-    "DIVERGENT_REASON",
-    "NEUTRAL_REASON",
     "HEADING_GAIN_RANGE",
-    "UNDECIDED_RTOL",
-    "NV_MAX",
 ]
 
 _DELAY_RTOL = 1e-7
 """Relative bracket width at which `critical_delay` stops (reports show 4 digits)."""
-
-UNDECIDED_RTOL = 1e-9
-"""|NV/NV* − 1| below this is reported as "undecided" (on the boundary)."""
 
 HEADING_GAIN_RANGE = (-0.99, 100.0)
 """Closed range of the heading gain c (`Loop.c`, dimensionless).
@@ -73,47 +61,6 @@ reverses the loop's heading feedback, and the continuous loop
 coefficient is <= 0). Such a c is refused rather than answered, with that
 reason; −0.99 keeps 1 + c >= 0.01. 100 is a generous cap (a heading term a
 hundred times the steering loop's own)."""
-
-DIVERGENT_REASON = "N < 0: the equilibrium diverges (a real root in the right half-plane) at any speed"
-"""Why every model says "unstable" for NV < 0 (`divergent_reason`)."""
-
-
-NEUTRAL_REASON = "N = 0: the lateral mode is neutral (no restoring force); the verdict is the heading loop's"
-"""Why a verdict at NV = 0 is the heading loop's, when it is not told which (`neutral_reason`; a sweep's reason column)."""
-
-_NEUTRAL_REASONS = {
-    True: "N = 0: the lateral mode is neutral (no restoring force); the heading loop is stable",
-    False: "N = 0: the lateral mode is neutral (no restoring force) and the heading loop is unstable by itself",
-}
-
-
-def neutral_reason(NV: float, stable: bool | None = None) -> str | None:
-    """Why the verdict at NV = 0 is what it is; None for NV != 0.
-
-    At N = 0 the field exerts no restoring force: the characteristic
-    function of every model is s·D1(s) (a root at z = 1 for `sampled`),
-    and the lateral root stays at s = 0 whatever V, T, k and c are — the
-    robot drifts sideways, it does not oscillate. Every model then judges
-    the other roots, D1 — the heading loop: τs² + s + k(1 + c) for
-    `continuous`, τs² + s + k + kc·e^(−sT) for `exact_delay`, the sampled
-    loop without its lateral state (the whole command k(δ − θ) held can
-    make it unstable even with c = 0). `is_stable` is the heading loop's
-    verdict, `rightmost_root` its dominant root, `critical_delay` and
-    `critical_gain_k` its T* and k*; the margin is ``inf`` when it is
-    stable and −1 when it is not (`interval_margin`), never "undecided".
-
-    Parameters
-    ----------
-    NV : float
-        Loop gain, 1/s.
-    stable : bool, optional
-        The model's verdict at NV = 0 (`LoopModel.is_stable`); None:
-        `NEUTRAL_REASON`, which does not say it (several models in one row).
-    """
-    if NV != 0:
-        return None
-    return NEUTRAL_REASON if stable is None else _NEUTRAL_REASONS[bool(stable)]
-
 
 def neutral_quotient(p, domain: str = "s") -> np.ndarray:
     """p(s)/s (``domain="s"``) or p(z)/(z − 1) (``"z"``): a characteristic polynomial at NV = 0 without its
@@ -126,24 +73,6 @@ def neutral_quotient(p, domain: str = "s") -> np.ndarray:
     if domain == "s":
         return p[:-1]
     return np.polydiv(p, [1.0, -1.0])[0]
-
-
-def divergent_reason(NV: float) -> str | None:
-    """`DIVERGENT_REASON` when NV < 0, else None.
-
-    With N < 0 the field pushes the robot away from its equilibrium: the
-    characteristic function of every model is kNV < 0 at s = 0 (z = 1 for
-    `sampled`) and positive for large real s (z), so it has a real root
-    s > 0 (a real pole z > 1) whatever V, T, k and c are (the one exception,
-    `kb_first_order` with τ = 0 and kcT > 1, has coefficients of both signs
-    and is unstable at every NV anyway). Every model's `is_stable` is then
-    False, `critical_delay` and `critical_gain_k` are 0 (no T and no k
-    helps), `rightmost_root` is that real root (or an oscillating pair
-    further right, in a loop unstable at every NV anyway), `gain_margin` is
-    −1 and `verdict_label` "unstable". A verdict can show this string as the
-    reason (docs/models.md, "N < 0").
-    """
-    return DIVERGENT_REASON if NV < 0 else None
 
 
 @dataclass(frozen=True)
@@ -251,58 +180,6 @@ class Boundary:
             "K_critical": json_number(self.K_critical),
             "stable_set": [[json_number(lo), json_number(hi)] for lo, hi in self.stable_set],
         }
-
-
-def _edges(stable_set, critical: float):
-    """Finite positive edges of the stable set (the critical value alone if the set is unknown)."""
-    if stable_set:
-        return [x for pair in stable_set for x in pair if 0 < x < math.inf]
-    return [critical] if 0 < critical < math.inf else []
-
-
-def interval_verdict(gain: float, stable_set, critical: float, stable: bool, rtol: float = UNDECIDED_RTOL) -> str:
-    """"stable", "unstable" or "undecided" (within `rtol` of an edge of `stable_set`) for any loop gain (NV, κ)."""
-    if any(abs(gain / edge - 1.0) <= rtol for edge in _edges(stable_set, critical)):
-        return "undecided"
-    return "stable" if stable else "unstable"
-
-
-def interval_margin(gain: float, stable_set, critical: float, stable: bool) -> float:
-    """Relative distance to the nearest boundary below or above, gain_edge/gain − 1, for any loop gain (NV, κ).
-
-    Stable: the edge is the upper end of the stable interval that holds the
-    gain (``inf`` if unbounded), so the margin is how much the gain may grow.
-    Unstable: the upper end of the nearest stable interval below, so the
-    (negative) margin is how much it must shrink; −1 when no smaller gain is
-    stable. With the usual stable set (0, critical) both are critical/gain − 1.
-
-    Gain 0 (N = 0, `neutral_reason`): ``inf`` when stable, −1 when not — the
-    limits of critical/gain − 1 as the gain → 0+ (no gain below 0 exists).
-    """
-    if gain == 0:
-        return math.inf if stable else -1.0
-    intervals = stable_set or (((0.0, critical),) if critical > 0 else ())
-    if stable:
-        holding = [hi for lo, hi in intervals if lo <= gain <= hi]
-        edge = holding[0] if holding else critical
-    else:
-        below = [hi for lo, hi in intervals if hi <= gain * (1 + UNDECIDED_RTOL)]
-        edge = max(below) if below else 0.0
-    return edge / gain - 1.0
-
-
-def verdict_label(NV: float, boundary: Boundary, stable: bool, rtol: float = UNDECIDED_RTOL) -> str:
-    """"stable", "unstable" or "undecided" (within `rtol` of an edge of the stable set): `interval_verdict` in NV."""
-    return interval_verdict(NV, boundary.stable_set, boundary.NV_critical, stable, rtol)
-
-
-def gain_margin(NV: float, boundary: Boundary, stable: bool) -> float:
-    """NV_edge/NV − 1 (`interval_margin` in NV): with the usual stable set (0, NV*), NV*/NV − 1."""
-    return interval_margin(NV, boundary.stable_set, boundary.NV_critical, stable)
-
-
-NV_MAX = 1e12
-"""Largest loop gain NV (1/s) a model accepts: beyond it the root finders leave floating point."""
 
 
 def _check_NV(NV) -> float:

@@ -360,12 +360,6 @@ class DelayLoop:
         polished = np.array(polished)
         return polished[np.argsort(-polished.real)][:count]
 
-    def spectral_abscissa(self, K: float) -> float:
-        """max Re s over all roots, 1/s (NaN where `rightmost_roots` cannot resolve them)."""
-        K = check_number("K", K, -_K_MAX, _K_MAX, low_open=False, high_open=False)
-        roots = self.rightmost_roots(K, count=1)
-        return float(roots[0].real) if roots.size else math.nan
-
     def _generator(self, K, nodes):
         n = len(self.a) - 1
         lead = self.a[0]

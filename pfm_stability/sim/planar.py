@@ -94,8 +94,6 @@ its lateral velocity changes sign every 2 + d samples, d the compute delay), by 
 the two (5.3 mm measured at T = 0.065 s, d = 1, against a bound of 19 mm). A steering
 robot's relay cycle has no such bound (its amplitude is ∝ T, tenths of a metre at KB's T)."""
 
-EVENT_KINDS = ("gate_open", "gate_close", "influence_enter", "influence_exit", "collision_unavoidable", "contact")
-
 @dataclass(frozen=True)
 class Field:
     """Attraction plus repulsion.

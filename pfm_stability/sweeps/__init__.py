@@ -12,10 +12,10 @@
   finish, retried, resumable; local threads, local worker processes
   (simulation), or a running ``dask.distributed`` scheduler;
 * `table` — Parquet parts, the output (Parquet or CSV) and its statistics;
-* `summary_map` (module `summary`) — the data of the summary figure
+* `summary_figure_data` (module `summary`) — the data of the summary figure
   (`pfm_stability.plots.sweep`).
 
-Level 10, beside `validation`: it joins the vectorized predictions and,
+Level 7, beside `validation`: it joins the vectorized predictions and,
 when asked, simulations; it may import `validation`, never the other way.
 CLI: ``pfm-stability sweep SPEC.yaml --out FILE.parquet``.
 """

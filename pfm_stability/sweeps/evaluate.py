@@ -40,7 +40,7 @@ from functools import lru_cache
 import numpy as np
 
 from ..laws.force_law import Equilibrium, corridor_gain, power_law_corridor_gain, power_law_wall_gain, wall_equilibria, wall_gain
-from ..models.base import DIVERGENT_REASON, NEUTRAL_REASON, NV_MAX
+from ..models.verdicts import DIVERGENT_REASON, NEUTRAL_REASON, NV_MAX, beyond_reason, judge_arrays
 from ..parameters import RADIANS_PER_DEGREE, Controller, Robot
 from .points import chunk_points
 from .spec import LAW_SWEPT, SweepSpec
@@ -182,7 +182,7 @@ def model_answers(model: str, tau, T, k, NV, *, groups=_GROUP, **options) -> tup
     (docs/models.md), and a sweep usually has few distinct loops (a grid in V
     and T has one per T). So `loop_verdicts` is asked once per distinct loop
     for NV* and whether the stable set is the usual (0, NV*); there a point is
-    stable iff NV < NV*, with margin NV*/NV − 1 (`models.gain_margin`). Points
+    stable iff NV < NV*, labelled by the one verdict rule (`models.verdicts.judge_arrays`). Points
     within `SHORTCUT_BAND` of NV*, points with NV = 0 (the heading loop decides:
     docs/models.md, "N = 0") and every point of a loop with another stable
     set are decided by `loop_verdicts` at their own NV. With more than half as
@@ -202,9 +202,9 @@ def model_answers(model: str, tau, T, k, NV, *, groups=_GROUP, **options) -> tup
     with np.errstate(divide="ignore", invalid="ignore"):
         edge = (critical > 0) & np.isfinite(critical)
         near = ~regular | (NV == 0) | (edge & (np.abs(NV / np.where(edge, critical, 1.0) - 1.0) <= SHORTCUT_BAND))
-        stable = NV < critical
-        margin = critical / NV - 1.0
-    verdict = np.where(stable, "stable", "unstable").astype(object)
+    stable = (NV > 0) & (NV < critical)  # inside the stable set (0, NV*) of a regular loop; N < 0 diverges
+    verdict, margin = judge_arrays(NV, critical, stable)
+    verdict = verdict.astype(object)
     index = np.flatnonzero(near)
     if index.size:
         v = loop_verdicts(model, tau[index], T[index], k[index], NV[index], **options)
@@ -226,16 +226,14 @@ def _verdict_columns(spec: SweepSpec, inputs: dict, NV: np.ndarray, reasons: np.
     reasons[zero & ~given] = NEUTRAL_REASON  # the verdict is each model's own at NV = 0: its heading loop's
     undefined = beyond | given & ~negative & ~zero
     for i in np.flatnonzero(beyond & ~given):
-        reasons[i] = (f"N*V = {NV[i]:g} 1/s exceeds what the loop models represent (<= {NV_MAX:g} 1/s); "
-                      "choose a less extreme force law (f, n), angle or width")
-    safe = np.where(negative | beyond, 1.0, NV)  # NV* does not depend on NV; the answer there is overwritten
+        reasons[i] = beyond_reason(float(NV[i]))
+    safe = np.where(beyond, 1.0, NV)  # NV* does not depend on NV; the answer there is overwritten
     names, arrays = [], []
     groups = loop_groups(tau, T, inputs["k"])
     for model in spec.models:
         stable, verdict, critical, margin = model_answers(
             model, tau, T, inputs["k"], safe, groups=groups,
             hold=spec.controller.hold, compute_delay=spec.controller.compute_delay, pade_order=spec.pade_order)
-        stable[negative], verdict[negative], margin[negative] = False, "unstable", -1.0
         stable[undefined], verdict[undefined], margin[undefined] = False, None, math.nan
         names += list(model_columns(model))
         arrays += [stable, verdict, critical, margin]

@@ -34,7 +34,8 @@ import numpy as np
 
 from ..checks import check_choice, check_integer, check_number
 from ..models import Loop, make_model
-from ..models.base import NV_MAX, UNDECIDED_RTOL, _check_NV, gain_margin, verdict_label
+from ..models.base import _check_NV
+from ..models.verdicts import NV_MAX, gain_margin, judge_arrays, verdict_label
 from ..parameters import HOLDS, MODEL_NAMES
 from . import routes
 from .exact_delay import _check, heading_gain_array, resolved_lag_and_delay
@@ -153,18 +154,6 @@ def _regular_set(boundary) -> bool:
     return not boundary.stable_set or tuple(boundary.stable_set) == expected
 
 
-def _labels(NV, NV_critical, stable):
-    """`verdict_label` and `gain_margin` for stable sets (0, NV*) (or empty), in arrays (NV = 0: margin inf or −1)."""
-    edge = (NV_critical > 0) & np.isfinite(NV_critical)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        undecided = edge & (np.abs(NV / np.where(edge, NV_critical, 1.0) - 1.0) <= UNDECIDED_RTOL)
-        verdict = np.where(undecided, "undecided", np.where(stable, "stable", "unstable"))
-        below = (NV_critical > 0) & (NV_critical <= NV * (1 + UNDECIDED_RTOL))
-        margin = np.where(stable | below, NV_critical, 0.0) / NV - 1.0
-    margin[NV == 0] = np.where(stable[NV == 0], np.inf, -1.0)
-    return verdict, margin
-
-
 def _fallback(points, options):
     """The scalar model at every point (a route for a model without an array route)."""
     n = points[0].size
@@ -230,7 +219,7 @@ def _all_columns(name, points, shape, options) -> LoopVerdicts:
         scalar_model = make_model(name, pade_order=options["pade_order"], hold=options["hold"], compute_delay=options["compute_delay"])
         irregular = _scalar_route(scalar_model, points, scalar, answers, verdicts)
     NV = points[4]
-    verdict, margin = _labels(NV, answers.NV_critical, answers.stable)
+    verdict, margin = judge_arrays(NV, answers.NV_critical, answers.stable)
     if irregular:
         verdict = verdict.astype("<U9")
         for i, boundary in irregular:
