@@ -46,7 +46,8 @@ import numpy as np
 from ..laws.effective_force import GridWallLaw
 from ..laws.force_law import ForceLaw, PowerLaw
 from ..models import Loop, divergent_reason, gain_margin, models_for, neutral_reason, verdict_label
-from ..parameters import MAP_LAWS, Controller, Robot
+from ..laws.registry import MAP_LAWS
+from ..parameters import Controller, Robot
 from ..io.serialize import json_number
 from .equilibria import Samples, grid_equilibria, power_equilibria
 from .field import UNKNOWN_AS, HistogramMap, histogram_of
