@@ -1,8 +1,10 @@
 """Robot, controller and scenario parameters, every vocabulary and range, and the CARMEL preset.
 
 The one place where names and ranges live: model names, sampled structures,
-geometries, simulator environments and force laws, and `RANGES` (library,
-vectorized code and CLI). This module imports no numpy, so the command line
+geometries, simulator environments and robot families, and `RANGES` (library,
+vectorized code and CLI). The force laws, their parameters and who takes them
+are declared in the law registry (`pfm_stability.laws.registry`), whose ranges
+are the entries here. This module imports no numpy, so the command line
 can validate input before loading it. The presets (``CARMEL``, `PRESETS`) are
 the package's configuration files ``data/presets/*.yaml`` (docs/config.md),
 each read on first use.
@@ -30,6 +32,7 @@ __all__ = [
     "Range",
     "RANGES",
     "check_parameter",
+    "describe_parameter",
     "Robot",
     "Controller",
     "Wall",
@@ -44,19 +47,9 @@ __all__ = [
     "MODEL_NAMES",
     "GEOMETRIES",
     "ENVIRONMENTS",
-    "FORCE_LAWS",
-    "MAP_LAWS",
     "DOOR_OBSTACLES",
     "TRAPS_RESOLUTION",
-    "LAW_PARAMETERS",
-    "FIELD_DEFAULTS",
     "ROBOT_FAMILIES",
-    "FAMILY_LAWS",
-    "HOLONOMIC_LAWS",
-    "FAMILY_LAW_PARAMETERS",
-    "FAMILY_DEFAULTS",
-    "FAMILY_LAW_CHOICES",
-    "FAMILY_CHOICE_DEFAULTS",
     "DERIVATION_LAWS",
     "DEGREES_PER_RADIAN",
     "RADIANS_PER_DEGREE",
@@ -102,63 +95,9 @@ TRAPS_RESOLUTION = 81
 DOOR_OBSTACLES = ("posts", "wall-ends")
 """What bounds a door (KB Fig 4; docs/door.md): two posts, or the ends of two walls."""
 
-FORCE_LAWS = ("power", "grid", "khatib", "gnron")
-"""Lateral force laws by name: KB's lumped power law, the histogram grid's effective law, Khatib's
-repulsion and Ge & Cui 2000's goal-aware repulsion (docs/fields.md)."""
-
-MAP_LAWS = ("grid", "power")
-"""The `FORCE_LAWS` a map analysis takes (``pfm-stability map``, docs/maps.md): the histogram grid's window sum
-(its default) and KB's power law; Khatib's and the goal-aware laws need the distance to a goal, which a map does not give."""
-
-LAW_PARAMETERS = {
-    "power": ("f", "n"),
-    "grid": ("f", "n", "cell_ratio", "cell_size", "window_cells"),
-    "khatib": ("xi", "eta", "rho0", "attraction_exponent", "goal_distance"),
-    "gnron": ("xi", "eta", "rho0", "attraction_exponent", "goal_exponent", "goal_distance", "delta"),
-}
-"""The parameters (`RANGES` keys) each law of `FORCE_LAWS` takes beside the robot's width W
-(docs/fields.md, "Command line"); a parameter given to a law that does not take it is an error."""
-
-FIELD_DEFAULTS = {"xi": 1.0, "eta": 0.1, "rho0": 0.8, "attraction_exponent": 2.0, "goal_exponent": 2.0, "delta": 0.0}
-"""Defaults of the Khatib and goal-aware laws: Ge & Cui 2000 Sec VI (ξ = 1, η = 0.1, ρ0 = 0.8 m,
-m = n = 2) and δ = 0 (eq 8, not eq 40). The goal distance has no default."""
-
 ROBOT_FAMILIES = ("steering", "kinematic", "holonomic")
 """Robot loop families of ``report --robot`` (docs/models.md, "Robot loop families"): KB's steering
 robot, Ge & Cui 2002's kinematic steering (τ = 0, k = K_s) and the holonomic robot (force = acceleration)."""
-
-FAMILY_LAWS = ("velocity", "velocity-gated", "fuzzy")
-"""Laws of ``report --law`` beyond `FORCE_LAWS` (docs/velocity_and_fuzzy.md): Ge & Cui 2002's velocity
-attraction with Khatib's repulsion, its velocity-gated repulsion, and the DFAPF fuzzy-scheduled repulsion."""
-
-HOLONOMIC_LAWS = ("velocity", "velocity-gated")
-"""The laws a holonomic robot (``--robot holonomic``) takes: forces in newtons on a mass (Ge & Cui 2002 §6)."""
-
-FAMILY_LAW_PARAMETERS = {
-    "velocity": ("alpha_p", "alpha_v", "attraction_exponent", "velocity_exponent", "eta", "rho0", "goal_distance"),
-    "velocity-gated": ("alpha_p", "attraction_exponent", "eta", "rho0", "a_max", "goal_distance"),
-    "fuzzy": ("alpha_p", "attraction_exponent", "rho0", "goal_exponent", "goal_distance"),
-}
-"""The parameters (`RANGES` keys) each law of `FAMILY_LAWS` takes; the attraction F_a = mα_p ρ_g^(m−1) (N)."""
-
-FAMILY_DEFAULTS = {"alpha_p": 0.5, "alpha_v": 0.1, "attraction_exponent": 2.0, "velocity_exponent": 2.0, "eta": 0.1, "rho0": 0.8,
-                   "a_max": 1.0, "goal_distance": 1.0, "goal_exponent": 0.0, "mass": 1.0}
-"""Defaults of the `FAMILY_LAWS` (docs/velocity_and_fuzzy.md): F_a = 1 N (α_p = 0.5, m = 2, ρ_g = 1 m),
-α_v = 0.1 and n = 2 (Ge & Cui 2002 §6), η and ρ0 as `FIELD_DEFAULTS`, a_max = 1 m/s², no goal factor
-(the fuzzy law's ρ_gⁿ with n = 0), a robot of 1 kg."""
-
-FAMILY_LAW_CHOICES = {
-    "velocity": {},
-    "velocity-gated": {"variant": ("gradient", "squared", "paper-eq23")},
-    "fuzzy": {"side": ("left", "right"), "symmetrize": ("none", "negative", "positive")},
-}
-"""The choice-valued parameters of each law of `FAMILY_LAWS` and their values (docs/velocity_and_fuzzy.md):
-the velocity-gated repulsion's magnitude (Ge & Cui 2002 eq 12/19 gradient η/D², its square η(1/D − 1/ρ0)²,
-or eq 23 as printed η³(1/D − 1/ρ0)²), the fuzzy law's wall side and which half of the DFAPF tables is
-mirrored onto the other (none: the tables as printed)."""
-
-FAMILY_CHOICE_DEFAULTS = {"variant": "gradient", "side": "left", "symmetrize": "none"}
-"""Defaults of `FAMILY_LAW_CHOICES`: the gradient variant, a wall on the left, the tables as printed."""
 
 DERIVATION_LAWS = ("power", "general")
 """Force laws of the symbolic derivation (`pfm_stability.analysis.derivation`, ``pfm-stability derive --law``):
@@ -325,6 +264,14 @@ Entries beyond the robot, controller and geometry:
 
 SHOWN_AS = {"alpha_deg": "alpha", "T_sampled": "T"}
 """Range entries that stand for a parameter the user knows under another name."""
+
+
+def describe_parameter(key: str) -> str:
+    """``RANGES[key]`` for a help text, e.g. ``(0, 100] m/s``; an integer range exactly, ``[3, 1001] cells``."""
+    r = RANGES[key]
+    if isinstance(r.low, int) and isinstance(r.high, int):
+        return f"[{r.low}, {r.high}]" + (f" {r.unit}" if r.unit else "")
+    return r.describe()
 
 
 def check_parameter(name: str, value) -> float:
@@ -533,22 +480,27 @@ class _Presets(Mapping):
 def _read_preset(path: Path) -> Preset:
     """The `Preset` of a shipped file (docs/config.md: ``name``, ``source``, ``robot``, ``controller``, ``assumed``).
 
-    The file's values are checked by `Robot` and `Controller`; a key they do not
-    take is an error. (User files go through the stricter `pfm_stability.io.config`.)
+    Read by the package's one YAML reader (`pfm_stability.io.yaml_files`); the file's values are checked
+    by `Robot` and `Controller`, and a key they do not take is an error naming the file and its line.
+    (User files go through the stricter `pfm_stability.io.config`.)
     """
-    import yaml
+    from .io.yaml_files import read_yaml
 
-    data = yaml.safe_load(path.read_text(encoding="utf-8"))
+    document = read_yaml(path, "preset")
+    data = document.data
     robot = dict(data["robot"])
     if "max_steering_rate" in robot:  # deg/s in the file, as angles everywhere at the edges
         robot["max_steering_rate"] = math.radians(robot["max_steering_rate"])
-    try:
-        return Preset(
-            name=data.get("name", path.stem), robot=Robot(**robot), controller=Controller(**data["controller"]),
-            assumed=dict(data.get("assumed") or {}), source=data.get("source", ""),
-        )
-    except TypeError as exc:  # an unknown key
-        raise ValueError(f"preset {path.name}: {exc}") from None
+    built = {}
+    for section, cls, values in (("robot", Robot, robot), ("controller", Controller, data["controller"])):
+        try:
+            built[section] = cls(**values)
+        except (TypeError, ValueError) as exc:  # an unknown key, a value out of range
+            raise document.error(f"{section}: {exc}", section) from None
+    return Preset(
+        name=data.get("name", path.stem), robot=built["robot"], controller=built["controller"],
+        assumed=dict(data.get("assumed") or {}), source=data.get("source", ""),
+    )
 
 
 PRESETS = _Presets(PRESET_DIRECTORY)

@@ -68,3 +68,33 @@ def disk_full(room: int):
         yield
     finally:
         files.open_new = saved
+
+
+WHOLE_FILE = ("the file", "not valid YAML", "none of", "must be", "key ")
+"""How the details about a whole file start (no key of its own)."""
+
+
+def file_error(message: str, origin: str, path=None) -> str:
+    """The detail of a file's one-line error ``<origin>, line <n>: <detail>``, after checking its form.
+
+    With `path` (the file), the line is checked to be the one that holds the key the detail starts with
+    (``robot.V must be …``: a line with ``V:``); a detail about the whole file (its shape, its YAML, keys not
+    found: `WHOLE_FILE`) only needs a line of the file (or the one after it, where YAML found the end too soon).
+    This is what `pfm_stability.io.yaml_files` promises for every file it reads.
+    """
+    import re
+
+    from pfm_stability.io.yaml_files import leading_key
+
+    match = re.fullmatch(rf"{re.escape(origin)}, line (\d+): (.*)", message)
+    assert match, f"not '<{origin}>, line N: …': {message!r}"
+    line, detail = int(match[1]), match[2]
+    if path is not None:
+        lines = open(path, encoding="utf-8").read().splitlines()
+        assert 1 <= line <= len(lines) + 1, (line, message)
+        key = leading_key(detail)
+        if detail.startswith(WHOLE_FILE) or key is None:
+            return detail
+        name = re.split(r"[.\[]", key.rstrip("]"))[-1]
+        assert re.search(rf"(^|[\s{{,-])'?{re.escape(name)}'?\s*:", lines[line - 1]), f"line {line} {lines[line - 1]!r} does not hold {key}: {message}"
+    return detail

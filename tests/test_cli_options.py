@@ -226,15 +226,17 @@ def test_validate_prints_plain_lines_in_a_log_and_nothing_when_quiet(capsys, ter
 
 
 def test_start_up_imports_nothing_heavy():
-    """Building the parser and parsing (what every command does first) import no tqdm, matplotlib, scipy or sympy;
-    a report does not import tqdm or matplotlib either."""
+    """Building the parser and parsing (what every command does first, and all of ``--help``) import no numpy, PyYAML,
+    tqdm, matplotlib, scipy or sympy: the law options come from the numpy-free law registry and files are read only
+    when a command runs; a report does not import tqdm or matplotlib either."""
     code = (
         "import sys\n"
         "from pfm_stability.cli import build_parser, main\n"
         "for argv in (['report', '--L', '1'], ['simulate', '--scenario', 'wall', '--plot', 'x.png', '--quiet'],"
-        " ['validate', '--scenario', 'wall', '--sweep', '8'], ['plot', 'rlocus', '--out', 'x.png'], ['derive']):\n"
+        " ['validate', '--scenario', 'wall', '--sweep', '8'], ['plot', 'rlocus', '--out', 'x.png'], ['derive'],"
+        " ['map', 'depot'], ['sweep', 's.yaml', '--out', 'x.parquet']):\n"
         "    build_parser().parse_args(argv)\n"
-        "heavy = ('tqdm', 'matplotlib', 'scipy', 'sympy')\n"
+        "heavy = ('numpy', 'yaml', 'tqdm', 'matplotlib', 'scipy', 'sympy')\n"
         "print(sorted(m for m in heavy if m in sys.modules))\n"
         "main(['report', '--L', '1'])\n"
         "print(sorted(m for m in ('tqdm', 'matplotlib') if m in sys.modules))\n"

@@ -27,6 +27,7 @@ from pfm_stability.cli import options as cli_options
 from pfm_stability.io.config import Config, config_from_mapping, load_config
 from pfm_stability.parameters import Controller, Robot, get_preset
 from pfm_stability.io.schema import load_schema
+from cli_helpers import file_error
 
 VALIDATOR = Draft202012Validator(load_schema())
 
@@ -250,7 +251,7 @@ BAD = [
     ({"law": {"name": "magnetic"}}, "law.name must be one of power, grid, khatib, gnron; got 'magnetic'"),
     ({"law": {"name": "power", "xi": 1}}, "law.xi applies to khatib or gnron, not to law power"),
     ({"law": {"name": "grid", "window_cells": 32}}, "law.window_cells must be an odd integer in [3, 1001]; got 32"),
-    ({"law": "grid"}, "law must be a mapping of key: value with keys name, cell_ratio"),
+    ({"law": ["grid"]}, "law must be a law's name or a mapping of key: value with keys name, cell_ratio"),
     ({"scenario": {"wall": {"alpha": 95}}}, "scenario.wall.alpha must be a finite number in [1e-06, 89.999999] deg; got 95"),
     ({"scenario": {"door": {"width": 1}}}, "scenario.door is not a key; scenario takes wall, corridor"),
     ({"scenario": {"corridor": [0.9]}}, "scenario.corridor must be a mapping"),
@@ -261,18 +262,18 @@ BAD = [
     ({"name": 3}, "name must be a text; got 3"),
     ("- 1\n- 2\n", "the file must be a mapping of key: value with keys preset"),
     ("robot: {V: [1\n", "not valid YAML: expected ',' or ']'"),
-    ("robot:\n  V: 1\n  V: 2\n", "V is given twice (line 3)"),
+    ("robot:\n  V: 1\n  V: 2\n", "robot.V is given twice"),
 ]
 
 
 @pytest.mark.parametrize("data, message", BAD, ids=[m.split(" ")[0] + f"-{i}" for i, (_, m) in enumerate(BAD)])
 def test_bad_file_is_a_one_line_error(tmp_path, capsys, data, message):
     """Each bad key, type, range or shape: ValueError from the library, exit 2 from every command, one
-    line naming the file and the key."""
+    line naming the file, the line of the key and the key (`cli_helpers.file_error` checks the line holds it)."""
     path = write(tmp_path, data)
     with pytest.raises(ValueError) as caught:
         load_config(path)
-    assert str(caught.value).startswith(f"config {path}: {message}")
+    assert file_error(str(caught.value), f"config {path}", path).startswith(message)
     assert "\n" not in str(caught.value)
     for command in (["report", "--alpha", "20"], ["plot", "force-law", "--out", str(tmp_path / "x.png")]):
         code, out, err = run(capsys, *command, "--config", path)
@@ -411,6 +412,6 @@ def test_nav2_bad_values(tmp_path, capsys, kwargs, message):
     path = nav2(tmp_path, **kwargs)
     with pytest.raises(ValueError) as caught:
         load_config(path)
-    assert message in str(caught.value) and str(caught.value).startswith(f"Nav2 {path}: ")
+    assert message in file_error(str(caught.value), f"Nav2 {path}", path)
     code, _, err = run(capsys, "report", "--config", path, "--L", "1")
     assert code == 2 and err == f"pfm-stability: error: {caught.value}\n"

@@ -22,6 +22,7 @@ import yaml
 from pfm_stability.cli import main
 from pfm_stability.io.config import load_config
 from pfm_stability.sweeps.spec import load_spec
+from cli_helpers import file_error
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLE = ROOT / "docs" / "examples" / "holonomic_robot.yaml"
@@ -216,7 +217,7 @@ def test_bad_family_keys_are_one_line_errors(tmp_path, capsys, data, message):
     path = write(tmp_path, data)
     with pytest.raises(ValueError) as caught:
         load_config(path)
-    assert str(caught.value).startswith(f"config {path}: {message}") and "\n" not in str(caught.value)
+    assert file_error(str(caught.value), f"config {path}", path).startswith(message) and "\n" not in str(caught.value)
     code, out, err = run(capsys, "report", "--config", path, "--L", "1")
     assert (code, out, err) == (2, "", f"pfm-stability: error: {caught.value}\n")
 
@@ -270,7 +271,8 @@ def test_sweep_refuses_families_and_family_laws(tmp_path, config, key):
     spec = write(tmp_path, "config: robot.yaml\nscenario: {corridor: {L: 1}}\ngrid: {V: {from: 0.2, to: 1.0, num: 3}}\n", "spec.yaml")
     with pytest.raises(ValueError) as caught:
         load_spec(spec)
-    assert str(caught.value).startswith(f"spec {spec}: config: {key} is not supported: sweeps analyse KB's steering robot")
+    detail = file_error(str(caught.value), f"spec {spec}", spec)
+    assert detail.startswith(f"config: {key} is not supported: sweeps analyse KB's steering robot")
     if "family" not in config.get("robot", {}):
         own = write(tmp_path, "config: robot.yaml\nlaw: {name: power}\nscenario: {corridor: {L: 1}}\ngrid: {V: {from: 0.2, to: 1.0, num: 3}}\n",
                     "own.yaml")

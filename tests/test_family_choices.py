@@ -19,7 +19,7 @@ import numpy as np
 import pytest
 import yaml
 import cli_helpers
-from cli_helpers import run
+from cli_helpers import file_error, run
 from scipy.optimize import brentq
 
 from pfm_stability.report.families import make_family_law
@@ -217,4 +217,5 @@ def test_config_refuses_bad_choices(tmp_path, law, message):
     path = _write(tmp_path, {"law": law})
     code, out, err = run(["report", "--config", str(path), "--alpha", "60"])
     assert (code, out) == (2, ""), err
-    assert err == f"pfm-stability: error: config {path}: {message}\n"
+    assert err.startswith("pfm-stability: error: ") and err.endswith("\n") and err.count("\n") == 1
+    assert file_error(err.removeprefix("pfm-stability: error: ").rstrip("\n"), f"config {path}", path) == message

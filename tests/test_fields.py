@@ -400,12 +400,12 @@ def test_report_law_option_json_and_text():
 @pytest.mark.parametrize(
     "argv, message",
     [
-        (["--xi", "1"], "--xi applies to khatib or gnron, not to --law power"),
+        (["--xi", "1"], "--xi applies to --law khatib or gnron, not to --law power"),
         (["--law", "khatib"], "--law khatib needs --goal-distance"),
-        (["--law", "khatib", "--goal-distance", "1", "--goal-exponent", "1"], "--goal-exponent applies to gnron, not to --law khatib"),
-        (["--law", "gnron", "--goal-distance", "1", "--f", "2"], "--f applies to power or grid, not to --law gnron"),
-        (["--law", "grid", "--rho0", "1"], "--rho0 applies to khatib or gnron, not to --law grid"),
-        (["--law", "power", "--cell-ratio", "0.1"], "--cell-ratio applies to grid, not to --law power"),
+        (["--law", "khatib", "--goal-distance", "1", "--goal-exponent", "1"], "--goal-exponent applies to --law gnron or fuzzy, not to --law khatib"),
+        (["--law", "gnron", "--goal-distance", "1", "--f", "2"], "--f applies to --law power or grid, not to --law gnron"),
+        (["--law", "grid", "--rho0", "1"], "--rho0 applies to --law khatib, gnron, velocity, velocity-gated or fuzzy, not to --law grid"),
+        (["--law", "power", "--cell-ratio", "0.1"], "--cell-ratio applies to --law grid, not to --law power"),
         (["--law", "khatib", "--goal-distance", "0"], "argument --goal-distance: goal_distance must be a finite number in [0.001, 10000] m"),
     ],
 )

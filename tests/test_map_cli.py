@@ -28,6 +28,7 @@ from PIL import Image
 from pfm_stability.cli import main
 from pfm_stability.maps.outputs import pixel_to_percent
 from pfm_stability.io.schema import load_schema
+from cli_helpers import file_error
 
 MAPS = Path(str(resources.files("pfm_stability").joinpath("data", "maps")))
 VALIDATOR = Draft202012Validator(load_schema())
@@ -120,7 +121,7 @@ def _edit(path: Path, **changes) -> None:
 BAD_MAPS = {
     "missing image": (lambda p: _edit(p, image="nothing.pgm"), "does not exist"),
     "image not an image": (lambda p: (p.parent / "depot.pgm").write_text("P5 not really"), "not a readable image"),
-    "unreadable YAML": (lambda p: p.write_text("image: [unclosed\n"), "is not YAML"),
+    "unreadable YAML": (lambda p: p.write_text("image: [unclosed\n"), "not valid YAML"),
     "missing key": (lambda p: _edit(p, resolution=None), "key 'resolution' is missing"),
     "resolution <= 0": (lambda p: _edit(p, resolution=0), "resolution must be"),
     "threshold above 1": (lambda p: _edit(p, occupied_thresh=1.5), "occupied_thresh must be"),
@@ -132,10 +133,15 @@ BAD_MAPS = {
 }
 
 
+ANALYSIS_ERRORS = ("no free space", "no route long enough")
+"""Cases of `BAD_MAPS` that the analysis refuses (a good file of a map without corridors), not the map reader."""
+
+
 @pytest.mark.parametrize("case", list(BAD_MAPS))
 def test_bad_map_exits_2_and_writes_nothing(tmp_path, case):
-    """Each bad map: exit 2, one line "pfm-stability: error: map '...': <problem>" (or the analysis' message), no traceback,
-    and the output directory (created on success only) does not exist afterwards."""
+    """Each bad map: exit 2, one line "pfm-stability: error: map FILE, line N: <problem>" with the line of the key it names
+    (`cli_helpers.file_error`; or the analysis' message), no traceback, and the output directory (created on success only)
+    does not exist afterwards."""
     spoil, message = BAD_MAPS[case]
     path = _copy_map(tmp_path)
     spoil(path)
@@ -143,6 +149,8 @@ def test_bad_map_exits_2_and_writes_nothing(tmp_path, case):
     code, stdout, err = run(["map", str(path), "--out-dir", str(out), "--quiet"])
     assert code == 2 and stdout == ""
     assert err.startswith("pfm-stability: error: ") and message in err and len(err.strip().splitlines()) == 1
+    if case not in ANALYSIS_ERRORS:
+        assert message in file_error(err.removeprefix("pfm-stability: error: ").rstrip("\n"), f"map {path}", path)
     assert not out.exists()
 
 

@@ -140,7 +140,7 @@ def test_velocity_gated_with_a_continuous_controller_has_no_cycle():
 
 @pytest.mark.parametrize("argv,message", [
     (["--alpha-v", "-1", "--law", "velocity", "--L", "1"], "argument --alpha-v: alpha_v must be a finite number in [0, 1000000] N s/m"),
-    (["--alpha-p", "1", "--L", "1"], "--alpha-p applies to --law velocity or velocity-gated or fuzzy, not to --law power"),
+    (["--alpha-p", "1", "--L", "1"], "--alpha-p applies to --law velocity, velocity-gated or fuzzy, not to --law power"),
     (["--law", "velocity", "--xi", "1", "--L", "1"], "--xi applies to --law khatib or gnron, not to --law velocity"),
     (["--law", "fuzzy", "--alpha-v", "1", "--alpha", "60"], "--alpha-v applies to --law velocity, not to --law fuzzy"),
     (["--law", "velocity", "--f", "2", "--alpha", "60"], "--f applies to --law power or grid, not to --law velocity"),

@@ -279,7 +279,7 @@ def test_config_file_gives_the_fixed_values(tmp_path):
     assert (s.robot.V, s.robot.k, s.controller.T, s.controller.hold, s.controller.compute_delay) == (0.5, 3.0, 0.05, "reference", 0)
     assert (s.geometry, s.geometry_value) == ("wall", 25.0)
     (tmp_path / "bad.yaml").write_text("config: missing.yaml\ngrid: {tau: {from: 0.1, to: 0.6, num: 3}}\n")
-    with pytest.raises(ValueError, match="bad.yaml: config: .*missing.yaml"):
+    with pytest.raises(ValueError, match=r"bad.yaml, line \d+: config: .*missing.yaml"):
         load_spec(tmp_path / "bad.yaml")
 
 

@@ -390,7 +390,7 @@ def test_cli_bad_scene_exits_2_naming_the_field(tmp_path, name):
 @pytest.mark.parametrize(
     "argv, message",
     [
-        (["traps", "/nonexistent/scene.yaml"], "cannot be read"),
+        (["traps", "/nonexistent/scene.yaml"], "scene /nonexistent/scene.yaml: cannot read the file (No such file or directory)"),
         (["traps", "gc2000_fig3", "--resolution", "5"], "resolution must be an integer in [10, 1000]; got '5'"),
         (["traps", "gc2000_fig3", "--resolution", "x"], "resolution must be an integer"),
         (["traps", "gc2000_fig3", "--plot", "/nonexistent/dir/x.png"], "plot must be a writable file path ending in .png"),
@@ -406,9 +406,9 @@ def test_cli_bad_arguments_exit_2(argv, message):
 def test_cli_not_yaml_and_not_a_mapping(tmp_path):
     path = tmp_path / "x.yaml"
     path.write_text("law: [unclosed\n")
-    assert "is not YAML" in run_cli(["traps", str(path)])[2]
+    assert f"scene {path}, line 2: not valid YAML" in run_cli(["traps", str(path)])[2]
     path.write_text("just text\n")
     assert "scene must be a mapping" in run_cli(["traps", str(path)])[2]
     path.write_bytes(b"\xff\xfe\x00bad")
     code, _, err = run_cli(["traps", str(path)])
-    assert code == 2 and "cannot be read" in err
+    assert code == 2 and f"scene {path}: cannot read the file" in err

@@ -23,7 +23,8 @@ from __future__ import annotations
 
 import argparse
 
-from ..parameters import MAP_LAWS, MODEL_NAMES
+from ..laws.registry import DEFAULT_LAW, laws_for
+from ..parameters import MODEL_NAMES
 from .options import add_law_options, add_parameter_options, describe, integer, number, resolve_law, resolve_parameters, shipped_or_given
 
 FORMATS = ("text", "json")
@@ -54,7 +55,7 @@ def add_parser(sub) -> None:
     )
     p.add_argument("map", metavar="MAP", help=f"map_server YAML file, or a shipped map: {', '.join(SHIPPED_MAPS)}")
     add_parameter_options(p)
-    add_law_options(p, MAP_LAWS, default="grid")  # a Default: a --config FILE's law beats it (`options.typed`)
+    add_law_options(p, laws_for("map"), default=DEFAULT_LAW["map"])  # a Default: a --config FILE's law beats it (`options.typed`)
     p.add_argument("--model", choices=MODEL_NAMES, default="sampled",
                    help="loop model of the verdicts (default sampled, with the controller's hold and compute delay)")
     p.add_argument("--out-dir", type=_out_dir, metavar="DIR",

@@ -14,7 +14,9 @@ from dataclasses import dataclass, fields
 from typing import TYPE_CHECKING
 
 from ..checks import check_integer, check_number, check_output_path
-from ..parameters import FAMILY_CHOICE_DEFAULTS, FAMILY_LAW_CHOICES, FAMILY_LAW_PARAMETERS, FAMILY_LAWS, FIELD_DEFAULTS, FORCE_LAWS, HOLDS, HOLONOMIC_LAWS, LAW_PARAMETERS, PRESETS, RANGES, ROBOT_FAMILIES, SHOWN_AS, Controller, Preset, Robot, get_preset
+from ..laws.registry import (COMMANDS, LAW_NAMES, MASS, PARAMETERS, check_parameters, choice_help, choice_keys, get_law, law_help,
+                             laws_for, laws_of_family, option_help, option_name, parameter_keys, takers)
+from ..parameters import HOLDS, PRESETS, RANGES, ROBOT_FAMILIES, SHOWN_AS, Controller, Preset, Robot, describe_parameter, get_preset
 
 if TYPE_CHECKING:
     from ..io.config import Config
@@ -31,12 +33,9 @@ __all__ = [
     "ResolvedParameters",
     "Default",
     "typed",
-    "LAW_OPTIONS",
     "add_law_options",
     "resolve_law",
     "shipped_or_given",
-    "FAMILY_OPTIONS",
-    "FAMILY_CHOICE_OPTIONS",
     "add_family_options",
     "resolve_family",
     "ResolvedFamily",
@@ -48,11 +47,8 @@ def _shown(key: str) -> str:
 
 
 def describe(key: str) -> str:
-    """``RANGES[key]`` for a help text, e.g. ``(0, 100] m/s`` or ``[3, 1000]`` (integers exactly)."""
-    r = RANGES[key]
-    if isinstance(r.low, int) and isinstance(r.high, int):
-        return f"[{r.low}, {r.high}]" + (f" {r.unit}" if r.unit else "")
-    return r.describe()
+    """``RANGES[key]`` for a help text, e.g. ``(0, 100] m/s`` or ``[3, 1000]`` (integers exactly): `parameters.describe_parameter`."""
+    return describe_parameter(key)
 
 
 def check(key: str, value) -> float:
@@ -302,52 +298,47 @@ def _fields(obj) -> dict:
     return {f.name: getattr(obj, f.name) for f in fields(obj)}
 
 
-# ------------------------------------------------------------------ force laws
-LAW_OPTIONS = {
-    "cell_ratio": "grid: force ratio F_cr/F_ct per cell (default: calibrated so that f_av = f, KB §4)",
-    "cell_size": "grid: cell size (default 0.1)",
-    "window_cells": "grid: active window side, odd (default 33)",
-    "xi": "khatib/gnron: attractive scaling factor xi (default 1)",
-    "eta": "khatib/gnron: repulsive scaling factor eta (default 0.1)",
-    "rho0": "khatib/gnron: influence distance rho0 (default 0.8)",
-    "attraction_exponent": "khatib/gnron: m of U_att = xi rho_g^m / 2 (default 2)",
-    "goal_exponent": "gnron: n of the goal-aware repulsion U_rep rho_g^n (default 2)",
-    "goal_distance": "khatib/gnron: the frozen distance to the goal rho_g (required)",
-    "delta": "gnron: surface offset delta of Ge & Cui eq (40) (default 0)",
-}
-"""The law options (`parameters.RANGES` keys) and their help, as ``--cell-ratio`` … ``--delta`` (docs/fields.md)."""
-
-_FIELD_SOURCE = "default (Ge & Cui 2000 Sec VI)"
-
-
-def _option(name: str) -> str:
-    return "--" + name.replace("_", "-")
+# ------------------------------------------------------------------ force laws (the law registry)
+def add_law_options(parser: argparse.ArgumentParser, laws=LAW_NAMES, default: str = "power") -> None:
+    """--law (one of `laws`, `default` unless a configuration file names one) and an option for every parameter and
+    choice of those laws, all as the law registry declares them (`laws.registry`: help, default, range); each applies
+    to the laws that take it (`resolve_law`, `resolve_family`). The help names only `laws`."""
+    title, text = law_help(laws, default)
+    group = parser.add_argument_group(title)
+    ordered = (default, *(name for name in laws if name != default))
+    group.add_argument("--law", choices=ordered, default=Default(default), help=text)
+    for key in parameter_keys(laws):
+        kind = integer(key, odd=True) if PARAMETERS[key].odd else number(key)
+        group.add_argument(option_name(key), type=kind, help=option_help(key, laws))
+    for key in choice_keys(laws):
+        values = get_law(takers(key, laws)[0]).choice(key).values
+        group.add_argument(option_name(key), choices=values, help=choice_help(key, laws))
 
 
-LAW_HELP = {"power": "KB's power law f(W/d)^n", "grid": "the histogram grid's law", "khatib": "Khatib's repulsion",
-            "gnron": "Ge & Cui's goal-aware repulsion (gnron)"}
-"""How ``--law``'s help names each of `parameters.FORCE_LAWS`."""
+def _offered(args) -> tuple:
+    """The laws the command offers (`registry.laws_for`), for refusals; every law for a command not in the registry."""
+    command = getattr(args, "command", None)
+    return laws_for(command) if command in COMMANDS else LAW_NAMES
 
 
-def add_law_options(parser: argparse.ArgumentParser, laws=FORCE_LAWS, default: str = "power") -> None:
-    """--law (one of `laws`, `default` unless a configuration file names one) and the options of those laws (`LAW_OPTIONS`
-    that `parameters.LAW_PARAMETERS` gives them); each applies to its laws only. The help names only `laws`."""
-    group = parser.add_argument_group("force law (docs/fields.md)")
-    extra = "; velocity, velocity-gated, fuzzy: docs/velocity_and_fuzzy.md" if len(laws) > len(FORCE_LAWS) else ""
-    named = [LAW_HELP[law] + (" (default, unless the configuration file names one)" if law == default else "")
-             for law in FORCE_LAWS if law in laws]
-    group.add_argument("--law", choices=laws, default=Default(default),
-                       help=f"lateral force law: {', '.join(named[:-1])}{' or ' if len(named) > 1 else ''}{named[-1]}{extra}")
-    taken = {name for law in laws for name in LAW_PARAMETERS.get(law, ())}
-    for name, text in LAW_OPTIONS.items():
-        if name not in taken:
-            continue
-        kind = integer(name, odd=True) if name == "window_cells" else number(name)
-        group.add_argument(_option(name), type=kind, help=f"{text}, {describe(name)}")
+def _typed_law_keys(args, params: ResolvedParameters) -> list:
+    """The law keys typed on the command line: f and n (the controller's, which only KB's laws read), then every
+    parameter and choice option of the registry the command has and the user gave, in registry order."""
+    typed_fn = [key for key in ("f", "n") if params.sources.get(key) == "user"]
+    return typed_fn + [key for key in (*parameter_keys(), *choice_keys()) if getattr(args, key, None) is not None]
+
+
+def _law_in_force(args, params: ResolvedParameters):
+    """(law, how the user named it, the configuration file's law mapping or {}) for ``--law`` or the file's law."""
+    from_file = (params.config.law if params.config is not None else None) or {}
+    by_user = typed(args, "law") or not from_file
+    name = str(args.law) if by_user else from_file["name"]
+    shown = f"--law {name}" if by_user else f"law {name} of --config {params.config.path}"
+    return get_law(name), shown, from_file
 
 
 def resolve_law(args, params: ResolvedParameters):
-    """The law of ``--law`` (else the configuration file's) and the sources of its parameters: (law, sources).
+    """The static law of ``--law`` (else the configuration file's) and the sources of its parameters: (law, sources).
 
     A configuration file's law parameters apply when its law is the one in force;
     an option typed beats them.
@@ -355,71 +346,36 @@ def resolve_law(args, params: ResolvedParameters):
     Raises
     ------
     ValueError
-        An option the law does not take (``--xi applies to khatib or gnron, not to --law power``),
-        or ``--law khatib``/``gnron`` without ``--goal-distance``.
+        A law built by the report only (``law velocity of --config FILE is analysed by report only …``),
+        an option the law does not take (`registry.refusal`: ``--xi applies to --law khatib or gnron,
+        not to --law power``), or ``--law khatib``/``gnron`` without ``--goal-distance``.
     """
-    from ..laws.fields import check_law_parameters, make_law
+    from ..laws.fields import make_law
 
-    from_file = (params.config.law if params.config is not None else None) or {}
-    law_name = args.law if typed(args, "law") or not from_file else from_file["name"]
-    if law_name in FAMILY_LAWS:
-        raise ValueError(f"law {law_name} of --config {params.config.path} is analysed by report only (docs/velocity_and_fuzzy.md); "
-                         f"this command takes --law {', '.join(FORCE_LAWS)}")
-    given = {key: getattr(args, key) for key in LAW_OPTIONS if getattr(args, key, None) is not None}
-    filed = {k: v for k, v in from_file.items() if k != "name" and k not in given} if from_file.get("name") == law_name else {}
-    typed_fn = [key for key in ("f", "n") if params.sources.get(key) == "user"]
-    shown = f"--law {law_name}" if typed(args, "law") or not from_file else f"law {law_name} of --config {params.config.path}"
-    check_law_parameters(law_name, typed_fn + list(given) + list(filed), _option, shown)
-    law = make_law(law_name, params.robot, params.controller, **given, **filed)
+    law, shown, from_file = _law_in_force(args, params)
+    if law.kind != "static":
+        static = [name for name in _offered(args) if get_law(name).kind == "static"]
+        raise ValueError(f"law {law.name} of --config {params.config.path} is analysed by report only ({law.doc}); "
+                         f"this command takes --law {', '.join(static)}")
+    given = {key: getattr(args, key) for key in parameter_keys() if getattr(args, key, None) is not None}
+    filed = {k: v for k, v in from_file.items() if k != "name" and k not in given} if from_file.get("name") == law.name else {}
+    check_parameters(law.name, _typed_law_keys(args, params) + list(filed), shown=option_name, law_shown=shown, laws=_offered(args))
+    built = make_law(law.name, params.robot, params.controller, **given, **filed)
     sources = {}
-    for name in LAW_PARAMETERS[law_name]:
-        if name in ("f", "n"):
-            continue
-        if name in given:
-            sources[name] = "user"
-        elif name in filed:
-            sources[name] = params.config.sources[name]
-        elif name == "cell_ratio":
-            sources[name] = "calibrated so that f_av = f (KB §4)"
-        else:
-            sources[name] = "default (0: Ge & Cui eq 8)" if name == "delta" else _FIELD_SOURCE if name in FIELD_DEFAULTS else "default (KB §2)"
-    return law, sources
-
+    for setting in law.settings:
+        key = setting.key
+        sources[key] = "user" if key in given else params.config.sources[key] if key in filed else setting.source
+    return built, sources
 
 
 # ------------------------------------------------------------------ robot families (report)
-FAMILY_OPTIONS = {
-    "alpha_p": "velocity, velocity-gated, fuzzy: position gain alpha_p; F_a = m alpha_p rho_g^(m-1) (default 0.5)",
-    "alpha_v": "velocity: velocity gain alpha_v of GC2002 eq 1 (default 0.1)",
-    "velocity_exponent": "velocity: n of alpha_v |de/dt|^n (default 2)",
-    "a_max": "velocity-gated: braking deceleration a_max of GC2002 eq 11 (default 1)",
-}
-"""The new laws' own options (`parameters.RANGES` keys), as ``--alpha-p`` … ``--a-max`` (docs/velocity_and_fuzzy.md)."""
-
-FAMILY_CHOICE_OPTIONS = {
-    "variant": "velocity-gated: the repulsion's magnitude: gradient eta/D^2 (Ge & Cui 2002 eq 12, 19; default), "
-               "squared eta(1/D - 1/rho0)^2, or paper-eq23 eta^3(1/D - 1/rho0)^2 (eq 23 as printed)",
-    "side": "fuzzy: the wall's side (the DFAPF tables are asymmetric; default left)",
-    "symmetrize": "fuzzy: make the DFAPF tables left-right symmetric by copying the rows of negative (obstacle on the right) "
-                  "or positive bearings onto the others (default none: the tables as printed)",
-}
-"""Help of the laws' choice-valued options (`parameters.FAMILY_LAW_CHOICES`), as ``--variant``, ``--side``, ``--symmetrize``."""
-
-_FAMILY_SOURCE = "default (docs/velocity_and_fuzzy.md)"
-
-
 def add_family_options(parser: argparse.ArgumentParser) -> None:
-    """--robot, --mass, --no-simulate and the options of `FAMILY_OPTIONS` and `FAMILY_CHOICE_OPTIONS` (``report`` only)."""
-    group = parser.add_argument_group("robot family and velocity/fuzzy laws (docs/velocity_and_fuzzy.md)")
+    """--robot, --mass and --no-simulate (``report`` only; the laws' options are `add_law_options`')."""
+    group = parser.add_argument_group("robot family (docs/velocity_and_fuzzy.md)")
     group.add_argument("--robot", choices=ROBOT_FAMILIES, default=Default("steering"),
                        help="loop family: KB's steering robot (default), kinematic steering (tau = 0, --k is K_s) "
-                            "or holonomic (force = acceleration; --law velocity or velocity-gated)")
-    group.add_argument("--mass", type=number("mass"), help=f"holonomic robot mass, {describe('mass')} (default 1)")
-    for name, text in FAMILY_OPTIONS.items():
-        group.add_argument(_option(name), type=number(name), help=f"{text}, {describe(name)}")
-    for name, text in FAMILY_CHOICE_OPTIONS.items():
-        values = next(choices[name] for choices in FAMILY_LAW_CHOICES.values() if name in choices)
-        group.add_argument(_option(name), choices=values, help=text)
+                            f"or holonomic (force = acceleration; --law {' or '.join(laws_of_family('holonomic'))})")
+    group.add_argument("--mass", type=number("mass"), help=f"holonomic robot mass, {describe('mass')} (default {MASS.default:g})")
     group.add_argument("--no-simulate", action="store_true",
                        help="velocity-gated: do not simulate the wall's limit cycle (the report gives the rest band only)")
 
@@ -446,7 +402,7 @@ class ResolvedFamily:
 
 
 def resolve_family(args, params: ResolvedParameters) -> ResolvedFamily:
-    """``--robot``, ``--law`` and their options: a static law through `resolve_law`, a law of `FAMILY_LAWS` here.
+    """``--robot``, ``--law`` and their options: a static law through `resolve_law`, a law the report builds here.
 
     Precedence as `resolve_parameters`: an option typed > the ``--config`` file's
     ``robot.family``, ``robot.mass`` and ``law`` (docs/config.md) > the defaults.
@@ -456,13 +412,12 @@ def resolve_family(args, params: ResolvedParameters) -> ResolvedFamily:
     Raises
     ------
     ValueError
-        An option the law or the robot family does not take (``--alpha-p applies to
-        --law velocity, velocity-gated or fuzzy, not to --law power``, ``--mass applies
+        An option the law or the robot family does not take (`registry.refusal`: ``--alpha-p applies to
+        --law velocity, velocity-gated or fuzzy, not to --law power``; ``--mass applies
         to --robot holonomic``), or a value out of range.
     """
     config = params.config
     filed_family = config.family if config is not None else None
-    from_file = (config.law if config is not None else None) or {}
     by_user = typed(args, "robot") or filed_family is None
     family = str(args.robot) if by_user else filed_family
     robot_shown = f"--robot {family}" if by_user else f"robot family {family} of --config {config.path}"
@@ -470,53 +425,31 @@ def resolve_family(args, params: ResolvedParameters) -> ResolvedFamily:
     if args.mass is not None and family != "holonomic":
         raise ValueError(f"--mass applies to --robot holonomic, not to {robot_shown}")
     filed_mass = config.mass if config is not None and family == "holonomic" and args.mass is None else None
-    mass = args.mass if args.mass is not None else filed_mass if filed_mass is not None else 1.0
-    sources["mass"] = "user" if args.mass is not None else config.sources["mass"] if filed_mass is not None else "default (1 kg)"
-    law_by_user = typed(args, "law") or not from_file
-    law_name = str(args.law) if law_by_user else from_file["name"]
-    law_shown = f"--law {law_name}" if law_by_user else f"law {law_name} of --config {config.path}"
-    if family == "holonomic" and law_name not in HOLONOMIC_LAWS:
-        raise ValueError(f"{robot_shown} takes --law velocity or velocity-gated (a force in newtons on a mass, Ge & Cui 2002 Sec 6); got {law_shown}")
-    typed_family = [k for k in FAMILY_OPTIONS if getattr(args, k, None) is not None]
-    if law_name not in FAMILY_LAWS:
-        if typed_family:
-            _refuse(typed_family[0], FAMILY_LAW_PARAMETERS, law_shown)
-        _check_choices_taken(args, None, law_shown)
-        law, law_sources = resolve_law(args, params)
-        return ResolvedFamily(family, law, mass, {**sources, **law_sources})
+    mass = args.mass if args.mass is not None else filed_mass if filed_mass is not None else MASS.default
+    sources["mass"] = "user" if args.mass is not None else config.sources["mass"] if filed_mass is not None else MASS.source
+    law, law_shown, from_file = _law_in_force(args, params)
+    if family not in law.families:
+        raise ValueError(f"{robot_shown} takes --law {' or '.join(laws_of_family(family))} (a force in newtons on a mass, "
+                         f"Ge & Cui 2002 Sec 6); got {law_shown}")
+    check_parameters(law.name, _typed_law_keys(args, params), shown=option_name, law_shown=law_shown, laws=_offered(args), required=False)
+    if law.kind == "static":
+        built, law_sources = resolve_law(args, params)
+        return ResolvedFamily(family, built, mass, {**sources, **law_sources})
     from ..report.families import make_family_law
 
-    taken = FAMILY_LAW_PARAMETERS[law_name]
-    given = {k: getattr(args, k) for k in (*LAW_OPTIONS, *FAMILY_OPTIONS) if getattr(args, k, None) is not None}
-    typed_fn = [key for key in ("f", "n") if params.sources.get(key) == "user"]
-    for key in typed_fn + list(given):
-        if key not in taken:
-            _refuse(key, {**LAW_PARAMETERS, **FAMILY_LAW_PARAMETERS}, law_shown)
-    _check_choices_taken(args, law_name, law_shown)
+    given = {k: getattr(args, k) for k in law.parameters if getattr(args, k, None) is not None}
     # the file's law parameters and choices (checked against the law by `config`) where it is the law in force and no option is typed
-    filed_law = from_file if from_file.get("name") == law_name else {}
-    filed = {k: v for k, v in filed_law.items() if k != "name" and k not in FAMILY_CHOICE_DEFAULTS and k not in given}
+    filed_law = from_file if from_file.get("name") == law.name else {}
+    filed = {k: v for k, v in filed_law.items() if k in law.parameters and k not in given}
     choices = {}
-    for key in FAMILY_LAW_CHOICES[law_name]:
+    for choice in law.choices:
+        key = choice.key
         if getattr(args, key, None) is not None:
             choices[key], sources[key] = getattr(args, key), "user"
         elif key in filed_law:
             choices[key], sources[key] = filed_law[key], config.sources[key]
         else:
-            sources[key] = f"default ({FAMILY_CHOICE_DEFAULTS[key]})"
-    law = make_family_law(law_name, choices, **given, **filed)
-    sources.update({key: "user" if key in given else config.sources[key] if key in filed else _FAMILY_SOURCE for key in taken})
-    return ResolvedFamily(family, law, mass, sources)
-
-
-def _check_choices_taken(args, law_name, law_shown) -> None:
-    """ValueError for a choice option (``--variant``, ``--side``, ``--symmetrize``) the law in force does not take."""
-    for key in FAMILY_CHOICE_OPTIONS:
-        if getattr(args, key, None) is not None and key not in FAMILY_LAW_CHOICES.get(law_name, {}):
-            _refuse(key, FAMILY_LAW_CHOICES, law_shown)
-
-
-def _refuse(key: str, taken_by: dict, law_shown: str) -> None:
-    """ValueError: option `key` applies to the laws of `taken_by` (law → the keys it takes) that take it, not to `law_shown`."""
-    takers = [law for law, keys in taken_by.items() if key in keys]
-    raise ValueError(f"{_option(key)} applies to --law {' or '.join(takers)}, not to {law_shown}")
+            sources[key] = choice.source
+    built = make_family_law(law.name, choices, **given, **filed)
+    sources.update({s.key: "user" if s.key in given else config.sources[s.key] if s.key in filed else s.source for s in law.settings})
+    return ResolvedFamily(family, built, mass, sources)

@@ -2,7 +2,8 @@
 
 from __future__ import annotations
 
-from ..parameters import DOOR_OBSTACLES, FAMILY_LAWS, FORCE_LAWS, MODEL_NAMES, Wall
+from ..laws.registry import FAMILY_LAWS, FORCE_LAWS
+from ..parameters import DOOR_OBSTACLES, MODEL_NAMES, Wall
 from .options import PADE_ORDER, add_family_options, add_law_options, add_parameter_options, describe, number, resolve_family, resolve_parameters
 
 FORMATS = ("text", "json", "markdown")

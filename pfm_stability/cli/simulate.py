@@ -23,6 +23,7 @@ terminal (``--quiet``: never).
 
 from __future__ import annotations
 
+from ..laws.registry import laws_for
 from .options import add_parameter_options, describe, integer, number, output_path, resolve_parameters
 from .progress import step_progress
 
@@ -48,7 +49,7 @@ def add_parser(sub) -> None:
                    "(|offset| < L - W/2, - c/2 in the grid) or clear of the wall (default 0.02)")
     g.add_argument("--duration", type=number("duration"), help=f"simulated time, {describe('duration')} (default per scenario)")
     g.add_argument("--cell-ratio", type=number("cell_ratio"), help=f"grid: F_cr/F_ct per cell, {describe('cell_ratio')} (default: calibrated to f_av = f)")
-    g.add_argument("--law", choices=("power", "grid"), help="analytic: KB's lumped power law (default) or the grid's effective law")
+    g.add_argument("--law", choices=laws_for("simulate"), help="analytic: KB's lumped power law (default) or the grid's effective law")
     g.add_argument("--window-cells", type=integer("window_cells", odd=True),
                    help=f"grid: active window side, odd, {describe('window_cells')} (default: the preset's, 33)")
     g.add_argument("--cell-size", type=number("cell_size"), help=f"grid: cell size, {describe('cell_size')} (default: the preset's, 0.1)")
@@ -77,7 +78,7 @@ def config_law(args, params) -> dict:
     the law (docs/config.md, precedence).
     """
     law = (params.config.law if params.config is not None else None) or {}
-    if law.get("name") not in ("power", "grid"):
+    if law.get("name") not in laws_for("simulate"):
         law = {}
     typed_law, typed_ratio = getattr(args, "law", None), getattr(args, "cell_ratio", None)
     out = {

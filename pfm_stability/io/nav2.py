@@ -28,8 +28,14 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from typing import TYPE_CHECKING
+
 from ..checks import check_number
 from ..parameters import RANGES
+from .yaml_files import InputError, parse_yaml
+
+if TYPE_CHECKING:
+    from .yaml_files import YamlFile
 
 __all__ = ["SPEED_KEYS", "Nav2Value", "Nav2Values", "is_nav2", "read_nav2"]
 
@@ -88,29 +94,28 @@ def is_nav2(data) -> bool:
     return any(PARAMETERS in node for node in nodes + nested)
 
 
-def read_nav2(data, origin: str) -> Nav2Values:
+def read_nav2(source: "YamlFile") -> Nav2Values:
     """T, V and W from a Nav2 parameters file (see the module's docstring for the keys).
 
     Parameters
     ----------
-    data : dict
-        The parsed file (`is_nav2`).
-    origin : str
-        How messages name the file, e.g. ``"Nav2 nav2_params.yaml"``.
+    source : io.yaml_files.YamlFile
+        The parsed file (`is_nav2` of its data), named ``Nav2 <path>`` in messages.
 
     Raises
     ------
     ValueError
-        A value of the wrong type or out of range (``"<origin>: <key> must be …"``),
+        A value of the wrong type or out of range (``"Nav2 FILE, line 12: <key> must be …"``),
         or none of the three found (the message lists what was looked for).
     """
+    data, origin = source.data, source.origin
     server = _node(data, ("controller_server",))
-    readers = (("T", *_period(server, origin)), ("V", *_speed(server, origin)), ("W", *_width(data, origin)))
+    readers = (("T", *_period(server, source)), ("V", *_speed(server, source)), ("W", *_width(data, source)))
     values = {name: found for name, found, _ in readers if found is not None}
     notes = tuple(f"{origin}: no {looked} found; {name} is the preset's" for name, found, looked in readers if found is None)
     if not values:
         looked = "; ".join(f"{name}: {looked}" for name, _, looked in readers)
-        raise ValueError(f"{origin}: none of the Nav2 keys read was found (looked for {looked})")
+        raise source.error(f"none of the Nav2 keys read was found (looked for {looked})")
     return Nav2Values(values, notes)
 
 
@@ -123,22 +128,23 @@ def _node(data, path):
     return node if isinstance(node, dict) else None
 
 
-def _period(server, origin):
+def _period(server, source):
     key = "controller_server.controller_frequency"
     looked = f"{key} (in ros__parameters, Hz)"
     if server is None or "controller_frequency" not in server:
         return None, looked
     given = server["controller_frequency"]
-    hz = _check(origin, key, given, *_FREQUENCY, "Hz", low_open=False)
+    hz = _check(source, key, ("controller_server", PARAMETERS, "controller_frequency"), given, *_FREQUENCY, "Hz", low_open=False)
     return Nav2Value("T", 1.0 / hz, key, given, "Hz"), looked
 
 
-def _speed(server, origin):
+def _speed(server, source):
     plugins = (server or {}).get("controller_plugins", ["FollowPath"])
     if isinstance(plugins, str):
         plugins = [plugins]
     if not isinstance(plugins, list):
-        raise ValueError(f"{origin}: controller_server.controller_plugins must be a list of plugin names; got {plugins!r}")
+        raise source.error(f"controller_server.controller_plugins must be a list of plugin names; got {plugins!r}",
+                           ("controller_server", PARAMETERS, "controller_plugins"))
     looked = f"controller_server.<plugin>.{{{', '.join(SPEED_KEYS)}}} for plugins {', '.join(map(str, plugins)) or 'none'}"
     for plugin in plugins:
         params = (server or {}).get(plugin)
@@ -146,12 +152,13 @@ def _speed(server, origin):
             if name in params:
                 key = f"controller_server.{plugin}.{name}"
                 r = RANGES["V"]
-                value = _check(origin, key, params[name], r.low, r.high, r.unit, low_open=r.low_open, high_open=r.high_open)
+                value = _check(source, key, ("controller_server", PARAMETERS, plugin, name), params[name], r.low, r.high, r.unit,
+                               low_open=r.low_open, high_open=r.high_open)
                 return Nav2Value("V", value, key, params[name], "m/s"), looked
     return None, looked
 
 
-def _width(data, origin):
+def _width(data, source):
     r = RANGES["W"]
     looked = "footprint or robot_radius of local_costmap.local_costmap (or local_costmap, global_costmap)"
     for path in COSTMAPS:
@@ -162,33 +169,32 @@ def _width(data, origin):
         footprint = costmap.get("footprint")
         if footprint not in (None, "", "[]", []):
             key = f"{where}.footprint"
-            ys = _footprint_ys(origin, key, footprint)
-            width = _check(origin, f"{key} lateral extent (max y - min y)", max(ys) - min(ys), r.low, r.high, "m", low_open=r.low_open)
+            location = (*path, PARAMETERS, "footprint")
+            ys = _footprint_ys(source, key, location, footprint)
+            width = _check(source, f"{key} lateral extent (max y - min y)", location, max(ys) - min(ys), r.low, r.high, "m", low_open=r.low_open)
             return Nav2Value("W", width, key, footprint, ""), looked
         if "robot_radius" in costmap:
             key = f"{where}.robot_radius"
-            radius = _check(origin, key, costmap["robot_radius"], r.low / 2, r.high / 2, "m", low_open=r.low_open)
+            radius = _check(source, key, (*path, PARAMETERS, "robot_radius"), costmap["robot_radius"], r.low / 2, r.high / 2, "m", low_open=r.low_open)
             return Nav2Value("W", 2.0 * radius, key, costmap["robot_radius"], "m"), looked
     return None, looked
 
 
-def _footprint_ys(origin, key, footprint) -> list:
-    """The y of each vertex of a footprint (a list, or Nav2's string ``"[[x, y], …]"``), m."""
-    message = f"{origin}: {key} must be a polygon [[x, y], ...] of at least 3 points of finite numbers (m); got {footprint!r}"
+def _footprint_ys(source, key, location, footprint) -> list:
+    """The y of each vertex of a footprint (a list, or Nav2's string ``"[[x, y], …]"``, read by the file rule), m."""
+    error = source.error(f"{key} must be a polygon [[x, y], ...] of at least 3 points of finite numbers (m); got {footprint!r}", location)
     points = footprint
     if isinstance(footprint, str):
-        import yaml
-
         try:
-            points = yaml.safe_load(footprint)
-        except yaml.YAMLError:
-            raise ValueError(message) from None
+            points = parse_yaml(footprint)
+        except InputError:
+            raise error from None
     if not isinstance(points, list) or len(points) < 3:
-        raise ValueError(message)
+        raise error
     ys = []
     for point in points:
         if not (isinstance(point, list) and len(point) == 2 and all(_finite(c) for c in point)):
-            raise ValueError(message)
+            raise error
         ys.append(float(point[1]))
     return ys
 
@@ -197,8 +203,8 @@ def _finite(value) -> bool:
     return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
 
 
-def _check(origin, key, value, low, high, unit, *, low_open=True, high_open=False) -> float:
+def _check(source, key, location, value, low, high, unit, *, low_open=True, high_open=False) -> float:
     try:
         return check_number(key, value, low, high, low_open=low_open, high_open=high_open, unit=unit)
     except ValueError as exc:
-        raise ValueError(f"{origin}: {exc}") from None
+        raise source.error(str(exc), location) from None

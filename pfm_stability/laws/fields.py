@@ -19,8 +19,8 @@ enters P and Q. The goal convention is KB's: the target direction is frozen
 and ρ_g enters only the magnitudes; a finite goal straight ahead would add
 1/ρ_g to a corridor's N (`finite_goal_gain`, reported apart, never added).
 
-`make_law` builds any law of `parameters.FORCE_LAWS` from a robot, a
-controller and the law's own parameters (`parameters.LAW_PARAMETERS`).
+`make_law` builds any static law of the law registry (`pfm_stability.laws.registry`) from
+a robot, a controller and the law's own parameters, with the registry's defaults.
 `Branch` follows one equilibrium as a parameter moves (a law parameter, α,
 L) and finds where its gain crosses a threshold: the critical values of
 `pfm_stability.analysis.critical` for laws that are not monotone.
@@ -37,11 +37,12 @@ import numpy as np
 from ..checks import check_choice
 from .effective_force import GridWallLaw, calibrate_cell_ratio
 from .force_law import Equilibrium, ForceLaw, PowerLaw
-from ..parameters import FIELD_DEFAULTS, FORCE_LAWS, LAW_PARAMETERS, RANGES, Controller, Robot, check_parameter
+from ..parameters import Controller, Robot, check_parameter
+from .registry import FORCE_LAWS, check_parameters
 from .potentials import attraction_force, repulsion_derivatives
 from ..numerics.solve import newton_increasing
 
-__all__ = ["KhatibLaw", "GnronLaw", "make_law", "check_law_parameters", "finite_goal_gain", "Branch"]
+__all__ = ["KhatibLaw", "GnronLaw", "make_law", "finite_goal_gain", "Branch"]
 
 _REACH = 1e-9
 """The laws' domain starts at d = 1e-9·ρ0 (P ∝ 1/d³ there: an equilibrium closer is not representable)."""
@@ -218,46 +219,33 @@ def finite_goal_gain(law: ForceLaw, N: float) -> float | None:
     return None if rho_g is None else N + 1.0 / rho_g
 
 
-def check_law_parameters(law: str, given, shown=lambda name: name, law_shown=None) -> None:
-    """Raise ValueError if a parameter of `given` is not one `law` takes (`parameters.LAW_PARAMETERS`).
-
-    `shown` names a parameter as the caller knows it (the CLI: ``--goal-distance``),
-    `law_shown` the law (default ``law <name>``); a law of Ge & Cui needs its goal distance.
-    """
-    check_choice("law", law, FORCE_LAWS)
-    law_shown = law_shown or f"law {law}"
-    for name in given:
-        if name not in LAW_PARAMETERS[law]:
-            takers = [k for k in FORCE_LAWS if name in LAW_PARAMETERS[k]]
-            raise ValueError(f"{shown(name)} applies to {' or '.join(takers)}, not to {law_shown}")
-    if law in ("khatib", "gnron") and "goal_distance" not in given:
-        raise ValueError(f"{law_shown} needs {shown('goal_distance')}: the distance to the goal, {RANGES['goal_distance'].describe()} (docs/fields.md)")
-
-
 def make_law(name: str, robot: Robot, controller: Controller, **parameters) -> ForceLaw:
-    """The law `name` of `parameters.FORCE_LAWS` for this robot and controller.
+    """The static law `name` (``registry.FORCE_LAWS``) for this robot and controller.
 
     ``power``: KB's `PowerLaw(f, n, W)`. ``grid``: `GridWallLaw` with ``cell_ratio``
     (default: calibrated so that its f_av is the controller's f, KB §4),
-    ``cell_size`` (0.1 m) and ``window_cells`` (33). ``khatib`` / ``gnron``:
+    ``cell_size`` and ``window_cells``. ``khatib`` / ``gnron``:
     ``xi``, ``eta``, ``rho0``, ``attraction_exponent``, ``goal_exponent``,
-    ``delta`` (defaults `parameters.FIELD_DEFAULTS`, GC2000 Sec VI) and
-    ``goal_distance`` (required). A parameter given as None is not given.
+    ``delta`` and ``goal_distance`` (required). The parameters each law takes and
+    their defaults are the law registry's (`pfm_stability.laws.registry`: the grid's
+    0.1 m cells and 33-cell window, KB §2; GC2000 Sec VI's ξ = 1, η = 0.1, ρ0 = 0.8 m,
+    m = n = 2, and δ = 0). A parameter given as None is not given.
 
     Raises
     ------
     ValueError
-        A parameter the law does not take, a missing goal distance, or a value out of range.
+        A parameter the law does not take (`registry.refusal`), a missing goal distance, or a value out of range.
     """
+    check_choice("law", name, FORCE_LAWS)
     given = {k: v for k, v in parameters.items() if v is not None}
-    check_law_parameters(name, [k for k in given if k not in ("f", "n")])
+    law = check_parameters(name, [k for k in given if k not in ("f", "n")], laws=FORCE_LAWS)
+    v = {**law.defaults(), **given}
     if name == "power":
         return PowerLaw(controller.f, controller.n, robot.W)
     if name == "grid":
-        size, cells = given.get("cell_size", 0.1), given.get("window_cells", 33)
+        size, cells = v["cell_size"], v["window_cells"]
         ratio = given["cell_ratio"] if "cell_ratio" in given else calibrate_cell_ratio(controller.f, controller.n, robot.W, size, cells)
         return GridWallLaw(ratio, controller.n, robot.W, size, cells)
-    v = {**FIELD_DEFAULTS, **given}
     common = (v["xi"], v["eta"], v["rho0"], v["attraction_exponent"])
     if name == "khatib":
         return KhatibLaw(*common, v["goal_distance"])

@@ -78,7 +78,7 @@ class ForceLaw:
         `distance_for`. Otherwise (the default: nothing is assumed) every
         root is searched (`wall_equilibria`).
     key : str or None
-        The law's name in `parameters.FORCE_LAWS` (None for a law built in code).
+        The law's name in the law registry (`laws.registry.FORCE_LAWS`; None for a law built in code).
     goal_distance : float or None
         ρ_g, m, for a law whose magnitudes depend on a frozen goal distance
         (docs/fields.md, "The frozen goal"); None for a target at infinity.

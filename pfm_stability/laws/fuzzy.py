@@ -16,8 +16,8 @@ The tables are data (``data/fuzzy/dfapf.yaml``), read by `load_dfapf`. Besides t
 output, `FuzzySystem.evaluate_with_gradient` gives the exact derivatives of the
 discretised centroid with respect to both inputs (the aggregated membership at each
 output point is a max–min of smooth memberships, so it is differentiable almost
-everywhere: forward-mode through the active branch). numpy only (and PyYAML for the
-data file).
+everywhere: forward-mode through the active branch). numpy only; the data file is read
+by the package's one YAML reader (`pfm_stability.io.yaml_files`).
 """
 
 from __future__ import annotations
@@ -29,7 +29,7 @@ from pathlib import Path
 import numpy as np
 
 from ..checks import check_choice, check_integer
-from ..io.config import read_yaml
+from ..io.yaml_files import read_yaml
 
 __all__ = [
     "DFAPF_FILE",
@@ -359,11 +359,24 @@ def load_dfapf(symmetrize=False, path=None) -> DfapfControllers:
         side = None
     else:
         side = check_choice("symmetrize", symmetrize, ("negative", "positive"))
-    data = read_yaml(path or DFAPF_FILE, "fuzzy tables")
+    tables = read_yaml(path or DFAPF_FILE, "fuzzy tables")
+    data = tables.data
     try:
-        variables = {k: _variable(k, v) for k, v in data["variables"].items()}
+        items = data["variables"].items()
         controllers = data["controllers"]
         eta, kv = controllers["eta"], controllers["K_V"]
     except (KeyError, TypeError, AttributeError) as exc:
-        raise ValueError(f"fuzzy tables: needs variables and controllers eta and K_V ({exc})") from None
-    return DfapfControllers(_system("eta", eta, variables, side), _system("K_V", kv, variables, side), side)
+        raise tables.error(f"needs variables and controllers eta and K_V ({exc})") from None
+    variables = {}
+    for name, spec in items:
+        try:
+            variables[name] = _variable(name, spec)
+        except ValueError as exc:
+            raise tables.error(str(exc), ("variables", name)) from None
+    systems = []
+    for name, spec in (("eta", eta), ("K_V", kv)):
+        try:
+            systems.append(_system(name, spec, variables, side))
+        except ValueError as exc:
+            raise tables.error(str(exc), ("controllers", name)) from None
+    return DfapfControllers(*systems, side)

@@ -3,7 +3,8 @@
 A `Scene` holds a goal, obstacles (`Circle`, `Segment`, closed `Polygon`), a
 `FieldLaw` (Khatib's repulsion, Ge & Cui 2000 eq 3, or the goal-aware one, eq 8,
 with the attraction ½ξρ_gᵐ) and a search region, read from YAML
-(`Scene.load`; docs/traps.md, "Scene files") with every field checked.
+(`Scene.load`; docs/traps.md, "Scene files") with every field checked (the file by the package's one YAML reader, `pfm_stability.io.yaml_files`:
+errors name the file, the line and the field).
 `field` gives U = ½ξρ_gᵐ + Σ_i U_rep(ρ_i, ρ_g), ρ_i the minimal distance to
 obstacle i (`pfm_stability.laws.potentials`), with the exact gradient and Hessian
 (∇ρ the unit vector from the nearest point, ∇²ρ = κ(I − ∇ρ∇ρᵀ), κ =
@@ -240,17 +241,21 @@ class Scene:
 
     @classmethod
     def load(cls, path) -> Scene:
-        """The scene in the YAML file `path` (``yaml.safe_load``)."""
-        import yaml
+        """The scene in the YAML file `path`, read by the package's one YAML reader (`pfm_stability.io.yaml_files`).
 
+        Raises
+        ------
+        ValueError
+            `from_dict`'s message prefixed by the file and the line of the field it names
+            (``scene hall.yaml, line 4: law.rho0 must be …``), or the file unreadable or not YAML.
+        """
+        from ..io.yaml_files import read_yaml
+
+        document = read_yaml(path, "scene")
         try:
-            with open(path, encoding="utf-8") as fh:
-                data = yaml.safe_load(fh)
-        except (OSError, UnicodeDecodeError) as exc:
-            raise ValueError(f"scene file {str(path)!r} cannot be read: {exc.strerror if isinstance(exc, OSError) else exc}") from None
-        except yaml.YAMLError as exc:
-            raise ValueError(f"scene file {str(path)!r} is not YAML: {str(exc).splitlines()[0]}") from None
-        return cls.from_dict(data)
+            return cls.from_dict(document.data)
+        except ValueError as exc:
+            raise document.refuse(exc) from None
 
     def to_dict(self) -> dict:
         """The scene as in a scene file."""

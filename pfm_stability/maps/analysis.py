@@ -45,9 +45,10 @@ import numpy as np
 
 from ..laws.effective_force import GridWallLaw
 from ..laws.force_law import ForceLaw, PowerLaw
+from ..laws.registry import MAP_LAWS
 from ..models import Loop, gain_margin, models_for, verdict_label
 from ..models.verdicts import Judgement, inside, judge
-from ..parameters import MAP_LAWS, Controller, Robot
+from ..parameters import Controller, Robot
 from ..io.serialize import json_number
 from .equilibria import Samples, grid_equilibria, power_equilibria
 from .field import UNKNOWN_AS, HistogramMap, histogram_of

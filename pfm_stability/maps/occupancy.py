@@ -46,6 +46,7 @@ import numpy as np
 
 from ..checks import check_number
 from ..extras import require
+from ..io.yaml_files import InputError, YamlFile, leading_key, read_yaml
 
 __all__ = ["MAP_KEYS", "MAX_PIXELS", "MODES", "OccupancyMap", "load_map", "occupancy_values"]
 
@@ -166,79 +167,75 @@ def _classify(values: np.ndarray, mode: str, occupied_thresh: float, free_thresh
 
 
 # ------------------------------------------------------------------ reading
-def _fail(path, why: str):
-    raise ValueError(f"map {str(path)!r}: {why}")
+def _fail(document: YamlFile, why: str, key=None):
+    """Raise the map file's error: ``map FILE, line N: <why>``, at the line of `key` (default: the key `why` starts with)."""
+    raise document.error(why, key if key is not None else leading_key(why))
 
 
-def _read_yaml(path) -> dict:
-    import yaml
-
-    try:
-        with open(path, encoding="utf-8") as fh:
-            data = yaml.safe_load(fh)
-    except (OSError, UnicodeDecodeError) as exc:
-        _fail(path, f"cannot be read: {exc.strerror if isinstance(exc, OSError) else exc}")
-    except yaml.YAMLError as exc:
-        _fail(path, f"is not YAML: {str(exc).splitlines()[0]}")
+def _read_yaml(path) -> YamlFile:
+    """The map file, read by the package's one YAML reader (`pfm_stability.io.yaml_files`), with its required keys."""
+    document = read_yaml(path, "map")
+    data = document.data
     if not isinstance(data, dict):
-        _fail(path, f"must be a YAML mapping with keys {', '.join(REQUIRED_KEYS)}; got {type(data).__name__}")
+        _fail(document, f"must be a YAML mapping with keys {', '.join(REQUIRED_KEYS)}; got {type(data).__name__}", ())
     for key in REQUIRED_KEYS:
         if key not in data:
-            _fail(path, f"key {key!r} is missing (a map file needs {', '.join(REQUIRED_KEYS)})")
-    return data
+            _fail(document, f"key {key!r} is missing (a map file needs {', '.join(REQUIRED_KEYS)})", ())
+    return document
 
 
-def _number(path, key, value, low=-math.inf, high=math.inf, **kw) -> float:
+def _number(document, key, value, low=-math.inf, high=math.inf, **kw) -> float:
     try:
         return check_number(key, value, low, high, **kw)
     except ValueError as exc:
-        _fail(path, str(exc))
+        _fail(document, str(exc), key)
 
 
-def _parameters(path, data: dict) -> dict:
-    resolution = _number(path, "resolution", data["resolution"], 0.0, 1e3, unit="m")
+def _parameters(document: YamlFile) -> dict:
+    data = document.data
+    resolution = _number(document, "resolution", data["resolution"], 0.0, 1e3, unit="m")
     origin = data["origin"]
     if not isinstance(origin, (list, tuple)) or len(origin) != 3:  # map_server: "should have 3 elements"
-        _fail(path, f"origin must be a list [x, y, yaw] of three finite numbers (m, m, rad), as Nav2's map_server requires; got {origin!r}")
-    origin = tuple(_number(path, f"origin[{i}]", v, -1e7, 1e7) for i, v in enumerate(origin))
+        _fail(document, f"origin must be a list [x, y, yaw] of three finite numbers (m, m, rad), as Nav2's map_server requires; got {origin!r}")
+    origin = tuple(_number(document, f"origin[{i}]", v, -1e7, 1e7) for i, v in enumerate(origin))
     negate = data["negate"]
     if negate not in (0, 1) or isinstance(negate, float):  # True/False and 0/1
-        _fail(path, f"negate must be 0 or 1; got {negate!r}")
-    occupied = _number(path, "occupied_thresh", data["occupied_thresh"], 0.0, 1.0, low_open=False, high_open=False)
-    free = _number(path, "free_thresh", data["free_thresh"], 0.0, 1.0, low_open=False, high_open=False)
+        _fail(document, f"negate must be 0 or 1; got {negate!r}")
+    occupied = _number(document, "occupied_thresh", data["occupied_thresh"], 0.0, 1.0, low_open=False, high_open=False)
+    free = _number(document, "free_thresh", data["free_thresh"], 0.0, 1.0, low_open=False, high_open=False)
     if not free < occupied:
-        _fail(path, f"free_thresh must be below occupied_thresh; got free_thresh {free:g} >= occupied_thresh {occupied:g}")
+        _fail(document, f"free_thresh must be below occupied_thresh; got free_thresh {free:g} >= occupied_thresh {occupied:g}")
     mode = data.get("mode", "trinary")
     if mode not in MODES:
-        _fail(path, f"mode must be one of {', '.join(MODES)}; got {mode!r}")
+        _fail(document, f"mode must be one of {', '.join(MODES)}; got {mode!r}")
     image = data["image"]
     if not isinstance(image, str) or not image.strip():
-        _fail(path, f"image must be a file name; got {image!r}")
+        _fail(document, f"image must be a file name; got {image!r}")
     return {"resolution": resolution, "origin": origin, "negate": bool(negate), "occupied_thresh": occupied,
             "free_thresh": free, "mode": mode, "image": image}
 
 
-def _read_image(path, image_path: str):
+def _read_image(document: YamlFile, image_path: str):
     """`_channels` of the image file, rows as in the file (row 0 = top)."""
     require("maps", "reading a map image")
     from PIL import Image, UnidentifiedImageError
 
     if not os.path.isfile(image_path):
-        _fail(path, f"image {image_path!r} does not exist")
+        _fail(document, f"image {image_path!r} does not exist")
     try:
         with Image.open(image_path) as im:
             if im.width * im.height > MAX_PIXELS:
-                _fail(path, f"image {image_path!r} has {im.width} x {im.height} pixels, more than {MAX_PIXELS:.0e}")
+                _fail(document, f"image {image_path!r} has {im.width} x {im.height} pixels, more than {MAX_PIXELS:.0e}")
             im.load()
             image = im.copy()
+    except InputError:
+        raise
     except (UnidentifiedImageError, OSError, SyntaxError, ValueError) as exc:
-        if str(exc).startswith(f"map {str(path)!r}"):
-            raise
-        _fail(path, f"image {image_path!r} is not a readable image (PGM, PNG, ...): {exc}")
-    return _channels(path, image_path, image)
+        _fail(document, f"image {image_path!r} is not a readable image (PGM, PNG, ...): {exc}")
+    return _channels(document, image_path, image)
 
 
-def _channels(path, image_path, im):
+def _channels(document, image_path, im):
     """(shade, opaque, alpha, colour channels) of a Pillow image: shade the mean of the colour channels in [0, 1]."""
     mode = im.mode
     if mode == "P":
@@ -250,7 +247,7 @@ def _channels(path, image_path, im):
     elif mode in ("I;16", "I;16B", "I;16L", "I"):
         a = np.asarray(im, dtype=float) / 65535.0
     else:
-        _fail(path, f"image {image_path!r} has pixel mode {mode}; a map is grey, RGB or with alpha (L, LA, RGB, RGBA, P, 16-bit)")
+        _fail(document, f"image {image_path!r} has pixel mode {mode}; a map is grey, RGB or with alpha (L, LA, RGB, RGBA, P, 16-bit)")
     if a.ndim == 2:
         return a, np.ones(a.shape, dtype=bool), None, 1
     has_alpha = mode in ("LA", "RGBA")
@@ -273,18 +270,19 @@ def load_map(path, name: str | None = None) -> OccupancyMap:
     Raises
     ------
     ValueError
-        One line naming the file and the problem: unreadable YAML, a missing key,
+        One line naming the file, the line of the key concerned and the problem (`pfm_stability.io.yaml_files`):
+        unreadable YAML, a missing key,
         resolution <= 0, an origin that is not three finite numbers, thresholds outside
         [0, 1] or free_thresh >= occupied_thresh, an unknown mode, a missing or
         unreadable image, an empty map.
     """
     path = os.fspath(path)
-    data = _read_yaml(path)
-    params = _parameters(path, data)
+    document = _read_yaml(path)
+    params = _parameters(document)
     image_path = os.path.join(os.path.dirname(os.path.abspath(path)), params.pop("image"))
-    shade, opaque, alpha, channels = _read_image(path, image_path)
+    shade, opaque, alpha, channels = _read_image(document, image_path)
     if shade.size == 0:
-        _fail(path, f"image {image_path!r} has no pixels")
+        _fail(document, f"image {image_path!r} has no pixels")
     if params["mode"] == "trinary" and alpha is not None:  # Nav2 averages the alpha in as one more channel
         shade = (shade * channels + alpha) / (channels + 1)
     values = occupancy_values(shade, opaque, mode=params["mode"], negate=params["negate"],

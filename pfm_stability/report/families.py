@@ -36,7 +36,8 @@ from ..laws.fuzzy_law import FuzzyScheduledLaw
 from ..models import HEADING_GAIN_RANGE, Loop, interval_margin, interval_verdict, models_for
 from ..models.holonomic import HolonomicLoop
 from ..models.holonomic_delay import make_holonomic_model
-from ..parameters import FAMILY_CHOICE_DEFAULTS, FAMILY_DEFAULTS, FAMILY_LAW_CHOICES, FAMILY_LAW_PARAMETERS, FAMILY_LAWS, HOLONOMIC_LAWS, MODEL_NAMES, RANGES, ROBOT_FAMILIES, Controller, Corridor, Robot, Wall, check_parameter
+from ..laws.registry import FAMILY_CHOICE_DEFAULTS, FAMILY_DEFAULTS, FAMILY_LAW_CHOICES, FAMILY_LAW_PARAMETERS, FAMILY_LAWS, HOLONOMIC_LAWS
+from ..parameters import MODEL_NAMES, RANGES, ROBOT_FAMILIES, Controller, Corridor, Robot, Wall, check_parameter
 from .stability import UNITS, StabilityReport, build_report, kb_errors, remedies, remedies_by_key
 from ..io.serialize import json_number
 from ..models.tracking import tracking_dynamics

@@ -24,7 +24,8 @@ from ..analysis.comparison import relative_error
 from ..analysis.criteria import CorridorAnalysis, WallAnalysis, analyze_corridor, analyze_wall, loop_of
 from ..laws.force_law import ForceLaw, law_in_force
 from ..models import HEADING_GAIN_RANGE, KBFirstOrder, Loop, Sampled, models_for
-from ..parameters import LAW_PARAMETERS, MODEL_NAMES, RANGES, Controller, Corridor, Robot, Wall, check_parameter
+from ..laws.registry import LAW_PARAMETERS
+from ..parameters import MODEL_NAMES, RANGES, Controller, Corridor, Robot, Wall, check_parameter
 from ..io.serialize import SCHEMA_VERSION, json_number, json_ready
 
 __all__ = ["StabilityReport", "KBError", "build_report", "remedies", "remedies_by_key", "kb_error", "kb_errors"]

@@ -12,8 +12,12 @@ A spec is a YAML mapping (module `load_spec`) or a dict (`spec_from_mapping`)::
     # or  sample: {method: latin-hypercube, n: 100000, seed: 0, ranges: {V: [0.2, 1.6]}}
     simulate: false
 
-Every error is a `ValueError` of one line naming the spec file and the field
-(``spec s.yaml: grid.V.num must be an integer in [1, 100000000]; got 0``),
+``law: grid`` is short for ``law: {name: grid}``; the laws, the parameters each takes and
+those a sweep may vary are the law registry's (`pfm_stability.laws.registry`: the laws
+``sweep`` offers). The file is read by the package's one YAML reader
+(`pfm_stability.io.yaml_files`: ``1e-3`` is a number). Every error is a `ValueError` of
+one line naming the spec file, the line and the field
+(``spec s.yaml, line 4: grid.V.num: num must be an integer in [1, 100000000]; got 0``),
 raised before anything is computed or written. Values are checked against
 `parameters.RANGES` with the command line's messages (`parameters.check_parameter`;
 α in degrees). The result, `SweepSpec`, is what the engine and its workers
@@ -30,12 +34,15 @@ import os
 from dataclasses import dataclass, field
 
 from ..checks import check_choice, check_integer
-from ..parameters import HOLDS, LAW_PARAMETERS, MODEL_NAMES, RANGES, Controller, Robot, check_parameter, get_preset
+from ..io.yaml_files import YamlFile, mapping_source, read_yaml
+from ..laws.registry import DEFAULT_LAW, LAW_NAMES, check_parameters, get_law, laws_for, parameter_keys, refusal
+from ..parameters import HOLDS, MODEL_NAMES, RANGES, Controller, Robot, check_parameter, get_preset
 from ..version import __version__
 
 __all__ = [
     "ENVS",
     "LAW_SWEPT",
+    "SWEEP_LAWS",
     "MAX_POINTS",
     "SAMPLE_METHODS",
     "SPEC_KEYS",
@@ -53,8 +60,11 @@ SPEC_KEYS = ("preset", "config", "scenario", "models", "hold", "compute_delay", 
 ROBOT_SWEPT = ("V", "tau", "k", "W")
 CONTROLLER_SWEPT = ("T", "f", "n")
 GEOMETRY_SWEPT = ("alpha", "L")
-LAW_SWEPT = ("cell_ratio", "cell_size", "window_cells", "xi", "eta", "rho0", "attraction_exponent", "goal_exponent", "goal_distance", "delta")
-"""Law parameters that may vary (the command line's law options, `cli/options.LAW_OPTIONS`)."""
+SWEEP_LAWS = laws_for("sweep")
+"""The laws a sweep takes (the law registry's; power, the default, first)."""
+
+LAW_SWEPT = parameter_keys(SWEEP_LAWS)
+"""Law parameters a spec may fix or vary: those of `SWEEP_LAWS` (as the command line's law options)."""
 
 SWEPT_PARAMETERS = ("V", "tau", "T", "k", "f", "n", "W") + GEOMETRY_SWEPT + LAW_SWEPT
 """Every parameter a spec may vary, in the column order of the output."""
@@ -123,7 +133,7 @@ class SweepSpec:
     geometry_value : float or None
         Fixed α (deg) or L (m); None when it varies.
     law : str
-        Force law name (`parameters.FORCE_LAWS`).
+        Force law name (`SWEEP_LAWS`).
     law_parameters : dict
         Fixed law parameters (as given; defaults are `fields.make_law`'s).
     models : tuple of str
@@ -212,32 +222,33 @@ class SweepSpec:
 
 
 class _Where:
-    """Prefix of every message: ``spec FILE: `` (or ``spec: `` for a dict)."""
+    """Where the spec's values come from (its file with the line of every key, or a mapping), for every message:
+    ``spec FILE, line N: <key>…`` (``spec FILE: …`` for a mapping given in code, ``spec: …`` without a file)."""
 
-    def __init__(self, origin: str | None):
-        self.prefix = f"spec {origin}: " if origin else "spec: "
+    def __init__(self, source: YamlFile):
+        self.source = source
 
-    def fail(self, message: str):
-        raise ValueError(self.prefix + message)
+    def fail(self, message: str, key=None):
+        raise self.source.error(message, key)
 
     def wrap(self, key: str, func, *args, **kwargs):
-        """func(*args) with its ValueError re-raised as ``spec FILE: key: message``."""
+        """func(*args) with its ValueError re-raised as ``spec FILE, line N: key: message``."""
         try:
             return func(*args, **kwargs)
         except ValueError as exc:
-            raise ValueError(f"{self.prefix}{key}: {exc}") from None
+            raise self.source.error(f"{key}: {exc}", key) from None
 
 
-def _mapping(where: _Where, key: str, value) -> dict:
+def _mapping(where: _Where, key: str, value, what: str = "a mapping") -> dict:
     if not isinstance(value, dict):
-        where.fail(f"{key} must be a mapping; got {value!r}")
+        where.fail(f"{key} must be {what}; got {value!r}", key)
     return value
 
 
 def _known(where: _Where, key: str, data: dict, allowed) -> None:
     for name in data:
         if name not in allowed:
-            where.fail(f"unknown key {key + '.' if key else ''}{name}; allowed: {', '.join(allowed)}")
+            where.fail(f"unknown key {key + '.' if key else ''}{name}; allowed: {', '.join(allowed)}", f"{key}.{name}" if key else name)
 
 
 def _check_value(where: _Where, key: str, name: str, value) -> float:
@@ -247,7 +258,7 @@ def _check_value(where: _Where, key: str, name: str, value) -> float:
             value = int(value)
         v = where.wrap(key, check_integer, "window_cells", value, int(RANGES["window_cells"].low), int(RANGES["window_cells"].high))
         if v % 2 == 0:
-            where.fail(f"{key}: window_cells must be an odd integer; got {value!r}")
+            where.fail(f"{key}: window_cells must be an odd integer; got {value!r}", key)
         return float(v)
     return where.wrap(key, check_parameter, "alpha_deg" if name == "alpha" else name, value)
 
@@ -267,24 +278,16 @@ def load_spec(path, *, config=None) -> SweepSpec:
     Raises
     ------
     ValueError
-        Missing or unreadable file, YAML that is not a mapping, or any field
-        `spec_from_mapping` rejects.
+        Missing or unreadable file, invalid YAML, a key given twice, YAML that is not a mapping,
+        or any field `spec_from_mapping` rejects, at its line.
     """
-    import yaml
-
     path = os.fspath(path)
-    where = _Where(path)
-    try:
-        with open(path, encoding="utf-8") as handle:
-            data = yaml.safe_load(handle)
-    except OSError as exc:
-        where.fail(f"cannot read the file ({exc.strerror or exc})")
-    except yaml.YAMLError as exc:
-        where.fail(f"not valid YAML ({str(exc).splitlines()[0]})")
+    document = read_yaml(path, "spec")
+    data = document.data
     if config is not None and isinstance(data, dict):
         data = {key: value for key, value in data.items() if key not in ("preset", "config")}
         data["config"] = os.path.abspath(os.fspath(config))
-    return spec_from_mapping(data, origin=path, base_dir=os.path.dirname(os.path.abspath(path)))
+    return _spec(YamlFile(data, document.origin, path, document.lines), path, os.path.dirname(os.path.abspath(path)))
 
 
 def spec_from_mapping(data, *, origin: str | None = None, base_dir: str | None = None) -> SweepSpec:
@@ -308,8 +311,13 @@ def spec_from_mapping(data, *, origin: str | None = None, base_dir: str | None =
     ValueError
         ``spec FILE: <field>: <why>`` for the first problem found.
     """
-    where = _Where(origin)
-    data = _mapping(where, "the spec", data)
+    return _spec(mapping_source(data, f"spec {origin}" if origin else "spec"), origin, base_dir)
+
+
+def _spec(source: YamlFile, origin: str | None, base_dir: str | None) -> SweepSpec:
+    """The `SweepSpec` of a spec document (a file with its lines, or a mapping)."""
+    where = _Where(source)
+    data = _mapping(where, "the spec", source.data)
     _known(where, "", data, SPEC_KEYS)
     robot, controller, config_law, config_scenario, sources = _base(where, data, base_dir)
     hold = data.get("hold", controller.hold)
@@ -320,29 +328,30 @@ def spec_from_mapping(data, *, origin: str | None = None, base_dir: str | None =
     pade_order = where.wrap("pade_order", check_integer, "pade_order", data.get("pade_order", 3), 1, 12)
     simulate = data.get("simulate", False)
     if not isinstance(simulate, bool):
-        where.fail(f"simulate must be true or false; got {simulate!r}")
+        where.fail(f"simulate must be true or false; got {simulate!r}", "simulate")
     env = data.get("env", "analytic")
     where.wrap("env", check_choice, "env", env, ENVS)
     if ("grid" in data) == ("sample" in data):
-        where.fail("give exactly one of grid (a full factorial) or sample (a seeded sample)")
+        where.fail("give exactly one of grid (a full factorial) or sample (a seeded sample)", "grid" if "grid" in data else "sample" if "sample" in data else None)
     axes, sample = (_grid(where, data["grid"]), None) if "grid" in data else ((), _sample(where, data["sample"]))
     varying = tuple(a.name for a in axes) if sample is None else tuple(r[0] for r in sample.ranges)
-    law, law_parameters = _law(where, data.get("law", config_law), varying)
+    law, law_parameters = _law(where, data.get("law", config_law), varying, "grid" if sample is None else "sample.ranges")
     geometry, value = _scenario(where, data.get("scenario", config_scenario), varying, "scenario" in data)
     if simulate:
         _check_simulable(where, axes, sample, controller)
         if env == "grid" and law != "grid":
-            where.fail(f"env grid simulates the histogram grid, whose law is its cells: it needs law grid; got law {law} (or use env analytic)")
+            where.fail(f"env grid simulates the histogram grid, whose law is its cells: it needs law grid; got law {law} (or use env analytic)", "env")
     spec = SweepSpec(robot, controller, geometry, value, law, law_parameters, models, pade_order, axes, sample, simulate, env, origin, sources)
     if spec.count > MAX_POINTS:
-        where.fail(f"{'grid' if sample is None else 'sample.n'}: {spec.count} points; at most {MAX_POINTS} per sweep")
+        key = "grid" if sample is None else "sample.n"
+        where.fail(f"{key}: {spec.count} points; at most {MAX_POINTS} per sweep", key)
     return spec
 
 
 def _base(where: _Where, data: dict, base_dir):
     """Robot, controller, the config's law and scenario, and sources, from ``preset`` or ``config``."""
     if "preset" in data and "config" in data:
-        where.fail("give preset or config, not both")
+        where.fail("give preset or config, not both", "config")
     if "config" in data:
         from ..io.config import config_from_mapping, load_config
 
@@ -353,7 +362,7 @@ def _base(where: _Where, data: dict, base_dir):
             path = given if os.path.isabs(given) or base_dir is None else os.path.join(base_dir, given)
             config = where.wrap("config", load_config, path)
         else:
-            where.fail(f"config must be a file name or a mapping; got {given!r}")
+            where.fail(f"config must be a file name or a mapping; got {given!r}", "config")
         _steering_only(where, config, "law" in data)
         return config.robot, config.controller, config.law, dict(config.scenario or {}), dict(config.sources)
     preset = where.wrap("preset", get_preset, data.get("preset", "carmel"))
@@ -362,21 +371,22 @@ def _base(where: _Where, data: dict, base_dir):
 
 
 def _steering_only(where: _Where, config, own_law: bool) -> None:
-    """Refuse a config's robot family other than steering, and its law of `parameters.FAMILY_LAWS` unless the spec's
-    own ``law`` replaces it: sweeps analyse KB's steering robot with the static laws (docs/config.md)."""
-    why = "sweeps analyse KB's steering robot with the laws power, grid, khatib, gnron; robot families and the laws " \
-          "velocity, velocity-gated, fuzzy are report's (docs/velocity_and_fuzzy.md)"
+    """Refuse a config's robot family other than steering, and its law that sweeps do not take (`SWEEP_LAWS`) unless
+    the spec's own ``law`` replaces it: sweeps analyse KB's steering robot with the static laws (docs/config.md)."""
+    others = [name for name in LAW_NAMES if name not in SWEEP_LAWS]
+    why = f"sweeps analyse KB's steering robot with the laws {', '.join(SWEEP_LAWS)}; robot families and the laws " \
+          f"{', '.join(others)} are report's (docs/velocity_and_fuzzy.md)"
     if config.family not in (None, "steering"):
-        where.fail(f"config: robot.family {config.family} is not supported: {why}")
-    if config.law is not None and config.law["name"] not in LAW_PARAMETERS and not own_law:
-        where.fail(f"config: law.name {config.law['name']} is not supported: {why}")
+        where.fail(f"config: robot.family {config.family} is not supported: {why}", "config")
+    if config.law is not None and config.law["name"] not in SWEEP_LAWS and not own_law:
+        where.fail(f"config: law.name {config.law['name']} is not supported: {why}", "config")
 
 
 def _models(where: _Where, models) -> tuple:
     if isinstance(models, str):
         models = [models]
     if not isinstance(models, list) or not models:
-        where.fail(f"models must be a non-empty list of {', '.join(MODEL_NAMES)}; got {models!r}")
+        where.fail(f"models must be a non-empty list of {', '.join(MODEL_NAMES)}; got {models!r}", "models")
     for name in models:
         where.wrap("models", check_choice, "model", name, MODEL_NAMES)
     return tuple(dict.fromkeys(models))
@@ -384,7 +394,7 @@ def _models(where: _Where, models) -> tuple:
 
 def _number(where: _Where, key: str, value) -> float:
     if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-        where.fail(f"{key} must be a finite number; got {value!r}")
+        where.fail(f"{key} must be a finite number; got {value!r}", key)
     return float(value)
 
 
@@ -392,10 +402,10 @@ def _swept(where: _Where, key: str, data) -> dict:
     """``grid`` or ``sample.ranges``: a non-empty mapping whose keys are parameters that may vary."""
     data = _mapping(where, key, data)
     if not data:
-        where.fail(f"{key} must name at least one parameter")
+        where.fail(f"{key} must name at least one parameter", key)
     for name in data:
         if name not in SWEPT_PARAMETERS:
-            where.fail(f"unknown parameter {key}.{name}; parameters that may vary: {', '.join(SWEPT_PARAMETERS)}")
+            where.fail(f"unknown parameter {key}.{name}; parameters that may vary: {', '.join(SWEPT_PARAMETERS)}", f"{key}.{name}")
     return data
 
 
@@ -407,22 +417,22 @@ def _grid(where: _Where, grid) -> tuple:
         _known(where, key, axis, ("from", "to", "num", "scale"))
         for required in ("from", "to", "num"):
             if required not in axis:
-                where.fail(f"{key}.{required} is missing")
+                where.fail(f"{key}.{required} is missing", key)
         start = _check_value(where, f"{key}.from", name, _number(where, f"{key}.from", axis["from"]))
         stop = _check_value(where, f"{key}.to", name, _number(where, f"{key}.to", axis["to"]))
         num = where.wrap(f"{key}.num", check_integer, "num", axis["num"], 1, MAX_POINTS)
         scale = axis.get("scale", "linear")
         where.wrap(f"{key}.scale", check_choice, "scale", scale, _SCALES)
         if num == 1 and start != stop:
-            where.fail(f"{key}: num = 1 needs from == to (one value); got from {start:g}, to {stop:g}")
+            where.fail(f"{key}: num = 1 needs from == to (one value); got from {start:g}, to {stop:g}", key)
         if num > 1 and not start < stop:
-            where.fail(f"{key}: the range is empty or reversed: from must be < to when num > 1; got from {start:g}, to {stop:g}")
+            where.fail(f"{key}: the range is empty or reversed: from must be < to when num > 1; got from {start:g}, to {stop:g}", key)
         if scale == "log" and start <= 0:
-            where.fail(f"{key}: scale log needs from > 0; got {start:g}")
+            where.fail(f"{key}: scale log needs from > 0; got {start:g}", key)
         if name == "window_cells":
             values = _axis_values(Axis(name, start, stop, num, scale))
             if any(v != round(v) or round(v) % 2 == 0 for v in values):
-                where.fail(f"{key}: window_cells values must be odd integers; from {start:g} to {stop:g} in {num} steps gives others")
+                where.fail(f"{key}: window_cells values must be odd integers; from {start:g} to {stop:g} in {num} steps gives others", key)
         axes.append(Axis(name, start, stop, num, scale))
     return tuple(axes)
 
@@ -442,7 +452,7 @@ def _sample(where: _Where, sample) -> Sample:
     _known(where, "sample", sample, ("method", "n", "seed", "ranges"))
     for required in ("method", "n", "ranges"):
         if required not in sample:
-            where.fail(f"sample.{required} is missing")
+            where.fail(f"sample.{required} is missing", "sample")
     where.wrap("sample.method", check_choice, "method", sample["method"], SAMPLE_METHODS)
     n = where.wrap("sample.n", check_integer, "n", sample["n"], 1, MAX_POINTS)
     seed = where.wrap("sample.seed", check_integer, "seed", sample.get("seed", 0), 0, 2**63 - 1)
@@ -450,37 +460,44 @@ def _sample(where: _Where, sample) -> Sample:
     for name, bounds in _swept(where, "sample.ranges", sample["ranges"]).items():
         key = f"sample.ranges.{name}"
         if name == "window_cells":
-            where.fail(f"{key}: window_cells is an odd integer and cannot be sampled; vary it in a grid")
+            where.fail(f"{key}: window_cells is an odd integer and cannot be sampled; vary it in a grid", key)
         if not isinstance(bounds, list) or len(bounds) != 2:
-            where.fail(f"{key} must be [low, high]; got {bounds!r}")
+            where.fail(f"{key} must be [low, high]; got {bounds!r}", key)
         lo = _check_value(where, f"{key}[0]", name, _number(where, f"{key}[0]", bounds[0]))
         hi = _check_value(where, f"{key}[1]", name, _number(where, f"{key}[1]", bounds[1]))
         if not lo < hi:
-            where.fail(f"{key}: the range is empty or reversed: low must be < high; got [{lo:g}, {hi:g}]")
+            where.fail(f"{key}: the range is empty or reversed: low must be < high; got [{lo:g}, {hi:g}]", key)
         out.append((name, lo, hi))
     return Sample(sample["method"], n, seed, tuple(out))
 
 
-def _law(where: _Where, law, varying) -> tuple[str, dict]:
-    """Law name and its fixed parameters; a varying law parameter must be one the law takes."""
-    from ..laws.fields import check_law_parameters
+def _law(where: _Where, law, varying, varies_in: str) -> tuple[str, dict]:
+    """Law name and its fixed parameters (`SWEEP_LAWS`, the registry's); a varying law parameter must be one the law takes.
 
+    ``law: grid`` (a name) is short for ``law: {name: grid}``; `varies_in` is where the varying parameters are
+    (``grid``, ``sample.ranges``), for the messages."""
     if law is None:
-        law = {"name": "power"}
-    law = dict(_mapping(where, "law", law))
-    name = law.pop("name", "power")
-    where.wrap("law.name", check_choice, "law", name, tuple(LAW_PARAMETERS))
+        law = {"name": DEFAULT_LAW["sweep"]}
+    if isinstance(law, str):
+        law = {"name": law}
+    law = dict(_mapping(where, "law", law, "a law's name or a mapping"))
+    name = law.pop("name", DEFAULT_LAW["sweep"])
+    where.wrap("law.name", check_choice, "law", name, SWEEP_LAWS)
     for key in law:
         if key not in LAW_SWEPT:
-            where.fail(f"unknown key law.{key}; the laws take: {', '.join(LAW_SWEPT)}")
+            where.fail(f"unknown key law.{key}; the laws take: {', '.join(LAW_SWEPT)}", f"law.{key}")
     fixed = {key: _check_value(where, f"law.{key}", key, value) for key, value in law.items()}
     if "window_cells" in fixed:
         fixed["window_cells"] = int(fixed["window_cells"])
     for key in varying:
         if key in fixed:
-            where.fail(f"law.{key} is fixed and also varies; give it in one place")
+            where.fail(f"law.{key} is fixed and also varies; give it in one place", f"law.{key}")
     swept = [key for key in varying if key in LAW_SWEPT or key in ("f", "n")]  # f, n: KB's laws only, as report --law says
-    where.wrap("law", check_law_parameters, name, list(fixed) + swept, law_shown=f"law {name}")
+    entry = get_law(name)
+    for key, shown in [(key, f"law.{key}") for key in fixed] + [(key, f"{varies_in}.{key}") for key in swept]:
+        if not entry.takes(key):
+            where.fail(str(refusal(key, f"law {name}", shown=shown, laws=SWEEP_LAWS)), shown)
+    where.wrap("law", check_parameters, name, list(fixed) + swept, law_shown=f"law {name}", laws=SWEEP_LAWS)
     return name, fixed
 
 
@@ -490,22 +507,22 @@ def _scenario(where: _Where, scenario, varying, given: bool) -> tuple[str, float
     _known(where, "scenario", scenario, ("wall", "corridor"))
     swept = [name for name in GEOMETRY_SWEPT if name in varying]
     if len(swept) == 2:
-        where.fail("alpha (a wall) and L (a corridor) cannot both vary: a sweep has one geometry")
+        where.fail("alpha (a wall) and L (a corridor) cannot both vary: a sweep has one geometry", "scenario")
     kinds = list(scenario)
     if swept:
         kind = "wall" if swept[0] == "alpha" else "corridor"
         if given and kinds and kinds != [kind]:
-            where.fail(f"scenario {', '.join(kinds)} contradicts the varying {swept[0]} (a {kind})")
+            where.fail(f"scenario {', '.join(kinds)} contradicts the varying {swept[0]} (a {kind})", "scenario")
         return kind, None
     if len(kinds) != 1:
         where.fail("scenario must be exactly one of {wall: {alpha: DEG}} or {corridor: {L: M}} (or vary alpha or L)"
-                   + (f"; got {', '.join(kinds)}" if kinds else ""))
+                   + (f"; got {', '.join(kinds)}" if kinds else ""), "scenario")
     kind = kinds[0]
     key, name = ("alpha", "alpha") if kind == "wall" else ("L", "L")
     values = _mapping(where, f"scenario.{kind}", scenario[kind])
     _known(where, f"scenario.{kind}", values, (key,))
     if key not in values:
-        where.fail(f"scenario.{kind}.{key} is missing")
+        where.fail(f"scenario.{kind}.{key} is missing", f"scenario.{kind}")
     return kind, _check_value(where, f"scenario.{kind}.{key}", name, _number(where, f"scenario.{kind}.{key}", values[key]))
 
 
@@ -514,4 +531,4 @@ def _check_simulable(where: _Where, axes, sample, controller: Controller) -> Non
     lows = [a.start for a in axes if a.name == "T"] + ([lo for name, lo, _ in sample.ranges if name == "T"] if sample else [])
     T = lows[0] if lows else controller.T
     if not T > 0:
-        where.fail(f"simulate: the simulator samples, T must be in {RANGES['T_sampled'].describe()}; got T = {T:g}")
+        where.fail(f"simulate: the simulator samples, T must be in {RANGES['T_sampled'].describe()}; got T = {T:g}", "simulate")
