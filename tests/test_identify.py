@@ -20,7 +20,7 @@ import pytest
 import yaml
 from jsonschema import Draft202012Validator
 
-from log_helpers import BAD_LOGS, Plant, Recording, _respond, bad_log, random_plant, simulate, write_log, write_ros2
+from log_helpers import BAD_LOGS, Plant, Recording, bad_log, random_plant, simulate, write_log, write_ros2
 from pfm_stability.analysis.identification import (
     _affine_scan, controller_timing, excitation_windows, identify, lag_response)
 from pfm_stability.cli import main

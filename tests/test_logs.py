@@ -93,6 +93,14 @@ def test_scans_need_a_reducer_and_a_bag(tmp_path):
         read_log(write_csv(LOG, tmp_path / "log.csv"), need=("scan",), scan_reducer=len)
 
 
+def test_a_failing_reducer_is_the_callers_error_not_a_corrupt_file(tmp_path):
+    def broken(scan):
+        raise ZeroDivisionError("the caller's bug")
+
+    with pytest.raises(ZeroDivisionError, match="the caller's bug"):
+        read_log(write_log(LOG, tmp_path, "mcap"), need=("scan",), scan_reducer=broken)
+
+
 def test_topics_are_configurable(tmp_path):
     path = write_ros2(LOG, tmp_path / "bag", topics={"command": "/robot/cmd_vel", "odometry": "/robot/odom"})
     data = read_log(path, LogTopics(command="/robot/cmd_vel", odometry="/robot/odom"))

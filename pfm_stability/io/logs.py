@@ -37,6 +37,7 @@ from __future__ import annotations
 
 import csv
 import math
+from array import array
 import os
 import struct
 from collections.abc import Callable, Sequence
@@ -261,6 +262,10 @@ def read_log(path, topics: LogTopics = LogTopics(), *, need: Sequence[str] = ("c
     return _read_bag(path, kind, topics, tuple(need), scan_reducer)
 
 
+class _ReducerFailed(Exception):
+    """The caller's scan reducer raised (its exception is the cause): passed on as it is, not as a corrupt file."""
+
+
 def _one_line(exc: BaseException) -> str:
     text = " ".join(str(exc).split()) or type(exc).__name__
     return text if len(text) <= 200 else text[:197] + "..."
@@ -283,6 +288,8 @@ def _read_bag(path: str, kind: str, topics: LogTopics, need: tuple[str, ...], sc
         return _stream(reader, path, kind, topics, need, scan_reducer)
     except LogError:
         raise
+    except _ReducerFailed as failed:  # the caller's own error, not the file's
+        raise failed.__cause__ from None
     except Exception as exc:  # noqa: BLE001 - a file cut short shows only when its messages are read
         raise LogError(f"could not read {path} (corrupt or truncated?): {_one_line(exc)}") from None
     finally:
@@ -309,8 +316,8 @@ def _stream(reader, path: str, kind: str, topics: LogTopics, need: tuple[str, ..
                                f"{' or '.join(MESSAGE_TYPES[series])}")
             role_of[c.id] = series
     start_ns = reader.start_time
-    times = {s: [] for s in need}
-    values = {s: [] for s in need}
+    times = {s: array("q") for s in need}  # packed 8-byte numbers, not Python objects: 16 bytes a message
+    values = {s: [] if s == "scan" else array("d") for s in need}
     msgtypes = {}
     decode = _ros1_value if ros1 else _cdr_value
     for connection, received_ns, raw in reader.messages(connections=[c for c in reader.connections if c.id in role_of]):
@@ -321,8 +328,12 @@ def _stream(reader, path: str, kind: str, topics: LogTopics, need: tuple[str, ..
             stamp = msg.header.stamp.sec * 1_000_000_000 + msg.header.stamp.nanosec
             t = (stamp - start_ns) * 1e-9
             times[series].append(stamp)
-            values[series].append(scan_reducer(Scan(t, float(msg.angle_min), float(msg.angle_increment), float(msg.range_min),
-                                                    float(msg.range_max), np.asarray(msg.ranges))))
+            scan = Scan(t, float(msg.angle_min), float(msg.angle_increment), float(msg.range_min), float(msg.range_max),
+                        np.asarray(msg.ranges))
+            try:
+                values[series].append(scan_reducer(scan))
+            except Exception as exc:
+                raise _ReducerFailed from exc
             continue
         stamp, value = decode(raw, _FIELDS[connection.msgtype])
         times[series].append(received_ns if stamp is None else stamp)
@@ -332,13 +343,13 @@ def _stream(reader, path: str, kind: str, topics: LogTopics, need: tuple[str, ..
         topic = topics.of(series)
         if not times[series]:
             raise LogError(f"topic {topic} of {path} has no messages")
-        t = (np.asarray(times[series], dtype=np.int64) - start_ns) * 1e-9
+        t = (np.frombuffer(times[series], dtype=np.int64) - start_ns) * 1e-9
         _check_order(t, topic, path)
         if series == "scan":
             result[series] = ScanSeries(topic, t, _stack(values[series]))
         else:
-            stamps = "receive" if _FIELDS[msgtypes[series]].header is False else "header"
-            result[series] = TimeSeries(topic, msgtypes[series], t, np.asarray(values[series], dtype=float), stamps)
+            stamps = "header" if _FIELDS[msgtypes[series]].header else "receive"
+            result[series] = TimeSeries(topic, msgtypes[series], t, np.frombuffer(values[series], dtype=float).copy(), stamps)
     duration = (reader.end_time - start_ns) * 1e-9
     return LogData(path, kind, start_ns * 1e-9, duration, tuple(present), **result)
 
