@@ -10,6 +10,7 @@ extra    packages                     needed by
 ======== ============================ ===================================
 sweep    dask[distributed], pyarrow   ``pfm-stability sweep``
 maps     scikit-image, Pillow         ``pfm-stability map`` (reading map images, the corridors)
+logs     rosbags                      ``pfm-stability identify`` (reading ROS 1 and ROS 2 bags)
 ======== ============================ ===================================
 
 `require` is called before any work; without the extra it raises
@@ -26,6 +27,7 @@ __all__ = ["EXTRAS", "MissingExtra", "require"]
 EXTRAS = {
     "sweep": {"dask": "dask[distributed]", "pyarrow": "pyarrow"},
     "maps": {"skimage": "scikit-image", "PIL": "Pillow"},
+    "logs": {"rosbags": "rosbags"},
 }
 """Extra → {module imported: the package that provides it}."""
 

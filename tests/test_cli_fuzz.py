@@ -380,7 +380,7 @@ def test_every_option_is_fuzzed():
     for command in SUBPARSERS:
         options, _ = _options(command)
         for name, action in options.items():
-            assert action.nargs == 0 or action.choices is not None or getattr(action.type, "kind", None) in ("number", "integer", "path", "directory", "address"), (command, name)
+            assert action.nargs == 0 or action.choices is not None or getattr(action.type, "kind", None) in ("number", "integer", "path", "directory", "address", "topic"), (command, name)
 
 
 # -------------------------------------------- once tracebacks, now defined answers

@@ -28,7 +28,7 @@ from ..extras import MissingExtra
 
 __all__ = ["main", "build_parser", "UsageError", "unknown_options"]
 
-SUBCOMMANDS = ("report", "derive", "simulate", "validate", "plot", "traps", "map", "sweep")
+SUBCOMMANDS = ("report", "derive", "simulate", "validate", "plot", "traps", "map", "sweep", "identify")
 
 
 class UsageError(Exception):

@@ -1,0 +1,181 @@
+"""``pfm-stability identify``: the steering plant and the controller's period from a robot's own log.
+
+    pfm-stability identify LOG [--out ROBOT.yaml] [--format text|json|markdown]
+                               [--cmd-topic /cmd_vel] [--odom-topic /odom] [--imu-topic /imu] [--rate-source odometry|imu]
+
+LOG is a ROS 2 bag (its directory, or a ``.db3``/``.mcap`` file), a ROS 1 ``.bag`` or a CSV
+(docs/diagnose.md, "Logs"). The commanded yaw rate (``/cmd_vel``) against the achieved one (the
+odometry's, or the IMU's with ``--rate-source imu``) gives the plant g·e^(−sD)/(τs + 1) with 95 %
+intervals; the command's stamps give the controller's period T, its jitter and missed cycles
+(`pfm_stability.analysis.identification`). JSON keys (`pfm_stability/io/schema/output.schema.json`):
+``schema_version``, ``command`` ("identify"), ``identified``, ``reason``, ``plant`` (``g``, ``tau``,
+``dead_time``, each ``{value, low, high}``), ``controller`` (``T``, ``jitter``, ``missed``, …), ``fit``
+(``quality``, ``warnings``), ``log`` (path, format, duration, topics), ``timing``.
+
+A log that shows nothing to identify (the command never changes, the robot does not move) is an
+answer, not an error: exit 0 with ``identified`` false and the reason (the controller's period is
+still measured). ``--out`` then fails (exit 2, nothing written): there is no plant to write. A bad log
+is one line, exit 2. Reading a bag needs the extra ``logs`` (rosbags).
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import re
+import time
+
+__all__ = ["add_parser", "run", "render_text", "render_markdown", "robot_yaml", "topic", "FORMATS"]
+
+FORMATS = ("text", "json", "markdown")
+_TOPIC = re.compile(r"^(~/|/)?[A-Za-z_][A-Za-z0-9_]*(/[A-Za-z0-9_]+)*$")
+"""A ROS topic name: tokens of letters, digits and underscores separated by single slashes, not starting with a digit."""
+
+
+def topic(name: str):
+    """An argparse ``type=`` for the topic option `name`: a ROS topic name (``/cmd_vel``, ``robot1/odom``)."""
+
+    def parse(text: str) -> str:
+        if not _TOPIC.match(text):
+            raise argparse.ArgumentTypeError(f"{name} must be a ROS topic name such as /cmd_vel (letters, digits, _ "
+                                             f"and single slashes); got {text!r}")
+        return text
+
+    parse.__name__ = name
+    parse.kind = "topic"  # for tests/test_cli_fuzz.py: every option has a checked type
+    return parse
+
+
+def add_parser(sub) -> None:
+    """Add the ``identify`` subcommand to `sub` (argparse subparsers)."""
+    from .options import output_path
+
+    p = sub.add_parser(
+        "identify",
+        help="identify the steering plant (gain, lag, dead time) and the controller's period from a robot's log",
+        description="Read a ROS 2 bag (directory, .db3 or .mcap), a ROS 1 .bag or a CSV; fit the yaw-rate plant "
+        "g*exp(-sD)/(tau*s + 1) to the commanded and achieved yaw rates, with 95%% intervals, and measure the "
+        "controller's period T, its jitter and missed cycles from the command's stamps (docs/diagnose.md).",
+    )
+    p.add_argument("log", metavar="LOG", help="a ROS 2 bag directory, a .db3 or .mcap file, a ROS 1 .bag, or a .csv")
+    p.add_argument("--out", type=output_path("out", ".yaml"), metavar="ROBOT.yaml",
+                   help="write the identified tau, dead_time, plant_gain and T as a configuration file (docs/config.md)")
+    p.add_argument("--format", choices=FORMATS, default="text")
+    p.add_argument("--cmd-topic", type=topic("cmd-topic"), default="/cmd_vel", metavar="TOPIC", help="the command (Twist or TwistStamped; default /cmd_vel)")
+    p.add_argument("--odom-topic", type=topic("odom-topic"), default="/odom", metavar="TOPIC", help="the odometry (Odometry; default /odom)")
+    p.add_argument("--imu-topic", type=topic("imu-topic"), default="/imu", metavar="TOPIC", help="the IMU (Imu; default /imu), read with --rate-source imu")
+    p.add_argument("--rate-source", choices=("odometry", "imu"), default="odometry",
+                   help="where the achieved yaw rate comes from (default: odometry)")
+    p.set_defaults(run=run)
+
+
+def run(args) -> int:
+    """Read the log, identify, write ``--out`` and print the result; returns the exit status (0)."""
+    from ..analysis.identification import identify
+    from ..extras import require
+    from ..io.logs import LogTopics, log_format, read_log
+    from ..io.serialize import SCHEMA_VERSION, dumps
+
+    started = time.perf_counter()
+    if log_format(args.log) != "csv":
+        require("logs", "pfm-stability identify")
+    topics = LogTopics(command=args.cmd_topic, odometry=args.odom_topic, imu=args.imu_topic)
+    log = read_log(args.log, topics, need=("command", args.rate_source))
+    result = identify(log, args.rate_source)
+    if args.out:
+        if not result.identified:
+            raise ValueError(f"nothing identified from {args.log}: {result.reason}; {args.out} not written")
+        from ..io.files import write_text
+
+        write_text(args.out, robot_yaml(result), what="configuration")
+    if args.format == "json":
+        print(dumps({"schema_version": SCHEMA_VERSION, "command": "identify", **result.to_dict(),
+                     "timing": {"seconds": time.perf_counter() - started}}))
+    elif args.format == "markdown":
+        print(render_markdown(result), end="")
+    else:
+        print(render_text(result) + (f"configuration written to {args.out}\n" if args.out else ""), end="")
+    return 0
+
+
+# ------------------------------------------------------------------------------------------ renderings
+def _ms(seconds: float) -> str:
+    return f"{1000 * seconds:.1f} ms"
+
+
+def _lines(result) -> dict:
+    """The pieces both renderings share."""
+    log, c = result.log, result.controller
+    return {
+        "source": f"{log.path} ({log.format}, {log.duration:.1f} s): command {log.command_topic} ({log.command_stamps} times), "
+                  f"rate {log.rate_topic} ({log.rate_source})",
+        "T": f"{_ms(c.T)} (nominal {c.nominal:.2f} Hz, achieved {c.rate:.2f} Hz over {c.messages} commands)",
+        "jitter": f"{_ms(c.p5)} to {_ms(c.p95)} (5th to 95th percentile of the intervals)",
+        "missed": f"{c.missed} interval{'s' if c.missed != 1 else ''} longer than 1.5·T",
+    }
+
+
+def _plant_rows(plant) -> list[tuple[str, str, str]]:
+    g, tau, D = plant.g, plant.tau, plant.dead_time
+    return [("g (plant gain)", f"{g.value:.4g}", f"{g.low:.4g} to {g.high:.4g}"),
+            ("τ (lag)", f"{tau.value:.4g} s", f"{tau.low:.4g} to {tau.high:.4g} s"),
+            ("D (dead time)", _ms(D.value), f"{_ms(D.low)} to {_ms(D.high)}")]
+
+
+def _quality(q) -> str:
+    white = "white" if q.white else f"not white ({100 * q.outside:.0f} % of lags 1–20 outside the band)"
+    return (f"R² {q.r2:.4f}, NRMSE {q.nrmse:.3f}, residuals {white} (lag-1 autocorrelation {q.lag1:+.3f}); "
+            f"{q.samples} samples in {q.windows} window{'s' if q.windows != 1 else ''} ({q.excited:.1f} s), "
+            f"bias {q.bias:+.2g} rad/s")
+
+
+def render_text(result) -> str:
+    """The text output of ``identify`` (an `Identification`)."""
+    parts = _lines(result)
+    out = [f"log: {parts['source']}", "", f"controller (from {result.log.command_topic})",
+           f"  T       {parts['T']}", f"  jitter  {parts['jitter']}", f"  missed  {parts['missed']}", ""]
+    if not result.identified:
+        return "\n".join(out + [f"plant: not identified — {result.reason}", ""])
+    plant = result.plant
+    out.append("plant g·e^(−sD)/(τs + 1), 95 % intervals")
+    out += [f"  {name:15s} {value:>10s}   [{interval}]" for name, value, interval in _plant_rows(plant)]
+    out += ["", f"fit: {_quality(plant.quality)}"]
+    out += [f"warning ({w.kind}): {w.message}" for w in plant.warnings] or ["warnings: none"]
+    return "\n".join(out + [""])
+
+
+def render_markdown(result) -> str:
+    """The Markdown output of ``identify`` (an `Identification`)."""
+    parts = _lines(result)
+    out = ["## Identified from the log", "", f"Log: {parts['source']}.", "", "| controller | |", "| --- | --- |",
+           f"| T | {parts['T']} |", f"| jitter | {parts['jitter']} |", f"| missed | {parts['missed']} |", ""]
+    if not result.identified:
+        return "\n".join(out + [f"**Plant not identified:** {result.reason}.", ""])
+    plant = result.plant
+    out += ["| plant g·e^(−sD)/(τs + 1) | value | 95 % interval |", "| --- | --- | --- |"]
+    out += [f"| {name} | {value} | {interval} |" for name, value, interval in _plant_rows(plant)]
+    out += ["", f"Fit: {_quality(plant.quality)}.", ""]
+    out += [f"- **{w.kind}**: {w.message}" for w in plant.warnings] or ["No warnings: the model explains the data."]
+    return "\n".join(out + [""])
+
+
+def robot_yaml(result) -> str:
+    """The configuration file ``--out`` writes: ``robot: {tau, dead_time, plant_gain}``, ``controller: {T}``, commented."""
+    plant, c, log = result.plant, result.controller, result.log
+    name = os.path.basename(os.path.normpath(log.path))
+    D = max(plant.dead_time.value, 0.0)
+    lines = [
+        f"# Identified by `pfm-stability identify` from {name} ({log.duration:.0f} s;",
+        f"# command {log.command_topic}, rate {log.rate_topic}). 95 % intervals in the comments.",
+        "# Add the steering gain k, the force ratio f, the exponent n, the width W, the speed V",
+        "# and the law (docs/config.md) before using it with `pfm-stability report --config`.",
+        "robot:",
+        f"  tau: {plant.tau.value:.6g}          # s, steering lag, identified from {name} ({plant.tau.low:.4g} to {plant.tau.high:.4g})",
+        f"  dead_time: {D:.6g}    # s, identified from {name} ({plant.dead_time.low:.4g} to {plant.dead_time.high:.4g})",
+        f"  plant_gain: {plant.g.value:.6g}   # -, achieved/commanded yaw rate, identified from {name} "
+        f"({plant.g.low:.4g} to {plant.g.high:.4g})",
+        "controller:",
+        f"  T: {c.T:.6g}            # s, median period of {log.command_topic} in {name} "
+        f"(jitter {1000 * c.p5:.1f} to {1000 * c.p95:.1f} ms, {c.missed} missed)",
+    ]
+    return "\n".join(lines) + "\n"

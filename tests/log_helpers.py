@@ -1,0 +1,416 @@
+"""Synthetic robot logs with a known truth, written as ROS 2 bags (sqlite3, MCAP), ROS 1 bags and CSV.
+
+No download and no ROS: a simulated robot whose controller publishes its yaw-rate command every T
+(with jitter and dropped messages) drives the plant g·e^(−sD)/(τs + 1) (optionally with a second lag,
+a rate limit or a deadband), integrated exactly between events — independently of
+`pfm_stability.analysis.identification` (a plain event loop here, an affine scan there) — and
+odometry (50 Hz by default), an IMU and laser scans are sampled from it with sensor noise.
+`rosbags` writes the files (``Writer`` of `rosbags.rosbag2` and `rosbags.rosbag1`).
+
+`bad_log` writes every kind of broken log the reader must refuse in one line.
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+__all__ = ["Plant", "Recording", "SyntheticLog", "simulate", "write_ros2", "write_ros1", "write_csv", "write_log",
+           "random_plant", "bad_log", "BAD_LOGS"]
+
+
+@dataclass(frozen=True)
+class Plant:
+    """The yaw-rate plant g·e^(−sD)/((τs + 1)(τ2·s + 1)) with an optional rate limit and deadband.
+
+    g (−), tau and dead_time (s); tau2 (s, 0: first order); rate_limit (rad/s², |dω/dt| at most; inf: none);
+    deadband (rad/s: a command u delivers sign(u)·max(|u| − deadband, 0)).
+    """
+
+    g: float = 0.9
+    tau: float = 0.2
+    dead_time: float = 0.08
+    tau2: float = 0.0
+    rate_limit: float = math.inf
+    deadband: float = 0.0
+
+
+@dataclass(frozen=True)
+class Recording:
+    """How the robot is driven and recorded.
+
+    T (s) the controller period, jitter (fraction of T, standard deviation of each publication time),
+    drop (probability that a command is lost), profile ("steps", "chirp", "still", "turn_in_place",
+    "stopped": commands vary but the robot does not move), amplitude (rad/s), duration (s), odometry
+    at odom_rate (Hz) with noise odom_noise (rad/s), an IMU at imu_rate (Hz, 0: none) with noise and bias,
+    scans at scan_rate (Hz, 0: none) of `beams` ranges, seed of every random draw.
+    """
+
+    T: float = 0.05
+    jitter: float = 0.05
+    drop: float = 0.02
+    profile: str = "steps"
+    amplitude: float = 1.0
+    duration: float = 60.0
+    odom_rate: float = 50.0
+    odom_noise: float = 0.01
+    imu_rate: float = 0.0
+    imu_noise: float = 0.02
+    imu_bias: float = 0.01
+    scan_rate: float = 0.0
+    beams: int = 360
+    start: float = 1_700_000_000.0
+    seed: int = 0
+
+
+@dataclass(frozen=True)
+class SyntheticLog:
+    """The simulated messages (times in s since `recording.start`) and the truth that made them."""
+
+    plant: Plant
+    recording: Recording
+    cmd_t: np.ndarray
+    cmd_wz: np.ndarray
+    cmd_vx: np.ndarray
+    odom_t: np.ndarray
+    odom_wz: np.ndarray
+    imu_t: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    imu_wz: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    scan_t: np.ndarray = field(default_factory=lambda: np.zeros(0))
+
+    @property
+    def true_T(self) -> float:
+        """The controller's nominal period (s)."""
+        return self.recording.T
+
+
+def random_plant(rng: np.random.Generator) -> tuple[Plant, Recording]:
+    """A plant and a recording drawn from the ranges the identification must cover.
+
+    g 0.5–1.2, τ 0.05–0.8 s, D 0–0.2 s, T 0.02–0.2 s with 0–10 % jitter and 0–5 % dropped commands,
+    odometry noise 0.005–0.03 rad/s; step turns or a chirp.
+    """
+    plant = Plant(g=rng.uniform(0.5, 1.2), tau=rng.uniform(0.05, 0.8), dead_time=rng.uniform(0.0, 0.2))
+    recording = Recording(T=rng.uniform(0.02, 0.2), jitter=rng.uniform(0.0, 0.1), drop=rng.uniform(0.0, 0.05),
+                          odom_noise=rng.uniform(0.005, 0.03), profile=str(rng.choice(["steps", "chirp"])),
+                          duration=90.0, seed=int(rng.integers(1 << 30)))
+    return plant, recording
+
+
+def _profile(recording: Recording, rng: np.random.Generator, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The commanded (yaw rate rad/s, forward speed m/s) at the controller's ticks `t`."""
+    a, name = recording.amplitude, recording.profile
+    if name in ("steps", "stopped"):
+        edges, levels = [0.0], [0.0]
+        while edges[-1] < recording.duration:
+            edges.append(edges[-1] + rng.uniform(0.8, 2.5))
+            levels.append(0.0 if rng.random() < 0.2 else rng.uniform(-a, a))
+        wz = np.asarray(levels)[np.searchsorted(edges, t, side="right") - 1]
+        return wz, np.full_like(t, 0.3)
+    if name == "chirp":
+        f0, f1 = 0.05, 2.0
+        phase = 2 * np.pi * (f0 * t + (f1 - f0) * t**2 / (2 * recording.duration))
+        return a * np.sin(phase), np.full_like(t, 0.3)
+    if name == "turn_in_place":
+        cycle = np.floor(t / 3.0).astype(int) % 4
+        return a * np.array([1.0, 0.0, -1.0, 0.0])[cycle], np.zeros_like(t)
+    if name == "still":
+        return np.zeros_like(t), np.zeros_like(t)
+    raise ValueError(f"unknown profile {name}")
+
+
+def _step(plant: Plant, state: list[float], v: float, dt: float) -> None:
+    """Advance `state` = [x1, y] by `dt` under the constant delivered input g·u = `v`, exactly."""
+    x1, y = state
+    if dt <= 0:
+        return
+    if plant.tau2 > 0:  # two lags in cascade: x1 then y
+        e1, e2 = math.exp(-dt / plant.tau), math.exp(-dt / plant.tau2)
+        c = x1 - v
+        state[0] = v + c * e1
+        state[1] = v + (y - v) * e2 + c * plant.tau / (plant.tau - plant.tau2) * (e1 - e2)
+        return
+    gap, A = v - y, plant.rate_limit
+    if math.isfinite(A) and abs(gap) > A * plant.tau:  # ramp at the limit until the lag's own slope is A
+        ramp = (abs(gap) - A * plant.tau) / A
+        if dt <= ramp:
+            state[1] = y + math.copysign(A * dt, gap)
+            return
+        y += math.copysign(A * ramp, gap)
+        dt -= ramp
+    state[1] = v + (y - v) * math.exp(-dt / plant.tau)
+    state[0] = state[1]
+
+
+def _respond(plant: Plant, cmd_t: np.ndarray, cmd_wz: np.ndarray, sample_t: np.ndarray, still: bool) -> np.ndarray:
+    """The plant's yaw rate at `sample_t` (sorted) for the command held from each `cmd_t` on, delayed by D."""
+    if still:
+        return np.zeros_like(sample_t)
+    u = np.sign(cmd_wz) * np.maximum(np.abs(cmd_wz) - plant.deadband, 0.0) if plant.deadband else cmd_wz
+    events = np.concatenate([cmd_t + plant.dead_time, sample_t])
+    kinds = np.concatenate([np.arange(len(cmd_t)), -1 - np.arange(len(sample_t))])
+    order = np.lexsort((kinds >= 0, events))  # a sample at the instant of a change sees the value before it
+    start = plant.g * u[0]
+    state, now, v = [start, start], 0.0, start
+    out = np.empty(len(sample_t))
+    for when, kind in zip(events[order].tolist(), kinds[order].tolist()):
+        _step(plant, state, v, when - now)
+        now = max(now, when)
+        if kind >= 0:
+            v = plant.g * float(u[kind])
+        else:
+            out[-1 - kind] = state[1]
+    return out
+
+
+def simulate(plant: Plant, recording: Recording) -> SyntheticLog:
+    """The log of `recording` of a robot whose yaw rate follows `plant` (exactly, between events)."""
+    rng = np.random.default_rng(recording.seed)
+    ticks = np.arange(0.0, recording.duration, recording.T)
+    ticks = ticks + np.clip(rng.normal(0.0, recording.jitter * recording.T, ticks.size), -0.4 * recording.T, 0.4 * recording.T)
+    ticks = np.sort(np.clip(ticks, 0.0, None))
+    keep = rng.random(ticks.size) >= recording.drop
+    keep[:2] = True
+    cmd_t = ticks[keep]
+    cmd_wz, cmd_vx = _profile(recording, rng, cmd_t)
+    still = recording.profile == "stopped"
+    phase = rng.uniform(0.0, 1.0 / recording.odom_rate)
+    odom_t = np.arange(phase, recording.duration, 1.0 / recording.odom_rate)
+    odom_wz = _respond(plant, cmd_t, cmd_wz, odom_t, still) + rng.normal(0.0, recording.odom_noise, odom_t.size)
+    imu_t = imu_wz = np.zeros(0)
+    if recording.imu_rate:
+        imu_t = np.arange(0.0, recording.duration, 1.0 / recording.imu_rate) + 0.001
+        imu_wz = (_respond(plant, cmd_t, cmd_wz, imu_t, still) + recording.imu_bias
+                  + rng.normal(0.0, recording.imu_noise, imu_t.size))
+    scan_t = np.arange(0.0, recording.duration, 1.0 / recording.scan_rate) if recording.scan_rate else np.zeros(0)
+    return SyntheticLog(plant, recording, cmd_t, cmd_wz, cmd_vx, odom_t, odom_wz, imu_t, imu_wz, scan_t)
+
+
+# ------------------------------------------------------------------------------------------- messages
+def _typestore(ros1: bool = False):
+    from rosbags.typesys import Stores, get_typestore
+
+    return get_typestore(Stores.ROS1_NOETIC if ros1 else Stores.ROS2_HUMBLE)
+
+
+def _ns(log: SyntheticLog, t: float) -> int:
+    return int(round((log.recording.start + t) * 1e9))
+
+
+class _Messages:
+    """Builds the messages of one log with one typestore (ROS 1 or ROS 2)."""
+
+    def __init__(self, typestore, ros1: bool):
+        self.ts, self.ros1 = typestore, ros1
+        T = typestore.types
+        self.T = T
+        self.cov36 = np.zeros(36)
+        self.cov9 = np.zeros(9)
+
+    def header(self, stamp_ns: int, frame: str):
+        T = self.T
+        stamp = T["builtin_interfaces/msg/Time"](sec=stamp_ns // 10**9, nanosec=stamp_ns % 10**9)
+        if self.ros1:
+            return T["std_msgs/msg/Header"](seq=0, stamp=stamp, frame_id=frame)
+        return T["std_msgs/msg/Header"](stamp=stamp, frame_id=frame)
+
+    def twist(self, vx: float, wz: float):
+        V = self.T["geometry_msgs/msg/Vector3"]
+        return self.T["geometry_msgs/msg/Twist"](linear=V(x=vx, y=0.0, z=0.0), angular=V(x=0.0, y=0.0, z=wz))
+
+    def twist_stamped(self, stamp_ns: int, vx: float, wz: float):
+        return self.T["geometry_msgs/msg/TwistStamped"](header=self.header(stamp_ns, "base_link"), twist=self.twist(vx, wz))
+
+    def odometry(self, stamp_ns: int, wz: float):
+        T = self.T
+        pose = T["geometry_msgs/msg/Pose"](position=T["geometry_msgs/msg/Point"](x=0.0, y=0.0, z=0.0),
+                                           orientation=T["geometry_msgs/msg/Quaternion"](x=0.0, y=0.0, z=0.0, w=1.0))
+        return T["nav_msgs/msg/Odometry"](
+            header=self.header(stamp_ns, "odom"), child_frame_id="base_link",
+            pose=T["geometry_msgs/msg/PoseWithCovariance"](pose=pose, covariance=self.cov36),
+            twist=T["geometry_msgs/msg/TwistWithCovariance"](twist=self.twist(0.3, wz), covariance=self.cov36))
+
+    def imu(self, stamp_ns: int, wz: float):
+        T = self.T
+        V = T["geometry_msgs/msg/Vector3"]
+        return T["sensor_msgs/msg/Imu"](
+            header=self.header(stamp_ns, "imu_link"), orientation=T["geometry_msgs/msg/Quaternion"](x=0.0, y=0.0, z=0.0, w=1.0),
+            orientation_covariance=self.cov9, angular_velocity=V(x=0.0, y=0.0, z=wz), angular_velocity_covariance=self.cov9,
+            linear_acceleration=V(x=0.0, y=0.0, z=9.81), linear_acceleration_covariance=self.cov9)
+
+    def scan(self, stamp_ns: int, ranges: np.ndarray):
+        return self.T["sensor_msgs/msg/LaserScan"](
+            header=self.header(stamp_ns, "laser"), angle_min=-math.pi, angle_max=math.pi, angle_increment=2 * math.pi / ranges.size,
+            time_increment=0.0, scan_time=0.1, range_min=0.05, range_max=30.0, ranges=ranges.astype(np.float32),
+            intensities=np.zeros(0, dtype=np.float32))
+
+    def serialize(self, msg, msgtype: str) -> bytes:
+        return bytes(self.ts.serialize_ros1(msg, msgtype) if self.ros1 else self.ts.serialize_cdr(msg, msgtype))
+
+
+COMMAND_TYPES = {"Twist": "geometry_msgs/msg/Twist", "TwistStamped": "geometry_msgs/msg/TwistStamped"}
+
+
+def _records(log: SyntheticLog, messages: _Messages, topics: dict, cmd_type: str, odom_type: str, swap_odom: int | None):
+    """(receive time ns, topic, msgtype, raw) of every message, in receive order."""
+    out = []
+    cmd_msgtype = COMMAND_TYPES[cmd_type]
+    for t, vx, wz in zip(log.cmd_t.tolist(), log.cmd_vx.tolist(), log.cmd_wz.tolist()):
+        ns = _ns(log, t)
+        msg = messages.twist(vx, wz) if cmd_type == "Twist" else messages.twist_stamped(ns, vx, wz)
+        out.append((ns, topics["command"], cmd_msgtype, messages.serialize(msg, cmd_msgtype)))
+    odom_stamps = [_ns(log, t) for t in log.odom_t.tolist()]
+    if swap_odom is not None:  # two stamps exchanged: the header stamps go backwards once
+        odom_stamps[swap_odom], odom_stamps[swap_odom + 1] = odom_stamps[swap_odom + 1], odom_stamps[swap_odom]
+    odom_msgtype = "nav_msgs/msg/Odometry" if odom_type == "Odometry" else "geometry_msgs/msg/Twist"
+    for k, (stamp, wz) in enumerate(zip(odom_stamps, log.odom_wz.tolist())):
+        msg = messages.odometry(stamp, wz) if odom_type == "Odometry" else messages.twist(0.3, wz)
+        out.append((_ns(log, float(log.odom_t[k])) + 3_000_000, topics["odometry"], odom_msgtype, messages.serialize(msg, odom_msgtype)))
+    for t, wz in zip(log.imu_t.tolist(), log.imu_wz.tolist()):
+        ns = _ns(log, t)
+        out.append((ns + 1_000_000, topics["imu"], "sensor_msgs/msg/Imu", messages.serialize(messages.imu(ns, wz), "sensor_msgs/msg/Imu")))
+    if log.scan_t.size:
+        rng = np.random.default_rng(log.recording.seed + 1)
+        base = rng.uniform(0.5, 10.0, log.recording.beams)
+        for t in log.scan_t.tolist():
+            ns = _ns(log, t)
+            raw = messages.serialize(messages.scan(ns, base + 0.01 * math.sin(t)), "sensor_msgs/msg/LaserScan")
+            out.append((ns + 2_000_000, topics["scan"], "sensor_msgs/msg/LaserScan", raw))
+    out.sort(key=lambda r: r[0])
+    return out
+
+
+DEFAULT_TOPICS = {"command": "/cmd_vel", "odometry": "/odom", "imu": "/imu", "scan": "/scan"}
+
+
+def write_ros2(log: SyntheticLog, path, *, storage: str = "sqlite3", cmd_type: str = "Twist", odom_type: str = "Odometry",
+               topics: dict | None = None, swap_odom: int | None = None) -> Path:
+    """Write `log` as a ROS 2 bag directory `path` (storage "sqlite3" or "mcap"); returns `path`."""
+    from rosbags.rosbag2 import StoragePlugin, Writer
+
+    topics = {**DEFAULT_TOPICS, **(topics or {})}
+    typestore = _typestore()
+    records = _records(log, _Messages(typestore, False), topics, cmd_type, odom_type, swap_odom)
+    plugin = StoragePlugin.MCAP if storage == "mcap" else StoragePlugin.SQLITE3
+    with Writer(Path(path), version=9, storage_plugin=plugin) as writer:
+        connections = {}
+        for _, topic, msgtype, _ in records:
+            if topic not in connections:
+                connections[topic] = writer.add_connection(topic, msgtype, typestore=typestore)
+        for ns, topic, _, raw in records:
+            writer.write(connections[topic], ns, raw)
+    return Path(path)
+
+
+def write_ros1(log: SyntheticLog, path, *, cmd_type: str = "Twist", topics: dict | None = None) -> Path:
+    """Write `log` as a ROS 1 ``.bag`` file `path`; returns `path`."""
+    from rosbags.rosbag1 import Writer
+
+    topics = {**DEFAULT_TOPICS, **(topics or {})}
+    typestore = _typestore(ros1=True)
+    records = _records(log, _Messages(typestore, True), topics, cmd_type, "Odometry", None)
+    with Writer(Path(path)) as writer:
+        connections = {}
+        for _, topic, msgtype, _ in records:
+            if topic not in connections:
+                connections[topic] = writer.add_connection(topic, msgtype, typestore=typestore)
+        for ns, topic, _, raw in records:
+            writer.write(connections[topic], ns, raw)
+    return Path(path)
+
+
+def write_csv(log: SyntheticLog, path, *, drop_column: str | None = None) -> Path:
+    """Write `log` as one wide CSV (``t, cmd_wz, odom_wz[, imu_wz]``, blanks where a row has no value of a column)."""
+    columns = ["t", "cmd_wz", "odom_wz"] + (["imu_wz"] if log.imu_t.size else [])
+    rows = [(t, "cmd_wz", v) for t, v in zip(log.cmd_t.tolist(), log.cmd_wz.tolist())]
+    rows += [(t, "odom_wz", v) for t, v in zip(log.odom_t.tolist(), log.odom_wz.tolist())]
+    rows += [(t, "imu_wz", v) for t, v in zip(log.imu_t.tolist(), log.imu_wz.tolist())]
+    rows.sort(key=lambda r: r[0])
+    kept = [c for c in columns if c != drop_column]
+    with open(path, "w", newline="") as fh:
+        writer = csv.writer(fh)
+        writer.writerow(kept)
+        for t, column, value in rows:
+            if column in kept:
+                writer.writerow([repr(t)] + [repr(value) if c == column else "" for c in kept[1:]])
+    return Path(path)
+
+
+def write_log(log: SyntheticLog, directory, kind: str, **options) -> Path:
+    """Write `log` in `kind` ("sqlite3", "mcap", "ros1", "csv") under `directory`; returns the path to give the reader."""
+    directory = Path(directory)
+    if kind in ("sqlite3", "mcap"):
+        return write_ros2(log, directory / f"bag_{kind}", storage=kind, **options)
+    if kind == "ros1":
+        return write_ros1(log, directory / "log.bag", **options)
+    if kind == "csv":
+        return write_csv(log, directory / "log.csv", **options)
+    raise ValueError(kind)
+
+
+# ------------------------------------------------------------------------------------------- bad logs
+BAD_LOGS = ("empty bag", "empty ros1 bag", "truncated mcap", "truncated ros1", "corrupt db3", "renamed topic", "wrong type",
+            "stamps out of order", "csv missing column", "csv not a number", "not a log", "missing path")
+"""Every broken log `bad_log` writes."""
+
+
+def bad_log(kind: str, directory) -> Path:
+    """A broken log of `kind` (one of `BAD_LOGS`) under `directory`: the path to give the reader."""
+    from rosbags.rosbag2 import StoragePlugin, Writer
+
+    directory = Path(directory)
+    small = simulate(Plant(), Recording(duration=6.0, seed=1))
+    if kind == "empty bag":
+        path = directory / "empty"
+        with Writer(path, version=9, storage_plugin=StoragePlugin.MCAP) as writer:
+            writer.add_connection("/cmd_vel", "geometry_msgs/msg/Twist", typestore=_typestore())
+        return path
+    if kind == "empty ros1 bag":
+        from rosbags.rosbag1 import Writer as Writer1
+
+        path = directory / "empty.bag"
+        with Writer1(path):
+            pass
+        return path
+    if kind == "truncated mcap":
+        bag = write_ros2(small, directory / "whole", storage="mcap")
+        (mcap,) = bag.glob("*.mcap")
+        data = mcap.read_bytes()
+        path = directory / "truncated.mcap"
+        path.write_bytes(data[: len(data) // 2])
+        return path
+    if kind == "truncated ros1":
+        bag = write_ros1(small, directory / "whole.bag")
+        path = directory / "truncated.bag"
+        path.write_bytes(bag.read_bytes()[: bag.stat().st_size // 2])
+        return path
+    if kind == "corrupt db3":
+        path = directory / "corrupt.db3"
+        path.write_bytes(b"SQLite format 3\x00" + bytes(np.random.default_rng(0).integers(0, 256, 4000, dtype=np.uint8)))
+        return path
+    if kind == "renamed topic":
+        return write_ros2(small, directory / "renamed", topics={"odometry": "/robot/odom"})
+    if kind == "wrong type":
+        return write_ros2(small, directory / "wrong", odom_type="Twist")
+    if kind == "stamps out of order":
+        return write_ros2(small, directory / "order", swap_odom=100)
+    if kind == "csv missing column":
+        return write_csv(small, directory / "missing.csv", drop_column="odom_wz")
+    if kind == "csv not a number":
+        path = write_csv(small, directory / "nan.csv")
+        lines = path.read_text().splitlines()
+        lines[5] = lines[5].split(",")[0] + ",abc," + ",".join(lines[5].split(",")[2:])
+        path.write_text("\n".join(lines) + "\n")
+        return path
+    if kind == "not a log":
+        path = directory / "notes.txt"
+        path.write_text("hello\n")
+        return path
+    if kind == "missing path":
+        return directory / "nowhere.mcap"
+    raise ValueError(kind)
+
