@@ -17,9 +17,8 @@ from cli_helpers import report_json, run
 
 from pfm_stability import CARMEL
 from pfm_stability.report.families import build_family_report, make_family_law
-from pfm_stability.models import ExactDelay
+from pfm_stability.models import ExactDelay, make_model
 from pfm_stability.models.holonomic import HolonomicLoop, kinematic_loop
-from pfm_stability.models.holonomic_delay import make_holonomic_model
 from pfm_stability.parameters import MODEL_NAMES
 
 KHATIB_CORRIDOR = ["--robot", "holonomic", "--law", "velocity", "--eta", "0.3", "--rho0", "2", "--L", "0.5", "--alpha-v", "0.1"]
@@ -66,7 +65,7 @@ def test_holonomic_gains_and_delay_margins_on_random_parameters():
         assert c_h == pytest.approx(2 * alpha_v / mass, rel=1e-12)
         loop = HolonomicLoop(T, c_h)
         for name in MODEL_NAMES:
-            expected = make_holonomic_model(name, compute_delay=0).critical_delay(kappa, loop)
+            expected = make_model(name, compute_delay=0).critical_delay(kappa, loop)
             got = d["corridor"][name]["T_critical"]
             assert (got == "inf" and math.isinf(expected)) or got == pytest.approx(expected, rel=1e-12), name
         assert d["corridor"]["exact_delay"]["T_critical"] == pytest.approx(exact_delay_T(kappa, c_h), rel=1e-6)

@@ -34,15 +34,15 @@ from ..laws.fields import KhatibLaw
 from ..laws.fuzzy import DfapfControllers, load_dfapf
 from ..laws.fuzzy_law import FuzzyScheduledLaw
 from ..models import HEADING_GAIN_RANGE, Loop, interval_margin, interval_verdict, models_for
-from ..models.holonomic import HolonomicLoop
-from ..models.holonomic_delay import make_holonomic_model
+from ..models import STEERING, make_models
+from ..models.holonomic import HOLONOMIC, HolonomicLoop
 from ..parameters import FAMILY_CHOICE_DEFAULTS, FAMILY_DEFAULTS, FAMILY_LAW_CHOICES, FAMILY_LAW_PARAMETERS, FAMILY_LAWS, HOLONOMIC_LAWS, MODEL_NAMES, RANGES, ROBOT_FAMILIES, Controller, Corridor, Robot, Wall, check_parameter
 from .stability import UNITS, StabilityReport, build_report, kb_errors, remedies, remedies_by_key
 from ..io.serialize import json_number
 from ..models.tracking import tracking_dynamics
 from ..laws.velocity_laws import HolonomicGains, VelocityAttraction, VelocityGatedRepulsion
 
-__all__ = ["FamilyLaw", "HolonomicVerdict", "make_family_law", "build_family_report", "holonomic_verdict", "KINEMATIC_TAU_SOURCE"]
+__all__ = ["FamilyLaw", "HolonomicVerdict", "make_family_law", "build_family_report", "KINEMATIC_TAU_SOURCE"]
 
 KINEMATIC_TAU_SOURCE = "not used (kinematic robot: no motor lag, tau = 0; --k is K_s)"
 """The source the report gives τ for ``--robot kinematic``."""
@@ -257,9 +257,6 @@ def _kappa_margin(kappa: float, boundary, stable: bool) -> tuple:
     return interval_margin(kappa, boundary.stable_set, boundary.kappa_critical, stable), verdict
 
 
-def holonomic_verdict(name: str, kappa: float, c_h: float, controller: Controller, pade_order: int = 3) -> HolonomicVerdict:
-    """The holonomic model `name` at κ (1/s²) and c_h (1/s) with the controller's T and compute delay."""
-    return _verdict_of(make_holonomic_model(name, pade_order=pade_order, compute_delay=controller.compute_delay), kappa, c_h, controller)
 
 
 def _verdict_of(model, kappa: float, c_h: float, controller: Controller) -> HolonomicVerdict:
@@ -512,7 +509,7 @@ def build_family_report(
         extras.setdefault("environment", {})["corridor"] = {"equilibria": [{"N_frozen": e.N_frozen} for e in corridor_result.equilibria]}
     static = family_law.repulsion() if family_law.name == "velocity" else None
     fixes = remedies_by_key(wall_result, corridor_result, lambda scenario, verdict: _loop_remedies(scenario, verdict, robot, controller, static))
-    options = {m.name: {"equation": m.equation, **m.options()} for m in model_objs}
+    options = {m.name: STEERING.describe(m) for m in model_objs}
     errors = kb_errors(robot, controller, wall_result, corridor_result)
     return StabilityReport(inputs, options, wall_result, corridor_result, errors[0] if errors else None, fixes, family_law.described(), None, extras,
                            errors if len(errors) > 1 else ())
@@ -529,7 +526,7 @@ def _loop_remedies(scenario: str, verdict, robot: Robot, controller: Controller,
 def _model_objects(controller: Controller, models, pade_order: int, family: str) -> tuple:
     """The steering models (`models.models_for`, ``sampled`` as the controller samples) or the holonomic ones."""
     if family == "holonomic":
-        return tuple(make_holonomic_model(name, pade_order=pade_order, compute_delay=controller.compute_delay) for name in models)
+        return tuple(make_models(list(models), pade_order=pade_order, compute_delay=controller.compute_delay))
     return tuple(models_for(controller, models, pade_order=pade_order))
 
 
@@ -583,7 +580,7 @@ def _holonomic(inputs, family_law, controller, robot, wall, corridor, model_objs
     if att.m == 2.0 and att.n == 2.0:
         t = tracking_dynamics(att.alpha_p, att.alpha_v, mass)
         extras["tracking"] = {"damping_ratio": t.damping_ratio, "natural_frequency": t.natural_frequency, "regime": t.regime}
-    options = {m.name: {"equation": m.equation, **m.options()} for m in model_objs}
+    options = {m.name: HOLONOMIC.describe(m) for m in model_objs}
     return StabilityReport(inputs, options, None, None, None, {}, family_law.described(), None, extras)
 
 

@@ -23,7 +23,7 @@ from ..checks import check_type
 from ..analysis.comparison import relative_error
 from ..analysis.criteria import CorridorAnalysis, WallAnalysis, analyze_corridor, analyze_wall, loop_of
 from ..laws.force_law import ForceLaw, law_in_force
-from ..models import HEADING_GAIN_RANGE, KBFirstOrder, Loop, Sampled, models_for
+from ..models import HEADING_GAIN_RANGE, STEERING, KBFirstOrder, Loop, Sampled, models_for
 from ..parameters import LAW_PARAMETERS, MODEL_NAMES, RANGES, Controller, Corridor, Robot, Wall, check_parameter
 from ..io.serialize import SCHEMA_VERSION, json_number, json_ready
 
@@ -425,7 +425,7 @@ def build_report(
     if corridor is not None:
         values["L"] = corridor.L
     inputs = {name: {"value": value, "unit": UNITS[name], "source": sources.get(name, "user")} for name, value in values.items()}
-    options = {m.name: {"equation": m.equation, **m.options()} for m in model_objs}
+    options = {m.name: STEERING.describe(m) for m in model_objs}
     wall_result = analyze_wall(robot, controller, wall, model_objs, law) if wall else None
     corridor_result = analyze_corridor(robot, controller, corridor, model_objs, law) if corridor else None
     fixes = remedies_by_key(wall_result, corridor_result,
