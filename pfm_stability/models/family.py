@@ -17,7 +17,7 @@ import numpy as np
 from ..io.serialize import json_number
 from ..numerics.crossings import StabilityInterval
 
-__all__ = ["LoopFamily", "Characteristic", "StableSet"]
+__all__ = ["LoopFamily", "Characteristic", "StableSet", "root_json"]
 
 
 @dataclass(frozen=True)
@@ -150,3 +150,9 @@ class StableSet:
     def stable_set_json(self) -> list:
         """The stable set as JSON: [[lo, hi], …] (``"inf"`` for an unbounded end)."""
         return [[json_number(lo), json_number(hi)] for lo, hi in self.stable_set]
+
+
+def root_json(root: complex | None) -> dict:
+    """A model's rightmost root (`LoopModel.rightmost_root`) as JSON: {"sigma": 1/s, "omega": rad/s >= 0}; nulls when the
+    model could not resolve it (None)."""
+    return {"sigma": json_number(root.real), "omega": json_number(abs(root.imag))} if root is not None else {"sigma": None, "omega": None}

@@ -70,7 +70,7 @@ from ..parameters import RANGES, T_RESOLUTION, check_parameter
 from ..io.serialize import json_number
 from .base import Loop, LoopModel, interval_margin, interval_verdict
 from .continuous import Continuous
-from .family import Characteristic, LoopFamily, StableSet
+from .family import Characteristic, LoopFamily, StableSet, root_json
 
 __all__ = [
     "BEST_CURVATURE_PRODUCT",
@@ -331,6 +331,22 @@ class HolonomicVerdict:
     def stable(self) -> bool:
         """True only when the verdict is "stable"."""
         return self.verdict == "stable"
+
+    def to_dict(self, remedy: dict | None = None) -> dict:
+        """The fields as a JSON-ready dict (SI units) with `remedy` (``to_stabilize``); κ* and T* are stable below."""
+        return {
+            "stable": self.stable,
+            "verdict": self.verdict,
+            "kappa": self.kappa,
+            "kappa_critical": json_number(self.kappa_critical),
+            "margin": json_number(self.margin),
+            "omega_critical": json_number(self.omega_critical),
+            "rightmost_root": root_json(self.rightmost_root),
+            "T_critical": json_number(self.T_critical),
+            "damping_range": [[json_number(lo), json_number(hi)] for lo, hi in self.damping_range],
+            "stable_side": {"kappa_critical": "below", "T_critical": "below"},  # stable for 0 < κ < κ*, for T in [0, T*)
+            "to_stabilize": remedy or {},
+        }
 
 
 def holonomic_verdict(model: LoopModel, kappa: float, loop: HolonomicLoop) -> HolonomicVerdict:
