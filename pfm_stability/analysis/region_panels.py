@@ -134,10 +134,12 @@ def _speeds(V, resolution: int) -> np.ndarray:
     return np.linspace(0.02, 2.0, resolution) if V is None else np.asarray(V, dtype=float)
 
 
-def _shading(controller: Controller, shaded):
-    """(model, text) of the shaded model (`regions.region_model`, `shading_text`)."""
+def _shading(controller: Controller, shaded, region_of, shade: bool = True) -> tuple:
+    """(region, text) of the shaded model (`regions.region_model`, `shading_text`): ``region_of(model)``; (None, None) unshaded."""
+    if not shade:
+        return None, None
     model = region_model(controller, shaded)
-    return model, shading_text(model, controller)
+    return region_of(model), shading_text(model, controller)
 
 
 def wall_f_panel(robot: Robot, controller: Controller, alpha: float, *, V=None, f=None, models=None, shaded=None,
@@ -172,8 +174,7 @@ def wall_f_panel(robot: Robot, controller: Controller, alpha: float, *, V=None, 
     V = _speeds(V, resolution)
     f = np.geomspace(0.01, 100.0, resolution) if f is None else np.asarray(f, dtype=float)
     models = default_models(controller) if models is None else models
-    model, text = _shading(controller, shaded)
-    region = wall_f_region(robot, controller, alpha, V, f, model=model)
+    region, text = _shading(controller, shaded, lambda model: wall_f_region(robot, controller, alpha, V, f, model=model))
     curves = tuple(wall_f_curves(robot, controller, alpha, V, models))
     return RegionPanel("wall_f", robot, controller, curves, region, text, _loop_text(robot, controller), V, f, alpha)
 
@@ -206,10 +207,7 @@ def wall_alpha_panel(robot: Robot, controller: Controller, *, V=None, models=Non
     V = _speeds(V, resolution)
     models = default_models(controller) if models is None else models
     alpha = np.radians(np.linspace(0.2, 89.8, resolution))
-    region = text = None
-    if shade:
-        model, text = _shading(controller, shaded)
-        region = wall_alpha_region(robot, controller, V, alpha, law=law, model=model)
+    region, text = _shading(controller, shaded, lambda model: wall_alpha_region(robot, controller, V, alpha, law=law, model=model), shade)
     curves = tuple(wall_alpha_curves(robot, controller, V, models, law=law))
     return RegionPanel("wall_alpha", robot, controller, curves, region, text, _loop_text(robot, controller, law), V, alpha)
 
@@ -226,17 +224,8 @@ def corridor_V_panel(robot: Robot, controller: Controller, *, L=None, V=None, mo
     robot, controller : Robot, Controller
     L : array_like, optional
         Half-widths, m (default (W/2, 2] m).
-    V : array_like, optional
-        Speeds, m/s (default [0.02, 2]).
-    models : list of LoopModel, optional
-    law : ForceLaw, optional
-        Default KB's power law.
-    shaded : LoopModel or str, optional
-        The model whose verdicts are shaded (default the report's verdict model, see `wall_f_panel`).
-    shade : bool
-        Shade the `shaded` model's verdicts.
-    resolution : int
-        Grid points per axis of the shading.
+    V, models, law, shaded, shade, resolution
+        As `wall_alpha_panel`.
 
     Returns
     -------
@@ -245,10 +234,7 @@ def corridor_V_panel(robot: Robot, controller: Controller, *, L=None, V=None, mo
     L = np.linspace(robot.W / 2 * 1.0005, 2.0, resolution) if L is None else np.asarray(L, dtype=float)
     V = _speeds(V, resolution)
     models = default_models(controller) if models is None else models
-    region = text = None
-    if shade:
-        model, text = _shading(controller, shaded)
-        region = corridor_region(robot, controller, L, V, law=law, model=model)
+    region, text = _shading(controller, shaded, lambda model: corridor_region(robot, controller, L, V, law=law, model=model), shade)
     curves = tuple(corridor_V_curves(robot, controller, L, models, law=law))
     return RegionPanel("corridor_V", robot, controller, curves, region, text, _loop_text(robot, controller, law), L, V)
 
@@ -260,16 +246,8 @@ def corridor_L_panel(robot: Robot, controller: Controller, *, V=None, models=Non
     Parameters
     ----------
     robot, controller : Robot, Controller
-    V : array_like, optional
-        Speeds, m/s (default [0.02, 2]).
-    models : list of LoopModel, optional
-    law : ForceLaw, optional
-    shaded : LoopModel or str, optional
-        The model whose verdicts are shaded (default the report's verdict model, see `wall_f_panel`).
-    shade : bool
-        Shade the `shaded` model's verdicts.
-    resolution : int
-        Grid points per axis of the shading.
+    V, models, law, shaded, shade, resolution
+        As `wall_alpha_panel`.
 
     Returns
     -------
@@ -281,11 +259,12 @@ def corridor_L_panel(robot: Robot, controller: Controller, *, V=None, models=Non
     curves = tuple(corridor_L_curves(robot, controller, V, models, law=law))
     top = max(1.6, 1.15 * max(float(np.nanmax(np.where(np.isfinite(c.y), c.y, np.nan))) for c in curves))
     L = np.linspace(robot.W / 2 * 1.0005, top, resolution)
-    region = text = None
-    if shade:
-        model, text = _shading(controller, shaded)
+
+    def across(model):  # the grid is (V rows, L columns): L up, V across
         grid = corridor_region(robot, controller, L, V, law=law, model=model)
-        region = replace(grid, x=grid.y, y=grid.x, stable=grid.stable.T)  # the grid is (V rows, L columns): L up, V across
+        return replace(grid, x=grid.y, y=grid.x, stable=grid.stable.T)
+
+    region, text = _shading(controller, shaded, across, shade)
     return RegionPanel("corridor_L", robot, controller, curves, region, text, _loop_text(robot, controller, law), V, L)
 
 

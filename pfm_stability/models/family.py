@@ -5,7 +5,8 @@
 each decides every family: KB's steering robot (`models.base.Loop`: a(s) = τs³ + s² + ks,
 δ = kc, K = kNV; kinematic steering is τ = 0) and the holonomic robot
 (`models.holonomic.HolonomicLoop`: a(s) = s², δ = c_h, K = κ). `LoopFamily` names a
-family's gain and the equation each model solves for it.
+family's gain and the equation each model solves for it; `StableSet` and `root_json` are
+what every family's results share (a stable set of the gain, a rightmost root).
 """
 
 from __future__ import annotations

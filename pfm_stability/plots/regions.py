@@ -175,6 +175,26 @@ def _no_fit_band(ax, W, *, vertical=True):
         ax.axhspan(lo, W / 2, label=f"robot does not fit (L ≤ W/2 = {W / 2:g} m)", zorder=1, **_NOFIT)
 
 
+def _panel(m, ax, legend: bool, y_scale: float = 1.0):
+    """(figure, axes) of a panel with its shading (when the panel has one) and every model's curve drawn."""
+    fig, ax = figure_and_axes(ax, _WITH_LEGEND if legend else _SINGLE)
+    if m.region is not None:
+        _shade(ax, m.region, m.shaded, y_scale=y_scale)
+    _draw_curves(ax, m.curves, y_scale=y_scale)
+    return fig, ax
+
+
+def _finish(fig, ax, m, labels: tuple, title: str, stable: tuple, oscillates: tuple, legend: bool):
+    """The axis `labels`, the title (the loop and the shaded model under it), the words "stable" and "oscillates" at
+    (x, y, alignment) in axes fractions, the legend; returns the figure."""
+    _style_axes(ax, *labels, _title(f"{title}\n{m.loop}", m.shaded))
+    ax.text(stable[0], stable[1], "stable", transform=ax.transAxes, fontsize=10, color="#2a6a1f", weight="bold", **stable[2])
+    ax.text(oscillates[0], oscillates[1], "oscillates", transform=ax.transAxes, fontsize=10, color="#9b2b22", weight="bold", **oscillates[2])
+    if legend:
+        region_legend(ax, fontsize=7)
+    return fig
+
+
 # ------------------------------------------------------------------ wall
 def plot_wall_f_region(m, ax=None, *, legend: bool = True, mark: bool = True):
     """Stable and unstable regions along a wall in the (V, f) plane at one target angle α (`region_panels.wall_f_panel`).
@@ -193,21 +213,14 @@ def plot_wall_f_region(m, ax=None, *, legend: bool = True, mark: bool = True):
     -------
     matplotlib.figure.Figure
     """
-    fig, ax = figure_and_axes(ax, _WITH_LEGEND if legend else _SINGLE)
-    _shade(ax, m.region, m.shaded)
-    _draw_curves(ax, m.curves)
+    fig, ax = _panel(m, ax, legend)
     if mark:
         _mark(ax, m.robot.V, m.controller.f, "CARMEL", label=MARK_LABEL, offset=(-8, 6))
     ax.set_yscale("log")
     ax.set_xlim(m.x[0], m.x[-1])
     ax.set_ylim(m.y[0], m.y[-1])
-    title = f"Wall, α = {math.degrees(m.alpha):.3g}°: stable above f*(V) (KB eq 24)\n{m.loop}"
-    _style_axes(ax, V_LABEL, F_LABEL, _title(title, m.shaded))
-    ax.text(0.03, 0.96, "stable", transform=ax.transAxes, va="top", fontsize=10, color="#2a6a1f", weight="bold")
-    ax.text(0.97, 0.04, "oscillates", transform=ax.transAxes, ha="right", fontsize=10, color="#9b2b22", weight="bold")
-    if legend:
-        region_legend(ax, fontsize=7)
-    return fig
+    return _finish(fig, ax, m, (V_LABEL, F_LABEL), f"Wall, α = {math.degrees(m.alpha):.3g}°: stable above f*(V) (KB eq 24)",
+                   (0.03, 0.96, {"va": "top"}), (0.97, 0.04, {"ha": "right"}), legend)
 
 
 def plot_wall_alpha_critical(m, ax=None, *, marks=((20.0, "KB Fig 5: α = 20°"), (50.0, "before the corner: α = 50°")), legend: bool = True):
@@ -228,21 +241,13 @@ def plot_wall_alpha_critical(m, ax=None, *, marks=((20.0, "KB Fig 5: α = 20°")
     -------
     matplotlib.figure.Figure
     """
-    fig, ax = figure_and_axes(ax, _WITH_LEGEND if legend else _SINGLE)
-    if m.region is not None:
-        _shade(ax, m.region, m.shaded, y_scale=180 / math.pi)
-    _draw_curves(ax, m.curves, y_scale=180 / math.pi)
+    fig, ax = _panel(m, ax, legend, y_scale=180 / math.pi)
     _marks(ax, marks, lambda a: (m.robot.V, a), {50.0: (-8, 6)})
     ax.set_xlim(m.x[0], m.x[-1])
     ax.set_ylim(0, 90)
     ax.set_yticks(range(0, 91, 15))
-    title = f"Wall: stable above α*(V) (KB eq 21 with eq 23)\n{m.loop}"
-    _style_axes(ax, V_LABEL, ALPHA_LABEL, _title(title, m.shaded))
-    ax.text(0.03, 0.96, "stable", transform=ax.transAxes, va="top", fontsize=10, color="#2a6a1f", weight="bold")
-    ax.text(0.97, 0.04, "oscillates", transform=ax.transAxes, ha="right", fontsize=10, color="#9b2b22", weight="bold")
-    if legend:
-        region_legend(ax, fontsize=7)
-    return fig
+    return _finish(fig, ax, m, (V_LABEL, ALPHA_LABEL), "Wall: stable above α*(V) (KB eq 21 with eq 23)",
+                   (0.03, 0.96, {"va": "top"}), (0.97, 0.04, {"ha": "right"}), legend)
 
 
 # ------------------------------------------------------------------ corridor
@@ -265,21 +270,13 @@ def plot_corridor_region(m, ax=None, *, marks=((0.9, "KB Fig 6a\n(wide)"), (0.6,
     -------
     matplotlib.figure.Figure
     """
-    fig, ax = figure_and_axes(ax, _WITH_LEGEND if legend else _SINGLE)
-    if m.region is not None:
-        _shade(ax, m.region, m.shaded)
-    _draw_curves(ax, m.curves)
+    fig, ax = _panel(m, ax, legend)
     _marks(ax, marks, lambda Lm: (Lm, m.robot.V), {0.9: (8, -8), 0.6: (-8, 6)})
     ax.set_xlim(min(m.x[0], m.robot.W / 2) - 0.1, m.x[-1])
     ax.set_ylim(m.y[0], m.y[-1])
     _no_fit_band(ax, m.robot.W, vertical=True)
-    title = f"Corridor: stable below V*(L) = NV*/N(L) (KB eq 25)\n{m.loop}"
-    _style_axes(ax, L_LABEL, V_LABEL, _title(title, m.shaded))
-    ax.text(0.97, 0.04, "stable", transform=ax.transAxes, ha="right", fontsize=10, color="#2a6a1f", weight="bold")
-    ax.text(0.25, 0.96, "oscillates", transform=ax.transAxes, va="top", fontsize=10, color="#9b2b22", weight="bold")
-    if legend:
-        region_legend(ax, fontsize=7)
-    return fig
+    return _finish(fig, ax, m, (L_LABEL, V_LABEL), "Corridor: stable below V*(L) = NV*/N(L) (KB eq 25)",
+                   (0.97, 0.04, {"ha": "right"}), (0.25, 0.96, {"va": "top"}), legend)
 
 
 def plot_corridor_L_critical(m, ax=None, *, marks=((0.9, "KB Fig 6a\n(wide)"), (0.6, "KB Fig 6b\n(narrow)")), legend: bool = True):
@@ -300,21 +297,13 @@ def plot_corridor_L_critical(m, ax=None, *, marks=((0.9, "KB Fig 6a\n(wide)"), (
     -------
     matplotlib.figure.Figure
     """
-    fig, ax = figure_and_axes(ax, _WITH_LEGEND if legend else _SINGLE)
-    if m.region is not None:
-        _shade(ax, m.region, m.shaded)
-    _draw_curves(ax, m.curves)
+    fig, ax = _panel(m, ax, legend)
     _marks(ax, marks, lambda Lm: (m.robot.V, Lm), {0.9: (-8, 6)})
     ax.set_xlim(m.x[0], m.x[-1])
     ax.set_ylim(0.0, m.y[-1])
     _no_fit_band(ax, m.robot.W, vertical=False)
-    title = f"Corridor: stable above L*(V) (KB eq 25)\n{m.loop}"
-    _style_axes(ax, V_LABEL, L_STAR_LABEL, _title(title, m.shaded))
-    ax.text(0.03, 0.96, "stable", transform=ax.transAxes, va="top", fontsize=10, color="#2a6a1f", weight="bold")
-    ax.text(0.97, 0.3, "oscillates", transform=ax.transAxes, ha="right", fontsize=10, color="#9b2b22", weight="bold")
-    if legend:
-        region_legend(ax, fontsize=7)
-    return fig
+    return _finish(fig, ax, m, (V_LABEL, L_STAR_LABEL), "Corridor: stable above L*(V) (KB eq 25)",
+                   (0.03, 0.96, {"va": "top"}), (0.97, 0.3, {"ha": "right"}), legend)
 
 
 PANELS = {"wall_f": plot_wall_f_region, "wall_alpha": plot_wall_alpha_critical, "corridor_V": plot_corridor_region,
