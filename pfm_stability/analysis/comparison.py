@@ -7,14 +7,14 @@ NV*_model: KB calls stable a loop that oscillates) or conservative
 (docs/models.md).
 
 * `critical_gain_vs_delay`, `critical_gain_vs_k`: NV* of every model against
-  T/τ or k (`GainCurve`);
+  T/τ or k (`GainCurves`, one `GainCurve` per model);
 * `kb_error_map`, `kb_error_maps`: KB's relative error over (kτ, T/τ)
   (`KBErrorMap`); `kb_relative_error` for one loop (the stability report's
   figure);
 * `root_locus`: the Padé loop's root locus in NV with every model's
   imaginary-axis crossing (`RootLocus`).
 
-Computation only; `pfm_stability.plots.comparison` and `plots.rlocus` draw.
+Computation only; `pfm_stability.plots.comparison` and `plots.rlocus` draw (each result's ``.plot()``).
 """
 
 from __future__ import annotations
@@ -31,6 +31,7 @@ from ..io.serialize import json_array
 
 __all__ = [
     "GainCurve",
+    "GainCurves",
     "KBErrorMap",
     "RootLocus",
     "critical_gain_vs_delay",
@@ -86,6 +87,20 @@ class GainCurve:
         }
 
 
+class GainCurves(list):
+    """Every model's `GainCurve` against one loop parameter (T/τ or k): what `critical_gain_vs_delay` and `critical_gain_vs_k` return."""
+
+    def plot(self, ax=None, **kwargs):
+        """`plots.comparison.plot_critical_gain_vs_delay` (x = T/τ) or `plots.rlocus.plot_critical_gain_vs_k` (x = k); returns the figure."""
+        if self[0].x_name == "k":
+            from ..plots.rlocus import plot_critical_gain_vs_k
+
+            return plot_critical_gain_vs_k(self, ax=ax, **kwargs)
+        from ..plots.comparison import plot_critical_gain_vs_delay
+
+        return plot_critical_gain_vs_delay(self, ax=ax, **kwargs)
+
+
 @dataclass(frozen=True)
 class KBErrorMap:
     """How far KB's criterion (eq 20) is from another model, over (kτ, T/τ).
@@ -139,6 +154,12 @@ class KBErrorMap:
             f"KB optimistic on {100 * self.optimistic.mean():.0f} %, error {e.min():+.2f} … {e.max():+.2f})"
         )
 
+    def plot(self, ax=None, **kwargs):
+        """`plots.comparison.plot_kb_error_map` of this map; returns the figure."""
+        from ..plots.comparison import plot_kb_error_map
+
+        return plot_kb_error_map(self, ax=ax, **kwargs)
+
     def to_dict(self) -> dict:
         """Plain JSON types (arrays as lists, non-finite values as None)."""
         return {
@@ -152,7 +173,7 @@ class KBErrorMap:
         }
 
 
-def critical_gain_vs_delay(tau: float, k: float, T_over_tau, models=None, *, pade_order: int = 3) -> list[GainCurve]:
+def critical_gain_vs_delay(tau: float, k: float, T_over_tau=None, models=None, *, pade_order: int = 3) -> GainCurves:
     """NV* (1/s) of every model against the sampling period, T = (T/τ)·τ.
 
     Parameters
@@ -161,22 +182,24 @@ def critical_gain_vs_delay(tau: float, k: float, T_over_tau, models=None, *, pad
         Steering time constant, s (> 0).
     k : float
         Steering gain, 1/s.
-    T_over_tau : array_like
-        Sampling periods in units of τ.
+    T_over_tau : array_like, optional
+        Sampling periods in units of τ (default 60 log-spaced values in [0.01, 3]).
     models : list of LoopModel, optional
         Default: continuous, kb_first_order, pade, exact_delay and ``sampled``
         in all four structures (`SAMPLED_STRUCTURES`).
+    pade_order : int
+        Order m of the ``pade`` model.
 
     Returns
     -------
-    list of GainCurve
+    GainCurves
         x = T/τ (dimensionless).
     """
     tau = check_number("tau", tau, 0.0, unit="s")
     k = check_parameter("k", k)
-    x = check_positive_axis("T_over_tau", T_over_tau)
+    x = check_positive_axis("T_over_tau", np.geomspace(0.01, 3.0, 60) if T_over_tau is None else T_over_tau)
     models = _all_models(pade_order) if models is None else models
-    curves = []
+    curves = GainCurves()
     for model in models:
         values = np.array([model.boundary(Loop(tau, float(r) * tau, k)).NV_critical for r in x])
         curves.append(GainCurve(model, "T/tau", "", x, values, tau=tau, k=k))
@@ -240,7 +263,7 @@ def _all_models(pade_order: int) -> list[LoopModel]:
     return [Continuous(), KBFirstOrder(), Pade(pade_order), ExactDelay()] + [Sampled(h, c) for h, c in SAMPLED_STRUCTURES]
 
 
-def critical_gain_vs_k(tau: float, T: float, ks, *, pade_order: int = 3, models=None) -> list[GainCurve]:
+def critical_gain_vs_k(tau: float, T: float, ks=None, *, pade_order: int = 3, models=None) -> GainCurves:
     """NV* (1/s) of every model against the steering gain k (1/s), τ and T fixed.
 
     KB's eq (20) says NV* does not depend on k; only ``continuous`` and
@@ -250,8 +273,8 @@ def critical_gain_vs_k(tau: float, T: float, ks, *, pade_order: int = 3, models=
     ----------
     tau, T : float
         Steering time constant and sampling period, s.
-    ks : array_like
-        Steering gains, 1/s.
+    ks : array_like, optional
+        Steering gains, 1/s (default 60 log-spaced values in [0.2, 30]).
     pade_order : int
         Order m of the ``pade`` model.
     models : list of LoopModel, optional
@@ -259,17 +282,17 @@ def critical_gain_vs_k(tau: float, T: float, ks, *, pade_order: int = 3, models=
 
     Returns
     -------
-    list of GainCurve
+    GainCurves
         x = k (1/s).
     """
     tau = check_number("tau", tau, 0.0, unit="s")
     T = check_number("T", T, 0.0, unit="s")
-    ks = check_positive_axis("k", ks, "1/s")
+    ks = check_positive_axis("k", np.geomspace(0.2, 30, 60) if ks is None else ks, "1/s")
     models = _all_models(pade_order) if models is None else models
-    return [
+    return GainCurves(
         GainCurve(model, "k", "1/s", ks, np.array([model.boundary(Loop(tau, T, float(k))).NV_critical for k in ks]), tau=tau, T=T)
         for model in models
-    ]
+    )
 
 
 @dataclass(frozen=True)
@@ -301,6 +324,12 @@ class RootLocus:
     zeros: np.ndarray
     crossings: tuple
     omega_scale: float
+
+    def plot(self, ax=None):
+        """`plots.rlocus.plot_root_locus` of this locus; returns the figure."""
+        from ..plots.rlocus import plot_root_locus
+
+        return plot_root_locus(self, ax=ax)
 
 
 def root_locus(loop: Loop, *, pade_order: int = 3, hold: str = "command", compute_delay: int = 0, NV_max: float | None = None,

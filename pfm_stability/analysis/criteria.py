@@ -204,10 +204,10 @@ class CorridorAnalysis:
 
 
 def loop_of(robot: Robot, controller: Controller) -> Loop:
-    """The (τ, T, k) every model needs."""
+    """The (τ, T, k) every model needs (`Loop.of`, after checking the types)."""
     check_type("robot", robot, Robot, "a Robot")
     check_type("controller", controller, Controller, "a Controller")
-    return Loop(robot.tau, controller.T, robot.k)
+    return Loop.of(robot, controller)
 
 
 # --------------------------------------------------------------- root finding

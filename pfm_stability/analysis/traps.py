@@ -103,6 +103,12 @@ class TrapAnalysis:
             return head + ("the goal is the only minimum" if goal_ok else "no minimum in the region")
         return head + "; ".join(f"trap at ({p.x:.6g}, {p.y:.6g})" for p in self.traps)
 
+    def plot(self, ax=None, **kwargs):
+        """`plots.traps.plot_traps` of this analysis; returns the figure."""
+        from ..plots.traps import plot_traps
+
+        return plot_traps(self, ax=ax, **kwargs)
+
     def to_dict(self) -> dict:
         """JSON-ready, with schema_version, command "traps" and the scene under inputs."""
         return {"schema_version": SCHEMA_VERSION, "command": "traps", "inputs": {"scene": self.scene.to_dict(), "resolution": self.resolution},

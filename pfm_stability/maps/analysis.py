@@ -226,6 +226,12 @@ class MapAnalysis:
         values = [s.V_critical for s in self.segments if s.V_critical is not None]
         return min(values) if values else None
 
+    def plot(self, ax=None, **kwargs):
+        """`plots.map.plot_map_stability` of this analysis; returns the figure."""
+        from ..plots.map import plot_map_stability
+
+        return plot_map_stability(self, ax=ax, **kwargs)
+
     def summary(self) -> dict:
         """``unstable_length_m``, ``V_critical_min``, segment counts by verdict, total length."""
         counts = {v: sum(s.verdict == v for s in self.segments) for v in ("stable", "unstable", "undecided", *NO_VERDICT)}

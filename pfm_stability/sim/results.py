@@ -96,6 +96,12 @@ class RunResult:
     def collided(self) -> bool:
         return self.event("collision") is not None
 
+    def plot(self, ax=None, **kwargs):
+        """`plots.trajectory.plot_trajectory` of this run (recorded with its trajectory); returns the figure."""
+        from ..plots.trajectory import plot_trajectory
+
+        return plot_trajectory(self, ax=ax, **kwargs)
+
     def to_dict(self, trajectory: bool = False) -> dict:
         """Events, metrics and inputs as a JSON-ready dict (SI units); the sampled trajectory too if asked.
 

@@ -84,6 +84,12 @@ class SweepFigureData:
     labels: tuple = ()
     matrix: np.ndarray | None = None
 
+    def plot(self, ax=None):
+        """`plots.sweep.plot_sweep_summary` of this figure's data; returns the figure."""
+        from ..plots.sweep import plot_sweep_summary
+
+        return plot_sweep_summary(self, ax=ax)
+
 
 def _label(name: str) -> str:
     unit = UNITS.get(name)

@@ -259,6 +259,12 @@ class SimulatedBoundary:
     lumped_curves: dict | None = None
     models: tuple = ()
 
+    def plot(self, ax=None, **kwargs):
+        """`plots.validation.plot_simulated_boundary` of these points; returns the figure."""
+        from ..plots.validation import plot_simulated_boundary
+
+        return plot_simulated_boundary(self, ax=ax, **kwargs)
+
     def to_dict(self) -> dict:
         """Plain JSON types (arrays as lists, non-finite values as None)."""
         curves = lambda d: None if d is None else {k: json_array(v) for k, v in d.items()}

@@ -215,6 +215,12 @@ class SweepResult:
     ranges: dict
     seconds: float
 
+    def plot(self, axes=None):
+        """`plots.validation.plot_sweep`: σ against NV/NV* of ``sampled``, and the other models' view; returns the figure."""
+        from ..plots.validation import plot_sweep
+
+        return plot_sweep(self, axes=axes)
+
     def to_dict(self, points: bool = False) -> dict:
         """Plain JSON form; every point only with ``points=True`` (the disagreements always).
 
