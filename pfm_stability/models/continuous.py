@@ -30,15 +30,37 @@ class Continuous(AffineGainModel):
     equation = "tau s^3 + s^2 + k s + k N V = 0  (KB eq 17)"
 
     def polynomials(self, loop: Loop):
-        """D = τs³ + s² + k(1 + c)s, E = 1 (descending powers of s; c = 0: KB eq 17)."""
+        """D = τs³ + s² + k(1 + c)s, E = 1 (descending powers of s; c = 0: KB eq 17).
+
+        Parameters
+        ----------
+        loop : Loop
+            τ (s), T (s), k (1/s) and the heading gain c.
+        """
         return loop.closed_plant, np.array([1.0])
 
     @checked
     def critical_delay(self, NV: float, loop: Loop) -> float:
-        """T does not enter (17): ``inf`` if τNV < 1 + c (and NV >= 0: `is_stable`), else 0 (s)."""
+        """T does not enter (17): ``inf`` if τNV < 1 + c (and NV >= 0: `is_stable`), else 0 (s).
+
+        Parameters
+        ----------
+        NV : float
+            Loop gain N·V, 1/s.
+        loop : Loop
+            τ (s), T (s), k (1/s) and the heading gain c.
+        """
         return math.inf if self.is_stable(NV, loop) else 0.0
 
     @checked
     def critical_gain_k(self, NV: float, loop: Loop) -> float:
-        """k cancels from Routh's condition 0 <= τNV < 1 + c (`is_stable`): ``inf`` if it holds, else 0 (1/s)."""
+        """k cancels from Routh's condition 0 <= τNV < 1 + c (`is_stable`): ``inf`` if it holds, else 0 (1/s).
+
+        Parameters
+        ----------
+        NV : float
+            Loop gain N·V, 1/s.
+        loop : Loop
+            τ (s), T (s), k (1/s) and the heading gain c.
+        """
         return math.inf if self.is_stable(NV, loop) else 0.0

@@ -62,14 +62,26 @@ class ExactDelay(LoopModel):
 
     @staticmethod
     def quasi_polynomial(loop: Loop) -> DelayLoop:
-        """The quasi-polynomial a(s) + (kcs + K)·e^(−sT) with a(s) = τs³ + s² + ks (c = 0: a(s) + K e^(−sT))."""
+        """The quasi-polynomial a(s) + (kcs + K)·e^(−sT) with a(s) = τs³ + s² + ks (c = 0: a(s) + K e^(−sT)).
+
+        Parameters
+        ----------
+        loop : Loop
+            τ (s), T (s), k (1/s) and the heading gain c.
+        """
         if loop.c == 0.0:
             return DelayLoop(loop.plant, loop.T)
         return DelayLoop(loop.plant, loop.T, delayed=[loop.heading, 0.0])
 
     @staticmethod
     def heading_quasi_polynomial(loop: Loop) -> DelayLoop:
-        """N = 0: the quasi-polynomial divided by s, τs² + s + k + kc·e^(−sT) (its gain K is kc)."""
+        """N = 0: the quasi-polynomial divided by s, τs² + s + k + kc·e^(−sT) (its gain K is kc).
+
+        Parameters
+        ----------
+        loop : Loop
+            τ (s), T (s), k (1/s) and the heading gain c.
+        """
         return DelayLoop(loop.plant[:-1], loop.T)
 
     def _quasi(self, NV: float, loop: Loop):
@@ -93,12 +105,28 @@ class ExactDelay(LoopModel):
 
     @checked
     def is_stable(self, NV: float, loop: Loop) -> bool:
-        """Crossing count Z(T) = 0 (no root in Re s >= 0)."""
+        """Crossing count Z(T) = 0 (no root in Re s >= 0).
+
+        Parameters
+        ----------
+        NV : float
+            Loop gain N·V, 1/s.
+        loop : Loop
+            τ (s), T (s), k (1/s) and the heading gain c.
+        """
         return self._count(NV, loop)[0]
 
     @checked
     def unstable_root_count(self, NV: float, loop: Loop) -> int | None:
-        """Roots with Re s > 0 (None when a root is on the imaginary axis; NV = 0: the heading loop's)."""
+        """Roots with Re s > 0 (None when a root is on the imaginary axis; NV = 0: the heading loop's).
+
+        Parameters
+        ----------
+        NV : float
+            Loop gain N·V, 1/s.
+        loop : Loop
+            τ (s), T (s), k (1/s) and the heading gain c.
+        """
         q, K = self._quasi(NV, loop)
         return q.unstable_root_count(K)
 
@@ -106,7 +134,15 @@ class ExactDelay(LoopModel):
     def rightmost_root(self, NV: float, loop: Loop) -> complex | None:
         """Dominant root σ + jω (1/s, rad/s); None where the pseudospectral method cannot resolve
         it (|s|·T in the thousands: `DelayLoop.rightmost_roots`). The verdict does not need it.
-        NV = 0: the heading loop's (`heading_quasi_polynomial`)."""
+        NV = 0: the heading loop's (`heading_quasi_polynomial`).
+
+        Parameters
+        ----------
+        NV : float
+            Loop gain N·V, 1/s.
+        loop : Loop
+            τ (s), T (s), k (1/s) and the heading gain c.
+        """
         q, K = self._quasi(NV, loop)
         for nodes in (40, 160):
             roots = q.rightmost_roots(K, count=2, nodes=nodes)
@@ -117,7 +153,15 @@ class ExactDelay(LoopModel):
 
     @checked
     def critical_delay(self, NV: float, loop: Loop) -> float:
-        """Delay margin: the smallest T at which NV loses stability (τ, k fixed), s."""
+        """Delay margin: the smallest T at which NV loses stability (τ, k fixed), s.
+
+        Parameters
+        ----------
+        NV : float
+            Loop gain N·V, 1/s.
+        loop : Loop
+            τ (s), T (s), k (1/s) and the heading gain c.
+        """
         return self._count(NV, loop)[2]
 
     @checked
@@ -135,6 +179,13 @@ class ExactDelay(LoopModel):
         stand-in that peaks where a root nears the axis, so the search refines
         near-misses between grid points). NV < 0: 0. NV = 0: the heading
         loop's k* (c = 0: τs² + s + k, ``inf``).
+
+        Parameters
+        ----------
+        NV : float
+            Loop gain N·V, 1/s.
+        loop : Loop
+            τ (s), T (s), k (1/s) and the heading gain c.
         """
         from ..numerics.solve import first_crossing
 

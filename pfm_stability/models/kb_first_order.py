@@ -42,7 +42,13 @@ class KBFirstOrder(AffineGainModel):
     equation = "tau s^3 + s^2 + k(1 - N V T) s + k N V = 0  (KB eq 19)"
 
     def polynomials(self, loop: Loop):
-        """D = τs³ + (1 − kcT)s² + k(1 + c)s, E = 1 − sT (descending powers of s; c = 0: KB eq 19)."""
+        """D = τs³ + (1 − kcT)s² + k(1 + c)s, E = 1 − sT (descending powers of s; c = 0: KB eq 19).
+
+        Parameters
+        ----------
+        loop : Loop
+            τ (s), T (s), k (1/s) and the heading gain c.
+        """
         if loop.c == 0.0:
             return loop.plant, np.array([-loop.T, 1.0])
         D = loop.closed_plant.copy()
@@ -58,6 +64,13 @@ class KBFirstOrder(AffineGainModel):
         (0 when τNV >= 1 + c: unstable already at T = 0). NV < 0: 0. NV = 0
         (the heading loop τs² + (1 − kcT)s + k(1 + c), `neutral_reason`): the
         same root, 1/(kc) for c > 0, ``inf`` for c <= 0.
+
+        Parameters
+        ----------
+        NV : float
+            Loop gain N·V, 1/s.
+        loop : Loop
+            τ (s), T (s), k (1/s) and the heading gain c.
         """
         NV = _check_NV(NV)
         if NV < 0:
@@ -82,6 +95,13 @@ class KBFirstOrder(AffineGainModel):
         k* = (1 + c − NV(τ + T))/(cT(1 + c − NVT)) (``inf`` beyond the largest
         allowed k, 10⁴ 1/s). NV < 0: 0. NV = 0: the same rules, the heading
         loop's (k* = 1/(cT) for c > 0).
+
+        Parameters
+        ----------
+        NV : float
+            Loop gain N·V, 1/s.
+        loop : Loop
+            τ (s), T (s), k (1/s) and the heading gain c.
         """
         NV = _check_NV(NV)
         if NV < 0:

@@ -84,12 +84,24 @@ class Pade(AffineGainModel):
         self.order = check_integer("pade_order", order, 1, MAX_PADE_ORDER)
 
     def polynomials(self, loop: Loop):
-        """D = (τs³ + s² + ks)·Q_m + kc·s·P_m, E = P_m (descending powers of s; Q_m(0) = P_m(0) = 1)."""
+        """D = (τs³ + s² + ks)·Q_m + kc·s·P_m, E = P_m (descending powers of s; Q_m(0) = P_m(0) = 1).
+
+        Parameters
+        ----------
+        loop : Loop
+            τ (s), T (s), k (1/s) and the heading gain c.
+        """
         D, E = self.batch_polynomials([loop])
         return np.trim_zeros(D[0], "f"), np.trim_zeros(E[0], "f")
 
     def batch_polynomials(self, loops):
-        """`polynomials` of many loops at once: rows of D = (τs³ + s² + ks)·Q_m + kc·s·P_m and E = P_m."""
+        """`polynomials` of many loops at once: rows of D = (τs³ + s² + ks)·Q_m + kc·s·P_m and E = P_m.
+
+        Parameters
+        ----------
+        loops : sequence of Loop
+            The loops, one row each.
+        """
         tau, T, k = (np.array([getattr(loop, name) for loop in loops]) for name in ("tau", "T", "k"))
         heading = np.array([loop.heading for loop in loops])
         m = self.order

@@ -119,7 +119,15 @@ def continuous_plant(loop: Loop, hold: str):
 
 
 def discretize(A, B, T: float):
-    """Zero-order-hold discretization: Φ = e^(AT), Γ = ∫₀ᵀ e^(As) ds B (`matrix_exponential.zoh_blocks`)."""
+    """Zero-order-hold discretization: Φ = e^(AT), Γ = ∫₀ᵀ e^(As) ds B (`matrix_exponential.zoh_blocks`).
+
+    Parameters
+    ----------
+    A, B : ndarray
+        The continuous-time plant ẋ = Ax + Bu.
+    T : float
+        Sampling period, s.
+    """
     Phi, integral = zoh_blocks(A, T)
     return Phi, integral @ B
 
@@ -182,7 +190,17 @@ def _delta_matrix(loop: Loop, K: float, hold: str, compute_delay: int) -> np.nda
 
 
 def bilinear_polynomial(p_w, degree: int, T: float) -> np.ndarray:
-    """Q(μ) = (1 − Tμ/2)^degree · P(μ/(1 − Tμ/2)) for P(w) given descending (degree >= deg P)."""
+    """Q(μ) = (1 − Tμ/2)^degree · P(μ/(1 − Tμ/2)) for P(w) given descending (degree >= deg P).
+
+    Parameters
+    ----------
+    p_w : array_like
+        P(w), descending coefficients.
+    degree : int
+        The power of (1 − Tμ/2), >= deg P.
+    T : float
+        Sampling period, s.
+    """
     p = np.asarray(p_w, dtype=float)[::-1]  # ascending: p_i w^i
     factor = np.array([-T / 2, 1.0])  # 1 − Tμ/2, descending
     out = np.zeros(degree + 1)
@@ -233,6 +251,11 @@ class Sampled(AffineGainModel):
 
         D = (1 + Tw)^c det(wI − Ψ) + F0 adj(wI − Ψ) G and E = F1 adj(wI − Ψ) G,
         each rank-one term as det(wI − Ψ + G F) − det(wI − Ψ).
+
+        Parameters
+        ----------
+        loop : Loop
+            τ (s), T (s), k (1/s) and the heading gain c.
         """
         Psi, G, F0, F1 = delta_plant(loop, self.hold)
         p = np.poly(Psi)
@@ -242,7 +265,13 @@ class Sampled(AffineGainModel):
         return np.polyadd(lead, base), np.trim_zeros(e, "f") if np.any(e) else np.zeros(1)
 
     def bilinear_polynomials(self, loop: Loop):
-        """(D, E) in μ (z = (1 + Tμ/2)/(1 − Tμ/2)): stable ⇔ D + K·E is Hurwitz, descending, one length."""
+        """(D, E) in μ (z = (1 + Tμ/2)/(1 − Tμ/2)): stable ⇔ D + K·E is Hurwitz, descending, one length.
+
+        Parameters
+        ----------
+        loop : Loop
+            τ (s), T (s), k (1/s) and the heading gain c.
+        """
         d, e = self.delta_polynomials(loop)
         degree = len(np.trim_zeros(d, "f")) - 1
         return bilinear_polynomial(d, degree, loop.T), bilinear_polynomial(e, degree, loop.T)
@@ -252,6 +281,11 @@ class Sampled(AffineGainModel):
 
         Formed from the δ form, P_z(z) = Σ p_i T^(d−i) (z − 1)^i; a polynomial
         in z is ill-conditioned for T → 0 (use `bilinear_polynomials` there).
+
+        Parameters
+        ----------
+        loop : Loop
+            τ (s), T (s), k (1/s) and the heading gain c.
         """
         d, e = self.delta_polynomials(loop)
         degree = len(np.trim_zeros(d, "f")) - 1
@@ -277,7 +311,15 @@ class Sampled(AffineGainModel):
 
     @checked
     def delta_eigenvalues(self, NV: float, loop: Loop) -> np.ndarray:
-        """Eigenvalues λ of (Φ_cl − I)/T (poles z = 1 + Tλ; T = 0: the continuous poles)."""
+        """Eigenvalues λ of (Φ_cl − I)/T (poles z = 1 + Tλ; T = 0: the continuous poles).
+
+        Parameters
+        ----------
+        NV : float
+            Loop gain N·V, 1/s.
+        loop : Loop
+            τ (s), T (s), k (1/s) and the heading gain c.
+        """
         return self._delta_eigenvalues(NV, loop)
 
     def _delta_eigenvalues(self, NV: float, loop: Loop) -> np.ndarray:
@@ -293,18 +335,42 @@ class Sampled(AffineGainModel):
 
     @checked
     def closed_loop(self, NV: float, loop: Loop) -> np.ndarray:
-        """Φ_cl for NV (1/s)."""
+        """Φ_cl for NV (1/s).
+
+        Parameters
+        ----------
+        NV : float
+            Loop gain N·V, 1/s.
+        loop : Loop
+            τ (s), T (s), k (1/s) and the heading gain c.
+        """
         return closed_loop_matrix(loop, loop.k * _check_NV(NV), self.hold, self.compute_delay)
 
     @checked
     def eigenvalues(self, NV: float, loop: Loop) -> np.ndarray:
-        """Closed-loop poles z (T > 0), as 1 + Tλ."""
+        """Closed-loop poles z (T > 0), as 1 + Tλ.
+
+        Parameters
+        ----------
+        NV : float
+            Loop gain N·V, 1/s.
+        loop : Loop
+            τ (s), T (s), k (1/s) and the heading gain c.
+        """
         return 1.0 + loop.T * self._delta_eigenvalues(NV, loop)
 
     @checked
     def is_stable(self, NV: float, loop: Loop) -> bool:
         """Every pole strictly inside the unit circle: 2 Re λ + T|λ|² < 0 (T = 0: KB eq 17 by Routh;
-        NV = 0: every pole but the neutral z = 1, `_judged_eigenvalues`)."""
+        NV = 0: every pole but the neutral z = 1, `_judged_eigenvalues`).
+
+        Parameters
+        ----------
+        NV : float
+            Loop gain N·V, 1/s.
+        loop : Loop
+            τ (s), T (s), k (1/s) and the heading gain c.
+        """
         return self._stable(NV, loop)
 
     def _stable(self, NV: float, loop: Loop) -> bool:
@@ -316,12 +382,28 @@ class Sampled(AffineGainModel):
 
     @checked
     def jury_stable(self, NV: float, loop: Loop) -> bool:
-        """Schur–Cohn (Jury) verdict on det(zI − Φ_cl), independent of the eigenvalues."""
+        """Schur–Cohn (Jury) verdict on det(zI − Φ_cl), independent of the eigenvalues.
+
+        Parameters
+        ----------
+        NV : float
+            Loop gain N·V, 1/s.
+        loop : Loop
+            τ (s), T (s), k (1/s) and the heading gain c.
+        """
         return schur_cohn_stable(self.characteristic(NV, loop))
 
     @checked
     def rightmost_root(self, NV: float, loop: Loop) -> complex:
-        """Dominant pole as s = ln(z)/T: σ = ln|z|/T (1/s), ω = arg(z)/T in [0, π/T] (rad/s); NV = 0: the heading loop's."""
+        """Dominant pole as s = ln(z)/T: σ = ln|z|/T (1/s), ω = arg(z)/T in [0, π/T] (rad/s); NV = 0: the heading loop's.
+
+        Parameters
+        ----------
+        NV : float
+            Loop gain N·V, 1/s.
+        loop : Loop
+            τ (s), T (s), k (1/s) and the heading gain c.
+        """
         if loop.T == 0:
             return Continuous().rightmost_root(NV, loop)
         lam = self._judged_eigenvalues(NV, loop)
@@ -333,11 +415,27 @@ class Sampled(AffineGainModel):
 
     @checked
     def roots(self, NV: float, loop: Loop) -> np.ndarray:
-        """All closed-loop poles z (T > 0); the continuous roots s at T = 0."""
+        """All closed-loop poles z (T > 0); the continuous roots s at T = 0.
+
+        Parameters
+        ----------
+        NV : float
+            Loop gain N·V, 1/s.
+        loop : Loop
+            τ (s), T (s), k (1/s) and the heading gain c.
+        """
         return self._delta_eigenvalues(NV, loop) if loop.T == 0 else 1.0 + loop.T * self._delta_eigenvalues(NV, loop)
 
     def growth_rates(self, NV: float, loops) -> np.ndarray:
-        """σ = max ln|z|/T (1/s) at NV for each loop, all exponentials and eigenvalues in one batch."""
+        """σ = max ln|z|/T (1/s) at NV for each loop, all exponentials and eigenvalues in one batch.
+
+        Parameters
+        ----------
+        NV : float
+            Loop gain N·V, 1/s.
+        loops : iterable of Loop
+            The loops (τ, T, k, c each).
+        """
         loops = list(loops)
         K = np.array([loop.k for loop in loops]) * _check_NV(NV)
         T = np.array([loop.T for loop in loops])

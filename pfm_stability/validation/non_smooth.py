@@ -71,6 +71,21 @@ def fill_cycles(report, family: str, robot: Robot, controller: Controller, law, 
 
     A corridor has none (the simulator measures wall cycles only), nor has a continuous
     controller (T = 0): the cycle stays None there.
+
+    Parameters
+    ----------
+    report : StabilityReport
+        The report of a non-smooth law.
+    family : str
+        The report's robot family (`parameters.ROBOT_FAMILIES`).
+    robot, controller : Robot, Controller
+        The robot and its controller.
+    law : ForceLaw
+        The non-smooth law.
+    mass : float
+        The point mass's mass, kg.
+    duration : float
+        Simulated time, s.
     """
     scenes = report.extras.get("scenes", {})
     wall = scenes.get("wall")
