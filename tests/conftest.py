@@ -12,16 +12,32 @@ Hypothesis profiles, chosen with the environment variable ``HYPOTHESIS_PROFILE``
 
 Tests that fix ``max_examples`` themselves keep it; ``tests/test_cli_fuzz.py``
 scales its budgets from the active profile's ``max_examples``.
+
+BLAS runs on one thread in the suite, as `pfm-stability` itself runs it (``cli.main`` sets
+``OPENBLAS_NUM_THREADS``, ``OMP_NUM_THREADS`` and ``MKL_NUM_THREADS`` to 1 before numpy loads,
+unless the user set them): the package solves many small eigenvalue problems and matrix
+exponentials, on which BLAS threads only spin. Under ``pytest -n 2`` on two cores each worker's
+BLAS threads also compete with the other worker; a 2 × 2 ``scipy.linalg.expm`` took 0.7 ms of CPU
+instead of 9 µs, and the suite three times as long. The variables are set here, before numpy is
+imported (they reach the notebooks' kernels and the fresh processes of the CLI tests too), and
+`threadpoolctl` pins the thread pools in case a plugin loaded numpy first. Numbers do not depend
+on it (the recorded answers of tests/test_answers_unchanged.py replay to 1e-12 either way).
 """
 
 import os
 
-import numpy as np
-import pytest
-from hypothesis import HealthCheck, settings
+for _variable in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ.setdefault(_variable, "1")
 
-from pfm_stability.models import Loop
-from pfm_stability.parameters import CARMEL
+import numpy as np  # noqa: E402  (after the thread variables)
+import pytest  # noqa: E402
+from hypothesis import HealthCheck, settings  # noqa: E402
+from threadpoolctl import threadpool_limits  # noqa: E402
+
+threadpool_limits(1, user_api="blas")
+
+from pfm_stability.models import Loop  # noqa: E402
+from pfm_stability.parameters import CARMEL  # noqa: E402
 
 settings.register_profile(
     "ci", max_examples=100, derandomize=True, deadline=None, print_blob=True, suppress_health_check=[HealthCheck.too_slow]
