@@ -22,6 +22,16 @@ instead of 9 µs, and the suite three times as long. The variables are set here,
 imported (they reach the notebooks' kernels and the fresh processes of the CLI tests too), and
 `threadpoolctl` pins the thread pools in case a plugin loaded numpy first. Numbers do not depend
 on it (the recorded answers of tests/test_answers_unchanged.py replay to 1e-12 either way).
+
+Scheduling under ``pytest -n N`` (``--dist loadgroup`` in pyproject.toml):
+
+* tests that share an expensive module fixture carry ``pytest.mark.xdist_group(name)``: a group runs
+  on one worker, so its fixture is computed once per suite rather than once per worker that happens
+  to get one of its tests (the experiments in quick mode, the verdict sweep, the grid validations,
+  the random trap scenes). xdist hands out the groups first, largest first;
+* then the tests marked ``slow`` (each a few seconds or more; the notebooks of ``analyses/`` are
+  marked here), so that no long test starts last while the other worker idles;
+* then the rest in collection order.
 """
 
 import os
@@ -65,3 +75,12 @@ def random_loops(count, seed, *, tau=(0.02, 1.0), T=(0.005, 0.5), k=(0.3, 10.0))
         K = rng.uniform(0.2, 3.0) * g / (t + d)
         out.append((t, d, g, K))
     return out
+
+
+def pytest_collection_modifyitems(config, items):
+    """The notebooks are slow; the slow tests go first (a stable sort: otherwise collection order)."""
+    for item in items:
+        if item.path.suffix == ".ipynb":
+            item.add_marker(pytest.mark.slow)
+    items.sort(key=lambda item: item.get_closest_marker("slow") is None)
+

@@ -321,7 +321,7 @@ def _fuzz_test(command):
 
     test.__name__ = f"test_fuzz_{command}"
     test.__doc__ = f"Random `pfm-stability {command}` command lines: exit 0 or 2, one error line, strict JSON, files written ({examples} examples)."
-    return test
+    return pytest.mark.slow(test)  # seconds each: scheduled first (tests/conftest.py)
 
 
 test_fuzz_report = _fuzz_test("report")

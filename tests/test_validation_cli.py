@@ -41,6 +41,7 @@ def test_text_plot_and_sweep(tmp_path, capsys):
     assert "validate: round 1" in captured.err  # progress on stderr
 
 
+@pytest.mark.slow  # seconds: scheduled first (tests/conftest.py)
 def test_grid_overlay_with_stability_map(tmp_path, capsys):
     """--plot in the grid draws the 7 x 9 map over every model's boundary curve; the text shows KB's lumped law beside."""
     png = tmp_path / "v.png"
