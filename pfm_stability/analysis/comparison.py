@@ -136,7 +136,15 @@ class KBErrorMap:
         return self.relative_error > 0
 
     def at(self, k_tau: float, T_over_tau: float) -> float:
-        """Relative error at one (kτ, T/τ), bilinear in (log kτ, log T/τ) between grid nodes."""
+        """Relative error at one (kτ, T/τ), bilinear in (log kτ, log T/τ) between grid nodes.
+
+        Parameters
+        ----------
+        k_tau : float
+            Steering gain kτ (dimensionless), inside the map's range.
+        T_over_tau : float
+            Sampling period T/τ (dimensionless), inside the map's range.
+        """
         from scipy.interpolate import RegularGridInterpolator
 
         values = np.where(np.isfinite(self.relative_error), self.relative_error, np.nan)
@@ -144,7 +152,15 @@ class KBErrorMap:
         return float(f([[math.log(T_over_tau), math.log(k_tau)]])[0])
 
     def exact(self, k_tau: float, T_over_tau: float) -> float:
-        """Relative error at one (kτ, T/τ), computed exactly (`kb_relative_error` at τ = 1 s), not interpolated."""
+        """Relative error at one (kτ, T/τ), computed exactly (`kb_relative_error` at τ = 1 s), not interpolated.
+
+        Parameters
+        ----------
+        k_tau : float
+            Steering gain kτ (dimensionless).
+        T_over_tau : float
+            Sampling period T/τ (dimensionless).
+        """
         return kb_relative_error(Loop(1.0, float(T_over_tau), float(k_tau)), self.reference)
 
     def __repr__(self) -> str:
@@ -236,12 +252,30 @@ def kb_error_map(k_tau, T_over_tau, reference: LoopModel | None = None) -> KBErr
 
 
 def kb_error_maps(k_tau, T_over_tau, structures=SAMPLED_STRUCTURES) -> list[KBErrorMap]:
-    """`kb_error_map` against ``sampled`` for each (hold, compute_delay)."""
+    """`kb_error_map` against ``sampled`` for each (hold, compute_delay).
+
+    Parameters
+    ----------
+    k_tau : array_like, shape (nx,)
+        Dimensionless steering gains kτ.
+    T_over_tau : array_like, shape (ny,)
+        Dimensionless sampling periods T/τ.
+    structures : sequence of (str, int)
+        The (hold, compute_delay) pairs of the ``sampled`` references.
+    """
     return [kb_error_map(k_tau, T_over_tau, Sampled(h, c)) for h, c in structures]
 
 
 def kb_relative_error(loop: Loop, reference: LoopModel) -> float:
-    """NV*_KB/NV*_reference − 1 for one loop (`relative_error`: > 0 KB's eq 20 optimistic; ``inf`` if NV*_reference = 0)."""
+    """NV*_KB/NV*_reference − 1 for one loop (`relative_error`: > 0 KB's eq 20 optimistic; ``inf`` if NV*_reference = 0).
+
+    Parameters
+    ----------
+    loop : Loop
+        τ (s), T (s), k (1/s).
+    reference : LoopModel
+        The model KB's eq (20) is compared with.
+    """
     return relative_error(KBFirstOrder().boundary(loop).NV_critical, reference.boundary(loop).NV_critical)
 
 
@@ -250,6 +284,13 @@ def relative_error(NV_kb: float, NV_reference: float) -> float:
 
     ``inf`` when the reference is unstable at every NV (NV*_reference = 0);
     ``nan`` when both are stable at every NV (no finite boundary to compare).
+
+    Parameters
+    ----------
+    NV_kb : float
+        KB's NV* (eq 20), 1/s.
+    NV_reference : float
+        The reference model's NV*, 1/s (``inf``: stable at every NV).
     """
     if NV_reference == 0:
         return math.inf

@@ -103,6 +103,15 @@ def make_models(names=MODEL_NAMES, *, controller=None, **options) -> list[LoopMo
 
     With `controller`, the ``sampled`` model takes the controller's hold and
     compute delay (giving ``hold``/``compute_delay`` as well is an error).
+
+    Parameters
+    ----------
+    names : list or tuple of str
+        Model names (`parameters.MODEL_NAMES`).
+    controller : Controller, optional
+        Gives ``sampled`` its hold and compute delay.
+    **options
+        Passed to `make_model` (``pade_order``, ``hold``, ``compute_delay``).
     """
     if isinstance(names, str) or not isinstance(names, (list, tuple)) or not all(isinstance(n, str) for n in names):
         raise ValueError(f"names must be a list or tuple of model names ({', '.join(MODEL_NAMES)}); got {names!r}")

@@ -132,6 +132,13 @@ class ExactDelay(LoopModel):
         stand-in that peaks where a root nears the axis, so the search refines
         near-misses between grid points). NV < 0: 0. NV = 0: the heading
         loop's k* (c = 0: τs² + s + k, ``inf``).
+
+        Parameters
+        ----------
+        NV : float
+            Loop gain N·V, 1/s.
+        loop : Loop
+            τ (s), T (s), k (1/s) and the heading gain c.
         """
         from ..numerics.solve import first_crossing
 

@@ -94,6 +94,13 @@ class KBFirstOrder(AffineGainModel):
         k* = (1 + c − NV(τ + T))/(cT(1 + c − NVT)) (``inf`` beyond the largest
         allowed k, 10⁴ 1/s). NV < 0: 0. NV = 0: the same rules, the heading
         loop's (k* = 1/(cT) for c > 0).
+
+        Parameters
+        ----------
+        NV : float
+            Loop gain N·V, 1/s.
+        loop : Loop
+            τ (s), T (s), k (1/s) and the heading gain c.
         """
         loop = _steering(loop, "critical_gain_k")
         NV = _check_NV(NV)

@@ -106,7 +106,15 @@ def continuous_plant(loop: Characteristic, hold: str):
 
 
 def discretize(A, B, T: float):
-    """Zero-order-hold discretization: Φ = e^(AT), Γ = ∫₀ᵀ e^(As) ds B (`matrix_exponential.zoh_blocks`)."""
+    """Zero-order-hold discretization: Φ = e^(AT), Γ = ∫₀ᵀ e^(As) ds B (`matrix_exponential.zoh_blocks`).
+
+    Parameters
+    ----------
+    A, B : ndarray
+        The continuous-time plant ẋ = Ax + Bu.
+    T : float
+        Sampling period, s.
+    """
     Phi, integral = zoh_blocks(A, T)
     return Phi, integral @ B
 
@@ -169,7 +177,17 @@ def _delta_matrix(loop: Characteristic, K: float, hold: str, compute_delay: int)
 
 
 def bilinear_polynomial(p_w, degree: int, T: float) -> np.ndarray:
-    """Q(μ) = (1 − Tμ/2)^degree · P(μ/(1 − Tμ/2)) for P(w) given descending (degree >= deg P)."""
+    """Q(μ) = (1 − Tμ/2)^degree · P(μ/(1 − Tμ/2)) for P(w) given descending (degree >= deg P).
+
+    Parameters
+    ----------
+    p_w : array_like
+        P(w), descending coefficients.
+    degree : int
+        The power of (1 − Tμ/2), >= deg P.
+    T : float
+        Sampling period, s.
+    """
     p = np.asarray(p_w, dtype=float)[::-1]  # ascending: p_i w^i
     factor = np.array([-T / 2, 1.0])  # 1 − Tμ/2, descending
     out = np.zeros(degree + 1)
@@ -225,6 +243,11 @@ class Sampled(AffineGainModel):
 
         D = (1 + Tw)^c det(wI − Ψ) + F0 adj(wI − Ψ) G and E = F1 adj(wI − Ψ) G,
         each rank-one term as det(wI − Ψ + G F) − det(wI − Ψ).
+
+        Parameters
+        ----------
+        loop : Loop
+            τ (s), T (s), k (1/s) and the heading gain c.
         """
         Psi, G, F0, F1 = delta_plant(loop, self.hold)
         lead = self._lead(loop, Psi)
@@ -255,6 +278,11 @@ class Sampled(AffineGainModel):
 
         Formed from the δ form, P_z(z) = Σ p_i T^(d−i) (z − 1)^i; a polynomial
         in z is ill-conditioned for T → 0 (use `bilinear_polynomials` there).
+
+        Parameters
+        ----------
+        loop : Loop
+            τ (s), T (s), k (1/s) and the heading gain c.
         """
         d, e = self.delta_polynomials(loop)
         degree = len(np.trim_zeros(d, "f")) - 1

@@ -166,7 +166,7 @@ def stability_map(simulate, scenario, spec, env, robot, controller, law, geometr
     scenario : {"corridor", "wall"}
     spec : common.ParameterSpec
         The bisected parameter.
-    env, robot, controller, law, geometry, cell_size
+    env, robot, controller, law, geometry
         As in `validate_boundary` (geometry: L m or α rad).
     boundary : float
         The bisected boundary (reported units).
@@ -174,6 +174,8 @@ def stability_map(simulate, scenario, spec, env, robot, controller, law, geometr
         The simulable values of the bisected parameter.
     shape : (int, int)
         (nx, ny).
+    cell_size : float
+        As in `validate_boundary`: cell side c, m.
     models : list of LoopModel
     progress : callable or None
     """
