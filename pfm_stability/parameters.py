@@ -267,7 +267,13 @@ SHOWN_AS = {"alpha_deg": "alpha", "T_sampled": "T"}
 
 
 def describe_parameter(key: str) -> str:
-    """``RANGES[key]`` for a help text, e.g. ``(0, 100] m/s``; an integer range exactly, ``[3, 1001] cells``."""
+    """``RANGES[key]`` for a help text, e.g. ``(0, 100] m/s``; an integer range exactly, ``[3, 1001] cells``.
+
+    Parameters
+    ----------
+    key : str
+        A key of `RANGES`.
+    """
     r = RANGES[key]
     if isinstance(r.low, int) and isinstance(r.high, int):
         return f"[{r.low}, {r.high}]" + (f" {r.unit}" if r.unit else "")

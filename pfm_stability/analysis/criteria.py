@@ -204,7 +204,15 @@ class CorridorAnalysis:
 
 
 def loop_of(robot: Robot, controller: Controller) -> Loop:
-    """The (τ, T, k) every model needs (`Loop.of`, after checking the types)."""
+    """The (τ, T, k) every model needs (`Loop.of`, after checking the types).
+
+    Parameters
+    ----------
+    robot : Robot
+        The robot (τ, s; k, 1/s).
+    controller : Controller
+        The controller (T, s).
+    """
     check_type("robot", robot, Robot, "a Robot")
     check_type("controller", controller, Controller, "a Controller")
     return Loop.of(robot, controller)

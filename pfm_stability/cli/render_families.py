@@ -38,7 +38,19 @@ _CYCLE = (("mean_distance", "mean distance", "m"), ("peak_to_peak", "peak-to-pea
 
 
 def holonomic_sections(scene, env: dict, verdicts: dict, report):
-    """Yield the (title, header, rows, remedies, notes) of a holonomic robot's geometry (`report.families.HolonomicScene`)."""
+    """Yield the (title, header, rows, remedies, notes) of a holonomic robot's geometry (`report.families.HolonomicScene`).
+
+    Parameters
+    ----------
+    scene : HolonomicScene
+        The geometry's result.
+    env : dict
+        Its environment entry of the report's JSON.
+    verdicts : dict
+        Model name → its verdict entry of the report's JSON.
+    report : StabilityReport
+        The whole report.
+    """
     scenario = scene.geometry
     where = f"alpha = {number(env['alpha_deg'])} deg" if scenario == "wall" else f"L = {number(env['L'])} m"
     name = "Wall" if scenario == "wall" else "Corridor"
@@ -59,7 +71,19 @@ def holonomic_sections(scene, env: dict, verdicts: dict, report):
 
 
 def non_smooth_sections(scene, env: dict, verdicts: None, report):
-    """Yield the section of a non-smooth geometry (`report.families.NonSmoothScene`): the rest band and the simulated cycle."""
+    """Yield the section of a non-smooth geometry (`report.families.NonSmoothScene`): the rest band and the simulated cycle.
+
+    Parameters
+    ----------
+    scene : NonSmoothScene
+        The geometry's result.
+    env : dict
+        Its environment entry of the report's JSON.
+    verdicts : None
+        A non-smooth geometry has no model verdicts.
+    report : StabilityReport
+        The whole report.
+    """
     scenario = scene.geometry
     where = f"alpha = {number(env['alpha_deg'])} deg" if scenario == "wall" else f"L = {number(env['L'])} m"
     name = "Wall" if scenario == "wall" else "Corridor"

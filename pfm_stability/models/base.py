@@ -169,27 +169,65 @@ class Loop(Characteristic):
         return np.array([self.tau, 1.0, self.k * (1.0 + self.c), 0.0]) if self.tau > 0 else np.array([1.0, self.k * (1.0 + self.c), 0.0])
 
     def loop_gain(self, NV: float) -> float:
-        """K = kNV, 1/s²."""
+        """K = kNV, 1/s².
+
+        Parameters
+        ----------
+        NV : float
+            Loop gain N·V, 1/s.
+        """
         return self.k * NV
 
     def gain_of(self, K: float) -> float:
-        """NV = K/k, 1/s."""
+        """NV = K/k, 1/s.
+
+        Parameters
+        ----------
+        K : float
+            Loop gain K, 1/s².
+        """
         return K / self.k
 
     def check_gain(self, NV) -> float:
-        """NV (1/s) as a float in [−`NV_MAX`, `NV_MAX`] (−0.0 becomes 0.0), or ValueError naming NV."""
+        """NV (1/s) as a float in [−`NV_MAX`, `NV_MAX`] (−0.0 becomes 0.0), or ValueError naming NV.
+
+        Parameters
+        ----------
+        NV : float
+            Loop gain N·V, 1/s.
+        """
         return check_number("NV", NV, -NV_MAX, NV_MAX, low_open=False, high_open=False, unit="1/s") + 0.0
 
     def boundary_from(self, model: str, interval: StabilityInterval) -> "Boundary":
-        """`Boundary` in NV (K/k)."""
+        """`Boundary` in NV (K/k).
+
+        Parameters
+        ----------
+        model : str
+            The model's name (`parameters.MODEL_NAMES`).
+        interval : StabilityInterval
+            The stable loop gains K, 1/s², with K* and ω*.
+        """
         return Boundary.from_interval(model, interval, self.k)
 
     def with_delay(self, T: float) -> "Loop":
-        """τ, k and c with delay / period T, s."""
+        """τ, k and c with delay / period T, s.
+
+        Parameters
+        ----------
+        T : float
+            Delay / sampling period, s, >= 0.
+        """
         return Loop(self.tau, T, self.k, c=self.c)
 
     def delay_search(self, NV: float) -> tuple:
-        """T* searched from 1 % of the loop's fastest time scale to 1e-7 relative (a report shows 4 digits)."""
+        """T* searched from 1 % of the loop's fastest time scale to 1e-7 relative (a report shows 4 digits).
+
+        Parameters
+        ----------
+        NV : float
+            Loop gain N·V, 1/s.
+        """
         scale = _time_scale(self, NV)
         return scale * 1e-2, _DELAY_RTOL, 1e-12 * scale
 
@@ -197,6 +235,11 @@ class Loop(Characteristic):
         """(A, B, F0, F1) of the sampled steering loop (`models.sampled`): states (ω, θ, y), (θ, y) for τ = 0; y = x/V.
 
         The held input is v_k = −(F0 + K·F1)·state_k; the heading gain c adds kc to F0's θ entry.
+
+        Parameters
+        ----------
+        hold : str
+            What the computer holds between samples: ``"command"`` or ``"reference"`` (`parameters.HOLDS`).
         """
         check_choice("hold", hold, HOLDS)
         tau, k = self.tau, self.k
@@ -243,11 +286,23 @@ class Loop(Characteristic):
         return bool(stable[0]), int(Z[0]), float(margin[0])
 
     def delay_stable(self, K: float) -> bool:
-        """The crossing count Z(T) = 0 (`delay.delay_verdicts_from_gain`; K = 0: the heading loop's)."""
+        """The crossing count Z(T) = 0 (`delay.delay_verdicts_from_gain`; K = 0: the heading loop's).
+
+        Parameters
+        ----------
+        K : float
+            Loop gain K = kNV, 1/s².
+        """
         return self._count(K)[0]
 
     def delay_margin(self, K: float) -> float:
-        """T*, s, of the crossing count (`delay.delay_verdicts_from_gain`)."""
+        """T*, s, of the crossing count (`delay.delay_verdicts_from_gain`).
+
+        Parameters
+        ----------
+        K : float
+            Loop gain K = kNV, 1/s².
+        """
         return self._count(K)[2]
 
 
@@ -466,7 +521,15 @@ class LoopModel:
 
     @checked
     def damping_range(self, gain: float, loop: Characteristic) -> tuple:  # pragma: no cover - interface
-        """Every interval of the damping δ (the holonomic c_h, 1/s) that makes the gain stable at the loop's T."""
+        """Every interval of the damping δ (the holonomic c_h, 1/s) that makes the gain stable at the loop's T.
+
+        Parameters
+        ----------
+        gain : float
+            The family's loop gain (κ, 1/s², of a holonomic loop).
+        loop : Characteristic
+            The loop judged; its T, s, is kept and its own damping ignored.
+        """
         raise NotImplementedError
 
     def __repr__(self) -> str:
@@ -520,7 +583,13 @@ class AffineGainModel(LoopModel):
         raise NotImplementedError
 
     def parts(self, loop: Characteristic):  # pragma: no cover - interface
-        """(P0, P1, P2), descending, one length: the characteristic polynomial P0 + δ·P1 + K·P2 (s; μ for `sampled`)."""
+        """(P0, P1, P2), descending, one length: the characteristic polynomial P0 + δ·P1 + K·P2 (s; μ for `sampled`).
+
+        Parameters
+        ----------
+        loop : Characteristic
+            The loop judged (`Loop`, `HolonomicLoop`).
+        """
         raise NotImplementedError
 
     @checked
@@ -556,7 +625,13 @@ class AffineGainModel(LoopModel):
         return StabilityInterval(0.0, None, (), ()) if crossings is None else stable_interval(crossings, stable)
 
     def stable_gains(self, loop: Characteristic) -> StabilityInterval:
-        """Every stable loop gain K (1/s²), K* and ω*, uncached (`boundary` gives them in the family's gain)."""
+        """Every stable loop gain K (1/s²), K* and ω*, uncached (`boundary` gives them in the family's gain).
+
+        Parameters
+        ----------
+        loop : Characteristic
+            The loop judged (`Loop`, `HolonomicLoop`).
+        """
         d, e = self.polynomials(loop)
         return self._interval(d, e, lambda K: verdict_at(d, e, K, self.domain), loop)
 
@@ -576,6 +651,13 @@ class AffineGainModel(LoopModel):
 
         A holonomic loop's c_h (`HolonomicLoop`; ``loop.c_h`` itself is ignored);
         ``()`` when no damping helps (a negative gain, or a delay too long for it).
+
+        Parameters
+        ----------
+        gain : float
+            The family's loop gain (κ, 1/s², of a holonomic loop).
+        loop : Characteristic
+            The loop judged; its T, s, is kept and its own damping ignored.
         """
         loop.with_damping(0.0)  # a family whose damping is a parameter of its own
         if gain < 0:

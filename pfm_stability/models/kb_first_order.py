@@ -47,7 +47,13 @@ class KBFirstOrder(AffineGainModel):
     name = "kb_first_order"
 
     def polynomials(self, loop: Characteristic):
-        """D = a(s) + δs(1 − sT), E = 1 − sT (descending powers of s): τs³ + (1 − kcT)s² + k(1 + c)s (c = 0: KB eq 19)."""
+        """D = a(s) + δs(1 − sT), E = 1 − sT (descending powers of s): τs³ + (1 − kcT)s² + k(1 + c)s (c = 0: KB eq 19).
+
+        Parameters
+        ----------
+        loop : Characteristic
+            The loop judged (`Loop`, `HolonomicLoop`).
+        """
         if loop.damping == 0.0:
             return loop.plant, np.array([-loop.T, 1.0])
         D = loop.closed_plant.copy()
@@ -55,7 +61,13 @@ class KBFirstOrder(AffineGainModel):
         return D, np.array([-loop.T, 1.0])
 
     def parts(self, loop: Characteristic):
-        """(a(s), s(1 − sT), 1 − sT)."""
+        """(a(s), s(1 − sT), 1 − sT).
+
+        Parameters
+        ----------
+        loop : Characteristic
+            The loop judged (`Loop`, `HolonomicLoop`).
+        """
         return _aligned(loop.plant, [-loop.T, 1.0, 0.0], [-loop.T, 1.0])
 
     @checked
@@ -68,6 +80,13 @@ class KBFirstOrder(AffineGainModel):
         (the heading loop τs² + (1 − kcT)s + k(1 + c), `neutral_reason`): the
         same root, 1/(kc) for c > 0, ``inf`` for c <= 0. Another family's loop: searched
         (`LoopModel.critical_delay`).
+
+        Parameters
+        ----------
+        NV : float
+            Loop gain N·V, 1/s.
+        loop : Characteristic
+            The loop judged; its own T, s, is replaced by T*.
         """
         if loop.family is not STEERING:
             return LoopModel.critical_delay(self, NV, loop)

@@ -255,7 +255,13 @@ class Sampled(AffineGainModel):
         return np.polyadd(lead, _rank_one(Psi, G, F0)), np.trim_zeros(e, "f") if np.any(e) else np.zeros(1)
 
     def bilinear_polynomials(self, loop: Characteristic):
-        """(D, E) in μ (z = (1 + Tμ/2)/(1 − Tμ/2)): stable ⇔ D + K·E is Hurwitz, descending, one length."""
+        """(D, E) in μ (z = (1 + Tμ/2)/(1 − Tμ/2)): stable ⇔ D + K·E is Hurwitz, descending, one length.
+
+        Parameters
+        ----------
+        loop : Characteristic
+            The loop judged (`Loop`, `HolonomicLoop`); T > 0, s.
+        """
         d, e = self.delta_polynomials(loop)
         degree = len(np.trim_zeros(d, "f")) - 1
         return bilinear_polynomial(d, degree, loop.T), bilinear_polynomial(e, degree, loop.T)
@@ -264,6 +270,11 @@ class Sampled(AffineGainModel):
         """(P0, P1, P2) in μ: the characteristic polynomial P0 + δ·P1 + K·P2 (Tustin's map of the δ form; T = 0: `continuous`'s).
 
         P1 is the rank-one term of the unit damping row (the family's F0 at δ = 1 less at δ = 0).
+
+        Parameters
+        ----------
+        loop : Characteristic
+            The loop judged (`Loop`, `HolonomicLoop`).
         """
         if loop.T == 0:
             return Continuous().parts(loop)
@@ -291,7 +302,13 @@ class Sampled(AffineGainModel):
     # --------------------------------------------------------------- queries
     def stable_gains(self, loop: Characteristic):
         """Every stable loop gain K: the crossings of the bilinear polynomials, each stretch decided by the eigenvalues
-        (T = 0: the continuous loop, KB eq 17 for the steering robot, exactly)."""
+        (T = 0: the continuous loop, KB eq 17 for the steering robot, exactly).
+
+        Parameters
+        ----------
+        loop : Characteristic
+            The loop judged (`Loop`, `HolonomicLoop`).
+        """
         if loop.T == 0:
             return Continuous().stable_gains(loop)
         d, e = self.bilinear_polynomials(loop)
@@ -307,7 +324,15 @@ class Sampled(AffineGainModel):
 
     @checked
     def delta_eigenvalues(self, gain: float, loop: Characteristic) -> np.ndarray:
-        """Eigenvalues λ of (Φ_cl − I)/T (poles z = 1 + Tλ; T = 0: the continuous poles)."""
+        """Eigenvalues λ of (Φ_cl − I)/T (poles z = 1 + Tλ; T = 0: the continuous poles).
+
+        Parameters
+        ----------
+        gain : float
+            The family's loop gain: NV (1/s) or κ (1/s²).
+        loop : Characteristic
+            The loop judged (`Loop`, `HolonomicLoop`).
+        """
         return self._delta_eigenvalues(gain, loop)
 
     def _delta_eigenvalues(self, gain: float, loop: Characteristic) -> np.ndarray:
@@ -323,18 +348,42 @@ class Sampled(AffineGainModel):
 
     @checked
     def closed_loop(self, gain: float, loop: Characteristic) -> np.ndarray:
-        """Φ_cl at the gain (NV 1/s, κ 1/s²)."""
+        """Φ_cl at the gain (NV 1/s, κ 1/s²).
+
+        Parameters
+        ----------
+        gain : float
+            The family's loop gain: NV (1/s) or κ (1/s²).
+        loop : Characteristic
+            The loop judged (`Loop`, `HolonomicLoop`).
+        """
         return closed_loop_matrix(loop, loop.loop_gain(_check_NV(gain)), self.hold, self.compute_delay)
 
     @checked
     def eigenvalues(self, gain: float, loop: Characteristic) -> np.ndarray:
-        """Closed-loop poles z (T > 0), as 1 + Tλ."""
+        """Closed-loop poles z (T > 0), as 1 + Tλ.
+
+        Parameters
+        ----------
+        gain : float
+            The family's loop gain: NV (1/s) or κ (1/s²).
+        loop : Characteristic
+            The loop judged (`Loop`, `HolonomicLoop`).
+        """
         return 1.0 + loop.T * self._delta_eigenvalues(gain, loop)
 
     @checked
     def is_stable(self, gain: float, loop: Characteristic) -> bool:
         """Every pole strictly inside the unit circle: 2 Re λ + T|λ|² < 0 (T = 0: the continuous loop by Routh;
-        NV = 0: every pole but the neutral z = 1, `_judged_eigenvalues`)."""
+        NV = 0: every pole but the neutral z = 1, `_judged_eigenvalues`).
+
+        Parameters
+        ----------
+        gain : float
+            The family's loop gain: NV (1/s) or κ (1/s²).
+        loop : Characteristic
+            The loop judged (`Loop`, `HolonomicLoop`).
+        """
         return self._stable(gain, loop)
 
     def _stable(self, gain: float, loop: Characteristic) -> bool:
@@ -346,14 +395,30 @@ class Sampled(AffineGainModel):
 
     @checked
     def jury_stable(self, gain: float, loop: Characteristic) -> bool:
-        """Schur–Cohn (Jury) verdict on det(zI − Φ_cl), independent of the eigenvalues (T = 0: the continuous loop's)."""
+        """Schur–Cohn (Jury) verdict on det(zI − Φ_cl), independent of the eigenvalues (T = 0: the continuous loop's).
+
+        Parameters
+        ----------
+        gain : float
+            The family's loop gain: NV (1/s) or κ (1/s²).
+        loop : Characteristic
+            The loop judged (`Loop`, `HolonomicLoop`).
+        """
         if loop.T == 0:
             return self._stable(gain, loop)
         return schur_cohn_stable(self.characteristic(gain, loop))
 
     @checked
     def rightmost_root(self, gain: float, loop: Characteristic) -> complex:
-        """Dominant pole as s = ln(z)/T: σ = ln|z|/T (1/s), ω = arg(z)/T in [0, π/T] (rad/s); NV = 0: the heading loop's."""
+        """Dominant pole as s = ln(z)/T: σ = ln|z|/T (1/s), ω = arg(z)/T in [0, π/T] (rad/s); NV = 0: the heading loop's.
+
+        Parameters
+        ----------
+        gain : float
+            The family's loop gain: NV (1/s) or κ (1/s²).
+        loop : Characteristic
+            The loop judged (`Loop`, `HolonomicLoop`).
+        """
         if loop.T == 0:
             return Continuous().rightmost_root(gain, loop)
         lam = self._judged_eigenvalues(gain, loop)
@@ -365,11 +430,27 @@ class Sampled(AffineGainModel):
 
     @checked
     def roots(self, gain: float, loop: Characteristic) -> np.ndarray:
-        """All closed-loop poles z (T > 0); the continuous roots s at T = 0."""
+        """All closed-loop poles z (T > 0); the continuous roots s at T = 0.
+
+        Parameters
+        ----------
+        gain : float
+            The family's loop gain: NV (1/s) or κ (1/s²).
+        loop : Characteristic
+            The loop judged (`Loop`, `HolonomicLoop`).
+        """
         return self._delta_eigenvalues(gain, loop) if loop.T == 0 else 1.0 + loop.T * self._delta_eigenvalues(gain, loop)
 
     def growth_rates(self, NV: float, loops) -> np.ndarray:
-        """σ = max ln|z|/T (1/s) at the gain for each loop, all exponentials and eigenvalues in one batch."""
+        """σ = max ln|z|/T (1/s) at the gain for each loop, all exponentials and eigenvalues in one batch.
+
+        Parameters
+        ----------
+        NV : float
+            The family's loop gain: NV (1/s) or κ (1/s²).
+        loops : sequence of Characteristic
+            The loops, one growth rate each.
+        """
         loops = list(loops)
         NV = _check_NV(NV)
         K = np.array([loop.loop_gain(NV) for loop in loops])

@@ -227,7 +227,13 @@ class HolonomicScene:
 
     def to_dicts(self, report) -> tuple:
         """(environment entry, top-level verdicts) as the report's JSON holds them, each verdict with its remedy
-        (`report.remedies`: (geometry, model), and (geometry, i, model) for each wall equilibrium)."""
+        (`report.remedies`: (geometry, model), and (geometry, i, model) for each wall equilibrium).
+
+        Parameters
+        ----------
+        report : StabilityReport
+            The report holding this geometry (its remedies).
+        """
         geometry, fixes = self.geometry, report.remedies
         first = self.equilibria[self.main]
         key, where = ("alpha_deg", "d0") if geometry == "wall" else ("L", "x0")
@@ -269,7 +275,13 @@ class NonSmoothScene:
         return ()
 
     def to_dicts(self, report) -> tuple:
-        """(environment entry, None): the verdict, the band (a wall's) or the friction levels (a corridor's), the cycle."""
+        """(environment entry, None): the verdict, the band (a wall's) or the friction levels (a corridor's), the cycle.
+
+        Parameters
+        ----------
+        report : StabilityReport
+            The report holding this geometry (unused: no remedies).
+        """
         key = "alpha_deg" if self.geometry == "wall" else "L"
         env = {key: self.value, "N": None, "NV": None, "verdict": "non-smooth"}
         r = self.result
