@@ -44,6 +44,12 @@ enter/exit at D = ρ0, ``collision_unavoidable`` at D ≤ 0 while approaching �
 eq 12 leaves the force undefined there — and ``contact`` at clearance ≤ 0).
 `wall_cycle` runs the non-smooth wall of the velocity-gated repulsion and measures its
 cycle (`WallCycle`); growth rates and frequencies of a run: `sim.cycles.lateral_metrics`.
+
+The engine is batched (`sim.planar_batch`): `simulate_planar_batch` steps many
+`PlanarMember` runs together in arrays, each with its own robot, field, world, start, T,
+compute delay and duration; `simulate_planar` and `wall_cycle` are batches of one, and
+`wall_member` makes a wall run a member. This module gathers the planar simulator's names
+(the scene of `sim.planar_field`, the robots of `sim.planar_robots`).
 """
 
 from __future__ import annotations

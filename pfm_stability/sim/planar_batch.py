@@ -248,7 +248,8 @@ class _Events:
         self.found = []  # (member, obstacle, kind code, time) arrays per step with events
 
     def step(self, t, T, sensed, due):
-        """Events of the due members at one sample (times t); returns (contact, collision) per member (bool arrays)."""
+        """Events of the due members at one sample (times t); returns (contact, collision) per member (bool arrays),
+        or None when no member touched an obstacle or met an unavoidable collision."""
         c, v, D = sensed.clearance, sensed.closing_speed, sensed.braked
         live = self.valid & due[:, None]
         contact = live & (c <= 0)
@@ -265,7 +266,7 @@ class _Events:
                 gate = None
         if gate is None:
             if not touch.any():
-                return contact.any(axis=1), collision.any(axis=1)
+                return None
             gate = influence = np.zeros_like(live)
         mask = np.stack([gate, influence, touch], axis=-1)
         m, j, slot = np.nonzero(mask)
@@ -292,13 +293,18 @@ class _Events:
         self.found.append((m, j, kind, when))
         return contact.any(axis=1), collision.any(axis=1)
 
-    def per_member(self, B) -> list:
-        """Each member's events, in the order they were found (by step, then obstacle, then gate, influence, contact)."""
-        out = [[] for _ in range(B)]
-        for m, j, kind, when in self.found:
-            for mi, ji, ki, ti in zip(m.tolist(), j.tolist(), kind.tolist(), when.tolist()):
-                out[mi].append(PlanarEvent(EVENT_KINDS[ki], ti, ji))
-        return out
+    def per_member(self, B):
+        """(events, collided): each member's events as a tuple, in the order they were found (by step, then obstacle,
+        then gate, influence, contact), and whether it had a contact or an unavoidable collision (bool array)."""
+        collided = np.zeros(B, dtype=bool)
+        if not self.found:
+            return [()] * B, collided
+        m, j, kind, when = (np.concatenate(parts) for parts in zip(*self.found))
+        collided[m[kind >= 4]] = True
+        order = np.argsort(m, kind="stable")
+        made = [PlanarEvent(EVENT_KINDS[k], t, o) for k, t, o in zip(kind[order].tolist(), when[order].tolist(), j[order].tolist())]
+        ends = np.searchsorted(m[order], np.arange(B + 1))
+        return [tuple(made[ends[i]:ends[i + 1]]) for i in range(B)], collided
 
 
 class _Recorder:
@@ -315,6 +321,18 @@ class _Recorder:
         self.fx[k], self.fy[k] = sensed.fx, sensed.fy
         if self.theta is not None:
             self.theta[k] = state.theta
+
+    def by_member(self, n: int) -> dict:
+        """The first n samples member-major (one transposed copy each; a run's arrays are views of them):
+        p, v, force, wheels of shape (B, n, 2), theta (B, n)."""
+        def pair(a, b):
+            out = np.empty((a.shape[1], n, 2))
+            out[:, :, 0], out[:, :, 1] = a[:n].T, b[:n].T
+            return out
+
+        return {"p": pair(self.px, self.py), "v": pair(self.vx, self.vy), "force": pair(self.fx, self.fy),
+                "theta": None if self.theta is None else np.ascontiguousarray(self.theta[:n].T),
+                "wheels": None if self.wheels is None else pair(*self.wheels)}
 
 
 def simulate_planar_batch(members) -> PlanarBatch:
@@ -352,7 +370,7 @@ def simulate_planar_batch(members) -> PlanarBatch:
     events = _Events(field)
     alive = np.ones(B, dtype=bool)
     reason = np.zeros(B, dtype=np.int64)
-    done = np.zeros(B, dtype=np.int64)
+    done = steps.copy()  # the last sample of each member: its duration's, or the one of the event that stopped it
     pending = None
     single = groups[0] if len(groups) == 1 else None
     started = time.perf_counter()
@@ -363,11 +381,12 @@ def simulate_planar_batch(members) -> PlanarBatch:
             for g in mover_groups:
                 g.velocity(state)
             sensed = field.sense(t, state.px, state.py, state.vx, state.vy)
-            contact, collision = events.step(t, T, sensed, due)
+            touched = events.step(t, T, sensed, due)
             rec.record(k, state, sensed)
-            done[due] = k
-            stopped = contact | (collision & stop_on_collision)
-            if stopped.any():
+            if touched is not None:
+                contact, collision = touched
+                stopped = contact | (collision & stop_on_collision)
+                done[stopped] = k
                 reason[contact] = 1
                 reason[~contact & collision & stop_on_collision] = 2
                 alive &= ~stopped
@@ -396,8 +415,9 @@ def simulate_planar_batch(members) -> PlanarBatch:
                 _check_finite(state, running, k + 1, T)
     seconds = time.perf_counter() - started
     _check_finite(state, due, int(done.max()), T)
-    found = events.per_member(B)
-    runs = tuple(_run(members[m], rec, m, int(done[m]), found[m], STOP_REASONS[reason[m]]) for m in range(B))
+    found, collided = events.per_member(B)
+    arrays = rec.by_member(int(done.max()) + 1)
+    runs = tuple(_run(members[m], arrays, m, int(done[m]), found[m], bool(collided[m]), STOP_REASONS[reason[m]]) for m in range(B))
     return PlanarBatch(runs, int(done.sum()), seconds)
 
 
@@ -408,20 +428,17 @@ def _check_finite(state: PlanarState, which, k, T):
         raise FloatingPointError(f"member {m} reached a non-finite state at t = {k * T[m]:g} s")
 
 
-def _run(member: PlanarMember, rec: _Recorder, m: int, steps: int, events: list, reason: str) -> PlanarRun:
+def _run(member: PlanarMember, arrays: dict, m: int, steps: int, events: tuple, collided: bool, reason: str) -> PlanarRun:
     n = steps + 1
-    column = lambda a: a[:n, m].copy()  # noqa: E731
-    pair = lambda a, b: np.stack([a[:n, m], b[:n, m]], axis=1)  # noqa: E731
-    wheels = pair(*rec.wheels) if isinstance(member.robot, DiffDrive) else None
     return PlanarRun(
         t=np.arange(n) * member.T,
-        p=pair(rec.px, rec.py),
-        v=pair(rec.vx, rec.vy),
-        theta=None if isinstance(member.robot, PointMass) else column(rec.theta),
-        force=pair(rec.fx, rec.fy),
-        wheel_speeds=wheels,
-        events=tuple(events),
-        collision=any(e.kind in ("contact", "collision_unavoidable") for e in events),
+        p=arrays["p"][m, :n],
+        v=arrays["v"][m, :n],
+        theta=None if isinstance(member.robot, PointMass) else arrays["theta"][m, :n],
+        force=arrays["force"][m, :n],
+        wheel_speeds=arrays["wheels"][m, :n] if isinstance(member.robot, DiffDrive) else None,
+        events=events,
+        collision=collided,
         stop_reason=reason,
         T=member.T,
         compute_delay=member.compute_delay,

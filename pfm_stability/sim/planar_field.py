@@ -23,6 +23,7 @@ import numpy as np
 from ..checks import check_number, check_type
 from ..laws.force_law import ForceLaw
 from ..laws.velocity_laws import VARIANTS, VelocityAttraction, VelocityGatedRepulsion
+from .engine import _law_key  # equal laws share one evaluation, as in the VFF engine
 from .movers import Obstacle, Pull, Target, Wall, vector
 from .planar_robots import positive
 
@@ -142,15 +143,6 @@ class Sensed:
     nearest: np.ndarray
 
 
-def _law_key(law):
-    """Equal laws (frozen dataclasses) share one evaluation; unhashable ones are grouped by identity."""
-    try:
-        hash(law)
-        return law
-    except TypeError:
-        return id(law)
-
-
 class FieldArrays:
     """The fields and worlds of a batch as arrays; `sense` evaluates them at one sample.
 
@@ -215,7 +207,7 @@ class FieldArrays:
         self.nearest_only = np.array([f.nearest_only for f in fields], dtype=bool)[:, None]
         self.any_nearest_only = bool(self.nearest_only.any())
         self.gated = np.array([isinstance(r, VelocityGatedRepulsion) for r in rep], dtype=bool)
-        self.any_gated = bool(self.gated.any())
+        self.any_gated, self.all_gated = bool(self.gated.any()), bool(self.gated.all())
         gated = [r if isinstance(r, VelocityGatedRepulsion) else None for r in rep]
         value = lambda name, default: np.array([[getattr(g, name) if g is not None else default] for g in gated], dtype=float)  # noqa: E731
         self.eta, self.rho0, self.a_max, self.robot_radius = value("eta", 1.0), value("rho0", 1.0), value("a_max", 1.0), value("robot_radius", 0.0)
@@ -300,9 +292,10 @@ class FieldArrays:
         evaluated = self.repels[:, None] & self.valid & (clearance > 0)
         if self.any_nearest_only:
             evaluated &= ~self.nearest_only | (self.slot == np.argmin(clearance, axis=1)[:, None])
-        v_ro = D = np.full((B, O), math.nan)
         collision = np.zeros((B, O), dtype=bool)
-        if self.any_gated:
+        if not self.any_gated:
+            v_ro = D = np.full((B, O), math.nan)
+        else:
             relx, rely = vx[:, None] - self.ovx, vy[:, None] - self.ovy
             v_ro = -(relx * ux + rely * uy)
             D = clearance - self.robot_radius - v_ro * v_ro / (2.0 * self.a_max)
@@ -311,8 +304,9 @@ class FieldArrays:
             active = gate & (D > 0) & (D < self.rho0)
             if np.any(active):
                 fx, fy = self._gated_force(fx, fy, active, D, v_ro, relx, rely, ux, uy, R)
-            v_ro = np.where(self.gated[:, None], v_ro, math.nan)
-            D = np.where(self.gated[:, None], D, math.nan)
+            if not self.all_gated:
+                v_ro = np.where(self.gated[:, None], v_ro, math.nan)
+                D = np.where(self.gated[:, None], D, math.nan)
         if self.any_static:
             fx, fy = self._static_force(fx, fy, evaluated, clearance, ux, uy, gx, gy)
         return Sensed(fx, fy, clearance, v_ro, D, collision, nearest)

@@ -22,7 +22,10 @@ from ..parameters import HOLDS, TAU_RESOLUTION
 from .robot import advance_position, constant_input, constant_input_modes, graded_rule, propagate, servo, servo_modes, slow_rate
 from .vff import wrap_angle
 
-__all__ = ["ROBOTS", "DiffDrive", "DiffDriveGroup", "MassGroup", "PlanarState", "PointMass", "Steering", "SteeringGroup", "positive", "robot_groups"]
+__all__ = [
+    "ROBOTS", "DiffDrive", "DiffDriveGroup", "MassGroup", "PlanarState", "PointMass", "RobotGroup", "Steering", "SteeringGroup", "positive",
+    "robot_groups",
+]
 
 _BIG = 1e6
 
@@ -183,18 +186,89 @@ def _keep(running, new, old):
     return new if running is None else np.where(running, new, old)
 
 
-def _rows(index, first, second, running):
-    """A group's rows of the batch's applied values and running mask."""
-    return first[index], second[index], (None if running is None else running[index])
-
-
 def _direction(fx, fy, theta):
     """The force's direction (rad from +x), or θ where the force is exactly 0."""
     return np.where((fx != 0.0) | (fy != 0.0), np.arctan2(fy, fx), theta)
 
 
-class MassGroup:
-    """Point masses (`PointMass`): a = F/m saturated to a_max, held; p, v exact under constant acceleration.
+class RobotGroup:
+    """Members of a batch with robots of one kind: their parameters as arrays, their command and exact motion.
+
+    A group reads the force of its members from the batch's arrays and returns the value it
+    holds over the next period as two arrays (`command`); `advance` applies the batch's
+    applied values (the command of this sample or, with a compute delay, of the previous one)
+    to the running members. Subclasses: `MassGroup`, `SteeringGroup`, `DiffDriveGroup`.
+
+    Parameters
+    ----------
+    index : ndarray of int or slice
+        The group's members in the batch.
+    robots : sequence
+        Their parameters (`PointMass`, `Steering` of one hold, or `DiffDrive`).
+    T : ndarray, shape (n,)
+        Their sampling periods, s.
+    """
+
+    heading = True
+    """Whether the robot has a heading (recorded as θ; a point mass has none)."""
+
+    def __init__(self, index, robots, T):
+        self.index = index
+        self.T = np.asarray(T, dtype=float)
+        self._compile(list(robots))
+
+    def _compile(self, robots):  # pragma: no cover - interface
+        raise NotImplementedError
+
+    def _rows(self, first, second, running):
+        """The group's rows of the batch's applied values and running mask."""
+        i = self.index
+        return first[i], second[i], (None if running is None else running[i])
+
+    def velocity(self, state: PlanarState) -> None:
+        """Write the members' velocity (m/s) into the state's velocity rows, from their heading and speed.
+
+        Parameters
+        ----------
+        state : PlanarState
+            The batch's state.
+        """
+        i = self.index
+        theta, speed = state.theta[i], self._speed(state)
+        state.vx[i], state.vy[i] = speed * np.cos(theta), speed * np.sin(theta)
+
+    def command(self, state: PlanarState, fx, fy, clearance):  # pragma: no cover - interface
+        """The value held over the next period, as two arrays of the group's members.
+
+        Parameters
+        ----------
+        state : PlanarState
+            The batch's state.
+        fx, fy : ndarray, shape (B,)
+            The field's force on every member, N.
+        clearance : ndarray, shape (B,)
+            Every member's nearest clearance ρ, m (inf without obstacles).
+        """
+        raise NotImplementedError
+
+    def advance(self, state: PlanarState, first, second, running) -> None:  # pragma: no cover - interface
+        """Advance the running members over one period under the applied values (the state updated in place).
+
+        Parameters
+        ----------
+        state : PlanarState
+            The batch's state.
+        first, second : ndarray, shape (B,)
+            The batch's applied values (`command`'s two arrays).
+        running : ndarray of bool, shape (B,), or None
+            Which members advance (None: all).
+        """
+        raise NotImplementedError
+
+
+class MassGroup(RobotGroup):
+    """Point masses (`PointMass`): a = F/m scaled down to |a| = a_max beyond it (the conference paper's eq 22),
+    held; p += vT + aT²/2 and v += aT, exact under the constant acceleration. The command is (a_x, a_y), m/s².
 
     Parameters
     ----------
@@ -208,33 +282,14 @@ class MassGroup:
 
     heading = False
 
-    def __init__(self, index, robots, T):
-        self.index = index
+    def _compile(self, robots):
         self.mass, self.a_max = _array(robots, "mass"), _array(robots, "a_max")
-        self.T = np.asarray(T, dtype=float)
         self.saturates = bool(np.any(np.isfinite(self.a_max)))
 
     def velocity(self, state: PlanarState) -> None:
-        """Nothing to do: a point mass's velocity is its state.
-
-        Parameters
-        ----------
-        state : PlanarState
-            The batch's state.
-        """
+        pass  # a point mass's velocity is its state
 
     def command(self, state: PlanarState, fx, fy, clearance):
-        """(a_x, a_y), m/s²: F/m, scaled down to |a| = a_max beyond it (the conference paper's eq 22).
-
-        Parameters
-        ----------
-        state : PlanarState
-            The batch's state.
-        fx, fy : ndarray, shape (B,)
-            The field's force, N.
-        clearance : ndarray, shape (B,)
-            The nearest clearance, m (unused).
-        """
         i = self.index
         ax, ay = fx[i] / self.mass, fy[i] / self.mass
         if self.saturates:
@@ -246,19 +301,8 @@ class MassGroup:
         return ax, ay
 
     def advance(self, state: PlanarState, first, second, running) -> None:
-        """p += vT + aT²/2, v += aT over one period for the running members.
-
-        Parameters
-        ----------
-        state : PlanarState
-            The batch's state (updated in place).
-        first, second : ndarray, shape (B,)
-            The applied (a_x, a_y), m/s².
-        running : ndarray of bool, shape (B,), or None
-            Which members advance (None: all).
-        """
         i, T = self.index, self.T
-        first, second, running = _rows(i, first, second, running)
+        first, second, running = self._rows(first, second, running)
         px, py, vx, vy = state.px[i], state.py[i], state.vx[i], state.vy[i]
         state.px[i] = _keep(running, px + vx * T + 0.5 * first * T * T, px)
         state.py[i] = _keep(running, py + vy * T + 0.5 * second * T * T, py)
@@ -266,13 +310,13 @@ class MassGroup:
         state.vy[i] = _keep(running, vy + second * T, vy)
 
 
-class SteeringGroup:
-    """KB's steering robots of one hold (`Steering`): the exact solutions of `sim.robot` in KB's axes.
+class SteeringGroup(RobotGroup):
+    """KB's steering robots of one hold (`Steering`) at constant speed V: the exact solutions of `sim.robot`.
 
-    KB's axes swap x and y (ẋ' = V sin θ, ẏ' = V cos θ with θ from +y'); with x' = y and
-    y' = x the heading from +x is the same θ. ``hold="command"`` holds
-    u = k·wrap(δ − θ) clipped to ±max_rate; ``hold="reference"`` holds θ + wrap(δ − θ),
-    closed by the servo u = k(δ̃ − θ).
+    The command is (u, 0) with u = k·wrap(δ − θ) clipped to ±max_rate (``hold="command"``) or
+    (δ̃, 0) with δ̃ = θ + wrap(δ − θ), closed by the servo u = k(δ̃ − θ) (``hold="reference"``),
+    δ the force's direction. KB's axes swap x and y (ẋ' = V sin θ, ẏ' = V cos θ with θ from
+    +y'); with x' = y and y' = x the heading from +x is the same θ.
 
     Parameters
     ----------
@@ -284,45 +328,22 @@ class SteeringGroup:
         Their sampling periods, s.
     """
 
-    heading = True
-
-    def __init__(self, index, robots, T):
-        self.index = index
+    def _compile(self, robots):
         self.hold = robots[0].hold
         self.V, self.k, self.max_rate = _array(robots, "V"), _array(robots, "k"), _array(robots, "max_rate")
         tau = _array(robots, "tau")
         tau = np.where(tau * self.k >= TAU_RESOLUTION, tau, 0.0)  # an ideal motor, as the models take it
-        T = np.asarray(T, dtype=float)
         slow = slow_rate(self.k, np.where(np.isfinite(self.max_rate), self.max_rate, _BIG))
         if self.hold == "command":
-            self.coef = constant_input(tau, graded_rule(T, *constant_input_modes(tau), slow))
+            self.coef = constant_input(tau, graded_rule(self.T, *constant_input_modes(tau), slow))
         else:
-            self.coef = servo(tau, self.k, graded_rule(T, *servo_modes(tau, self.k), slow))
+            self.coef = servo(tau, self.k, graded_rule(self.T, *servo_modes(tau, self.k), slow))
         self.clips = bool(np.any(np.isfinite(self.max_rate)))
 
-    def velocity(self, state: PlanarState) -> None:
-        """V(cos θ, sin θ) into the state's velocity rows.
-
-        Parameters
-        ----------
-        state : PlanarState
-            The batch's state.
-        """
-        theta = state.theta[self.index]
-        state.vx[self.index], state.vy[self.index] = self.V * np.cos(theta), self.V * np.sin(theta)
+    def _speed(self, state):
+        return self.V
 
     def command(self, state: PlanarState, fx, fy, clearance):
-        """(held value, 0): u = k·wrap(δ − θ) (clipped) or δ̃ = θ + wrap(δ − θ), δ the force's direction.
-
-        Parameters
-        ----------
-        state : PlanarState
-            The batch's state.
-        fx, fy : ndarray, shape (B,)
-            The field's force, N.
-        clearance : ndarray, shape (B,)
-            The nearest clearance, m (unused).
-        """
         i = self.index
         theta = state.theta[i]
         error = wrap_angle(_direction(fx[i], fy[i], theta) - theta)
@@ -335,19 +356,8 @@ class SteeringGroup:
         return value, np.zeros_like(value)
 
     def advance(self, state: PlanarState, first, second, running) -> None:
-        """θ, ω and the position over one period, exact in θ and ω (`sim.robot.propagate`, `advance_position`).
-
-        Parameters
-        ----------
-        state : PlanarState
-            The batch's state (updated in place).
-        first, second : ndarray, shape (B,)
-            The applied value (rad/s or rad) and 0.
-        running : ndarray of bool, shape (B,), or None
-            Which members advance (None: all).
-        """
         i = self.index
-        first, second, running = _rows(i, first, second, running)
+        first, second, running = self._rows(first, second, running)
         theta, omega, px, py = state.theta[i], state.omega[i], state.px[i], state.py[i]
         delta, correction, theta_end, omega_end = propagate(self.coef, theta, omega, first)
         y, x = advance_position(py, px, self.V, self.coef.rule, theta, delta, correction)
@@ -355,8 +365,12 @@ class SteeringGroup:
         state.theta[i], state.omega[i] = _keep(running, theta_end, theta), _keep(running, omega_end, omega)
 
 
-class DiffDriveGroup:
-    """GC2002 §7's differential-drive robots (`DiffDrive`): ω and v held, the unicycle's arc exact.
+class DiffDriveGroup(RobotGroup):
+    """GC2002 §7's differential-drive robots (`DiffDrive`): (v, ω) held, the unicycle's arc exact.
+
+    The command is v = v_opt·min(1, ρ/ρ0) ≥ 0 (eq 41, ρ the nearest clearance) and
+    ω = K_s·wrap(θ_f − θ) (eq 42–43); over a period the robot moves along the chord
+    vT·sinc(ωT/2π) in the direction θ + ωT/2 and turns by ωT.
 
     Parameters
     ----------
@@ -368,38 +382,14 @@ class DiffDriveGroup:
         Their sampling periods, s.
     """
 
-    heading = True
-
-    def __init__(self, index, robots, T):
-        self.index = index
+    def _compile(self, robots):
         self.K_s, self.v_opt = _array(robots, "K_s"), _array(robots, "v_opt")
         self.rho0, self.axle = _array(robots, "rho0_speed"), _array(robots, "axle")
-        self.T = np.asarray(T, dtype=float)
 
-    def velocity(self, state: PlanarState) -> None:
-        """v(cos θ, sin θ) into the state's velocity rows.
-
-        Parameters
-        ----------
-        state : PlanarState
-            The batch's state.
-        """
-        i = self.index
-        theta, speed = state.theta[i], state.speed[i]
-        state.vx[i], state.vy[i] = speed * np.cos(theta), speed * np.sin(theta)
+    def _speed(self, state):
+        return state.speed[self.index]
 
     def command(self, state: PlanarState, fx, fy, clearance):
-        """(v, ω): v = v_opt·min(1, ρ/ρ0) ≥ 0 (eq 41), ω = K_s·wrap(θ_f − θ) (eq 42–43).
-
-        Parameters
-        ----------
-        state : PlanarState
-            The batch's state.
-        fx, fy : ndarray, shape (B,)
-            The field's force, N.
-        clearance : ndarray, shape (B,)
-            The nearest clearance ρ, m (inf without obstacles).
-        """
         i = self.index
         theta = state.theta[i]
         omega = self.K_s * wrap_angle(_direction(fx[i], fy[i], theta) - theta)
@@ -407,7 +397,7 @@ class DiffDriveGroup:
         return np.maximum(speed, 0.0), omega
 
     def wheels(self, speed, omega):
-        """(v_l, v_r) = v ∓ Lω/2, m/s (GC2002 eq 40, rows in counter-clockwise order).
+        """(v_l, v_r) = v ∓ Lω/2 of the group's members, m/s (GC2002 eq 40, rows in counter-clockwise order).
 
         Parameters
         ----------
@@ -418,19 +408,8 @@ class DiffDriveGroup:
         return speed - self.axle * omega / 2.0, speed + self.axle * omega / 2.0
 
     def advance(self, state: PlanarState, first, second, running) -> None:
-        """The arc of length vT turning by ωT: chord vT·sinc(ωT/2π) along θ + ωT/2.
-
-        Parameters
-        ----------
-        state : PlanarState
-            The batch's state (updated in place).
-        first, second : ndarray, shape (B,)
-            The applied speed v (m/s) and rate ω (rad/s).
-        running : ndarray of bool, shape (B,), or None
-            Which members advance (None: all).
-        """
         i, T = self.index, self.T
-        first, second, running = _rows(i, first, second, running)
+        first, second, running = self._rows(first, second, running)
         theta, px, py = state.theta[i], state.px[i], state.py[i]
         turn = second * T
         chord = first * T * np.sinc(turn / (2.0 * math.pi))
