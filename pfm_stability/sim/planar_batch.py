@@ -251,23 +251,24 @@ class _Events:
         """Events of the due members at one sample (times t); returns (contact, collision) per member (bool arrays),
         or None when no member touched an obstacle or met an unavoidable collision."""
         c, v, D = sensed.clearance, sensed.closing_speed, sensed.braked
+        touch = (c <= 0) | sensed.collision  # a contact, else an unavoidable collision
+        signs = (v > 0, D < self.rho0) if self.gated else None  # gate open, inside the influence
+        previous, self.previous = self.previous, (c, v, D, signs)
+        changed = touch
+        if previous is not None and self.gated:
+            changed = touch | (previous[3][0] != signs[0]) | (previous[3][1] != signs[1])
         live = self.valid & due[:, None]
+        if not (changed & live).any():
+            return None
         contact = live & (c <= 0)
         collision = live & ~contact & sensed.collision
         touch = contact | collision
-        previous, self.previous = self.previous, (c, v, D)
-        gate = influence = None
+        gate = influence = np.zeros_like(live)
         if previous is not None:
-            c0, v0, D0 = previous
-        if previous is not None and self.gated:
-            gate = live & ((v0 > 0) != (v > 0))
-            influence = live & ((D0 < self.rho0) != (D < self.rho0))
-            if not (gate.any() or influence.any()):
-                gate = None
-        if gate is None:
-            if not touch.any():
-                return None
-            gate = influence = np.zeros_like(live)
+            c0, v0, D0, _ = previous
+            if self.gated:
+                gate = live & (previous[3][0] != signs[0])
+                influence = live & (previous[3][1] != signs[1])
         mask = np.stack([gate, influence, touch], axis=-1)
         m, j, slot = np.nonzero(mask)
         t1 = t[m]
