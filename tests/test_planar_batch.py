@@ -300,3 +300,18 @@ def test_batch_bad_input():
         simulate_planar_batch([object()])
     with pytest.raises(ValueError, match="T"):
         PlanarMember(PointMass(), Field(Pull(1.0, 0.0)), World(), Start((0.0, 0.0)), T=0.0, duration=1.0)
+
+
+@pytest.mark.parametrize("J", [1, 4, 12, 32, 33, 64])
+def test_node_sum_is_cumsum_bit_for_bit(J):
+    """`sim.robot.node_sum` (a column at a time for short rules) equals numpy's sequential cumsum bit for bit.
+
+    Both add the nodes left to right, so the results are identical, not merely close: the
+    zero-weight padding of a batch's shorter rules still adds nothing (docs/simulator.md, "Batches").
+    """
+    from pfm_stability.sim.robot import node_sum
+
+    rng = np.random.default_rng(J)
+    for shape in ((50, J), (50, J, 3)):
+        a = rng.normal(size=shape) * 10.0 ** rng.integers(-8, 8, size=shape)
+        assert np.array_equal(node_sum(a), np.cumsum(a, axis=1)[:, -1])
