@@ -197,6 +197,7 @@ class FieldArrays:
         take = lambda name: np.array([float(getattr(a, name)) for a in att])  # noqa: E731
         self.alpha_p, self.alpha_v, self.m, self.n = take("alpha_p"), take("alpha_v"), take("m"), take("n")
         self.position_gain, self.velocity_gain = self.m * self.alpha_p, self.n * self.alpha_v
+        self.m_is_2, self.n_is_2 = bool(np.all(self.m == 2.0)), bool(np.all(self.n == 2.0))
         self.tx, self.ty = np.array([t.position[0] for t in targets]), np.array([t.position[1] for t in targets])
         self.tvx, self.tvy = np.array([t.velocity[0] for t in targets]), np.array([t.velocity[1] for t in targets])
 
@@ -234,8 +235,8 @@ class FieldArrays:
         r, rv = np.hypot(ex, ey), np.hypot(dx, dy)
         on, von = r > 0, rv > 0
         safe_r, safe_rv = np.where(on, r, 1.0), np.where(von, rv, 1.0)
-        c = self.position_gain * safe_r ** (self.m - 2.0)
-        cv = self.velocity_gain * safe_rv ** (self.n - 2.0)
+        c = self.position_gain if self.m_is_2 else self.position_gain * safe_r ** (self.m - 2.0)  # r⁰ = 1 exactly
+        cv = self.velocity_gain if self.n_is_2 else self.velocity_gain * safe_rv ** (self.n - 2.0)
         ax = np.where(on, 0.0 + c * ex, 0.0)
         ay = np.where(on, 0.0 + c * ey, 0.0)
         ax, ay = np.where(von, ax + cv * dx, ax), np.where(von, ay + cv * dy, ay)
