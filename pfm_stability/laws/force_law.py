@@ -421,8 +421,14 @@ def wall_gain(law: ForceLaw, alpha) -> tuple:
     check_type("law", law, ForceLaw, _LAW)
     if np.ndim(alpha) > 0:
         return wall_gain_arrays(law, alpha)
+    check_parameter("alpha", alpha)
+    return _wall_gain(law, alpha)
+
+
+def _wall_gain(law: ForceLaw, alpha: float) -> tuple:
+    """`wall_gain` of a checked law at a checked scalar α, rad (a search over α in range: `critical_alpha`)."""
     if law.monotone:
-        d0 = law.distance_for(math.cos(check_parameter("alpha", alpha)))
+        d0 = law.distance_for(math.cos(alpha))
         if math.isinf(d0):
             return d0, 0.0
         N = float(-law.slope(d0) / math.sin(alpha)) if d0 > 0 else math.inf

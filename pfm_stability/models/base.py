@@ -46,7 +46,7 @@ from ..checks import check_choice, check_number
 from ..parameters import HOLDS, RANGES, T_RESOLUTION, TAU_RESOLUTION, check_parameter
 from ..numerics.crossings import Crossing, StabilityInterval, affine_crossings, stable_interval, stable_set, verdict_at
 from ..io.serialize import json_number
-from .family import Characteristic, LoopFamily, StableSet
+from .family import Characteristic, LoopFamily, StableSet, _unchecked
 from .verdicts import NV_MAX
 
 __all__ = [
@@ -220,6 +220,16 @@ class Loop(Characteristic):
         """
         return Loop(self.tau, T, self.k, c=self.c)
 
+    def _with_delay(self, T: float) -> "Loop":
+        """`with_delay` unchecked (a probe of T in range, `Characteristic._with_delay`); T < `T_RESOLUTION` is 0."""
+        T = float(T)
+        return _unchecked(Loop, tau=self.tau, T=T if T >= T_RESOLUTION else 0.0, k=self.k, c=self.c)
+
+    def _with_steering_gain(self, k: float) -> "Loop":
+        """τ, T and c with steering gain k, 1/s, unchecked (a probe of k in `gain_range`); τ with τk < 10⁻⁹ is 0."""
+        k = float(k)
+        return _unchecked(Loop, tau=self.tau if self.tau * k >= TAU_RESOLUTION else 0.0, T=self.T, k=k, c=self.c)
+
     def delay_search(self, NV: float) -> tuple:
         """T* searched from 1 % of the loop's fastest time scale to 1e-7 relative (a report shows 4 digits).
 
@@ -241,7 +251,10 @@ class Loop(Characteristic):
         hold : str
             What the computer holds between samples: ``"command"`` or ``"reference"`` (`parameters.HOLDS`).
         """
-        check_choice("hold", hold, HOLDS)
+        return self._state_space(check_choice("hold", hold, HOLDS))
+
+    def _state_space(self, hold: str) -> tuple:
+        """`state_space` for a `hold` already checked (`Characteristic._state_space`)."""
         tau, k = self.tau, self.k
         if tau > 0:
             if hold == "command":
@@ -467,10 +480,13 @@ class LoopModel:
         """Real part of the dominant root, 1/s, at the gain for each loop of a sequence.
 
         At NV = 0 the heading loop's (`neutral_reason`: the neutral lateral
-        root left out), as `rightmost_root`. Models override this with a
-        vectorized version where they can.
+        root left out), as `rightmost_root`. Models override `_growth_rates`
+        with a vectorized version where they can.
         """
-        gain = _check_NV(gain)
+        return self._growth_rates(_check_NV(gain), loops)
+
+    def _growth_rates(self, gain: float, loops) -> np.ndarray:
+        """`growth_rates` of a gain already checked (the searches of `critical_delay` and `critical_gain_k`)."""
         return np.array([self.rightmost_root(gain, loop).real for loop in loops])
 
     @checked
@@ -488,12 +504,11 @@ class LoopModel:
         """
         from ..numerics.solve import first_crossing
 
-        gain = _check_NV(gain)
-        if gain < 0 or self.growth_rates(gain, [loop.with_delay(0.0)])[0] >= 0:
+        if gain < 0 or self._growth_rates(gain, [loop._with_delay(0.0)])[0] >= 0:
             return 0.0
 
-        def measure(Ts):
-            return self.growth_rates(gain, [loop.with_delay(float(T)) for T in Ts])
+        def measure(Ts):  # probes of the checked loop: T in [start, RANGES["T"].high]
+            return self._growth_rates(gain, [loop._with_delay(T) for T in Ts])
 
         start, rtol, atol = loop.delay_search(gain)
         return first_crossing(measure, start, RANGES["T"].high, rtol=rtol, atol=atol)
@@ -509,13 +524,12 @@ class LoopModel:
         from ..numerics.solve import first_crossing
 
         loop = _steering(loop, "critical_gain_k")
-        NV = _check_NV(NV)
         lo, hi = gain_range(loop)
-        if NV < 0 or self.growth_rates(NV, [Loop(loop.tau, loop.T, lo, c=loop.c)])[0] >= 0:
+        if NV < 0 or self._growth_rates(NV, [loop._with_steering_gain(lo)])[0] >= 0:
             return 0.0
 
-        def measure(ks):
-            return self.growth_rates(NV, [Loop(loop.tau, loop.T, float(k), c=loop.c) for k in ks])
+        def measure(ks):  # probes of the checked loop: k in gain_range
+            return self._growth_rates(NV, [loop._with_steering_gain(k) for k in ks])
 
         return first_crossing(measure, lo, hi, start=lo, rtol=_DELAY_RTOL, atol=1e-12 * lo)
 
@@ -681,12 +695,11 @@ class AffineGainModel(LoopModel):
         E = np.array([np.pad(e, (width - len(e), 0)) for _, e in pairs])
         return D, E
 
-    def growth_rates(self, gain: float, loops) -> np.ndarray:
+    def _growth_rates(self, gain: float, loops) -> np.ndarray:
         """max Re s (1/s) at the gain for each loop: eigenvalues of the companion matrices, batched by degree
         (NV = 0: of D/s, the heading loop; −inf for a constant)."""
         loops = list(loops)
         D, E = self.batch_polynomials(loops)
-        gain = _check_NV(gain)
         P = D + np.array([loop.loop_gain(gain) for loop in loops])[:, None] * E
         if gain == 0:  # D(0) = 0 exactly: drop the neutral lateral root
             P = P[:, :-1]

@@ -71,7 +71,7 @@ from ..io.serialize import json_number
 from .base import Loop, LoopModel
 from .verdicts import interval_margin, interval_verdict
 from .continuous import Continuous
-from .family import Characteristic, LoopFamily, StableSet, root_json
+from .family import Characteristic, LoopFamily, StableSet, _unchecked, root_json
 
 __all__ = [
     "BEST_CURVATURE_PRODUCT",
@@ -259,6 +259,11 @@ class HolonomicLoop(Characteristic):
             Delay / sampling period, s, >= 0.
         """
         return replace(self, T=T)
+
+    def _with_delay(self, T: float) -> "HolonomicLoop":
+        """`with_delay` unchecked (a probe of T in range, `Characteristic._with_delay`); T < `T_RESOLUTION` is 0."""
+        T = float(T)
+        return _unchecked(HolonomicLoop, T=T if T >= T_RESOLUTION else 0.0, c_h=self.c_h)
 
     def with_damping(self, damping: float) -> "HolonomicLoop":
         """T with damping c_h = `damping`, 1/s.

@@ -101,8 +101,7 @@ def continuous_plant(loop: Characteristic, hold: str):
     -------
     A, B, F0, F1 : ndarray
     """
-    check_choice("hold", hold, HOLDS)
-    return loop.state_space(hold)
+    return loop._state_space(check_choice("hold", hold, HOLDS))
 
 
 def discretize(A, B, T: float):
@@ -441,21 +440,12 @@ class Sampled(AffineGainModel):
         """
         return self._delta_eigenvalues(gain, loop) if loop.T == 0 else 1.0 + loop.T * self._delta_eigenvalues(gain, loop)
 
-    def growth_rates(self, NV: float, loops) -> np.ndarray:
-        """σ = max ln|z|/T (1/s) at the gain for each loop, all exponentials and eigenvalues in one batch.
-
-        Parameters
-        ----------
-        NV : float
-            The family's loop gain: NV (1/s) or κ (1/s²).
-        loops : sequence of Characteristic
-            The loops, one growth rate each.
-        """
+    def _growth_rates(self, NV: float, loops) -> np.ndarray:
+        """σ = max ln|z|/T (1/s) at the gain for each loop, all exponentials and eigenvalues in one batch."""
         loops = list(loops)
-        NV = _check_NV(NV)
         K = np.array([loop.loop_gain(NV) for loop in loops])
         T = np.array([loop.T for loop in loops])
-        plants = [continuous_plant(loop, self.hold) for loop in loops]
+        plants = [loop._state_space(self.hold) for loop in loops]
         A, B, F0, F1 = (np.stack([p[i] for p in plants]) for i in range(4))
         n = A.shape[-1]
         Psi, G = A.copy(), B.copy()
