@@ -40,13 +40,14 @@ from ..io.serialize import SCHEMA_VERSION, json_number, json_ready
 from ..laws.force_law import ForceLaw, PowerLaw, law_in_force
 from ..models import HEADING_GAIN_RANGE, STEERING, KBFirstOrder, Loop, LoopFamily, Sampled, make_models, models_for
 from ..models.family import root_json
-from ..laws.registry import FAMILY_CHOICE_DEFAULTS, FAMILY_DEFAULTS, HOLONOMIC_LAWS, LAW_PARAMETERS
+from ..laws.registry import FAMILY_CHOICE_DEFAULTS, FAMILY_DEFAULTS, FORCE_LAWS, HOLONOMIC_LAWS, LAW_PARAMETERS, parameter_keys
 from ..parameters import MODEL_NAMES, RANGES, ROBOT_FAMILIES, Controller, Corridor, Robot, Wall, check_parameter
 
 __all__ = ["StabilityReport", "KBError", "LawDescription", "build_report", "remedies", "kb_error", "kb_errors", "KINEMATIC_TAU_SOURCE"]
 
-LAW_INPUTS = ("cell_ratio", "cell_size", "window_cells", "xi", "eta", "rho0", "attraction_exponent", "goal_exponent", "goal_distance", "delta")
-"""The law's own parameters, listed after W when the law takes them (`parameters.LAW_PARAMETERS`)."""
+LAW_INPUTS = parameter_keys(FORCE_LAWS)
+"""The static laws' own parameters, listed after W when the law takes them (`laws.registry.parameter_keys`: in
+`laws.registry.PARAMETERS` order)."""
 
 INPUTS = ("V", "tau", "T", "k", "f", "n", "W", *LAW_INPUTS, "hold", "compute_delay", "pade_order", "alpha_deg", "L")
 """The report's inputs for a static law, in the order it lists them (``alpha_deg`` and ``L`` when given; f and n for KB's laws only)."""
