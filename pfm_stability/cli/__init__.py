@@ -136,7 +136,3 @@ def main(argv=None) -> int:
     except OSError as exc:  # the environment, not the code: a full disk, a vanished file, a device error
         where = f" ({exc.filename})" if getattr(exc, "filename", None) else ""
         return _fail(f"{exc.strerror or exc}{where}")
-
-
-def entry_point() -> None:  # pragma: no cover - thin wrapper
-    sys.exit(main())
