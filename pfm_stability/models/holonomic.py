@@ -113,7 +113,13 @@ HOLONOMIC = LoopFamily(
 
 
 def check_kappa(kappa) -> float:
-    """κ (1/s²) as a float: finite, in ``RANGES["kappa"]``, non-zero (κ = 0 puts a root at s = 0)."""
+    """κ (1/s²) as a float: finite, in ``RANGES["kappa"]``, non-zero (κ = 0 puts a root at s = 0).
+
+    Parameters
+    ----------
+    kappa : float
+        Stiffness κ, 1/s².
+    """
     kappa = check_parameter("kappa", kappa)
     if kappa == 0.0:
         raise ValueError("kappa must be a finite non-zero number 1/s^2 (kappa = 0: no force gradient, a root at s = 0); got 0.0")

@@ -90,7 +90,13 @@ class FamilyLaw:
     choices: dict = field(default_factory=dict)
 
     def choice(self, key: str) -> str:
-        """The value of the choice `key` (`parameters.FAMILY_CHOICE_DEFAULTS` when not given)."""
+        """The value of the choice `key` (`parameters.FAMILY_CHOICE_DEFAULTS` when not given).
+
+        Parameters
+        ----------
+        key : str
+            A choice of `parameters.FAMILY_CHOICE_DEFAULTS`.
+        """
         return self.choices.get(key, FAMILY_CHOICE_DEFAULTS[key])
 
     @property
@@ -153,6 +159,15 @@ def make_family_law(name: str, choices: dict | None = None, **parameters) -> Fam
 
     `choices` (`parameters.FAMILY_LAW_CHOICES`, e.g. ``{"side": "right"}``) go over
     `parameters.FAMILY_CHOICE_DEFAULTS`; a choice may also be a keyword (``symmetrize="negative"``).
+
+    Parameters
+    ----------
+    name : str
+        A law of `FAMILY_LAWS`.
+    choices : dict, optional
+        Choice → value (e.g. ``{"side": "right"}``).
+    **parameters
+        The law's parameters (over `FAMILY_DEFAULTS`), or choices as keywords.
 
     Raises
     ------
