@@ -259,6 +259,12 @@ class VelocityAttraction:
             raise ValueError(f"V must be > 0 m/s for n != 2 (the damping nα_v V^(n-2) is 0 or infinite at rest); got {V!r}")
         return self.n * self.alpha_v * V ** (self.n - 2.0) / mass
 
+    def _holonomic_inputs(self, law, rho_g: float, mass: float, V: float) -> tuple:
+        """(F_a in N, m_rob in kg, c_h in 1/s) of a holonomic robot's equilibria, after checking the law, ρ_g, the mass and V."""
+        check_type("law", law, ForceLaw, _LAW)
+        Fa, mass = self.position_force(rho_g), check_parameter("mass", mass)
+        return Fa, mass, self._damping(check_number("V", V, 0.0, 100.0, low_open=False, unit="m/s"), mass)
+
     def holonomic_wall_gains(self, law: ForceLaw, alpha: float, rho_g: float, mass: float = 1.0, V: float = 0.0) -> tuple:
         """(x0 = d0, κ, c_h) at every wall equilibrium of a holonomic robot (GC2002 §6: force = acceleration).
 
@@ -278,10 +284,8 @@ class VelocityAttraction:
         V : float, optional
             Speed along the wall, m/s.
         """
-        check_type("law", law, ForceLaw, _LAW)
-        Fa, mass = self.position_force(rho_g), check_parameter("mass", mass)
         alpha = check_parameter("alpha", alpha)
-        c_h = self._damping(check_number("V", V, 0.0, 100.0, low_open=False, unit="m/s"), mass)
+        Fa, mass, c_h = self._holonomic_inputs(law, rho_g, mass, V)
         out = []
         for eq in wall_equilibria(law, alpha):
             if math.isfinite(eq.x0):
@@ -305,10 +309,8 @@ class VelocityAttraction:
         V : float, optional
             Speed along the corridor, m/s.
         """
-        check_type("law", law, ForceLaw, _LAW)
-        Fa, mass = self.position_force(rho_g), check_parameter("mass", mass)
         L = check_parameter("L", L)
-        c_h = self._damping(check_number("V", V, 0.0, 100.0, low_open=False, unit="m/s"), mass)
+        Fa, mass, c_h = self._holonomic_inputs(law, rho_g, mass, V)
         out = []
         for eq in corridor_equilibria(law, L):
             slope = float(law.slope(L + eq.x0)) + float(law.slope(L - eq.x0))
