@@ -117,7 +117,13 @@ def _non_smooth_table(scenario: str, env: dict):
 
 
 def equilibrium_notes(e: dict) -> list[str]:
-    """The fuzzy law's frozen-gain N and the one-sided heading gains at one equilibrium (its JSON form)."""
+    """The fuzzy law's frozen-gain N and the one-sided heading gains at one equilibrium (its JSON form).
+
+    Parameters
+    ----------
+    e : dict
+        One equilibrium's JSON entry.
+    """
     line = f"  fuzzy-scheduled gains: N total {number(e['N'])} 1/m (used), N frozen {number(e['N_frozen'])} 1/m"
     if "c_plus" in e:
         line += f"; c = {number(e['c'])} (c- {number(e['c_minus'])}, c+ {number(e['c_plus'])}); eta = {number(e['eta'])}, d eta/dd = {number(e['eta_d'])} 1/m"
@@ -125,7 +131,15 @@ def equilibrium_notes(e: dict) -> list[str]:
 
 
 def family_tail(report, data: dict) -> list[str]:
-    """Lines after the geometries: the fuzzy law's robust bracket and the tracking error's dynamics (values from the JSON `data`)."""
+    """Lines after the geometries: the fuzzy law's robust bracket and the tracking error's dynamics (values from the JSON `data`).
+
+    Parameters
+    ----------
+    report : StabilityReport
+        The report.
+    data : dict
+        Its JSON form.
+    """
     lines = []
     if report.schedule is not None and report.schedule.bracket is not None:
         bracket = data["environment"]["wall"]["robust_bracket"]

@@ -46,7 +46,7 @@ from ..checks import check_choice, check_number
 from ..parameters import HOLDS, RANGES, T_RESOLUTION, TAU_RESOLUTION, check_parameter
 from ..numerics.crossings import Crossing, StabilityInterval, affine_crossings, stable_interval, stable_set, verdict_at
 from ..io.serialize import json_number
-from .family import Characteristic, LoopFamily, StableSet
+from .family import Characteristic, LoopFamily, StableSet, _unchecked
 from .verdicts import NV_MAX
 
 __all__ = [
@@ -81,6 +81,13 @@ def neutral_quotient(p, domain: str = "s") -> np.ndarray:
 
     Every affine model's D has the root there exactly (D(0) = 0: the s⁰ coefficient is a product with
     the plant's zero constant term), so the s quotient drops that coefficient without arithmetic.
+
+    Parameters
+    ----------
+    p : array_like
+        The polynomial, descending.
+    domain : str, optional
+        ``"s"`` or ``"z"``.
     """
     p = np.trim_zeros(np.asarray(p, dtype=float), "f")
     if domain == "s":
@@ -220,6 +227,16 @@ class Loop(Characteristic):
         """
         return Loop(self.tau, T, self.k, c=self.c)
 
+    def _with_delay(self, T: float) -> "Loop":
+        """`with_delay` unchecked (a probe of T in range, `Characteristic._with_delay`); T < `T_RESOLUTION` is 0."""
+        T = float(T)
+        return _unchecked(Loop, tau=self.tau, T=T if T >= T_RESOLUTION else 0.0, k=self.k, c=self.c)
+
+    def _with_steering_gain(self, k: float) -> "Loop":
+        """τ, T and c with steering gain k, 1/s, unchecked (a probe of k in `gain_range`); τ with τk < 10⁻⁹ is 0."""
+        k = float(k)
+        return _unchecked(Loop, tau=self.tau if self.tau * k >= TAU_RESOLUTION else 0.0, T=self.T, k=k, c=self.c)
+
     def delay_search(self, NV: float) -> tuple:
         """T* searched from 1 % of the loop's fastest time scale to 1e-7 relative (a report shows 4 digits).
 
@@ -241,7 +258,10 @@ class Loop(Characteristic):
         hold : str
             What the computer holds between samples: ``"command"`` or ``"reference"`` (`parameters.HOLDS`).
         """
-        check_choice("hold", hold, HOLDS)
+        return self._state_space(check_choice("hold", hold, HOLDS))
+
+    def _state_space(self, hold: str) -> tuple:
+        """`state_space` for a `hold` already checked (`Characteristic._state_space`)."""
         tau, k = self.tau, self.k
         if tau > 0:
             if hold == "command":
@@ -355,7 +375,17 @@ class Boundary(StableSet):
 
     @classmethod
     def from_interval(cls, model: str, interval, k: float) -> "Boundary":
-        """From a `crossings.StabilityInterval` in gain K = kNV."""
+        """From a `crossings.StabilityInterval` in gain K = kNV.
+
+        Parameters
+        ----------
+        model : str
+            The model's name (`parameters.MODEL_NAMES`).
+        interval : StabilityInterval
+            The stable loop gains K, 1/s², with K* and ω*.
+        k : float
+            Steering gain, 1/s.
+        """
         intervals = tuple((lo / k, hi / k) for lo, hi in interval.intervals)
         return cls(model, interval.gain / k, interval.frequency, interval.gain, intervals)
 
@@ -376,7 +406,13 @@ def _check_NV(NV) -> float:
 
 
 def check_heading_gain(c) -> float:
-    """c as a float if it is finite and in `HEADING_GAIN_RANGE`, else ValueError (with the reason for c <= −1)."""
+    """c as a float if it is finite and in `HEADING_GAIN_RANGE`, else ValueError (with the reason for c <= −1).
+
+    Parameters
+    ----------
+    c : float
+        Heading gain, dimensionless.
+    """
     low, high = HEADING_GAIN_RANGE
     try:
         return check_number("c", c, low, high, low_open=False, high_open=False)
@@ -400,6 +436,11 @@ def checked(method):
     checked beyond the last crossing gain, may go further); NV < 0 is accepted
     (N < 0, `divergent_reason`), and NV = 0 (N = 0: the heading loop is judged,
     `neutral_reason`). κ for a holonomic loop (non-zero).
+
+    Parameters
+    ----------
+    method : callable
+        A model method ``method(self, gain, loop, ...)``.
     """
 
     @functools.wraps(method)
@@ -442,16 +483,36 @@ class LoopModel:
         return {}
 
     def boundary(self, loop: Characteristic):
-        """The critical gain (NV* or κ*), the boundary frequency and the stable set for the loop (cached)."""
+        """The critical gain (NV* or κ*), the boundary frequency and the stable set for the loop (cached).
+
+        Parameters
+        ----------
+        loop : Characteristic
+            The loop judged (`Loop`, `HolonomicLoop`).
+        """
         return _cached_boundary(self, _check_loop(loop))
 
     def compute_boundary(self, loop: Characteristic):  # pragma: no cover - interface
-        """`boundary`, uncached."""
+        """`boundary`, uncached.
+
+        Parameters
+        ----------
+        loop : Characteristic
+            The loop judged (`Loop`, `HolonomicLoop`).
+        """
         raise NotImplementedError
 
     @checked
     def is_stable(self, gain: float, loop: Characteristic) -> bool:
-        """Verdict at the gain (NV 1/s, κ 1/s²) by a route independent of `boundary`."""
+        """Verdict at the gain (NV 1/s, κ 1/s²) by a route independent of `boundary`.
+
+        Parameters
+        ----------
+        gain : float
+            The family's loop gain: NV (1/s) or κ (1/s²).
+        loop : Characteristic
+            The loop judged (`Loop`, `HolonomicLoop`).
+        """
         return self._stable(gain, loop)
 
     def _stable(self, gain: float, loop: Characteristic) -> bool:  # pragma: no cover - interface
@@ -460,17 +521,35 @@ class LoopModel:
 
     @checked
     def rightmost_root(self, gain: float, loop: Characteristic) -> complex:  # pragma: no cover - interface
-        """Dominant root σ + jω (1/s, rad/s, ω >= 0); sampled models map z by ln(z)/T."""
+        """Dominant root σ + jω (1/s, rad/s, ω >= 0); sampled models map z by ln(z)/T.
+
+        Parameters
+        ----------
+        gain : float
+            The family's loop gain: NV (1/s) or κ (1/s²).
+        loop : Characteristic
+            The loop judged (`Loop`, `HolonomicLoop`).
+        """
         raise NotImplementedError
 
     def growth_rates(self, gain: float, loops) -> np.ndarray:
         """Real part of the dominant root, 1/s, at the gain for each loop of a sequence.
 
         At NV = 0 the heading loop's (`neutral_reason`: the neutral lateral
-        root left out), as `rightmost_root`. Models override this with a
-        vectorized version where they can.
+        root left out), as `rightmost_root`. Models override `_growth_rates`
+        with a vectorized version where they can.
+
+        Parameters
+        ----------
+        gain : float
+            The family's loop gain: NV (1/s) or κ (1/s²).
+        loops : sequence of Characteristic
+            The loops, one growth rate each.
         """
-        gain = _check_NV(gain)
+        return self._growth_rates(_check_NV(gain), loops)
+
+    def _growth_rates(self, gain: float, loops) -> np.ndarray:
+        """`growth_rates` of a gain already checked (the searches of `critical_delay` and `critical_gain_k`)."""
         return np.array([self.rightmost_root(gain, loop).real for loop in loops])
 
     @checked
@@ -485,15 +564,21 @@ class LoopModel:
         bisection to the family's tolerance, `Characteristic.delay_search`:
         1e-7 relative for a steering loop, 1e-9 for a holonomic one); models
         with an exact route override it.
+
+        Parameters
+        ----------
+        gain : float
+            The family's loop gain: NV (1/s) or κ (1/s²).
+        loop : Characteristic
+            The loop judged; its own T, s, is replaced by the searched ones.
         """
         from ..numerics.solve import first_crossing
 
-        gain = _check_NV(gain)
-        if gain < 0 or self.growth_rates(gain, [loop.with_delay(0.0)])[0] >= 0:
+        if gain < 0 or self._growth_rates(gain, [loop._with_delay(0.0)])[0] >= 0:
             return 0.0
 
-        def measure(Ts):
-            return self.growth_rates(gain, [loop.with_delay(float(T)) for T in Ts])
+        def measure(Ts):  # probes of the checked loop: T in [start, RANGES["T"].high]
+            return self._growth_rates(gain, [loop._with_delay(T) for T in Ts])
 
         start, rtol, atol = loop.delay_search(gain)
         return first_crossing(measure, start, RANGES["T"].high, rtol=rtol, atol=atol)
@@ -505,17 +590,23 @@ class LoopModel:
         Stable for every k in (0, k*): lowering k below k* is a remedy that
         works. 0 if no k is small enough; ``inf`` if NV stays stable up to the
         largest allowed k (10⁴ 1/s). Same search as `critical_delay`, over k.
+
+        Parameters
+        ----------
+        NV : float
+            Loop gain N·V, 1/s.
+        loop : Loop
+            The steering loop judged; its own k is replaced by the searched ones.
         """
         from ..numerics.solve import first_crossing
 
         loop = _steering(loop, "critical_gain_k")
-        NV = _check_NV(NV)
         lo, hi = gain_range(loop)
-        if NV < 0 or self.growth_rates(NV, [Loop(loop.tau, loop.T, lo, c=loop.c)])[0] >= 0:
+        if NV < 0 or self._growth_rates(NV, [loop._with_steering_gain(lo)])[0] >= 0:
             return 0.0
 
-        def measure(ks):
-            return self.growth_rates(NV, [Loop(loop.tau, loop.T, float(k), c=loop.c) for k in ks])
+        def measure(ks):  # probes of the checked loop: k in gain_range
+            return self._growth_rates(NV, [loop._with_steering_gain(k) for k in ks])
 
         return first_crossing(measure, lo, hi, start=lo, rtol=_DELAY_RTOL, atol=1e-12 * lo)
 
@@ -553,6 +644,11 @@ def gain_range(loop: Loop) -> tuple[float, float]:
 
     k_lo = 1e-3·k, but never below the smallest allowed k (a loop with a k
     outside its range cannot be built: the search would fail on its own probe).
+
+    Parameters
+    ----------
+    loop : Loop
+        The steering loop (its k, 1/s, sets the search's lower end).
     """
     return max(1e-3 * loop.k, RANGES["k"].low), RANGES["k"].high
 
@@ -579,7 +675,13 @@ class AffineGainModel(LoopModel):
     domain = "s"
 
     def polynomials(self, loop: Characteristic):  # pragma: no cover - interface
-        """(D, E), descending coefficients: the characteristic polynomial is D + K·E."""
+        """(D, E), descending coefficients: the characteristic polynomial is D + K·E.
+
+        Parameters
+        ----------
+        loop : Characteristic
+            The loop judged (`Loop`, `HolonomicLoop`).
+        """
         raise NotImplementedError
 
     def parts(self, loop: Characteristic):  # pragma: no cover - interface
@@ -594,7 +696,15 @@ class AffineGainModel(LoopModel):
 
     @checked
     def characteristic(self, gain: float, loop: Characteristic) -> np.ndarray:
-        """Characteristic polynomial D + K·E, descending coefficients."""
+        """Characteristic polynomial D + K·E, descending coefficients.
+
+        Parameters
+        ----------
+        gain : float
+            The family's loop gain: NV (1/s) or κ (1/s²).
+        loop : Characteristic
+            The loop judged (`Loop`, `HolonomicLoop`).
+        """
         d, e = _aligned(*self.polynomials(loop))
         return np.trim_zeros(d + loop.loop_gain(_check_NV(gain)) * e, "f")
 
@@ -670,23 +780,36 @@ class AffineGainModel(LoopModel):
 
     @checked
     def roots(self, gain: float, loop: Characteristic) -> np.ndarray:
-        """All roots of the characteristic polynomial (s or z)."""
+        """All roots of the characteristic polynomial (s or z).
+
+        Parameters
+        ----------
+        gain : float
+            The family's loop gain: NV (1/s) or κ (1/s²).
+        loop : Characteristic
+            The loop judged (`Loop`, `HolonomicLoop`).
+        """
         return np.roots(self.characteristic(gain, loop))
 
     def batch_polynomials(self, loops):
-        """(D, E) of each loop as two arrays of rows of one length (descending; leading zeros allowed)."""
+        """(D, E) of each loop as two arrays of rows of one length (descending; leading zeros allowed).
+
+        Parameters
+        ----------
+        loops : sequence of Characteristic
+            The loops, one row each.
+        """
         pairs = [self.polynomials(loop) for loop in loops]
         width = max(max(len(d), len(e)) for d, e in pairs)
         D = np.array([np.pad(d, (width - len(d), 0)) for d, _ in pairs])
         E = np.array([np.pad(e, (width - len(e), 0)) for _, e in pairs])
         return D, E
 
-    def growth_rates(self, gain: float, loops) -> np.ndarray:
+    def _growth_rates(self, gain: float, loops) -> np.ndarray:
         """max Re s (1/s) at the gain for each loop: eigenvalues of the companion matrices, batched by degree
         (NV = 0: of D/s, the heading loop; −inf for a constant)."""
         loops = list(loops)
         D, E = self.batch_polynomials(loops)
-        gain = _check_NV(gain)
         P = D + np.array([loop.loop_gain(gain) for loop in loops])[:, None] * E
         if gain == 0:  # D(0) = 0 exactly: drop the neutral lateral root
             P = P[:, :-1]
@@ -707,7 +830,15 @@ class AffineGainModel(LoopModel):
     @checked
     def rightmost_root(self, gain: float, loop: Characteristic) -> complex:
         """Dominant root σ + jω (1/s, rad/s; of a pair the one with ω > 0); NV = 0: the heading loop's (−inf when only
-        the neutral root is left)."""
+        the neutral root is left).
+
+        Parameters
+        ----------
+        gain : float
+            The family's loop gain: NV (1/s) or κ (1/s²).
+        loop : Characteristic
+            The loop judged (`Loop`, `HolonomicLoop`).
+        """
         if gain == 0:
             roots = np.roots(neutral_quotient(self.characteristic(gain, loop), self.domain))
             if roots.size == 0:

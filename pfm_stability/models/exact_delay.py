@@ -216,12 +216,14 @@ class ExactDelay(LoopModel):
         """k* for c ≠ 0 (`critical_gain_k`): first sign change of the signed measure over k."""
         from ..numerics.solve import first_crossing
 
+        pade = Pade(6)  # one model for every probe
+
         def measure(ks):
-            loops = [Loop(loop.tau, loop.T, float(k), c=loop.c) for k in ks]
+            loops = [loop._with_steering_gain(k) for k in ks]
             arrays = (np.array([getattr(x, name) for x in loops]) for name in ("tau", "T", "k"))
             tau, T, k = arrays
             stable = delay_verdicts_from_gain(tau, T, k, k * NV, np.full(k.shape, loop.c))[0]
-            size = np.abs(Pade(6).growth_rates(NV, loops)) + 1e-300
+            size = np.abs(pade._growth_rates(NV, loops)) + 1e-300
             return np.where(stable, -size, size)
 
         lo, hi = gain_range(loop)

@@ -160,6 +160,15 @@ class Characteristic:
         """
         raise NotImplementedError
 
+    def _with_delay(self, T: float) -> "Characteristic":
+        """`with_delay` for an internal probe of this (checked) loop at a T a search keeps in range (a family may
+        skip the checks: `Loop`, `HolonomicLoop`)."""
+        return self.with_delay(T)
+
+    def _state_space(self, hold: str) -> tuple:
+        """`state_space` for a `hold` already checked (a model's own, `Sampled.hold`): a family may skip the check."""
+        return self.state_space(hold)
+
     def delay_interval(self) -> StabilityInterval:  # pragma: no cover - interface
         """The stable gains K of the exact delay loop (every interval, K*, ω*), from the family's crossing structure."""
         raise NotImplementedError
@@ -231,6 +240,19 @@ class StableSet:
     def stable_set_json(self) -> list:
         """The stable set as JSON: [[lo, hi], …] (``"inf"`` for an unbounded end)."""
         return [[json_number(lo), json_number(hi)] for lo, hi in self.stable_set]
+
+
+def _unchecked(cls, **fields):
+    """An instance of the frozen dataclass `cls` with `fields` set as given, without its ``__post_init__`` checks.
+
+    For a loop's internal probes only (`Characteristic._with_delay`, a k or T search): copies of an
+    already-checked loop whose changed value the search keeps inside its range: re-checking every
+    probe would only repeat the check of the public entry that made the loop.
+    """
+    obj = object.__new__(cls)
+    for name, value in fields.items():
+        object.__setattr__(obj, name, value)
+    return obj
 
 
 def root_json(root: complex | None) -> dict:

@@ -71,7 +71,7 @@ from ..io.serialize import json_number
 from .base import Loop, LoopModel
 from .verdicts import interval_margin, interval_verdict
 from .continuous import Continuous
-from .family import Characteristic, LoopFamily, StableSet, root_json
+from .family import Characteristic, LoopFamily, StableSet, _unchecked, root_json
 
 __all__ = [
     "BEST_CURVATURE_PRODUCT",
@@ -113,7 +113,13 @@ HOLONOMIC = LoopFamily(
 
 
 def check_kappa(kappa) -> float:
-    """κ (1/s²) as a float: finite, in ``RANGES["kappa"]``, non-zero (κ = 0 puts a root at s = 0)."""
+    """κ (1/s²) as a float: finite, in ``RANGES["kappa"]``, non-zero (κ = 0 puts a root at s = 0).
+
+    Parameters
+    ----------
+    kappa : float
+        Stiffness κ, 1/s².
+    """
     kappa = check_parameter("kappa", kappa)
     if kappa == 0.0:
         raise ValueError("kappa must be a finite non-zero number 1/s^2 (kappa = 0: no force gradient, a root at s = 0); got 0.0")
@@ -259,6 +265,11 @@ class HolonomicLoop(Characteristic):
             Delay / sampling period, s, >= 0.
         """
         return replace(self, T=T)
+
+    def _with_delay(self, T: float) -> "HolonomicLoop":
+        """`with_delay` unchecked (a probe of T in range, `Characteristic._with_delay`); T < `T_RESOLUTION` is 0."""
+        T = float(T)
+        return _unchecked(HolonomicLoop, T=T if T >= T_RESOLUTION else 0.0, c_h=self.c_h)
 
     def with_damping(self, damping: float) -> "HolonomicLoop":
         """T with damping c_h = `damping`, 1/s.

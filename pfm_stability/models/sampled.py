@@ -76,7 +76,7 @@ from ..checks import check_choice, check_integer
 from ..numerics.matrix_exponential import zoh_blocks
 from ..parameters import HOLDS
 from ..numerics.routh import schur_cohn_stable
-from .base import AffineGainModel, _check_NV, checked
+from .base import AffineGainModel, checked
 from .continuous import Continuous
 from .family import Characteristic
 
@@ -101,8 +101,7 @@ def continuous_plant(loop: Characteristic, hold: str):
     -------
     A, B, F0, F1 : ndarray
     """
-    check_choice("hold", hold, HOLDS)
-    return loop.state_space(hold)
+    return loop._state_space(check_choice("hold", hold, HOLDS))
 
 
 def discretize(A, B, T: float):
@@ -322,19 +321,6 @@ class Sampled(AffineGainModel):
         """A pole passing through z = −1 when Q's degree drops: ω = π/T."""
         return math.pi / loop.T
 
-    @checked
-    def delta_eigenvalues(self, gain: float, loop: Characteristic) -> np.ndarray:
-        """Eigenvalues λ of (Φ_cl − I)/T (poles z = 1 + Tλ; T = 0: the continuous poles).
-
-        Parameters
-        ----------
-        gain : float
-            The family's loop gain: NV (1/s) or κ (1/s²).
-        loop : Characteristic
-            The loop judged (`Loop`, `HolonomicLoop`).
-        """
-        return self._delta_eigenvalues(gain, loop)
-
     def _delta_eigenvalues(self, gain: float, loop: Characteristic) -> np.ndarray:
         return np.linalg.eigvals(_delta_matrix(loop, loop.loop_gain(gain), self.hold, self.compute_delay))
 
@@ -345,19 +331,6 @@ class Sampled(AffineGainModel):
         y = delta_plant(loop, self.hold)[0].shape[0] - 1  # the lateral state: the plant's last
         matrix = _delta_matrix(loop, 0.0, self.hold, self.compute_delay)
         return np.linalg.eigvals(np.delete(np.delete(matrix, y, axis=0), y, axis=1))
-
-    @checked
-    def closed_loop(self, gain: float, loop: Characteristic) -> np.ndarray:
-        """Φ_cl at the gain (NV 1/s, κ 1/s²).
-
-        Parameters
-        ----------
-        gain : float
-            The family's loop gain: NV (1/s) or κ (1/s²).
-        loop : Characteristic
-            The loop judged (`Loop`, `HolonomicLoop`).
-        """
-        return closed_loop_matrix(loop, loop.loop_gain(_check_NV(gain)), self.hold, self.compute_delay)
 
     @checked
     def eigenvalues(self, gain: float, loop: Characteristic) -> np.ndarray:
@@ -441,21 +414,12 @@ class Sampled(AffineGainModel):
         """
         return self._delta_eigenvalues(gain, loop) if loop.T == 0 else 1.0 + loop.T * self._delta_eigenvalues(gain, loop)
 
-    def growth_rates(self, NV: float, loops) -> np.ndarray:
-        """σ = max ln|z|/T (1/s) at the gain for each loop, all exponentials and eigenvalues in one batch.
-
-        Parameters
-        ----------
-        NV : float
-            The family's loop gain: NV (1/s) or κ (1/s²).
-        loops : sequence of Characteristic
-            The loops, one growth rate each.
-        """
+    def _growth_rates(self, NV: float, loops) -> np.ndarray:
+        """σ = max ln|z|/T (1/s) at the gain for each loop, all exponentials and eigenvalues in one batch."""
         loops = list(loops)
-        NV = _check_NV(NV)
         K = np.array([loop.loop_gain(NV) for loop in loops])
         T = np.array([loop.T for loop in loops])
-        plants = [continuous_plant(loop, self.hold) for loop in loops]
+        plants = [loop._state_space(self.hold) for loop in loops]
         A, B, F0, F1 = (np.stack([p[i] for p in plants]) for i in range(4))
         n = A.shape[-1]
         Psi, G = A.copy(), B.copy()

@@ -121,6 +121,17 @@ class _Steering:
         iP, iQ = self.servo_integral
         return delta, (iP - self.h) * e + iQ * omega, ref + P * e + Q * omega, R * e + S * omega
 
+    def servo_step(self, x, y, V, theta, omega, ref, max_rate):
+        """(x, y, θ, ω) at the end of the interval for a held reference whose servo command k(ref − θ) is taken at
+        its start and saturated at ±`max_rate` (the constant command then) — one substep of a saturating servo."""
+        u = self.k * (ref - theta)
+        if abs(u) > max_rate:
+            nodes, integral, theta_end, omega_end = self.constant(theta, omega, min(max(u, -max_rate), max_rate))
+        else:
+            nodes, integral, theta_end, omega_end = self.reference(theta, omega, ref)
+        x, y = self.move(x, y, V, theta, nodes, integral)
+        return x, y, theta_end, omega_end
+
     def move(self, x, y, V, theta, delta, integral):
         """x + V∫sin θ, y + V∫cos θ: ∫Δ exact, the residuals sin Δ − Δ and cos Δ − 1 by quadrature."""
         across, along = integral, self.h
@@ -192,14 +203,7 @@ def _position_after(s, tau, t, theta, omega, applied, V, x, y, substepped):
     for length in [part] * whole + [t - whole * part]:
         if length <= 0:
             break
-        one = _Steering(tau, k, length, wmax, ("servo", "constant"))
-        u = k * (applied - theta)
-        if abs(u) > wmax:
-            nodes, integral, theta2, omega2 = one.constant(theta, omega, min(max(u, -wmax), wmax))
-        else:
-            nodes, integral, theta2, omega2 = one.reference(theta, omega, applied)
-        x, y = one.move(x, y, V, theta, nodes, integral)
-        theta, omega = theta2, omega2
+        x, y, theta, omega = _Steering(tau, k, length, wmax, ("servo", "constant")).servo_step(x, y, V, theta, omega, applied, wmax)
     return x, y
 
 
@@ -306,13 +310,7 @@ def simulate_reference(s: Scenario):
                 substepped = True
                 theta_end, omega_end = theta, omega
                 for _ in range(SUBSTEPS):
-                    u = k * (applied - theta_end)
-                    if abs(u) > wmax:
-                        nodes, integral, th2, om2 = sub.constant(theta_end, omega_end, min(max(u, -wmax), wmax))
-                    else:
-                        nodes, integral, th2, om2 = sub.reference(theta_end, omega_end, applied)
-                    x, y = sub.move(x, y, V, theta_end, nodes, integral)
-                    theta_end, omega_end = th2, om2
+                    x, y, theta_end, omega_end = sub.servo_step(x, y, V, theta_end, omega_end, applied, wmax)
         theta, omega = theta_end, omega_end
         xs.append(x), ys.append(y), ths.append(theta)
         contact = _path_contact(s, sense, tau, start, applied, V, substepped, gap)
