@@ -170,7 +170,7 @@ def test_library_refuses_bad_choices():
         (("velocity-gated", {"variant": "paper_eq23"}), {}, "variant must be one of gradient, squared, paper-eq23; got 'paper_eq23'"),
         (("fuzzy", {"variant": "squared"}), {}, "variant applies to velocity-gated, not to law fuzzy"),
         (("fuzzy",), {"symmetrize": True}, "symmetrize must be one of none, negative, positive; got True"),
-        (("velocity", {"colour": "red"}), {}, "colour applies to no law, not to law velocity"),
+        (("velocity", {"colour": "red"}), {}, "colour is not a parameter of any law (see the laws in docs/fields.md and docs/velocity_and_fuzzy.md), given to law velocity"),
         (("velocity",), {"xi": 1.0}, "xi applies to khatib or gnron, not to law velocity"),
         (("fuzzy",), {"eta": 1.0}, "eta applies to velocity or velocity-gated, not to law fuzzy"),
         (("fuzzy", {"side": "up"}), {}, "side must be one of left, right; got 'up'"),

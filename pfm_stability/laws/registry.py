@@ -423,7 +423,8 @@ def option_name(key: str) -> str:
 def refusal(key: str, law_shown: str, *, shown: str | None = None, laws=LAW_NAMES) -> ValueError:
     """The one message for a parameter given to a law that does not take it.
 
-    ``<shown> applies to <the laws of `laws` that take it>, not to <law_shown>``. On the command line
+    ``<shown> applies to <the laws of `laws` that take it>, not to <law_shown>`` (a name no law takes:
+    ``<shown> is not a parameter of any law …, given to <law_shown>``). On the command line
     (`shown` an option) the laws are named as options: ``--xi applies to --law khatib or gnron, not to
     --law power``; in files and the library by name: ``law.xi applies to khatib or gnron, not to law power``.
 
@@ -444,8 +445,11 @@ def refusal(key: str, law_shown: str, *, shown: str | None = None, laws=LAW_NAME
         To be raised by the caller.
     """
     shown = shown or key
-    names = either(takers(key, laws) or takers(key) or ("no law",))
-    return ValueError(f"{shown} applies to {'--law ' if shown.startswith('--') else ''}{names}, not to {law_shown}")
+    laws_taking = takers(key, laws) or takers(key)
+    if not laws_taking:  # a name no law declares: a typo, not a parameter of another law
+        return ValueError(f"{shown} is not a parameter of any law (see the laws in docs/fields.md and docs/velocity_and_fuzzy.md), "
+                          f"given to {law_shown}")
+    return ValueError(f"{shown} applies to {'--law ' if shown.startswith('--') else ''}{either(laws_taking)}, not to {law_shown}")
 
 
 def check_parameters(name: str, given, *, shown=None, law_shown: str | None = None, laws=LAW_NAMES, required: bool = True) -> Law:
