@@ -12,7 +12,7 @@ from pfm_stability.models.base import Loop
 from pfm_stability.parameters import CARMEL
 
 KEYS = {"amplitude", "heading_amplitude", "omega", "reaches_wall", "criticality", "V_tolerance", "tolerance", "V_critical", "V_fold",
-        "third_harmonic", "method", "reason"}
+        "third_harmonic", "rate_harmonic", "method", "reason"}
 
 
 @pytest.fixture(scope="module")

@@ -40,7 +40,9 @@ nonlinearities make. `third_harmonic` bounds the predicted third harmonic of y r
 its fundamental: the third harmonics of the field (of δ(A sin θ)) and of the rate limit
 (of sat(E sin θ)), each through the loop's filtering |L(3jω)|/|L(jω)| with
 L(s) = 1/(s(τs² + s + k')), plus the heading's, J₃(Θ)/(3J₁(Θ)) (ẏ = V sin θ integrated once). Above `THIRD_HARMONIC_LIMIT`, where the rate limit holds the
-cycle (n_s < `RATE_GAIN_FLOOR`), on a subcritical branch, or where the heading swing passes
+cycle — `rate_harmonic`, the third harmonic the limit puts into the heading over the
+fundamental, h₃(sat(E sin θ))·|P(3jω)|/|P(jω)| with P(s) = 1/(s(τs + 1)) (the rate's way to
+θ), above `RATE_HARMONIC_LIMIT` — on a subcritical branch, or where the heading swing passes
 the peak of 2J₁ (Θ > 1.84 rad), a report prints no amplitude and says why (`trusted_cycle`).
 """
 
@@ -73,7 +75,7 @@ __all__ = [
     "corridor_branch",
     "corridor_wobble",
     "trusted_cycle",
-    "RATE_GAIN_FLOOR",
+    "RATE_HARMONIC_LIMIT",
 ]
 
 WOBBLE_MODELS = ("exact_delay", "sampled")
@@ -82,10 +84,10 @@ WOBBLE_MODELS = ("exact_delay", "sampled")
 THIRD_HARMONIC_LIMIT = 0.1
 """Largest predicted third-harmonic ratio of y at which the describing function's amplitude is reported."""
 
-RATE_GAIN_FLOOR = 0.7
-"""Smallest describing function of the steering-rate limit at which the amplitude is reported: below it the limit
-holds the cycle (a relay-like regime whose sampled switching the first harmonic misses: −14 % in amplitude, +8 % in
-frequency at n_s = 0.56 in experiments/wobble_amplitude.py)."""
+RATE_HARMONIC_LIMIT = 0.02
+"""Largest `rate_harmonic` (the rate limit's third harmonic in the heading) at which the amplitude is reported: beyond
+it the limit shapes θ into a trapezoid the first harmonic misses — with a fast motor (τ <= 0.18 s) the amplitude came
+out 8–29 % low and ω 3–18 % high at 0.026–0.063 in experiments/wobble_amplitude.py, within 8 % and 3 % below 0.02."""
 
 DEFAULT_TOLERANCE_FRACTION = 0.1
 """`report --wobble` without a value: a tenth of the clearance L − W/2 (the play the robot has either side)."""
@@ -171,6 +173,8 @@ class WobbleCycle:
         Predicted third-harmonic ratio of y (module docstring).
     rate_gain : float
         The rate limit's describing function n_s (1: not saturated).
+    rate_harmonic : float
+        The rate limit's third harmonic in the heading over the fundamental (module docstring).
     """
 
     amplitude: float
@@ -179,6 +183,7 @@ class WobbleCycle:
     stable: bool
     third_harmonic: float
     rate_gain: float
+    rate_harmonic: float
 
 
 @dataclass(frozen=True)
@@ -202,6 +207,8 @@ class WobbleBranch:
         n_s(A), the rate limit's describing function.
     third_harmonics : ndarray
         Predicted third-harmonic ratio of y.
+    rate_harmonics : ndarray
+        The rate limit's third harmonic in the heading (0 where it does not saturate).
     V_critical : float
         V*, m/s (the model's NV*/N).
     omega_critical : float
@@ -219,6 +226,7 @@ class WobbleBranch:
     headings: np.ndarray
     rate_gains: np.ndarray
     third_harmonics: np.ndarray
+    rate_harmonics: np.ndarray
     V_critical: float
     omega_critical: float
     beta: float
@@ -257,7 +265,7 @@ class WobbleBranch:
             t = d[i] / (d[i] - d[i + 1])
             pick = lambda x: float(x[i] + t * (x[i + 1] - x[i]))
             out.append(WobbleCycle(pick(A), pick(self.headings), pick(self.omegas), bool(S[i + 1] > S[i]),
-                                   pick(self.third_harmonics), pick(self.rate_gains)))
+                                   pick(self.third_harmonics), pick(self.rate_gains), pick(self.rate_harmonics)))
         return tuple(out)
 
     def tolerance_speed(self, tolerance: float) -> float:
@@ -307,11 +315,13 @@ class Wobble:
     V_fold : float
         The slowest speed at which a cycle exists inside the corridor, m/s (V* when supercritical).
     third_harmonic : float or None
-        The trust measure at the cycle.
+        The trust measure at the cycle: the predicted third harmonic of y over its fundamental.
     method : str
         How it was computed.
     reason : str or None
         Why the amplitude is null, or what to know about it.
+    rate_harmonic : float or None
+        The second trust measure: the rate limit's third harmonic in the heading over the fundamental.
     """
 
     amplitude: float | None
@@ -326,6 +336,7 @@ class Wobble:
     third_harmonic: float | None
     method: str
     reason: str | None = None
+    rate_harmonic: float | None = None
 
     @classmethod
     def unavailable(cls, reason: str, tolerance: float | None) -> "Wobble":
@@ -354,20 +365,21 @@ class Wobble:
             "V_critical": number(self.V_critical),
             "V_fold": number(self.V_fold),
             "third_harmonic": number(self.third_harmonic),
+            "rate_harmonic": number(self.rate_harmonic),
             "method": self.method,
             "reason": self.reason,
         }
 
 
 def trusted_cycle(cycle: WobbleCycle) -> bool:
-    """The describing function's trust test at a cycle: third harmonic <= `THIRD_HARMONIC_LIMIT` and rate gain >= `RATE_GAIN_FLOOR`.
+    """The describing function's trust test at a cycle: `third_harmonic` <= `THIRD_HARMONIC_LIMIT`, `rate_harmonic` <= `RATE_HARMONIC_LIMIT`.
 
     Parameters
     ----------
     cycle : WobbleCycle
         A cycle of the branch.
     """
-    return cycle.third_harmonic <= THIRD_HARMONIC_LIMIT and cycle.rate_gain >= RATE_GAIN_FLOOR
+    return cycle.third_harmonic <= THIRD_HARMONIC_LIMIT and cycle.rate_harmonic <= RATE_HARMONIC_LIMIT
 
 
 def _fundamental_input(U: float, M: float) -> float:
@@ -467,7 +479,7 @@ def corridor_branch(robot, controller, law: ForceLaw, L: float, *, model: str = 
     delta = corridor_steering(law, L)
     h3 = harmonic_content(delta, A)
     sat = lambda x: np.clip(x, -M, M)
-    speeds, omegas, headings, gains, thirds = (np.full(A.size, np.nan) for _ in range(5))
+    speeds, omegas, headings, gains, thirds, rates = (np.full(A.size, np.nan) for _ in range(6))
     table = None
     for i, (a, nf) in enumerate(zip(A, Nf)):
         theta, w, factor = a * w0 * nf / NV0, w0, 1.0
@@ -483,10 +495,12 @@ def corridor_branch(robot, controller, law: ForceLaw, L: float, *, model: str = 
         U = theta * w * math.hypot(1.0, w * tau)
         speeds[i] = a * w / (2.0 * special.j1(theta))
         omegas[i], headings[i], gains[i] = w, theta, factor
-        thirds[i] = (h3[i] + harmonic_content(sat, _fundamental_input(U, M))) * _filtering(w, tau, k * factor) \
+        h3_rate = harmonic_content(sat, _fundamental_input(U, M)) if factor < 1.0 else 0.0
+        rates[i] = h3_rate * math.hypot(1.0, w * tau) / (3.0 * math.hypot(1.0, 3.0 * w * tau))
+        thirds[i] = (h3[i] + h3_rate) * _filtering(w, tau, k * factor) \
             + special.jv(3, theta) / (3.0 * special.j1(theta))
     beta = field_cubic(law, L) - w0**2 / (8.0 * V_star**2)
-    return WobbleBranch(model, A, speeds, omegas, headings, gains, thirds, V_star, w0, beta, clearance)
+    return WobbleBranch(model, A, speeds, omegas, headings, gains, thirds, rates, V_star, w0, beta, clearance)
 
 
 def corridor_wobble(robot, controller, law: ForceLaw, L: float, tolerance: float | None = None, *, model: str = "sampled") -> Wobble:
@@ -532,12 +546,14 @@ def corridor_wobble(robot, controller, law: ForceLaw, L: float, tolerance: float
         return Wobble(None, None, None, True, third_harmonic=None,
                       reason="no limit cycle inside the corridor: the wobble grows until the robot touches a wall", **common)
     cycle = stable[0]
+    common["rate_harmonic"] = cycle.rate_harmonic
     if not cycle.third_harmonic <= THIRD_HARMONIC_LIMIT:
         return Wobble(None, None, None, False, third_harmonic=cycle.third_harmonic,
                       reason=f"strong harmonics: predicted third harmonic {cycle.third_harmonic:.2f} of the fundamental "
                              f"(> {THIRD_HARMONIC_LIMIT:g}); the describing function is not trusted", **common)
-    if not cycle.rate_gain >= RATE_GAIN_FLOOR:
+    if not cycle.rate_harmonic <= RATE_HARMONIC_LIMIT:
         return Wobble(None, None, None, False, third_harmonic=cycle.third_harmonic,
-                      reason=f"the steering-rate limit holds the cycle (its describing function {cycle.rate_gain:.2f} < "
-                             f"{RATE_GAIN_FLOOR:g}): the describing function is not trusted", **common)
+                      reason=f"the steering-rate limit shapes the heading (its third harmonic {cycle.rate_harmonic:.3f} of the "
+                             f"fundamental > {RATE_HARMONIC_LIMIT:g}; rate describing function {cycle.rate_gain:.2f}): "
+                             "the describing function is not trusted", **common)
     return Wobble(cycle.amplitude, cycle.heading_amplitude, cycle.omega, False, third_harmonic=cycle.third_harmonic, **common)
