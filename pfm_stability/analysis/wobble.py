@@ -537,11 +537,19 @@ def corridor_wobble(robot, controller, law: ForceLaw, L: float, tolerance: float
     V = robot.V
     stable = [c for c in branch.cycles_at(V) if c.stable]
     if branch.criticality == "subcritical" and V > branch.fold_speed:
-        return Wobble(None, None, None, not stable, third_harmonic=None,
-                      reason=f"subcritical: between V_fold = {branch.fold_speed:.4g} and V* = {branch.V_critical:.4g} m/s a small start "
-                             "settles and a large one wobbles; the describing function does not follow the jump", **common)
+        unstable = [c for c in branch.cycles_at(V) if not c.stable]
+        where = "a wall" if not stable else "a large cycle"
+        if V <= branch.V_critical:
+            edge = f" (beyond the unstable cycle of {unstable[0].amplitude:.3g} m)" if unstable else ""
+            reason = (f"subcritical: between V_fold = {branch.fold_speed:.4g} and V* = {branch.V_critical:.4g} m/s a small start settles "
+                      f"and a large one{edge} jumps to {where}; the describing function does not say which start the robot has")
+        else:
+            reason = f"subcritical: past V* = {branch.V_critical:.4g} m/s the wobble jumps to {where}; the describing function is not trusted there"
+        return Wobble(None, None, None, not stable, third_harmonic=None, reason=reason, **common)
     if V <= branch.V_critical:
-        return Wobble(0.0, 0.0, None, False, third_harmonic=None, reason="below V*: the robot settles", **common)
+        below = "below V*: the robot settles" if branch.criticality == "supercritical" else \
+            "below V_fold: every start inside the corridor settles"
+        return Wobble(0.0, 0.0, None, False, third_harmonic=None, reason=below, **common)
     if not stable:
         return Wobble(None, None, None, True, third_harmonic=None,
                       reason="no limit cycle inside the corridor: the wobble grows until the robot touches a wall", **common)
