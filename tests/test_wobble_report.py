@@ -65,10 +65,21 @@ def test_text_and_markdown():
     assert code == 0 and "## Wobble in the corridor" in md and "- limit cycle: lateral amplitude 0.2094 m" in md
 
 
-@pytest.mark.parametrize("argv", [["--alpha", "30", "--wobble"], ["--robot", "holonomic", "--law", "velocity", "--L", "1", "--wobble"]])
-def test_refusals(argv):
-    """--wobble without a corridor, or for a holonomic robot: exit 2, one line, nothing on stdout."""
-    code, out, err = run(["report", *argv])
+def test_wall_wobble():
+    """With --alpha the wall gets its wobble too (JSON ``wall.wobble``, the biased describing function): CARMEL at 0.8 m/s
+    beside a wall at 30 deg is past the sampled model's V* (the wall's verdict says so) and has a cycle; the text says it."""
+    data = report_json(["--preset", "carmel", "--alpha", "30", "--model", "sampled", "--wobble"])
+    w = data["wall"]["wobble"]
+    assert set(w) == KEYS and "biased" in w["method"]
+    assert w["V_critical"] == pytest.approx(data["wall"]["sampled"]["V_critical"], rel=1e-9)
+    assert w["amplitude"] > 0 and w["criticality"] == "supercritical"
+    code, text, _ = run(["report", "--preset", "carmel", "--alpha", "30", "--model", "sampled", "--wobble"])
+    assert code == 0 and "Wobble beside the wall" in text
+
+
+def test_refusals():
+    """--wobble for a holonomic robot: exit 2, one line, nothing on stdout."""
+    code, out, err = run(["report", "--robot", "holonomic", "--law", "velocity", "--L", "1", "--wobble"])
     assert code == 2 and out == ""
-    assert err.strip().splitlines() == ["pfm-stability: error: --wobble applies to a corridor (--L) with --robot steering or kinematic "
-                                        "and a static law (power, grid, khatib, gnron)"]
+    assert err.strip().splitlines() == ["pfm-stability: error: --wobble applies to a wall (--alpha) or a corridor (--L) with --robot "
+                                        "steering or kinematic and a static law (power, grid, khatib, gnron)"]

@@ -57,7 +57,7 @@ from scipy import interpolate, optimize, special
 from ..checks import check_choice, check_number
 from ..io.serialize import json_number
 from ..laws.effective_force import corridor_lateral_force
-from ..laws.force_law import ForceLaw, corridor_gain
+from ..laws.force_law import ForceLaw, corridor_gain, wall_equilibrium, wall_gain
 from ..models import make_model
 from ..models.base import Loop
 from .describing import describing_function, harmonic_content, saturation_df_for_output
@@ -74,6 +74,10 @@ __all__ = [
     "Wobble",
     "corridor_branch",
     "corridor_wobble",
+    "wall_steering",
+    "wall_df",
+    "wall_branch",
+    "wall_wobble",
     "trusted_cycle",
     "RATE_HARMONIC_LIMIT",
 ]
@@ -382,6 +386,102 @@ def trusted_cycle(cycle: WobbleCycle) -> bool:
     return cycle.third_harmonic <= THIRD_HARMONIC_LIMIT and cycle.rate_harmonic <= RATE_HARMONIC_LIMIT
 
 
+def wall_steering(law: ForceLaw, alpha: float):
+    """δ(x), rad: the direction of the resultant at distance d0 + x from a wall (x > 0 away from it), target at angle α (KB eq 4, 9).
+
+    δ = atan2(P(d) − (1 + Q(d))·cos α, (1 + Q(d))·sin α), d = d0 + x: 0 at the equilibrium, −N·x to first order,
+    not odd (the law's 1/dⁿ is steeper towards the wall).
+
+    Parameters
+    ----------
+    law : ForceLaw
+        The lateral law.
+    alpha : float
+        Target angle from the wall normal, rad.
+    """
+    d0 = wall_equilibrium(law, alpha)
+    c, s = math.cos(alpha), math.sin(alpha)
+
+    def delta(x):
+        d = d0 + np.asarray(x, dtype=float)
+        with np.errstate(all="ignore"):
+            G = 1.0 + np.asarray(law.goal_force(d), dtype=float)
+            return np.arctan2(np.asarray(law.force(d), dtype=float) - G * c, G * s)
+
+    return delta
+
+
+def wall_df(law: ForceLaw, alpha: float, A):
+    """The biased (dual-input) describing function at a wall: (N_f(A) in 1/m, the bias B(A) in m) for amplitudes A (m).
+
+    With x = B + A·sin θ the heading's mean must vanish for the robot to travel along the wall, so the mean of
+    δ(B + A sin θ) is 0 (the bias B solves it, scipy brentq; B > 0: the cycle's centre lies further out than d0, the law
+    being steeper towards the wall), and N_f(A) = −(first harmonic of δ)/A.
+
+    Parameters
+    ----------
+    law : ForceLaw
+        The lateral law.
+    alpha : float
+        Target angle from the wall normal, rad.
+    A : array_like
+        Amplitudes, m, below d0.
+    """
+    delta = wall_steering(law, alpha)
+    d0 = wall_equilibrium(law, alpha)
+    theta = 2.0 * math.pi * (np.arange(256) + 0.5) / 256
+    sin = np.sin(theta)
+    N, B = [], []
+    for a in np.atleast_1d(np.asarray(A, dtype=float)):
+        mean = lambda b: float(np.mean(delta(b + a * sin)))
+        lo, hi = -d0 + a * (1.0 + 1e-9) + 1e-12, max(a, d0)
+        while mean(hi) > 0:
+            hi *= 2.0
+        b = optimize.brentq(mean, lo, hi, xtol=1e-15, rtol=1e-13) if mean(lo) > 0 else math.nan
+        B.append(b)
+        N.append(-2.0 * float(np.mean(delta(b + a * sin) * sin)) / a if math.isfinite(b) else math.nan)
+    return np.array(N), np.array(B)
+
+
+def wall_branch(robot, controller, law: ForceLaw, alpha: float, *, model: str = "sampled", points: int = _BRANCH_POINTS) -> WobbleBranch:
+    """The describing-function branch V(A) beside a wall (the biased describing function `wall_df`; otherwise as
+    `corridor_branch`). The branch ends where the cycle's inner extreme d0 + B − A reaches W/2 (the robot touches the wall):
+    that amplitude is its `clearance`.
+
+    Parameters
+    ----------
+    robot : parameters.Robot
+        τ, k, W and `max_steering_rate`.
+    controller : parameters.Controller
+        T, hold, compute delay.
+    law : ForceLaw
+        The wall's lateral law.
+    alpha : float
+        Target angle from the wall normal, rad.
+    model : {"exact_delay", "sampled"}
+        The loop model whose boundary closes the balance.
+    points : int
+        Amplitudes on the branch.
+    """
+    check_choice("model", model, WOBBLE_MODELS)
+    d0, N = wall_gain(law, alpha)
+    room = d0 - robot.W / 2
+    if not (room > 0 and N > 0):
+        raise ValueError(f"the wobble needs a restoring wall equilibrium clear of the wall (d0 > W/2, N > 0); got d0 = {d0:g} m, N = {N:g} 1/m")
+    A = room * np.geomspace(1e-3, 1.0, int(points))
+    Nf, B = wall_df(law, alpha, A)
+    inner = d0 + B - A - robot.W / 2  # > 0: the cycle stays clear of the wall
+    touching = np.flatnonzero(~(inner > 0))
+    clearance = room
+    if touching.size:
+        j = touching[0]
+        clearance = float(np.interp(0.0, [inner[j], inner[j - 1]], [A[j], A[j - 1]])) if j > 0 else float(A[0])
+        Nf = np.where(A <= clearance, Nf, np.nan)
+    a1 = min(d0, 1.0 / N) / 100.0
+    r = [(wall_df(law, alpha, [a])[0][0] / N - 1.0) / a**2 for a in (a1, a1 / 2)]
+    return _branch(robot, controller, wall_steering(law, alpha), N, A, Nf, clearance, model, (4.0 * r[1] - r[0]) / 3.0)
+
+
 def _fundamental_input(U: float, M: float) -> float:
     """E: the saturation's input amplitude whose output fundamental is U (< 4M/π)."""
     return U / saturation_df_for_output(U, M)
@@ -463,6 +563,12 @@ def corridor_branch(robot, controller, law: ForceLaw, L: float, *, model: str = 
     N = corridor_gain(law, L)
     if not N > 0:
         raise ValueError(f"the wobble needs a restoring centre line (N > 0); got N = {N:g} 1/m")
+    A = clearance * np.geomspace(1e-3, 1.0, int(points))
+    return _branch(robot, controller, corridor_steering(law, L), N, A, field_df(law, L, A), clearance, model, field_cubic(law, L))
+
+
+def _branch(robot, controller, delta, N: float, A, Nf, clearance: float, model: str, beta_f: float) -> WobbleBranch:
+    """The branch V(A) for the field's describing function `Nf` at amplitudes `A` (module docstring)."""
     loop_model = make_model(model, hold=controller.hold, compute_delay=controller.compute_delay)
     tau, k, T, M = robot.tau, robot.k, controller.T, robot.max_steering_rate
 
@@ -474,14 +580,13 @@ def corridor_branch(robot, controller, law: ForceLaw, L: float, *, model: str = 
     if not (math.isfinite(NV0) and NV0 > 0 and w0):
         raise ValueError(f"the {model} loop has no oscillatory stability boundary here (NV* = {NV0:g} 1/s): no wobble to predict")
     V_star = NV0 / N
-    A = clearance * np.geomspace(1e-3, 1.0, int(points))
-    Nf = field_df(law, L, A)
-    delta = corridor_steering(law, L)
     h3 = harmonic_content(delta, A)
     sat = lambda x: np.clip(x, -M, M)
     speeds, omegas, headings, gains, thirds, rates = (np.full(A.size, np.nan) for _ in range(6))
     table = None
     for i, (a, nf) in enumerate(zip(A, Nf)):
+        if not math.isfinite(nf):
+            continue
         theta, w, factor = a * w0 * nf / NV0, w0, 1.0
         if theta * w0 * math.hypot(1.0, w0 * tau) > M:  # the rate limit bites: solve for the steering gain's factor
             table = table or _GainTable(boundary)
@@ -499,7 +604,7 @@ def corridor_branch(robot, controller, law: ForceLaw, L: float, *, model: str = 
         rates[i] = h3_rate * math.hypot(1.0, w * tau) / (3.0 * math.hypot(1.0, 3.0 * w * tau))
         thirds[i] = (h3[i] + h3_rate) * _filtering(w, tau, k * factor) \
             + special.jv(3, theta) / (3.0 * special.j1(theta))
-    beta = field_cubic(law, L) - w0**2 / (8.0 * V_star**2)
+    beta = beta_f - w0**2 / (8.0 * V_star**2)
     return WobbleBranch(model, A, speeds, omegas, headings, gains, thirds, rates, V_star, w0, beta, clearance)
 
 
@@ -529,12 +634,48 @@ def corridor_wobble(robot, controller, law: ForceLaw, L: float, tolerance: float
     if tolerance is not None:
         tolerance = check_number("tolerance", tolerance, 0.0, math.inf, unit="m")
     branch = corridor_branch(robot, controller, law, L, model=model)
+    method = f"harmonic balance (describing functions of the field, the heading and the steering-rate limit) on the {model} loop"
+    return _wobble_at(branch, robot.V, tolerance, method)
+
+
+def wall_wobble(robot, controller, law: ForceLaw, alpha: float, tolerance: float | None = None, *, model: str = "sampled") -> Wobble:
+    """The wobble of `robot` at its speed V beside a wall (the biased describing function, `wall_branch`), and the speed
+    limit for a tolerance.
+
+    Parameters
+    ----------
+    robot : parameters.Robot
+        V, τ, k, W, `max_steering_rate`.
+    controller : parameters.Controller
+        T, hold, compute delay.
+    law : ForceLaw
+        The wall's lateral law.
+    alpha : float
+        Target angle from the wall normal, rad.
+    tolerance : float, optional
+        Largest acceptable lateral amplitude, m; default a tenth of the room d0 − W/2 the cycle has before it
+        touches the wall (the branch's clearance).
+    model : {"exact_delay", "sampled"}
+        The loop model whose boundary closes the balance.
+
+    Returns
+    -------
+    Wobble
+    """
+    if tolerance is not None:
+        tolerance = check_number("tolerance", tolerance, 0.0, math.inf, unit="m")
+    branch = wall_branch(robot, controller, law, alpha, model=model)
+    method = (f"harmonic balance with the biased (dual-input) describing function of the field, the heading and the "
+              f"steering-rate limit on the {model} loop")
+    return _wobble_at(branch, robot.V, tolerance, method)
+
+
+def _wobble_at(branch: WobbleBranch, V: float, tolerance: float | None, method: str) -> Wobble:
+    """What a branch says at speed V (m/s) and for a tolerance (m; None: a tenth of the clearance)."""
     if tolerance is None:
         tolerance = DEFAULT_TOLERANCE_FRACTION * branch.clearance
-    method = f"harmonic balance (describing functions of the field, the heading and the steering-rate limit) on the {model} loop"
     common = dict(criticality=branch.criticality, V_tolerance=branch.tolerance_speed(tolerance), tolerance=tolerance,
                   V_critical=branch.V_critical, V_fold=branch.fold_speed, method=method)
-    V = robot.V
     stable = [c for c in branch.cycles_at(V) if c.stable]
     if branch.criticality == "subcritical" and V > branch.fold_speed:
         unstable = [c for c in branch.cycles_at(V) if not c.stable]
@@ -548,11 +689,11 @@ def corridor_wobble(robot, controller, law: ForceLaw, L: float, tolerance: float
         return Wobble(None, None, None, not stable, third_harmonic=None, reason=reason, **common)
     if V <= branch.V_critical:
         below = "below V*: the robot settles" if branch.criticality == "supercritical" else \
-            "below V_fold: every start inside the corridor settles"
+            "below V_fold: every start clear of the walls settles"
         return Wobble(0.0, 0.0, None, False, third_harmonic=None, reason=below, **common)
     if not stable:
         return Wobble(None, None, None, True, third_harmonic=None,
-                      reason="no limit cycle inside the corridor: the wobble grows until the robot touches a wall", **common)
+                      reason="no limit cycle clear of the walls: the wobble grows until the robot touches a wall", **common)
     cycle = stable[0]
     common["rate_harmonic"] = cycle.rate_harmonic
     if not cycle.third_harmonic <= THIRD_HARMONIC_LIMIT:

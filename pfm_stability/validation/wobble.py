@@ -1,4 +1,4 @@
-"""The simulated wobble: a corridor robot's limit cycle measured by the VFF simulator, to check `analysis.wobble` (docs/wobble.md).
+"""The simulated wobble: a corridor (or wall) robot's limit cycle measured by the VFF simulator, to check `analysis.wobble` (docs/wobble.md).
 
 Each `WobbleCase` is one robot in the middle of a corridor started at a lateral offset;
 the batched simulator (`sim.engine.run_batch`) runs them together and `measure_wobble`
@@ -46,6 +46,9 @@ class WobbleCase:
         Continuous walls or a histogram grid.
     law : {"power", "grid"}
         The analytic walls' law (``env="grid"``: the grid itself, whose averaged law is "grid").
+    alpha : float or None
+        Beside a wall: the target angle from its normal, rad (`L` unused; the offset from d0, positive away from the
+        wall); None: the corridor.
     """
 
     robot: Robot
@@ -55,6 +58,7 @@ class WobbleCase:
     duration: float
     env: str = "analytic"
     law: str = "power"
+    alpha: float | None = None
 
 
 @dataclass(frozen=True)
@@ -133,7 +137,8 @@ def simulate_wobbles(cases) -> tuple:
         In the order of `cases`.
     """
     scenarios = [
-        make_scenario("corridor", robot=c.robot, controller=c.controller, env=c.env, L=c.L, offset=c.offset, duration=c.duration,
+        make_scenario("corridor" if c.alpha is None else "wall", robot=c.robot, controller=c.controller, env=c.env, offset=c.offset,
+                      duration=c.duration, **({"L": c.L} if c.alpha is None else {"alpha": c.alpha}),
                       **({"law": c.law} if c.env == "analytic" else {}))
         for c in cases
     ]
