@@ -48,6 +48,7 @@ the peak of 2J₁ (Θ > 1.84 rad), a report prints no amplitude and says why (`t
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -152,10 +153,14 @@ def field_cubic(law: ForceLaw, L: float) -> float:
         Half-width, m.
     """
     N = corridor_gain(law, L)
-    a1 = min(L, 1.0 / N) / 100.0  # both the law's scale L and the direction's 1/N
-    a2 = a1 / 2.0
-    r1 = (field_df(law, L, a1) / N - 1.0) / a1**2
-    r2 = (field_df(law, L, a2) / N - 1.0) / a2**2
+    return _quadratic_coefficient(lambda a: field_df(law, L, a), N, L)
+
+
+def _quadratic_coefficient(df, N: float, scale: float) -> float:
+    """β_f with df(A)/N = 1 + β_f·A² + O(A⁴): Richardson at A = ℓ/100 and ℓ/200, ℓ = min(scale, 1/N) (both the law's
+    length scale and the direction's 1/N)."""
+    a1 = min(scale, 1.0 / N) / 100.0
+    r1, r2 = ((float(df(a)) / N - 1.0) / a**2 for a in (a1, a1 / 2.0))
     return float((4.0 * r2 - r1) / 3.0)
 
 
@@ -477,9 +482,8 @@ def wall_branch(robot, controller, law: ForceLaw, alpha: float, *, model: str = 
         j = touching[0]
         clearance = float(np.interp(0.0, [inner[j], inner[j - 1]], [A[j], A[j - 1]])) if j > 0 else float(A[0])
         Nf = np.where(A <= clearance, Nf, np.nan)
-    a1 = min(d0, 1.0 / N) / 100.0
-    r = [(wall_df(law, alpha, [a])[0][0] / N - 1.0) / a**2 for a in (a1, a1 / 2)]
-    return _branch(robot, controller, wall_steering(law, alpha), N, A, Nf, clearance, model, (4.0 * r[1] - r[0]) / 3.0)
+    beta_f = _quadratic_coefficient(lambda a: wall_df(law, alpha, [a])[0][0], N, d0)
+    return _branch(robot, controller, wall_steering(law, alpha), N, A, Nf, clearance, model, beta_f)
 
 
 def _fundamental_input(U: float, M: float) -> float:
@@ -527,6 +531,18 @@ class _GainTable:
             return saturation_df_for_output(u, M) - factor
 
         return optimize.brentq(residual, f[j], f[j + 1], xtol=1e-13)
+
+
+@functools.lru_cache(maxsize=32)
+def _gain_table(model: str, hold: str, compute_delay: int, tau: float, T: float, k: float) -> _GainTable:
+    """The `_GainTable` of one loop, shared by its wall and corridor branches (64 model boundaries)."""
+    loop_model = make_model(model, hold=hold, compute_delay=compute_delay)
+
+    def boundary(gain_factor: float):
+        b = loop_model.boundary(Loop(tau, T, k * gain_factor))
+        return b.NV_critical, b.omega_critical
+
+    return _GainTable(boundary)
 
 
 def corridor_branch(robot, controller, law: ForceLaw, L: float, *, model: str = "sampled", points: int = _BRANCH_POINTS) -> WobbleBranch:
@@ -583,13 +599,13 @@ def _branch(robot, controller, delta, N: float, A, Nf, clearance: float, model: 
     h3 = harmonic_content(delta, A)
     sat = lambda x: np.clip(x, -M, M)
     speeds, omegas, headings, gains, thirds, rates = (np.full(A.size, np.nan) for _ in range(6))
-    table = None
+    table = None  # built on the first amplitude the rate limit bites at
     for i, (a, nf) in enumerate(zip(A, Nf)):
         if not math.isfinite(nf):
             continue
         theta, w, factor = a * w0 * nf / NV0, w0, 1.0
         if theta * w0 * math.hypot(1.0, w0 * tau) > M:  # the rate limit bites: solve for the steering gain's factor
-            table = table or _GainTable(boundary)
+            table = table or _gain_table(model, controller.hold, controller.compute_delay, tau, T, k)
             factor = table.factor(a * nf, tau, M)
             if factor is None:
                 continue
