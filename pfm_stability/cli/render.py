@@ -102,7 +102,8 @@ def _scenarios(report, data: dict):
     """Yield (title, header, rows, remedies, notes) of each geometry, by its result's type (`_sections_of`), with the values
     of the report's JSON form `data`."""
     for geometry, result in report.scenes():
-        yield from _sections_of(result)(result, data["environment"][geometry], data.get(geometry), report)
+        verdicts = {k: v for k, v in data[geometry].items() if k != "wobble"} if data.get(geometry) is not None else None
+        yield from _sections_of(result)(result, data["environment"][geometry], verdicts, report)
 
 
 def _sections_of(result):
@@ -206,6 +207,33 @@ def _tail(report, data: dict) -> list[str]:
     return family_tail(report, data)
 
 
+def _wobble_lines(data: dict) -> list[str]:
+    """``report --wobble``: each geometry's limit cycle past V*, its criticality and the speed for the tolerance (docs/wobble.md)."""
+    lines = []
+    for geometry, title in (("wall", "beside the wall (biased describing function"), ("corridor", "in the corridor (describing functions")):
+        w = (data.get(geometry) or {}).get("wobble")
+        if w is None:
+            continue
+        lines += ([""] if lines else []) + [f"Wobble {title}; docs/wobble.md)"]
+        if w["criticality"] is None:
+            lines.append(f"  not predicted: {w['reason']}")
+            continue
+        if w["amplitude"] is not None and w["amplitude"] > 0:
+            lines.append(f"  limit cycle: lateral amplitude {number(w['amplitude'])} m, heading {number(w['heading_amplitude'])} rad, "
+                         f"omega {number(w['omega'])} rad/s")
+        elif w["amplitude"] == 0:
+            lines.append(f"  no limit cycle ({w['reason']})")
+        else:
+            lines.append(f"  amplitude not given: {w['reason']}")
+        if w["reaches_wall"]:
+            lines.append("  the wobble reaches a wall: the robot collides")
+        fold = f", cycles from V_fold = {number(w['V_fold'])} m/s" if w["criticality"] == "subcritical" else ""
+        lines.append(f"  Hopf at V* = {number(w['V_critical'])} m/s: {w['criticality']}{fold}")
+        lines.append(f"  fastest speed whose wobble stays under {number(w['tolerance'])} m: V_tolerance = {number(w['V_tolerance'])} m/s")
+        lines.append(f"  method: {w['method']}")
+    return lines
+
+
 def _corridor_notes(env: dict) -> list[str]:
     """The corridor's lines beyond the table: the finite-goal gain, equilibria off the centre line."""
     notes = []
@@ -284,6 +312,8 @@ def render_text(report) -> str:
         for model, fix in fixes.items():
             lines.append(_remedy_line(model, fix))
     lines += _tail(report, data)
+    wobble = _wobble_lines(data)
+    lines += ["", *wobble] if wobble else []
     if data.get("door"):
         lines += ["", *render_door_text(data["door"]).rstrip("\n").splitlines()]
     lines += _footnote(report)
@@ -349,6 +379,8 @@ def render_markdown(report) -> str:
             lines.append("")
             lines.append("-" + _remedy_line(model, fix)[1:])
     lines += _tail(report, data)
+    for line in _wobble_lines(data):
+        lines += ["", f"## {line}", ""] if line and not line.startswith(" ") else ([f"- {line.strip()}"] if line else [])
     if data.get("door"):
         lines += ["", "## Door", "", "```", *render_door_text(data["door"]).rstrip("\n").splitlines(), "```"]
     lines += _footnote(report)

@@ -27,6 +27,9 @@ def add_parser(sub) -> None:
     p.add_argument("--door-obstacle", choices=DOOR_OBSTACLES, default="posts", help="what bounds the door (default posts)")
     p.add_argument("--post-radius", type=number("post_radius"), default=0.0,
                    help=f"post radius, or the walls' half-thickness, {describe('post_radius')} (default 0)")
+    p.add_argument("--wobble", type=number("wobble"), nargs="?", const=True, default=None, metavar="TOL",
+                   help=f"corridor: the limit cycle past V* by describing functions (docs/wobble.md) and the fastest speed whose "
+                        f"wobble stays under TOL, {describe('wobble')} (default a tenth of L - W/2)")
     p.add_argument("--model", action="append", choices=MODEL_NAMES, help="model to include (repeatable; default: all)")
     p.add_argument(
         "--pade-order", type=PADE_ORDER, default=DEFAULT_PADE_ORDER,
@@ -61,6 +64,7 @@ def run(args) -> int:
         door_obstacle=args.door_obstacle,
         post_radius=args.post_radius,
         simulate_cycle=None if args.no_simulate else _simulated_cycle,
+        wobble=args.wobble,
     )
     if args.format == "json":
         print(dumps(report.to_dict()))

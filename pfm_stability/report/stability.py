@@ -185,6 +185,10 @@ class StabilityReport:
         The fuzzy law's frozen gains and robust bracket.
     tracking : models.tracking.TrackingDynamics or None
         The tracking error's ζ and ω_n (a holonomic robot under the velocity law with m = n = 2).
+    wobble : analysis.wobble.Wobble or None
+        The corridor's wobble past V* (``report --wobble``; JSON ``corridor.wobble``).
+    wall_wobble : analysis.wobble.Wobble or None
+        The wall's (the biased describing function; JSON ``wall.wobble``).
     """
 
     inputs: dict
@@ -198,6 +202,8 @@ class StabilityReport:
     kb_errors: tuple = ()
     schedule: object | None = None
     tracking: object | None = None
+    wobble: object | None = None
+    wall_wobble: object | None = None
 
     @property
     def kb_error(self) -> KBError | None:
@@ -223,6 +229,10 @@ class StabilityReport:
             out.setdefault("environment", {})[geometry] = env
             if verdicts is not None:
                 out[geometry] = verdicts
+        if self.wobble is not None and "corridor" in out:
+            out["corridor"]["wobble"] = self.wobble.to_dict()
+        if self.wall_wobble is not None and "wall" in out:
+            out["wall"]["wobble"] = self.wall_wobble.to_dict()
         if self.tracking is not None:
             t = self.tracking
             out["tracking"] = json_ready({"damping_ratio": t.damping_ratio, "natural_frequency": t.natural_frequency, "regime": t.regime})
@@ -313,6 +323,7 @@ def build_report(
     door_obstacle: str = "posts",
     post_radius: float = 0.0,
     simulate_cycle=None,
+    wobble=None,
 ) -> StabilityReport:
     """The report of any robot family and law for a wall (α) and/or a corridor (L, m), and a door with a static law.
 
@@ -353,6 +364,10 @@ def build_report(
         The velocity-gated law's simulated cycle beside a wall,
         ``simulate_cycle(family, robot, controller, law, alpha, mass=…) -> dict``
         (`validation.non_smooth.simulated_cycle`, above this level); None: not simulated.
+    wobble : float or bool, optional
+        The wobble past V* in the corridor and beside the wall (`analysis.wobble.corridor_wobble`, `wall_wobble`,
+        docs/wobble.md): the tolerance on its lateral amplitude, m, or True for the default (a tenth of the clearance:
+        L − W/2, or the room before the wall); None or False: not computed. A steering or kinematic robot with a static law.
 
     Returns
     -------
@@ -366,6 +381,10 @@ def build_report(
         the law has no equilibrium.
     """
     check_choice("robot", family, ROBOT_FAMILIES)
+    if wobble is not None and wobble is not False:
+        return _with_wobble(wobble, robot, controller, family=family, law=law, alpha=alpha, alpha_deg=alpha_deg, L=L, models=models,
+                            pade_order=pade_order, mass=mass, sources=sources, door=door, door_obstacle=door_obstacle,
+                            post_radius=post_radius, simulate_cycle=simulate_cycle)
     if law is not None and not isinstance(law, ForceLaw):
         from .families import FamilyLaw
 
@@ -383,6 +402,36 @@ def build_report(
     sources = {**(sources or {}), "tau": KINEMATIC_TAU_SOURCE}
     report = _static_report(robot.replace(tau=0.0), controller, law, alpha, alpha_deg, L, models, pade_order, sources, None, door_obstacle, post_radius)
     return replace(report, inputs={"robot": {"value": family, "unit": "", "source": sources.get("robot", "user")}, **report.inputs})
+
+
+_WOBBLE_REFUSED = ("--wobble applies to a wall (--alpha) or a corridor (--L) with --robot steering or kinematic and a static law "
+                   "(power, grid, khatib, gnron)")
+"""The message when a wobble is asked of a report without a corridor, or of a robot family or law it does not apply to."""
+
+
+def _with_wobble(wobble, robot, controller, *, family, law, L, **options) -> StabilityReport:
+    """`build_report` and the corridor's wobble (`analysis.wobble.corridor_wobble`; the sampled loop with the controller's
+    hold and compute delay, the exact-delay loop for a continuous controller), or the reason it has none (N <= 0, …)."""
+    from ..analysis.wobble import Wobble, corridor_wobble, wall_wobble
+
+    if (L is None and options["alpha"] is None and options["alpha_deg"] is None) or family == "holonomic" \
+            or (law is not None and not isinstance(law, ForceLaw)):
+        raise ValueError(_WOBBLE_REFUSED)
+    tolerance = None if wobble is True else check_parameter("wobble", wobble)
+    report = build_report(robot, controller, family=family, law=law, L=L, **options)
+    steering = robot.replace(tau=0.0) if family == "kinematic" else robot
+    force_law = law_in_force(robot, controller, law)
+    model = "sampled" if controller.T > 0 else "exact_delay"
+
+    def predicted(function, where):
+        try:
+            return function(steering, controller, force_law, where, tolerance, model=model)
+        except ValueError as exc:
+            return Wobble.unavailable(str(exc), tolerance)
+
+    corridor = predicted(corridor_wobble, report.corridor.L) if report.corridor is not None else None
+    wall = predicted(wall_wobble, math.radians(report.wall.alpha_deg)) if report.wall is not None else None
+    return replace(report, wobble=corridor, wall_wobble=wall)
 
 
 _NO_GEOMETRY = f"alpha or L must be given: a wall (--alpha DEG, in {RANGES['alpha_deg'].describe()}) and/or a corridor (--L M)"
