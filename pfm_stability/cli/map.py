@@ -88,6 +88,13 @@ def _validate(analysis, count: int, seed: int, progress):
                                  cell_ratio=law.ratio, window_cells=law.window_cells, count=count, seed=seed, progress=progress)
 
 
+def _drive(analysis, count: int, seed: int, progress):
+    """Validation by driving (`validation.map_drives.drive_map`): recall and precision of the routes' unstable stretches."""
+    from ..validation.map_drives import drive_map
+
+    return drive_map(analysis, count, seed=seed, progress=progress)
+
+
 def _write_outputs(analysis, out_dir: str) -> dict:
     """The four files of ``--out-dir``, all or none (`files.atomic_directory`)."""
     import os
@@ -139,10 +146,12 @@ def run(args) -> int:
                                cell_size=args.cell_size, min_length=args.min_length, progress=progress,
                                warn=lambda line: print(f"pfm-stability: warning: {line}", file=sys.stderr, flush=True))
         validation = _validate(analysis, args.validate, args.seed, progress) if args.validate else None
+        drives = _drive(analysis, args.validate, args.seed, progress) if args.validate and analysis.paths is not None else None
         outputs = _write_outputs(analysis, args.out_dir) if args.out_dir else None
     data = {
         **analysis.to_dict(),
         "validation": validation.to_dict() if validation is not None else None,
+        "drives": drives.to_dict() if drives is not None else None,
         "outputs": outputs,
         "timing": {"seconds": time.perf_counter() - started, **{f"{k}_seconds": v for k, v in analysis.timing.items()}},
     }

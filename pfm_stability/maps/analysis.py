@@ -53,7 +53,8 @@ from ..io.serialize import json_number
 from .equilibria import Samples, grid_equilibria, power_equilibria
 from .field import UNKNOWN_AS, HistogramMap, histogram_of
 from .occupancy import OccupancyMap
-from .routes import Route, default_min_length, find_routes
+from .paths import PathVerdicts, SampledTransition, analyze_paths
+from .routes import Route, default_min_length, find_paths, find_routes
 from .verdicts import END_FRACTION, TAPER_SLOPE, GrowthRate, drift_slope, critical_speed, is_weak, judged_run, segment_gain, wavelength
 
 __all__ = ["DIRECTIONS", "MAP_LAWS", "MAX_CORRIDOR_WIDTHS", "MAX_MAP_SIDE", "MAX_RESOLUTION", "NO_VERDICT", "MapAnalysis", "MapSegment",
@@ -198,6 +199,8 @@ class MapAnalysis:
         Seconds per stage (read, grid, routes, equilibria, verdicts).
     warnings : tuple of str
         One line each: an implausible scale of the map (`scale_warnings`, `corridor_warnings`).
+    paths : PathVerdicts or None
+        The verdict along every route, linearized about the robot's path (`paths.analyze_paths`; grid law only).
     """
 
     occupancy: OccupancyMap
@@ -214,6 +217,7 @@ class MapAnalysis:
     unknown: str
     timing: dict = field(default_factory=dict)
     warnings: tuple = ()
+    paths: PathVerdicts | None = None
 
     @property
     def unstable_length(self) -> float:
@@ -260,6 +264,7 @@ class MapAnalysis:
             "segments": [s.to_dict() for s in self.segments],
             "summary": self.summary(),
             "warnings": list(self.warnings),
+            "paths": self.paths.to_dict() if self.paths is not None else None,
         }
 
 
@@ -398,10 +403,12 @@ def analyze_map(occupancy: OccupancyMap, robot: Robot, controller: Controller, l
         raise ValueError(f"map {occupancy.name!r} has no free space (every cell is occupied{'' if unknown == 'free' else ' or unknown'})")
     stage("grid")
     routes, skeleton, clearance = find_routes(grid, robot.W, min_length)
-    if not routes:
-        raise ValueError(f"map {occupancy.name!r} has no route long enough: no straight corridor of at least "
+    paths = find_paths(grid, skeleton, clearance) if is_grid else []
+    shortest = min_length if min_length is not None else default_min_length(robot.W)
+    if not routes and not any(p.length >= shortest for p in paths):
+        raise ValueError(f"map {occupancy.name!r} has no route long enough: no corridor of at least "
                          f"{min_length if min_length is not None else default_min_length(robot.W):g} m where a robot of width W = {robot.W:g} m fits")
-    if not warnings:  # one cause, one line: a resolution already flagged makes the corridors wide too
+    if not warnings and routes:  # one cause, one line: a resolution already flagged makes the corridors wide too
         caution(corridor_warnings(occupancy, grid, routes, clearance, robot.W))
     stage("routes")
     if is_grid:
@@ -418,8 +425,13 @@ def analyze_map(occupancy: OccupancyMap, robot: Robot, controller: Controller, l
     segments = tuple(_segment(r, samples, k, boundary, robot, c, growth, heading_stable, end_fraction, taper_slope)
                      for k, r in enumerate(routes))
     stage("verdicts")
+    transition = SampledTransition.of(loop_model, loop) if loop_model.name == "sampled" else None
+    along = analyze_paths(grid, law, paths, clearance, robot.W, robot.V, boundary, growth, heading_stable, transition,
+                          end_fraction) if paths else None
+    if is_grid:
+        stage("paths")
     return MapAnalysis(occupancy, grid, law, robot, controller, loop_model.name, boundary.NV_critical, segments, samples,
-                       skeleton, clearance, unknown, timing, tuple(warnings))
+                       skeleton, clearance, unknown, timing, tuple(warnings), along)
 
 
 def sample_verdict(N: float, V: float, boundary, heading_stable: bool) -> Judgement:

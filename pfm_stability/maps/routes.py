@@ -34,7 +34,8 @@ import numpy as np
 from ..extras import require
 from .field import HistogramMap
 
-__all__ = ["JUNCTION_CUT", "MIN_LENGTH", "TOLERANCE_CELLS", "Route", "default_min_length", "find_routes", "prune_spurs", "skeleton_of"]
+__all__ = ["JUNCTION_CUT", "MIN_LENGTH", "TOLERANCE_CELLS", "Route", "RoutePath", "default_min_length", "find_paths", "find_routes", "path_of",
+           "prune_spurs", "skeleton_of"]
 
 MIN_LENGTH = 1.0
 """Shortest segment analysed, m (default; at least 1.25 W is used): shorter pieces are bends and junction stubs."""
@@ -68,6 +69,104 @@ class Route:
     def length(self) -> float:
         """m."""
         return math.hypot(self.x1 - self.x0, self.y1 - self.y0)
+
+
+@dataclass(frozen=True)
+class RoutePath:
+    """A route of any shape: a polyline the robot drives along (docs/maps.md, "Verdicts along every route").
+
+    Attributes
+    ----------
+    points : ndarray, shape (n, 2)
+        Vertices in map coordinates, m, in the order of travel (n >= 2).
+    branch : int
+        Index of the route (a skeleton branch, or the user's route).
+    source : str
+        Where it comes from: "skeleton", "path" (a Nav2 path or CSV), "waypoints" or "goals".
+    """
+
+    points: np.ndarray
+    branch: int
+    source: str = "skeleton"
+
+    @property
+    def length(self) -> float:
+        """m."""
+        return float(np.hypot(*np.diff(self.points, axis=0).T).sum())
+
+
+def path_of(points, branch: int = 0, source: str = "path") -> RoutePath:
+    """A `RoutePath` through `points` (m; repeated points dropped); ValueError if fewer than two distinct points.
+
+    Parameters
+    ----------
+    points : array_like, shape (n, 2)
+        Vertices, m.
+    branch : int
+        Index of the route.
+    source : str
+        Where it comes from (`RoutePath.source`).
+    """
+    p = np.asarray(points, dtype=float).reshape(-1, 2)
+    if not np.isfinite(p).all():
+        raise ValueError(f"a {source} route's points must be finite numbers (m); got {p[~np.isfinite(p).all(axis=1)][:1].tolist()}")
+    keep = np.concatenate([[True], np.hypot(*np.diff(p, axis=0).T) > 1e-9]) if len(p) else np.zeros(0, dtype=bool)
+    p = p[keep]
+    if len(p) < 2:
+        raise ValueError(f"a {source} route needs at least two distinct points; got {len(p)}")
+    return RoutePath(p, int(branch), source)
+
+
+def find_paths(grid: HistogramMap, skeleton: np.ndarray, clearance: np.ndarray) -> list:
+    """Every branch of the (pruned) skeleton as a `RoutePath`, uncut, joined to the junctions it meets.
+
+    The branches of `find_routes` without the straight-piece split, the junction cut or the minimum length: each
+    is ordered, simplified into a polyline (tolerance `TOLERANCE_CELLS` cells), and an end that touches a junction
+    zone is extended to that zone's centroid, so the routes run through every junction. Branches of a single cell
+    are dropped.
+
+    Parameters
+    ----------
+    grid : HistogramMap
+        The map's histogram grid.
+    skeleton : ndarray of bool, shape (nx, ny)
+        The pruned skeleton (`find_routes`).
+    clearance : ndarray, shape (nx, ny)
+        Distance to the nearest occupied cell, m.
+    """
+    from scipy.ndimage import center_of_mass, label
+    from skimage.measure import approximate_polygon
+
+    junction = _junctions(skeleton, _crossing_number(skeleton))
+    zones, n_zones = label(junction, structure=np.ones((3, 3), dtype=int))
+    centres = np.array(center_of_mass(junction, zones, range(1, n_zones + 1))).reshape(-1, 2)
+    labels, n_branches = label(skeleton & ~junction, structure=np.ones((3, 3), dtype=int))
+    nx, ny = skeleton.shape
+    paths = []
+    for index, cells in enumerate(_branch_cells(labels, n_branches)):
+        if len(cells) < 2:
+            continue
+        cell_set = set(cells)
+        branch_count = {p: sum((p[0] + di, p[1] + dj) in cell_set for di, dj in _STEPS) for p in cells}
+        ends = [p for p in cells if branch_count[p] <= 1]
+        path = _order(cell_set, min(ends) if ends else min(cells))
+        ij = np.array(path, dtype=float)
+
+        def zone_of(cell):
+            near = {int(zones[cell[0] + di, cell[1] + dj]) for di, dj in _STEPS
+                    if 0 <= cell[0] + di < nx and 0 <= cell[1] + dj < ny and zones[cell[0] + di, cell[1] + dj] > 0}
+            return min(near) if near else 0
+
+        head, tail = zone_of(path[0]), zone_of(path[-1])
+        if head:
+            ij = np.vstack([centres[head - 1], ij])
+        if tail and (tail != head or len(path) > 2):
+            ij = np.vstack([ij, centres[tail - 1]])
+        points = np.column_stack(grid.cell_center(ij[:, 0], ij[:, 1]))
+        simple = approximate_polygon(points, tolerance=TOLERANCE_CELLS * grid.cell_size)
+        if len(simple) >= 2 and np.hypot(*np.diff(simple, axis=0).T).sum() > 0:
+            paths.append(path_of(simple, index, "skeleton"))
+    return paths
 
 
 def skeleton_of(grid: HistogramMap, W: float):
