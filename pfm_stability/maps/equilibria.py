@@ -228,9 +228,10 @@ def lateral_force(grid, law, x, y, tx, ty, s, jacobian=False):
     return fn, ft, nx_ * nx_ * jxx + 2 * nx_ * ny_ * jxy + ny_ * ny_ * jyy
 
 
-def _walls_in_window(grid: HistogramMap, law: GridWallLaw, x, y) -> np.ndarray:
-    """Whether the window of each point's cell holds an occupied cell (False: an open area, no repulsion)."""
-    h = law.window_cells // 2
+def _walls_in_window(grid: HistogramMap, law: GridWallLaw, x, y, extra: int = 0) -> np.ndarray:
+    """Whether the window of each point's cell, widened by `extra` cells each way, holds an occupied cell (False: an
+    open area, no repulsion)."""
+    h = law.window_cells // 2 + extra
     nx, ny = grid.shape
     counts = np.zeros((nx + 1, ny + 1), dtype=np.int64)
     counts[1:, 1:] = np.cumsum(np.cumsum(grid.occupied, axis=0), axis=1)  # summed-area table
@@ -303,7 +304,10 @@ def equilibria_at(grid: HistogramMap, law: GridWallLaw, x, y, tx, ty, segment, c
     x, y, tx, ty = (np.asarray(v, dtype=float) for v in (x, y, tx, ty))
     seg = np.asarray(segment)
     low, high = _band(grid, clearance, x, y, tx, ty, W, law.reach)
-    span = np.where(high > low, high - low, 0.0)
+    # a sample whose band lies where no window holds a wall has F_n = 0 exactly across it: no root, no scan needed
+    # (the band reaches at most `law.reach` from the sample, so every window of it lies in the widened one)
+    walls_near = _walls_in_window(grid, law, x, y, extra=int(math.ceil(law.reach / c)) + 2)  # + the cell phase
+    span = np.where((high > low) & walls_near, high - low, 0.0)
     # the scan: `steps` equal steps of at most c/2 from low to high, both ends included (at least two steps, so a
     # band narrower than one step still has a middle point), flattened over the samples
     steps = np.where(span > 0, np.maximum(2, np.ceil(span / (SCAN_STEP_CELLS * c))), 0).astype(np.int64)

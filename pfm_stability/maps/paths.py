@@ -91,7 +91,7 @@ class PathStretch:
     growth_rate : float or None
         σ̄_w of the worst window, 1/s.
     efolds : float or None
-        σ̄_w·Λ/V: e-folds a disturbance gains (< 0: loses) over that window.
+        e-folds a disturbance gains (< 0: loses) over the worst window of the stretch (σ̄_w times the window's time).
     N : float or None
         N_eff of the worst window, 1/m.
     margin : float or None
@@ -102,6 +102,10 @@ class PathStretch:
         "forward" (along the route's order) or "reverse": the worse travel direction of the worst window.
     linearized_at_route : float
         Fraction of the stretch's samples without a lateral equilibrium (linearized about the route).
+    oscillates : bool
+        The linear loop driven along the route weaves over part of it (`maps.episodes`).
+    amplitude : float
+        The largest lateral amplitude the linear loop predicts for the runs through it, m.
     """
 
     route: int
@@ -121,6 +125,8 @@ class PathStretch:
     V_critical: float | None = None
     direction: str | None = None
     linearized_at_route: float = 0.0
+    oscillates: bool = False
+    amplitude: float = 0.0
 
     @property
     def decided(self) -> bool:
@@ -163,6 +169,10 @@ class PathVerdicts:
     window : float
         Window length Λ, m.
     stretches : tuple of PathStretch
+    oscillates : ndarray of bool
+        The linear loop driven along the route weaves here (`maps.episodes`: a forced or growing oscillation).
+    amplitude : ndarray
+        The largest predicted lateral amplitude of the run through each sample, m.
     """
 
     paths: tuple
@@ -181,6 +191,8 @@ class PathVerdicts:
     local_margin: np.ndarray
     window: float
     stretches: tuple
+    oscillates: np.ndarray = None
+    amplitude: np.ndarray = None
 
     @property
     def route_length(self) -> float:
@@ -317,9 +329,10 @@ def analyze_paths(grid, law, paths, clearance: np.ndarray, W: float, V: float, b
     # the gradient at the route's own point where there is no equilibrium (and at an equilibrium the repulsion stops
     # the robot at in one direction, where the corridor search keeps no N)
     redo = np.flatnonzero(~np.isfinite(slope))
+    pull = np.zeros(x.size)  # F_n at the linearization point (0 at an equilibrium)
     if redo.size:
-        _, ft0, df0 = lateral_force(grid, law, x[redo], y[redo], tx[redo], ty[redo], offset[redo], jacobian=True)
-        along[redo], slope[redo] = ft0, -df0
+        fn0, ft0, df0 = lateral_force(grid, law, x[redo], y[redo], tx[redo], ty[redo], offset[redo], jacobian=True)
+        along[redo], slope[redo], pull[redo] = ft0, -df0, np.where(has[redo], 0.0, fn0)
     inside = ~(np.isfinite(along) & np.isfinite(slope))
     with np.errstate(divide="ignore", invalid="ignore"):
         N_forward = np.where(1 + along >= 1 - end_fraction, slope / (1 + along), np.nan)
@@ -346,14 +359,26 @@ def analyze_paths(grid, law, paths, clearance: np.ndarray, W: float, V: float, b
     code = np.where(stopped, 2, code)
     code = np.where(inside, 3, code)
     code = np.where(~np.isfinite(window_growth) & (code < 2), 2, code)
+    # the equilibrium line the loop is pulled to: s0, or without one the linear extrapolation F_n/(−dF_n/ds) from the
+    # route point (a virtual equilibrium), within the room the robot has there
+    i, j = grid.cell_index(x, y)
+    room = np.maximum(clearance[np.clip(i, 0, clearance.shape[0] - 1), np.clip(j, 0, clearance.shape[1] - 1)] - W / 2, 0.0)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        virtual = np.where(slope > 0, pull / slope, 0.0)
+    line = np.where(has, offset, np.clip(np.nan_to_num(virtual), -room, room))
+    oscillates = np.zeros(x.size, dtype=bool)
+    amplitude = np.zeros(x.size)
+    if transition is not None and boundary.omega_critical and boundary.omega_critical > 0:
+        oscillates, amplitude = _forced(route, arc, (N_forward, N_reverse), line, V, transition, 2 * math.pi / boundary.omega_critical)
+        code = np.where((code == 0) & oscillates, 1, code)
     N_worse = np.stack([N_forward, N_reverse])[worse, rows]
     NV = np.nan_to_num(N_worse) * V
     local_stable = np.array([bool(heading_stable) if v == 0 else in_set(boundary, float(v)) for v in NV]) if NV.size else np.zeros(0, bool)
     local_verdict, local_margin = judge_arrays(NV, np.full(NV.shape, boundary.NV_critical), local_stable)
     stretches = _stretches(paths, route, arc, ds, x, y, code, window_growth, worse, np.stack(mean_N), np.stack([N_forward, N_reverse]),
-                           has, boundary, growth, heading_stable, V, window)
+                           has, boundary, growth, heading_stable, V, window, efolds, oscillates, amplitude)
     return PathVerdicts(paths, samples, arc, ds, px, py, N_forward, N_reverse, sig[0], sig[1], window_growth, code, local_verdict,
-                        local_margin, window, stretches)
+                        local_margin, window, stretches, oscillates, amplitude)
 
 
 @dataclass(frozen=True)
@@ -440,7 +465,67 @@ def _window_product(N: np.ndarray, route: np.ndarray, arc: np.ndarray, half: flo
     return out, seconds
 
 
-def _stretches(paths, route, arc, ds, x, y, code, window_growth, worse, mean_N, N, has, boundary, growth, heading_stable, V, window):
+PREDICTION_OFFSET = 0.03
+"""Lateral offset (m) of the linear loop's start from the equilibrium line in `_forced` (the drives' start offset,
+`validation.maps.START_OFFSET`): the disturbance whose growth shows where the loop is unstable."""
+
+
+LEAVES = 1.0
+"""Lateral distance (m) from the route at which the linear loop's run stops: it has left any corridor (its amplitude
+is then "at least this")."""
+
+
+def _forced(route, arc, gains, line, V: float, transition: SampledTransition, period: float):
+    """(oscillates, amplitude) per sample: the sampled loop driven along each route in both directions at V, pulled
+    to the equilibrium line (x_{k+1} = Φ(N_k V)·x_k − N_k V·Φ1·s0_k e_y), started `PREDICTION_OFFSET` off it; its
+    lateral position's episodes (`episodes.lateral_episodes`) mark the samples the robot passes meanwhile."""
+    from .episodes import lateral_episodes
+
+    y_index = int(np.flatnonzero(np.abs(transition.Phi1).sum(axis=0))[0])
+    forcing = transition.Phi1[:, y_index]
+    step = V * transition.T
+    oscillates, amplitude = np.zeros(arc.size, dtype=bool), np.zeros(arc.size)
+    runs = []  # (samples passed at each step, K, s0) of each route and direction
+    for r in np.unique(route):
+        idx = np.flatnonzero(route == r)
+        a = arc[idx]
+        if a.size < 2:
+            continue
+        positions = (np.arange(int((a[-1] + (a[1] - a[0]) / 2) / step)) + 0.5) * step
+        if positions.size < 8:
+            continue
+        for d, N in enumerate(gains):
+            pos = positions if d == 0 else positions[::-1]
+            nearest = idx[np.clip(np.searchsorted((a[:-1] + a[1:]) / 2, pos), 0, a.size - 1)]
+            runs.append((nearest, np.nan_to_num(N[nearest]) * V, line[nearest] if d == 0 else -line[nearest]))  # the normal flips
+    if not runs:
+        return oscillates, amplitude
+    steps = max(r[0].size for r in runs)
+    K, s0 = np.zeros((len(runs), steps)), np.zeros((len(runs), steps))
+    for i, (nearest, k, line_k) in enumerate(runs):
+        K[i, :k.size], s0[i, :k.size] = k, line_k
+    state = np.zeros((len(runs), transition.Phi0.shape[0]))
+    state[:, y_index] = s0[:, 0] + PREDICTION_OFFSET
+    lateral = np.full((len(runs), steps), np.nan)
+    alive = np.ones(len(runs), dtype=bool)
+    for k in range(steps):
+        lateral[alive, k] = state[alive, y_index]
+        state = state @ transition.Phi0.T + K[:, k, None] * (state @ transition.Phi1.T - forcing[None, :] * s0[:, k, None])
+        alive &= np.isfinite(state).all(axis=1) & (np.abs(state[:, y_index]) <= LEAVES)
+        state[~alive] = 0.0
+    t = np.arange(steps) * transition.T
+    for i, (nearest, _, _) in enumerate(runs):
+        m = nearest.size
+        ok = np.isfinite(lateral[i, :m])
+        found, peak = lateral_episodes(t[:m][ok], lateral[i, :m][ok], period)
+        for lo, hi in found:
+            oscillates[nearest[(t[:m] >= lo) & (t[:m] <= hi)]] = True
+        amplitude[nearest] = np.maximum(amplitude[nearest], peak if ok.all() else max(peak, LEAVES))
+    return oscillates, amplitude
+
+
+def _stretches(paths, route, arc, ds, x, y, code, window_growth, worse, mean_N, N, has, boundary, growth, heading_stable, V, window,
+               efolds, oscillates, amplitude):
     """The runs of one verdict along each route, with their worst window's numbers (module docstring)."""
     out = []
     for r in range(len(paths)):
@@ -465,8 +550,12 @@ def _stretches(paths, route, arc, ds, x, y, code, window_growth, worse, mean_N, 
             near = np.flatnonzero((route == r) & (np.abs(arc - arc[k]) <= window / 2))
             Nw = N[d, near]
             Nw = Nw[np.isfinite(Nw)]
-            out.append(PathStretch(**base, **_window_numbers(sigma, float(mean_N[d, k]), Nw, V, window, boundary, growth, heading_stable),
-                                   direction=("forward", "reverse")[d]))
+            numbers = _window_numbers(sigma, float(mean_N[d, k]), Nw, V, window, boundary, growth, heading_stable)
+            numbers["efolds"] = float(np.nanmax(efolds[run]))
+            if code[first] == 1 and not numbers["efolds"] >= EFOLDS:
+                numbers["label"] = "oscillates"  # a forced weave (`_forced`), the loop itself damped
+            out.append(PathStretch(**base, **numbers, direction=("forward", "reverse")[d], oscillates=bool(oscillates[run].any()),
+                                   amplitude=float(amplitude[run].max())))
     return tuple(out)
 
 

@@ -8,13 +8,9 @@ last (`Target.point`: the VFF robot finds its own path); the other half go betwe
 the routes (the same free component), the robot starting towards the goal. Every drive runs until its target is reached,
 it collides or stalls, or `DRIVE_TIME_FACTOR` times its straight-line time.
 
-**Episodes** (`episodes`): the robot's lateral oscillation is its position minus its own path averaged over one
-period P = 2π/ω* (the model's oscillation at the boundary; `scipy.ndimage.uniform_filter1d`), across that path,
-smoothed over P/8 (the cell ripple, at c/V, is faster). Its turning points give amplitudes; an episode is
-`EPISODE_PERIODS` periods (2·`EPISODE_PERIODS` turning points, alternating in side, consecutive ones P/4 to P
-apart: an oscillation, not a bend of the path) whose amplitudes grow (a least-squares fit of
-log amplitude against time rises by at least one e-fold over the stretch, `GROWTH_EFOLDS`) or all stay above
-`AMPLITUDE_THRESHOLD`. Amplitudes below `NOISE_FLOOR` are no oscillation.
+**Episodes** (`maps.episodes.episodes`, the one definition the map's prediction uses too): the robot's
+lateral oscillation about its own path averaged over one period P = 2π/ω*; an episode is three periods of it
+that grow by an e-fold or stay above 5 cm.
 
 **Route length** (`score`). Each trajectory point marks its nearest route sample (within `MATCH_DISTANCE` or
 the robot's width): those samples are driven; the points during an episode mark episode samples; samples passed
@@ -40,23 +36,17 @@ from ..checks import check_integer
 from ..io.serialize import json_number, json_ready
 from ..sim.engine import run_batch
 from ..sim.scenario import Pose, Scenario, Target
+from ..maps.episodes import AMPLITUDE_THRESHOLD, EPISODE_PERIODS, GROWTH_EFOLDS, NOISE_FLOOR, episodes
 from .maps import START_OFFSET, _batches, _table_size, crop_grid, simulator_grid
 
-__all__ = ["AMPLITUDE_THRESHOLD", "DRIVE_TIME_FACTOR", "EPISODE_PERIODS", "GROWTH_EFOLDS", "MATCH_DISTANCE", "NOISE_FLOOR",
-           "Disagreement", "Drive", "DriveValidation", "drive_map", "episodes"]
+__all__ = ["DRIVE_TIME_FACTOR", "MATCH_DISTANCE", "Disagreement", "Drive", "DriveValidation", "drive_map"]
 
-EPISODE_PERIODS = 3
-"""Periods of an episode (the issue's "grows over at least three periods"; `maps.paths.WINDOW_PERIODS`)."""
-GROWTH_EFOLDS = 1.0
-"""e-folds the fitted amplitude must gain over an episode's periods to count as growing."""
-AMPLITUDE_THRESHOLD = 0.05
-"""Lateral amplitude (m) that, held over `EPISODE_PERIODS` periods, is an episode whether or not it grows."""
-NOISE_FLOOR = 0.005
-"""Amplitudes below this (m) are no oscillation (the grid's quantization ripple is ~mm)."""
 MATCH_DISTANCE = 0.5
 """Largest distance (m) from a trajectory point to the route sample it marks (at least the robot's width W)."""
 DRIVE_TIME_FACTOR = 2.5
 """A drive lasts at most this many times its straight-line time, plus 5 s."""
+START_ROOM = 1e-3
+"""Least room (m) beside the robot at a drive's start offset by δ; with less the drive starts on the route itself."""
 CROP_SLACK = 3.0
 """How far (m) around a drive's straight line its cropped grid reaches beyond the window."""
 
@@ -176,67 +166,6 @@ class DriveValidation:
         }
 
 
-def episodes(t, x, y, period: float) -> tuple:
-    """(episodes, max_amplitude): the (t_start, t_end) of each oscillation episode of a trajectory and its largest
-    lateral amplitude (m) (module docstring).
-
-    Parameters
-    ----------
-    t : ndarray
-        Times, s (uniform step).
-    x, y : ndarray
-        Positions, m.
-    period : float
-        The oscillation period P, s.
-    """
-    from scipy.ndimage import uniform_filter1d
-
-    t, x, y = (np.asarray(v, dtype=float) for v in (t, x, y))
-    if t.size < 8 or not period > 0 or not math.isfinite(period):
-        return (), 0.0
-    dt = float(np.median(np.diff(t)))
-    n = max(3, int(round(period / dt)))
-    if t.size < 2 * n:
-        return (), 0.0
-    sx, sy = uniform_filter1d(x, n, mode="nearest"), uniform_filter1d(y, n, mode="nearest")
-    hx, hy = np.gradient(sx), np.gradient(sy)
-    norm = np.hypot(hx, hy)
-    norm[norm == 0] = 1.0
-    r = ((x - sx) * -hy + (y - sy) * hx) / norm
-    r = uniform_filter1d(r, max(1, n // 8), mode="nearest")
-    r[: n // 2], r[-(n // 2):] = 0.0, 0.0  # the averaged path is not centred at the ends
-    dr = np.diff(r)
-    turn = np.flatnonzero((dr[:-1] > 0) & (dr[1:] <= 0) | (dr[:-1] < 0) & (dr[1:] >= 0)) + 1
-    turn = turn[np.abs(r[turn]) > NOISE_FLOOR]
-    # turning points closer than a quarter period are ripple: keep the larger of each close pair
-    kept = []
-    for k in turn:
-        if kept and t[k] - t[kept[-1]] < period / 4:
-            if abs(r[k]) > abs(r[kept[-1]]):
-                kept[-1] = k
-            continue
-        kept.append(k)
-    kept = np.array(kept, dtype=int)
-    amplitude = np.abs(r[kept]) if kept.size else np.zeros(0)
-    found = []
-    m = 2 * EPISODE_PERIODS
-    for i in range(0, max(0, kept.size - m + 1)):
-        sel = kept[i:i + m]
-        a = amplitude[i:i + m]
-        gaps = np.diff(t[sel])
-        if np.any(np.sign(r[sel][1:]) == np.sign(r[sel][:-1])) or gaps.min() < period / 4 or gaps.max() > period:
-            continue  # not an oscillation: turning points on one side, or half-periods far from P/2 (a bend of the path)
-        slope = np.polyfit(t[sel], np.log(a), 1)[0]
-        span = t[sel[-1]] - t[sel[0]]
-        if slope * span >= GROWTH_EFOLDS or a.min() >= AMPLITUDE_THRESHOLD:
-            lo, hi = t[sel[0]] - period / 4, t[sel[-1]]
-            if found and lo <= found[-1][1]:
-                found[-1] = (found[-1][0], hi)
-            else:
-                found.append((float(lo), float(hi)))
-    return tuple(found), float(amplitude.max()) if amplitude.size else 0.0
-
-
 def _components(analysis):
     """Free-space component label of each route sample (the robot fits: clearance > W/2)."""
     from scipy.ndimage import label
@@ -308,7 +237,7 @@ def drive_map(analysis, count: int, *, seed: int = 0, progress=None) -> DriveVal
     period = 2 * math.pi / omega if omega else math.inf
     h = law.window_cells // 2
     reach = (h + 1) * grid.cell_size + CROP_SLACK
-    runs = []
+    runs, skipped = [], 0
     for kind, p, q, heading, length in _plan(analysis, count, rng):
         ux, uy = math.sin(heading), math.cos(heading)
         delta = START_OFFSET if kind == "route" else 0.0
@@ -317,11 +246,15 @@ def drive_map(analysis, count: int, *, seed: int = 0, progress=None) -> DriveVal
         target = Target.point(float(q[0]), float(q[1]), radius=0.3)
         duration = DRIVE_TIME_FACTOR * length / robot.V + 5.0
         room = float(local.clearance([sx], [sy])[0]) - robot.W / 2
-        if not room > 0:
+        if not room > START_ROOM:
             sx, sy = float(p[0]), float(p[1])
-        scenario = Scenario(name=f"drive {len(runs)} ({kind})", robot=robot, controller=controller, environment=local,
-                            start=Pose(float(sx), float(sy), heading), target=target, duration=duration,
-                            cell_ratio=law.ratio, window_cells=law.window_cells, trap_time=max(10.0, 1.5 / robot.V))
+        try:
+            scenario = Scenario(name=f"drive {len(runs)} ({kind})", robot=robot, controller=controller, environment=local,
+                                start=Pose(float(sx), float(sy), heading), target=target, duration=duration,
+                                cell_ratio=law.ratio, window_cells=law.window_cells, trap_time=max(10.0, 1.5 / robot.V))
+        except ValueError:  # the start or the goal touches an obstacle: a drive that cannot start
+            skipped += 1
+            continue
         runs.append(_Prepared(kind, (float(p[0]), float(p[1]), float(q[0]), float(q[1])), scenario,
                               _table_size(local, h)))
     drives, traces = [], []
@@ -375,7 +308,7 @@ def drive_map(analysis, count: int, *, seed: int = 0, progress=None) -> DriveVal
     disagreements = (_runs("missed", episode & ~near_unstable, pv, passed_by)
                      + _runs("false alarm", unstable & driven & ~near_episode, pv, passed_by))
     events = [d.event or "time" for d in drives]
-    counts = {"drives": len(drives), "route_drives": sum(d.kind == "route" for d in drives),
+    counts = {"drives": len(drives), "not_started": skipped, "route_drives": sum(d.kind == "route" for d in drives),
               "waypoint_drives": sum(d.kind == "waypoints" for d in drives), "episodes": sum(len(d.episodes) for d in drives),
               **{f"ended_{e}": events.count(e) for e in sorted(set(events))}}
     inputs = {"count": count, "seed": seed, "V": robot.V, "period": json_number(period), "window": json_number(pv.window),

@@ -1,0 +1,179 @@
+"""Verdicts along every route of a map (`maps.paths`) and validation by driving (`validation.map_drives`).
+
+docs/maps.md, "Verdicts along every route" and "Validation by driving". The expected values come from other
+routes: the loop model's own rightmost root and `analyze_corridor` (what ``report --law grid`` prints) for a straight
+corridor, numpy's eigenvalues of the model's transition matrix, closed-form test signals for the episode detector,
+the geometry of the test maps for the routes, and the simulator for the validation.
+"""
+
+from __future__ import annotations
+
+import math
+from functools import lru_cache
+from pathlib import Path
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from pfm_stability.analysis.criteria import analyze_corridor
+from pfm_stability.laws.fields import make_law
+from pfm_stability.maps.analysis import analyze_map
+from pfm_stability.maps.episodes import AMPLITUDE_THRESHOLD, episodes, lateral_episodes
+from pfm_stability.maps.occupancy import load_map
+from pfm_stability.maps.paths import PATH_VERDICTS, SampledTransition
+from pfm_stability.models import Loop, models_for
+from pfm_stability.parameters import CARMEL, Corridor
+
+ROBOT = CARMEL.robot.replace(W=0.4, tau=0.1, k=20.0, V=1.0)
+CONTROLLER = CARMEL.controller.replace(T=0.025, f=2.0)
+"""The robot of tests/test_map_corridors.py (a 25 ms loop: narrow corridors are unstable at 1 m/s, wide ones stable)."""
+
+
+def write_map(directory: Path, pixels: np.ndarray, resolution: float = 0.1, name: str = "m") -> Path:
+    """A map_server map (PGM + YAML) of `pixels` (row 0 at the top), origin (0, 0)."""
+    Image.fromarray(np.asarray(pixels, dtype=np.uint8)).save(directory / f"{name}.pgm")
+    path = directory / f"{name}.yaml"
+    path.write_text(f"image: {name}.pgm\nresolution: {resolution}\norigin: [0.0, 0.0, 0.0]\nnegate: 0\n"
+                    "occupied_thresh: 0.65\nfree_thresh: 0.196\n")
+    return path
+
+
+def corridor(directory: Path, L: float, length: int = 200) -> Path:
+    """A straight corridor along y, one-cell walls on cell centres at ±L from its axis, `length` cells long."""
+    half = round(L / 0.1)
+    img = np.full((length, 2 * half + 1), 254, dtype=np.uint8)
+    img[:, 0] = img[:, -1] = 0
+    return write_map(directory, img)
+
+
+@lru_cache(maxsize=None)
+def corridor_analysis(L: float, V: float, root: str):
+    directory = Path(root) / f"c{L}_{V}"
+    directory.mkdir(exist_ok=True)
+    robot = ROBOT.replace(V=V)
+    return analyze_map(load_map(corridor(directory, L)), robot, CONTROLLER, make_law("grid", robot, CONTROLLER))
+
+
+@pytest.fixture(scope="module")
+def root(tmp_path_factory):
+    return str(tmp_path_factory.mktemp("paths"))
+
+
+def _report(L: float):
+    law = make_law("grid", ROBOT, CONTROLLER)
+    return analyze_corridor(ROBOT, CONTROLLER, Corridor(L), ["sampled"], law=law)
+
+
+def _model():
+    return models_for(CONTROLLER, ["sampled"])[0], Loop(ROBOT.tau, CONTROLLER.T, ROBOT.k)
+
+
+def test_transition_matrix_is_affine_in_the_loop_gain():
+    """Φ(NV) = Φ0 + NV·Φ1 at random gains, against the model's own closed-loop matrix, to round-off (1e-12: the
+    feedback row is the only one that depends on the gain, linearly); its spectral radius gives the model's root."""
+    model, loop = _model()
+    transition = SampledTransition.of(model, loop)
+    rng = np.random.default_rng(1)
+    for NV in rng.uniform(-5, 40, 6):
+        Phi = np.asarray(model.closed_loop(float(NV), loop))
+        assert np.abs(transition.Phi0 + NV * transition.Phi1 - Phi).max() < 1e-12
+        radius = np.abs(np.linalg.eigvals(Phi)).max()
+        assert math.log(radius) / loop.T == pytest.approx(model.rightmost_root(float(NV), loop).real, abs=1e-9)
+
+
+@pytest.mark.parametrize("L, factor", [(0.6, 0.7), (0.6, 1.4)])
+def test_straight_corridor_growth_and_verdict_are_the_reports(root, L, factor):
+    """In the middle of a straight corridor (more than half a window plus the active window's reach from its ends,
+    where the window product covers a uniform N) the window's growth rate is the model's rightmost root at the report's N·V (the map's N is the grid
+    law's to 2e-3, docs/maps.md, "Checked": σ to 2 % of |σ| + 0.01 1/s), and the verdict is the report's at that speed:
+    stable below V* = NV*/N, unstable above (the speeds 0.7 and 1.4 V* leave 30 % of margin)."""
+    ref = _report(L)
+    V_star = ref.models["sampled"].critical["V_critical"]
+    V = factor * V_star
+    analysis = corridor_analysis(L, V, root)
+    pv = analysis.paths
+    model, loop = _model()
+    middle = np.abs(pv.samples.y - 10.0) < 10.0 - pv.window / 2 - analysis.law.reach - 0.2
+    assert middle.sum() > 20
+    expected = model.rightmost_root(ref.N * V, loop).real
+    assert np.abs(pv.window_growth[middle] - expected).max() < 0.02 * abs(expected) + 0.01
+    verdict = "stable" if factor < 1 else "unstable"
+    assert {PATH_VERDICTS[c] for c in pv.code[middle]} == {verdict}
+    assert pv.summary()["decided_fraction"] == 1.0
+
+
+def test_unstable_corridor_stretch_has_the_reports_critical_speed(root):
+    """The unstable stretch of a corridor driven at 1.4 V*: margin < 0, and its V* (the speed at which its worst window's
+    growth turns positive) at most the report's (2 % for the map's N against the law's) and above 0.7 of it: the worst
+    window lies at the corridor's ends, where the window sees truncated walls and N rises (docs/maps.md, "Checked":
+    up to twice the middle's N in the last samples, averaged over the window)."""
+    ref = _report(0.6)
+    V_star = ref.models["sampled"].critical["V_critical"]
+    pv = corridor_analysis(0.6, 1.4 * V_star, root).paths
+    unstable = [s for s in pv.stretches if s.verdict == "unstable"]
+    assert unstable and max(s.length for s in unstable) > 10
+    worst = max(unstable, key=lambda s: s.length)
+    assert worst.margin < 0 and 0.7 * V_star < worst.V_critical <= 1.02 * V_star
+
+
+def test_open_hall_is_a_verdict_nothing_grows(tmp_path):
+    """A 10 × 24 m hall: along its middle no wall is in the 3.3 m window, N = 0 exactly, and the answer is a verdict —
+    stable, nothing grows (σ(0) = 0 with a stable heading loop; margin inf) — not "no verdict"."""
+    img = np.full((240, 100), 254, dtype=np.uint8)
+    img[0, :] = img[-1, :] = img[:, 0] = img[:, -1] = 0
+    analysis = analyze_map(load_map(write_map(tmp_path, img)), ROBOT, CONTROLLER, make_law("grid", ROBOT, CONTROLLER))
+    pv = analysis.paths
+    centre = (np.abs(pv.samples.x - 5.0) < 0.5) & (np.abs(pv.samples.y - 12.0) < 5.0)
+    assert centre.sum() > 5
+    assert np.all(pv.N_forward[centre] == 0) and np.all(pv.code[centre] == PATH_VERDICTS.index("stable"))
+    assert pv.summary()["decided_fraction"] == 1.0
+    open_stretches = [s for s in pv.stretches if s.N == 0.0]
+    assert all(s.label == "nothing grows" and s.margin == math.inf for s in open_stretches)
+
+
+def test_routes_run_straight_through_a_side_gap(tmp_path):
+    """A 20 m corridor with a side opening at its middle (a T): the route along the corridor is one route through the
+    junction (length 20 m within the cut at the map's ends, 0.5 m), the side branch its own."""
+    img = np.full((200, 61), 0, dtype=np.uint8)
+    img[:, 20:31] = 254  # corridor x in [2.0, 3.1) m
+    img[95:106, 31:] = 254  # side branch to the right at y ~ 10 m
+    analysis = analyze_map(load_map(write_map(tmp_path, img)), ROBOT, CONTROLLER, make_law("grid", ROBOT, CONTROLLER))
+    lengths = sorted(p.length for p in analysis.paths.paths)
+    along = [p for p in analysis.paths.paths if abs(p.points[:, 0] - 2.55).max() < 0.2]
+    assert len(along) == 1 and along[0].length == pytest.approx(20.0, abs=1.0)
+    assert len(lengths) == 2
+
+
+def test_episode_detector_on_closed_form_signals():
+    """Growing oscillation e^{0.3 t}·sin(ω t) (from 1 cm): an episode; a decaying one: none; a constant 8 cm weave:
+    an episode (above the 1.5 cm threshold); a 1 cm one: none; a single bend of the path (a step of 0.5 m): none."""
+    T, omega = 0.025, 2.0
+    period = 2 * math.pi / omega
+    t = np.arange(0, 30, T)
+    assert lateral_episodes(t, 0.01 * np.exp(0.3 * t) * np.sin(omega * t), period)[0]
+    assert not lateral_episodes(t, 0.2 * np.exp(-0.3 * t) * np.sin(omega * t), period)[0]
+    assert lateral_episodes(t, 0.08 * np.sin(omega * t), period)[0]
+    assert not lateral_episodes(t, 0.01 * np.sin(omega * t), period)[0]
+    assert not lateral_episodes(t, 0.5 * (t > 15), period)[0]
+    # in the plane: a weave about a diagonal line
+    s = 1.0 * t
+    x, y = s / math.sqrt(2) - 0.08 * np.sin(omega * t) / math.sqrt(2), s / math.sqrt(2) + 0.08 * np.sin(omega * t) / math.sqrt(2)
+    found, amplitude = episodes(t, x, y, period)
+    assert found and amplitude == pytest.approx(0.08, rel=0.1) and AMPLITUDE_THRESHOLD < 0.08
+
+
+@pytest.mark.slow
+def test_driving_finds_the_unstable_corridor_and_nothing_in_the_stable_one(root):
+    """Validation by driving on two corridors: at 1.4 V* the simulator's drives oscillate and the map's unstable
+    stretch recalls >= 90 % of the episodes' length with >= 80 % precision; at 0.7 V* no drive oscillates, nothing is
+    predicted unstable, and recall and precision are undefined (None: nothing to measure), not counted as agreement."""
+    from pfm_stability.validation.map_drives import drive_map
+
+    V_star = _report(0.6).models["sampled"].critical["V_critical"]
+    unstable = drive_map(corridor_analysis(0.6, 1.4 * V_star, root), 6, seed=1)
+    assert unstable.counts["episodes"] > 0
+    assert unstable.recall >= 0.9 and unstable.precision >= 0.8, (unstable.lengths, unstable.disagreements)
+    stable = drive_map(corridor_analysis(0.6, 0.7 * V_star, root), 6, seed=1)
+    assert stable.counts["episodes"] == 0 and stable.lengths["predicted_unstable_driven"] == 0
+    assert stable.recall is None and stable.precision is None
