@@ -177,3 +177,36 @@ def test_driving_finds_the_unstable_corridor_and_nothing_in_the_stable_one(root)
     stable = drive_map(corridor_analysis(0.6, 0.7 * V_star, root), 6, seed=1)
     assert stable.counts["episodes"] == 0 and stable.lengths["predicted_unstable_driven"] == 0
     assert stable.recall is None and stable.precision is None
+
+
+def test_user_routes_read_nav2_paths_waypoints_and_csv(tmp_path):
+    """A Nav2 nav_msgs/Path echoed as YAML, waypoints as pairs and as mappings, several routes, and a CSV with a header:
+    the points as written (m); a bad point is one line naming the file and the point."""
+    from pfm_stability.maps.user_routes import read_points, read_routes
+
+    (tmp_path / "plan.yaml").write_text("header: {frame_id: map}\nposes:\n  - header: {frame_id: map}\n    pose:\n"
+                                        "      position: {x: 1.0, y: 2.0, z: 0.0}\n      orientation: {w: 1.0}\n"
+                                        "  - pose: {position: {x: 4.0, y: 6.0, z: 0.0}}\n")
+    (route,) = read_routes(tmp_path / "plan.yaml")
+    assert route.points.tolist() == [[1.0, 2.0], [4.0, 6.0]] and route.length == pytest.approx(5.0) and route.source == "path"
+    (tmp_path / "wp.yaml").write_text("routes:\n  - [[0, 0], [3, 4]]\n  - [{x: 1, y: 1}, {x: 1, y: 3}]\n")
+    assert [r.length for r in read_routes(tmp_path / "wp.yaml")] == pytest.approx([5.0, 2.0])
+    (tmp_path / "r.csv").write_text("x,y\n0,0\n0,2.5\n")
+    assert read_points(tmp_path / "r.csv")[0].tolist() == [[0.0, 0.0], [0.0, 2.5]]
+    (tmp_path / "bad.yaml").write_text("waypoints:\n  - [0, 0]\n  - [1, nan]\n")
+    with pytest.raises(ValueError, match=r"route file bad.yaml, point 2: a point must be"):
+        read_routes(tmp_path / "bad.yaml")
+
+
+def test_a_users_route_along_an_unstable_corridor_is_judged_unstable(root):
+    """A waypoint route drawn by the user along the unstable corridor's axis (x = 0.65 m) is judged like the skeleton's
+    route there: unstable at 1.4 V*, over most of its length (its ends within the window of the corridor's ends aside)."""
+    from pfm_stability.maps.analysis import add_routes
+    from pfm_stability.maps.routes import path_of
+
+    V_star = _report(0.6).models["sampled"].critical["V_critical"]
+    analysis = add_routes(corridor_analysis(0.6, 1.4 * V_star, root), [path_of([[0.65, 3.0], [0.65, 17.0]], 0, "waypoints")])
+    pv = analysis.paths
+    mine = pv.samples.segment == len(pv.paths) - 1
+    assert pv.paths[-1].source == "waypoints"
+    assert np.mean(pv.code[mine] == PATH_VERDICTS.index("unstable")) > 0.8

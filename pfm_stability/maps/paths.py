@@ -550,8 +550,8 @@ def _stretches(paths, route, arc, ds, x, y, code, window_growth, worse, mean_N, 
             near = np.flatnonzero((route == r) & (np.abs(arc - arc[k]) <= window / 2))
             Nw = N[d, near]
             Nw = Nw[np.isfinite(Nw)]
-            numbers = _window_numbers(sigma, float(mean_N[d, k]), Nw, V, window, boundary, growth, heading_stable)
-            numbers["efolds"] = float(np.nanmax(efolds[run]))
+            numbers = _window_numbers(sigma, float(mean_N[d, k]), Nw, V, float(efolds[k]), code[first] == 0, boundary, growth, heading_stable)
+            numbers["efolds"] = float(efolds[k])
             if code[first] == 1 and not numbers["efolds"] >= EFOLDS:
                 numbers["label"] = "oscillates"  # a forced weave (`_forced`), the loop itself damped
             out.append(PathStretch(**base, **numbers, direction=("forward", "reverse")[d], oscillates=bool(oscillates[run].any()),
@@ -559,24 +559,22 @@ def _stretches(paths, route, arc, ds, x, y, code, window_growth, worse, mean_N, 
     return tuple(out)
 
 
-def _window_numbers(sigma, mean_N, N, V, window, boundary, growth, heading_stable) -> dict:
-    """label, growth_rate, efolds, N, margin, V_critical of one window with mean growth `sigma` (1/s) and gains `N` (1/m)."""
-    length = min(window, N.size * 1.0) if math.isfinite(window) else N.size
-    efolds = sigma * window / V if math.isfinite(window) else None
-    stable = not sigma > 0
-    if not np.any(N != 0):  # no field: the heading loop's verdict at NV = 0
-        return dict(label="nothing grows" if heading_stable else "unstable", growth_rate=sigma, efolds=efolds, N=0.0,
+def _window_numbers(sigma, mean_N, N, V, efolds, verdict_stable, boundary, growth, heading_stable) -> dict:
+    """label, growth_rate, N, margin, V_critical of one window with mean growth `sigma` (1/s), gains `N` (1/m) and
+    `efolds` over it; `verdict_stable` is the point's verdict (less than one e-fold of growth: stable, "nothing grows")."""
+    grows = sigma > 0
+    if N.size == 0 or not np.any(N != 0):  # no field: the heading loop's verdict at NV = 0
+        return dict(label="nothing grows" if heading_stable else "unstable", growth_rate=sigma, N=0.0,
                     margin=math.inf if heading_stable else -1.0, V_critical=math.inf if heading_stable else 0.0)
     N_eff = effective_gain(sigma, mean_N, V, growth, boundary.NV_critical)
     V_star = critical_speed(N, growth, boundary.NV_critical)
     if N_eff <= 0 or not math.isfinite(N_eff):
-        margin = -1.0 if N_eff < 0 or not stable else math.inf
-        label = "nothing grows" if stable else "unstable"
+        margin = -1.0 if N_eff < 0 or grows else math.inf
+        label = "unstable" if grows else "nothing grows"
     else:
         NV = N_eff * V
-        margin = float(gain_margin(NV, boundary, stable))
-        label = verdict_label(NV, boundary, stable)
-        if stable and efolds is not None and abs(efolds) < 1:
-            label = "nothing grows"
-    del length
-    return dict(label=label, growth_rate=sigma, efolds=efolds, N=float(N_eff), margin=margin, V_critical=float(V_star))
+        margin = float(gain_margin(NV, boundary, not grows))
+        label = verdict_label(NV, boundary, not grows)
+    if verdict_stable and (grows or abs(efolds) < EFOLDS):
+        label = "nothing grows"  # less than one e-fold either way over the window
+    return dict(label=label, growth_rate=sigma, N=float(N_eff), margin=margin, V_critical=float(V_star))

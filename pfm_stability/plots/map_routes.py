@@ -13,7 +13,7 @@ __all__ = ["ROUTE_STYLES", "plot_route_verdicts"]
 ROUTE_STYLES = {
     "nothing grows": dict(color="#a6d96a", lw=1.6, label="stable: nothing grows (< 1 e-fold, or no field)"),
     "stable": dict(color="#1a9641", lw=2.6, label="stable (a disturbance decays)"),
-    "oscillates": dict(color="#fdae61", lw=3.2, label="unstable: the loop weaves (forced, >= 5 cm)"),
+    "oscillates": dict(color="#fdae61", lw=3.2, label="unstable: the loop weaves (an episode over 3 periods)"),
     "unstable": dict(color="#d7191c", lw=3.6, label="unstable: a disturbance grows (>= 1 e-fold)"),
     "wall ahead both ways": dict(color="0.45", lw=1.4, label="no verdict: wall ahead both ways", ls=(0, (1.5, 2.0))),
     "inside an obstacle": dict(color="0.3", lw=1.4, label="no verdict: inside an obstacle", ls=(0, (4.0, 2.0))),

@@ -39,7 +39,7 @@ from ..sim.scenario import Pose, Scenario, Target
 from ..maps.episodes import AMPLITUDE_THRESHOLD, EPISODE_PERIODS, GROWTH_EFOLDS, NOISE_FLOOR, episodes
 from .maps import START_OFFSET, _batches, _table_size, crop_grid, simulator_grid
 
-__all__ = ["DRIVE_TIME_FACTOR", "MATCH_DISTANCE", "Disagreement", "Drive", "DriveValidation", "drive_map"]
+__all__ = ["DRIVE_TIME_FACTOR", "MATCH_DISTANCE", "Disagreement", "Drive", "DriveValidation", "drive_map", "goal_routes"]
 
 MATCH_DISTANCE = 0.5
 """Largest distance (m) from a trajectory point to the route sample it marks (at least the robot's width W)."""
@@ -364,3 +364,55 @@ def _runs(kind: str, mask: np.ndarray, pv, passed_by) -> tuple:
             out.append(Disagreement(kind, int(r), start, stop, float(pv.spacing[run].sum()), float(pv.samples.x[run[0]]),
                                     float(pv.samples.y[run[0]]), float(pv.samples.x[run[-1]]), float(pv.samples.y[run[-1]]), tuple(drives)))
     return tuple(out)
+
+
+def goal_routes(analysis, goals, progress=None) -> list:
+    """The paths the simulated VFF robot takes between consecutive goals, as routes to judge (`maps.analysis.add_routes`):
+    each drive (point target, the robot starting towards it; the simulator's grid law on the map's grid) averaged over
+    one oscillation period P = 2π/ω* — the path it follows, about which `maps.paths` linearizes — from its start to
+    where it stopped (the goal, a collision or a stall).
+
+    Parameters
+    ----------
+    analysis : MapAnalysis
+        A grid-law analysis with its routes' verdicts.
+    goals : array_like, shape (n, 2)
+        Goals in map coordinates, m (n >= 2).
+    progress : callable, optional
+        ``progress(line)`` once the drives are done.
+    """
+    from scipy.ndimage import uniform_filter1d
+
+    from ..maps.routes import path_of
+
+    goals = np.asarray(goals, dtype=float).reshape(-1, 2)
+    if len(goals) < 2:
+        raise ValueError(f"goals must hold at least two points (m); got {len(goals)}")
+    robot, controller, law = analysis.robot, analysis.controller, analysis.law
+    grid = simulator_grid(analysis.grid)
+    omega = _omega(analysis)
+    period = 2 * math.pi / omega if omega else 1.0
+    scenarios = []
+    for k, (p, q) in enumerate(zip(goals[:-1], goals[1:])):
+        length = float(math.hypot(*(q - p)))
+        heading = math.atan2(q[0] - p[0], q[1] - p[1])
+        try:
+            scenarios.append(Scenario(name=f"goal {k + 1}", robot=robot, controller=controller, environment=grid,
+                                      start=Pose(float(p[0]), float(p[1]), heading), target=Target.point(float(q[0]), float(q[1]), radius=0.3),
+                                      duration=DRIVE_TIME_FACTOR * length / robot.V + 5.0, cell_ratio=law.ratio,
+                                      window_cells=law.window_cells, trap_time=max(10.0, 1.5 / robot.V)))
+        except ValueError as exc:
+            raise ValueError(f"goal {k + 1} -> {k + 2}: {exc}") from None
+    outcome = run_batch(scenarios, record="trajectory", metrics=False)
+    routes = []
+    for k, run in enumerate(outcome.runs):
+        tr = run.trajectory
+        n = max(1, int(round(period / controller.T)))
+        x, y = uniform_filter1d(tr.x, n, mode="nearest"), uniform_filter1d(tr.y, n, mode="nearest")
+        arc = np.concatenate([[0.0], np.cumsum(np.hypot(np.diff(x), np.diff(y)))])
+        step = np.flatnonzero(np.diff(np.concatenate([[-1.0], arc // analysis.grid.cell_size])) > 0)  # a point every cell
+        points = np.column_stack([x[step], y[step]]) if step.size >= 2 else np.column_stack([x[[0, -1]], y[[0, -1]]])
+        routes.append(path_of(points, k, "goals"))
+    if progress:
+        progress(f"goals: {len(routes)} drives between {len(goals)} goals")
+    return routes
