@@ -97,8 +97,10 @@ def plot_route_verdicts(analysis, drives=None, ax=None, *, title: str | None = N
             return "n/a" if v is None else f"{100 * v:.0f}%"
 
         L = drives.lengths
+        kinds = "; ".join(f"{kind} drives {pct(v['recall'])} / {pct(v['precision'])}" for kind, v in drives.by_kind.items())
         validation = (f"\n{drives.counts['drives']} drives: {drives.counts['episodes']} episodes; recall {pct(drives.recall)}, "
-                      f"precision {pct(drives.precision)} (by route length; {L['driven']:.0f} of {L['route']:.0f} m driven)")
+                      f"precision {pct(drives.precision)} by route length ({kinds}); {L['driven']:.0f} of {L['route']:.0f} m driven, "
+                      f"{L['episode_off_route']:.0f} m of episodes off the routes")
     handles.append(Line2D([], [], marker="s", ls="", color=str(OCCUPIED_GREY), markersize=8, label="occupied"))
     if occupancy.unknown.any():
         handles.append(Line2D([], [], marker="s", ls="", color=str(UNKNOWN_GREY), markeredgecolor="0.6", markersize=8, label="unknown"))

@@ -132,7 +132,8 @@ class DriveValidation:
     drives : tuple of Drive
     disagreements : tuple of Disagreement
     lengths : dict
-        Route length (m): ``route``, ``driven``, ``not_driven``, ``episode``, ``episode_recalled``,
+        Route length (m): ``route``, ``driven``, ``not_driven``, ``episode``, ``episode_recalled``, ``episode_off_route``
+        (the drives' path length in episodes farther than the match distance from any route: measured, not scored),
         ``predicted_unstable_driven``, ``predicted_unstable_matched``, ``predicted_unstable_not_driven``.
     counts : dict
         Drives by how they ended, episodes found.
@@ -140,6 +141,8 @@ class DriveValidation:
     seconds : float
     episode_points : ndarray, shape (n, 2)
         Robot positions during the episodes, m (for the picture).
+    by_kind : dict
+        ``route`` and ``waypoints``: the same recall, precision and lengths over that kind of drive only.
     """
 
     recall: float | None
@@ -151,12 +154,14 @@ class DriveValidation:
     inputs: dict = field(default_factory=dict)
     seconds: float = 0.0
     episode_points: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))
+    by_kind: dict = field(default_factory=dict)
 
     def to_dict(self) -> dict:
         """JSON form."""
         return {
             "recall": json_number(self.recall) if self.recall is not None else None,
             "precision": json_number(self.precision) if self.precision is not None else None,
+            "by_kind": json_ready(self.by_kind),
             "lengths": json_ready(self.lengths),
             "counts": json_ready(self.counts),
             "disagreements": [d.to_dict() for d in self.disagreements],
@@ -271,40 +276,37 @@ def drive_map(analysis, count: int, *, seed: int = 0, progress=None) -> DriveVal
         if progress:
             progress(f"map drives: batch {b}/{len(batches)}: {len(batch)} drives")
 
-    # route samples driven, and during episodes
+    # route samples driven, and during episodes, per drive
     tree = cKDTree(np.column_stack([pv.samples.x, pv.samples.y]))
     limit = max(MATCH_DISTANCE, robot.W)
-    driven = np.zeros(pv.code.size, dtype=bool)
-    episode = np.zeros(pv.code.size, dtype=bool)
-    passed_by = [set() for _ in range(pv.code.size)]
-    points = []
+    marks, points = [], []
     for d, (t, x, y) in zip(drives, traces):
         if t.size == 0:
+            marks.append((np.zeros(0, dtype=int), np.zeros(0, dtype=int), 0.0))
             continue
         dist, nearest = tree.query(np.column_stack([x, y]), distance_upper_bound=limit)
         hit = np.isfinite(dist) & (t - t[0] >= min(period, 0.25 * d.duration))  # the start's transient is not measured
         during = np.zeros(t.size, dtype=bool)
         for lo, hi in d.episodes:
             during |= (t >= lo) & (t <= hi)
-        driven[nearest[hit]] = True
-        episode[nearest[hit & during]] = True
+        step = np.concatenate([[0.0], np.hypot(np.diff(x), np.diff(y))])
+        off = float(step[during & ~np.isfinite(dist)].sum())  # an episode where no route runs: measured, not scored
+        marks.append((np.unique(nearest[hit]), np.unique(nearest[hit & during]), off))
         points.append(np.column_stack([x[during], y[during]]))
-        for k in np.unique(nearest[hit]):
-            passed_by[k].add(d.index)
     unstable = pv.code == PATH_VERDICTS.index("unstable")
     half = pv.window / 2 if math.isfinite(pv.window) else 0.0
-    near_episode = _within(episode, pv.samples.segment, pv.arc, half)
     near_unstable = _within(unstable, pv.samples.segment, pv.arc, half)
-    ds = pv.spacing
-    lengths = {
-        "route": float(ds.sum()), "driven": float(ds[driven].sum()), "not_driven": float(ds[~driven].sum()),
-        "episode": float(ds[episode].sum()), "episode_recalled": float(ds[episode & near_unstable].sum()),
-        "predicted_unstable_driven": float(ds[unstable & driven].sum()),
-        "predicted_unstable_matched": float(ds[unstable & driven & near_episode].sum()),
-        "predicted_unstable_not_driven": float(ds[unstable & ~driven].sum()),
-    }
-    recall = lengths["episode_recalled"] / lengths["episode"] if lengths["episode"] > 0 else None
-    precision = lengths["predicted_unstable_matched"] / lengths["predicted_unstable_driven"] if lengths["predicted_unstable_driven"] > 0 else None
+    lengths, recall, precision, driven, episode, near_episode = _score(pv, marks, range(len(drives)), unstable, near_unstable, half)
+    by_kind = {}
+    for kind in ("route", "waypoints"):
+        chosen = [k for k, d in enumerate(drives) if d.kind == kind]
+        kind_lengths, kind_recall, kind_precision = _score(pv, marks, chosen, unstable, near_unstable, half)[:3]
+        by_kind[kind] = {"recall": json_number(kind_recall) if kind_recall is not None else None,
+                         "precision": json_number(kind_precision) if kind_precision is not None else None, "lengths": kind_lengths}
+    passed_by = [set() for _ in range(pv.code.size)]
+    for d, (hit, _, _) in zip(drives, marks):
+        for k in hit:
+            passed_by[k].add(d.index)
     disagreements = (_runs("missed", episode & ~near_unstable, pv, passed_by)
                      + _runs("false alarm", unstable & driven & ~near_episode, pv, passed_by))
     events = [d.event or "time" for d in drives]
@@ -315,7 +317,34 @@ def drive_map(analysis, count: int, *, seed: int = 0, progress=None) -> DriveVal
               "episode_periods": EPISODE_PERIODS, "growth_efolds": GROWTH_EFOLDS, "amplitude_threshold": AMPLITUDE_THRESHOLD,
               "noise_floor": NOISE_FLOOR, "match_distance": limit, "start_offset": START_OFFSET}
     pts = np.vstack(points) if points else np.zeros((0, 2))
-    return DriveValidation(recall, precision, tuple(drives), disagreements, lengths, counts, inputs, time.perf_counter() - started, pts)
+    return DriveValidation(recall, precision, tuple(drives), disagreements, lengths, counts, inputs, time.perf_counter() - started, pts,
+                           by_kind)
+
+
+def _score(pv, marks, chosen, unstable, near_unstable, half):
+    """(lengths, recall, precision, driven, episode, near_episode) of the drives `chosen` (module docstring)."""
+    driven = np.zeros(pv.code.size, dtype=bool)
+    episode = np.zeros(pv.code.size, dtype=bool)
+    off_route = 0.0
+    for k in chosen:
+        hit, during, off = marks[k]
+        driven[hit] = True
+        episode[during] = True
+        off_route += off
+    near_episode = _within(episode, pv.samples.segment, pv.arc, half)
+    ds = pv.spacing
+    lengths = {
+        "route": float(ds.sum()), "driven": float(ds[driven].sum()), "not_driven": float(ds[~driven].sum()),
+        "episode": float(ds[episode].sum()), "episode_recalled": float(ds[episode & near_unstable].sum()),
+        "episode_off_route": off_route,
+        "predicted_unstable_driven": float(ds[unstable & driven].sum()),
+        "predicted_unstable_matched": float(ds[unstable & driven & near_episode].sum()),
+        "predicted_unstable_not_driven": float(ds[unstable & ~driven].sum()),
+    }
+    recall = lengths["episode_recalled"] / lengths["episode"] if lengths["episode"] > 0 else None
+    precision = (lengths["predicted_unstable_matched"] / lengths["predicted_unstable_driven"]
+                 if lengths["predicted_unstable_driven"] > 0 else None)
+    return lengths, recall, precision, driven, episode, near_episode
 
 
 @dataclass(frozen=True)
