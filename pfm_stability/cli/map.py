@@ -181,7 +181,7 @@ def run(args) -> int:
                                warn=lambda line: print(f"pfm-stability: warning: {line}", file=sys.stderr, flush=True), routes=routes)
         if args.goals:
             analysis = _with_goals(analysis, args.goals, progress)
-        validation = _validate(analysis, args.validate, args.seed, progress) if args.validate else None
+        validation = _validate(analysis, args.validate, args.seed, progress) if args.validate and analysis.segments else None
         drives = _drive(analysis, args.validate, args.seed, progress) if args.validate and analysis.paths is not None else None
         outputs = _write_outputs(analysis, args.out_dir, drives) if args.out_dir else None
     data = {
