@@ -280,7 +280,8 @@ def grid_equilibria(grid: HistogramMap, law: GridWallLaw, routes, clearance: np.
     return equilibria_at(grid, law, x, y, tx, ty, seg, clearance, W)
 
 
-def equilibria_at(grid: HistogramMap, law: GridWallLaw, x, y, tx, ty, segment, clearance: np.ndarray, W: float) -> Samples:
+def equilibria_at(grid: HistogramMap, law: GridWallLaw, x, y, tx, ty, segment, clearance: np.ndarray, W: float,
+                  newton_steps: int = NEWTON_STEPS) -> Samples:
     """Equilibria and N at given points with travel directions (`grid_equilibria` for any route; module docstring).
 
     Parameters
@@ -299,6 +300,8 @@ def equilibria_at(grid: HistogramMap, law: GridWallLaw, x, y, tx, ty, segment, c
         Distance to the nearest occupied cell, m, per histogram cell.
     W : float
         Robot width, m.
+    newton_steps : int
+        Safeguarded Newton steps per root (`NEWTON_STEPS`: a jump located to the bracket / 2^12).
     """
     c = grid.cell_size
     x, y, tx, ty = (np.asarray(v, dtype=float) for v in (x, y, tx, ty))
@@ -333,7 +336,7 @@ def equilibria_at(grid: HistogramMap, law: GridWallLaw, x, y, tx, ty, segment, c
         f, _, df = lateral_force(grid, law, x[k], y[k], tx[k], ty[k], at, jacobian=True)
         return sign * f, sign * df
 
-    s0 = newton_increasing(increasing, lo, hi, atol=ROOT_TOLERANCE, iterations=NEWTON_STEPS)
+    s0 = newton_increasing(increasing, lo, hi, atol=ROOT_TOLERANCE, iterations=newton_steps)
     f, ft, df = lateral_force(grid, law, x[k], y[k], tx[k], ty[k], s0, jacobian=True)
     forward = 1.0 - np.abs(ft)
     offset, N, F_t, along = (np.full(x.size, np.nan) for _ in range(4))

@@ -62,6 +62,9 @@ WINDOW_PERIODS = 3.0
 """Length of the window whose accumulated growth decides a point, in oscillation wavelengths λ = 2πV/ω*: the
 simulator's oscillation metrics need three periods to call a growth (`validation.map_selection.MIN_PERIODS`), and an
 episode of the driving validation is a growth over at least three periods (`validation.map_drives`)."""
+PATH_NEWTON_STEPS = 6
+"""Newton steps per equilibrium along the routes (`equilibria.equilibria_at`): a root at a cell boundary's jump to the
+scan bracket (c/2) / 2^6 < 1 mm, a smooth root to round-off; half the corridor analysis' 12, half its cost there."""
 UNJUDGED = ("wall ahead both ways", "inside an obstacle")
 """Reasons a sample gets no verdict: a wall ahead in both travel directions (the repulsion along the route cancels more
 than `verdicts.END_FRACTION` of the attraction either way: the robot turns there, a narrow dead end), or the sample
@@ -321,7 +324,7 @@ def analyze_paths(grid, law, paths, clearance: np.ndarray, W: float, V: float, b
     """
     paths = tuple(paths)
     x, y, tx, ty, route, arc, ds = path_samples(paths, grid.cell_size)
-    samples = equilibria_at(grid, law, x, y, tx, ty, route, clearance, W)
+    samples = equilibria_at(grid, law, x, y, tx, ty, route, clearance, W, newton_steps=PATH_NEWTON_STEPS)
     has = np.isfinite(samples.offset)
     offset = np.where(has, samples.offset, 0.0)
     px, py = x - ty * offset, y + tx * offset
