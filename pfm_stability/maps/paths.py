@@ -62,9 +62,10 @@ WINDOW_PERIODS = 3.0
 """Length of the window whose accumulated growth decides a point, in oscillation wavelengths λ = 2πV/ω*: the
 simulator's oscillation metrics need three periods to call a growth (`validation.map_selection.MIN_PERIODS`), and an
 episode of the driving validation is a growth over at least three periods (`validation.map_drives`)."""
-PATH_NEWTON_STEPS = 6
-"""Newton steps per equilibrium along the routes (`equilibria.equilibria_at`): a root at a cell boundary's jump to the
-scan bracket (c/2) / 2^6 < 1 mm, a smooth root to round-off; half the corridor analysis' 12, half its cost there."""
+PATH_NEWTON_STEPS = 12
+"""Newton steps per equilibrium along the routes (`equilibria.equilibria_at`): the corridor analysis' `NEWTON_STEPS`.
+With 6 (a jump located to < 1 mm) the depot's north-wall weave at CARMEL's preset, predicted near the episode
+threshold, was lost (recall 97 % -> 54 %): the forced weave is that sensitive to where the line is."""
 UNJUDGED = ("wall ahead both ways", "inside an obstacle")
 """Reasons a sample gets no verdict: a wall ahead in both travel directions (the repulsion along the route cancels more
 than `verdicts.END_FRACTION` of the attraction either way: the robot turns there, a narrow dead end), or the sample

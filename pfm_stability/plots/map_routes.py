@@ -98,9 +98,9 @@ def plot_route_verdicts(analysis, drives=None, ax=None, *, title: str | None = N
 
         L = drives.lengths
         kinds = "; ".join(f"{kind} drives {pct(v['recall'])} / {pct(v['precision'])}" for kind, v in drives.by_kind.items())
-        validation = (f"\n{drives.counts['drives']} drives: {drives.counts['episodes']} episodes; recall {pct(drives.recall)}, "
-                      f"precision {pct(drives.precision)} by route length ({kinds}); {L['driven']:.0f} of {L['route']:.0f} m driven, "
-                      f"{L['episode_off_route']:.0f} m of episodes off the routes")
+        validation = (f"\n{drives.counts['drives']} drives, {drives.counts['episodes']} episodes: recall {pct(drives.recall)}, "
+                      f"precision {pct(drives.precision)} by route length ({kinds})\n{L['driven']:.0f} of {L['route']:.0f} m "
+                      f"driven; {L['episode']:.1f} m of episodes on the routes, {L['episode_off_route']:.0f} m off them (not scored)")
     handles.append(Line2D([], [], marker="s", ls="", color=str(OCCUPIED_GREY), markersize=8, label="occupied"))
     if occupancy.unknown.any():
         handles.append(Line2D([], [], marker="s", ls="", color=str(UNKNOWN_GREY), markeredgecolor="0.6", markersize=8, label="unknown"))
