@@ -7,7 +7,6 @@ costmap_filter_info_server and map_server): a key Nav2 does not read would be si
 
 from __future__ import annotations
 
-import ast
 from importlib import resources
 from pathlib import Path
 
@@ -50,9 +49,13 @@ def test_speed_filter_parameters_use_only_documented_keys():
 
 
 def test_launch_example_starts_the_nodes_the_parameters_name():
-    """The launch example is Python whose nodes are the parameter file's: the mask server (nav2_map_server's
-    map_server), the costmap_filter_info_server and the lifecycle manager."""
-    tree = ast.parse((NAV2 / "speed_filter.launch.py").read_text())
-    names = {kw.value.value for node in ast.walk(tree) if isinstance(node, ast.Call) and getattr(node.func, "id", "") == "Node"
-             for kw in node.keywords if kw.arg == "name"}
-    assert names == {"filter_mask_server", "costmap_filter_info_server", "lifecycle_manager_costmap_filters"}
+    """The launch example (ROS 2 XML launch) starts the parameter file's nodes — the mask server (nav2_map_server's
+    map_server), the costmap_filter_info_server, the lifecycle manager — each reading that file."""
+    import xml.etree.ElementTree as ET
+
+    root = ET.parse(NAV2 / "speed_filter.launch.xml").getroot()
+    nodes = {n.get("name"): (n.get("pkg"), n.get("exec")) for n in root.iter("node")}
+    assert nodes == {"filter_mask_server": ("nav2_map_server", "map_server"),
+                     "costmap_filter_info_server": ("nav2_map_server", "costmap_filter_info_server"),
+                     "lifecycle_manager_costmap_filters": ("nav2_lifecycle_manager", "lifecycle_manager")}
+    assert all(any(p.get("from") == "$(var params_file)" for p in n.iter("param")) for n in root.iter("node"))

@@ -253,3 +253,53 @@ def test_slam_like_hall_is_decided_along_nine_tenths_of_its_routes(tmp_path, unk
         summary = analyze_map(occupancy, robot, CARMEL.controller, law, unknown=unknown).paths.summary()
         assert summary["route_length_m"] > 15 and summary["decided_fraction"] >= 0.9, summary
         assert set(summary["unjudged_length_m"]) == {"wall ahead both ways", "inside an obstacle"}
+
+
+def test_cli_judges_a_route_file_and_goals_and_refuses_a_bad_one(tmp_path):
+    """``map --route FILE --goals FILE`` on a corridor: the JSON's routes hold the skeleton's, the user's (source
+    "path") and the simulated drive between the goals (source "goals"), every one decided; a route file with one
+    point is exit 2 with one line naming it."""
+    from cli_helpers import run
+    import json
+
+    yaml_map = corridor(tmp_path, 0.6)
+    (tmp_path / "plan.yaml").write_text("poses:\n  - pose: {position: {x: 0.65, y: 3.0}}\n  - pose: {position: {x: 0.65, y: 15.0}}\n")
+    (tmp_path / "goals.csv").write_text("x,y\n0.65,2.0\n0.65,12.0\n")
+    options = ["--W", "0.4", "--tau", "0.1", "--k", "20", "--T", "0.025", "--f", "2", "--V", "0.5", "--quiet", "--format", "json"]
+    code, out, err = run(["map", str(yaml_map), "--route", str(tmp_path / "plan.yaml"), "--goals", str(tmp_path / "goals.csv"), *options])
+    assert code == 0, err
+    paths = json.loads(out)["paths"]
+    assert [r["source"] for r in paths["routes"]] == ["skeleton", "path", "goals"]
+    assert paths["summary"]["decided_fraction"] == 1.0
+    (tmp_path / "one.yaml").write_text("waypoints: [[0.65, 3.0]]\n")
+    code, out, err = run(["map", str(yaml_map), "--route", str(tmp_path / "one.yaml"), *options])
+    assert code == 2 and out == "" and err.strip().count("\n") == 0 and "one.yaml" in err
+
+
+@pytest.mark.slow
+def test_thin_slam_walls_with_unknown_behind_the_simulation_sides_with_unknown_free(tmp_path):
+    """The --unknown evidence (docs/maps.md, "Map files"): a 0.8 m corridor whose walls are one pixel thin (0.05 m) with
+    unknown space behind them, as SLAM draws a wall it saw from one side. Read with unknown = occupied the walls are
+    1 m thick and N is several times larger, so V* several times smaller, than with unknown = free. The robot's own
+    grid fills from its sensors (only the faces), so the simulator on the thin-wall grid is the judge: driven at the
+    geometric mean of the two V* (unstable by the occupied reading), it does not oscillate (no episode), as
+    unknown = free predicts. (Measured: V* 0.074 m/s occupied, 0.29 m/s free — the latter from the windows at the
+    map's ends, where the truncated walls raise N; at 1.3 × 0.29 m/s the drives show no episode either.)"""
+    from pfm_stability.validation.map_drives import drive_map
+
+    r = 0.05
+    img = np.full((400, 56), 205, dtype=np.uint8)  # 20 m long; x: 1 m unknown, wall, 0.8 m free, wall, 1 m unknown
+    img[:, 20] = img[:, 36] = 0
+    img[:, 21:36] = 254
+    occupancy = load_map(write_map(tmp_path, img, resolution=r))
+    V_star = {}
+    for unknown in ("occupied", "free"):
+        robot = ROBOT.replace(V=0.5)
+        analysis = analyze_map(occupancy, robot, CONTROLLER, make_law("grid", robot, CONTROLLER), unknown=unknown)
+        V_star[unknown] = min(s.V_critical for s in analysis.paths.stretches if s.V_critical is not None and s.length > 5)
+    assert V_star["free"] > 2 * V_star["occupied"]
+    V = math.sqrt(V_star["free"] * V_star["occupied"])
+    robot = ROBOT.replace(V=V)
+    thin = analyze_map(occupancy, robot, CONTROLLER, make_law("grid", robot, CONTROLLER), unknown="free")
+    judged = drive_map(thin, 4, seed=2)
+    assert judged.counts["episodes"] == 0, judged.counts
