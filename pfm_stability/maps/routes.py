@@ -147,13 +147,7 @@ def find_paths(grid: HistogramMap, skeleton: np.ndarray, clearance: np.ndarray) 
     labels, n_branches = label(skeleton & ~junction, structure=np.ones((3, 3), dtype=int))
     nx, ny = skeleton.shape
     branches = []  # (points (m), zone at the head, zone at the tail)
-    for index, cells in enumerate(_branch_cells(labels, n_branches)):
-        if len(cells) < 2:
-            continue
-        cell_set = set(cells)
-        branch_count = {p: sum((p[0] + di, p[1] + dj) in cell_set for di, dj in _STEPS) for p in cells}
-        ends = [p for p in cells if branch_count[p] <= 1]
-        path = _order(cell_set, min(ends) if ends else min(cells))
+    for index, path in _ordered_branches(labels, n_branches):
         ij = np.array(path, dtype=float)
 
         def zone_of(cell):
@@ -362,13 +356,7 @@ def find_routes(grid: HistogramMap, W: float, min_length: float | None = None) -
     near_junction = _junction_radius(junction, clearance)
     c = grid.cell_size
     routes = []
-    for index, cells in enumerate(_branch_cells(labels, n_branches)):
-        if len(cells) < 2:
-            continue
-        cell_set = set(cells)
-        branch_count = {p: sum((p[0] + di, p[1] + dj) in cell_set for di, dj in _STEPS) for p in cells}
-        ends = [p for p in cells if branch_count[p] <= 1]
-        path = _order(cell_set, min(ends) if ends else min(cells))
+    for index, path in _ordered_branches(labels, n_branches):
         ij = np.array(path, dtype=float)
         points = np.column_stack(grid.cell_center(ij[:, 0], ij[:, 1]))
         cut0, cut1 = JUNCTION_CUT * near_junction(path[0]), JUNCTION_CUT * near_junction(path[-1])
@@ -381,6 +369,17 @@ def find_routes(grid: HistogramMap, W: float, min_length: float | None = None) -
             if route.length >= min_length:
                 routes.append(route)
     return routes, skeleton, clearance
+
+
+def _ordered_branches(labels: np.ndarray, count: int):
+    """(index, cells from one end to the other) of each labelled branch of two or more cells (`_order`)."""
+    for index, cells in enumerate(_branch_cells(labels, count)):
+        if len(cells) < 2:
+            continue
+        cell_set = set(cells)
+        branch_count = {p: sum((p[0] + di, p[1] + dj) in cell_set for di, dj in _STEPS) for p in cells}
+        ends = [p for p in cells if branch_count[p] <= 1]
+        yield index, _order(cell_set, min(ends) if ends else min(cells))
 
 
 def _junctions(skeleton: np.ndarray, crossing: np.ndarray) -> np.ndarray:

@@ -5,8 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .common import figure_and_axes
-from .map import OCCUPIED_GREY, UNKNOWN_GREY, known_extent, map_greys
+from .map import OCCUPIED_GREY, UNKNOWN_GREY, map_frame
 
 __all__ = ["ROUTE_STYLES", "plot_route_verdicts"]
 
@@ -62,13 +61,7 @@ def plot_route_verdicts(analysis, drives=None, ax=None, *, title: str | None = N
 
     occupancy = analysis.occupancy
     pv = analysis.paths
-    x0, x1, y0, y1 = known_extent(occupancy)
-    aspect = (y1 - y0) / max(x1 - x0, 1e-9)
-    if size is None:
-        w_map, h_map = (9.5, 9.5 * aspect) if aspect <= 1.2 else (10.5 / aspect, 10.5)
-        size = (max(w_map + 0.6, 7.0), max(h_map + 2.4, 4.5))
-    fig, ax = figure_and_axes(ax, size)
-    ax.imshow(map_greys(occupancy), extent=occupancy.extent, origin="upper", interpolation="nearest", zorder=0)
+    fig, ax, (x0, x1, y0, y1), _ = map_frame(occupancy, ax, size, (0.6, 2.4))
     kinds = []
     for kind, style in ROUTE_STYLES.items():
         lines = [_stretch_lines(pv.paths, s) for s in pv.stretches if _kind(s) == kind]
