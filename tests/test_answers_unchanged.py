@@ -201,9 +201,9 @@ def differences(now, then, where="", found=None, rtol=RTOL, absolute=None) -> li
             for i, (a, b) in enumerate(zip(now, then)):
                 differences(a, b, f"{where}[{i}]", found, rtol, absolute)
     elif isinstance(then, dict):
-        if not isinstance(now, dict) or set(now) != set(then):
+        if not isinstance(now, dict) or not set(then) <= set(now):  # new keys are new answers, not changed ones
             keys = set(now) if isinstance(now, dict) else set()
-            found.append(f"{where}: keys {sorted(keys ^ set(then))} differ")
+            found.append(f"{where}: keys {sorted(set(then) - keys)} missing")
         else:
             for key in then:
                 differences(now[key], then[key], f"{where}.{key}", found, rtol, absolute)
@@ -245,7 +245,13 @@ def test_report_answers_are_unchanged(recorded, argvs):
 def test_traps_and_map_answers_are_unchanged(recorded, argv):
     """Each recorded `traps` and `map` command line, a map to its method's accuracy (module docstring)."""
     tolerances = {"rtol": MAP_RTOL, "absolute": MAP_ABSOLUTE} if argv[0] == "map" else {}
-    found = differences(run(argv), recorded[" ".join(argv)], **tolerances)
+    now, then = run(argv), recorded[" ".join(argv)]
+    if argv[0] == "map" and then["code"] == 2 and "has no route long enough" in (then["error"] or "") and now["code"] == 0:
+        # a map refused for want of a straight corridor now has routes of any shape (docs/maps.md, "Verdicts along
+        # every route"): a new answer where there was none; no segment verdict can have flipped, there are none
+        assert now["json"]["segments"] == [] and now["json"]["paths"]["summary"]["route_length_m"] > 0
+        return
+    found = differences(now, then, **tolerances)
     assert not found, "\n".join(found)
 
 

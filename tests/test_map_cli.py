@@ -53,7 +53,8 @@ def test_shipped_map_outputs(tmp_path, name):
     code, stdout, err = run(["map", name, *ROBOTS[name], "--out-dir", str(out), "--format", "json", "--quiet"])
     assert code == 0, err
     data = json.loads(stdout)
-    assert sorted(p.name for p in out.iterdir()) == ["segments.csv", "speed_mask.pgm", "speed_mask.yaml", "stability.png"]
+    assert sorted(p.name for p in out.iterdir()) == ["routes.csv", "routes.png", "segments.csv", "speed_mask.pgm", "speed_mask.yaml",
+                                                     "stability.png"]
     with Image.open(out / "stability.png") as im:
         assert im.format == "PNG" and im.width > 500
     rows = list(csv.DictReader((out / "segments.csv").open()))

@@ -25,7 +25,8 @@ import argparse
 
 from ..laws.registry import DEFAULT_LAW, laws_for
 from ..parameters import MODEL_NAMES
-from .options import add_law_options, add_parameter_options, describe, integer, number, resolve_law, resolve_parameters, shipped_or_given
+from .options import (add_law_options, add_parameter_options, describe, input_file, integer, number, resolve_law, resolve_parameters,
+                      shipped_or_given)
 
 FORMATS = ("text", "json")
 SHIPPED_MAPS = ("depot", "warehouse", "tb3_sandbox")
@@ -66,6 +67,10 @@ def add_parser(sub) -> None:
     p.add_argument("--min-length", type=number("min_length"), metavar="M",
                    help=f"shortest segment analysed, {describe('min_length')} (default the larger of 1 m and 1.25 W)")
     p.add_argument("--seed", type=integer("seed"), default=0, help=f"seed of the --validate selection, {describe('seed')} (default 0)")
+    p.add_argument("--route", type=input_file("route"), action="append", metavar="FILE",
+                   help="also judge your own route: a Nav2 path (nav_msgs/Path as YAML), waypoints in YAML, or a CSV of x,y (m); repeatable")
+    p.add_argument("--goals", type=input_file("goals"), metavar="FILE",
+                   help="drive the simulated robot between these goals (YAML or CSV of x,y, m) and judge the paths it takes")
     p.add_argument("--format", choices=FORMATS, default="text")
     p.add_argument("--quiet", action="store_true", help="no progress on stderr")
     p.set_defaults(run=run)
@@ -88,8 +93,35 @@ def _validate(analysis, count: int, seed: int, progress):
                                  cell_ratio=law.ratio, window_cells=law.window_cells, count=count, seed=seed, progress=progress)
 
 
-def _write_outputs(analysis, out_dir: str) -> dict:
-    """The four files of ``--out-dir``, all or none (`files.atomic_directory`)."""
+def _user_routes(files) -> list:
+    """The routes of every ``--route FILE`` (`maps.user_routes.read_routes`)."""
+    from ..maps.user_routes import read_routes
+
+    routes = []
+    for name in files:
+        routes += read_routes(name, len(routes))
+    return routes
+
+
+def _with_goals(analysis, goals_file: str, progress):
+    """The analysis with the paths the simulated robot takes between the goals of ``--goals FILE``."""
+    from ..maps.analysis import add_routes
+    from ..maps.user_routes import read_points
+    from ..validation.map_drives import goal_routes
+
+    return add_routes(analysis, goal_routes(analysis, read_points(goals_file)[0], progress))
+
+
+def _drive(analysis, count: int, seed: int, progress):
+    """Validation by driving (`validation.map_drives.drive_map`): recall and precision of the routes' unstable stretches."""
+    from ..validation.map_drives import drive_map
+
+    return drive_map(analysis, count, seed=seed, progress=progress)
+
+
+def _write_outputs(analysis, out_dir: str, drives=None) -> dict:
+    """The files of ``--out-dir``, all or none (`files.atomic_directory`): the four of the segments, and with the routes'
+    verdicts their picture (with the drives' episodes) and CSV."""
     import os
 
     import matplotlib
@@ -98,21 +130,29 @@ def _write_outputs(analysis, out_dir: str) -> dict:
     import matplotlib.pyplot as plt
 
     from ..io.files import atomic_directory, open_new
-    from ..maps.outputs import OUTPUT_FILES, segments_csv, speed_mask_pgm, speed_mask_yaml
+    from ..maps.outputs import OUTPUT_FILES, ROUTE_FILES, routes_csv, segments_csv, speed_mask_pgm, speed_mask_yaml
     from ..plots.map import plot_map_stability
+    from ..plots.map_routes import plot_route_verdicts
 
-    with atomic_directory(out_dir, OUTPUT_FILES, what="map outputs") as paths:
-        fig = plot_map_stability(analysis)
-        try:
-            with open_new(paths["stability.png"], "wb") as fh:
-                fig.savefig(fh, format="png", dpi=110)
-        finally:
-            plt.close(fig)
+    names = OUTPUT_FILES + (ROUTE_FILES if analysis.paths is not None else ())
+    with atomic_directory(out_dir, names, what="map outputs") as paths:
+        figures = [("stability.png", lambda: plot_map_stability(analysis))]
+        if analysis.paths is not None:
+            figures.append(("routes.png", lambda: plot_route_verdicts(analysis, drives)))
+            with open_new(paths["routes.csv"], "wb") as fh:
+                fh.write(routes_csv(analysis).encode("utf-8"))
+        for name, draw in figures:
+            fig = draw()
+            try:
+                with open_new(paths[name], "wb") as fh:
+                    fig.savefig(fh, format="png", dpi=110)
+            finally:
+                plt.close(fig)
         for name, content in (("segments.csv", segments_csv(analysis).encode("utf-8")), ("speed_mask.pgm", speed_mask_pgm(analysis)),
                               ("speed_mask.yaml", speed_mask_yaml(analysis.occupancy).encode("utf-8"))):
             with open_new(paths[name], "wb") as fh:
                 fh.write(content)
-    return {name: os.path.join(out_dir, name) for name in OUTPUT_FILES}
+    return {name: os.path.join(out_dir, name) for name in names}
 
 
 def run(args) -> int:
@@ -135,14 +175,19 @@ def run(args) -> int:
     check_map_law(law)  # the law resolved: typed, or named by --config FILE
     occupancy = load_map(map_path(args.map))
     with line_progress("map", quiet=args.quiet) as progress:
+        routes = _user_routes(args.route or ())
         analysis = analyze_map(occupancy, params.robot, params.controller, law, model=args.model, unknown=args.unknown,
                                cell_size=args.cell_size, min_length=args.min_length, progress=progress,
-                               warn=lambda line: print(f"pfm-stability: warning: {line}", file=sys.stderr, flush=True))
-        validation = _validate(analysis, args.validate, args.seed, progress) if args.validate else None
-        outputs = _write_outputs(analysis, args.out_dir) if args.out_dir else None
+                               warn=lambda line: print(f"pfm-stability: warning: {line}", file=sys.stderr, flush=True), routes=routes)
+        if args.goals:
+            analysis = _with_goals(analysis, args.goals, progress)
+        validation = _validate(analysis, args.validate, args.seed, progress) if args.validate and analysis.segments else None
+        drives = _drive(analysis, args.validate, args.seed, progress) if args.validate and analysis.paths is not None else None
+        outputs = _write_outputs(analysis, args.out_dir, drives) if args.out_dir else None
     data = {
         **analysis.to_dict(),
         "validation": validation.to_dict() if validation is not None else None,
+        "drives": drives.to_dict() if drives is not None else None,
         "outputs": outputs,
         "timing": {"seconds": time.perf_counter() - started, **{f"{k}_seconds": v for k, v in analysis.timing.items()}},
     }

@@ -573,6 +573,17 @@ def render_map_text(data: dict) -> str:
         f"unstable: {s['unstable_length_m']:.1f} m; slowest V* = {number(worst)} m/s"
         + (f" -> the robot oscillates somewhere at V = {i['V']:g} m/s" if s["unstable_length_m"] > 0 else f" -> stable everywhere at V = {i['V']:g} m/s"),
     ]
+    p = (data.get("paths") or {}).get("summary")
+    if p:  # the verdict along every route (docs/maps.md, "Verdicts along every route")
+        unjudged = ", ".join(f"{length:.1f} m {reason}" for reason, length in p["unjudged_length_m"].items() if length > 0)
+        lines.append(f"routes: {p['routes']} routes, {p['route_length_m']:.1f} m: {percent(p['decided_fraction'])[1:]} decided; "
+                     f"unstable {p['unstable_length_m']:.1f} m, stable {p['stable_length_m']:.1f} m" + (f"; no verdict: {unjudged}" if unjudged else ""))
+    d = data.get("drives")
+    if d is not None:
+        share = {k: (percent(d[k])[1:] if d[k] is not None else "n/a (nothing to measure)") for k in ("recall", "precision")}
+        lines.append(f"validation by driving: {d['counts']['drives']} drives, {d['counts']['episodes']} oscillation episodes; "
+                     f"recall {share['recall']}, precision {share['precision']} by route length ({d['lengths']['driven']:.1f} of "
+                     f"{d['lengths']['route']:.1f} m driven); {len(d['disagreements'])} disagreements")
     v = data.get("validation")
     if v is not None:
         share = f"{percent(v['agreement'])[1:]} of the {v['measured']} measured" if v.get("agreement") is not None else "- (none measured)"

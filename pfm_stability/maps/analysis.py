@@ -39,7 +39,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -53,11 +53,12 @@ from ..io.serialize import json_number
 from .equilibria import Samples, grid_equilibria, power_equilibria
 from .field import UNKNOWN_AS, HistogramMap, histogram_of
 from .occupancy import OccupancyMap
-from .routes import Route, default_min_length, find_routes
+from .paths import PathVerdicts, SampledTransition, analyze_paths
+from .routes import Route, default_min_length, find_paths, find_routes
 from .verdicts import END_FRACTION, TAPER_SLOPE, GrowthRate, drift_slope, critical_speed, is_weak, judged_run, segment_gain, wavelength
 
 __all__ = ["DIRECTIONS", "MAP_LAWS", "MAX_CORRIDOR_WIDTHS", "MAX_MAP_SIDE", "MAX_RESOLUTION", "NO_VERDICT", "MapAnalysis", "MapSegment",
-           "analyze_map", "corridor_warnings", "sample_verdict", "scale_warnings"]
+           "add_routes", "analyze_map", "corridor_warnings", "sample_verdict", "scale_warnings"]
 
 DIRECTIONS = ("forward", "reverse")
 """Travel directions of a segment: from (x0, y0) to (x1, y1), and back."""
@@ -198,6 +199,8 @@ class MapAnalysis:
         Seconds per stage (read, grid, routes, equilibria, verdicts).
     warnings : tuple of str
         One line each: an implausible scale of the map (`scale_warnings`, `corridor_warnings`).
+    paths : PathVerdicts or None
+        The verdict along every route, linearized about the robot's path (`paths.analyze_paths`; grid law only).
     """
 
     occupancy: OccupancyMap
@@ -214,6 +217,7 @@ class MapAnalysis:
     unknown: str
     timing: dict = field(default_factory=dict)
     warnings: tuple = ()
+    paths: PathVerdicts | None = None
 
     @property
     def unstable_length(self) -> float:
@@ -268,6 +272,7 @@ class MapAnalysis:
             "segments": [s.to_dict() for s in self.segments],
             "summary": self.summary(),
             "warnings": list(self.warnings),
+            "paths": self.paths.to_dict() if self.paths is not None else None,
         }
 
 
@@ -338,7 +343,8 @@ def corridor_warnings(occupancy: OccupancyMap, grid: HistogramMap, routes, clear
 
 def analyze_map(occupancy: OccupancyMap, robot: Robot, controller: Controller, law: ForceLaw, *, model: str = "sampled",
                 unknown: str = "occupied", cell_size: float | None = None, min_length: float | None = None,
-                progress=None, end_fraction: float = END_FRACTION, taper_slope: float = TAPER_SLOPE, warn=None) -> MapAnalysis:
+                progress=None, end_fraction: float = END_FRACTION, taper_slope: float = TAPER_SLOPE, warn=None,
+                routes=()) -> MapAnalysis:
     """Every corridor segment of a map, decided (module docstring).
 
     Parameters
@@ -367,6 +373,8 @@ def analyze_map(occupancy: OccupancyMap, robot: Robot, controller: Controller, l
     warn : callable, optional
         ``warn(line)`` for each warning as soon as it is known (`scale_warnings` before any work,
         `corridor_warnings` once the routes are found); the warnings are also in `MapAnalysis.warnings`.
+    routes : sequence of RoutePath
+        The user's own routes (`user_routes.read_routes`), judged after the skeleton's (`MapAnalysis.paths`; grid law).
 
     Raises
     ------
@@ -375,6 +383,7 @@ def analyze_map(occupancy: OccupancyMap, robot: Robot, controller: Controller, l
         space or no route long enough.
     """
     check_map_law(law)
+    own_routes = tuple(routes)  # `routes` is the segments' below
     if not (isinstance(end_fraction, (int, float)) and 0 < end_fraction <= 1):
         raise ValueError(f"end_fraction must be a number in (0, 1] (of the attraction); got {end_fraction!r}")
     if not (isinstance(taper_slope, (int, float)) and not isinstance(taper_slope, bool) and taper_slope > 0):
@@ -406,10 +415,15 @@ def analyze_map(occupancy: OccupancyMap, robot: Robot, controller: Controller, l
         raise ValueError(f"map {occupancy.name!r} has no free space (every cell is occupied{'' if unknown == 'free' else ' or unknown'})")
     stage("grid")
     routes, skeleton, clearance = find_routes(grid, robot.W, min_length)
-    if not routes:
-        raise ValueError(f"map {occupancy.name!r} has no route long enough: no straight corridor of at least "
+    paths = find_paths(grid, skeleton, clearance) if is_grid else []
+    if own_routes and not is_grid:
+        raise ValueError("routes need --law grid: a route is judged with the histogram grid's field")
+    paths = paths + [replace(r, branch=len(paths) + k) for k, r in enumerate(own_routes)]
+    shortest = min_length if min_length is not None else default_min_length(robot.W)
+    if not routes and not any(p.length >= shortest for p in paths):
+        raise ValueError(f"map {occupancy.name!r} has no route long enough: no corridor of at least "
                          f"{min_length if min_length is not None else default_min_length(robot.W):g} m where a robot of width W = {robot.W:g} m fits")
-    if not warnings:  # one cause, one line: a resolution already flagged makes the corridors wide too
+    if not warnings and routes:  # one cause, one line: a resolution already flagged makes the corridors wide too
         caution(corridor_warnings(occupancy, grid, routes, clearance, robot.W))
     stage("routes")
     if is_grid:
@@ -426,8 +440,37 @@ def analyze_map(occupancy: OccupancyMap, robot: Robot, controller: Controller, l
     segments = tuple(_segment(r, samples, k, boundary, robot, c, growth, heading_stable, end_fraction, taper_slope)
                      for k, r in enumerate(routes))
     stage("verdicts")
+    transition = SampledTransition.of(loop_model, loop) if loop_model.name == "sampled" else None
+    along = analyze_paths(grid, law, paths, clearance, robot.W, robot.V, boundary, growth, heading_stable, transition,
+                          end_fraction) if paths else None
+    if is_grid:
+        stage("paths")
     return MapAnalysis(occupancy, grid, law, robot, controller, loop_model.name, boundary.NV_critical, segments, samples,
-                       skeleton, clearance, unknown, timing, tuple(warnings))
+                       skeleton, clearance, unknown, timing, tuple(warnings), along)
+
+
+def add_routes(analysis: MapAnalysis, routes) -> MapAnalysis:
+    """The analysis with `routes` (RoutePath) judged too, after its own (`paths.analyze_paths`; grid law only).
+
+    Parameters
+    ----------
+    analysis : MapAnalysis
+        A grid-law analysis.
+    routes : sequence of RoutePath
+        More routes, in map coordinates (m): the user's, or the paths the simulated robot took between goals.
+    """
+    if analysis.paths is None:
+        raise ValueError("routes need --law grid: a route is judged with the histogram grid's field")
+    (loop_model,) = models_for(analysis.controller, [analysis.model])
+    loop = Loop(analysis.robot.tau, analysis.controller.T, analysis.robot.k, c=0.0)
+    boundary = loop_model.boundary(loop)
+    growth = GrowthRate(lambda NV: loop_model.rightmost_root(NV, loop), boundary.NV_critical)
+    transition = SampledTransition.of(loop_model, loop) if loop_model.name == "sampled" else None
+    paths = list(analysis.paths.paths)
+    paths += [replace(r, branch=len(paths) + k) for k, r in enumerate(routes)]
+    along = analyze_paths(analysis.grid, analysis.law, paths, analysis.clearance, analysis.robot.W, analysis.robot.V, boundary, growth,
+                          loop_model.is_stable(0.0, loop), transition)
+    return replace(analysis, paths=along)
 
 
 def sample_verdict(N: float, V: float, boundary, heading_stable: bool) -> Judgement:

@@ -49,7 +49,7 @@ from ..laws.effective_force import GridWallLaw
 from ..numerics.solve import newton_increasing
 from .field import HistogramMap, window_force
 
-__all__ = ["NEWTON_STEPS", "RAY_LENGTH", "Samples", "grid_equilibria", "power_equilibria"]
+__all__ = ["NEWTON_STEPS", "RAY_LENGTH", "Samples", "equilibria_at", "grid_equilibria", "lateral_force", "power_equilibria"]
 
 NEWTON_STEPS = 12
 """Safeguarded Newton steps narrowing a root's scan bracket (`solve.newton_increasing`): a smooth root reaches
@@ -190,12 +190,27 @@ def _band(grid: HistogramMap, clearance: np.ndarray, x, y, tx, ty, W: float, rea
     return np.where(any_fit, low, 1.0), np.where(any_fit, high, -1.0)
 
 
-def _lateral(grid, law, x, y, tx, ty, s, jacobian=False):
+def lateral_force(grid, law, x, y, tx, ty, s, jacobian=False):
     """F_n, F_r·t (and dF_n/ds) at p + s·nrm, nrm = (−ty, tx), averaged over the robot's position along t within one cell.
 
     The average is over u in [−c/2, c/2) (Gauss–Legendre, `PHASE_NODES` nodes), the
     convention of the grid's wall law (`effective_force.GridWallLaw`: the robot
     passes every position in its cell many times before the oscillation builds up).
+
+    Parameters
+    ----------
+    grid : HistogramMap
+        The map's histogram grid.
+    law : GridWallLaw
+        KB's grid law.
+    x, y : ndarray
+        Points p, m.
+    tx, ty : ndarray
+        Unit travel directions t at them.
+    s : ndarray
+        Lateral offsets along nrm = (−ty, tx), m.
+    jacobian : bool
+        Also return dF_n/ds (1/m).
     """
     from ..numerics.solve import gauss_legendre
 
@@ -213,9 +228,10 @@ def _lateral(grid, law, x, y, tx, ty, s, jacobian=False):
     return fn, ft, nx_ * nx_ * jxx + 2 * nx_ * ny_ * jxy + ny_ * ny_ * jyy
 
 
-def _walls_in_window(grid: HistogramMap, law: GridWallLaw, x, y) -> np.ndarray:
-    """Whether the window of each point's cell holds an occupied cell (False: an open area, no repulsion)."""
-    h = law.window_cells // 2
+def _walls_in_window(grid: HistogramMap, law: GridWallLaw, x, y, extra: int = 0) -> np.ndarray:
+    """Whether the window of each point's cell, widened by `extra` cells each way, holds an occupied cell (False: an
+    open area, no repulsion)."""
+    h = law.window_cells // 2 + extra
     nx, ny = grid.shape
     counts = np.zeros((nx + 1, ny + 1), dtype=np.int64)
     counts[1:, 1:] = np.cumsum(np.cumsum(grid.occupied, axis=0), axis=1)  # summed-area table
@@ -260,10 +276,41 @@ def grid_equilibria(grid: HistogramMap, law: GridWallLaw, routes, clearance: np.
     W : float
         Robot width, m.
     """
+    x, y, seg, tx, ty = sample_points(routes, grid.cell_size)
+    return equilibria_at(grid, law, x, y, tx, ty, seg, clearance, W)
+
+
+def equilibria_at(grid: HistogramMap, law: GridWallLaw, x, y, tx, ty, segment, clearance: np.ndarray, W: float,
+                  newton_steps: int = NEWTON_STEPS) -> Samples:
+    """Equilibria and N at given points with travel directions (`grid_equilibria` for any route; module docstring).
+
+    Parameters
+    ----------
+    grid : HistogramMap
+        The map's histogram grid.
+    law : GridWallLaw
+        KB's grid law (window, cell size, certainty value).
+    x, y : ndarray
+        Sample points, m.
+    tx, ty : ndarray
+        Unit travel directions at them.
+    segment : ndarray of int
+        The route of each point.
+    clearance : ndarray, shape (nx, ny)
+        Distance to the nearest occupied cell, m, per histogram cell.
+    W : float
+        Robot width, m.
+    newton_steps : int
+        Safeguarded Newton steps per root (`NEWTON_STEPS`: a jump located to the bracket / 2^12).
+    """
     c = grid.cell_size
-    x, y, seg, tx, ty = sample_points(routes, c)
+    x, y, tx, ty = (np.asarray(v, dtype=float) for v in (x, y, tx, ty))
+    seg = np.asarray(segment)
     low, high = _band(grid, clearance, x, y, tx, ty, W, law.reach)
-    span = np.where(high > low, high - low, 0.0)
+    # a sample whose band lies where no window holds a wall has F_n = 0 exactly across it: no root, no scan needed
+    # (the band reaches at most `law.reach` from the sample, so every window of it lies in the widened one)
+    walls_near = _walls_in_window(grid, law, x, y, extra=int(math.ceil(law.reach / c)) + 2)  # + the cell phase
+    span = np.where((high > low) & walls_near, high - low, 0.0)
     # the scan: `steps` equal steps of at most c/2 from low to high, both ends included (at least two steps, so a
     # band narrower than one step still has a middle point), flattened over the samples
     steps = np.where(span > 0, np.maximum(2, np.ceil(span / (SCAN_STEP_CELLS * c))), 0).astype(np.int64)
@@ -272,7 +319,7 @@ def grid_equilibria(grid: HistogramMap, law: GridWallLaw, routes, clearance: np.
     first = np.cumsum(lengths) - lengths
     position = np.arange(owner.size) - first[owner]
     s = low[owner] + position * (span / np.maximum(steps, 1))[owner]
-    fn, _ = _lateral(grid, law, x[owner], y[owner], tx[owner], ty[owner], s)
+    fn, _ = lateral_force(grid, law, x[owner], y[owner], tx[owner], ty[owner], s)
     field = _walls_in_window(grid, law, x, y)
     k_all, lo_all, hi_all, start_all, sign_lo = _brackets(owner, s, fn)
     roots = np.bincount(k_all, minlength=x.size)
@@ -286,11 +333,11 @@ def grid_equilibria(grid: HistogramMap, law: GridWallLaw, routes, clearance: np.
     sign = np.where(sign_lo[chosen] < 0, 1.0, -1.0)
 
     def increasing(at):
-        f, _, df = _lateral(grid, law, x[k], y[k], tx[k], ty[k], at, jacobian=True)
+        f, _, df = lateral_force(grid, law, x[k], y[k], tx[k], ty[k], at, jacobian=True)
         return sign * f, sign * df
 
-    s0 = newton_increasing(increasing, lo, hi, atol=ROOT_TOLERANCE, iterations=NEWTON_STEPS)
-    f, ft, df = _lateral(grid, law, x[k], y[k], tx[k], ty[k], s0, jacobian=True)
+    s0 = newton_increasing(increasing, lo, hi, atol=ROOT_TOLERANCE, iterations=newton_steps)
+    f, ft, df = lateral_force(grid, law, x[k], y[k], tx[k], ty[k], s0, jacobian=True)
     forward = 1.0 - np.abs(ft)
     offset, N, F_t, along = (np.full(x.size, np.nan) for _ in range(4))
     offset[k] = s0

@@ -26,6 +26,9 @@ import numpy as np
 
 __all__ = [
     "OUTPUT_FILES",
+    "ROUTE_COLUMNS",
+    "ROUTE_FILES",
+    "routes_csv",
     "percent_to_pixel",
     "pixel_to_percent",
     "segments_csv",
@@ -35,6 +38,10 @@ __all__ = [
 ]
 
 OUTPUT_FILES = ("stability.png", "segments.csv", "speed_mask.pgm", "speed_mask.yaml")
+ROUTE_FILES = ("routes.png", "routes.csv")
+"""Also written with the routes' verdicts (`MapAnalysis.paths`, the grid law): their picture and their stretches."""
+ROUTE_COLUMNS = ("route", "start", "stop", "x0", "y0", "x1", "y1", "length", "verdict", "label", "growth_rate", "efolds", "N", "margin",
+                 "V_critical", "direction", "oscillates", "amplitude", "linearized_at_route")
 """What ``--out-dir`` receives."""
 CSV_COLUMNS = ("x0", "y0", "x1", "y1", "length", "N", "c", "V_critical", "margin", "stable", "verdict", "offset", "samples", "analysed",
                "N_max", "V_critical_local", "wavelength")
@@ -50,6 +57,22 @@ def _csv_value(v) -> str:
     if isinstance(v, float):
         return "inf" if v == math.inf else f"{v:.6g}"
     return str(v)
+
+
+def routes_csv(analysis) -> str:
+    """One row per stretch of a route (`maps.paths.PathStretch`): route, arc positions and ends (m), length, verdict or
+    the reason without one, label, the worst window's growth rate (1/s), e-folds, N_eff (1/m), margin, V* (m/s),
+    direction, whether the linear loop weaves there and its amplitude (m), the share linearized about the route.
+
+    Parameters
+    ----------
+    analysis : MapAnalysis
+        With `MapAnalysis.paths`.
+    """
+    lines = [",".join(ROUTE_COLUMNS)]
+    for stretch in analysis.paths.stretches:
+        lines.append(",".join(_csv_value(getattr(stretch, key)) for key in ROUTE_COLUMNS))
+    return "\n".join(lines) + "\n"
 
 
 def segments_csv(analysis) -> str:

@@ -34,7 +34,8 @@ import numpy as np
 from ..extras import require
 from .field import HistogramMap
 
-__all__ = ["JUNCTION_CUT", "MIN_LENGTH", "TOLERANCE_CELLS", "Route", "default_min_length", "find_routes", "prune_spurs", "skeleton_of"]
+__all__ = ["JUNCTION_CUT", "MIN_LENGTH", "TOLERANCE_CELLS", "Route", "RoutePath", "default_min_length", "find_paths", "find_routes", "path_of",
+           "prune_spurs", "skeleton_of"]
 
 MIN_LENGTH = 1.0
 """Shortest segment analysed, m (default; at least 1.25 W is used): shorter pieces are bends and junction stubs."""
@@ -68,6 +69,165 @@ class Route:
     def length(self) -> float:
         """m."""
         return math.hypot(self.x1 - self.x0, self.y1 - self.y0)
+
+
+@dataclass(frozen=True)
+class RoutePath:
+    """A route of any shape: a polyline the robot drives along (docs/maps.md, "Verdicts along every route").
+
+    Attributes
+    ----------
+    points : ndarray, shape (n, 2)
+        Vertices in map coordinates, m, in the order of travel (n >= 2).
+    branch : int
+        Index of the route (a skeleton branch, or the user's route).
+    source : str
+        Where it comes from: "skeleton", "path" (a Nav2 path or CSV), "waypoints" or "goals".
+    """
+
+    points: np.ndarray
+    branch: int
+    source: str = "skeleton"
+
+    @property
+    def length(self) -> float:
+        """m."""
+        return float(np.hypot(*np.diff(self.points, axis=0).T).sum())
+
+
+def path_of(points, branch: int = 0, source: str = "path") -> RoutePath:
+    """A `RoutePath` through `points` (m; repeated points dropped); ValueError if fewer than two distinct points.
+
+    Parameters
+    ----------
+    points : array_like, shape (n, 2)
+        Vertices, m.
+    branch : int
+        Index of the route.
+    source : str
+        Where it comes from (`RoutePath.source`).
+    """
+    p = np.asarray(points, dtype=float).reshape(-1, 2)
+    if not np.isfinite(p).all():
+        raise ValueError(f"a {source} route's points must be finite numbers (m); got {p[~np.isfinite(p).all(axis=1)][:1].tolist()}")
+    keep = np.concatenate([[True], np.hypot(*np.diff(p, axis=0).T) > 1e-9]) if len(p) else np.zeros(0, dtype=bool)
+    p = p[keep]
+    if len(p) < 2:
+        raise ValueError(f"a {source} route needs at least two distinct points; got {len(p)}")
+    return RoutePath(p, int(branch), source)
+
+
+def find_paths(grid: HistogramMap, skeleton: np.ndarray, clearance: np.ndarray) -> list:
+    """Every branch of the (pruned) skeleton as a `RoutePath`, uncut, joined to the junctions it meets.
+
+    The branches of `find_routes` without the straight-piece split, the junction cut or the minimum length: each
+    is ordered, simplified into a polyline (tolerance `TOLERANCE_CELLS` cells), and an end that touches a junction
+    zone is extended to that zone's centroid, so the routes run through every junction. Branches of a single cell
+    are dropped.
+
+    Parameters
+    ----------
+    grid : HistogramMap
+        The map's histogram grid.
+    skeleton : ndarray of bool, shape (nx, ny)
+        The pruned skeleton (`find_routes`).
+    clearance : ndarray, shape (nx, ny)
+        Distance to the nearest occupied cell, m.
+    """
+    from scipy.ndimage import center_of_mass, label
+    from skimage.measure import approximate_polygon
+
+    from scipy.ndimage import binary_dilation
+
+    junction = _junctions(skeleton, _crossing_number(skeleton))
+    # junction zones a few cells apart are one crossing (a branch of a cell or two between them is no corridor)
+    zones, n_zones = label(binary_dilation(junction, structure=np.ones((3, 3), dtype=bool), iterations=JUNCTION_MERGE),
+                           structure=np.ones((3, 3), dtype=int))
+    centres = np.array(center_of_mass(junction, zones, range(1, n_zones + 1))).reshape(-1, 2)
+    labels, n_branches = label(skeleton & ~junction, structure=np.ones((3, 3), dtype=int))
+    nx, ny = skeleton.shape
+    branches = []  # (points (m), zone at the head, zone at the tail)
+    for index, path in _ordered_branches(labels, n_branches):
+        ij = np.array(path, dtype=float)
+
+        def zone_of(cell):
+            near = {int(zones[cell[0] + di, cell[1] + dj]) for di, dj in _STEPS + [(0, 0)]
+                    if 0 <= cell[0] + di < nx and 0 <= cell[1] + dj < ny and zones[cell[0] + di, cell[1] + dj] > 0}
+            return min(near) if near else 0
+
+        if all(zones[p] for p in path):
+            continue  # a stub between junction cells of one crossing
+        head, tail = zone_of(path[0]), zone_of(path[-1])
+        if head:
+            ij = np.vstack([centres[head - 1], ij])
+        if tail and (tail != head or len(path) > 2):
+            ij = np.vstack([ij, centres[tail - 1]])
+        branches.append((np.column_stack(grid.cell_center(ij[:, 0], ij[:, 1])), head, tail))
+    paths = []
+    for k, chain in enumerate(_chains(branches)):
+        simple = approximate_polygon(chain, tolerance=TOLERANCE_CELLS * grid.cell_size)
+        if len(simple) >= 2 and np.hypot(*np.diff(simple, axis=0).T).sum() > 0:
+            paths.append(path_of(simple, k, "skeleton"))
+    return paths
+
+
+JUNCTION_MERGE = 2
+"""Cells by which junction zones are grown before they are told apart (`find_paths`): zones closer than that are one."""
+THROUGH_ANGLE = 45.0
+"""Largest turn (deg) between two branches meeting at a junction that `find_paths` joins into one route: a corridor
+crossing a junction (a gap between shelves, a side door) continues; a branch turning off more sharply starts its own."""
+THROUGH_REACH = 1.0
+"""Length (m) of a branch end over which its direction at a junction is measured."""
+
+
+def _direction_at(points: np.ndarray, at_head: bool) -> np.ndarray:
+    """Unit direction from a branch's end (head or tail) into the branch, over `THROUGH_REACH` m."""
+    p = points if at_head else points[::-1]
+    arc = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(p, axis=0).T))])
+    far = p[min(int(np.searchsorted(arc, THROUGH_REACH)), len(p) - 1)]
+    d = far - p[0]
+    n = math.hypot(*d)
+    return d / n if n > 0 else d
+
+
+def _chains(branches) -> list:
+    """The branches joined through junctions where they continue within `THROUGH_ANGLE` (greedy, straightest
+    first; each branch end joins at most one other): a list of point arrays, m."""
+    ends = {}
+    for b, (points, head, tail) in enumerate(branches):
+        for at_head, zone in ((True, head), (False, tail)):
+            if zone:
+                ends.setdefault(zone, []).append((b, at_head, _direction_at(points, at_head)))
+    link = {}
+    limit = -math.cos(math.radians(THROUGH_ANGLE))
+    for zone in sorted(ends):
+        pairs = sorted(((float(np.dot(d1, d2)), (b1, h1), (b2, h2)) for i, (b1, h1, d1) in enumerate(ends[zone])
+                        for (b2, h2, d2) in ends[zone][i + 1:] if b1 != b2), key=lambda item: item[0])
+        for score, e1, e2 in pairs:
+            if score <= limit and e1 not in link and e2 not in link:
+                link[e1], link[e2] = e2, e1
+    seen, chains = set(), []
+    order = sorted(range(len(branches)), key=lambda b: ((b, True) in link and (b, False) in link, b))  # chain ends first
+    for start in order:
+        if start in seen:
+            continue
+        # walk back to a free end (or round a loop), then forward
+        b, at_head = start, True
+        while (b, at_head) in link and link[(b, at_head)][0] != start:
+            nb, nh = link[(b, at_head)]
+            b, at_head = nb, not nh
+        pieces, current, entering_head = [], b, at_head
+        while current not in seen:
+            seen.add(current)
+            pts = branches[current][0]
+            pieces.append(pts if entering_head else pts[::-1])
+            exit_end = (current, not entering_head)
+            if exit_end not in link:
+                break
+            current, entering = link[exit_end]
+            entering_head = entering
+        chains.append(np.vstack(pieces))
+    return chains
 
 
 def skeleton_of(grid: HistogramMap, W: float):
@@ -196,13 +356,7 @@ def find_routes(grid: HistogramMap, W: float, min_length: float | None = None) -
     near_junction = _junction_radius(junction, clearance)
     c = grid.cell_size
     routes = []
-    for index, cells in enumerate(_branch_cells(labels, n_branches)):
-        if len(cells) < 2:
-            continue
-        cell_set = set(cells)
-        branch_count = {p: sum((p[0] + di, p[1] + dj) in cell_set for di, dj in _STEPS) for p in cells}
-        ends = [p for p in cells if branch_count[p] <= 1]
-        path = _order(cell_set, min(ends) if ends else min(cells))
+    for index, path in _ordered_branches(labels, n_branches):
         ij = np.array(path, dtype=float)
         points = np.column_stack(grid.cell_center(ij[:, 0], ij[:, 1]))
         cut0, cut1 = JUNCTION_CUT * near_junction(path[0]), JUNCTION_CUT * near_junction(path[-1])
@@ -215,6 +369,17 @@ def find_routes(grid: HistogramMap, W: float, min_length: float | None = None) -
             if route.length >= min_length:
                 routes.append(route)
     return routes, skeleton, clearance
+
+
+def _ordered_branches(labels: np.ndarray, count: int):
+    """(index, cells from one end to the other) of each labelled branch of two or more cells (`_order`)."""
+    for index, cells in enumerate(_branch_cells(labels, count)):
+        if len(cells) < 2:
+            continue
+        cell_set = set(cells)
+        branch_count = {p: sum((p[0] + di, p[1] + dj) in cell_set for di, dj in _STEPS) for p in cells}
+        ends = [p for p in cells if branch_count[p] <= 1]
+        yield index, _order(cell_set, min(ends) if ends else min(cells))
 
 
 def _junctions(skeleton: np.ndarray, crossing: np.ndarray) -> np.ndarray:

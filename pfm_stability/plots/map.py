@@ -8,7 +8,7 @@ import numpy as np
 
 from .common import figure_and_axes
 
-__all__ = ["NO_VERDICT_LABELS", "NO_VERDICT_STYLES", "known_extent", "map_greys", "plot_map_stability"]
+__all__ = ["NO_VERDICT_LABELS", "NO_VERDICT_STYLES", "known_extent", "map_frame", "map_greys", "plot_map_stability"]
 
 FREE_GREY, UNKNOWN_GREY, OCCUPIED_GREY = 1.0, 0.82, 0.15
 """Shades of free, unknown and occupied map cells (white, light grey, near black)."""
@@ -70,6 +70,31 @@ def known_extent(occupancy, margin: float = 1.0) -> tuple:
             max(y0, y0 + rows[0] * r - margin), min(y1, y0 + (rows[-1] + 1) * r + margin))
 
 
+def map_frame(occupancy, ax, size, room: tuple):
+    """(fig, ax, extent, aspect): the axes with the map drawn in greys, sized from the known part's aspect ratio plus
+    `room` (width, height, inches) for the colour bar, legend and title unless `size` is given.
+
+    Parameters
+    ----------
+    occupancy : OccupancyMap
+        The map.
+    ax : matplotlib Axes or None
+        Where to draw (None: a new figure).
+    size : (float, float) or None
+        Figure size, inches.
+    room : (float, float)
+        Inches added to the map's width and height.
+    """
+    x0, x1, y0, y1 = known_extent(occupancy)
+    aspect = (y1 - y0) / max(x1 - x0, 1e-9)
+    if size is None:
+        w_map, h_map = (9.5, 9.5 * aspect) if aspect <= 1.2 else (10.5 / aspect, 10.5)
+        size = (max(w_map + room[0], 7.0), max(h_map + room[1], 4.5))
+    fig, ax = figure_and_axes(ax, size)
+    ax.imshow(map_greys(occupancy), extent=occupancy.extent, origin="upper", interpolation="nearest", zorder=0)
+    return fig, ax, (x0, x1, y0, y1), aspect
+
+
 def _colour_limit(analysis) -> float:
     """Top of the V* colour scale, m/s: 2 V (so V sits mid-scale), or the largest finite V* below it."""
     return 2.0 * analysis.robot.V
@@ -105,14 +130,7 @@ def plot_map_stability(analysis, ax=None, *, title: str | None = None, size=None
     from matplotlib.lines import Line2D
 
     occupancy = analysis.occupancy
-    full = occupancy.extent
-    x0, x1, y0, y1 = known_extent(occupancy)
-    aspect = (y1 - y0) / max(x1 - x0, 1e-9)
-    if size is None:
-        w_map, h_map = (9.5, 9.5 * aspect) if aspect <= 1.2 else (10.5 / aspect, 10.5)
-        size = (max(w_map + 1.6, 7.0), max(h_map + 2.2, 4.5))
-    fig, ax = figure_and_axes(ax, size)
-    ax.imshow(map_greys(occupancy), extent=full, origin="upper", interpolation="nearest", zorder=0)
+    fig, ax, (x0, x1, y0, y1), aspect = map_frame(occupancy, ax, size, (1.6, 2.2))
     V = analysis.robot.V
     top = _colour_limit(analysis)
     cmap = colormaps["RdYlGn"]

@@ -1,0 +1,120 @@
+"""Oscillation episodes of a lateral motion: where a robot weaves (docs/maps.md, "Validation by driving").
+
+One definition serves the map's prediction (`maps.paths`: the linear loop driven along a route) and its judge
+(`validation.map_drives`: the simulator's drives). The lateral oscillation is the motion minus its own average
+over one period P = 2π/ω* (the loop's oscillation at the boundary; `scipy.ndimage.uniform_filter1d`), smoothed
+over P/8 (the cell ripple, at c/V, is faster). Its turning points give amplitudes; an **episode** is
+`EPISODE_PERIODS` periods — 2·`EPISODE_PERIODS` turning points alternating in side, consecutive ones P/4 to P
+apart (an oscillation, not a bend of the path) — whose amplitudes grow (a least-squares fit of log amplitude
+against time rises by at least `GROWTH_EFOLDS` e-fold over them) or all stay above `AMPLITUDE_THRESHOLD`.
+Amplitudes below `NOISE_FLOOR` are no oscillation.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+__all__ = ["AMPLITUDE_THRESHOLD", "EPISODE_PERIODS", "GROWTH_EFOLDS", "NOISE_FLOOR", "episodes", "lateral_episodes"]
+
+EPISODE_PERIODS = 3
+"""Periods of an episode ("a lateral deviation that grows over at least three periods, or stays above a threshold")."""
+GROWTH_EFOLDS = 1.0
+"""e-folds the fitted amplitude must gain over an episode's periods to count as growing."""
+AMPLITUDE_THRESHOLD = 0.015
+"""Lateral amplitude (m) that, held over `EPISODE_PERIODS` periods, is an episode whether or not it grows. An unstable
+loop's oscillation grows until the steering-rate limit holds it in a limit cycle: ±2 cm on the straight test corridor
+at 1.4 V* (W 0.4 m, k 20 1/s, 120 deg/s; tests/test_map_paths.py), reached within two periods, too soon for the
+growth to count; a stable loop's forced ripple on the same grid, and its decaying start transient after the first
+period, stay below 1.3 cm."""
+NOISE_FLOOR = 0.005
+"""Amplitudes below this (m) are no oscillation (the grid's quantization ripple is ~mm)."""
+
+
+def lateral_episodes(t, lateral, period: float) -> tuple:
+    """(episodes, max_amplitude) of a lateral signal: the (t_start, t_end) of each episode (s) and the largest
+    amplitude of its oscillation about its one-period average (m) (module docstring).
+
+    Parameters
+    ----------
+    t : ndarray
+        Times, s (uniform step).
+    lateral : ndarray
+        Lateral position, m.
+    period : float
+        The oscillation period P, s.
+    """
+    from scipy.ndimage import uniform_filter1d
+
+    t, lateral = np.asarray(t, dtype=float), np.asarray(lateral, dtype=float)
+    if t.size < 8 or not period > 0 or not math.isfinite(period):
+        return (), 0.0
+    n = max(3, int(round(period / float(np.median(np.diff(t))))))
+    if t.size < 2 * n:
+        return (), 0.0
+    return _episodes(t, lateral - uniform_filter1d(lateral, n, mode="nearest"), period, n)
+
+
+def episodes(t, x, y, period: float) -> tuple:
+    """(episodes, max_amplitude) of a trajectory in the plane: its lateral oscillation is its distance across its own
+    path averaged over one period (module docstring).
+
+    Parameters
+    ----------
+    t : ndarray
+        Times, s (uniform step).
+    x, y : ndarray
+        Positions, m.
+    period : float
+        The oscillation period P, s.
+    """
+    from scipy.ndimage import uniform_filter1d
+
+    t, x, y = (np.asarray(v, dtype=float) for v in (t, x, y))
+    if t.size < 8 or not period > 0 or not math.isfinite(period):
+        return (), 0.0
+    n = max(3, int(round(period / float(np.median(np.diff(t))))))
+    if t.size < 2 * n:
+        return (), 0.0
+    sx, sy = uniform_filter1d(x, n, mode="nearest"), uniform_filter1d(y, n, mode="nearest")
+    hx, hy = np.gradient(sx), np.gradient(sy)
+    norm = np.hypot(hx, hy)
+    norm[norm == 0] = 1.0
+    return _episodes(t, ((x - sx) * -hy + (y - sy) * hx) / norm, period, n)
+
+
+def _episodes(t, r, period, n) -> tuple:
+    """The episodes of the oscillation `r` (m) about the average path (`n` samples a period)."""
+    from scipy.ndimage import uniform_filter1d
+
+    r = uniform_filter1d(r, max(1, n // 8), mode="nearest")
+    r[: n // 2], r[-(n // 2):] = 0.0, 0.0  # the averaged path is not centred at the ends
+    dr = np.diff(r)
+    turn = np.flatnonzero((dr[:-1] > 0) & (dr[1:] <= 0) | (dr[:-1] < 0) & (dr[1:] >= 0)) + 1
+    turn = turn[np.abs(r[turn]) > NOISE_FLOOR]
+    kept = []  # turning points closer than a quarter period are ripple: keep the larger of each close pair
+    for k in turn:
+        if kept and t[k] - t[kept[-1]] < period / 4:
+            if abs(r[k]) > abs(r[kept[-1]]):
+                kept[-1] = k
+            continue
+        kept.append(k)
+    kept = np.array(kept, dtype=int)
+    amplitude = np.abs(r[kept]) if kept.size else np.zeros(0)
+    found = []
+    m = 2 * EPISODE_PERIODS
+    for i in range(0, max(0, kept.size - m + 1)):
+        sel, a = kept[i:i + m], amplitude[i:i + m]
+        gaps = np.diff(t[sel])
+        if np.any(np.sign(r[sel][1:]) == np.sign(r[sel][:-1])) or gaps.min() < period / 4 or gaps.max() > period:
+            continue  # not an oscillation: turning points on one side, or half-periods far from P/2 (a bend of the path)
+        span = t[sel[-1]] - t[sel[0]]
+        slope = np.polyfit(t[sel], np.log(a), 1)[0]
+        if slope * span >= GROWTH_EFOLDS or a.min() >= AMPLITUDE_THRESHOLD:
+            lo, hi = t[sel[0]] - period / 4, t[sel[-1]]
+            if found and lo <= found[-1][1]:
+                found[-1] = (found[-1][0], float(hi))
+            else:
+                found.append((float(lo), float(hi)))
+    return tuple(found), float(amplitude.max()) if amplitude.size else 0.0

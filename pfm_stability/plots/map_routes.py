@@ -1,0 +1,112 @@
+"""A map with the verdict along every route, and what the drives found (`maps.paths.PathVerdicts`,
+`validation.map_drives.DriveValidation`)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .map import OCCUPIED_GREY, UNKNOWN_GREY, map_frame
+
+__all__ = ["ROUTE_STYLES", "plot_route_verdicts"]
+
+ROUTE_STYLES = {
+    "nothing grows": dict(color="#a6d96a", lw=1.6, label="stable: nothing grows (< 1 e-fold, or no field)"),
+    "stable": dict(color="#1a9641", lw=2.6, label="stable (a disturbance decays)"),
+    "oscillates": dict(color="#fdae61", lw=3.2, label="unstable: the loop weaves (an episode over 3 periods)"),
+    "unstable": dict(color="#d7191c", lw=3.6, label="unstable: a disturbance grows (>= 1 e-fold)"),
+    "wall ahead both ways": dict(color="0.45", lw=1.4, label="no verdict: wall ahead both ways", ls=(0, (1.5, 2.0))),
+    "inside an obstacle": dict(color="0.3", lw=1.4, label="no verdict: inside an obstacle", ls=(0, (4.0, 2.0))),
+}
+"""Style of a stretch by its kind: the label of a stable or unstable stretch, else its verdict (a reason)."""
+
+
+def _kind(stretch) -> str:
+    if stretch.verdict == "stable":
+        return "nothing grows" if stretch.label == "nothing grows" else "stable"
+    if stretch.verdict == "unstable":
+        return "oscillates" if stretch.label == "oscillates" else "unstable"
+    return stretch.verdict if stretch.verdict in ROUTE_STYLES else "inside an obstacle"
+
+
+def _stretch_lines(paths, stretch) -> np.ndarray:
+    """The polyline of a stretch (m): its route's points between its start and stop arc positions."""
+    points = paths[stretch.route].points
+    arc = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(points, axis=0).T))])
+    inner = (arc > stretch.start) & (arc < stretch.stop)
+    ends = [np.array([np.interp(a, arc, points[:, 0]), np.interp(a, arc, points[:, 1])]) for a in (stretch.start, stretch.stop)]
+    return np.vstack([ends[0], points[inner], ends[1]])
+
+
+def plot_route_verdicts(analysis, drives=None, ax=None, *, title: str | None = None, size=None):
+    """The map with every route stretch drawn by its verdict, the unjudged ones by reason, and the drives' episodes.
+
+    Parameters
+    ----------
+    analysis : MapAnalysis
+        With its routes' verdicts (`MapAnalysis.paths`).
+    drives : DriveValidation, optional
+        Validation by driving: its episodes (magenta dots), recall and precision (in the title).
+    ax : matplotlib Axes, optional
+    title : str, optional
+        Default: map name, V, the decided fraction, unstable length, and the validation's figures.
+    size : (float, float), optional
+        Figure size, inches.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    from matplotlib.collections import LineCollection
+    from matplotlib.lines import Line2D
+
+    occupancy = analysis.occupancy
+    pv = analysis.paths
+    fig, ax, (x0, x1, y0, y1), _ = map_frame(occupancy, ax, size, (0.6, 2.4))
+    kinds = []
+    for kind, style in ROUTE_STYLES.items():
+        lines = [_stretch_lines(pv.paths, s) for s in pv.stretches if _kind(s) == kind]
+        if not lines:
+            continue
+        kinds.append(kind)
+        ax.add_collection(LineCollection(lines, colors=style["color"], linewidths=style["lw"], linestyles=[style.get("ls", "-")],
+                                         zorder=3 + list(ROUTE_STYLES).index(kind) / 10, capstyle="butt"))
+    handles = [Line2D([], [], color=ROUTE_STYLES[k]["color"], lw=ROUTE_STYLES[k]["lw"], ls=ROUTE_STYLES[k].get("ls", "-"),
+                      label=ROUTE_STYLES[k]["label"]) for k in kinds]
+    validation = ""
+    if drives is not None:
+        if drives.episode_points.size:
+            ax.scatter(drives.episode_points[:, 0], drives.episode_points[:, 1], s=3, color="#c51b7d", alpha=0.5, zorder=6, lw=0)
+            handles.append(Line2D([], [], marker="o", ls="", color="#c51b7d", markersize=5, label="simulated oscillation episodes"))
+        missed = [d for d in drives.disagreements if d.kind == "missed"]
+        alarms = [d for d in drives.disagreements if d.kind == "false alarm"]
+        for group, marker, colour, label in ((missed, "v", "#542788", "missed (episode, predicted stable)"),
+                                             (alarms, "^", "#e66101", "false alarm (predicted unstable, no episode)")):
+            if group:
+                ax.scatter([(d.x0 + d.x1) / 2 for d in group], [(d.y0 + d.y1) / 2 for d in group], marker=marker, s=60, color=colour,
+                           edgecolors="white", linewidths=0.8, zorder=7)
+                handles.append(Line2D([], [], marker=marker, ls="", color=colour, markeredgecolor="white", markersize=8, label=label))
+
+        def pct(v):
+            return "n/a" if v is None else f"{100 * v:.0f}%"
+
+        L = drives.lengths
+        kinds = "; ".join(f"{kind} drives {pct(v['recall'])} / {pct(v['precision'])}" for kind, v in drives.by_kind.items())
+        validation = (f"\n{drives.counts['drives']} drives, {drives.counts['episodes']} episodes: recall {pct(drives.recall)}, "
+                      f"precision {pct(drives.precision)} by route length ({kinds})\n{L['driven']:.0f} of {L['route']:.0f} m "
+                      f"driven; {L['episode']:.1f} m of episodes on the routes, {L['episode_off_route']:.0f} m off them (not scored)")
+    handles.append(Line2D([], [], marker="s", ls="", color=str(OCCUPIED_GREY), markersize=8, label="occupied"))
+    if occupancy.unknown.any():
+        handles.append(Line2D([], [], marker="s", ls="", color=str(UNKNOWN_GREY), markeredgecolor="0.6", markersize=8, label="unknown"))
+    fig.legend(handles=handles, loc="outside lower center", ncol=2, fontsize=8.5, frameon=False)
+    ax.set_xlim(x0, x1)
+    ax.set_ylim(y0, y1)
+    ax.set_xlabel("x (m)")
+    ax.set_ylabel("y (m)")
+    ax.set_aspect("equal")
+    if title is None:
+        s = pv.summary()
+        title = (f"{occupancy.name}: will the robot oscillate at V = {analysis.robot.V:g} m/s? ({analysis.model} model, "
+                 f"unknown cells {analysis.unknown})\n{100 * (s['decided_fraction'] or 0):.0f}% of {s['route_length_m']:.0f} m of route "
+                 f"decided; unstable {s['unstable_length_m']:.1f} m" + validation)
+    ax.set_title(title, fontsize=10.5)
+    return fig

@@ -1,0 +1,447 @@
+"""Validation by driving: the simulated VFF robot driven along a map's routes and between random waypoints
+(``pfm-stability map --validate N``; docs/maps.md, "Validation by driving").
+
+**Drives** (batched, `sim.engine.run_batch`, the simulator's grid law on the map's histogram grid cropped
+around each drive). Half of them follow the routes: a route (`routes.RoutePath`) drawn at random (seeded), driven
+in a random direction from its first point plus a lateral offset δ = `START_OFFSET` (the disturbance) towards its
+last (`Target.point`: the VFF robot finds its own path); the other half go between two random reachable points of
+the routes (the same free component), the robot starting towards the goal. Every drive runs until its target is reached,
+it collides or stalls, or `DRIVE_TIME_FACTOR` times its straight-line time.
+
+**Episodes** (`maps.episodes.episodes`, the one definition the map's prediction uses too): the robot's
+lateral oscillation about its own path averaged over one period P = 2π/ω*; an episode is three periods of it
+that grow by an e-fold or stay above 5 cm.
+
+**Route length** (`score`). Each trajectory point marks its nearest route sample (within `MATCH_DISTANCE` or
+the robot's width): those samples are driven; the points during an episode mark episode samples; samples passed
+in the drive's first period are the start's transient and not measured. A driven sample predicted unstable
+(`maps.paths`: the window's mean growth rate > 0) matches an episode when an episode sample of the same route lies
+within half the verdict's window Λ (the point's verdict is the growth over the window centred there), and an
+episode sample is recalled when a predicted-unstable sample lies within Λ/2. Recall = recalled episode length /
+episode length; precision = matched predicted-unstable length / predicted-unstable length driven (None when a
+denominator is 0: nothing to measure, never counted as agreement). Every disagreement is listed as a stretch
+(`Disagreement`: "missed" — an episode where stable was predicted; "false alarm" — predicted unstable, driven, no
+episode). Route length never driven, and drives that stalled or collided, are counted as such.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..checks import check_integer
+from ..io.serialize import json_number, json_ready
+from ..sim.engine import run_batch
+from ..sim.scenario import Pose, Scenario, Target
+from ..maps.episodes import AMPLITUDE_THRESHOLD, EPISODE_PERIODS, GROWTH_EFOLDS, NOISE_FLOOR, episodes
+from .maps import START_OFFSET, _batches, _table_size, crop_grid, simulator_grid
+
+__all__ = ["DRIVE_TIME_FACTOR", "MATCH_DISTANCE", "Disagreement", "Drive", "DriveValidation", "drive_map", "goal_routes"]
+
+MATCH_DISTANCE = 0.5
+"""Largest distance (m) from a trajectory point to the route sample it marks (at least the robot's width W)."""
+DRIVE_TIME_FACTOR = 2.5
+"""A drive lasts at most this many times its straight-line time, plus 5 s."""
+START_ROOM = 1e-3
+"""Least room (m) beside the robot at a drive's start offset by δ; with less the drive starts on the route itself."""
+CROP_SLACK = 3.0
+"""How far (m) around a drive's straight line its cropped grid reaches beyond the window."""
+
+
+@dataclass(frozen=True)
+class Drive:
+    """One simulated drive.
+
+    Attributes
+    ----------
+    index : int
+    kind : str
+        "route" (along a route piece, target at infinity) or "waypoints" (point to point).
+    x0, y0, x1, y1 : float
+        Start and goal (or the piece's end), m.
+    event : str or None
+        What ended it ("target_reached", "collision", "trapped"; None: its time ran out).
+    duration : float
+        s.
+    episodes : tuple of tuple
+        (t_start, t_end) of each oscillation episode, s.
+    max_amplitude : float
+        Largest lateral oscillation amplitude, m.
+    """
+
+    index: int
+    kind: str
+    x0: float
+    y0: float
+    x1: float
+    y1: float
+    event: str | None
+    duration: float
+    episodes: tuple = ()
+    max_amplitude: float = 0.0
+
+    def to_dict(self) -> dict:
+        """JSON form."""
+        return json_ready({**self.__dict__, "episodes": [list(e) for e in self.episodes]})
+
+
+@dataclass(frozen=True)
+class Disagreement:
+    """A stretch of route where the map's verdict and the drives disagree.
+
+    Attributes
+    ----------
+    kind : str
+        "missed" (an episode where stable was predicted) or "false alarm" (predicted unstable, driven, no episode).
+    route : int
+    start, stop, length : float
+        Arc positions along the route and length, m.
+    x0, y0, x1, y1 : float
+        Its ends, m.
+    drives : tuple of int
+        The drives that passed it.
+    """
+
+    kind: str
+    route: int
+    start: float
+    stop: float
+    length: float
+    x0: float
+    y0: float
+    x1: float
+    y1: float
+    drives: tuple = ()
+
+    def to_dict(self) -> dict:
+        """JSON form."""
+        return json_ready({**self.__dict__, "drives": list(self.drives)})
+
+
+@dataclass(frozen=True)
+class DriveValidation:
+    """Recall and precision of the map's unstable stretches against the drives' episodes, by route length.
+
+    Attributes
+    ----------
+    recall, precision : float or None
+        By route length (None: nothing to measure).
+    drives : tuple of Drive
+    disagreements : tuple of Disagreement
+    lengths : dict
+        Route length (m): ``route``, ``driven``, ``not_driven``, ``episode``, ``episode_recalled``, ``episode_off_route``
+        (the drives' path length in episodes farther than the match distance from any route: measured, not scored),
+        ``predicted_unstable_driven``, ``predicted_unstable_matched``, ``predicted_unstable_not_driven``.
+    counts : dict
+        Drives by how they ended, episodes found.
+    inputs : dict
+    seconds : float
+    episode_points : ndarray, shape (n, 2)
+        Robot positions during the episodes, m (for the picture).
+    by_kind : dict
+        ``route`` and ``waypoints``: the same recall, precision and lengths over that kind of drive only.
+    """
+
+    recall: float | None
+    precision: float | None
+    drives: tuple
+    disagreements: tuple
+    lengths: dict
+    counts: dict
+    inputs: dict = field(default_factory=dict)
+    seconds: float = 0.0
+    episode_points: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))
+    by_kind: dict = field(default_factory=dict)
+
+    def to_dict(self) -> dict:
+        """JSON form."""
+        return {
+            "recall": json_number(self.recall) if self.recall is not None else None,
+            "precision": json_number(self.precision) if self.precision is not None else None,
+            "by_kind": json_ready(self.by_kind),
+            "lengths": json_ready(self.lengths),
+            "counts": json_ready(self.counts),
+            "disagreements": [d.to_dict() for d in self.disagreements],
+            "drives": [d.to_dict() for d in self.drives],
+            "inputs": json_ready(self.inputs),
+            "timing": {"seconds": json_number(self.seconds)},
+        }
+
+
+def _components(analysis):
+    """Free-space component label of each route sample (the robot fits: clearance > W/2)."""
+    from scipy.ndimage import label
+
+    grid = analysis.grid
+    labels, _ = label(analysis.clearance > analysis.robot.W / 2, structure=np.ones((3, 3), dtype=int))
+    pv = analysis.paths
+    i, j = grid.cell_index(pv.samples.x, pv.samples.y)
+    i, j = np.clip(i, 0, grid.shape[0] - 1), np.clip(j, 0, grid.shape[1] - 1)
+    return labels[i, j]
+
+
+def _plan(analysis, count: int, rng) -> list:
+    """The drives: (kind, start (x, y, heading), target, straight length) for `count` drives (module docstring)."""
+    pv = analysis.paths
+    c = analysis.grid.cell_size
+    pieces = [(path.points[0], path.points[-1]) for path in pv.paths if math.hypot(*(path.points[-1] - path.points[0])) >= 4 * c]
+    component = _components(analysis)
+    samples = np.column_stack([pv.samples.x, pv.samples.y])
+    ok = component > 0
+    plans = []
+    route_drives = min(len(pieces), (count + 1) // 2)
+    for k in (rng.permutation(len(pieces))[:route_drives] if pieces else []):
+        p, q = pieces[k]
+        if rng.random() < 0.5:
+            p, q = q, p
+        heading = math.atan2(q[0] - p[0], q[1] - p[1])
+        plans.append(("route", p, q, heading, float(math.hypot(*(q - p)))))
+    candidates = np.flatnonzero(ok)
+    tries = 0
+    while len(plans) < count and candidates.size >= 2 and tries < 50 * count:
+        tries += 1
+        a, b = rng.choice(candidates, 2, replace=False)
+        if component[a] != component[b] or math.hypot(*(samples[b] - samples[a])) < 2.0:
+            continue
+        p, q = samples[a], samples[b]
+        plans.append(("waypoints", p, q, math.atan2(q[0] - p[0], q[1] - p[1]), float(math.hypot(*(q - p)))))
+    return plans
+
+
+def drive_map(analysis, count: int, *, seed: int = 0, progress=None) -> DriveValidation:
+    """Drive the VFF robot `count` times over a map and score the map's unstable stretches (module docstring).
+
+    Parameters
+    ----------
+    analysis : MapAnalysis
+        A grid-law analysis with its routes' verdicts (`MapAnalysis.paths`).
+    count : int
+        Drives, >= 1.
+    seed : int
+        Seed of the drives' choice.
+    progress : callable, optional
+        ``progress(line)`` after each batch.
+    """
+    from scipy.spatial import cKDTree
+
+    from ..maps.paths import PATH_VERDICTS
+
+    started = time.perf_counter()
+    count = check_integer("count", count, 1, 100_000)
+    seed = check_integer("seed", seed, 0, 2**63 - 1)
+    pv = analysis.paths
+    if pv is None:
+        raise ValueError("validation by driving needs --law grid: the simulator senses the map through its histogram grid")
+    robot, controller, law = analysis.robot, analysis.controller, analysis.law
+    rng = np.random.default_rng(seed)
+    grid = simulator_grid(analysis.grid)
+    omega = _omega(analysis)
+    period = 2 * math.pi / omega if omega else math.inf
+    h = law.window_cells // 2
+    reach = (h + 1) * grid.cell_size + CROP_SLACK
+    runs, skipped = [], 0
+    for kind, p, q, heading, length in _plan(analysis, count, rng):
+        ux, uy = math.sin(heading), math.cos(heading)
+        delta = START_OFFSET if kind == "route" else 0.0
+        sx, sy = p[0] + delta * uy, p[1] - delta * ux  # δ to the right of the travel direction
+        local = crop_grid(grid, min(p[0], q[0]) - reach, max(p[0], q[0]) + reach, min(p[1], q[1]) - reach, max(p[1], q[1]) + reach)
+        target = Target.point(float(q[0]), float(q[1]), radius=0.3)
+        duration = DRIVE_TIME_FACTOR * length / robot.V + 5.0
+        room = float(local.clearance([sx], [sy])[0]) - robot.W / 2
+        if not room > START_ROOM:
+            sx, sy = float(p[0]), float(p[1])
+        try:
+            scenario = Scenario(name=f"drive {len(runs)} ({kind})", robot=robot, controller=controller, environment=local,
+                                start=Pose(float(sx), float(sy), heading), target=target, duration=duration,
+                                cell_ratio=law.ratio, window_cells=law.window_cells, trap_time=max(10.0, 1.5 / robot.V))
+        except ValueError:  # the start or the goal touches an obstacle: a drive that cannot start
+            skipped += 1
+            continue
+        runs.append(_Prepared(kind, (float(p[0]), float(p[1]), float(q[0]), float(q[1])), scenario,
+                              _table_size(local, h)))
+    drives, traces = [], []
+    batches = _batches(runs)
+    for b, batch in enumerate(batches, 1):
+        outcome = run_batch([r.scenario for r in batch], record="trajectory", metrics=False)
+        for r, result in zip(batch, outcome.runs):
+            tr = result.trajectory
+            found, amplitude = episodes(tr.t, tr.x, tr.y, period)
+            event = result.events[0].type if result.events else None
+            drives.append(Drive(len(drives), r.kind, *r.ends, event=event, duration=float(tr.t[-1] - tr.t[0]) if tr.t.size else 0.0,
+                                episodes=found, max_amplitude=amplitude))
+            traces.append((tr.t, tr.x, tr.y))
+        if progress:
+            progress(f"map drives: batch {b}/{len(batches)}: {len(batch)} drives")
+
+    # route samples driven, and during episodes, per drive
+    tree = cKDTree(np.column_stack([pv.samples.x, pv.samples.y]))
+    limit = max(MATCH_DISTANCE, robot.W)
+    marks, points = [], []
+    for d, (t, x, y) in zip(drives, traces):
+        if t.size == 0:
+            marks.append((np.zeros(0, dtype=int), np.zeros(0, dtype=int), 0.0))
+            continue
+        dist, nearest = tree.query(np.column_stack([x, y]), distance_upper_bound=limit)
+        hit = np.isfinite(dist) & (t - t[0] >= min(period, 0.25 * d.duration))  # the start's transient is not measured
+        during = np.zeros(t.size, dtype=bool)
+        for lo, hi in d.episodes:
+            during |= (t >= lo) & (t <= hi)
+        step = np.concatenate([[0.0], np.hypot(np.diff(x), np.diff(y))])
+        off = float(step[during & ~np.isfinite(dist)].sum())  # an episode where no route runs: measured, not scored
+        marks.append((np.unique(nearest[hit]), np.unique(nearest[hit & during]), off))
+        points.append(np.column_stack([x[during], y[during]]))
+    unstable = pv.code == PATH_VERDICTS.index("unstable")
+    half = pv.window / 2 if math.isfinite(pv.window) else 0.0
+    near_unstable = _within(unstable, pv.samples.segment, pv.arc, half)
+    lengths, recall, precision, driven, episode, near_episode = _score(pv, marks, range(len(drives)), unstable, near_unstable, half)
+    by_kind = {}
+    for kind in ("route", "waypoints"):
+        chosen = [k for k, d in enumerate(drives) if d.kind == kind]
+        kind_lengths, kind_recall, kind_precision = _score(pv, marks, chosen, unstable, near_unstable, half)[:3]
+        by_kind[kind] = {"recall": json_number(kind_recall) if kind_recall is not None else None,
+                         "precision": json_number(kind_precision) if kind_precision is not None else None, "lengths": kind_lengths}
+    passed_by = [set() for _ in range(pv.code.size)]
+    for d, (hit, _, _) in zip(drives, marks):
+        for k in hit:
+            passed_by[k].add(d.index)
+    disagreements = (_runs("missed", episode & ~near_unstable, pv, passed_by)
+                     + _runs("false alarm", unstable & driven & ~near_episode, pv, passed_by))
+    events = [d.event or "time" for d in drives]
+    counts = {"drives": len(drives), "not_started": skipped, "route_drives": sum(d.kind == "route" for d in drives),
+              "waypoint_drives": sum(d.kind == "waypoints" for d in drives), "episodes": sum(len(d.episodes) for d in drives),
+              **{f"ended_{e}": events.count(e) for e in sorted(set(events))}}
+    inputs = {"count": count, "seed": seed, "V": robot.V, "period": json_number(period), "window": json_number(pv.window),
+              "episode_periods": EPISODE_PERIODS, "growth_efolds": GROWTH_EFOLDS, "amplitude_threshold": AMPLITUDE_THRESHOLD,
+              "noise_floor": NOISE_FLOOR, "match_distance": limit, "start_offset": START_OFFSET}
+    pts = np.vstack(points) if points else np.zeros((0, 2))
+    return DriveValidation(recall, precision, tuple(drives), disagreements, lengths, counts, inputs, time.perf_counter() - started, pts,
+                           by_kind)
+
+
+def _score(pv, marks, chosen, unstable, near_unstable, half):
+    """(lengths, recall, precision, driven, episode, near_episode) of the drives `chosen` (module docstring)."""
+    driven = np.zeros(pv.code.size, dtype=bool)
+    episode = np.zeros(pv.code.size, dtype=bool)
+    off_route = 0.0
+    for k in chosen:
+        hit, during, off = marks[k]
+        driven[hit] = True
+        episode[during] = True
+        off_route += off
+    near_episode = _within(episode, pv.samples.segment, pv.arc, half)
+    ds = pv.spacing
+    lengths = {
+        "route": float(ds.sum()), "driven": float(ds[driven].sum()), "not_driven": float(ds[~driven].sum()),
+        "episode": float(ds[episode].sum()), "episode_recalled": float(ds[episode & near_unstable].sum()),
+        "episode_off_route": off_route,
+        "predicted_unstable_driven": float(ds[unstable & driven].sum()),
+        "predicted_unstable_matched": float(ds[unstable & driven & near_episode].sum()),
+        "predicted_unstable_not_driven": float(ds[unstable & ~driven].sum()),
+    }
+    recall = lengths["episode_recalled"] / lengths["episode"] if lengths["episode"] > 0 else None
+    precision = (lengths["predicted_unstable_matched"] / lengths["predicted_unstable_driven"]
+                 if lengths["predicted_unstable_driven"] > 0 else None)
+    return lengths, recall, precision, driven, episode, near_episode
+
+
+@dataclass(frozen=True)
+class _Prepared:
+    kind: str
+    ends: tuple
+    scenario: Scenario
+    table: tuple
+
+
+def _omega(analysis) -> float | None:
+    """ω* of the analysis' model (rad/s), from its routes' window (Λ = 3·2πV/ω*), or None."""
+    from ..maps.paths import WINDOW_PERIODS
+
+    w = analysis.paths.window
+    if not math.isfinite(w) or w <= 0:
+        return None
+    return WINDOW_PERIODS * 2 * math.pi * analysis.robot.V / w
+
+
+def _within(mask: np.ndarray, route: np.ndarray, arc: np.ndarray, half: float) -> np.ndarray:
+    """True at samples with a `mask` sample of the same route within `half` m of arc."""
+    out = np.zeros(mask.shape, dtype=bool)
+    for r in np.unique(route[mask]):
+        idx = np.flatnonzero(route == r)
+        marked = arc[idx][mask[idx]]
+        pos = np.searchsorted(marked, arc[idx])
+        before = np.abs(arc[idx] - marked[np.clip(pos - 1, 0, marked.size - 1)])
+        after = np.abs(marked[np.clip(pos, 0, marked.size - 1)] - arc[idx])
+        out[idx] = np.minimum(before, after) <= half + 1e-9
+    return out
+
+
+def _runs(kind: str, mask: np.ndarray, pv, passed_by) -> tuple:
+    """The stretches of consecutive `mask` samples of each route, as `Disagreement`s."""
+    out = []
+    route = pv.samples.segment
+    for r in np.unique(route[mask]):
+        idx = np.flatnonzero(route == r)
+        m = mask[idx]
+        edges = np.flatnonzero(np.diff(np.concatenate([[0], m.astype(int), [0]])))
+        for a, b in zip(edges[::2], edges[1::2]):
+            run = idx[a:b]
+            start, stop = float(pv.arc[run[0]] - pv.spacing[run[0]] / 2), float(pv.arc[run[-1]] + pv.spacing[run[-1]] / 2)
+            drives = sorted(set().union(*(passed_by[k] for k in run)))
+            out.append(Disagreement(kind, int(r), start, stop, float(pv.spacing[run].sum()), float(pv.samples.x[run[0]]),
+                                    float(pv.samples.y[run[0]]), float(pv.samples.x[run[-1]]), float(pv.samples.y[run[-1]]), tuple(drives)))
+    return tuple(out)
+
+
+def goal_routes(analysis, goals, progress=None) -> list:
+    """The paths the simulated VFF robot takes between consecutive goals, as routes to judge (`maps.analysis.add_routes`):
+    each drive (point target, the robot starting towards it; the simulator's grid law on the map's grid) averaged over
+    one oscillation period P = 2π/ω* — the path it follows, about which `maps.paths` linearizes — from its start to
+    where it stopped (the goal, a collision or a stall).
+
+    Parameters
+    ----------
+    analysis : MapAnalysis
+        A grid-law analysis with its routes' verdicts.
+    goals : array_like, shape (n, 2)
+        Goals in map coordinates, m (n >= 2).
+    progress : callable, optional
+        ``progress(line)`` once the drives are done.
+    """
+    from scipy.ndimage import uniform_filter1d
+
+    from ..maps.routes import path_of
+
+    goals = np.asarray(goals, dtype=float).reshape(-1, 2)
+    if len(goals) < 2:
+        raise ValueError(f"goals must hold at least two points (m); got {len(goals)}")
+    robot, controller, law = analysis.robot, analysis.controller, analysis.law
+    grid = simulator_grid(analysis.grid)
+    omega = _omega(analysis)
+    period = 2 * math.pi / omega if omega else 1.0
+    scenarios = []
+    for k, (p, q) in enumerate(zip(goals[:-1], goals[1:])):
+        length = float(math.hypot(*(q - p)))
+        heading = math.atan2(q[0] - p[0], q[1] - p[1])
+        try:
+            scenarios.append(Scenario(name=f"goal {k + 1}", robot=robot, controller=controller, environment=grid,
+                                      start=Pose(float(p[0]), float(p[1]), heading), target=Target.point(float(q[0]), float(q[1]), radius=0.3),
+                                      duration=DRIVE_TIME_FACTOR * length / robot.V + 5.0, cell_ratio=law.ratio,
+                                      window_cells=law.window_cells, trap_time=max(10.0, 1.5 / robot.V)))
+        except ValueError as exc:
+            raise ValueError(f"goal {k + 1} -> {k + 2}: {exc}") from None
+    outcome = run_batch(scenarios, record="trajectory", metrics=False)
+    routes = []
+    for k, run in enumerate(outcome.runs):
+        tr = run.trajectory
+        n = max(1, int(round(period / controller.T)))
+        x, y = uniform_filter1d(tr.x, n, mode="nearest"), uniform_filter1d(tr.y, n, mode="nearest")
+        arc = np.concatenate([[0.0], np.cumsum(np.hypot(np.diff(x), np.diff(y)))])
+        step = np.flatnonzero(np.diff(np.concatenate([[-1.0], arc // analysis.grid.cell_size])) > 0)  # a point every cell
+        points = np.column_stack([x[step], y[step]]) if step.size >= 2 else np.column_stack([x[[0, -1]], y[[0, -1]]])
+        routes.append(path_of(points, k, "goals"))
+    if progress:
+        progress(f"goals: {len(routes)} drives between {len(goals)} goals")
+    return routes
