@@ -23,6 +23,7 @@ from pfm_stability.maps.episodes import AMPLITUDE_THRESHOLD, episodes, lateral_e
 from pfm_stability.maps.occupancy import load_map
 from pfm_stability.maps.paths import PATH_VERDICTS, SampledTransition
 from pfm_stability.models import Loop, models_for
+from pfm_stability.models.sampled import closed_loop_matrix
 from pfm_stability.parameters import CARMEL, Corridor
 
 ROBOT = CARMEL.robot.replace(W=0.4, tau=0.1, k=20.0, V=1.0)
@@ -76,7 +77,7 @@ def test_transition_matrix_is_affine_in_the_loop_gain():
     transition = SampledTransition.of(model, loop)
     rng = np.random.default_rng(1)
     for NV in rng.uniform(-5, 40, 6):
-        Phi = np.asarray(model.closed_loop(float(NV), loop))
+        Phi = np.asarray(closed_loop_matrix(loop, loop.loop_gain(float(NV)), model.hold, model.compute_delay))
         assert np.abs(transition.Phi0 + NV * transition.Phi1 - Phi).max() < 1e-12
         radius = np.abs(np.linalg.eigvals(Phi)).max()
         assert math.log(radius) / loop.T == pytest.approx(model.rightmost_root(float(NV), loop).real, abs=1e-9)

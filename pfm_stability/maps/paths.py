@@ -413,8 +413,13 @@ class SampledTransition:
         loop : Loop
             KB's loop (τ, T, k, c).
         """
-        Phi0 = np.asarray(model.closed_loop(0.0, loop), dtype=float)
-        return cls(Phi0, np.asarray(model.closed_loop(1.0, loop), dtype=float) - Phi0, float(loop.T))
+        from ..models.sampled import closed_loop_matrix
+
+        def at(NV):  # Φ_cl at the loop gain NV (1/s)
+            return np.asarray(closed_loop_matrix(loop, loop.loop_gain(NV), model.hold, model.compute_delay), dtype=float)
+
+        Phi0 = at(0.0)
+        return cls(Phi0, at(1.0) - Phi0, float(loop.T))
 
 
 RENORMALIZE = 8
