@@ -48,21 +48,22 @@ HERE = Path(__file__).resolve().parent
 
 
 def corridor_regions():
-    from pfm_stability.plots.regions import plot_corridor_regions
+    from pfm_stability.analysis.region_panels import corridor_panels
 
-    return plot_corridor_regions(ROBOT, CONTROLLER)
+    return corridor_panels(ROBOT, CONTROLLER).plot()
 
 
 def wall_regions():
-    from pfm_stability.plots.regions import plot_wall_regions
+    from pfm_stability.analysis.region_panels import wall_panels
 
-    return plot_wall_regions(ROBOT, CONTROLLER, alphas_deg=(20.0, 45.0, 70.0))
+    return wall_panels(ROBOT, CONTROLLER, alphas_deg=(20.0, 45.0, 70.0)).plot()
 
 
 def model_comparison():
+    from pfm_stability.analysis.comparison import critical_gain_vs_delay, critical_gain_vs_k
     from pfm_stability.plots.comparison import plot_model_comparison
 
-    return plot_model_comparison(ROBOT.tau, CONTROLLER.T, ROBOT.k)
+    return plot_model_comparison(critical_gain_vs_k(ROBOT.tau, CONTROLLER.T), critical_gain_vs_delay(ROBOT.tau, ROBOT.k))
 
 
 def kb_error_maps(resolution: int = 40):
@@ -77,9 +78,9 @@ def kb_error_maps(resolution: int = 40):
 
 
 def root_locus():
-    from pfm_stability.plots.rlocus import plot_root_locus
+    from pfm_stability.analysis.comparison import root_locus as locus_of
 
-    return plot_root_locus(loop_of(ROBOT, CONTROLLER), hold=CONTROLLER.hold, compute_delay=CONTROLLER.compute_delay)
+    return locus_of(loop_of(ROBOT, CONTROLLER), hold=CONTROLLER.hold, compute_delay=CONTROLLER.compute_delay).plot()
 
 
 def simulated_points():
@@ -103,9 +104,9 @@ def grid_law():
 
 
 def simulation_vs_prediction(points=None):
-    from pfm_stability.plots.regions import plot_corridor_region, plot_wall_alpha_critical, region_legend, shading_text
-    from pfm_stability.plots.validation import plot_simulated_boundary
+    from pfm_stability.analysis.region_panels import corridor_V_panel, shading_text, wall_alpha_panel
     from pfm_stability.analysis.regions import region_model
+    from pfm_stability.plots.regions import region_legend
 
     points = simulated_points() if points is None else points
     law = grid_law()
@@ -113,11 +114,11 @@ def simulation_vs_prediction(points=None):
     for col, env in enumerate(("analytic", "grid")):
         env_law = None if env == "analytic" else law
         what = "analytic walls, KB's power law f(W/d)^n" if env == "analytic" else "histogram grid, curves with the grid's effective law"
-        plot_corridor_region(ROBOT, CONTROLLER, law=env_law, ax=axes[0, col], legend=False, resolution=200)
-        plot_simulated_boundary(points["corridor", env], ax=axes[0, col], label="simulated boundary (bisection)")
+        corridor_V_panel(ROBOT, CONTROLLER, law=env_law, resolution=200).plot(ax=axes[0, col], legend=False)
+        points["corridor", env].plot(ax=axes[0, col], label="simulated boundary (bisection)")
         axes[0, col].set_title(f"Corridor, {what}\nstable below V*(L); points: simulated V* at fixed L", fontsize=9)
-        plot_wall_alpha_critical(ROBOT, CONTROLLER, law=env_law, ax=axes[1, col], legend=False, resolution=200)
-        plot_simulated_boundary(points["wall", env], ax=axes[1, col], label="simulated boundary (bisection)")
+        wall_alpha_panel(ROBOT, CONTROLLER, law=env_law, resolution=200).plot(ax=axes[1, col], legend=False)
+        points["wall", env].plot(ax=axes[1, col], label="simulated boundary (bisection)")
         axes[1, col].set_title(f"Wall, {what}\nstable above α*(V); points: simulated α* at fixed V", fontsize=9)
     region_legend(fig=fig, ncol=3)
     fig.suptitle(
@@ -154,13 +155,12 @@ TRAJECTORY_RUNS = (
 
 
 def trajectories():
-    from pfm_stability.plots.trajectory import plot_trajectory
     from pfm_stability.sim import simulate
 
     fig, axes = plt.subplots(1, 3, figsize=(13, 9.0), layout="constrained", gridspec_kw=dict(width_ratios=[1, 1.8, 1]))
     for ax, (name, title) in zip(axes, TRAJECTORY_RUNS):
         result = simulate(name)
-        plot_trajectory(result, ax=ax, title=f"{title}\n{outcome(result)}", legend=False)
+        result.plot(ax=ax, title=f"{title}\n{outcome(result)}", legend=False)
         ax.title.set_fontsize(9)
     figure_legend(fig, ncol=6)
     fig.suptitle("Simulated CARMEL runs in the histogram grid, drawn like Koren & Borenstein 1991 Figs 5 and 6 (robot every 1 s, to scale)", fontsize=11)

@@ -44,9 +44,9 @@ PAPER_TSTAR = {
 
 
 def models() -> dict:
-    from pfm_stability.models.holonomic_delay import make_holonomic_model
+    from pfm_stability.models import make_model
 
-    return {key: make_holonomic_model("exact_delay" if key == "exact_delay" else "sampled", **opts) for key, _, opts in MODELS}
+    return {key: make_model("exact_delay" if key == "exact_delay" else "sampled", **opts) for key, _, opts in MODELS}
 
 
 def corridor_kappa(alpha_v: float) -> tuple:

@@ -12,16 +12,42 @@ Hypothesis profiles, chosen with the environment variable ``HYPOTHESIS_PROFILE``
 
 Tests that fix ``max_examples`` themselves keep it; ``tests/test_cli_fuzz.py``
 scales its budgets from the active profile's ``max_examples``.
+
+BLAS runs on one thread in the suite, as `pfm-stability` itself runs it (``cli.main`` sets
+``OPENBLAS_NUM_THREADS``, ``OMP_NUM_THREADS`` and ``MKL_NUM_THREADS`` to 1 before numpy loads,
+unless the user set them): the package solves many small eigenvalue problems and matrix
+exponentials, on which BLAS threads only spin. Under ``pytest -n 2`` on two cores each worker's
+BLAS threads also compete with the other worker; a 2 × 2 ``scipy.linalg.expm`` took 0.7 ms of CPU
+instead of 9 µs, and the suite three times as long. The variables are set here, before numpy is
+imported (they reach the notebooks' kernels and the fresh processes of the CLI tests too), and
+`threadpoolctl` pins the thread pools in case a plugin loaded numpy first. Numbers do not depend
+on it (the recorded answers of tests/test_answers_unchanged.py replay to 1e-12 either way).
+
+Scheduling under ``pytest -n N`` (``--dist loadgroup`` in pyproject.toml):
+
+* tests that share an expensive module fixture carry ``pytest.mark.xdist_group(name)``: a group runs
+  on one worker, so its fixture is computed once per suite rather than once per worker that happens
+  to get one of its tests (the experiments in quick mode, the verdict sweep, the grid validations,
+  the random trap scenes). xdist hands out the groups first, largest first;
+* then the tests marked ``slow`` (each a few seconds or more; the notebooks of ``analyses/`` are
+  marked here), so that no long test starts last while the other worker idles;
+* then the rest in collection order.
 """
 
 import os
 
-import numpy as np
-import pytest
-from hypothesis import HealthCheck, settings
+for _variable in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ.setdefault(_variable, "1")
 
-from pfm_stability.models import Loop
-from pfm_stability.parameters import CARMEL
+import numpy as np  # noqa: E402  (after the thread variables)
+import pytest  # noqa: E402
+from hypothesis import HealthCheck, settings  # noqa: E402
+from threadpoolctl import threadpool_limits  # noqa: E402
+
+threadpool_limits(1, user_api="blas")
+
+from pfm_stability.models import Loop  # noqa: E402
+from pfm_stability.parameters import CARMEL  # noqa: E402
 
 settings.register_profile(
     "ci", max_examples=100, derandomize=True, deadline=None, print_blob=True, suppress_health_check=[HealthCheck.too_slow]
@@ -49,3 +75,12 @@ def random_loops(count, seed, *, tau=(0.02, 1.0), T=(0.005, 0.5), k=(0.3, 10.0))
         K = rng.uniform(0.2, 3.0) * g / (t + d)
         out.append((t, d, g, K))
     return out
+
+
+def pytest_collection_modifyitems(config, items):
+    """The notebooks are slow; the slow tests go first (a stable sort: otherwise collection order)."""
+    for item in items:
+        if item.path.suffix == ".ipynb":
+            item.add_marker(pytest.mark.slow)
+    items.sort(key=lambda item: item.get_closest_marker("slow") is None)
+

@@ -64,27 +64,14 @@ def test_model_selection_and_options(capsys):
 @pytest.mark.parametrize(
     "args, message",
     [
-        (["--V", "-1"], "V must be a finite number in (0, 100] m/s; got -1.0"),
-        (["--V", "0"], "V must be a finite number in (0, 100] m/s"),
-        (["--tau", "-0.1"], "tau must be a finite number in [0, 100] s"),
-        (["--T", "-0.1"], "T must be a finite number in [0, 100] s"),
-        (["--f", "0"], "f must be a finite number in [1e-06, 1000000]"),
-        (["--n", "-2"], "n must be a finite number in [0.01, 10]"),
-        (["--W", "0"], "W must be a finite number in [0.001, 100] m"),
-        (["--k", "nan"], "k must be a finite number in [1e-06, 10000] 1/s; got nan"),
-        (["--V", "fast"], "V must be a finite number in (0, 100] m/s; got 'fast'"),
-        (["--alpha", "90"], "alpha must be a finite number in [1e-06, 89.999999] deg; got 90.0"),
-        (["--alpha", "0"], "alpha must be a finite number in [1e-06, 89.999999] deg"),
         (["--L", "0.4"], "L must be a finite number in (W/2, 10000] m = (0.4, 10000] m; got 0.4"),
-        (["--L", "inf"], "L must be a finite number in (0, 10000] m; got inf"),
-        (["--compute-delay", "2"], "compute_delay must be an integer in [0, 1]; got '2'"),
-        (["--pade-order", "0"], "pade_order must be an integer in [1, 12]; got '0'"),
         (["--hold", "both"], "invalid choice: 'both'"),
         ([], "alpha or L must be given"),
     ],
 )
 def test_bad_input_exits_2_with_one_line(capsys, args, message):
-    """Exit code 2 and a single stderr line naming the parameter and its range."""
+    """Exit code 2 and a single stderr line naming the parameter and its range (every option's own range:
+    tests/test_cli_fuzz.py::test_every_range_end_is_accepted_or_rejected_as_stated)."""
     extra = [] if any(a in args for a in ("--alpha", "--L")) or args == [] else ["--L", "0.9"]
     code, out, err = run(capsys, "report", *args, *extra)
     assert code == 2

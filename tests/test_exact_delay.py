@@ -105,6 +105,7 @@ def test_delay_margin_is_where_a_root_reaches_the_axis(tau, T, k, K):
     assert not DelayLoop(a, margin * (1 + 1e-7)).is_stable(K)
 
 
+@pytest.mark.slow  # seconds: scheduled first (tests/conftest.py)
 def test_resonant_steering_loop_has_three_crossing_frequencies():
     """kτ > 2 + √3: |a(jω)| dips, so one K meets it at three frequencies, with
     crossing directions +, −, + (Cooke & van den Driessche); counts stay >= 0

@@ -16,6 +16,8 @@ from pathlib import Path
 
 import pytest
 
+pytestmark = pytest.mark.xdist_group("experiments_gc2002")  # one worker runs the scripts once (tests/conftest.py)
+
 EXPERIMENTS = Path(__file__).resolve().parents[1] / "experiments"
 SCRIPTS = ("gc2002_tracking", "gc2002_exponents", "gc2002_eq23", "gc2002_holonomic_corridor", "gc2002_steering",
            "gc2002_relay_wall", "dfapf_fuzzy")

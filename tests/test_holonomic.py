@@ -15,27 +15,15 @@ import pytest
 import scipy.linalg
 import scipy.optimize
 
-from pfm_stability.models import ExactDelay, Loop
-from pfm_stability.models.holonomic import (
-    HolonomicContinuous,
-    HolonomicFirstOrder,
-    HolonomicLoop,
-    HolonomicPade,
-    kinematic_loop,
-)
-from pfm_stability.models.holonomic_delay import (
-    BEST_CURVATURE_PRODUCT,
-    HolonomicExactDelay,
-    HolonomicSampled,
-    make_holonomic_model,
-)
+from pfm_stability.models import Continuous, ExactDelay, KBFirstOrder, Loop, Pade, Sampled, make_model
+from pfm_stability.models.holonomic import BEST_CURVATURE_PRODUCT, HOLONOMIC, HolonomicLoop, kinematic_loop
 
 cxroots = pytest.importorskip("cxroots")
 
-EXACT = HolonomicExactDelay()
-ZOH = HolonomicSampled(0)
-ZOH1 = HolonomicSampled(1)
-ALL = [HolonomicContinuous(), HolonomicFirstOrder(), HolonomicPade(4), EXACT, ZOH, ZOH1]
+EXACT = ExactDelay()
+ZOH = Sampled("command", 0)
+ZOH1 = Sampled("command", 1)
+ALL = [Continuous(), KBFirstOrder(), Pade(4), EXACT, ZOH, ZOH1]
 
 
 def _pure_delay_T_star(c, kappa):
@@ -102,8 +90,8 @@ def test_closed_forms_of_T_star(c_h, kappa):
     loop = HolonomicLoop(0.01, c_h)
     assert EXACT.critical_delay(kappa, loop) == pytest.approx(_pure_delay_T_star(c_h, kappa)[0], rel=1e-9)
     assert ZOH.critical_delay(kappa, loop) == pytest.approx(min(2 / c_h, 2 * c_h / kappa), rel=1e-7)
-    assert HolonomicFirstOrder().critical_delay(kappa, loop) == pytest.approx(min(1 / c_h, c_h / kappa), rel=1e-7)
-    assert HolonomicPade(8).critical_delay(kappa, loop) == pytest.approx(_pure_delay_T_star(c_h, kappa)[0], rel=1e-4)
+    assert KBFirstOrder().critical_delay(kappa, loop) == pytest.approx(min(1 / c_h, c_h / kappa), rel=1e-7)
+    assert Pade(8).critical_delay(kappa, loop) == pytest.approx(_pure_delay_T_star(c_h, kappa)[0], rel=1e-4)
 
 
 @pytest.mark.parametrize("c_h, kappa", _random_points(12, seed=4))
@@ -121,7 +109,7 @@ def test_T_star_is_where_stability_ends(c_h, kappa):
 def test_continuous_stable_iff_positive_damping_and_stiffness():
     """Continuous loop s² + c_h s + κ: stable ⇔ c_h > 0 and κ > 0, on random signs and sizes; T* inf or 0."""
     rng = np.random.default_rng(5)
-    model = HolonomicContinuous()
+    model = Continuous()
     for _ in range(200):
         c_h = float(rng.choice([-1, 0, 1]) * 10 ** rng.uniform(-3, 3))
         kappa = float(rng.choice([-1, 1]) * 10 ** rng.uniform(-3, 3))
@@ -262,7 +250,7 @@ def test_sampled_verdict_against_scipy_poles(compute_delay):
     |z| < 1 of poles from scipy's expm (points with ||z| − 1| < 1e-9 skipped: round-off decides those);
     the dominant pole's ln|z|/T to 1e-9 relative."""
     rng = np.random.default_rng(30 + compute_delay)
-    model = HolonomicSampled(compute_delay)
+    model = Sampled("command", compute_delay)
     for _ in range(120):
         T = float(10 ** rng.uniform(-3, 1))
         c_h = float(10 ** rng.uniform(-1, 1)) / T * rng.uniform(0, 2.5)
@@ -324,9 +312,12 @@ def test_steering_velocity_attraction_in_kb_normalisation(q, expected):
         (lambda: EXACT.is_stable(0.0, HolonomicLoop(0.1, 0.2)), "kappa"),
         (lambda: ZOH.critical_delay(math.inf, HolonomicLoop(0.1, 0.2)), "kappa"),
         (lambda: ZOH.rightmost_root(1.0, (0.1, 0.2)), "loop"),
-        (lambda: HolonomicSampled(2), "compute_delay"),
-        (lambda: HolonomicPade(0), "pade_order"),
-        (lambda: make_holonomic_model("nope"), "model"),
+        (lambda: Sampled("command", 2), "compute_delay"),
+        (lambda: Pade(0), "pade_order"),
+        (lambda: make_model("nope"), "model"),
+        (lambda: Sampled("reference", 0).is_stable(1.0, HolonomicLoop(0.1, 0.2)), "hold"),
+        (lambda: Continuous().critical_gain_k(1.0, HolonomicLoop(0.1, 0.2)), "loop"),
+        (lambda: ZOH.damping_range(1.0, Loop(0.3, 0.1, 2.0)), "damping_range"),
         (lambda: kinematic_loop(0.0, 0.1), "K_s"),
         (lambda: EXACT.damping_range(True, HolonomicLoop(0.1, 0.2)), "kappa"),
     ],
@@ -340,12 +331,16 @@ def test_bad_input_names_the_parameter(call, name):
 
 
 def test_factory_and_json():
-    """Every name builds its model, with its options; a boundary serializes with "inf" for an unbounded set."""
-    for name, cls in [("continuous", HolonomicContinuous), ("kb_first_order", HolonomicFirstOrder), ("pade", HolonomicPade), ("exact_delay", HolonomicExactDelay), ("sampled", HolonomicSampled)]:
-        assert isinstance(make_holonomic_model(name), cls)
-    assert make_holonomic_model("sampled", compute_delay=1).options() == {"compute_delay": 1}
-    assert make_holonomic_model("pade", pade_order=5).options() == {"order": 5}
-    d = HolonomicContinuous().boundary(HolonomicLoop(0.1, 0.2)).to_dict()
+    """Every name builds its model, which takes a holonomic loop; the holonomic family lists a model with its
+    equation and options, the sampled one without a hold (the acceleration is held); a boundary serializes with
+    "inf" for an unbounded set."""
+    for name, cls in [("continuous", Continuous), ("kb_first_order", KBFirstOrder), ("pade", Pade), ("exact_delay", ExactDelay), ("sampled", Sampled)]:
+        model = make_model(name)
+        assert isinstance(model, cls) and model.boundary(HolonomicLoop(0.1, 0.2)).model == name
+    assert HOLONOMIC.describe(make_model("sampled", compute_delay=1)) == {
+        "equation": "det(zI - Phi_cl(kappa, c_h)) = 0, ZOH of the acceleration, period T", "compute_delay": 1}
+    assert HOLONOMIC.describe(make_model("pade", pade_order=5)) == {"equation": "s^2 Q_m(s) + (c_h s + kappa) P_m(s) = 0  (Pade(m,m))", "order": 5}
+    d = Continuous().boundary(HolonomicLoop(0.1, 0.2)).to_dict()
     assert d["kappa_critical"] == "inf" and d["stable_set"] == [[0.0, "inf"]]
 
 
@@ -425,7 +420,7 @@ def test_T_star_below_a_microsecond_meets_its_promise(c_h, kappa):
     loop = HolonomicLoop(0.01, c_h)
     first_order = min(1 / c_h, c_h / kappa)
     assert 1e-10 < first_order <= 1e-6
-    assert HolonomicFirstOrder().critical_delay(kappa, loop) == pytest.approx(first_order, rel=2e-9, abs=0)
+    assert KBFirstOrder().critical_delay(kappa, loop) == pytest.approx(first_order, rel=2e-9, abs=0)
     assert ZOH.critical_delay(kappa, loop) == pytest.approx(min(2 / c_h, 2 * c_h / kappa), rel=2e-9, abs=0)
     with mp.workdps(30):  # abs=0 below: pytest.approx's default absolute 1e-12 would pass anything at T* ~ 1e-9 s
         w0, T0 = _pure_delay_T_star(c_h, kappa)[1], _pure_delay_T_star(c_h, kappa)[0]
@@ -435,4 +430,4 @@ def test_T_star_below_a_microsecond_meets_its_promise(c_h, kappa):
         T_zoh1 = _mp_first_loss(_mp_zoh1_stable(mp.mpf(kappa), mp.mpf(c_h)), 4 * first_order)
         T_pade = _mp_first_loss(_mp_pade_stable(mp.mpf(kappa), mp.mpf(c_h), 4), 4 * first_order)
     assert ZOH1.critical_delay(kappa, loop) == pytest.approx(T_zoh1, rel=2e-9, abs=0)
-    assert HolonomicPade(4).critical_delay(kappa, loop) == pytest.approx(T_pade, rel=2e-9, abs=0)
+    assert Pade(4).critical_delay(kappa, loop) == pytest.approx(T_pade, rel=2e-9, abs=0)

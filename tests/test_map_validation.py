@@ -349,6 +349,7 @@ def _shipped(name: str, V: float):
     return analyze_map(load_map(maps / f"{name}.yaml"), robot, controller, law), robot, controller, law
 
 
+@pytest.mark.slow  # seconds: scheduled first (tests/conftest.py)
 def test_shipped_maps_clear_segments_agree_at_least_85_percent():
     """>= 85 % of >= 18 clear (|margin| > 10 %) measured segments of the shipped maps agree with the simulator.
 

@@ -42,7 +42,15 @@ from pfm_stability.plots.regions import (  # noqa: E402
     plot_wall_f_region,
     plot_wall_regions,
 )
-from pfm_stability.analysis.comparison import kb_error_map, kb_relative_error  # noqa: E402
+from pfm_stability.analysis.comparison import critical_gain_vs_delay, critical_gain_vs_k, kb_error_map, kb_relative_error, root_locus  # noqa: E402
+from pfm_stability.analysis.region_panels import (  # noqa: E402
+    corridor_L_panel,
+    corridor_panels,
+    corridor_V_panel,
+    wall_alpha_panel,
+    wall_f_panel,
+    wall_panels,
+)
 from pfm_stability.plots.validation import plot_simulated_boundary  # noqa: E402
 from pfm_stability.validation import SimulatedBoundary  # noqa: E402
 
@@ -89,10 +97,10 @@ def _has_mark(ax, x, y):
 @pytest.mark.parametrize(
     "plot,xunit,yunit,mark",
     [
-        (lambda ax: plot_wall_f_region(ROBOT, CONTROLLER, math.radians(30), ax=ax, resolution=RES), "(m/s)", "dimensionless", (0.8, 0.8)),
-        (lambda ax: plot_wall_alpha_critical(ROBOT, CONTROLLER, ax=ax, resolution=RES), "(m/s)", "(deg)", (0.8, 20.0)),
-        (lambda ax: plot_corridor_region(ROBOT, CONTROLLER, ax=ax, resolution=RES), "(m)", "(m/s)", (0.9, 0.8)),
-        (lambda ax: plot_corridor_L_critical(ROBOT, CONTROLLER, ax=ax, resolution=RES), "(m/s)", "(m)", (0.8, 0.6)),
+        (lambda ax: plot_wall_f_region(wall_f_panel(ROBOT, CONTROLLER, math.radians(30), resolution=RES), ax=ax), "(m/s)", "dimensionless", (0.8, 0.8)),
+        (lambda ax: plot_wall_alpha_critical(wall_alpha_panel(ROBOT, CONTROLLER, resolution=RES), ax=ax), "(m/s)", "(deg)", (0.8, 20.0)),
+        (lambda ax: plot_corridor_region(corridor_V_panel(ROBOT, CONTROLLER, resolution=RES), ax=ax), "(m)", "(m/s)", (0.9, 0.8)),
+        (lambda ax: plot_corridor_L_critical(corridor_L_panel(ROBOT, CONTROLLER, resolution=RES), ax=ax), "(m/s)", "(m)", (0.8, 0.6)),
     ],
     ids=["wall_f", "wall_alpha", "corridor_LV", "corridor_Lstar"],
 )
@@ -113,13 +121,14 @@ def test_region_plot_contract(plot, xunit, yunit, mark):
 
 def test_region_plot_creates_figure_without_ax():
     """Without ax= a new figure is created and returned."""
-    fig = plot_corridor_region(ROBOT, CONTROLLER, resolution=RES)
+    fig = plot_corridor_region(corridor_V_panel(ROBOT, CONTROLLER, resolution=RES))
     assert fig.axes and fig.axes[0].get_xlabel().endswith("(m)")
 
 
 def test_summary_figures_have_one_shared_legend():
     """plot_wall_regions (3 angles + α*) and plot_corridor_regions: one figure legend naming every model."""
-    for fig, panels in ((plot_wall_regions(ROBOT, CONTROLLER, resolution=RES), 4), (plot_corridor_regions(ROBOT, CONTROLLER, resolution=RES), 2)):
+    for fig, panels in ((plot_wall_regions(wall_panels(ROBOT, CONTROLLER, resolution=RES)), 4),
+                        (plot_corridor_regions(corridor_panels(ROBOT, CONTROLLER, resolution=RES)), 2)):
         visible = [a for a in fig.axes if a.get_visible()]
         assert len(visible) == panels
         assert all(a.get_legend() is None for a in visible)
@@ -134,9 +143,9 @@ def test_grid_law_curves_without_shading():
     from pfm_stability.laws.effective_force import GridWallLaw, calibrate_cell_ratio
 
     law = GridWallLaw(calibrate_cell_ratio(0.8, 2.0, 0.8), 2.0, 0.8)
-    fig = plot_corridor_region(ROBOT, CONTROLLER, law=law, shade=False, resolution=RES)
+    fig = plot_corridor_region(corridor_V_panel(ROBOT, CONTROLLER, law=law, shade=False, resolution=RES))
     _assert_models_styled(fig.axes[0])
-    fig = plot_wall_alpha_critical(ROBOT, CONTROLLER, law=law, resolution=RES)
+    fig = plot_wall_alpha_critical(wall_alpha_panel(ROBOT, CONTROLLER, law=law, resolution=RES))
     assert "grid wall" in fig.axes[0].get_title()
 
 
@@ -154,13 +163,13 @@ def test_simulated_points_drawn_in_degrees():
 def test_comparison_plots_contract():
     """NV* vs T/τ and vs k: units, every model named, sampled structures told apart; returns the figure."""
     fig, ax = plt.subplots()
-    assert plot_critical_gain_vs_delay(0.3, 2.0, np.geomspace(0.05, 2, 8), mark=0.065 / 0.3, ax=ax) is fig
+    assert plot_critical_gain_vs_delay(critical_gain_vs_delay(0.3, 2.0, np.geomspace(0.05, 2, 8)), mark=0.065 / 0.3, ax=ax) is fig
     assert "(1/s)" in ax.get_ylabel() and "T/τ" in ax.get_xlabel()
     texts = _legend_texts(ax)
     for name in MODEL_NAMES:
         assert any(t.startswith(name) for t in texts)
     assert sum(t.startswith("sampled") for t in texts) == 4
-    fig = plot_model_comparison(0.3, 0.065, 2.0, ks=np.geomspace(0.5, 10, 6), T_over_tau=np.geomspace(0.05, 2, 6))
+    fig = plot_model_comparison(critical_gain_vs_k(0.3, 0.065, np.geomspace(0.5, 10, 6)), critical_gain_vs_delay(0.3, 2.0, np.geomspace(0.05, 2, 6)))
     assert len(fig.axes) == 2 and "(1/s)" in fig.axes[0].get_xlabel()
 
 
@@ -201,12 +210,12 @@ def _assert_legends_outside(fig):
 @pytest.mark.parametrize(
     "plot",
     [
-        lambda: plot_wall_f_region(ROBOT, CONTROLLER, math.radians(30), resolution=RES),
-        lambda: plot_wall_alpha_critical(ROBOT, CONTROLLER, resolution=RES),
-        lambda: plot_corridor_region(ROBOT, CONTROLLER, resolution=RES),
-        lambda: plot_corridor_L_critical(ROBOT, CONTROLLER, resolution=RES),
-        lambda: plot_corridor_regions(ROBOT, CONTROLLER, resolution=RES),
-        lambda: plot_wall_regions(ROBOT, CONTROLLER, resolution=RES),
+        lambda: plot_wall_f_region(wall_f_panel(ROBOT, CONTROLLER, math.radians(30), resolution=RES)),
+        lambda: plot_wall_alpha_critical(wall_alpha_panel(ROBOT, CONTROLLER, resolution=RES)),
+        lambda: plot_corridor_region(corridor_V_panel(ROBOT, CONTROLLER, resolution=RES)),
+        lambda: plot_corridor_L_critical(corridor_L_panel(ROBOT, CONTROLLER, resolution=RES)),
+        lambda: plot_corridor_regions(corridor_panels(ROBOT, CONTROLLER, resolution=RES)),
+        lambda: plot_wall_regions(wall_panels(ROBOT, CONTROLLER, resolution=RES)),
     ],
     ids=["wall_f", "wall_alpha", "corridor_LV", "corridor_Lstar", "corridor_summary", "wall_summary"],
 )
@@ -235,7 +244,7 @@ def test_region_plot_shades_the_model_asked_for():
 
     L, V = np.linspace(0.45, 2.0, 12), np.linspace(0.05, 2.0, 10)
     fig, ax = plt.subplots()
-    plot_corridor_region(ROBOT, CONTROLLER, L=L, V=V, shaded="exact_delay", ax=ax)
+    plot_corridor_region(corridor_V_panel(ROBOT, CONTROLLER, L=L, V=V, shaded="exact_delay"), ax=ax)
     (mesh,) = [c for c in ax.collections if isinstance(c, QuadMesh)]
     expected = corridor_region(ROBOT, CONTROLLER, L, V, model="exact_delay").stable
     assert np.array_equal(np.asarray(mesh.get_array()).reshape(expected.shape), expected.astype(float))
@@ -249,11 +258,12 @@ def test_other_legends_sit_outside_the_axes():
     from pfm_stability.plots.trajectory import plot_trajectory
 
     loop = Loop(ROBOT.tau, CONTROLLER.T, ROBOT.k)
+    by_k, by_delay = critical_gain_vs_k(0.3, 0.065, np.geomspace(0.5, 10, 5)), critical_gain_vs_delay(0.3, 2.0, np.geomspace(0.05, 2, 5))
     for fig in (
-        plot_root_locus(loop, hold="command", compute_delay=1),
-        plot_critical_gain_vs_k(0.3, 0.065, np.geomspace(0.5, 10, 5)),
-        plot_critical_gain_vs_delay(0.3, 2.0, np.geomspace(0.05, 2, 5)),
-        plot_model_comparison(0.3, 0.065, 2.0, ks=np.geomspace(0.5, 10, 5), T_over_tau=np.geomspace(0.05, 2, 5)),
+        plot_root_locus(root_locus(loop, hold="command", compute_delay=1)),
+        plot_critical_gain_vs_k(by_k),
+        plot_critical_gain_vs_delay(by_delay),
+        plot_model_comparison(by_k, by_delay),
         plot_trajectory(_straight_run(), title="a run with a target at infinity (arrow)"),
     ):
         _assert_legends_outside(fig)
@@ -282,7 +292,7 @@ def test_root_locus_says_when_a_model_has_no_marker():
     from pfm_stability.plots.common import MODEL_STYLE
     from pfm_stability.plots.rlocus import crossing_text, plot_root_locus
 
-    fig = plot_root_locus(Loop(0.3, 0.065, 40.0), hold="command", compute_delay=0)
+    fig = plot_root_locus(root_locus(Loop(0.3, 0.065, 40.0), hold="command", compute_delay=0))
     ax = fig.axes[0]
     (entry,) = [l for l in ax.get_lines() if l.get_label().startswith("sampled")]
     assert "unstable at any NV" in entry.get_label() and "no marker" in entry.get_label()

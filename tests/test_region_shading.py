@@ -41,6 +41,7 @@ from pfm_stability.laws.force_law import ForceLaw, PowerLaw, corridor_gain, wall
 from pfm_stability.models import ExactDelay, Loop, Sampled, models_for  # noqa: E402
 from pfm_stability.models.verdicts import in_stable_set  # noqa: E402
 from pfm_stability.parameters import CARMEL, Controller, Robot  # noqa: E402
+from pfm_stability.analysis.region_panels import corridor_V_panel, wall_alpha_panel  # noqa: E402
 from pfm_stability.plots.regions import plot_corridor_region, plot_wall_alpha_critical  # noqa: E402
 from pfm_stability.analysis.regions import (  # noqa: E402
     corridor_region,
@@ -106,12 +107,12 @@ def test_fig6a_and_fig5_shading_is_the_report_verdict():
     assert wall_alpha_region(ROBOT, CONTROLLER, [ROBOT.V], [math.radians(20.0)]).stable[0, 0] == (wall == "stable")
     assert corridor_region(ROBOT, CONTROLLER, [0.9], [ROBOT.V], model="exact_delay").stable[0, 0]
     # the drawn figure: the shading cell at (L, V) = (0.9, 0.8) has the report's colour
-    fig = plot_corridor_region(ROBOT, CONTROLLER, L=[0.85, 0.9, 0.95], V=[0.7, 0.8, 0.9], legend=False)
+    fig = plot_corridor_region(corridor_V_panel(ROBOT, CONTROLLER, L=[0.85, 0.9, 0.95], V=[0.7, 0.8, 0.9]), legend=False)
     from matplotlib.collections import QuadMesh
 
     (mesh,) = [c for c in fig.axes[0].collections if isinstance(c, QuadMesh)]
     assert np.asarray(mesh.get_array()).reshape(3, 3)[1, 1] == (1.0 if corridor == "stable" else 0.0)
-    fig = plot_wall_alpha_critical(ROBOT, CONTROLLER, V=np.linspace(0.7, 0.9, 3), legend=False, resolution=3)
+    fig = plot_wall_alpha_critical(wall_alpha_panel(ROBOT, CONTROLLER, V=np.linspace(0.7, 0.9, 3), resolution=3), legend=False)
     assert "shaded: sampled (command hold, compute delay 1)" in fig.axes[0].get_title()
 
 

@@ -16,10 +16,10 @@ import pytest
 from cli_helpers import report_json, run
 
 from pfm_stability import CARMEL
-from pfm_stability.report.families import build_family_report, make_family_law
-from pfm_stability.models import ExactDelay
+from pfm_stability.report.families import make_family_law
+from pfm_stability.report.stability import build_report
+from pfm_stability.models import ExactDelay, make_model
 from pfm_stability.models.holonomic import HolonomicLoop, kinematic_loop
-from pfm_stability.models.holonomic_delay import make_holonomic_model
 from pfm_stability.parameters import MODEL_NAMES
 
 KHATIB_CORRIDOR = ["--robot", "holonomic", "--law", "velocity", "--eta", "0.3", "--rho0", "2", "--L", "0.5", "--alpha-v", "0.1"]
@@ -57,7 +57,7 @@ def test_holonomic_gains_and_delay_margins_on_random_parameters():
         T = 10 ** rng.uniform(-3, -1)
         law = make_family_law("velocity", eta=eta, rho0=rho0, alpha_v=alpha_v)
         controller = CARMEL.controller.replace(T=T, compute_delay=0)
-        report = build_family_report(CARMEL.robot, controller, family="holonomic", law=law, L=L, mass=mass)
+        report = build_report(CARMEL.robot, controller, family="holonomic", law=law, L=L, mass=mass)
         d = report.to_dict()
         gains = law.velocity_attraction().holonomic_corridor_gains(law.repulsion(), L, 1.0, mass, CARMEL.robot.V)
         mid = min(gains, key=lambda g: abs(g.x0))
@@ -66,7 +66,7 @@ def test_holonomic_gains_and_delay_margins_on_random_parameters():
         assert c_h == pytest.approx(2 * alpha_v / mass, rel=1e-12)
         loop = HolonomicLoop(T, c_h)
         for name in MODEL_NAMES:
-            expected = make_holonomic_model(name, compute_delay=0).critical_delay(kappa, loop)
+            expected = make_model(name, compute_delay=0).critical_delay(kappa, loop)
             got = d["corridor"][name]["T_critical"]
             assert (got == "inf" and math.isinf(expected)) or got == pytest.approx(expected, rel=1e-12), name
         assert d["corridor"]["exact_delay"]["T_critical"] == pytest.approx(exact_delay_T(kappa, c_h), rel=1e-6)
@@ -143,7 +143,6 @@ def test_holonomic_text_and_markdown_render():
 
 
 @pytest.mark.parametrize("argv,message", [
-    (["--mass", "0", "--L", "1"], "argument --mass: mass must be a finite number in (0, 1000000] kg"),
     (["--mass", "2", "--L", "1"], "--mass applies to --robot holonomic, not to --robot steering"),
     (["--robot", "holonomic", "--law", "grid", "--L", "1"], "--robot holonomic takes --law velocity or velocity-gated"),
     (["--robot", "holonomic", "--L", "1"], "--robot holonomic takes --law velocity or velocity-gated"),
@@ -152,7 +151,58 @@ def test_holonomic_text_and_markdown_render():
     (["--robot", "wheeled", "--L", "1"], "argument --robot: invalid choice"),
 ])
 def test_bad_input_exits_2_naming_the_option(argv, message):
-    """Bad input: exit 2, nothing on stdout, one line naming the option (and its range where it has one)."""
+    """Bad input: exit 2, nothing on stdout, one line naming the option (its range: tests/test_cli_fuzz.py)."""
     code, out, err = run(["report", *argv])
     assert code == 2 and out == ""
     assert err.startswith("pfm-stability: error: ") and message in err and len(err.splitlines()) == 1
+
+
+def test_one_report_types_each_family_result():
+    """`build_report` is the one entry point: each geometry's result is typed by the loop that decides it (a steering
+    analysis, a holonomic scene, a non-smooth scene), the remedies are held once under the report's keys for every family
+    (a holonomic verdict's: the period T*), and the JSON is what those objects hold. Exact comparisons: the same values."""
+    from pfm_stability.analysis.criteria import CorridorAnalysis, WallAnalysis
+    from pfm_stability.models.holonomic import HOLONOMIC, HolonomicVerdict
+    from pfm_stability.report.families import HolonomicScene, NonSmoothScene
+
+    controller = CARMEL.controller
+    static = build_report(CARMEL.robot, controller, alpha_deg=20.0, L=0.9)
+    assert isinstance(static.wall, WallAnalysis) and isinstance(static.corridor, CorridorAnalysis) and not hasattr(static, "extras")
+    law = make_family_law("velocity", eta=0.3, rho0=2.0, alpha_v=0.1)
+    holonomic = build_report(CARMEL.robot, controller, family="holonomic", law=law, alpha_deg=60.0, L=0.5)
+    assert isinstance(holonomic.wall, HolonomicScene) and isinstance(holonomic.corridor, HolonomicScene) and holonomic.family is HOLONOMIC
+    assert holonomic.kb_errors == () and holonomic.tracking is not None
+    d = holonomic.to_dict()
+    for name, v in holonomic.corridor.models.items():
+        assert isinstance(v, HolonomicVerdict) and d["corridor"][name]["to_stabilize"] == holonomic.remedies[("corridor", name)]
+        if not v.stable and 0 < v.T_critical < controller.T:
+            assert holonomic.remedies[("corridor", name)]["T"]["to"] == v.T_critical
+    for i, e in enumerate(holonomic.wall.equilibria):
+        assert [d["environment"]["wall"]["equilibria"][i][k] for k in ("kappa", "c_h")] == [e.gains.kappa, e.gains.c_h]
+    gated = build_report(CARMEL.robot, controller, law=make_family_law("velocity-gated", eta=0.1), alpha_deg=60.0, L=0.5)
+    assert isinstance(gated.wall, NonSmoothScene) and gated.models == () and gated.remedies == {} and gated.wall.cycle is None
+
+
+def test_simulated_cycle_is_handed_to_the_report():
+    """The non-smooth wall's cycle comes from the callable the caller gives (the CLI: `validation.non_smooth.simulated_cycle`),
+    called with the family, robot, controller, law, α (rad) and mass; a corridor and a continuous controller (T = 0) have none."""
+    calls = []
+
+    def cycle(family, robot, controller, law, alpha, *, mass):
+        calls.append((family, alpha, mass))
+        return {"period": 1.0}
+
+    law = make_family_law("velocity-gated", eta=0.1)
+    report = build_report(CARMEL.robot, CARMEL.controller, family="holonomic", law=law, alpha_deg=60.0, L=0.5, mass=2.0, simulate_cycle=cycle)
+    assert len(calls) == 1 and calls[0][0] == "holonomic" and calls[0][2] == 2.0 and calls[0][1] == pytest.approx(math.radians(60.0), rel=1e-15)
+    assert report.to_dict()["environment"]["wall"]["cycle"] == {"period": 1.0} and report.corridor.cycle is None
+    calls.clear()
+    build_report(CARMEL.robot, CARMEL.controller.replace(T=0.0), law=law, alpha_deg=60.0, simulate_cycle=cycle)
+    assert calls == []
+
+
+@pytest.mark.parametrize("family, law", [("kinematic", None), ("steering", "velocity"), ("holonomic", "velocity")])
+def test_door_applies_to_a_static_law_on_a_steering_robot_only(family, law):
+    """`build_report` itself refuses a door with a robot family or a family law (one line naming both)."""
+    with pytest.raises(ValueError, match=r"^--door applies to --robot steering with a static law"):
+        build_report(CARMEL.robot, CARMEL.controller, family=family, law=make_family_law(law) if law else None, L=0.9, door=1.0)

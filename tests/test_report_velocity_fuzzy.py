@@ -112,24 +112,39 @@ def test_velocity_gated_is_non_smooth_with_its_band():
 
 
 @pytest.mark.parametrize("family", ["steering", "kinematic", "holonomic"])
-def test_velocity_gated_cycle_from_the_planar_simulator(family):
+def test_velocity_gated_cycle_from_the_planar_simulator(family, monkeypatch):
     """With the simulator: η 0.1, a_max 1, F_a 1, α 60°, CARMEL's V 0.8, τ 0.3, k 2, hold, T 0.065, compute delay 1.
     The report's cycle is `sim.cycles.wall_cycle` of the family's robot (KB's steering robot, τ = 0 for kinematic,
     a point mass for holonomic), exactly: the wiring is checked against a direct call with the parameters written
-    out here; and it lies where the band says (mean and closest distance inside the rest band (0, d_s])."""
+    out here; and it lies where the band says (mean and closest distance inside the rest band (0, d_s]). The text
+    report of the same command line renders that cycle: the 60-second simulation runs once for the JSON and the
+    text (`validation.non_smooth.simulated_cycle` answers a second call with equal arguments from the first)."""
     from pfm_stability.sim.cycles import wall_cycle
     from pfm_stability.sim.planar import PointMass, Steering
     from pfm_stability.laws.velocity_laws import VelocityGatedRepulsion
+    from pfm_stability.validation import non_smooth
 
-    d = report_json(["--law", "velocity-gated", "--eta", "0.1", "--a-max", "1", "--alpha", "60", "--robot", family])
+    simulated, real = [], non_smooth.simulated_cycle
+
+    def once(*args, **kwargs):
+        for known_args, known_kwargs, cycle in simulated:
+            if known_args == args and known_kwargs == kwargs:
+                return cycle
+        simulated.append((args, kwargs, real(*args, **kwargs)))
+        return simulated[-1][2]
+
+    monkeypatch.setattr(non_smooth, "simulated_cycle", once)
+    argv = ["--law", "velocity-gated", "--eta", "0.1", "--a-max", "1", "--alpha", "60", "--robot", family]
+    d = report_json(argv)
     cycle = d["environment"]["wall"]["cycle"]
     robot = PointMass(1.0, 1.0) if family == "holonomic" else Steering(0.8, 0.0 if family == "kinematic" else 0.3, 2.0, hold="command")
     direct = wall_cycle(VelocityGatedRepulsion(0.1, 0.8, 1.0), 1.0, math.radians(60), robot, T=0.065, compute_delay=1).to_dict()
     assert cycle == direct  # JSON keeps floats exactly (repr round trip)
     d_s = d["environment"]["wall"]["d_s"]
     assert 0 < cycle["min_distance"] <= cycle["mean_distance"] <= d_s and not cycle["touches_wall"]
-    code, out, _ = run(["report", "--law", "velocity-gated", "--eta", "0.1", "--alpha", "60", "--robot", family])
+    code, out, _ = run(["report", *argv])
     assert code == 0 and "NON-SMOOTH" in out and "simulated cycle: mean distance" in out
+    assert len(simulated) == 1  # the text shows the JSON's cycle
 
 
 def test_velocity_gated_with_a_continuous_controller_has_no_cycle():
@@ -139,17 +154,15 @@ def test_velocity_gated_with_a_continuous_controller_has_no_cycle():
 
 
 @pytest.mark.parametrize("argv,message", [
-    (["--alpha-v", "-1", "--law", "velocity", "--L", "1"], "argument --alpha-v: alpha_v must be a finite number in [0, 1000000] N s/m"),
     (["--alpha-p", "1", "--L", "1"], "--alpha-p applies to --law velocity, velocity-gated or fuzzy, not to --law power"),
     (["--law", "velocity", "--xi", "1", "--L", "1"], "--xi applies to --law khatib or gnron, not to --law velocity"),
     (["--law", "fuzzy", "--alpha-v", "1", "--alpha", "60"], "--alpha-v applies to --law velocity, not to --law fuzzy"),
     (["--law", "velocity", "--f", "2", "--alpha", "60"], "--f applies to --law power or grid, not to --law velocity"),
     (["--law", "velocity", "--side", "left", "--alpha", "60"], "--side applies to --law fuzzy"),
-    (["--a-max", "0", "--law", "velocity-gated", "--alpha", "60"], "argument --a-max: a_max must be a finite number in (0, 1000000] m/s^2"),
     (["--law", "velocity", "--alpha-v", "10", "--alpha", "60"], "V must be below the speed at which the velocity attraction cancels"),
 ])
 def test_bad_input_exits_2_naming_the_option(argv, message):
-    """Bad input: exit 2, nothing on stdout, one line naming the option and its range or the law it applies to."""
+    """Bad input: exit 2, nothing on stdout, one line naming the law the option applies to (its range: tests/test_cli_fuzz.py)."""
     code, out, err = run(["report", *argv])
     assert code == 2 and out == "", err
     assert err.startswith("pfm-stability: error: ") and message in err and len(err.splitlines()) == 1, err

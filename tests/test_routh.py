@@ -16,6 +16,7 @@ from pfm_stability.numerics.routh import routh_array, routh_count, routh_stable,
 coefficient = st.floats(min_value=-10, max_value=10, allow_nan=False, allow_infinity=False)
 
 
+@pytest.mark.slow  # seconds: scheduled first (tests/conftest.py)
 @settings(max_examples=400, deadline=None)
 @given(st.lists(coefficient, min_size=2, max_size=9))
 def test_sign_changes_equal_rhp_root_count(coefficients):

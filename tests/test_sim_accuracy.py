@@ -101,6 +101,7 @@ def test_member_advances_identically_alone_and_in_a_mixed_batch():
         assert_same_to_roundoff(run.trajectory, alone.trajectory, alone.metrics.growth_rate, label)
 
 
+@pytest.mark.slow  # seconds: scheduled first (tests/conftest.py)
 def test_engine_equals_per_robot_loop_at_large_T_over_tau():
     """The batch engine equals `simulate_reference` (its own ∫Δ dt, via Van Loan's block exponential) to 1e-12 at T/τ = 30.
 

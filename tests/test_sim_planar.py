@@ -15,7 +15,6 @@ from pfm_stability.laws.fields import KhatibLaw
 from pfm_stability.laws.force_law import PowerLaw, wall_equilibria
 from pfm_stability.models.base import Loop
 from pfm_stability.models.holonomic import HolonomicLoop, kinematic_loop
-from pfm_stability.models.holonomic_delay import HolonomicSampled
 from pfm_stability.models.sampled import Sampled
 from pfm_stability.sim.cycles import lateral_metrics, loop_order, wall_cycle
 from pfm_stability.sim.movers import Ball, PointObstacle, Target, Wall
@@ -71,7 +70,7 @@ def test_holonomic_growth_rate_matches_sampled_pole(c_h, T, delay, mass, side):
     the boundary, where a relative error in σ alone is ill-conditioned), and the verdicts
     (sign of σ) must agree. Random (c_h, T, delay, mass) as well as hand-picked ones.
     """
-    model = HolonomicSampled(delay)
+    model = Sampled("command", delay)
     loop = HolonomicLoop(T, c_h)
     kappa_star = model.boundary(loop).kappa_critical
     assert math.isfinite(kappa_star) and kappa_star > 0

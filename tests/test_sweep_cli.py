@@ -197,6 +197,7 @@ def _interrupt_when(argv, parts, count, signal_number):
     return process.returncode, err, finished()
 
 
+@pytest.mark.slow  # seconds: scheduled first (tests/conftest.py)
 def test_a_really_interrupted_simulation_sweep_resumes_to_the_same_table(tmp_path):
     """The command in a process of its own, interrupted twice by a signal to its whole process group: SIGINT once 2
     parts are written (as Ctrl-C in a terminal: exit 130 and the --resume hint), then, resumed, SIGKILL once 2 more

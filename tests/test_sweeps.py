@@ -460,6 +460,7 @@ def test_simulation_on_cluster_with_retry_agrees_with_sampled(tmp_path, cluster)
     assert far and all(r["sim_verdict"] == r["sampled_verdict"] for r in far)
 
 
+@pytest.mark.slow  # seconds: scheduled first (tests/conftest.py)
 def test_simulation_on_local_processes_equals_cluster_and_in_process(tmp_path, cluster):
     """simulate: true without a scheduler runs on Dask's local worker processes (no cluster): the table equals the
     cluster's and the in-process evaluation (pyarrow equality), a chunk failing once in a worker process is retried

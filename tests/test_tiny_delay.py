@@ -107,16 +107,16 @@ def test_holonomic_damping_ranges_down_to_the_shortest_delay(T):
     from scipy.optimize import brentq
 
     from pfm_stability.models.holonomic import HolonomicLoop
-    from pfm_stability.models.holonomic_delay import make_holonomic_model
+    from pfm_stability.models import make_model
 
     kappa = 24.0
     loop = HolonomicLoop(T, 0.2)
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         for name in ("continuous", "kb_first_order", "pade", "exact_delay", "sampled"):
-            (lo, hi), = make_holonomic_model(name, pade_order=3, compute_delay=1).damping_range(kappa, loop)
+            (lo, hi), = make_model(name, pade_order=3, compute_delay=1).damping_range(kappa, loop)
             assert 0 <= lo < hi and (lo > 0 or name == "continuous"), name
-        (lo, hi), = make_holonomic_model("exact_delay").damping_range(kappa, loop)
+        (lo, hi), = make_model("exact_delay").damping_range(kappa, loop)
     if kappa * T * T < 1e-6:
         assert lo == pytest.approx(kappa * T, rel=1e-5) and hi == pytest.approx(math.pi / (2 * T), rel=1e-5)
     else:

@@ -203,6 +203,7 @@ def random_analyses():
     return [find_stationary_points(_random_scene(rng), 61) for _ in range(10)]
 
 
+@pytest.mark.xdist_group("traps_random_scenes")  # the ten scenes once per suite (tests/conftest.py)
 def test_random_scenes_points_are_stationary_and_classified_like_finite_differences(random_analyses):
     """Every smooth point found: |∇U| <= 1e-9 of the cancelling forces (analytic), the central-difference gradient
     of U is ~0 on that scale, and the signs of the finite-difference Hessian's eigenvalues give the same kind."""
@@ -222,6 +223,7 @@ def test_random_scenes_points_are_stationary_and_classified_like_finite_differen
     assert checked >= 10
 
 
+@pytest.mark.xdist_group("traps_random_scenes")
 def test_random_scenes_are_complete_by_poincare_hopf(random_analyses):
     """#minima − #saddles + #maxima = χ(plane minus k obstacles) = 1 − k: a missed point would break the count
     (the goal counts as a minimum when it is one, as at a cone or a non-C² point)."""
@@ -229,6 +231,7 @@ def test_random_scenes_are_complete_by_poincare_hopf(random_analyses):
         assert poincare_hopf(a) == 1 - len(a.scene.obstacles), [(p.x, p.y, p.kind) for p in a.stationary_points]
 
 
+@pytest.mark.xdist_group("traps_random_scenes")
 def test_random_scenes_goal_verdict_against_a_brute_force_grid(random_analyses):
     """goal_is_global_minimum ⇔ U(goal) <= min of U on a 401 × 401 grid of the free region and a small ring about the
     goal (which sees the descent from a goal that is not stationary)."""
@@ -243,6 +246,7 @@ def test_random_scenes_goal_verdict_against_a_brute_force_grid(random_analyses):
         assert a.goal_is_global_minimum == brute, (a.scene.law, goal_u, np.min(u[free]))
 
 
+@pytest.mark.xdist_group("traps_random_scenes")
 def test_random_scene_at_another_resolution_gives_the_same_points(random_analyses):
     """The search does not depend on its grid: resolution 41 finds the same points as 61 (to 1e-6 m)."""
     for a in random_analyses[:3]:

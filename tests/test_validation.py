@@ -70,6 +70,7 @@ def analytic_bracket(request):
     return kind, expected, batch
 
 
+@pytest.mark.xdist_group("validation_analytic_bracket")  # its fixture once per suite (tests/conftest.py)
 def test_analytic_boundary_within_1pct_of_sampled(analytic_bracket):
     """KB eq 24/25 with the sampled NV*: every set and structure oscillates 1 % below L*/α* and settles 1 % above.
 
@@ -93,6 +94,7 @@ def test_analytic_boundary_within_1pct_of_sampled(analytic_bracket):
     assert not failures, f"{kind}: " + "; ".join(failures)
 
 
+@pytest.mark.xdist_group("validation_analytic_bracket")
 def test_analytic_growth_rate_and_frequency_equal_the_dominant_root(analytic_bracket):
     """σ, ω at and ±1 % around the boundary equal the sampled dominant pole (σ = ln|z|/T, ω = arg z/T).
 
@@ -152,6 +154,7 @@ def grid_validation(request):
     return name, validate_boundary(scenario, parameter, robot=robot, controller=controller, env="grid", **geometry)
 
 
+@pytest.mark.xdist_group("validation_grid")  # its fixture once per suite (tests/conftest.py)
 def test_grid_boundary_within_5pct_of_the_effective_law(grid_validation):
     """In the VFF histogram grid, `sampled` fed the grid's own law (GridWallLaw) predicts the boundary (bar 5 %).
 
@@ -167,6 +170,7 @@ def test_grid_boundary_within_5pct_of_the_effective_law(grid_validation):
     assert v.lumped_predicted_boundary is not None and set(v.lumped_relative_error) == set(v.relative_error)
 
 
+@pytest.mark.xdist_group("validation_grid")
 def test_grid_frequency_near_the_boundary_within_5pct(grid_validation):
     """ω at the boundary and 3 % either side within 5 % of the sampled dominant root's (the bar of docs/validation.md).
 
@@ -198,6 +202,7 @@ def sweep():
     return verdict_sweep(200, seed=0, env="analytic")
 
 
+@pytest.mark.xdist_group("validation_sweep")  # the 200-set sweep once per suite (tests/conftest.py)
 def test_sweep_sign_of_growth_rate_agrees_with_sampled(sweep):
     """200 Latin-hypercube sets (V, τ, T, k, f, L or α; both holds and compute delays): ≥ 98 % agree (the bar of docs/validation.md).
 
@@ -212,6 +217,7 @@ def test_sweep_sign_of_growth_rate_agrees_with_sampled(sweep):
     assert all(p.excluded == (abs(p.gain_ratio - 1) < 0.03) for p in sweep.points if math.isfinite(p.gain_ratio))
 
 
+@pytest.mark.xdist_group("validation_sweep")
 def test_sweep_states_how_often_kb_and_exact_delay_are_wrong(sweep, record_property, capsys):
     """The same sweep states the wrong-verdict rates of kb_first_order (KB eq 20) and exact_delay (eq 18).
 

@@ -16,6 +16,8 @@ from pathlib import Path
 
 import pytest
 
+pytestmark = pytest.mark.xdist_group("experiments")  # one worker runs the experiments once (tests/conftest.py)
+
 EXPERIMENTS = Path(__file__).resolve().parents[1] / "experiments"
 CHECKED_HERE = ("fig3_calibration", "fig5_wall", "fig6_corridor", "validation_summary", "gc2000_traps", "gc2000_corridor", "kb_fig4_door")
 """The scripts this file runs and checks; Ge & Cui 2002's and the DFAPF paper's run in tests/test_experiments_gc2002.py."""

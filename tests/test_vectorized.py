@@ -12,6 +12,7 @@ from pfm_stability.parameters import Controller, Corridor, Robot, Wall
 from pfm_stability.vectorized import delay_verdicts_from_gain, exact_delay_verdicts
 
 
+@pytest.mark.slow  # seconds: scheduled first (tests/conftest.py)
 def test_verdicts_and_margins_equal_scalar_route_over_extreme_ranges():
     """3000 points with τ from 0 to 3 s (down to 1e-6), T from 0 to 20 s, k from
     0.05 to 100 1/s (resonant steering loops included), K over six decades:

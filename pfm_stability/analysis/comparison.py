@@ -7,14 +7,14 @@ NV*_model: KB calls stable a loop that oscillates) or conservative
 (docs/models.md).
 
 * `critical_gain_vs_delay`, `critical_gain_vs_k`: NV* of every model against
-  T/τ or k (`GainCurve`);
+  T/τ or k (`GainCurves`, one `GainCurve` per model);
 * `kb_error_map`, `kb_error_maps`: KB's relative error over (kτ, T/τ)
   (`KBErrorMap`); `kb_relative_error` for one loop (the stability report's
   figure);
 * `root_locus`: the Padé loop's root locus in NV with every model's
   imaginary-axis crossing (`RootLocus`).
 
-Computation only; `pfm_stability.plots.comparison` and `plots.rlocus` draw.
+Computation only; `pfm_stability.plots.comparison` and `plots.rlocus` draw (each result's ``.plot()``).
 """
 
 from __future__ import annotations
@@ -31,6 +31,7 @@ from ..io.serialize import json_array
 
 __all__ = [
     "GainCurve",
+    "GainCurves",
     "KBErrorMap",
     "RootLocus",
     "critical_gain_vs_delay",
@@ -86,6 +87,20 @@ class GainCurve:
         }
 
 
+class GainCurves(list):
+    """Every model's `GainCurve` against one loop parameter (T/τ or k): what `critical_gain_vs_delay` and `critical_gain_vs_k` return."""
+
+    def plot(self, ax=None, **kwargs):
+        """`plots.comparison.plot_critical_gain_vs_delay` (x = T/τ) or `plots.rlocus.plot_critical_gain_vs_k` (x = k); returns the figure."""
+        if self[0].x_name == "k":
+            from ..plots.rlocus import plot_critical_gain_vs_k
+
+            return plot_critical_gain_vs_k(self, ax=ax, **kwargs)
+        from ..plots.comparison import plot_critical_gain_vs_delay
+
+        return plot_critical_gain_vs_delay(self, ax=ax, **kwargs)
+
+
 @dataclass(frozen=True)
 class KBErrorMap:
     """How far KB's criterion (eq 20) is from another model, over (kτ, T/τ).
@@ -121,7 +136,15 @@ class KBErrorMap:
         return self.relative_error > 0
 
     def at(self, k_tau: float, T_over_tau: float) -> float:
-        """Relative error at one (kτ, T/τ), bilinear in (log kτ, log T/τ) between grid nodes."""
+        """Relative error at one (kτ, T/τ), bilinear in (log kτ, log T/τ) between grid nodes.
+
+        Parameters
+        ----------
+        k_tau : float
+            Steering gain kτ (dimensionless), inside the map's range.
+        T_over_tau : float
+            Sampling period T/τ (dimensionless), inside the map's range.
+        """
         from scipy.interpolate import RegularGridInterpolator
 
         values = np.where(np.isfinite(self.relative_error), self.relative_error, np.nan)
@@ -129,7 +152,15 @@ class KBErrorMap:
         return float(f([[math.log(T_over_tau), math.log(k_tau)]])[0])
 
     def exact(self, k_tau: float, T_over_tau: float) -> float:
-        """Relative error at one (kτ, T/τ), computed exactly (`kb_relative_error` at τ = 1 s), not interpolated."""
+        """Relative error at one (kτ, T/τ), computed exactly (`kb_relative_error` at τ = 1 s), not interpolated.
+
+        Parameters
+        ----------
+        k_tau : float
+            Steering gain kτ (dimensionless).
+        T_over_tau : float
+            Sampling period T/τ (dimensionless).
+        """
         return kb_relative_error(Loop(1.0, float(T_over_tau), float(k_tau)), self.reference)
 
     def __repr__(self) -> str:
@@ -138,6 +169,12 @@ class KBErrorMap:
             f"KBErrorMap(vs {self.reference.name}{self.reference.options() or ''}: {self.relative_error.shape}, "
             f"KB optimistic on {100 * self.optimistic.mean():.0f} %, error {e.min():+.2f} … {e.max():+.2f})"
         )
+
+    def plot(self, ax=None, **kwargs):
+        """`plots.comparison.plot_kb_error_map` of this map; returns the figure."""
+        from ..plots.comparison import plot_kb_error_map
+
+        return plot_kb_error_map(self, ax=ax, **kwargs)
 
     def to_dict(self) -> dict:
         """Plain JSON types (arrays as lists, non-finite values as None)."""
@@ -152,7 +189,7 @@ class KBErrorMap:
         }
 
 
-def critical_gain_vs_delay(tau: float, k: float, T_over_tau, models=None, *, pade_order: int = 3) -> list[GainCurve]:
+def critical_gain_vs_delay(tau: float, k: float, T_over_tau=None, models=None, *, pade_order: int = 3) -> GainCurves:
     """NV* (1/s) of every model against the sampling period, T = (T/τ)·τ.
 
     Parameters
@@ -161,22 +198,24 @@ def critical_gain_vs_delay(tau: float, k: float, T_over_tau, models=None, *, pad
         Steering time constant, s (> 0).
     k : float
         Steering gain, 1/s.
-    T_over_tau : array_like
-        Sampling periods in units of τ.
+    T_over_tau : array_like, optional
+        Sampling periods in units of τ (default 60 log-spaced values in [0.01, 3]).
     models : list of LoopModel, optional
         Default: continuous, kb_first_order, pade, exact_delay and ``sampled``
         in all four structures (`SAMPLED_STRUCTURES`).
+    pade_order : int
+        Order m of the ``pade`` model.
 
     Returns
     -------
-    list of GainCurve
+    GainCurves
         x = T/τ (dimensionless).
     """
     tau = check_number("tau", tau, 0.0, unit="s")
     k = check_parameter("k", k)
-    x = check_positive_axis("T_over_tau", T_over_tau)
+    x = check_positive_axis("T_over_tau", np.geomspace(0.01, 3.0, 60) if T_over_tau is None else T_over_tau)
     models = _all_models(pade_order) if models is None else models
-    curves = []
+    curves = GainCurves()
     for model in models:
         values = np.array([model.boundary(Loop(tau, float(r) * tau, k)).NV_critical for r in x])
         curves.append(GainCurve(model, "T/tau", "", x, values, tau=tau, k=k))
@@ -213,12 +252,30 @@ def kb_error_map(k_tau, T_over_tau, reference: LoopModel | None = None) -> KBErr
 
 
 def kb_error_maps(k_tau, T_over_tau, structures=SAMPLED_STRUCTURES) -> list[KBErrorMap]:
-    """`kb_error_map` against ``sampled`` for each (hold, compute_delay)."""
+    """`kb_error_map` against ``sampled`` for each (hold, compute_delay).
+
+    Parameters
+    ----------
+    k_tau : array_like, shape (nx,)
+        Dimensionless steering gains kτ.
+    T_over_tau : array_like, shape (ny,)
+        Dimensionless sampling periods T/τ.
+    structures : sequence of (str, int)
+        The (hold, compute_delay) pairs of the ``sampled`` references.
+    """
     return [kb_error_map(k_tau, T_over_tau, Sampled(h, c)) for h, c in structures]
 
 
 def kb_relative_error(loop: Loop, reference: LoopModel) -> float:
-    """NV*_KB/NV*_reference − 1 for one loop (`relative_error`: > 0 KB's eq 20 optimistic; ``inf`` if NV*_reference = 0)."""
+    """NV*_KB/NV*_reference − 1 for one loop (`relative_error`: > 0 KB's eq 20 optimistic; ``inf`` if NV*_reference = 0).
+
+    Parameters
+    ----------
+    loop : Loop
+        τ (s), T (s), k (1/s).
+    reference : LoopModel
+        The model KB's eq (20) is compared with.
+    """
     return relative_error(KBFirstOrder().boundary(loop).NV_critical, reference.boundary(loop).NV_critical)
 
 
@@ -227,6 +284,13 @@ def relative_error(NV_kb: float, NV_reference: float) -> float:
 
     ``inf`` when the reference is unstable at every NV (NV*_reference = 0);
     ``nan`` when both are stable at every NV (no finite boundary to compare).
+
+    Parameters
+    ----------
+    NV_kb : float
+        KB's NV* (eq 20), 1/s.
+    NV_reference : float
+        The reference model's NV*, 1/s (``inf``: stable at every NV).
     """
     if NV_reference == 0:
         return math.inf
@@ -240,7 +304,7 @@ def _all_models(pade_order: int) -> list[LoopModel]:
     return [Continuous(), KBFirstOrder(), Pade(pade_order), ExactDelay()] + [Sampled(h, c) for h, c in SAMPLED_STRUCTURES]
 
 
-def critical_gain_vs_k(tau: float, T: float, ks, *, pade_order: int = 3, models=None) -> list[GainCurve]:
+def critical_gain_vs_k(tau: float, T: float, ks=None, *, pade_order: int = 3, models=None) -> GainCurves:
     """NV* (1/s) of every model against the steering gain k (1/s), τ and T fixed.
 
     KB's eq (20) says NV* does not depend on k; only ``continuous`` and
@@ -250,8 +314,8 @@ def critical_gain_vs_k(tau: float, T: float, ks, *, pade_order: int = 3, models=
     ----------
     tau, T : float
         Steering time constant and sampling period, s.
-    ks : array_like
-        Steering gains, 1/s.
+    ks : array_like, optional
+        Steering gains, 1/s (default 60 log-spaced values in [0.2, 30]).
     pade_order : int
         Order m of the ``pade`` model.
     models : list of LoopModel, optional
@@ -259,17 +323,17 @@ def critical_gain_vs_k(tau: float, T: float, ks, *, pade_order: int = 3, models=
 
     Returns
     -------
-    list of GainCurve
+    GainCurves
         x = k (1/s).
     """
     tau = check_number("tau", tau, 0.0, unit="s")
     T = check_number("T", T, 0.0, unit="s")
-    ks = check_positive_axis("k", ks, "1/s")
+    ks = check_positive_axis("k", np.geomspace(0.2, 30, 60) if ks is None else ks, "1/s")
     models = _all_models(pade_order) if models is None else models
-    return [
+    return GainCurves(
         GainCurve(model, "k", "1/s", ks, np.array([model.boundary(Loop(tau, T, float(k))).NV_critical for k in ks]), tau=tau, T=T)
         for model in models
-    ]
+    )
 
 
 @dataclass(frozen=True)
@@ -301,6 +365,12 @@ class RootLocus:
     zeros: np.ndarray
     crossings: tuple
     omega_scale: float
+
+    def plot(self, ax=None):
+        """`plots.rlocus.plot_root_locus` of this locus; returns the figure."""
+        from ..plots.rlocus import plot_root_locus
+
+        return plot_root_locus(self, ax=ax)
 
 
 def root_locus(loop: Loop, *, pade_order: int = 3, hold: str = "command", compute_delay: int = 0, NV_max: float | None = None,

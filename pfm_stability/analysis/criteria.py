@@ -204,10 +204,10 @@ class CorridorAnalysis:
 
 
 def loop_of(robot: Robot, controller: Controller) -> Loop:
-    """The (τ, T, k) every model needs."""
+    """The (τ, T, k) every model needs (`Loop.of`, after checking the types)."""
     check_type("robot", robot, Robot, "a Robot")
     check_type("controller", controller, Controller, "a Controller")
-    return Loop(robot.tau, controller.T, robot.k)
+    return Loop.of(robot, controller)
 
 
 # --------------------------------------------------------------- root finding
@@ -254,6 +254,19 @@ def kb_critical_f_wall(alpha, V, tau_plus_T, n, W):
     ``inf`` when the value overflows (α → 0). Numbers are checked against their
     ranges (ValueError); sympy symbols pass through (the tests compare this with
     the derivation exactly).
+
+    Parameters
+    ----------
+    alpha : float or sympy.Expr
+        Target angle to the wall, rad.
+    V : float or sympy.Expr
+        Speed, m/s.
+    tau_plus_T : float or sympy.Expr
+        τ + T, s.
+    n : float or sympy.Expr
+        Force-law exponent (dimensionless).
+    W : float or sympy.Expr
+        Robot width, m.
     """
     if _numeric((alpha, V, tau_plus_T, n, W)):
         _check_closed_form_inputs(alpha=alpha, V=V, tau_plus_T=tau_plus_T, n=n, W=W)
@@ -266,6 +279,19 @@ def kb_critical_L(n, W, V, tau_plus_T, f):
 
     Plain arithmetic, so it accepts sympy symbols: the tests compare it with the
     derivation exactly. Numbers are checked against their ranges (ValueError).
+
+    Parameters
+    ----------
+    n : float or sympy.Expr
+        Force-law exponent (dimensionless).
+    W : float or sympy.Expr
+        Robot width, m.
+    V : float or sympy.Expr
+        Speed, m/s.
+    tau_plus_T : float or sympy.Expr
+        τ + T, s.
+    f : float or sympy.Expr
+        Force-law strength (dimensionless).
     """
     if _numeric((n, W, V, tau_plus_T, f)):
         _check_closed_form_inputs(n=n, W=W, V=V, tau_plus_T=tau_plus_T, f=f)
@@ -285,6 +311,15 @@ def critical_alpha(law: ForceLaw, V: float, NV_critical: float) -> float:
     """α*, rad: N(α)·V = NV* (stable for α > α* when N decreases with α).
 
     0 when NV* is infinite; π/2 when NV* = 0.
+
+    Parameters
+    ----------
+    law : ForceLaw
+        The lateral force law.
+    V : float
+        Speed, m/s.
+    NV_critical : float
+        The model's NV*, 1/s.
     """
     _check_critical_inputs(law, V, NV_critical)
     if math.isinf(NV_critical):
@@ -305,7 +340,19 @@ def critical_alpha(law: ForceLaw, V: float, NV_critical: float) -> float:
 
 
 def critical_f_wall(law: ForceLaw, alpha: float, V: float, NV_critical: float) -> float:
-    """f*: the force-law strength above which the wall is stable (KB eq 24)."""
+    """f*: the force-law strength above which the wall is stable (KB eq 24).
+
+    Parameters
+    ----------
+    law : ForceLaw
+        The lateral force law (its strength is scaled).
+    alpha : float
+        Target angle to the wall, rad.
+    V : float
+        Speed, m/s.
+    NV_critical : float
+        The model's NV*, 1/s.
+    """
     _check_critical_inputs(law, V, NV_critical)
     check_parameter("alpha", alpha)
     if math.isinf(NV_critical):
@@ -319,7 +366,17 @@ def critical_f_wall(law: ForceLaw, alpha: float, V: float, NV_critical: float) -
 
 
 def critical_L(law: ForceLaw, V: float, NV_critical: float) -> float:
-    """L*, m: corridor half-width above which the middle is stable (KB eq 25)."""
+    """L*, m: corridor half-width above which the middle is stable (KB eq 25).
+
+    Parameters
+    ----------
+    law : ForceLaw
+        The lateral force law.
+    V : float
+        Speed, m/s.
+    NV_critical : float
+        The model's NV*, 1/s.
+    """
     _check_critical_inputs(law, V, NV_critical)
     if math.isinf(NV_critical):
         return 0.0
@@ -331,7 +388,19 @@ def critical_L(law: ForceLaw, V: float, NV_critical: float) -> float:
 
 
 def critical_f_corridor(law: ForceLaw, L: float, V: float, NV_critical: float) -> float:
-    """f*: force-law strength below which the corridor middle is stable (N ∝ f)."""
+    """f*: force-law strength below which the corridor middle is stable (N ∝ f).
+
+    Parameters
+    ----------
+    law : ForceLaw
+        The lateral force law (its strength is scaled).
+    L : float
+        Corridor half-width, m.
+    V : float
+        Speed, m/s.
+    NV_critical : float
+        The model's NV*, 1/s.
+    """
     _check_critical_inputs(law, V, NV_critical)
     gain = corridor_gain(law, L) * V
     if math.isinf(NV_critical) or gain == 0:
@@ -345,6 +414,23 @@ def model_verdicts(controller: Controller, models, loop: Loop, N: float, NV: flo
 
     `geometric(NV*)` gives the geometry's own critical values (α* and f*, or
     L* and f*); V* = NV*/N, T* and k* are the same for every geometry.
+
+    Parameters
+    ----------
+    controller : Controller
+        Hold and compute delay of the default ``sampled`` model.
+    models : sequence of str or LoopModel, or None
+        The models (`models.models_for`; None: all five).
+    loop : Loop
+        τ (s), T (s), k (1/s), c.
+    N : float
+        Environment gain of the equilibrium, 1/m.
+    NV : float
+        Operating loop gain, 1/s.
+    critical_values : type
+        `WallCritical` or `CorridorCritical`, built with the geometry's values and V*, T*, k*.
+    geometric : callable
+        ``geometric(NV_critical) -> dict``: the geometry's own critical values.
     """
     out = {}
     for model in models_for(controller, models):

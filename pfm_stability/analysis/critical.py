@@ -73,7 +73,13 @@ class CriticalValues(Mapping):
         return tuple(f.name for f in fields(self) if f.name != "sides" and getattr(self, f.name) is not None)
 
     def stable_side(self, key: str) -> str | None:
-        """"below" or "above": on which side of the critical value `key` the loop is stable; None when the value is undefined (NaN)."""
+        """"below" or "above": on which side of the critical value `key` the loop is stable; None when the value is undefined (NaN).
+
+        Parameters
+        ----------
+        key : str
+            A critical value's name (e.g. ``"L_critical"``).
+        """
         value = self[key]
         if isinstance(value, float) and math.isnan(value):
             return None
@@ -200,7 +206,13 @@ _ALPHA_STEPS = 120
 
 
 def is_field_law(law: ForceLaw) -> bool:
-    """True for Khatib's and the goal-aware law: critical values of η, ρ0 and ξ instead of f."""
+    """True for Khatib's and the goal-aware law: critical values of η, ρ0 and ξ instead of f.
+
+    Parameters
+    ----------
+    law : ForceLaw
+        Any lateral force law.
+    """
     return isinstance(law, (KhatibLaw, GnronLaw))
 
 
@@ -210,6 +222,13 @@ def in_user_f(law: ForceLaw, strength: float) -> float:
     The force is ∝ the strength, so f = strength·lumped_f/scale: the power law's f
     itself, a grid law's cell ratio ρ as f_av = ρ·f_av(ρ0)/ρ0 (KB §4). ``inf``, 0
     and NaN keep their meaning.
+
+    Parameters
+    ----------
+    law : ForceLaw
+        The law whose strength it is.
+    strength : float
+        A value of the law's strength (`ForceLaw.scale`).
     """
     if not math.isfinite(strength) or strength == 0:
         return strength
@@ -297,7 +316,13 @@ class WallBranches(_Branches):
                       getattr(self.law, name), self.start, *_range(name))
 
     def critical(self, NV_critical: float) -> dict:
-        """α* (rad) and the law's parameters' critical values for a model with this NV* (1/s), and their stable sides."""
+        """α* (rad) and the law's parameters' critical values for a model with this NV* (1/s), and their stable sides.
+
+        Parameters
+        ----------
+        NV_critical : float
+            The model's NV*, 1/s.
+        """
         alpha, side = self._critical("alpha", NV_critical, 0.0, math.pi / 2, "above")
         own = self.law_parameters(NV_critical)
         return {"alpha_critical": alpha, **own, "sides": (("alpha_critical", side), ("alpha_critical_deg", side), *own["sides"])}
@@ -336,7 +361,13 @@ class CorridorBranches(_Branches):
         return Branch(lambda p, _: self._middle(make(p), self.L), start, self.start, lo, hi, breaks=_passing(make, lo, hi, self.L))
 
     def critical_L(self, NV_critical: float) -> tuple:
-        """(L*, m, stable side): the nearest half-width at which the middle's verdict changes (0: stable at every L; inf: at none)."""
+        """(L*, m, stable side): the nearest half-width at which the middle's verdict changes (0: stable at every L; inf: at none).
+
+        Parameters
+        ----------
+        NV_critical : float
+            The model's NV*, 1/s.
+        """
         return self._critical("L", NV_critical, 0.0, math.inf, "above")
 
 

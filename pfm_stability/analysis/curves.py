@@ -70,10 +70,10 @@ class BoundaryCurve:
         NV*, 1/s (``inf``: stable for every NV; 0: unstable for every NV > 0).
     omega_critical : float or None
         Oscillation frequency at the boundary, rad/s.
-    x_name, y_name : str
-        Parameter names (``V``, ``f``, ``alpha``, ``L``).
-    x_unit, y_unit : str
-        Units (``m/s``, ``rad``, ``m``, ``""`` for f).
+    x_name, x_unit : str
+        The x parameter's name (``V``, ``f``, ``alpha``, ``L``) and unit (``m/s``, ``rad``, ``m``, ``""`` for f).
+    y_name, y_unit : str
+        The y parameter's name and unit, likewise.
     x, y : ndarray
         The curve: y[i] is the critical y at x[i] (``inf``/``nan`` where the
         boundary leaves the parameter's range).
@@ -117,7 +117,15 @@ class BoundaryCurve:
 
 # ------------------------------------------------------------------ helpers
 def default_models(controller: Controller, pade_order: int = 3) -> list[LoopModel]:
-    """The five loop models; ``sampled`` with the controller's hold and compute delay (`models.models_for`)."""
+    """The five loop models; ``sampled`` with the controller's hold and compute delay (`models.models_for`).
+
+    Parameters
+    ----------
+    controller : Controller
+        Hold and compute delay of ``sampled``.
+    pade_order : int
+        Order of the ``pade`` model.
+    """
     return models_for(controller, pade_order=pade_order)
 
 

@@ -254,6 +254,11 @@ def simplify_physical(expr) -> sp.Expr:
     by positive symbols (sin α/cos α for tan α) before simplifying and put back
     afterwards; every other symbol already carries its positivity. This lets
     powers such as (f/cos α)^(1/n) combine exactly, with no ``force=True``.
+
+    Parameters
+    ----------
+    expr : sympy.Expr
+        An expression in the derivation's symbols.
     """
     S, C = sp.Dummy("sin_alpha", positive=True), sp.Dummy("cos_alpha", positive=True)
     expr = sp.sympify(expr).subs(sp.tan(alpha), S / C).subs({sp.sin(alpha): S, sp.cos(alpha): C})

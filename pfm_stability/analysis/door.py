@@ -122,7 +122,13 @@ class DoorGeometry:
 
     @classmethod
     def from_dict(cls, data: dict) -> DoorGeometry:
-        """Inverse of `to_dict` (derived entries ignored)."""
+        """Inverse of `to_dict` (derived entries ignored).
+
+        Parameters
+        ----------
+        data : dict
+            The output of `to_dict`.
+        """
         return cls(data["obstacle"], *(parse_json_number(data[k]) for k in ("width", "post_radius", "robot_width")))
 
 
@@ -409,7 +415,13 @@ class DoorPassage:
 
     @classmethod
     def from_dict(cls, data: dict) -> DoorPassage:
-        """Inverse of `to_dict` (``at_stop`` is derived)."""
+        """Inverse of `to_dict` (``at_stop`` is derived).
+
+        Parameters
+        ----------
+        data : dict
+            The output of `to_dict`.
+        """
 
         def optional(key):
             return None if data[key] is None else parse_json_number(data[key])
@@ -452,10 +464,12 @@ def door_passage(
     law : ForceLaw
         F_r(d)/F_a (``force``, ``slope``) and, if it has one, the goal-directed
         part Q(d)/F_a (``goal_force``).
-    width, obstacle, post_radius, robot_width, name
+    width, obstacle, post_radius, robot_width
         As in `door_geometry`.
     find_smallest : bool
         Also solve for `smallest_passable_width` (about 50 more scans).
+    name : str
+        As in `door_geometry`: the name error messages give `width`.
 
     Returns
     -------
@@ -574,6 +588,15 @@ def power_law_door_width(f: float, n: float, W: float) -> float:
     Setting the peak of `power_law_door_peak` to 1:
     w* = 2W·[2f nⁿᐟ²/(n + 1)^((n+1)/2)]^(1/n); for n = 2, w* = 2W√(4f/(3√3)).
     A robot of width W needs w > W as well: the narrowest it passes is max(w*, W) (W itself excluded).
+
+    Parameters
+    ----------
+    f : float
+        Force-law strength (dimensionless).
+    n : float
+        Force-law exponent (dimensionless).
+    W : float
+        Robot width, m.
     """
     f = check_number("f", f, 0.0)
     n = check_number("n", n, 0.0)

@@ -109,7 +109,13 @@ class RegionGrid:
 
 # ------------------------------------------------------------------ helpers
 def verdict_model(controller: Controller) -> LoopModel:
-    """The model whose verdict the stability report gives: ``sampled`` with the controller's hold and compute delay."""
+    """The model whose verdict the stability report gives: ``sampled`` with the controller's hold and compute delay.
+
+    Parameters
+    ----------
+    controller : Controller
+        Hold and compute delay.
+    """
     return models_for(controller, ("sampled",))[0]
 
 

@@ -40,6 +40,21 @@ class StationaryPoint:
     `hessian_eigenvalues` (ascending) is None where U is not twice
     differentiable: the goal for m = 1 or n < 2 with an obstacle within ρ0,
     a minimum on the crease of a non-convex polygon's distance (`smooth` False).
+
+    Attributes
+    ----------
+    x, y : float
+        Position, m.
+    kind : str
+        One of `KINDS`.
+    hessian_eigenvalues : tuple of float or None
+        Eigenvalues of U's Hessian there, ascending (None where U is not twice differentiable).
+    potential : float
+        The total potential U there.
+    goal : bool
+        True for the goal.
+    smooth : bool
+        False on the crease of a non-convex polygon's distance.
     """
 
     x: float
@@ -62,6 +77,25 @@ class GnronBound:
     `k_exact` is k_n (eq 28/29), `k_conservative` k′_n (eq 34/37), both None
     for Khatib's law (n = 0, no finite bound; `reason` says so); `satisfied`
     is ξ/η > k_n (False without a finite bound).
+
+    Attributes
+    ----------
+    index : int
+        The obstacle's index in the scene.
+    kind : str
+        The obstacle's type (``circle``, ``segment``, ``polygon``).
+    r : float
+        Its distance to the goal, m.
+    k_exact : float or None
+        k_n (eq 28/29), dimensionless.
+    k_conservative : float or None
+        k′_n (eq 34/37), dimensionless.
+    ratio : float
+        The scene's ξ/η, dimensionless.
+    satisfied : bool
+        ξ/η > k_n.
+    reason : str or None
+        Why there is no finite bound.
     """
 
     index: int
@@ -81,7 +115,21 @@ class GnronBound:
 
 @dataclass(frozen=True)
 class TrapAnalysis:
-    """Every stationary point found in a scene, the goal's verdict and the bounds (`find_stationary_points`)."""
+    """Every stationary point found in a scene, the goal's verdict and the bounds (`find_stationary_points`).
+
+    Attributes
+    ----------
+    scene : Scene
+        The scene analysed.
+    resolution : int
+        Grid points along the region's longer side.
+    stationary_points : tuple of StationaryPoint
+        Goal first, then by kind and position.
+    goal_is_global_minimum : bool
+        True when the goal is a minimum and no other minimum found has a lower potential.
+    gnron_bounds : tuple of GnronBound
+        GC2000's bounds (`gnron_bounds`).
+    """
 
     scene: Scene
     resolution: int
@@ -102,6 +150,12 @@ class TrapAnalysis:
         if not self.traps:
             return head + ("the goal is the only minimum" if goal_ok else "no minimum in the region")
         return head + "; ".join(f"trap at ({p.x:.6g}, {p.y:.6g})" for p in self.traps)
+
+    def plot(self, ax=None, **kwargs):
+        """`plots.traps.plot_traps` of this analysis; returns the figure."""
+        from ..plots.traps import plot_traps
+
+        return plot_traps(self, ax=ax, **kwargs)
 
     def to_dict(self) -> dict:
         """JSON-ready, with schema_version, command "traps" and the scene under inputs."""
@@ -250,6 +304,15 @@ def find_stationary_points(scene: Scene, resolution: int = DEFAULT_RESOLUTION, *
     side, the same spacing h along the other; Newton steps are at most 2h,
     `iterations` per start. Points are sorted goal first, then by kind and
     position. Two stationary points closer than ~h may be missed (docs/traps.md, "Limits").
+
+    Parameters
+    ----------
+    scene : Scene
+        Goal, obstacles, law and region.
+    resolution : int
+        Grid points along the region's longer side (`RESOLUTION_RANGE`).
+    iterations : int
+        Newton steps per start.
     """
     check_type("scene", scene, Scene, "a Scene")
     resolution = check_integer("resolution", resolution, *RESOLUTION_RANGE)
@@ -298,6 +361,11 @@ def gnron_bounds(scene: Scene) -> tuple:
     model on the ray from the goal away from its nearest point); δ enters as
     r + δ, ρ0 + δ (eq 40). For m = 1 the bound is our extension of eq (25)
     (factor 2/m, (ρ − r)^(n−m)).
+
+    Parameters
+    ----------
+    scene : Scene
+        Goal, obstacles and a GNRON (or Khatib) law.
     """
     law = scene.law
     ratio = law.xi / law.eta

@@ -23,17 +23,17 @@ def add_parser(sub) -> None:
 
 
 def _draw(kind, params, pade_order):
-    from ..analysis.criteria import loop_of
-
+    """The figure of `kind`: the result computed (`analysis.comparison`), drawn by its ``.plot()``; the grid's force law."""
     robot, controller = params.robot, params.controller
     if kind == "rlocus":
-        from ..plots.rlocus import plot_root_locus
+        from ..analysis.comparison import root_locus
+        from ..analysis.criteria import loop_of
 
-        return plot_root_locus(loop_of(robot, controller), pade_order=pade_order, hold=controller.hold, compute_delay=controller.compute_delay)
+        return root_locus(loop_of(robot, controller), pade_order=pade_order, hold=controller.hold, compute_delay=controller.compute_delay).plot()
     if kind == "gain-vs-k":
-        from ..plots.rlocus import plot_critical_gain_vs_k
+        from ..analysis.comparison import critical_gain_vs_k
 
-        return plot_critical_gain_vs_k(robot.tau, controller.T, pade_order=pade_order)
+        return critical_gain_vs_k(robot.tau, controller.T, pade_order=pade_order).plot()
     from ..plots.force import plot_force_summary
     from ..sim.scenario import scenario_law
 

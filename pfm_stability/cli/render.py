@@ -3,9 +3,11 @@
 One module for every human-readable rendering, with the number formatters
 they share:
 
-* ``report``: `render_text` and `render_markdown` of a `StabilityReport`,
-  rendered from its JSON form (`StabilityReport.to_dict`), so the text says
-  exactly what the JSON says;
+* ``report``: `render_text` and `render_markdown` of a `StabilityReport`: each
+  geometry's section chosen by its result's type (a steering loop's
+  `WallAnalysis`/`CorridorAnalysis` here; a holonomic or non-smooth scene in
+  `render_families`), the numbers taken from its JSON form
+  (`StabilityReport.to_dict`), so the text says exactly what the JSON says;
 * ``derive``: `render_derivation_text` (sympy's pretty printer) and
   `render_derivation_latex` (one ``equation*`` per step) of
   `pfm_stability.analysis.derivation.derivation`;
@@ -19,6 +21,7 @@ renderers.
 
 from __future__ import annotations
 
+import functools
 import math
 import textwrap
 
@@ -66,9 +69,6 @@ _LABELS = {
     "delta": "delta (surface offset, eq 40)",
 }
 
-_REPORT_SCENARIOS = ("wall", "corridor")
-"""The report's order of the geometries (a wall first), as `build_report` writes them."""
-
 _COLUMNS = {
     "wall": (["alpha* deg", "f*", "V* m/s", "T* s", "k* 1/s"], ["alpha_critical_deg", "f_critical", "V_critical", "T_critical", "k_critical"]),
     "corridor": (["L* m", "V* m/s", "f*", "T* s", "k* 1/s"], ["L_critical", "V_critical", "f_critical", "T_critical", "k_critical"]),
@@ -98,29 +98,53 @@ _FOOTNOTE = (
 )
 
 
-def _scenarios(data: dict):
-    """Yield (title, header, rows, remedies, notes) for each geometry of the report's JSON form (each wall equilibrium when there are several)."""
-    for scenario in _REPORT_SCENARIOS:
-        if scenario not in data.get("environment", {}):
-            continue
-        env = data["environment"][scenario]
-        if "kappa" in env or env.get("verdict") == "non-smooth":  # a holonomic robot or a non-smooth law (cli/render_families.py)
-            from .render_families import family_scenario
+def _scenarios(report, data: dict):
+    """Yield (title, header, rows, remedies, notes) of each geometry, by its result's type (`_sections_of`), with the values
+    of the report's JSON form `data`."""
+    for geometry, result in report.scenes():
+        yield from _sections_of(result)(result, data["environment"][geometry], data.get(geometry), report)
 
-            yield from family_scenario(scenario, env, data.get(scenario))
-            continue
-        if scenario == "corridor":
-            title = f"Corridor, L = {number(env['L'])} m: N = {number(env['N'])} 1/m, NV = {number(env['NV'])} 1/s"
-            yield (title, *_verdict_table(scenario, data[scenario]), _reason_lines(data[scenario]) + _corridor_notes(env))
-            continue
-        equilibria = env.get("equilibria") or [{"d0": env["d0"], "N": env["N"], "NV": env["NV"], "models": data["wall"]}]
-        for i, e in enumerate(equilibria):
-            which = f", equilibrium {i + 1} of {len(equilibria)}: d0" if len(equilibria) > 1 else ": equilibrium d0"
-            title = (
-                f"Wall, alpha = {number(env['alpha_deg'])} deg{which} = {number(e['d0'])} m, "
-                f"N = {number(e['N'])} 1/m, NV = {number(e['NV'])} 1/s"
-            )
-            yield (title, *_verdict_table(scenario, e["models"]), _reason_lines(e["models"]) + _equilibrium_notes(e))
+
+def _sections_of(result):
+    """The function yielding a result's sections, by the result's type: a steering loop's here (`_steering_sections`), another
+    family's in `render_families` (imported for the families only)."""
+    steering = _steering_sections()
+    if type(result) in steering:
+        return steering[type(result)]
+    from .render_families import SECTIONS
+
+    return SECTIONS[type(result)]
+
+
+@functools.cache
+def _steering_sections() -> dict:
+    """`WallAnalysis` and `CorridorAnalysis` → their sections (built on first use: a report has loaded the types by then)."""
+    from ..analysis.criteria import CorridorAnalysis, WallAnalysis
+
+    return {WallAnalysis: _wall_sections, CorridorAnalysis: _corridor_sections}
+
+
+def _wall_sections(wall, env: dict, verdicts: dict, report):
+    """A steering loop beside a wall: one table per equilibrium (the fuzzy law's frozen gains under each, `render_families`)."""
+    equilibria = env["equilibria"]
+    for i, e in enumerate(equilibria):
+        which = f", equilibrium {i + 1} of {len(equilibria)}: d0" if len(equilibria) > 1 else ": equilibrium d0"
+        title = (
+            f"Wall, alpha = {number(env['alpha_deg'])} deg{which} = {number(e['d0'])} m, "
+            f"N = {number(e['N'])} 1/m, NV = {number(e['NV'])} 1/s"
+        )
+        notes = _reason_lines(e["models"])
+        if report.schedule is not None:
+            from .render_families import equilibrium_notes
+
+            notes += equilibrium_notes(e)
+        yield (title, *_verdict_table("wall", e["models"], wall.equilibria[i].models), notes)
+
+
+def _corridor_sections(corridor, env: dict, verdicts: dict, report):
+    """A steering loop in a corridor: one table, the notes on the finite goal and the equilibria off the centre line."""
+    title = f"Corridor, L = {number(env['L'])} m: N = {number(env['N'])} 1/m, NV = {number(env['NV'])} 1/s"
+    yield (title, *_verdict_table("corridor", verdicts, corridor.models), _reason_lines(verdicts) + _corridor_notes(env))
 
 
 def _reason_lines(verdicts: dict) -> list[str]:
@@ -133,13 +157,14 @@ def _reason_lines(verdicts: dict) -> list[str]:
     return lines
 
 
-def _verdict_table(scenario: str, verdicts: dict):
-    """(header, rows, remedies) of one geometry's verdicts; a starred value whose stable side the footnote does not name as "<= x"/">= x"."""
+def _verdict_table(scenario: str, verdicts: dict, models: dict):
+    """(header, rows, remedies) of one geometry's verdicts (their JSON form; `models` the `ModelVerdict`s); a starred value
+    whose stable side the footnote does not name as "<= x"/">= x"."""
     columns, keys = _COLUMNS[scenario]
-    first = next(iter(verdicts.values()), {})
-    if verdicts and "f_critical" not in first:  # a law with its own parameters in place of f (none: velocity, fuzzy)
+    critical = next(iter(models.values())).critical if models else {}
+    if models and "f_critical" not in critical:  # a law with its own parameters in place of f (none: velocity, fuzzy)
         at = keys.index("f_critical")
-        own = _FIELD_COLUMNS if "eta_critical" in first else ([], [])
+        own = _FIELD_COLUMNS if "eta_critical" in critical else ([], [])
         columns = columns[:at] + own[0] + columns[at + 1:]
         keys = keys[:at] + own[1] + keys[at + 1:]
     header = ["model", "verdict", "margin", "NV* 1/s", "omega* rad/s"] + columns
@@ -163,15 +188,6 @@ def _starred(verdict: dict, key: str, marked: bool) -> str:
     return f"{'<=' if side == 'below' else '>='} {number(value)}"
 
 
-def _equilibrium_notes(e: dict) -> list[str]:
-    """The fuzzy law's frozen gains at one equilibrium (cli/render_families.py); none for other laws."""
-    if "N_frozen" not in e:
-        return []
-    from .render_families import equilibrium_notes
-
-    return equilibrium_notes(e)
-
-
 def _label(name: str) -> str:
     """An input's label (`_LABELS`, or the robot families' `render_families.FAMILY_LABELS`)."""
     if name in _LABELS:
@@ -181,13 +197,13 @@ def _label(name: str) -> str:
     return FAMILY_LABELS.get(name, name)
 
 
-def _tail(data: dict) -> list[str]:
-    """The families' closing lines (robust bracket, target tracking), when the report has them."""
-    if "tracking" not in data and "robust_bracket" not in data.get("environment", {}).get("wall", {}):
+def _tail(report, data: dict) -> list[str]:
+    """The families' closing lines (the fuzzy law's robust bracket, target tracking), when the report has them."""
+    if report.tracking is None and (report.schedule is None or report.schedule.bracket is None):
         return []
     from .render_families import family_tail
 
-    return family_tail(data)
+    return family_tail(report, data)
 
 
 def _corridor_notes(env: dict) -> list[str]:
@@ -223,11 +239,12 @@ def _law_line(data: dict) -> list[str]:
     return ["", f"Force law: {law['description']}" + (f" (law {law['name']})" if law["name"] else "")]
 
 
-def _footnote(data: dict) -> list[str]:
-    """What margin and the starred values mean: in NV (steering robots) or in kappa (holonomic); none without a model."""
-    if not data["models"]:
+def _footnote(report) -> list[str]:
+    """What margin and the starred values mean: in the report's loop gain, NV (steering robots) or kappa (holonomic); none
+    without a model."""
+    if not report.models:
         return []
-    if any("kappa" in env for env in data.get("environment", {}).values() if isinstance(env, dict)):
+    if report.family.name == "holonomic":
         from .render_families import HOLONOMIC_FOOTNOTE
 
         return ["", HOLONOMIC_FOOTNOTE]
@@ -235,8 +252,9 @@ def _footnote(data: dict) -> list[str]:
 
 
 def _kb_error_line(report) -> list[str]:
-    """KB's error: one line per loop the tables decide (`report.kb_errors`: a heading gain that differs between the geometries)."""
-    errors = report.kb_errors or ((report.kb_error,) if report.kb_error is not None else ())
+    """KB's error: one line per loop the tables decide (`report.kb_errors`: more than one where the heading gain differs between
+    the geometries)."""
+    errors = report.kb_errors
     return ([""] if errors else []) + [f"{e.sentence()}: NV* = {number(e.NV_kb)} vs {number(e.NV_sampled)} 1/s." for e in errors]
 
 
@@ -253,16 +271,16 @@ def render_text(report) -> str:
     for name, entry in data["models"].items():
         options = ", ".join(f"{k}={v}" for k, v in entry.items() if k != "equation")
         lines.append(f"  {name:<15} {entry['equation']}{'  [' + options + ']' if options else ''}")
-    for title, header, rows, fixes, notes in _scenarios(data):
+    for title, header, rows, fixes, notes in _scenarios(report, data):
         lines += ["", title]
         lines += ["  " + line for line in table(header, rows)]
         lines += notes
         for model, fix in fixes.items():
             lines.append(_remedy_line(model, fix))
-    lines += _tail(data)
+    lines += _tail(report, data)
     if data.get("door"):
         lines += ["", *render_door_text(data["door"]).rstrip("\n").splitlines()]
-    lines += _footnote(data)
+    lines += _footnote(report)
     lines += _kb_error_line(report)
     return "\n".join(lines) + "\n"
 
@@ -305,17 +323,17 @@ def render_markdown(report) -> str:
         source = f"**{entry['source']}**" if entry["source"].startswith("ASSUMED") else entry["source"]
         lines.append(f"| {_label(name)} | {number(entry['value'])} | {entry['unit']} | {source} |")
     lines += _law_line(data)
-    for title, header, rows, fixes, notes in _scenarios(data):
+    for title, header, rows, fixes, notes in _scenarios(report, data):
         lines += ["", f"## {title}", "", "| " + " | ".join(header) + " |", "|" + " --- |" * len(header)]
         lines += ["| " + " | ".join(str(c) for c in r) + " |" for r in rows]
         lines += ["", *(note.strip() for note in notes)] if notes else []
         for model, fix in fixes.items():
             lines.append("")
             lines.append("-" + _remedy_line(model, fix)[1:])
-    lines += _tail(data)
+    lines += _tail(report, data)
     if data.get("door"):
         lines += ["", "## Door", "", "```", *render_door_text(data["door"]).rstrip("\n").splitlines(), "```"]
-    lines += _footnote(data)
+    lines += _footnote(report)
     lines += _kb_error_line(report)
     return "\n".join(lines) + "\n"
 

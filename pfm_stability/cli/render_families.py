@@ -1,14 +1,16 @@
 """Text of the report's robot families and velocity/fuzzy laws (docs/velocity_and_fuzzy.md): holonomic
 verdicts, the non-smooth verdict and its cycle, the fuzzy law's frozen gains and bracket, target tracking.
 
-`cli.render` calls these for the parts of a `report.StabilityReport` that KB's report does not have.
+`cli.render` calls these for the parts of a `report.stability.StabilityReport` that KB's report does not have: the
+sections of a `HolonomicScene` and a `NonSmoothScene` (chosen by the result's type), the fuzzy law's notes and the tail.
 """
 
 from __future__ import annotations
 
+from ..report.families import HolonomicScene, NonSmoothScene
 from .formatting import number, percent
 
-__all__ = ["FAMILY_LABELS", "HOLONOMIC_FOOTNOTE", "family_scenario", "equilibrium_notes", "family_tail"]
+__all__ = ["FAMILY_LABELS", "HOLONOMIC_FOOTNOTE", "SECTIONS", "holonomic_sections", "non_smooth_sections", "equilibrium_notes", "family_tail"]
 
 FAMILY_LABELS = {
     "robot": "robot family",
@@ -35,16 +37,13 @@ _CYCLE = (("mean_distance", "mean distance", "m"), ("peak_to_peak", "peak-to-pea
           ("period", "period", "s"), ("min_distance", "closest", "m"), ("duration", "measured over", "s"))
 
 
-def family_scenario(scenario: str, env: dict, verdicts: dict | None):
-    """Yield (title, header, rows, remedies, notes) of a holonomic or non-smooth geometry."""
+def holonomic_sections(scene, env: dict, verdicts: dict, report):
+    """Yield the (title, header, rows, remedies, notes) of a holonomic robot's geometry (`report.families.HolonomicScene`)."""
+    scenario = scene.geometry
     where = f"alpha = {number(env['alpha_deg'])} deg" if scenario == "wall" else f"L = {number(env['L'])} m"
     name = "Wall" if scenario == "wall" else "Corridor"
-    if env.get("verdict") == "non-smooth":
-        yield (f"{name}, {where}: NON-SMOOTH (velocity-gated repulsion: no smooth equilibrium, no N, no linear verdict)",
-               *_non_smooth_table(scenario, env))
-        return
     x = "d0" if scenario == "wall" else "x0"
-    first = env["equilibria"][0] if scenario == "wall" else min(env["equilibria"], key=lambda e: abs(e["x0"]))
+    first = env["equilibria"][scene.main]
     title = f"{name}, {where}, holonomic robot: {x} = {number(first[x])} m, kappa = {number(env['kappa'])} 1/s^2, c_h = {number(env['c_h'])} 1/s"
     header = ["model", "verdict", "margin", "kappa* 1/s^2", "omega* rad/s", "T* s", "c_h range 1/s"]
     rows, fixes = [], {}
@@ -57,6 +56,19 @@ def family_scenario(scenario: str, env: dict, verdicts: dict | None):
     others = [e for e in env["equilibria"] if e is not first]
     notes = ["  other equilibria: " + "; ".join(f"{x} = {number(e[x])} m, kappa = {number(e['kappa'])} 1/s^2" for e in others)] if others else []
     yield title, header, rows, fixes, notes
+
+
+def non_smooth_sections(scene, env: dict, verdicts: None, report):
+    """Yield the section of a non-smooth geometry (`report.families.NonSmoothScene`): the rest band and the simulated cycle."""
+    scenario = scene.geometry
+    where = f"alpha = {number(env['alpha_deg'])} deg" if scenario == "wall" else f"L = {number(env['L'])} m"
+    name = "Wall" if scenario == "wall" else "Corridor"
+    yield (f"{name}, {where}: NON-SMOOTH (velocity-gated repulsion: no smooth equilibrium, no N, no linear verdict)",
+           *_non_smooth_table(scenario, env))
+
+
+SECTIONS = {HolonomicScene: holonomic_sections, NonSmoothScene: non_smooth_sections}
+"""The families' result types → the function yielding their sections (`cli.render` dispatches on the result's type)."""
 
 
 def _non_smooth_table(scenario: str, env: dict):
@@ -81,24 +93,22 @@ def _non_smooth_table(scenario: str, env: dict):
 
 
 def equilibrium_notes(e: dict) -> list[str]:
-    """The fuzzy law's frozen-gain N and the one-sided heading gains at one equilibrium."""
-    if "N_frozen" not in e:
-        return []
+    """The fuzzy law's frozen-gain N and the one-sided heading gains at one equilibrium (its JSON form)."""
     line = f"  fuzzy-scheduled gains: N total {number(e['N'])} 1/m (used), N frozen {number(e['N_frozen'])} 1/m"
     if "c_plus" in e:
         line += f"; c = {number(e['c'])} (c- {number(e['c_minus'])}, c+ {number(e['c_plus'])}); eta = {number(e['eta'])}, d eta/dd = {number(e['eta_d'])} 1/m"
     return [line]
 
 
-def family_tail(data: dict) -> list[str]:
-    """Lines after the geometries: the fuzzy law's robust bracket and the tracking error's dynamics."""
+def family_tail(report, data: dict) -> list[str]:
+    """Lines after the geometries: the fuzzy law's robust bracket and the tracking error's dynamics (values from the JSON `data`)."""
     lines = []
-    bracket = data.get("environment", {}).get("wall", {}).get("robust_bracket")
-    if bracket:
+    if report.schedule is not None and report.schedule.bracket is not None:
+        bracket = data["environment"]["wall"]["robust_bracket"]
         lines += ["", f"Robust bracket (eta in [{number(bracket['eta'][0])}, {number(bracket['eta'][1])}], frozen): "
                       f"N in [{number(bracket['N'][0])}, {number(bracket['N'][1])}] 1/m, d0 in [{number(bracket['d0'][0])}, {number(bracket['d0'][1])}] m"]
-    t = data.get("tracking")
-    if t:
+    if report.tracking is not None:
+        t = data["tracking"]
         lines += ["", f"Target tracking (Ge & Cui 2002 eq 34-36): zeta = {number(t['damping_ratio'])}, "
                       f"omega_n = {number(t['natural_frequency'])} rad/s ({t['regime']})"]
     return lines

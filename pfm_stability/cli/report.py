@@ -1,9 +1,10 @@
-"""``pfm-stability report``: every model's verdict for a wall and/or a corridor, with any force law (``--law``, docs/fields.md)."""
+"""``pfm-stability report``: every model's verdict for a wall and/or a corridor (and a door), for every robot family (``--robot``)
+and force law (``--law``, docs/fields.md, docs/velocity_and_fuzzy.md): `report.stability.build_report`, rendered."""
 
 from __future__ import annotations
 
 from ..laws.registry import FAMILY_LAWS, FORCE_LAWS
-from ..parameters import DOOR_OBSTACLES, MODEL_NAMES, Wall
+from ..parameters import DOOR_OBSTACLES, MODEL_NAMES
 from .options import PADE_ORDER, add_family_options, add_law_options, add_parameter_options, describe, number, resolve_family, resolve_parameters
 
 FORMATS = ("text", "json", "markdown")
@@ -37,14 +38,30 @@ def add_parser(sub) -> None:
 
 def run(args) -> int:
     from ..io.serialize import dumps
+    from ..report.stability import build_report
     from .render import render_markdown, render_text
 
     params = resolve_parameters(args)
     chosen = resolve_family(args, params)
-    if _family(args, chosen):
-        report = _family_report(args, params, chosen)
-    else:
-        report = _steering_report(args, params, chosen.law, chosen.sources)
+    report = build_report(
+        params.robot,
+        params.controller,
+        family=chosen.family,
+        law=chosen.law,
+        alpha_deg=args.alpha,
+        L=args.L,
+        models=tuple(dict.fromkeys(args.model)) if args.model else MODEL_NAMES,
+        pade_order=args.pade_order,
+        mass=chosen.mass,
+        sources={
+            "alpha_deg": "user", "L": "user", **params.sources, **chosen.sources,  # a --config scenario names its file
+            "pade_order": "user" if args.pade_order != DEFAULT_PADE_ORDER else "default",
+        },
+        door=args.door,
+        door_obstacle=args.door_obstacle,
+        post_radius=args.post_radius,
+        simulate_cycle=None if args.no_simulate else _simulated_cycle,
+    )
     if args.format == "json":
         print(dumps(report.to_dict()))
     elif args.format == "markdown":
@@ -54,48 +71,8 @@ def run(args) -> int:
     return 0
 
 
-def _family(args, chosen) -> bool:
-    """Whether the report is another robot family's or a law of `parameters.FAMILY_LAWS` (else KB's report, unchanged)."""
-    return chosen.family != "steering" or getattr(chosen.law, "name", None) in FAMILY_LAWS  # the law in force: typed or the file's
+def _simulated_cycle(*args, **kwargs) -> dict:
+    """`validation.non_smooth.simulated_cycle`, imported only when a non-smooth wall asks for its cycle."""
+    from ..validation.non_smooth import simulated_cycle
 
-
-def _family_report(args, params, chosen):
-    """`family_report.build_family_report` for ``--robot``/``--law``, the non-smooth wall's cycle simulated unless ``--no-simulate``."""
-    from ..report.families import FamilyLaw, build_family_report
-
-    if args.door is not None:
-        raise ValueError(f"--door applies to --robot steering with a static law (power, grid, khatib, gnron), "
-                         f"not to --robot {chosen.family} --law {getattr(chosen.law, 'name', None) or args.law}")
-    sources = {"alpha_deg": "user", "L": "user", **params.sources, **chosen.sources,
-               "pade_order": "user" if args.pade_order != DEFAULT_PADE_ORDER else "default"}
-    report = build_family_report(
-        params.robot, params.controller, family=chosen.family, law=chosen.law, alpha_deg=args.alpha, L=args.L,
-        models=tuple(dict.fromkeys(args.model)) if args.model else MODEL_NAMES, pade_order=args.pade_order, mass=chosen.mass, sources=sources,
-    )
-    if isinstance(chosen.law, FamilyLaw) and chosen.law.name == "velocity-gated" and not args.no_simulate:
-        from ..validation.non_smooth import fill_cycles
-
-        report = fill_cycles(report, chosen.family, params.robot, params.controller, chosen.law, mass=chosen.mass)
-    return report
-
-
-def _steering_report(args, params, law, law_sources):
-    """KB's steering robot with a static law: `report.build_report`, exactly as before the robot families."""
-    from ..report.stability import build_report
-
-    return build_report(
-        params.robot,
-        params.controller,
-        alpha=Wall.from_degrees(args.alpha).alpha if args.alpha is not None else None,  # degrees in, radians on
-        L=args.L,
-        models=tuple(dict.fromkeys(args.model)) if args.model else MODEL_NAMES,
-        pade_order=args.pade_order,
-        sources={
-            "alpha_deg": "user", "L": "user", **params.sources, **law_sources,  # a --config scenario names its file
-            "pade_order": "user" if args.pade_order != DEFAULT_PADE_ORDER else "default",
-        },
-        law=law,
-        door=args.door,
-        door_obstacle=args.door_obstacle,
-        post_radius=args.post_radius,
-    )
+    return simulated_cycle(*args, **kwargs)

@@ -121,8 +121,6 @@ class MapSegment:
         λ = 2πV/ω* at the robot's V, m (inf: the model has no oscillation frequency).
     stretch : int
         Samples averaged into σ̄ (the judged part's samples with an equilibrium).
-    growth_rate : float or None
-        σ̄, the mean growth rate over the judged part at the robot's V, 1/s (`verdicts.mean_growth`).
     direction : str or None
         The travel direction deciding the verdict ("forward": from (x0, y0) to (x1, y1); "reverse"):
         the one with the smaller V* (the forward force, and so N, differ between the two where a
@@ -130,6 +128,8 @@ class MapSegment:
     judged_from, judged_to : float or None
         The judged part, m from (x0, y0) along the segment (`verdicts.judged_run`: where
         |F_r·t| <= `verdicts.END_FRACTION`); None without an equilibrium.
+    growth_rate : float or None
+        σ̄, the mean growth rate over the judged part at the robot's V, 1/s (`verdicts.mean_growth`).
     """
 
     x0: float
@@ -226,6 +226,12 @@ class MapAnalysis:
         values = [s.V_critical for s in self.segments if s.V_critical is not None]
         return min(values) if values else None
 
+    def plot(self, ax=None, **kwargs):
+        """`plots.map.plot_map_stability` of this analysis; returns the figure."""
+        from ..plots.map import plot_map_stability
+
+        return plot_map_stability(self, ax=ax, **kwargs)
+
     def summary(self) -> dict:
         """``unstable_length_m``, ``V_critical_min``, segment counts by verdict, total length."""
         counts = {v: sum(s.verdict == v for s in self.segments) for v in ("stable", "unstable", "undecided", *NO_VERDICT)}
@@ -271,7 +277,15 @@ def check_map_law(law) -> None:
 
 def scale_warnings(occupancy: OccupancyMap, W: float) -> tuple:
     """One line if the map's resolution looks wrong for a robot of width W (m): coarser than `MAX_RESOLUTION`·W per
-    pixel, or a map side longer than `MAX_MAP_SIDE`; () otherwise (docs/maps.md, "Map files")."""
+    pixel, or a map side longer than `MAX_MAP_SIDE`; () otherwise (docs/maps.md, "Map files").
+
+    Parameters
+    ----------
+    occupancy : OccupancyMap
+        The map (resolution, size).
+    W : float
+        Robot width, m.
+    """
     r = occupancy.resolution
     x0, x1, y0, y1 = occupancy.extent
     reasons = [f"a pixel is wider than {MAX_RESOLUTION:g} W = {MAX_RESOLUTION * W:g} m"] if r > MAX_RESOLUTION * W else []
@@ -285,7 +299,21 @@ def scale_warnings(occupancy: OccupancyMap, W: float) -> tuple:
 
 def corridor_warnings(occupancy: OccupancyMap, grid: HistogramMap, routes, clearance: np.ndarray, W: float) -> tuple:
     """One line if even the narrowest corridor is wider than `MAX_CORRIDOR_WIDTHS` robot widths W (m): a corridor's
-    width is twice the clearance (m, per histogram cell) along its segment, the median over the segment's cells."""
+    width is twice the clearance (m, per histogram cell) along its segment, the median over the segment's cells.
+
+    Parameters
+    ----------
+    occupancy : OccupancyMap
+        The map (its name for the message).
+    grid : HistogramMap
+        Its histogram grid.
+    routes : list of Route
+        The segments found (`routes.find_routes`).
+    clearance : ndarray, shape (nx, ny)
+        Distance to the nearest occupied cell, m, per histogram cell.
+    W : float
+        Robot width, m.
+    """
     widths = []
     for r in routes:
         count = max(2, int(math.ceil(r.length / grid.cell_size)))

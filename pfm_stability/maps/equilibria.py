@@ -110,6 +110,11 @@ class Samples:
         dF_n/ds is the same both ways (the normal and s flip together); the forward
         force is 1 + F_r·t one way and 1 − F_r·t the other (nan where it is <= 0).
         `N` is the larger of the two (the forward force the smaller).
+
+        Parameters
+        ----------
+        index : int, slice or ndarray
+            Which samples.
         """
         N, forward = self.N[index], self.forward[index]
         if self.along is None:
@@ -240,7 +245,21 @@ def _brackets(owner: np.ndarray, s: np.ndarray, fn: np.ndarray):
 
 
 def grid_equilibria(grid: HistogramMap, law: GridWallLaw, routes, clearance: np.ndarray, W: float) -> Samples:
-    """Equilibria and N at samples every cell along `routes` with the exact window sum (module docstring)."""
+    """Equilibria and N at samples every cell along `routes` with the exact window sum (module docstring).
+
+    Parameters
+    ----------
+    grid : HistogramMap
+        The map's histogram grid.
+    law : GridWallLaw
+        KB's grid law (window, cell size, certainty value).
+    routes : list of Route
+        The segments (`routes.find_routes`).
+    clearance : ndarray, shape (nx, ny)
+        Distance to the nearest occupied cell, m, per histogram cell.
+    W : float
+        Robot width, m.
+    """
     c = grid.cell_size
     x, y, seg, tx, ty = sample_points(routes, c)
     low, high = _band(grid, clearance, x, y, tx, ty, W, law.reach)
@@ -305,7 +324,27 @@ def _ray_distance(blocked: np.ndarray, resolution: float, origin, x, y, dx, dy) 
 
 def power_equilibria(grid: HistogramMap, law, routes, clearance: np.ndarray, W: float, blocked: np.ndarray, resolution: float,
                      origin) -> Samples:
-    """Equilibria and N at samples every cell along `routes` for a distance law (module docstring, ``power``)."""
+    """Equilibria and N at samples every cell along `routes` for a distance law (module docstring, ``power``).
+
+    Parameters
+    ----------
+    grid : HistogramMap
+        The map's histogram grid.
+    law : ForceLaw
+        A distance law (KB's lumped power law).
+    routes : list of Route
+        The segments (`routes.find_routes`).
+    clearance : ndarray, shape (nx, ny)
+        Distance to the nearest occupied cell, m, per histogram cell.
+    W : float
+        Robot width, m.
+    blocked : ndarray of bool, shape (height, width)
+        Map pixels a ray stops at (occupied, and unknown if it counts as occupied).
+    resolution : float
+        Map pixel size, m.
+    origin : (float, float, float)
+        The map's origin (x, y in m, yaw).
+    """
     x, y, seg, tx, ty = sample_points(routes, grid.cell_size)
     a = _ray_distance(blocked, resolution, origin, x, y, -ty, tx)
     b = _ray_distance(blocked, resolution, origin, x, y, ty, -tx)

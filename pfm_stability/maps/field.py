@@ -71,13 +71,25 @@ class HistogramMap:
         return self.cv > 0
 
     def cell_index(self, x, y):
-        """(i, j) of the cells containing the points (may lie outside the grid)."""
+        """(i, j) of the cells containing the points (may lie outside the grid).
+
+        Parameters
+        ----------
+        x, y : array_like
+            Points, m.
+        """
         c = self.cell_size
         return (np.floor((np.asarray(x, dtype=float) - self.x_min) / c).astype(np.int64),
                 np.floor((np.asarray(y, dtype=float) - self.y_min) / c).astype(np.int64))
 
     def cell_center(self, i, j):
-        """(x, y) of cell centres, m."""
+        """(x, y) of cell centres, m.
+
+        Parameters
+        ----------
+        i, j : array_like of int
+            Cell indices along x and y.
+        """
         c = self.cell_size
         return self.x_min + (np.asarray(i) + 0.5) * c, self.y_min + (np.asarray(j) + 0.5) * c
 
@@ -225,6 +237,13 @@ def centre_field(grid: HistogramMap, law: GridWallLaw):
     F(i, j) = Σ_{a, b} C(i + a, j + b)·k(a, b), a correlation of the certainty grid
     with the window kernel (`window_kernels`), computed as a convolution with the
     flipped kernel (``scipy.signal.fftconvolve``); cells outside the grid are empty.
+
+    Parameters
+    ----------
+    grid : HistogramMap
+        Certainty values and cell size.
+    law : GridWallLaw
+        The window and its force constants.
     """
     from scipy.signal import fftconvolve
 

@@ -116,7 +116,13 @@ class OccupancyMap:
         return (x0, x0 + self.width * self.resolution, y0, y0 + self.height * self.resolution)
 
     def cell_of(self, x, y):
-        """(column i, row j) of the cells containing the points (may lie outside the map)."""
+        """(column i, row j) of the cells containing the points (may lie outside the map).
+
+        Parameters
+        ----------
+        x, y : array_like
+            Points in map coordinates, m.
+        """
         r = self.resolution
         i = np.floor((np.asarray(x, dtype=float) - self.origin[0]) / r).astype(np.int64)
         j = np.floor((np.asarray(y, dtype=float) - self.origin[1]) / r).astype(np.int64)

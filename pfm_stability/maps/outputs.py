@@ -54,7 +54,13 @@ def _csv_value(v) -> str:
 
 def segments_csv(analysis) -> str:
     """One row per segment: end points (m, map coordinates), length, N (N_eff), c, V*, margin, stable, verdict, offset,
-    samples, and the local worst (N_max, V_critical_local) with the averaging wavelength (m)."""
+    samples, and the local worst (N_max, V_critical_local) with the averaging wavelength (m).
+
+    Parameters
+    ----------
+    analysis : MapAnalysis
+        The analysis whose segments are written.
+    """
     lines = [",".join(CSV_COLUMNS)]
     for s in analysis.segments:
         lines.append(",".join(_csv_value(getattr(s, k)) for k in CSV_COLUMNS))
@@ -62,18 +68,36 @@ def segments_csv(analysis) -> str:
 
 
 def percent_to_pixel(percent) -> np.ndarray:
-    """PGM value (uint8) of a percentage 0 … 100 in the mask's scale mode (module docstring)."""
+    """PGM value (uint8) of a percentage 0 … 100 in the mask's scale mode (module docstring).
+
+    Parameters
+    ----------
+    percent : array_like
+        Speed limits, % of V (0 … 100).
+    """
     q = np.asarray(percent, dtype=float)
     return (255 - np.round(2.55 * q)).astype(np.uint8)
 
 
 def pixel_to_percent(value) -> np.ndarray:
-    """Nav2's reading of a PGM value in the mask's scale mode: rint(100·(255 − v)/255)."""
+    """Nav2's reading of a PGM value in the mask's scale mode: rint(100·(255 − v)/255).
+
+    Parameters
+    ----------
+    value : array_like of int
+        PGM values (0 … 255).
+    """
     return np.rint(100.0 * (255.0 - np.asarray(value, dtype=float)) / 255.0).astype(np.int64)
 
 
 def speed_limits(analysis) -> np.ndarray:
-    """Speed limit per map cell, % of V (int, shape (height, width), row 0 at y = origin)."""
+    """Speed limit per map cell, % of V (int, shape (height, width), row 0 at y = origin).
+
+    Parameters
+    ----------
+    analysis : MapAnalysis
+        The analysis (map, segments and their verdicts).
+    """
     occupancy = analysis.occupancy
     V, half = analysis.robot.V, analysis.robot.W / 2
     limits = np.full(occupancy.values.shape, 100, dtype=np.int64)
@@ -104,14 +128,28 @@ def _distance_to_segment(px, py, s):
 
 
 def speed_mask_yaml(occupancy, image: str = "speed_mask.pgm") -> str:
-    """The mask's map_server YAML: the map's resolution and origin, scale mode, thresholds that make the mapping exact."""
+    """The mask's map_server YAML: the map's resolution and origin, scale mode, thresholds that make the mapping exact.
+
+    Parameters
+    ----------
+    occupancy : OccupancyMap
+        The map (resolution, origin).
+    image : str
+        The PGM file's name, relative to the YAML file.
+    """
     origin = ", ".join(f"{v:.12g}" for v in occupancy.origin)
     return (f"image: {image}\nmode: scale\nresolution: {occupancy.resolution:.12g}\norigin: [{origin}]\nnegate: 0\n"
             "occupied_thresh: 1.0\nfree_thresh: 0.0\n")
 
 
 def speed_mask_pgm(analysis) -> bytes:
-    """The mask image as a binary PGM (P5, 8 bits, row 0 at the top, as map_server reads it)."""
+    """The mask image as a binary PGM (P5, 8 bits, row 0 at the top, as map_server reads it).
+
+    Parameters
+    ----------
+    analysis : MapAnalysis
+        The analysis (`speed_limits`).
+    """
     pixels = percent_to_pixel(speed_limits(analysis))[::-1]
     height, width = pixels.shape
     return f"P5\n{width} {height}\n255\n".encode("ascii") + np.ascontiguousarray(pixels).tobytes()

@@ -71,7 +71,15 @@ class Route:
 
 
 def skeleton_of(grid: HistogramMap, W: float):
-    """(skeleton, clearance): the medial axis of the free space where a robot of width W fits, and the clearance (m)."""
+    """(skeleton, clearance): the medial axis of the free space where a robot of width W fits, and the clearance (m).
+
+    Parameters
+    ----------
+    grid : HistogramMap
+        The map's histogram grid.
+    W : float
+        Robot width, m.
+    """
     require("maps", "finding a map's corridors")
     from skimage.morphology import skeletonize
 
@@ -150,7 +158,13 @@ def _cut(points: np.ndarray, start_cut: float, end_cut: float) -> np.ndarray:
 
 
 def default_min_length(W: float) -> float:
-    """Shortest segment analysed by default, m: the larger of `MIN_LENGTH` and 1.25 W (a robot length and a quarter)."""
+    """Shortest segment analysed by default, m: the larger of `MIN_LENGTH` and 1.25 W (a robot length and a quarter).
+
+    Parameters
+    ----------
+    W : float
+        Robot width, m.
+    """
     return max(MIN_LENGTH, 1.25 * W)
 
 
@@ -222,6 +236,17 @@ def prune_spurs(skeleton: np.ndarray, clearance: np.ndarray, cell_size: float, r
     wall, so it is as long as the clearance there. Removing them (a few rounds: a
     removed spur can leave another behind) leaves the corridors and their real
     junctions.
+
+    Parameters
+    ----------
+    skeleton : ndarray of bool, shape (nx, ny)
+        The medial axis.
+    clearance : ndarray, shape (nx, ny)
+        Distance to the nearest occupied cell, m.
+    cell_size : float
+        Cell side, m.
+    rounds : int
+        Pruning rounds at most.
     """
     from scipy.ndimage import label
 

@@ -102,7 +102,15 @@ sin 14° = 0.24 F_ct, a quarter of the forward force, half the along-track force
 
 def drift_slope(position: np.ndarray, offset: np.ndarray) -> float:
     """|ds0/ds|: the least-squares slope of the equilibrium offsets `offset` (m) against `position` (m) along the
-    segment, over the finite samples (0 with fewer than two)."""
+    segment, over the finite samples (0 with fewer than two).
+
+    Parameters
+    ----------
+    position : ndarray
+        Positions along the segment, m.
+    offset : ndarray
+        Equilibrium offsets s0, m (nan: none).
+    """
     position, offset = np.asarray(position, dtype=float), np.asarray(offset, dtype=float)
     ok = np.isfinite(offset) & np.isfinite(position)
     if ok.sum() < 2 or np.ptp(position[ok]) == 0:
@@ -139,7 +147,15 @@ def judged_run(along: np.ndarray, fraction: float = END_FRACTION) -> tuple:
 
 
 def wavelength(V: float, omega: float | None) -> float:
-    """One oscillation wavelength 2π·V/ω, m (inf when the model has no oscillation frequency)."""
+    """One oscillation wavelength 2π·V/ω, m (inf when the model has no oscillation frequency).
+
+    Parameters
+    ----------
+    V : float
+        Speed, m/s.
+    omega : float or None
+        Oscillation frequency, rad/s (None or 0: no oscillation).
+    """
     if omega is None or not omega > 0 or not math.isfinite(omega):
         return math.inf
     return 2.0 * math.pi * V / omega
@@ -200,7 +216,17 @@ class GrowthRate:
 
 
 def mean_growth(N: np.ndarray, V: float, growth: GrowthRate) -> float:
-    """σ̄: the mean of σ(N_i·V) over the samples with a finite N (1/m) at speed V (m/s), 1/s (nan without one)."""
+    """σ̄: the mean of σ(N_i·V) over the samples with a finite N (1/m) at speed V (m/s), 1/s (nan without one).
+
+    Parameters
+    ----------
+    N : ndarray
+        Per-sample gains, 1/m (nan: no equilibrium).
+    V : float
+        Speed, m/s.
+    growth : GrowthRate
+        The model's σ(NV).
+    """
     N = np.asarray(N, dtype=float)
     N = N[np.isfinite(N)]
     return float(np.mean(growth(N * V))) if N.size else math.nan
@@ -271,7 +297,21 @@ class SegmentGain:
 
 
 def segment_gain(N: np.ndarray, V: float, omega: float | None, growth: GrowthRate, NV_critical: float) -> SegmentGain:
-    """σ̄ and N_eff of a travel direction with per-sample gains `N` (1/m) at speed V (m/s); ω* (rad/s) gives λ only."""
+    """σ̄ and N_eff of a travel direction with per-sample gains `N` (1/m) at speed V (m/s); ω* (rad/s) gives λ only.
+
+    Parameters
+    ----------
+    N : ndarray
+        Per-sample gains, 1/m (nan: no equilibrium).
+    V : float
+        Speed, m/s.
+    omega : float or None
+        The model's ω*, rad/s (None: no oscillation frequency).
+    growth : GrowthRate
+        The model's σ(NV).
+    NV_critical : float
+        The model's NV*, 1/s.
+    """
     N = np.asarray(N, dtype=float)
     N = N[np.isfinite(N)]
     lam = wavelength(V, omega)
@@ -286,6 +326,15 @@ def critical_speed(N: np.ndarray, growth: GrowthRate, NV_critical: float) -> flo
 
     0 when the mean N is negative (σ̄ > 0 at every small V) or NV* = 0; inf without a
     sample with an equilibrium, or when NV* is infinite and no N is negative.
+
+    Parameters
+    ----------
+    N : ndarray
+        Per-sample gains, 1/m (nan: no equilibrium).
+    growth : GrowthRate
+        The model's σ(NV).
+    NV_critical : float
+        The model's NV*, 1/s.
     """
     N = np.asarray(N, dtype=float)
     N = N[np.isfinite(N) & (N != 0)]

@@ -14,15 +14,22 @@ A heading gain c (``Loop(tau, T, k, c=…)``, default 0) turns the gain term kNV
 into k(cs + NV) in every model (docs/models.md, "The heading gain"); NV < 0 is
 unstable in every model (`divergent_reason`); at NV = 0 every model judges its
 heading loop, the roots other than the neutral lateral one (`neutral_reason`).
+
+Every model also decides the holonomic robot's loop s² + (c_h s + κ)e^(−sT)
+(`models.holonomic.HolonomicLoop`, docs/models.md "Robot loop families"): a loop
+is a `Characteristic`, a(s) + (δ·s + K)·e^(−sT), and each model reads it through
+that interface only; `STEERING` and `models.holonomic.HOLONOMIC` name each
+family's gain and equations (`LoopFamily.describe`).
 """
 
 from __future__ import annotations
 
 from ..checks import check_choice
 from ..parameters import MODEL_NAMES, Controller
-from .base import HEADING_GAIN_RANGE, Boundary, Loop, LoopModel
+from .base import HEADING_GAIN_RANGE, STEERING, Boundary, Loop, LoopModel
 from .continuous import Continuous
 from .exact_delay import ExactDelay
+from .family import Characteristic, LoopFamily
 from .kb_first_order import KBFirstOrder
 from .pade import Pade, pade_coefficients
 from .sampled import Sampled
@@ -34,8 +41,11 @@ __all__ = [
     "DIVERGENT_REASON",
     "HEADING_GAIN_RANGE",
     "NEUTRAL_REASON",
+    "STEERING",
     "Boundary",
+    "Characteristic",
     "Loop",
+    "LoopFamily",
     "LoopModel",
     "Continuous",
     "KBFirstOrder",
@@ -93,6 +103,15 @@ def make_models(names=MODEL_NAMES, *, controller=None, **options) -> list[LoopMo
 
     With `controller`, the ``sampled`` model takes the controller's hold and
     compute delay (giving ``hold``/``compute_delay`` as well is an error).
+
+    Parameters
+    ----------
+    names : list or tuple of str
+        Model names (`parameters.MODEL_NAMES`).
+    controller : Controller, optional
+        Gives ``sampled`` its hold and compute delay.
+    **options
+        Passed to `make_model` (``pade_order``, ``hold``, ``compute_delay``).
     """
     if isinstance(names, str) or not isinstance(names, (list, tuple)) or not all(isinstance(n, str) for n in names):
         raise ValueError(f"names must be a list or tuple of model names ({', '.join(MODEL_NAMES)}); got {names!r}")

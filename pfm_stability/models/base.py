@@ -1,4 +1,4 @@
-"""What every loop model shares: the loop parameters, the boundary result, verdicts.
+"""What every loop model shares: the loop families, the boundary result, verdicts.
 
 Koren & Borenstein 1991 (KB) reduce robot + environment to a loop whose only
 environment-dependent quantity is the product NV (eq 16–19): the characteristic
@@ -11,6 +11,17 @@ K = kNV. A model therefore answers three questions for given (τ, T, k):
   (Routh, Schur–Cohn, a crossing count);
 * `rightmost_root(NV, …)`: the dominant root as a continuous-time rate
   σ + jω (1/s, rad/s); sampled models convert z by s = ln(z)/T.
+
+Every robot family closes a loop of one shape (docs/models.md, "Robot loop
+families"): a(s) + (δ·s + K)·e^(−sT) = 0, with a plant a(s), a delayed rate
+term δ·s and a loop gain K. `family.Characteristic` is that shape; `Loop` is KB's
+steering robot (a(s) = τs³ + s² + ks, δ = kc, K = kNV; kinematic steering is
+τ = 0) and `models.holonomic.HolonomicLoop` the holonomic one (a(s) = s²,
+δ = c_h, K = κ). Each model (`continuous`, `kb_first_order`, `pade`,
+`exact_delay`, `sampled`) is one implementation that reads the loop it is
+given through `Characteristic` only, so it decides every family; a family's
+`family.LoopFamily` names its gain and the equation each model solves
+(`STEERING` here).
 
 A heading gain c (`Loop.c`, docs/models.md "The heading gain") adds k·c·s to
 the gain term: τs³ + s² + ks + k(cs + NV)·e^(−sT) = 0. c = 0 (the default)
@@ -31,13 +42,15 @@ from functools import lru_cache
 
 import numpy as np
 
-from ..checks import check_number
-from ..parameters import RANGES, T_RESOLUTION, TAU_RESOLUTION, check_parameter
-from ..numerics.crossings import first_stable_interval, verdict_at
+from ..checks import check_choice, check_number
+from ..parameters import HOLDS, RANGES, T_RESOLUTION, TAU_RESOLUTION, check_parameter
+from ..numerics.crossings import Crossing, StabilityInterval, affine_crossings, stable_interval, stable_set, verdict_at
 from ..io.serialize import json_number
+from .family import Characteristic, LoopFamily, StableSet
 from .verdicts import NV_MAX
 
 __all__ = [
+    "STEERING",
     "Loop",
     "Boundary",
     "LoopModel",
@@ -76,8 +89,8 @@ def neutral_quotient(p, domain: str = "s") -> np.ndarray:
 
 
 @dataclass(frozen=True)
-class Loop:
-    """Loop parameters every model needs.
+class Loop(Characteristic):
+    """KB's steering loop τs³ + s² + ks + k(cs + NV)·e^(−sT) = 0: the parameters every model needs.
 
     Parameters
     ----------
@@ -112,6 +125,24 @@ class Loop:
         if self.c.__class__ is not float or self.c != 0.0:
             object.__setattr__(self, "c", check_heading_gain(self.c))
 
+    @classmethod
+    def of(cls, robot, controller, *, c: float = 0.0) -> "Loop":
+        """The loop of a robot and its controller (τ, k; T), with heading gain `c`: the one constructor from them.
+
+        Parameters
+        ----------
+        robot : parameters.Robot
+        controller : parameters.Controller
+        c : float
+            Heading gain of the equilibrium (0: a static law, KB's loop).
+        """
+        return cls(robot.tau, controller.T, robot.k, c=c)
+
+    @property
+    def family(self) -> LoopFamily:
+        """`STEERING`."""
+        return STEERING
+
     @property
     def plant(self) -> np.ndarray:
         """a(s) = τs³ + s² + ks, descending (KB eq 17 without the gain term)."""
@@ -123,6 +154,11 @@ class Loop:
         return self.k * self.c
 
     @property
+    def damping(self) -> float:
+        """δ = kc (`heading`), 1/s."""
+        return self.heading
+
+    @property
     def closed_plant(self) -> np.ndarray:
         """a(s) + kc·s = τs³ + s² + k(1 + c)s, descending: the loop without delay and without NV.
 
@@ -132,9 +168,110 @@ class Loop:
             return self.plant
         return np.array([self.tau, 1.0, self.k * (1.0 + self.c), 0.0]) if self.tau > 0 else np.array([1.0, self.k * (1.0 + self.c), 0.0])
 
+    def loop_gain(self, NV: float) -> float:
+        """K = kNV, 1/s²."""
+        return self.k * NV
+
+    def gain_of(self, K: float) -> float:
+        """NV = K/k, 1/s."""
+        return K / self.k
+
+    def check_gain(self, NV) -> float:
+        """NV (1/s) as a float in [−`NV_MAX`, `NV_MAX`] (−0.0 becomes 0.0), or ValueError naming NV."""
+        return check_number("NV", NV, -NV_MAX, NV_MAX, low_open=False, high_open=False, unit="1/s") + 0.0
+
+    def boundary_from(self, model: str, interval: StabilityInterval) -> "Boundary":
+        """`Boundary` in NV (K/k)."""
+        return Boundary.from_interval(model, interval, self.k)
+
+    def with_delay(self, T: float) -> "Loop":
+        """τ, k and c with delay / period T, s."""
+        return Loop(self.tau, T, self.k, c=self.c)
+
+    def delay_search(self, NV: float) -> tuple:
+        """T* searched from 1 % of the loop's fastest time scale to 1e-7 relative (a report shows 4 digits)."""
+        scale = _time_scale(self, NV)
+        return scale * 1e-2, _DELAY_RTOL, 1e-12 * scale
+
+    def state_space(self, hold: str) -> tuple:
+        """(A, B, F0, F1) of the sampled steering loop (`models.sampled`): states (ω, θ, y), (θ, y) for τ = 0; y = x/V.
+
+        The held input is v_k = −(F0 + K·F1)·state_k; the heading gain c adds kc to F0's θ entry.
+        """
+        check_choice("hold", hold, HOLDS)
+        tau, k = self.tau, self.k
+        if tau > 0:
+            if hold == "command":
+                A = np.array([[-1 / tau, 0, 0], [1, 0, 0], [0, 1, 0]], dtype=float)
+                F0 = np.array([0.0, k, 0.0])
+            else:
+                A = np.array([[-1 / tau, -k / tau, 0], [1, 0, 0], [0, 1, 0]], dtype=float)
+                F0 = np.zeros(3)
+            B = np.array([[1 / tau], [0.0], [0.0]])
+            F1 = np.array([0.0, 0.0, 1.0])
+        else:
+            if hold == "command":
+                A = np.array([[0, 0], [1, 0]], dtype=float)
+                F0 = np.array([k, 0.0])
+            else:
+                A = np.array([[-k, 0], [1, 0]], dtype=float)
+                F0 = np.zeros(2)
+            B = np.array([[1.0], [0.0]])
+            F1 = np.array([0.0, 1.0])
+        if self.c != 0.0:  # δ_k = −(K/k)·y_k − c·θ_k: the sampled θ enters with kc more
+            F0[-2] += self.heading
+        return A, B, F0, F1
+
+    def delay_interval(self) -> StabilityInterval:
+        """KB's delay loop: K* among three phase levels (`delay.kb_critical_gain`); with c ≠ 0 every gain crossing
+        that can bound the stable set (`models.heading.kb_heading_interval`)."""
+        if self.c != 0.0:
+            from .heading import kb_heading_interval  # only with a heading gain: KB's reports never compile it
+
+            return kb_heading_interval(self.tau, self.T, self.k, self.c)
+        from ..numerics.delay import kb_critical_gain
+
+        K, w = (float(x[0]) for x in kb_critical_gain(_one(self.tau), _one(self.T), _one(self.k)))
+        return StabilityInterval(K, w if math.isfinite(K) else None, (), ((0.0, K),))
+
+    def _count(self, K: float):
+        """(stable, unstable roots, T*) of the delay loop at K by the crossing count, in KB's array route."""
+        from ..numerics.delay import delay_verdicts_from_gain
+
+        heading = () if self.c == 0.0 else (_one(self.c),)
+        stable, Z, margin = delay_verdicts_from_gain(_one(self.tau), _one(self.T), _one(self.k), _one(K), *heading)
+        return bool(stable[0]), int(Z[0]), float(margin[0])
+
+    def delay_stable(self, K: float) -> bool:
+        """The crossing count Z(T) = 0 (`delay.delay_verdicts_from_gain`; K = 0: the heading loop's)."""
+        return self._count(K)[0]
+
+    def delay_margin(self, K: float) -> float:
+        """T*, s, of the crossing count (`delay.delay_verdicts_from_gain`)."""
+        return self._count(K)[2]
+
+
+def _one(x) -> np.ndarray:
+    return np.array([float(x)])
+
+
+STEERING = LoopFamily(
+    "steering",
+    "NV",
+    {
+        "continuous": "tau s^3 + s^2 + k s + k N V = 0  (KB eq 17)",
+        "kb_first_order": "tau s^3 + s^2 + k(1 - N V T) s + k N V = 0  (KB eq 19)",
+        "pade": "(tau s^3 + s^2 + k s) Q_m(s) + k N V P_m(s) = 0  (KB eq 18, Pade(m,m))",
+        "exact_delay": "tau s^3 + s^2 + k s + k N V exp(-s T) = 0  (KB eq 18)",
+        "sampled": "det(zI - Phi_cl(kNV)) = 0, ZOH, period T",
+    },
+    ("order", "hold", "compute_delay"),
+)
+"""KB's steering robot (kinematic steering: τ = 0): the gain NV, KB's equations (17)–(19)."""
+
 
 @dataclass(frozen=True)
-class Boundary:
+class Boundary(StableSet):
     """Stability boundary of one model for one loop (τ, T, k, c).
 
     Attributes
@@ -167,10 +304,6 @@ class Boundary:
         intervals = tuple((lo / k, hi / k) for lo, hi in interval.intervals)
         return cls(model, interval.gain / k, interval.frequency, interval.gain, intervals)
 
-    def contains(self, NV: float) -> bool:
-        """True when NV lies strictly inside a stable interval."""
-        return any(lo < NV < hi for lo, hi in self.stable_set)
-
     def to_dict(self) -> dict:
         """The fields as a JSON-ready dict (SI units)."""
         return {
@@ -178,7 +311,7 @@ class Boundary:
             "NV_critical": json_number(self.NV_critical),
             "omega_critical": self.omega_critical,
             "K_critical": json_number(self.K_critical),
-            "stable_set": [[json_number(lo), json_number(hi)] for lo, hi in self.stable_set],
+            "stable_set": self.stable_set_json(),
         }
 
 
@@ -198,43 +331,52 @@ def check_heading_gain(c) -> float:
         raise
 
 
-def _check_loop(loop) -> "Loop":
-    if not isinstance(loop, Loop):
-        raise ValueError(f"loop must be a Loop (tau, T, k); got {loop!r}")
+def _check_loop(loop) -> Characteristic:
+    if not isinstance(loop, Characteristic):
+        raise ValueError(f"loop must be a Loop (tau, T, k) or a HolonomicLoop (T, c_h); got {loop!r}")
     return loop
 
 
 def checked(method):
-    """Validate a public model method's (NV, loop) arguments: ValueError naming the bad one.
+    """Validate a public model method's (gain, loop) arguments: ValueError naming the bad one.
 
-    NV is capped at |NV| <= `NV_MAX` here only: internal probes (a stable
-    interval checked beyond the last crossing gain) may go further. NV < 0
-    is accepted (N < 0, `divergent_reason`), and NV = 0 (N = 0: the heading
-    loop is judged, `neutral_reason`).
+    The gain is the loop's family's (`Characteristic.check_gain`): NV for a steering
+    loop, capped at |NV| <= `NV_MAX` here only (internal probes, a stable interval
+    checked beyond the last crossing gain, may go further); NV < 0 is accepted
+    (N < 0, `divergent_reason`), and NV = 0 (N = 0: the heading loop is judged,
+    `neutral_reason`). κ for a holonomic loop (non-zero).
     """
 
     @functools.wraps(method)
-    def wrapper(self, NV, loop, *args, **kwargs):
-        NV = check_number("NV", NV, -NV_MAX, NV_MAX, low_open=False, high_open=False, unit="1/s") + 0.0
-        return method(self, NV, _check_loop(loop), *args, **kwargs)
+    def wrapper(self, gain, loop, *args, **kwargs):
+        loop = _check_loop(loop)
+        return method(self, loop.check_gain(gain), loop, *args, **kwargs)
 
     return wrapper
 
 
+def _steering(loop: Characteristic, what: str) -> Loop:
+    """`loop` if it is a steering loop; ValueError for a query that has none in another family (k*: the steering gain)."""
+    if not isinstance(loop, Loop):
+        raise ValueError(f"loop must be a Loop (tau, T, k) for {what}: a {loop.family.name} loop has no steering gain k; got {loop!r}")
+    return loop
+
+
 @lru_cache(maxsize=8192)
-def _cached_boundary(model: "LoopModel", loop: Loop) -> Boundary:
+def _cached_boundary(model: "LoopModel", loop: Characteristic):
     return model.compute_boundary(loop)
 
 
 class LoopModel:
-    """Base class: a named loop model. Subclasses implement the queries.
+    """Base class: a named loop model, for the loop of any family (`Characteristic`). Subclasses implement the queries.
 
-    Models are immutable and hashable, so `boundary` is cached per
-    (model, loop): a report asks for the same boundary many times.
+    Each query takes the family's gain (NV for a `Loop`, κ for a `HolonomicLoop`) and the
+    loop; a boundary is the family's (`Boundary` in NV, `HolonomicBoundary` in κ). Models are
+    immutable and hashable, so `boundary` is cached per (model, loop): a report asks for
+    the same boundary many times.
     """
 
     name: str = ""
-    equation: str = ""
 
     def options(self) -> dict:
         """The options that configure this model, in the order JSON writes them.
@@ -244,60 +386,66 @@ class LoopModel:
         """
         return {}
 
-    def boundary(self, loop: Loop) -> Boundary:
-        """NV* and the boundary frequency for (τ, T, k) (cached)."""
+    def boundary(self, loop: Characteristic):
+        """The critical gain (NV* or κ*), the boundary frequency and the stable set for the loop (cached)."""
         return _cached_boundary(self, _check_loop(loop))
 
-    def compute_boundary(self, loop: Loop) -> Boundary:  # pragma: no cover - interface
-        """NV* and ω* for (τ, T, k), uncached (`boundary` caches it)."""
+    def compute_boundary(self, loop: Characteristic):  # pragma: no cover - interface
+        """`boundary`, uncached."""
         raise NotImplementedError
 
     @checked
-    def is_stable(self, NV: float, loop: Loop) -> bool:  # pragma: no cover - interface
-        """Verdict for NV (1/s) by a route independent of `boundary`."""
+    def is_stable(self, gain: float, loop: Characteristic) -> bool:
+        """Verdict at the gain (NV 1/s, κ 1/s²) by a route independent of `boundary`."""
+        return self._stable(gain, loop)
+
+    def _stable(self, gain: float, loop: Characteristic) -> bool:  # pragma: no cover - interface
+        """`is_stable` without the public argument checks (internal probes)."""
         raise NotImplementedError
 
     @checked
-    def rightmost_root(self, NV: float, loop: Loop) -> complex:  # pragma: no cover - interface
-        """Dominant root σ + jω (1/s, rad/s); sampled models map z by ln(z)/T."""
+    def rightmost_root(self, gain: float, loop: Characteristic) -> complex:  # pragma: no cover - interface
+        """Dominant root σ + jω (1/s, rad/s, ω >= 0); sampled models map z by ln(z)/T."""
         raise NotImplementedError
 
-    def growth_rates(self, NV: float, loops) -> np.ndarray:
-        """Real part of the dominant root, 1/s, at NV for each loop of a sequence.
+    def growth_rates(self, gain: float, loops) -> np.ndarray:
+        """Real part of the dominant root, 1/s, at the gain for each loop of a sequence.
 
         At NV = 0 the heading loop's (`neutral_reason`: the neutral lateral
         root left out), as `rightmost_root`. Models override this with a
         vectorized version where they can.
         """
-        NV = _check_NV(NV)
-        return np.array([self.rightmost_root(NV, loop).real for loop in loops])
+        gain = _check_NV(gain)
+        return np.array([self.rightmost_root(gain, loop).real for loop in loops])
 
     @checked
-    def critical_delay(self, NV: float, loop: Loop) -> float:
-        """T*: the smallest sampling period / delay at which NV loses stability (τ, k fixed), s.
+    def critical_delay(self, gain: float, loop: Characteristic) -> float:
+        """T*: the smallest sampling period / delay at which the gain loses stability (the rest fixed), s.
 
         The operating point's delay margin, the same definition in every
-        model: stable for every T in [0, T*). 0 if NV is unstable already at
-        T → 0; ``inf`` if it stays stable up to the largest allowed T
+        model: stable for every T in [0, T*). 0 if the gain is unstable already
+        at T → 0; ``inf`` if it stays stable up to the largest allowed T
         (100 s). Found by `solve.first_crossing` on the dominant growth rate
         over T (a geometric grid with its local maxima refined, then
-        bisection to 1e-7 relative); models with an exact route override it.
+        bisection to the family's tolerance, `Characteristic.delay_search`:
+        1e-7 relative for a steering loop, 1e-9 for a holonomic one); models
+        with an exact route override it.
         """
         from ..numerics.solve import first_crossing
 
-        NV = _check_NV(NV)
-        if NV < 0 or self.growth_rates(NV, [Loop(loop.tau, 0.0, loop.k, c=loop.c)])[0] >= 0:
+        gain = _check_NV(gain)
+        if gain < 0 or self.growth_rates(gain, [loop.with_delay(0.0)])[0] >= 0:
             return 0.0
 
         def measure(Ts):
-            return self.growth_rates(NV, [Loop(loop.tau, float(T), loop.k, c=loop.c) for T in Ts])
+            return self.growth_rates(gain, [loop.with_delay(float(T)) for T in Ts])
 
-        scale = _time_scale(loop, NV)
-        return first_crossing(measure, scale * 1e-2, RANGES["T"].high, rtol=_DELAY_RTOL, atol=1e-12 * scale)
+        start, rtol, atol = loop.delay_search(gain)
+        return first_crossing(measure, start, RANGES["T"].high, rtol=rtol, atol=atol)
 
     @checked
     def critical_gain_k(self, NV: float, loop: Loop) -> float:
-        """k*: the smallest steering gain at which NV loses stability (τ, T fixed), 1/s.
+        """k*: the smallest steering gain at which NV loses stability (τ, T fixed), 1/s; a steering loop's only.
 
         Stable for every k in (0, k*): lowering k below k* is a remedy that
         works. 0 if no k is small enough; ``inf`` if NV stays stable up to the
@@ -305,6 +453,7 @@ class LoopModel:
         """
         from ..numerics.solve import first_crossing
 
+        loop = _steering(loop, "critical_gain_k")
         NV = _check_NV(NV)
         lo, hi = gain_range(loop)
         if NV < 0 or self.growth_rates(NV, [Loop(loop.tau, loop.T, lo, c=loop.c)])[0] >= 0:
@@ -314,6 +463,11 @@ class LoopModel:
             return self.growth_rates(NV, [Loop(loop.tau, loop.T, float(k), c=loop.c) for k in ks])
 
         return first_crossing(measure, lo, hi, start=lo, rtol=_DELAY_RTOL, atol=1e-12 * lo)
+
+    @checked
+    def damping_range(self, gain: float, loop: Characteristic) -> tuple:  # pragma: no cover - interface
+        """Every interval of the damping δ (the holonomic c_h, 1/s) that makes the gain stable at the loop's T."""
+        raise NotImplementedError
 
     def __repr__(self) -> str:
         return f"{type(self).__name__}()"
@@ -340,54 +494,102 @@ def gain_range(loop: Loop) -> tuple[float, float]:
     return max(1e-3 * loop.k, RANGES["k"].low), RANGES["k"].high
 
 
-class AffineGainModel(LoopModel):
-    """A model whose characteristic polynomial is D + K·E with K = kNV.
+def _aligned(*polys) -> tuple:
+    """The polynomials (descending) padded with leading zeros to one length."""
+    polys = [np.asarray(p, dtype=float) for p in polys]
+    n = max(len(p) for p in polys)
+    return tuple(np.pad(p, (n - len(p), 0)) for p in polys)
 
-    Subclasses provide `polynomials(loop) -> (D, E)` in descending powers of s
-    (``domain = "s"``) or z (``domain = "z"``).
+
+class AffineGainModel(LoopModel):
+    """A model whose characteristic polynomial is affine in the loop gain and in the damping: P0 + δ·P1 + K·P2.
+
+    Subclasses provide `polynomials(loop) -> (D, E)`, D + K·E in descending powers
+    of s (``domain = "s"``) or z (``domain = "z"``), and `parts(loop) -> (P0, P1, P2)`
+    in s (Tustin's μ for the sampled model), one length. The boundary: every gain
+    at which a root crosses the imaginary axis (`crossings.affine_crossings`) or
+    leaves through infinity (the degree of the polynomial drops), each stretch
+    between them decided by the model's own verdict (`crossings.stable_interval`);
+    the damping range is the same in δ.
     """
 
     domain = "s"
 
-    def polynomials(self, loop: Loop):  # pragma: no cover - interface
-        """(D, E), descending coefficients: the characteristic polynomial is D + kNV·E."""
+    def polynomials(self, loop: Characteristic):  # pragma: no cover - interface
+        """(D, E), descending coefficients: the characteristic polynomial is D + K·E."""
+        raise NotImplementedError
+
+    def parts(self, loop: Characteristic):  # pragma: no cover - interface
+        """(P0, P1, P2), descending, one length: the characteristic polynomial P0 + δ·P1 + K·P2 (s; μ for `sampled`)."""
         raise NotImplementedError
 
     @checked
-    def characteristic(self, NV: float, loop: Loop) -> np.ndarray:
-        """Characteristic polynomial D + kNV·E, descending coefficients."""
-        d, e = self.polynomials(loop)
-        n = max(len(d), len(e))
-        d = np.pad(d, (n - len(d), 0))
-        e = np.pad(e, (n - len(e), 0))
-        return np.trim_zeros(d + loop.k * _check_NV(NV) * e, "f")
+    def characteristic(self, gain: float, loop: Characteristic) -> np.ndarray:
+        """Characteristic polynomial D + K·E, descending coefficients."""
+        d, e = _aligned(*self.polynomials(loop))
+        return np.trim_zeros(d + loop.loop_gain(_check_NV(gain)) * e, "f")
 
-    def _frequency(self, raw: float | None, loop: Loop) -> float | None:
-        if raw is None:
+    def _frequency(self, raw: float, loop: Characteristic) -> float:
+        """The crossing frequency in rad/s from that of the polynomial's variable (identity in s)."""
+        return raw
+
+    def _infinite_frequency(self, loop: Characteristic) -> float:
+        """The frequency at which a root leaves when the degree drops: s = ∞ (``inf``)."""
+        return math.inf
+
+    def _crossings(self, d, e, loop: Characteristic) -> list | None:
+        """Every gain g > 0 at which a root of d + g·e crosses the imaginary axis or passes through infinity, sorted;
+        None when d·conj(e) is real on the whole axis (a root pair that stays on it: no crossing is isolated)."""
+        d, e = _aligned(d, e)
+        try:
+            found = affine_crossings(d, e, "s")
+        except ValueError:
             return None
-        return raw / loop.T if self.domain == "z" else raw
+        out = [Crossing(c.gain, self._frequency(c.frequency, loop)) for c in found]
+        if e[0] != 0.0 and -d[0] / e[0] > 0:  # the degree drops: a root passes through infinity (z = −1 for `sampled`)
+            out.append(Crossing(float(-d[0] / e[0]), self._infinite_frequency(loop)))
+        return sorted(out, key=lambda c: (c.gain, c.frequency))
 
-    def compute_boundary(self, loop: Loop) -> Boundary:
+    def _interval(self, d, e, stable, loop: Characteristic) -> StabilityInterval:
+        """The stable gains from the crossings of d + K·e in s, each stretch decided by ``stable(K)``."""
+        crossings = self._crossings(d, e, loop)
+        return StabilityInterval(0.0, None, (), ()) if crossings is None else stable_interval(crossings, stable)
+
+    def stable_gains(self, loop: Characteristic) -> StabilityInterval:
+        """Every stable loop gain K (1/s²), K* and ω*, uncached (`boundary` gives them in the family's gain)."""
         d, e = self.polynomials(loop)
-        interval = first_stable_interval(d, e, self.domain)
-        b = Boundary.from_interval(self.name, interval, loop.k)
-        return Boundary(b.model, b.NV_critical, self._frequency(b.omega_critical, loop), b.K_critical, b.stable_set)
+        return self._interval(d, e, lambda K: verdict_at(d, e, K, self.domain), loop)
 
-    @checked
-    def is_stable(self, NV: float, loop: Loop) -> bool:
-        return self._stable(NV, loop)
+    def compute_boundary(self, loop: Characteristic):
+        return loop.boundary_from(self.name, self.stable_gains(loop))
 
-    def _stable(self, NV: float, loop: Loop) -> bool:
+    def _stable(self, gain: float, loop: Characteristic) -> bool:
         """`is_stable` without the public argument checks (internal probes); NV = 0: D's quotient by its neutral root."""
         d, e = self.polynomials(loop)
-        if NV == 0:
+        if gain == 0:
             return verdict_at(neutral_quotient(d, self.domain), [0.0], 0.0, self.domain)
-        return verdict_at(d, e, loop.k * NV, self.domain)
+        return verdict_at(d, e, loop.loop_gain(gain), self.domain)
 
     @checked
-    def roots(self, NV: float, loop: Loop) -> np.ndarray:
+    def damping_range(self, gain: float, loop: Characteristic) -> tuple:
+        """Every interval of the damping δ (1/s) that makes the gain stable at the loop's T, ascending.
+
+        A holonomic loop's c_h (`HolonomicLoop`; ``loop.c_h`` itself is ignored);
+        ``()`` when no damping helps (a negative gain, or a delay too long for it).
+        """
+        loop.with_damping(0.0)  # a family whose damping is a parameter of its own
+        if gain < 0:
+            return ()
+        p0, p1, p2 = self.parts(loop)
+        crossings = self._crossings(p0 + loop.loop_gain(gain) * p2, p1, loop)
+        if crossings is None:  # pragma: no cover - only δ·P1 real on the axis, not met
+            return ()
+        return stable_set(crossings, lambda damping: self._stable(gain, loop.with_damping(damping)))
+
+    @checked
+    def roots(self, gain: float, loop: Characteristic) -> np.ndarray:
         """All roots of the characteristic polynomial (s or z)."""
-        return np.roots(self.characteristic(NV, loop))
+        return np.roots(self.characteristic(gain, loop))
 
     def batch_polynomials(self, loops):
         """(D, E) of each loop as two arrays of rows of one length (descending; leading zeros allowed)."""
@@ -397,13 +599,14 @@ class AffineGainModel(LoopModel):
         E = np.array([np.pad(e, (width - len(e), 0)) for _, e in pairs])
         return D, E
 
-    def growth_rates(self, NV: float, loops) -> np.ndarray:
-        """max Re s (1/s) at NV for each loop: eigenvalues of the companion matrices, batched by degree
+    def growth_rates(self, gain: float, loops) -> np.ndarray:
+        """max Re s (1/s) at the gain for each loop: eigenvalues of the companion matrices, batched by degree
         (NV = 0: of D/s, the heading loop; −inf for a constant)."""
         loops = list(loops)
         D, E = self.batch_polynomials(loops)
-        P = D + (np.array([loop.k for loop in loops]) * _check_NV(NV))[:, None] * E
-        if NV == 0:  # D(0) = 0 exactly: drop the neutral lateral root
+        gain = _check_NV(gain)
+        P = D + np.array([loop.loop_gain(gain) for loop in loops])[:, None] * E
+        if gain == 0:  # D(0) = 0 exactly: drop the neutral lateral root
             P = P[:, :-1]
         polys = [row[np.flatnonzero(row)[0]:] for row in P]
         out = np.empty(len(polys))
@@ -420,15 +623,24 @@ class AffineGainModel(LoopModel):
         return out
 
     @checked
-    def rightmost_root(self, NV: float, loop: Loop) -> complex:
-        """Dominant root σ + jω (1/s, rad/s); NV = 0: the heading loop's (−inf when only the neutral root is left)."""
-        if NV == 0:
-            roots = np.roots(neutral_quotient(self.characteristic(NV, loop), self.domain))
+    def rightmost_root(self, gain: float, loop: Characteristic) -> complex:
+        """Dominant root σ + jω (1/s, rad/s; of a pair the one with ω > 0); NV = 0: the heading loop's (−inf when only
+        the neutral root is left)."""
+        if gain == 0:
+            roots = np.roots(neutral_quotient(self.characteristic(gain, loop), self.domain))
             if roots.size == 0:
                 return complex(-math.inf, 0.0)
         else:
-            roots = self.roots(NV, loop)
+            roots = self.roots(gain, loop)
+        if roots.size == 0:  # pragma: no cover - a constant polynomial: degree 0 only at c_h·T = 1 and κ = c_h/T together
+            return complex(-math.inf, 0.0)
         if self.domain == "z":
             z = roots[np.argmax(np.abs(roots))]
             return complex(np.log(z) / loop.T)
-        return complex(roots[np.argmax(roots.real)])
+        return _dominant(roots)
+
+
+def _dominant(roots) -> complex:
+    """The root of largest real part; of roots level with it to round-off, the one of largest imaginary part (ω > 0)."""
+    top = roots[roots.real >= roots.real.max() - 1e-12 * max(1.0, np.abs(roots).max())]
+    return complex(top[np.argmax(top.imag)])

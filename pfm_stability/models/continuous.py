@@ -10,6 +10,9 @@ With a heading gain c (`Loop.c`, docs/models.md) the equation is
 and ω* = √(k(1 + c)/τ); k still cancels. NV < 0 leaves a sign change in the
 coefficients: unstable. NV = 0 leaves s·(τs² + s + k(1 + c)): the heading loop
 is stable (docs/models.md, "N = 0"), so T* = k* = ``inf``.
+
+The holonomic loop (`models.holonomic`) is s² + c_h s + κ = 0: stable exactly when
+c_h > 0 and κ > 0.
 """
 
 from __future__ import annotations
@@ -18,27 +21,31 @@ import math
 
 import numpy as np
 
-from .base import AffineGainModel, Loop, checked
+from .base import AffineGainModel, _aligned, _steering, checked
+from .family import Characteristic
 
 __all__ = ["Continuous"]
 
 
 class Continuous(AffineGainModel):
-    """Koren & Borenstein 1991 eq (17): the delay-free robot–environment loop."""
+    """No delay: a(s) + δs + K = 0; Koren & Borenstein 1991 eq (17) for the steering loop."""
 
     name = "continuous"
-    equation = "tau s^3 + s^2 + k s + k N V = 0  (KB eq 17)"
 
-    def polynomials(self, loop: Loop):
-        """D = τs³ + s² + k(1 + c)s, E = 1 (descending powers of s; c = 0: KB eq 17)."""
+    def polynomials(self, loop: Characteristic):
+        """D = a(s) + δs, E = 1 (descending powers of s): τs³ + s² + k(1 + c)s (c = 0: KB eq 17); s² + c_h s."""
         return loop.closed_plant, np.array([1.0])
 
-    @checked
-    def critical_delay(self, NV: float, loop: Loop) -> float:
-        """T does not enter (17): ``inf`` if τNV < 1 + c (and NV >= 0: `is_stable`), else 0 (s)."""
-        return math.inf if self.is_stable(NV, loop) else 0.0
+    def parts(self, loop: Characteristic):
+        """(a(s), s, 1)."""
+        return _aligned(loop.plant, [1.0, 0.0], [1.0])
 
     @checked
-    def critical_gain_k(self, NV: float, loop: Loop) -> float:
+    def critical_delay(self, gain: float, loop: Characteristic) -> float:
+        """T does not enter: ``inf`` if the loop is stable (`is_stable`; steering: τNV < 1 + c, NV >= 0), else 0 (s)."""
+        return math.inf if self._stable(gain, loop) else 0.0
+
+    @checked
+    def critical_gain_k(self, NV: float, loop) -> float:
         """k cancels from Routh's condition 0 <= τNV < 1 + c (`is_stable`): ``inf`` if it holds, else 0 (1/s)."""
-        return math.inf if self.is_stable(NV, loop) else 0.0
+        return math.inf if self._stable(NV, _steering(loop, "critical_gain_k")) else 0.0

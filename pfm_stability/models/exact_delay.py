@@ -35,6 +35,13 @@ delayed kc·s as they take K (`delay_verdicts_from_gain(…, c)`,
 destabilize, and `models.heading.kb_heading_interval` finds every one that can bound the
 stable set, from polynomial roots, each stretch decided by the crossing count.
 c = 0 runs exactly KB's code above.
+
+The model reads its loop through `family.Characteristic`, so it decides any
+family's a(s) + (δ·s + K)·e^(−sT): rightmost roots and root counts by the same
+`delay.DelayLoop` for every family; the boundary, the verdict and T* from the
+family's crossing structure (`Characteristic.delay_interval`, `delay_stable`,
+`delay_margin`): KB's array route above for the steering loop, the closed forms
+of `models.holonomic` (and `DelayLoop`'s crossing count) for the holonomic one.
 """
 
 from __future__ import annotations
@@ -44,84 +51,74 @@ import math
 import numpy as np
 
 from ..numerics.delay import DelayLoop, delay_verdicts_from_gain, kb_critical_gain
-from .base import Boundary, Loop, LoopModel, _check_NV, checked, gain_range
+from .base import Loop, LoopModel, _check_NV, _steering, checked, gain_range
+from .family import Characteristic
 from .pade import Pade
 
 __all__ = ["ExactDelay"]
 
 
-def _one(x) -> np.ndarray:
-    return np.array([float(x)])
-
-
 class ExactDelay(LoopModel):
-    """Koren & Borenstein 1991 eq (18) with the exact delay e^(−sT)."""
+    """The delay taken exactly: a(s) + (δs + K)·e^(−sT) = 0 (Koren & Borenstein 1991 eq 18 for the steering loop)."""
 
     name = "exact_delay"
-    equation = "tau s^3 + s^2 + k s + k N V exp(-s T) = 0  (KB eq 18)"
 
     @staticmethod
-    def quasi_polynomial(loop: Loop) -> DelayLoop:
-        """The quasi-polynomial a(s) + (kcs + K)·e^(−sT) with a(s) = τs³ + s² + ks (c = 0: a(s) + K e^(−sT))."""
-        if loop.c == 0.0:
-            return DelayLoop(loop.plant, loop.T)
-        return DelayLoop(loop.plant, loop.T, delayed=[loop.heading, 0.0])
+    def quasi_polynomial(loop: Characteristic) -> DelayLoop:
+        """The quasi-polynomial a(s) + (δs + K)·e^(−sT) (δ = 0: a(s) + K e^(−sT))."""
+        return loop.quasi_polynomial()
 
     @staticmethod
-    def heading_quasi_polynomial(loop: Loop) -> DelayLoop:
-        """N = 0: the quasi-polynomial divided by s, τs² + s + k + kc·e^(−sT) (its gain K is kc)."""
+    def heading_quasi_polynomial(loop: Characteristic) -> DelayLoop:
+        """Gain 0 (N = 0): the quasi-polynomial divided by s, a(s)/s + δ·e^(−sT) (its gain is δ)."""
         return DelayLoop(loop.plant[:-1], loop.T)
 
-    def _quasi(self, NV: float, loop: Loop):
-        """(quasi-polynomial, gain) of the roots the verdict judges: the loop's at kNV, the heading loop's at NV = 0."""
-        return (self.heading_quasi_polynomial(loop), loop.heading) if NV == 0 else (self.quasi_polynomial(loop), loop.k * NV)
+    def _quasi(self, gain: float, loop: Characteristic):
+        """(quasi-polynomial, K) of the roots the verdict judges: the loop's at its K, the heading loop's at gain 0."""
+        return (self.heading_quasi_polynomial(loop), loop.damping) if gain == 0 else (self.quasi_polynomial(loop), loop.loop_gain(gain))
 
-    def compute_boundary(self, loop: Loop) -> Boundary:
-        if loop.c != 0.0:
-            from .heading import kb_heading_interval  # only with a heading gain: KB's reports never compile it
+    def compute_boundary(self, loop: Characteristic):
+        """The family's crossing structure (`Characteristic.delay_interval`) in its gain."""
+        return loop.boundary_from(self.name, loop.delay_interval())
 
-            return Boundary.from_interval(self.name, kb_heading_interval(loop.tau, loop.T, loop.k, loop.c), loop.k)
-        K, w = (float(x[0]) for x in kb_critical_gain(_one(loop.tau), _one(loop.T), _one(loop.k)))
-        omega = w if math.isfinite(K) else None
-        return Boundary(self.name, K / loop.k, omega, K, ((0.0, K / loop.k),))
-
-    def _count(self, NV: float, loop: Loop):
-        K = loop.k * _check_NV(NV)
-        heading = () if loop.c == 0.0 else (_one(loop.c),)
-        stable, Z, margin = delay_verdicts_from_gain(_one(loop.tau), _one(loop.T), _one(loop.k), _one(K), *heading)
-        return bool(stable[0]), int(Z[0]), float(margin[0])
-
-    @checked
-    def is_stable(self, NV: float, loop: Loop) -> bool:
+    def _stable(self, gain: float, loop: Characteristic) -> bool:
         """Crossing count Z(T) = 0 (no root in Re s >= 0)."""
-        return self._count(NV, loop)[0]
+        return loop.delay_stable(loop.loop_gain(_check_NV(gain)))
 
     @checked
-    def unstable_root_count(self, NV: float, loop: Loop) -> int | None:
+    def unstable_root_count(self, gain: float, loop: Characteristic) -> int | None:
         """Roots with Re s > 0 (None when a root is on the imaginary axis; NV = 0: the heading loop's)."""
-        q, K = self._quasi(NV, loop)
+        q, K = self._quasi(gain, loop)
         return q.unstable_root_count(K)
 
     @checked
-    def rightmost_root(self, NV: float, loop: Loop) -> complex | None:
-        """Dominant root σ + jω (1/s, rad/s); None where the pseudospectral method cannot resolve
+    def rightmost_root(self, gain: float, loop: Characteristic) -> complex | None:
+        """Dominant root σ + jω (1/s, rad/s, ω >= 0); None where the pseudospectral method cannot resolve
         it (|s|·T in the thousands: `DelayLoop.rightmost_roots`). The verdict does not need it.
         NV = 0: the heading loop's (`heading_quasi_polynomial`)."""
-        q, K = self._quasi(NV, loop)
+        q, K = self._quasi(gain, loop)
         for nodes in (40, 160):
             roots = q.rightmost_roots(K, count=2, nodes=nodes)
             if roots.size:
-                top = roots[roots.real >= roots[0].real - 1e-9 * max(1.0, abs(roots[0]))]
-                return complex(top[top.imag.argmax()])
+                return _dominant_of_sorted(roots)
         return None
 
     @checked
-    def critical_delay(self, NV: float, loop: Loop) -> float:
-        """Delay margin: the smallest T at which NV loses stability (τ, k fixed), s."""
-        return self._count(NV, loop)[2]
+    def critical_delay(self, gain: float, loop: Characteristic) -> float:
+        """Delay margin: the smallest T at which the gain loses stability (the rest fixed), s."""
+        return loop.delay_margin(loop.loop_gain(gain))
 
     @checked
-    def critical_gain_k(self, NV: float, loop: Loop) -> float:
+    def damping_range(self, gain: float, loop: Characteristic) -> tuple:
+        """Every interval of the damping δ (the holonomic c_h, 1/s) that makes the gain stable at the loop's T
+        (`HolonomicLoop.delay_damping_range`: the closed form of docs/models.md); ``()`` for a negative gain."""
+        loop.with_damping(0.0)  # a family whose damping is a parameter of its own
+        if gain < 0:
+            return ()
+        return loop.delay_damping_range(loop.loop_gain(gain))
+
+    @checked
+    def critical_gain_k(self, NV: float, loop) -> float:
         """Smallest steering gain k at which NV loses stability (τ, T fixed), 1/s.
 
         Stability is NV < NV*(k); NV*(k) → 1/(τ + T) as k → 0 (the roots
@@ -135,9 +132,17 @@ class ExactDelay(LoopModel):
         stand-in that peaks where a root nears the axis, so the search refines
         near-misses between grid points). NV < 0: 0. NV = 0: the heading
         loop's k* (c = 0: τs² + s + k, ``inf``).
+
+        Parameters
+        ----------
+        NV : float
+            Loop gain N·V, 1/s.
+        loop : Loop
+            τ (s), T (s), k (1/s) and the heading gain c.
         """
         from ..numerics.solve import first_crossing
 
+        loop = _steering(loop, "critical_gain_k")
         NV = _check_NV(NV)
         if NV < 0:
             return 0.0
@@ -173,3 +178,9 @@ class ExactDelay(LoopModel):
         if measure(np.array([lo]))[0] >= 0:
             return 0.0
         return first_crossing(measure, lo, hi, start=lo)
+
+
+def _dominant_of_sorted(roots) -> complex:
+    """`base._dominant` of rightmost roots sorted by real part, the first the rightmost (its tolerance 1e-9)."""
+    top = roots[roots.real >= roots[0].real - 1e-9 * max(1.0, abs(roots[0]))]
+    return complex(top[top.imag.argmax()])

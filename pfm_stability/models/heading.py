@@ -33,6 +33,15 @@ def heading_level_offset(w, tau, T, k, c):
     it moves into Re s > 0 as K grows iff G′(ω) > 0 (Re ds/dK has the sign of
     G′). c = 0 gives KB's level function `_kb_level_offset`. G is defined
     where R >= k|c| (elsewhere no gain puts a root on the axis).
+
+    Parameters
+    ----------
+    w : float or ndarray
+        Frequency ω, rad/s.
+    tau, T, k : float
+        τ (s), T (s, > 0) and k (1/s).
+    c : float
+        Heading gain (dimensionless).
     """
     with np.errstate(divide="ignore", invalid="ignore"):
         y = w * w
@@ -78,6 +87,13 @@ def kb_heading_crossings(tau: float, T: float, k: float, c: float) -> list[Cross
       stretch has increasing K), and the list returned holds every crossing
       below the (S + 1)-th lowest destabilizing gain: `stable_interval` with
       the crossing count is then exact.
+
+    Parameters
+    ----------
+    tau, T, k : float
+        τ (s), T (s, > 0) and k (1/s).
+    c : float
+        Heading gain (dimensionless).
 
     Returns
     -------
@@ -139,6 +155,13 @@ def kb_heading_interval(tau: float, T: float, k: float, c: float) -> StabilityIn
     T = 0: the polynomial τs³ + s² + k(1 + c)s + K (Routh: K* = k(1 + c)/τ).
     T > 0: the crossings of `kb_heading_crossings`, each stretch between them
     decided by the crossing count (`delay_verdicts_from_gain`).
+
+    Parameters
+    ----------
+    tau, T, k : float
+        τ (s), T (s, >= 0) and k (1/s).
+    c : float
+        Heading gain (dimensionless).
     """
     if T == 0:
         plant = [tau, 1.0, k * (1.0 + c), 0.0] if tau > 0 else [1.0, k * (1.0 + c), 0.0]

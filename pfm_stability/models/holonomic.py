@@ -7,8 +7,10 @@ with the force computed from sensor data that are T old (docs/models.md,
 
     s² + (c_h·s + κ)·e^(−sT) = 0,   κ = −∂F_x/∂x / m  (1/s²),   c_h = −∂F_x/∂v_x / m  (1/s).
 
-κ is the loop gain (NV's part in KB's loop), c_h the damping a velocity-
-dependent field adds. The five models of KB's loop have a holonomic twin:
+It is the shape every family shares, a(s) + (δ·s + K)·e^(−sT) (`family.Characteristic`),
+with a(s) = s², δ = c_h and K = κ: `HolonomicLoop` is that characteristic, and the
+five models of KB's loop (`continuous`, `kb_first_order`, `pade`, `exact_delay`,
+`sampled`) decide it as they decide the steering loop:
 
 ================  ==========================================  ===========================
 name              characteristic equation                     decided by
@@ -20,53 +22,140 @@ exact_delay       s² + (c_h s + κ) e^(−sT) = 0                 crossing coun
 sampled           ZOH of u_k = −κx_k − c_h v_k, 0/1 delay      eigenvalues; bilinear + Routh
 ================  ==========================================  ===========================
 
-Each model answers `boundary` (κ* and the stable set in κ at fixed T, c_h),
-`is_stable`, `rightmost_root`, `critical_delay` (T*: stable for every T in
-[0, T*)) and `damping_range` (the stable set in c_h at fixed κ, T), with the
-names of the steering models (`models.base.LoopModel`). κ < 0 is unstable
-in every model (a real root s > 0, as NV < 0); κ = 0 is refused (a root at
-s = 0); c_h <= 0 is unstable in every model (c_h = 0: the undamped
-oscillator, which any delay destabilises, T* = 0).
+Each model answers `boundary` (κ* and the stable set in κ at fixed T, c_h:
+`HolonomicBoundary`), `is_stable`, `rightmost_root`, `critical_delay` (T*: stable
+for every T in [0, T*)) and `damping_range` (the stable set in c_h at fixed κ, T).
+κ < 0 is unstable in every model (a real root s > 0, as NV < 0); κ = 0 is refused
+(a root at s = 0); c_h <= 0 is unstable in every model (c_h = 0: the undamped
+oscillator, which any delay destabilises, T* = 0). What the holonomic family
+has and the steering one has not lives here: the exact delay's crossings in
+closed form (`HolonomicLoop.delay_interval`, `HolonomicLoop.delay_damping_range`)
+and a model's verdict in κ (`holonomic_verdict`).
+
+The exact delay, a(s) + (d(s) + K)e^(−sT) with a(s) = s², d(s) = c_h·s and K = κ:
+the crossing polynomial F(y) = y² − c_h²y − κ² (y = ω²) has one positive root,
+ω² = (c_h² + √(c_h⁴ + 4κ²))/2, where F′ > 0: every crossing as T grows
+destabilises, so the loop is stable exactly when c_h > 0, κ > 0 and
+T < T* = atan2(c_h ω, κ)/ω. T* decreases strictly in κ (from π/(2c_h) at κ → 0),
+so the stable set in κ is one interval (0, κ*): at κ* a root is at jω with
+ω sin ωT = c_h and κ* = ω² cos ωT, ωT ∈ (0, π/2) (ω sin ωT increases there; none
+when c_hT >= π/2). In c_h, T* rises from 0 and falls back to 0, so the stable
+set is one interval whose ends solve ω² cos ωT = κ on either side of the maximum
+of ω² cos ωT (x tan x = 2, x = ωT), c_h = ω sin ωT there; empty when κT² exceeds
+that maximum, ≈ 0.5498. Every interval is checked by the crossing count
+(`crossings.stable_set`).
+
+The sampled model is the double integrator ẋ = v, v̇ = u with a zero-order hold
+of the acceleration command u_k = −κx_k − c_h v_k, applied at once
+(compute_delay = 0) or one period later (1): KB's sampled loop with τ = 0 and
+the command held, its heading feedback k(1 + c) replaced by c_h. Jury's
+conditions for d = 0 give T* = min(2/c_h, 2c_h/κ) (the tests' closed form).
 
 **Kinematic steering** (Ge & Cui 2002 §7: ω = K_s(θ_f − θ), no motor lag) is
 KB's steering loop with τ = 0 and k = K_s, s² + K_s s + K_s(cs + NV)e^(−sT):
 `kinematic_loop` builds that `Loop`, which every steering model takes.
-The polynomial holonomic models live here, `exact_delay` and `sampled` in
-`models.holonomic_delay`; `make_holonomic_model` builds any of them by name.
 """
 
 from __future__ import annotations
 
-import functools
 import math
 from dataclasses import dataclass, replace
-from functools import lru_cache
 
 import numpy as np
 
 from ..checks import check_number
-from ..numerics.crossings import Crossing, affine_crossings, stable_interval, stable_set, verdict_at
+from ..numerics.crossings import Crossing, StabilityInterval, stable_interval, stable_set
+from ..numerics.solve import bisect_root
 from ..parameters import RANGES, T_RESOLUTION, check_parameter
 from ..io.serialize import json_number
 from .base import Loop, LoopModel
-from .pade import MAX_PADE_ORDER, pade_coefficients
+from .verdicts import interval_margin, interval_verdict
+from .continuous import Continuous
+from .family import Characteristic, LoopFamily, StableSet, root_json
 
 __all__ = [
+    "BEST_CURVATURE_PRODUCT",
+    "HOLONOMIC",
     "HolonomicBoundary",
-    "HolonomicContinuous",
-    "HolonomicFirstOrder",
     "HolonomicLoop",
-    "HolonomicModel",
-    "HolonomicPade",
-    "PolynomialHolonomicModel",
+    "HolonomicVerdict",
     "check_kappa",
+    "holonomic_verdict",
     "kinematic_loop",
 ]
 
+_DELAY_RTOL = 1e-9
+"""Relative bracket width at which the searched `critical_delay` stops."""
+
+
+def _curvature_peak() -> float:
+    """x0 with x·tan x = 2 on (0, π/2): where ω² cos ωT peaks (x = ωT)."""
+    return bisect_root(lambda x: x * math.tan(x) - 2.0, 1e-9, math.pi / 2 - 1e-12, rtol=1e-15)
+
+
+_X0 = _curvature_peak()
+BEST_CURVATURE_PRODUCT = _X0 * _X0 * math.cos(_X0)
+"""max over ω of ω²T²·cos ωT (≈ 0.5498): no damping stabilises κ with κT² at or above it (exact delay)."""
+
+HOLONOMIC = LoopFamily(
+    "holonomic",
+    "kappa",
+    {
+        "continuous": "s^2 + c_h s + kappa = 0",
+        "kb_first_order": "s^2 + (c_h s + kappa)(1 - s T) = 0",
+        "pade": "s^2 Q_m(s) + (c_h s + kappa) P_m(s) = 0  (Pade(m,m))",
+        "exact_delay": "s^2 + (c_h s + kappa) exp(-s T) = 0",
+        "sampled": "det(zI - Phi_cl(kappa, c_h)) = 0, ZOH of the acceleration, period T",
+    },
+    ("order", "compute_delay"),
+)
+"""The holonomic robot (Ge & Cui 2002 §6): the gain κ, the equations of the table above."""
+
+
+def check_kappa(kappa) -> float:
+    """κ (1/s²) as a float: finite, in ``RANGES["kappa"]``, non-zero (κ = 0 puts a root at s = 0)."""
+    kappa = check_parameter("kappa", kappa)
+    if kappa == 0.0:
+        raise ValueError("kappa must be a finite non-zero number 1/s^2 (kappa = 0: no force gradient, a root at s = 0); got 0.0")
+    return kappa
+
 
 @dataclass(frozen=True)
-class HolonomicLoop:
-    """Loop parameters of the holonomic family (everything but the gain κ).
+class HolonomicBoundary(StableSet):
+    """Stability boundary in κ of one model for one holonomic loop (T, c_h).
+
+    Attributes
+    ----------
+    model : str
+        Model name.
+    kappa_critical : float
+        κ*, 1/s²: stable for every 0 < κ < κ* (``inf``: for every κ > 0;
+        0: unstable at every small κ).
+    omega_critical : float or None
+        Frequency of the oscillation that starts at κ*, rad/s (None when κ*
+        is 0 or infinite).
+    stable_set : tuple of (float, float)
+        Every interval of κ (1/s²) on which the loop is stable, ascending.
+    """
+
+    model: str
+    kappa_critical: float
+    omega_critical: float | None
+    stable_set: tuple = ()
+
+    def to_dict(self) -> dict:
+        """The fields as a JSON-ready dict (SI units)."""
+        return {
+            "model": self.model,
+            "kappa_critical": json_number(self.kappa_critical),
+            "omega_critical": self.omega_critical,
+            "stable_set": self.stable_set_json(),
+        }
+
+
+@dataclass(frozen=True)
+class HolonomicLoop(Characteristic):
+    """The holonomic loop s² + (c_h·s + κ)e^(−sT) = 0: its parameters (everything but the gain κ).
 
     Parameters
     ----------
@@ -86,29 +175,102 @@ class HolonomicLoop:
             object.__setattr__(self, "T", 0.0)
         object.__setattr__(self, "c_h", check_parameter("c_h", self.c_h))
 
+    @classmethod
+    def of(cls, controller, *, c_h: float) -> "HolonomicLoop":
+        """The loop of a controller (its T) at an equilibrium of damping c_h, 1/s: the one constructor from them."""
+        return cls(controller.T, c_h)
 
-def check_kappa(kappa) -> float:
-    """κ (1/s²) as a float: finite, in ``RANGES["kappa"]``, non-zero (κ = 0 puts a root at s = 0)."""
-    kappa = check_parameter("kappa", kappa)
-    if kappa == 0.0:
-        raise ValueError("kappa must be a finite non-zero number 1/s^2 (kappa = 0: no force gradient, a root at s = 0); got 0.0")
-    return kappa
+    @property
+    def family(self) -> LoopFamily:
+        """`HOLONOMIC`."""
+        return HOLONOMIC
 
+    @property
+    def plant(self) -> np.ndarray:
+        """a(s) = s², descending."""
+        return np.array([1.0, 0.0, 0.0])
 
-def _check_loop(loop) -> HolonomicLoop:
-    if not isinstance(loop, HolonomicLoop):
-        raise ValueError(f"loop must be a HolonomicLoop (T, c_h); got {loop!r}")
-    return loop
+    @property
+    def damping(self) -> float:
+        """δ = c_h, 1/s."""
+        return self.c_h
 
+    @property
+    def closed_plant(self) -> np.ndarray:
+        """s² + c_h s, descending."""
+        return np.array([1.0, self.c_h, 0.0])
 
-def checked(method):
-    """Validate a public method's (kappa, loop) arguments: ValueError naming the bad one."""
+    def loop_gain(self, kappa: float) -> float:
+        """K = κ, 1/s²."""
+        return kappa
 
-    @functools.wraps(method)
-    def wrapper(self, kappa, loop, *args, **kwargs):
-        return method(self, check_kappa(kappa), _check_loop(loop), *args, **kwargs)
+    def gain_of(self, K: float) -> float:
+        """κ = K, 1/s²."""
+        return K
 
-    return wrapper
+    def check_gain(self, kappa) -> float:
+        """`check_kappa`."""
+        return check_kappa(kappa)
+
+    def boundary_from(self, model: str, interval: StabilityInterval) -> HolonomicBoundary:
+        """`HolonomicBoundary` in κ (= K)."""
+        return HolonomicBoundary(model, interval.gain, interval.frequency, tuple(interval.intervals))
+
+    def with_delay(self, T: float) -> "HolonomicLoop":
+        """c_h with delay / period T, s."""
+        return replace(self, T=T)
+
+    def with_damping(self, damping: float) -> "HolonomicLoop":
+        """T with damping c_h = `damping`, 1/s."""
+        return replace(self, c_h=damping)
+
+    def delay_search(self, kappa: float) -> tuple:
+        """T* searched from 10⁻³ of the loop's time scale min(1/|c_h|, 1/√|κ|) to 1e-9 relative, however small T* is:
+        a delay below `T_RESOLUTION` is T = 0, so T* >= 10⁻¹² s and the bracket's absolute floor, 10⁻⁹·10⁻¹² s,
+        never decides first."""
+        scale = min(1.0 / abs(self.c_h), 1.0 / math.sqrt(abs(kappa)))
+        return scale * 1e-3, _DELAY_RTOL, _DELAY_RTOL * T_RESOLUTION
+
+    def state_space(self, hold: str) -> tuple:
+        """(A, B, F0, F1) of the double integrator, states (v, x), the acceleration held: v_k = −(c_h v_k + κ x_k).
+
+        Raises
+        ------
+        ValueError
+            ``hold="reference"``: a holonomic robot has no servo closing a held reference.
+        """
+        if hold != "command":
+            raise ValueError(f"hold must be command for a holonomic loop (the acceleration command is held; no servo closes a reference); got {hold!r}")
+        return np.array([[0.0, 0.0], [1.0, 0.0]]), np.array([[1.0], [0.0]]), np.array([self.c_h, 0.0]), np.array([0.0, 1.0])
+
+    def delay_interval(self) -> StabilityInterval:
+        """The stable κ of the exact delay loop: one interval (0, κ*), κ* = ω² cos ωT where ω sin ωT = c_h (module docstring)."""
+        if self.T == 0:
+            return Continuous().stable_gains(self)
+        if self.c_h <= 0:
+            return StabilityInterval(0.0, None, (), ())
+        crossings = []
+        if self.c_h * self.T < math.pi / 2:
+            T, c = self.T, self.c_h
+            w = bisect_root(lambda x: x * math.sin(x * T) - c, 0.0, math.pi / (2 * T), rtol=1e-15)
+            crossings.append(Crossing(w * w * math.cos(w * T), w))
+        return stable_interval(crossings, self.delay_stable)
+
+    def delay_damping_range(self, kappa: float) -> tuple:
+        """Every interval of c_h (1/s) stable at κ in the exact delay loop: one interval whose ends solve ω² cos ωT = κ on
+        either side of the peak of ω² cos ωT, c_h = ω sin ωT there; ``()`` when κT² >= `BEST_CURVATURE_PRODUCT`."""
+        if self.T == 0:
+            return Continuous().damping_range(kappa, self)
+        T = self.T
+        if kappa * T * T >= BEST_CURVATURE_PRODUCT:
+            return ()
+        g = lambda x: x * x * math.cos(x * T) - kappa
+        # the second root near ωT = π/2 in v = π/2 − ωT: cos(ωT) = sin(v) keeps its digits where cos(π/2) rounds to 6e-17
+        h = lambda v: ((0.5 * math.pi - v) / T) ** 2 * math.sin(v) - kappa
+        v = bisect_root(h, 0.0, 0.5 * math.pi - _X0, rtol=1e-15)
+        ends = [bisect_root(g, 0.0, _X0 / T, rtol=1e-15), (0.5 * math.pi - v) / T]
+        crossings = [Crossing(w * math.sin(w * T), w) for w in ends]
+        return stable_set(crossings, lambda c: self.with_damping(c).delay_stable(kappa))
 
 
 def kinematic_loop(K_s, T, c=0.0) -> Loop:
@@ -131,281 +293,76 @@ def kinematic_loop(K_s, T, c=0.0) -> Loop:
     return Loop(0.0, T, K_s, c=c)
 
 
+# ------------------------------------------------------------------ a model's verdict in κ
 @dataclass(frozen=True)
-class HolonomicBoundary:
-    """Stability boundary in κ of one holonomic model for one loop (T, c_h).
+class HolonomicVerdict:
+    """One model's answer at one holonomic equilibrium: s² + (c_h s + κ)e^(−sT) (docs/models.md).
 
     Attributes
     ----------
     model : str
-        Model name.
+    kappa : float
+        κ, 1/s².
     kappa_critical : float
-        κ*, 1/s²: stable for every 0 < κ < κ* (``inf``: for every κ > 0;
-        0: unstable at every small κ).
+        κ*, 1/s²: stable for 0 < κ < κ* (``inf``: every κ > 0; 0: none).
     omega_critical : float or None
-        Frequency of the oscillation that starts at κ*, rad/s (None when κ*
-        is 0 or infinite).
-    stable_set : tuple of (float, float)
-        Every interval of κ (1/s²) on which the loop is stable, ascending.
+        rad/s at κ*.
+    margin : float
+        κ_edge/κ − 1 (as the steering gain margin, docs/models.md): > 0 stable, < 0 unstable.
+    verdict : str
+        "stable", "unstable" or "undecided" (within 1e-9 of an edge of the stable set).
+    T_critical : float
+        T*, s: stable for every delay / period in [0, T*) (0: unstable already at T = 0).
+    damping_range : tuple of (float, float)
+        Every interval of c_h (1/s) that makes this κ stable at the loop's T.
+    rightmost_root : complex or None
     """
 
     model: str
+    kappa: float
     kappa_critical: float
     omega_critical: float | None
-    stable_set: tuple = ()
+    margin: float
+    verdict: str
+    T_critical: float
+    damping_range: tuple
+    rightmost_root: complex | None
 
-    @classmethod
-    def from_interval(cls, model: str, interval) -> HolonomicBoundary:
-        """From a `crossings.StabilityInterval` in κ."""
-        return cls(model, interval.gain, interval.frequency, tuple(interval.intervals))
+    @property
+    def stable(self) -> bool:
+        """True only when the verdict is "stable"."""
+        return self.verdict == "stable"
 
-    def contains(self, kappa: float) -> bool:
-        """True when κ lies strictly inside a stable interval."""
-        return any(lo < kappa < hi for lo, hi in self.stable_set)
-
-    def to_dict(self) -> dict:
-        """The fields as a JSON-ready dict (SI units)."""
+    def to_dict(self, remedy: dict | None = None) -> dict:
+        """The fields as a JSON-ready dict (SI units) with `remedy` (``to_stabilize``); κ* and T* are stable below."""
         return {
-            "model": self.model,
+            "stable": self.stable,
+            "verdict": self.verdict,
+            "kappa": self.kappa,
             "kappa_critical": json_number(self.kappa_critical),
-            "omega_critical": self.omega_critical,
-            "stable_set": [[json_number(lo), json_number(hi)] for lo, hi in self.stable_set],
+            "margin": json_number(self.margin),
+            "omega_critical": json_number(self.omega_critical),
+            "rightmost_root": root_json(self.rightmost_root),
+            "T_critical": json_number(self.T_critical),
+            "damping_range": [[json_number(lo), json_number(hi)] for lo, hi in self.damping_range],
+            "stable_side": {"kappa_critical": "below", "T_critical": "below"},  # stable for 0 < κ < κ*, for T in [0, T*)
+            "to_stabilize": remedy or {},
         }
 
 
-@lru_cache(maxsize=4096)
-def _cached_boundary(model: HolonomicModel, loop: HolonomicLoop) -> HolonomicBoundary:
-    return model.compute_boundary(loop)
+def holonomic_verdict(model: LoopModel, kappa: float, loop: HolonomicLoop) -> HolonomicVerdict:
+    """`model`'s verdict at κ (1/s²) in the holonomic loop (T, c_h): κ*, the margin in κ, T*, the c_h range, the rightmost root.
 
-
-_DELAY_RTOL = 1e-9
-"""Relative bracket width at which the searched `critical_delay` stops."""
-
-
-class HolonomicModel:
-    """Base class of the holonomic models (immutable, hashable: `boundary` is cached)."""
-
-    name: str = ""
-    equation: str = ""
-
-    def options(self) -> dict:
-        """The options that configure this model (``{}``, ``{"order": m}``, ``{"compute_delay": d}``)."""
-        return {}
-
-    def boundary(self, loop: HolonomicLoop) -> HolonomicBoundary:
-        """κ*, ω* and the stable set in κ for (T, c_h) (cached)."""
-        return _cached_boundary(self, _check_loop(loop))
-
-    def compute_boundary(self, loop: HolonomicLoop) -> HolonomicBoundary:  # pragma: no cover - interface
-        """`boundary`, uncached."""
-        raise NotImplementedError
-
-    @checked
-    def is_stable(self, kappa: float, loop: HolonomicLoop) -> bool:
-        """Verdict at κ (1/s²) by a route independent of `boundary`."""
-        return self._stable(kappa, loop)
-
-    def _stable(self, kappa: float, loop: HolonomicLoop) -> bool:  # pragma: no cover - interface
-        raise NotImplementedError
-
-    @checked
-    def rightmost_root(self, kappa: float, loop: HolonomicLoop) -> complex | None:
-        """Dominant root σ + jω (1/s, rad/s); sampled models map z by ln(z)/T."""
-        return self._rightmost(kappa, loop)
-
-    def _rightmost(self, kappa: float, loop: HolonomicLoop) -> complex | None:  # pragma: no cover - interface
-        raise NotImplementedError
-
-    @checked
-    def critical_delay(self, kappa: float, loop: HolonomicLoop) -> float:
-        """T*: stable for every delay / period T in [0, T*) at this κ and c_h, s.
-
-        0 when the point is unstable already at T = 0 (κ < 0 or c_h <= 0);
-        ``inf`` if it stays stable up to 100 s. Found by `solve.first_crossing`
-        on the dominant growth rate over T (bisection to 1e-9 relative, however
-        small T* is: a delay below `T_RESOLUTION` is T = 0, so T* >= 10⁻¹² s and
-        the bracket's absolute floor, 10⁻⁹·10⁻¹² s, never decides first);
-        models with an exact route override it.
-        """
-        from ..numerics.solve import first_crossing
-
-        if not self._stable(kappa, replace(loop, T=0.0)):
-            return 0.0
-
-        def measure(Ts):
-            return self._growth_rates(kappa, [replace(loop, T=float(T)) for T in Ts])
-
-        scale = min(1.0 / abs(loop.c_h), 1.0 / math.sqrt(abs(kappa)))
-        return first_crossing(measure, scale * 1e-3, RANGES["T"].high, rtol=_DELAY_RTOL, atol=_DELAY_RTOL * T_RESOLUTION)
-
-    def _growth_rates(self, kappa: float, loops) -> np.ndarray:
-        """Real part of the dominant root (1/s) at κ for each loop (models batch this where they can)."""
-        return np.array([self._rightmost(kappa, loop).real for loop in loops])
-
-    @checked
-    def damping_range(self, kappa: float, loop: HolonomicLoop) -> tuple:
-        """Every interval of damping c_h (1/s) that makes κ stable at the loop's T, ascending.
-
-        ``loop.c_h`` is ignored. c_h <= 0 is never stable, so the intervals
-        lie in c_h > 0; ``()`` when no damping helps (κ < 0, or a delay too
-        long for κ).
-        """
-        if kappa < 0:
-            return ()
-        return self._damping_range(kappa, loop)
-
-    def _damping_range(self, kappa: float, loop: HolonomicLoop) -> tuple:  # pragma: no cover - interface
-        raise NotImplementedError
-
-    # equal and hashed by type and options, as the steering models (`boundary`'s cache keys on them)
-    __repr__ = LoopModel.__repr__
-    __eq__ = LoopModel.__eq__
-    __hash__ = LoopModel.__hash__
-
-
-class PolynomialHolonomicModel(HolonomicModel):
-    """A holonomic model whose characteristic polynomial is A0 + c_h·Ac + κ·Ak.
-
-    Affine in κ (the boundary: `crossings.affine_crossings` in κ) and in c_h
-    (the damping range: the same, in c_h); every stretch between crossing
-    gains is decided by Routh on the polynomial itself (`crossings.stable_set`).
-    Subclasses give `parts(loop)` in descending powers of s (or, for the
-    sampled model, of Tustin's μ).
+    The margin and the verdict are the steering report's rules in κ (`models.interval_margin`,
+    `models.interval_verdict`); κ < 0 (no restoring force) has margin −1 and, within 1e-9 of an
+    edge of the stable set, the verdict is "undecided" with margin 0.
     """
-
-    def parts(self, loop: HolonomicLoop):  # pragma: no cover - interface
-        """(A0, Ac, Ak): descending coefficients, one length."""
-        raise NotImplementedError
-
-    def characteristic(self, kappa: float, loop: HolonomicLoop) -> np.ndarray:
-        """A0 + c_h·Ac + κ·Ak, descending, leading zeros trimmed."""
-        a0, ac, ak = self.parts(loop)
-        return np.trim_zeros(a0 + loop.c_h * ac + kappa * ak, "f")
-
-    def _extra_crossings(self, d, e, loop) -> list:
-        """The gain at which the degree of D + g·E drops: a root passes through s = ∞.
-
-        `affine_crossings` sees only roots on the axis; a root leaving through
-        infinity changes the verdict too (`kb_first_order` at c_hT = 1). Its
-        frequency is reported as ``inf``.
-        """
-        if e[0] != 0.0 and -d[0] / e[0] > 0:
-            return [Crossing(float(-d[0] / e[0]), math.inf)]
-        return []
-
-    def _frequency(self, raw: float, loop: HolonomicLoop) -> float:
-        """Boundary frequency in rad/s from the crossing's (identity in s)."""
-        return raw
-
-    def _crossings(self, d, e, loop) -> list:
-        try:
-            found = affine_crossings(d, e, "s")
-        except ValueError:  # D·conj E real on the whole axis: c_h = 0, T = 0, a root pair stays on the axis
-            return None
-        out = [Crossing(c.gain, self._frequency(c.frequency, loop)) for c in found]
-        return sorted(out + self._extra_crossings(d, e, loop), key=lambda c: (c.gain, c.frequency))
-
-    def compute_boundary(self, loop: HolonomicLoop) -> HolonomicBoundary:
-        a0, ac, ak = self.parts(loop)
-        crossings = self._crossings(a0 + loop.c_h * ac, ak, loop)
-        if crossings is None:
-            return HolonomicBoundary(self.name, 0.0, None, ())
-        return HolonomicBoundary.from_interval(self.name, stable_interval(crossings, lambda g: self._stable(g, loop)))
-
-    def _damping_range(self, kappa: float, loop: HolonomicLoop) -> tuple:
-        a0, ac, ak = self.parts(loop)
-        crossings = self._crossings(a0 + kappa * ak, ac, loop)
-        if crossings is None:  # pragma: no cover - only c_h·Ac real on the axis, not met
-            return ()
-        return stable_set(crossings, lambda c: self._stable(kappa, replace(loop, c_h=c)))
-
-    def _stable(self, kappa: float, loop: HolonomicLoop) -> bool:
-        a0, ac, ak = self.parts(loop)
-        return verdict_at(a0 + loop.c_h * ac, ak, kappa, "s")
-
-    def _growth_rates(self, kappa: float, loops) -> np.ndarray:
-        """max Re s (1/s) of each loop: eigenvalues of the companion matrices, batched by degree."""
-        polys = [self.characteristic(kappa, loop) for loop in loops]
-        out = np.empty(len(polys))
-        for degree in {len(p) - 1 for p in polys}:
-            rows = [i for i, p in enumerate(polys) if len(p) - 1 == degree]
-            if degree == 0:  # pragma: no cover - see `_rightmost`
-                out[rows] = -np.inf
-                continue
-            companion = np.zeros((len(rows), degree, degree))
-            companion[:, 0, :] = -np.array([polys[i][1:] / polys[i][0] for i in rows])
-            companion[:, np.arange(1, degree), np.arange(degree - 1)] = 1.0
-            out[rows] = np.linalg.eigvals(companion).real.max(axis=1)
-        return out
-
-    def _rightmost(self, kappa: float, loop: HolonomicLoop) -> complex:
-        roots = np.roots(self.characteristic(kappa, loop))
-        if roots.size == 0:  # pragma: no cover - degree 0 only at c_h·T = 1 and κ = c_h/T together
-            return complex(-math.inf, 0.0)
-        top = roots[roots.real >= roots.real.max() - 1e-12 * max(1.0, np.abs(roots).max())]
-        return complex(top[np.argmax(top.imag)])
-
-
-class HolonomicContinuous(PolynomialHolonomicModel):
-    """No delay: s² + c_h s + κ = 0 (stable ⇔ c_h > 0 and κ > 0)."""
-
-    name = "continuous"
-    equation = "s^2 + c_h s + kappa = 0"
-
-    def parts(self, loop):
-        """A0 = s², Ac = s, Ak = 1."""
-        return np.array([1.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0]), np.array([0.0, 0.0, 1.0])
-
-    @checked
-    def critical_delay(self, kappa: float, loop: HolonomicLoop) -> float:
-        """T does not enter: ``inf`` if stable, else 0 (s)."""
-        return math.inf if self._stable(kappa, loop) else 0.0
-
-
-class HolonomicFirstOrder(PolynomialHolonomicModel):
-    """KB's approximation e^(−sT) ≈ 1 − sT: (1 − c_hT)s² + (c_h − κT)s + κ = 0.
-
-    Routh: stable ⇔ κ > 0, c_h > κT and c_hT < 1, so κ* = c_h/T and
-    T* = min(1/c_h, c_h/κ) — half the sampled loop's (the tests' closed form).
-    """
-
-    name = "kb_first_order"
-    equation = "s^2 + (c_h s + kappa)(1 - s T) = 0"
-
-    def parts(self, loop):
-        """A0 = s², Ac = s(1 − sT), Ak = 1 − sT."""
-        T = loop.T
-        return np.array([1.0, 0.0, 0.0]), np.array([-T, 1.0, 0.0]), np.array([0.0, -T, 1.0])
-
-
-class HolonomicPade(PolynomialHolonomicModel):
-    """e^(−sT) ≈ P_m(s)/Q_m(s): s²·Q_m + (c_h s + κ)·P_m = 0.
-
-    Parameters
-    ----------
-    order : int
-        Padé order m, 1 … 12.
-    """
-
-    name = "pade"
-    equation = "s^2 Q_m(s) + (c_h s + kappa) P_m(s) = 0  (Pade(m,m))"
-
-    def __init__(self, order: int = 3):
-        from ..checks import check_integer
-
-        self.order = check_integer("pade_order", order, 1, MAX_PADE_ORDER)
-
-    def options(self) -> dict:
-        """``{"order": m}``."""
-        return {"order": self.order}
-
-    def parts(self, loop):
-        """A0 = s²Q_m, Ac = s·P_m, Ak = P_m (P_m(0) = Q_m(0) = 1)."""
-        num, den = pade_coefficients(loop.T, self.order)
-        num, den = num / den[-1], den / den[-1]
-        n = len(den) + 2
-        pad = lambda p: np.pad(p, (n - len(p), 0))
-        return pad(np.polymul([1.0, 0.0, 0.0], den)), pad(np.polymul([1.0, 0.0], num)), pad(num)
-
-    def __repr__(self) -> str:
-        return f"HolonomicPade(order={self.order})"
+    boundary = model.boundary(loop)
+    stable = model.is_stable(kappa, loop)
+    if kappa <= 0:
+        margin, verdict = -1.0, "stable" if stable else "unstable"
+    else:
+        verdict = interval_verdict(kappa, boundary.stable_set, boundary.kappa_critical, stable)
+        margin = 0.0 if verdict == "undecided" else interval_margin(kappa, boundary.stable_set, boundary.kappa_critical, stable)
+    return HolonomicVerdict(model.name, kappa, boundary.kappa_critical, boundary.omega_critical, margin, verdict,
+                            model.critical_delay(kappa, loop), model.damping_range(kappa, loop), model.rightmost_root(kappa, loop))

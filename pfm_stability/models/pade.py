@@ -4,7 +4,8 @@ e^(−sT) ≈ P_m(s)/Q_m(s) turns (18) into the polynomial
 (τs³ + s² + ks)·Q_m(s) + kNV·P_m(s) = 0, decided by Routh; K* is the first
 crossing of the imaginary axis (module `crossings`). K* converges to the
 `exact_delay` value as m grows. With a heading gain c (`Loop.c`) the delayed
-term is k(cs + NV)·P_m(s): D = (τs³ + s² + ks)·Q_m + kc·s·P_m, E = P_m.
+term is k(cs + NV)·P_m(s): D = (τs³ + s² + ks)·Q_m + kc·s·P_m, E = P_m. The
+holonomic loop (`models.holonomic`) is s²·Q_m + (c_h s + κ)·P_m = 0.
 
 How `pade` with m = 1 differs from `kb_first_order`: KB's 1 − sT is the
 first-order *Taylor* polynomial of e^(−sT) — its gain grows without bound with
@@ -28,7 +29,8 @@ import math
 import numpy as np
 
 from ..checks import check_integer, check_number
-from .base import AffineGainModel, Loop
+from .base import AffineGainModel
+from .family import Characteristic
 
 __all__ = ["Pade", "pade_coefficients", "MAX_PADE_ORDER"]
 
@@ -69,7 +71,7 @@ def _pade_term(m: int, j: int) -> float:
 
 
 class Pade(AffineGainModel):
-    """KB eq (18) with e^(−sT) ≈ Padé(m, m).
+    """The delay replaced by Padé(m, m): a(s)·Q_m(s) + (δs + K)·P_m(s) = 0 (KB eq 18 for the steering loop).
 
     Parameters
     ----------
@@ -78,34 +80,46 @@ class Pade(AffineGainModel):
     """
 
     name = "pade"
-    equation = "(tau s^3 + s^2 + k s) Q_m(s) + k N V P_m(s) = 0  (KB eq 18, Pade(m,m))"
 
     def __init__(self, order: int = 3):
         self.order = check_integer("pade_order", order, 1, MAX_PADE_ORDER)
 
-    def polynomials(self, loop: Loop):
-        """D = (τs³ + s² + ks)·Q_m + kc·s·P_m, E = P_m (descending powers of s; Q_m(0) = P_m(0) = 1)."""
+    def polynomials(self, loop: Characteristic):
+        """D = a(s)·Q_m + δ·s·P_m, E = P_m (descending powers of s; Q_m(0) = P_m(0) = 1)."""
         D, E = self.batch_polynomials([loop])
         return np.trim_zeros(D[0], "f"), np.trim_zeros(E[0], "f")
 
-    def batch_polynomials(self, loops):
-        """`polynomials` of many loops at once: rows of D = (τs³ + s² + ks)·Q_m + kc·s·P_m and E = P_m."""
-        tau, T, k = (np.array([getattr(loop, name) for loop in loops]) for name in ("tau", "T", "k"))
-        heading = np.array([loop.heading for loop in loops])
+    def parts(self, loop: Characteristic):
+        """(a(s)·Q_m, s·P_m, P_m), one length."""
+        aQ, sP, P = self._rows([loop])
+        return aQ[0], sP[0], P[0]
+
+    def _rows(self, loops):
+        """Rows of a(s)·Q_m, s·P_m and P_m for each loop, one width (the plants padded to the largest degree)."""
+        T = np.array([loop.T for loop in loops])
         m = self.order
         c = np.array([_pade_term(m, j) for j in range(m + 1)])
         powers = T[:, None] ** np.arange(m + 1)
         den = (c * powers)[:, ::-1]  # descending; constant term 1 (no division by a vanishing T^m)
         num = (c * powers * (-1.0) ** np.arange(m + 1))[:, ::-1]
-        plant = np.stack([tau, np.ones_like(tau), k, np.zeros_like(tau)], axis=1)
-        D = np.zeros((len(loops), m + 4))
-        for i in range(4):
-            D[:, i:i + m + 1] += plant[:, i, None] * den
-        E = np.zeros_like(D)
-        E[:, 3:] = num
-        rows = np.flatnonzero(heading)
-        if rows.size:  # kc·s·P_m, only where c ≠ 0 (c = 0 keeps KB's rows untouched)
-            D[rows, 2:m + 3] += heading[rows, None] * num[rows]
+        width = max(4, max(len(loop.plant) for loop in loops))  # KB's plant τs³ + s² + ks + 0: four columns
+        plant = np.array([np.pad(loop.plant, (width - len(loop.plant), 0)) for loop in loops])
+        aQ = np.zeros((len(loops), m + width))
+        for i in range(width):
+            aQ[:, i:i + m + 1] += plant[:, i, None] * den
+        sP = np.zeros_like(aQ)
+        sP[:, width - 2:m + width - 1] = num
+        P = np.zeros_like(aQ)
+        P[:, width - 1:] = num
+        return aQ, sP, P
+
+    def batch_polynomials(self, loops):
+        """`polynomials` of many loops at once: rows of D = a(s)·Q_m + δ·s·P_m and E = P_m."""
+        D, sP, E = self._rows(loops)
+        damping = np.array([loop.damping for loop in loops])
+        rows = np.flatnonzero(damping)
+        if rows.size:  # δ·s·P_m, only where δ ≠ 0 (c = 0 keeps KB's rows untouched)
+            D[rows] += damping[rows, None] * sP[rows]
         return D, E
 
     def options(self) -> dict:

@@ -52,6 +52,12 @@ independent route; the dominant pole is σ = ln|1 + Tλ|/T (log1p),
 
 T = 0 is the continuous loop of KB eq (17) (`continuous`).
 
+Any family's loop: the model takes the continuous part from the loop
+(`family.Characteristic.state_space`), so the holonomic robot's double
+integrator with its acceleration held (`models.holonomic`) runs the same code —
+it is KB's loop with τ = 0 and the command held, its heading feedback k(1 + c)
+replaced by c_h and K by κ.
+
 NV = 0 (N = 0, `models.base.neutral_reason`): y feeds nothing back, so the
 closed-loop matrix's y column is zero and z = 1 (λ = 0) is a pole at every T,
 k and c. The verdict and the dominant pole are those of the matrix without
@@ -67,65 +73,54 @@ from functools import lru_cache
 import numpy as np
 
 from ..checks import check_choice, check_integer
-from ..numerics.crossings import Crossing, affine_crossings, stable_interval
 from ..numerics.matrix_exponential import zoh_blocks
 from ..parameters import HOLDS
 from ..numerics.routh import schur_cohn_stable
-from .base import AffineGainModel, Boundary, Loop, _check_NV, checked
+from .base import AffineGainModel, _check_NV, checked
 from .continuous import Continuous
+from .family import Characteristic
 
 __all__ = ["Sampled", "continuous_plant", "discretize", "closed_loop_matrix", "delta_plant", "bilinear_polynomial"]
 
 
-def continuous_plant(loop: Loop, hold: str):
-    """Continuous part of the sampled loop: (A, B, F0, F1).
+def continuous_plant(loop: Characteristic, hold: str):
+    """Continuous part of the sampled loop: (A, B, F0, F1) (`Characteristic.state_space`).
 
     The held input is v_k = −(F0 + K·F1)·state_k, and ẋ = A x + B v between
-    samples. States: (ω, θ, y) for τ > 0, (θ, y) for τ = 0; y = x/V (s).
-    The heading gain c adds kc to F0's θ entry.
+    samples, the lateral state last. Steering: states (ω, θ, y) for τ > 0,
+    (θ, y) for τ = 0; y = x/V (s); the heading gain c adds kc to F0's θ entry.
+    Holonomic: states (v, x), the acceleration held.
 
     Parameters
     ----------
-    loop : Loop
+    loop : Loop or HolonomicLoop
     hold : {"command", "reference"}
+        ``"command"`` only for a holonomic loop.
 
     Returns
     -------
     A, B, F0, F1 : ndarray
     """
     check_choice("hold", hold, HOLDS)
-    tau, k = loop.tau, loop.k
-    if tau > 0:
-        if hold == "command":
-            A = np.array([[-1 / tau, 0, 0], [1, 0, 0], [0, 1, 0]], dtype=float)
-            F0 = np.array([0.0, k, 0.0])
-        else:
-            A = np.array([[-1 / tau, -k / tau, 0], [1, 0, 0], [0, 1, 0]], dtype=float)
-            F0 = np.zeros(3)
-        B = np.array([[1 / tau], [0.0], [0.0]])
-        F1 = np.array([0.0, 0.0, 1.0])
-    else:
-        if hold == "command":
-            A = np.array([[0, 0], [1, 0]], dtype=float)
-            F0 = np.array([k, 0.0])
-        else:
-            A = np.array([[-k, 0], [1, 0]], dtype=float)
-            F0 = np.zeros(2)
-        B = np.array([[1.0], [0.0]])
-        F1 = np.array([0.0, 1.0])
-    if loop.c != 0.0:  # δ_k = −(K/k)·y_k − c·θ_k: the sampled θ enters with kc more
-        F0[-2] += loop.heading
-    return A, B, F0, F1
+    return loop.state_space(hold)
 
 
 def discretize(A, B, T: float):
-    """Zero-order-hold discretization: Φ = e^(AT), Γ = ∫₀ᵀ e^(As) ds B (`matrix_exponential.zoh_blocks`)."""
+    """Zero-order-hold discretization: Φ = e^(AT), Γ = ∫₀ᵀ e^(As) ds B (`matrix_exponential.zoh_blocks`).
+
+    Parameters
+    ----------
+    A, B : ndarray
+        The continuous-time plant ẋ = Ax + Bu.
+    T : float
+        Sampling period, s.
+    """
     Phi, integral = zoh_blocks(A, T)
     return Phi, integral @ B
 
 
 @lru_cache(maxsize=4096)
-def delta_plant(loop: Loop, hold: str):
+def delta_plant(loop: Characteristic, hold: str):
     """(Ψ, G, F0, F1) with Φ = I + TΨ and Γ = TG, accurate as T → 0.
 
     Ψ = (e^(AT) − I)/T is formed as (∫₀ᵀ e^(As) ds)·A/T when ‖A‖T <= 1 (no
@@ -145,15 +140,15 @@ def delta_plant(loop: Loop, hold: str):
     return Psi, G, F0, F1
 
 
-def closed_loop_matrix(loop: Loop, K: float, hold: str, compute_delay: int) -> np.ndarray:
-    """Φ_cl of the sampled loop for gain K = kNV (1/s²).
+def closed_loop_matrix(loop: Characteristic, K: float, hold: str, compute_delay: int) -> np.ndarray:
+    """Φ_cl of the sampled loop for the loop gain K (kNV, κ; 1/s²).
 
     Parameters
     ----------
-    loop : Loop
+    loop : Loop or HolonomicLoop
         T must be > 0.
     K : float
-        Loop gain kNV, 1/s².
+        Loop gain, 1/s².
     hold : {"command", "reference"}
     compute_delay : {0, 1}
 
@@ -172,7 +167,7 @@ def closed_loop_matrix(loop: Loop, K: float, hold: str, compute_delay: int) -> n
     return np.block([[Phi, Gamma], [-F, np.zeros((1, 1))]])
 
 
-def _delta_matrix(loop: Loop, K: float, hold: str, compute_delay: int) -> np.ndarray:
+def _delta_matrix(loop: Characteristic, K: float, hold: str, compute_delay: int) -> np.ndarray:
     """(Φ_cl − I)/T without cancellation: its eigenvalues λ give the poles z = 1 + Tλ."""
     Psi, G, F0, F1 = delta_plant(loop, hold)
     F = (F0 + K * F1)[None, :]
@@ -182,7 +177,17 @@ def _delta_matrix(loop: Loop, K: float, hold: str, compute_delay: int) -> np.nda
 
 
 def bilinear_polynomial(p_w, degree: int, T: float) -> np.ndarray:
-    """Q(μ) = (1 − Tμ/2)^degree · P(μ/(1 − Tμ/2)) for P(w) given descending (degree >= deg P)."""
+    """Q(μ) = (1 − Tμ/2)^degree · P(μ/(1 − Tμ/2)) for P(w) given descending (degree >= deg P).
+
+    Parameters
+    ----------
+    p_w : array_like
+        P(w), descending coefficients.
+    degree : int
+        The power of (1 − Tμ/2), >= deg P.
+    T : float
+        Sampling period, s.
+    """
     p = np.asarray(p_w, dtype=float)[::-1]  # ascending: p_i w^i
     factor = np.array([-T / 2, 1.0])  # 1 − Tμ/2, descending
     out = np.zeros(degree + 1)
@@ -202,18 +207,18 @@ def _power(poly, m: int):
 
 
 class Sampled(AffineGainModel):
-    """The sampled-data VFF loop with zero-order hold.
+    """The sampled-data loop with zero-order hold, for the loop of any family (`continuous_plant`).
 
     Parameters
     ----------
     hold : {"command", "reference"}
-        What is held between samples (`parameters.HOLDS`, docs/models.md).
+        What is held between samples (`parameters.HOLDS`, docs/models.md); a
+        holonomic robot holds its acceleration command (``"command"``).
     compute_delay : {0, 1}
         Samples between measurement and actuation.
     """
 
     name = "sampled"
-    equation = "det(zI - Phi_cl(kNV)) = 0, ZOH, period T"
     domain = "z"
 
     def __init__(self, hold: str = "command", compute_delay: int = 0):
@@ -228,103 +233,130 @@ class Sampled(AffineGainModel):
         return f"Sampled(hold={self.hold!r}, compute_delay={self.compute_delay})"
 
     # ------------------------------------------------------------ polynomials
-    def delta_polynomials(self, loop: Loop):
+    def _lead(self, loop: Characteristic, Psi: np.ndarray) -> np.ndarray:
+        """(1 + Tw)^c·det(wI − Ψ), descending in w (c = compute_delay)."""
+        p = np.poly(Psi)
+        return np.polymul([loop.T, 1.0], p) if self.compute_delay and loop.T > 0 else p
+
+    def delta_polynomials(self, loop: Characteristic):
         """(D, E) in the δ variable w = (z − 1)/T: P(w) = D(w) + K·E(w), descending.
 
         D = (1 + Tw)^c det(wI − Ψ) + F0 adj(wI − Ψ) G and E = F1 adj(wI − Ψ) G,
         each rank-one term as det(wI − Ψ + G F) − det(wI − Ψ).
+
+        Parameters
+        ----------
+        loop : Loop
+            τ (s), T (s), k (1/s) and the heading gain c.
         """
         Psi, G, F0, F1 = delta_plant(loop, self.hold)
-        p = np.poly(Psi)
-        base = np.polysub(np.poly(Psi - G @ F0[None, :]), p) if np.any(F0) else np.zeros(1)
-        e = np.polysub(np.poly(Psi - G @ F1[None, :]), p)
-        lead = np.polymul([loop.T, 1.0], p) if self.compute_delay and loop.T > 0 else p
-        return np.polyadd(lead, base), np.trim_zeros(e, "f") if np.any(e) else np.zeros(1)
+        lead = self._lead(loop, Psi)
+        e = _rank_one(Psi, G, F1)
+        return np.polyadd(lead, _rank_one(Psi, G, F0)), np.trim_zeros(e, "f") if np.any(e) else np.zeros(1)
 
-    def bilinear_polynomials(self, loop: Loop):
+    def bilinear_polynomials(self, loop: Characteristic):
         """(D, E) in μ (z = (1 + Tμ/2)/(1 − Tμ/2)): stable ⇔ D + K·E is Hurwitz, descending, one length."""
         d, e = self.delta_polynomials(loop)
         degree = len(np.trim_zeros(d, "f")) - 1
         return bilinear_polynomial(d, degree, loop.T), bilinear_polynomial(e, degree, loop.T)
 
-    def polynomials(self, loop: Loop):
+    def parts(self, loop: Characteristic):
+        """(P0, P1, P2) in μ: the characteristic polynomial P0 + δ·P1 + K·P2 (Tustin's map of the δ form; T = 0: `continuous`'s).
+
+        P1 is the rank-one term of the unit damping row (the family's F0 at δ = 1 less at δ = 0).
+        """
+        if loop.T == 0:
+            return Continuous().parts(loop)
+        Psi, G, F0, F1 = delta_plant(loop.with_damping(0.0), self.hold)
+        unit = delta_plant(loop.with_damping(1.0), self.hold)[2] - F0
+        lead = np.polyadd(self._lead(loop, Psi), _rank_one(Psi, G, F0))
+        degree = len(np.trim_zeros(lead, "f")) - 1
+        return tuple(bilinear_polynomial(p, degree, loop.T) for p in (lead, _rank_one(Psi, G, unit), _rank_one(Psi, G, F1)))
+
+    def polynomials(self, loop: Characteristic):
         """(D(z), E(z)): det(zI − Φ_cl(K)) = D + K·E, descending in z (T > 0).
 
         Formed from the δ form, P_z(z) = Σ p_i T^(d−i) (z − 1)^i; a polynomial
         in z is ill-conditioned for T → 0 (use `bilinear_polynomials` there).
+
+        Parameters
+        ----------
+        loop : Loop
+            τ (s), T (s), k (1/s) and the heading gain c.
         """
         d, e = self.delta_polynomials(loop)
         degree = len(np.trim_zeros(d, "f")) - 1
         return _to_z(d, degree, loop.T), _to_z(e, degree, loop.T)
 
     # --------------------------------------------------------------- queries
-    def compute_boundary(self, loop: Loop) -> Boundary:
-        if loop.T == 0:  # the continuous loop, KB eq (17), exactly
-            b = Continuous().boundary(loop)
-            return Boundary(self.name, b.NV_critical, b.omega_critical, b.K_critical, b.stable_set)
+    def stable_gains(self, loop: Characteristic):
+        """Every stable loop gain K: the crossings of the bilinear polynomials, each stretch decided by the eigenvalues
+        (T = 0: the continuous loop, KB eq 17 for the steering robot, exactly)."""
+        if loop.T == 0:
+            return Continuous().stable_gains(loop)
         d, e = self.bilinear_polynomials(loop)
-        crossings = [Crossing(c.gain, self._frequency_of(c.frequency, loop)) for c in affine_crossings(d, e, "s")]
-        if e[0] != 0.0 and -d[0] / e[0] > 0:  # the degree of Q drops: a pole passes through z = −1
-            crossings.append(Crossing(float(-d[0] / e[0]), math.pi / loop.T))
-        crossings.sort(key=lambda c: (c.gain, c.frequency))
-        interval = stable_interval(crossings, lambda K: self._stable(K / loop.k, loop))
-        return Boundary.from_interval(self.name, interval, loop.k)
+        return self._interval(d, e, lambda K: self._stable(loop.gain_of(K), loop), loop)
 
-    @staticmethod
-    def _frequency_of(Omega: float, loop: Loop) -> float:
+    def _frequency(self, Omega: float, loop: Characteristic) -> float:
         """ω (rad/s) of the unit-circle point that μ = jΩ maps to."""
         return 2.0 * math.atan(Omega * loop.T / 2.0) / loop.T if loop.T > 0 else Omega
 
+    def _infinite_frequency(self, loop: Characteristic) -> float:
+        """A pole passing through z = −1 when Q's degree drops: ω = π/T."""
+        return math.pi / loop.T
+
     @checked
-    def delta_eigenvalues(self, NV: float, loop: Loop) -> np.ndarray:
+    def delta_eigenvalues(self, gain: float, loop: Characteristic) -> np.ndarray:
         """Eigenvalues λ of (Φ_cl − I)/T (poles z = 1 + Tλ; T = 0: the continuous poles)."""
-        return self._delta_eigenvalues(NV, loop)
+        return self._delta_eigenvalues(gain, loop)
 
-    def _delta_eigenvalues(self, NV: float, loop: Loop) -> np.ndarray:
-        return np.linalg.eigvals(_delta_matrix(loop, loop.k * NV, self.hold, self.compute_delay))
+    def _delta_eigenvalues(self, gain: float, loop: Characteristic) -> np.ndarray:
+        return np.linalg.eigvals(_delta_matrix(loop, loop.loop_gain(gain), self.hold, self.compute_delay))
 
-    def _judged_eigenvalues(self, NV: float, loop: Loop) -> np.ndarray:
-        """The λ the verdict judges: every one, or at NV = 0 those of the heading loop (y's row and column removed)."""
-        if NV != 0:
-            return self._delta_eigenvalues(NV, loop)
+    def _judged_eigenvalues(self, gain: float, loop: Characteristic) -> np.ndarray:
+        """The λ the verdict judges: every one, or at gain 0 those of the heading loop (y's row and column removed)."""
+        if gain != 0:
+            return self._delta_eigenvalues(gain, loop)
         y = delta_plant(loop, self.hold)[0].shape[0] - 1  # the lateral state: the plant's last
         matrix = _delta_matrix(loop, 0.0, self.hold, self.compute_delay)
         return np.linalg.eigvals(np.delete(np.delete(matrix, y, axis=0), y, axis=1))
 
     @checked
-    def closed_loop(self, NV: float, loop: Loop) -> np.ndarray:
-        """Φ_cl for NV (1/s)."""
-        return closed_loop_matrix(loop, loop.k * _check_NV(NV), self.hold, self.compute_delay)
+    def closed_loop(self, gain: float, loop: Characteristic) -> np.ndarray:
+        """Φ_cl at the gain (NV 1/s, κ 1/s²)."""
+        return closed_loop_matrix(loop, loop.loop_gain(_check_NV(gain)), self.hold, self.compute_delay)
 
     @checked
-    def eigenvalues(self, NV: float, loop: Loop) -> np.ndarray:
+    def eigenvalues(self, gain: float, loop: Characteristic) -> np.ndarray:
         """Closed-loop poles z (T > 0), as 1 + Tλ."""
-        return 1.0 + loop.T * self._delta_eigenvalues(NV, loop)
+        return 1.0 + loop.T * self._delta_eigenvalues(gain, loop)
 
     @checked
-    def is_stable(self, NV: float, loop: Loop) -> bool:
-        """Every pole strictly inside the unit circle: 2 Re λ + T|λ|² < 0 (T = 0: KB eq 17 by Routh;
+    def is_stable(self, gain: float, loop: Characteristic) -> bool:
+        """Every pole strictly inside the unit circle: 2 Re λ + T|λ|² < 0 (T = 0: the continuous loop by Routh;
         NV = 0: every pole but the neutral z = 1, `_judged_eigenvalues`)."""
-        return self._stable(NV, loop)
+        return self._stable(gain, loop)
 
-    def _stable(self, NV: float, loop: Loop) -> bool:
+    def _stable(self, gain: float, loop: Characteristic) -> bool:
         if loop.T == 0:
-            return Continuous()._stable(NV, loop)
-        lam = self._judged_eigenvalues(NV, loop)
+            return Continuous()._stable(gain, loop)
+        lam = self._judged_eigenvalues(gain, loop)
         size = np.abs(lam)
         return bool(np.all(2.0 * lam.real + (loop.T * size) * size < 0.0))  # T|λ|·|λ|: no overflow of |λ|² at tiny T
 
     @checked
-    def jury_stable(self, NV: float, loop: Loop) -> bool:
-        """Schur–Cohn (Jury) verdict on det(zI − Φ_cl), independent of the eigenvalues."""
-        return schur_cohn_stable(self.characteristic(NV, loop))
+    def jury_stable(self, gain: float, loop: Characteristic) -> bool:
+        """Schur–Cohn (Jury) verdict on det(zI − Φ_cl), independent of the eigenvalues (T = 0: the continuous loop's)."""
+        if loop.T == 0:
+            return self._stable(gain, loop)
+        return schur_cohn_stable(self.characteristic(gain, loop))
 
     @checked
-    def rightmost_root(self, NV: float, loop: Loop) -> complex:
+    def rightmost_root(self, gain: float, loop: Characteristic) -> complex:
         """Dominant pole as s = ln(z)/T: σ = ln|z|/T (1/s), ω = arg(z)/T in [0, π/T] (rad/s); NV = 0: the heading loop's."""
         if loop.T == 0:
-            return Continuous().rightmost_root(NV, loop)
-        lam = self._judged_eigenvalues(NV, loop)
+            return Continuous().rightmost_root(gain, loop)
+        lam = self._judged_eigenvalues(gain, loop)
         T = loop.T
         sigma = _log_radius(lam, T) / T
         omega = np.abs(np.arctan2(T * lam.imag, 1.0 + T * lam.real)) / T
@@ -332,14 +364,15 @@ class Sampled(AffineGainModel):
         return complex(float(sigma[i]), float(omega[i]))
 
     @checked
-    def roots(self, NV: float, loop: Loop) -> np.ndarray:
+    def roots(self, gain: float, loop: Characteristic) -> np.ndarray:
         """All closed-loop poles z (T > 0); the continuous roots s at T = 0."""
-        return self._delta_eigenvalues(NV, loop) if loop.T == 0 else 1.0 + loop.T * self._delta_eigenvalues(NV, loop)
+        return self._delta_eigenvalues(gain, loop) if loop.T == 0 else 1.0 + loop.T * self._delta_eigenvalues(gain, loop)
 
     def growth_rates(self, NV: float, loops) -> np.ndarray:
-        """σ = max ln|z|/T (1/s) at NV for each loop, all exponentials and eigenvalues in one batch."""
+        """σ = max ln|z|/T (1/s) at the gain for each loop, all exponentials and eigenvalues in one batch."""
         loops = list(loops)
-        K = np.array([loop.k for loop in loops]) * _check_NV(NV)
+        NV = _check_NV(NV)
+        K = np.array([loop.loop_gain(NV) for loop in loops])
         T = np.array([loop.T for loop in loops])
         plants = [continuous_plant(loop, self.hold) for loop in loops]
         A, B, F0, F1 = (np.stack([p[i] for p in plants]) for i in range(4))
@@ -369,6 +402,13 @@ class Sampled(AffineGainModel):
         if (~sampled).any():
             sigma[~sampled] = np.linalg.eigvals(closed[~sampled][(slice(None),) + plant]).real.max(axis=1)
         return sigma
+
+
+def _rank_one(Psi, G, F) -> np.ndarray:
+    """F·adj(wI − Ψ)·G = det(wI − Ψ + G F) − det(wI − Ψ), descending in w (zero for F = 0)."""
+    if not np.any(F):
+        return np.zeros(1)
+    return np.polysub(np.poly(Psi - G @ F[None, :]), np.poly(Psi))
 
 
 def _log_radius(lam, T):

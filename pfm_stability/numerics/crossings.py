@@ -192,7 +192,17 @@ def affine_crossings(d, e, domain: str = "s") -> list[Crossing]:
 
 
 def verdict_at(d, e, gain: float, domain: str = "s") -> bool:
-    """True when D + gain·E is Hurwitz (``"s"``, Routh) or Schur (``"z"``, Schur–Cohn)."""
+    """True when D + gain·E is Hurwitz (``"s"``, Routh) or Schur (``"z"``, Schur–Cohn).
+
+    Parameters
+    ----------
+    d, e : array_like
+        Real coefficients of D and E, descending powers (aligned on the constant term).
+    gain : float
+        The gain K in D + K·E.
+    domain : {"s", "z"}
+        ``"s"``: continuous time (Hurwitz); ``"z"``: discrete time (Schur).
+    """
     d, e = _align(np.asarray(d, dtype=float), np.asarray(e, dtype=float))
     p = strip_leading_zeros(d + gain * e)
     return routh_array(p).stable if domain == "s" else schur_cohn_stable(p)

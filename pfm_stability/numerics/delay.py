@@ -150,7 +150,15 @@ class DelayLoop:
 
     # ------------------------------------------------------------------ values
     def value(self, s, K: float):
-        """a(s) + (d(s) + K)·e^(−sT) at complex `s`."""
+        """a(s) + (d(s) + K)·e^(−sT) at complex `s`.
+
+        Parameters
+        ----------
+        s : complex or array_like of complex
+            Where to evaluate, 1/s.
+        K : float
+            The gain K.
+        """
         b = K if self.d is None else np.polyval(self._b(K), s)
         return np.polyval(self.a, s) + b * np.exp(-s * self.T)
 
@@ -172,6 +180,11 @@ class DelayLoop:
 
     def crossing_frequencies(self, K: float):
         """Frequencies ω > 0 with |a(jω)| = |b(jω)|, and the crossing direction there.
+
+        Parameters
+        ----------
+        K : float
+            The gain K, finite.
 
         Returns
         -------
@@ -226,6 +239,11 @@ class DelayLoop:
         Z(T) = Z(0) + 2·Σ_{T_m < T} sign F′(ω_m²) (Cooke & van den Driessche 1986).
         Returns None when a root lies on the imaginary axis at this T (within a
         relative 1e-12 in delay) or at s = 0, or a crossing is tangent.
+
+        Parameters
+        ----------
+        K : float
+            The gain K, finite.
         """
         K = check_number("K", K, -_K_MAX, _K_MAX, low_open=False, high_open=False)
         if np.polyval(self.a, 0.0) + np.polyval(self._b(K), 0.0) == 0.0:
@@ -243,7 +261,13 @@ class DelayLoop:
         return count
 
     def is_stable(self, K: float) -> bool:
-        """True when every root has Re s < 0 (by the crossing count)."""
+        """True when every root has Re s < 0 (by the crossing count).
+
+        Parameters
+        ----------
+        K : float
+            The gain K, finite.
+        """
         K = check_number("K", K, -_K_MAX, _K_MAX, low_open=False, high_open=False)
         return self.unstable_root_count(K) == 0
 
@@ -252,6 +276,11 @@ class DelayLoop:
 
         0 if a(s) + K is not Hurwitz; ``inf`` when no root can reach the axis
         (delay-independent stability). Does not depend on this loop's own T.
+
+        Parameters
+        ----------
+        K : float
+            The gain K, finite.
         """
         K = check_number("K", K, -_K_MAX, _K_MAX, low_open=False, high_open=False)
         if not routh_array(self._delay_free(K)).stable:
@@ -343,6 +372,15 @@ class DelayLoop:
         where no eigenvalue polishes to a root (a loop with |s|·T in the
         thousands, e.g. an enormous gain), the array is empty: the rightmost
         root is then undefined, while verdicts (the crossing count) stay exact.
+
+        Parameters
+        ----------
+        K : float
+            The gain K, finite.
+        count : int
+            How many roots to return (at most).
+        nodes : int
+            Chebyshev nodes of the collocation on [−T, 0].
         """
         K = check_number("K", K, -_K_MAX, _K_MAX, low_open=False, high_open=False)
         if self.T == 0:
@@ -573,7 +611,15 @@ def delay_verdicts_from_gain(tau, T, k, K, c=None):
 
     τs³ + s² + ks + (kcs + K)·e^(−sT) (c None: KB eq 18): F(y) = τ²y³ + (1 − 2kτ)y² + k²(1 − c²)y − K²,
     first delays from arg(a(jω)/b(jω)), b = kcjω + K; Z(0), the Routh count of τs³ + s² + k(1 + c)s + K,
-    is 1 for K < 0 (a real root s > 0: N < 0, always unstable); K = 0 (N = 0) counts the heading loop (s = 0 left out)."""
+    is 1 for K < 0 (a real root s > 0: N < 0, always unstable); K = 0 (N = 0) counts the heading loop (s = 0 left out).
+
+    Parameters
+    ----------
+    tau, T, k, K : ndarray
+        τ (s), T (s), k (1/s) and K = kNV (1/s²), one loop per element (1-D, equal length).
+    c : ndarray or None
+        Heading gain c per loop (dimensionless); None: KB's loop (c = 0).
+    """
     linear = None if c is None else k**2 * (1 - c * c)
     y = _cubic_positive_roots(tau, k, K, linear)
     present = np.isfinite(y) & (y > 0)  # y = 0: K² underflowed to 0, no crossing at ω > 0

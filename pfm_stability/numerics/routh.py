@@ -73,7 +73,15 @@ class RouthResult:
 
 
 def real_coefficients(coefficients, name: str = "coefficients") -> np.ndarray:
-    """A 1-D float array of finite real polynomial coefficients, or ValueError naming `name`."""
+    """A 1-D float array of finite real polynomial coefficients, or ValueError naming `name`.
+
+    Parameters
+    ----------
+    coefficients : array_like
+        Polynomial coefficients, descending powers.
+    name : str
+        The name the error message gives them.
+    """
     message = f"{name} must be a non-empty sequence of finite real numbers (descending powers); got {coefficients!r}"
     if isinstance(coefficients, (str, bytes)) or np.ndim(coefficients) != 1:
         raise ValueError(message)
@@ -87,7 +95,13 @@ def real_coefficients(coefficients, name: str = "coefficients") -> np.ndarray:
 
 
 def strip_leading_zeros(coefficients) -> np.ndarray:
-    """Drop leading (highest-power) exact zeros of a descending coefficient array."""
+    """Drop leading (highest-power) exact zeros of a descending coefficient array.
+
+    Parameters
+    ----------
+    coefficients : array_like
+        Real polynomial coefficients, descending powers, not all zero.
+    """
     c = real_coefficients(coefficients)
     nonzero = np.flatnonzero(c)
     if nonzero.size == 0:
@@ -275,6 +289,11 @@ def routh_stable(coefficients) -> bool:
 
     A zero row or zero first-column entry (a root on, or symmetric about, the
     imaginary axis) counts as not stable.
+
+    Parameters
+    ----------
+    coefficients : array_like
+        Real polynomial coefficients, descending powers.
     """
     return routh_array(coefficients).stable
 

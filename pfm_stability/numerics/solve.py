@@ -197,6 +197,17 @@ def refine_sign_change(measure, lo: float, hi: float, *, members: int = 16, rtol
 
     `bisect_batched` on the label measure >= 0; returns the upper end of the
     final bracket (hi − lo <= max(rtol·hi, atol)).
+
+    Parameters
+    ----------
+    measure : callable
+        ``measure(x)`` for an array of x, returns an array of floats.
+    lo, hi : float
+        The bracket: measure(lo) < 0 <= measure(hi).
+    members : int
+        Values evaluated per round.
+    rtol, atol : float
+        Stop when hi − lo <= max(rtol·hi, atol).
     """
     return bisect_batched(lambda x: np.asarray(measure(x), dtype=float) >= 0, lo, hi, members=members, rtol=rtol, atol=atol, ends=(False, True)).hi
 
@@ -309,7 +320,19 @@ def bisect_batched(
 
 
 def spread_values(lo, hi, members, quantum, geometric):
-    """`members` values over [lo, hi] (ends included): evenly, geometrically, or on multiples of `quantum`."""
+    """`members` values over [lo, hi] (ends included): evenly, geometrically, or on multiples of `quantum`.
+
+    Parameters
+    ----------
+    lo, hi : float
+        The ends of the interval (both included).
+    members : int
+        How many values.
+    quantum : float or None
+        If given, the values are multiples of it (duplicates removed: maybe fewer than `members`).
+    geometric : bool
+        Geometric spacing (lo > 0) rather than even spacing; ignored when `quantum` is given.
+    """
     if quantum is not None:
         k0, k1 = math.ceil(lo / quantum - 1e-9), math.floor(hi / quantum + 1e-9)
         k = np.unique(np.round(np.linspace(k0, k1, members))) if k1 >= k0 else np.array([])

@@ -1,14 +1,14 @@
-"""Model comparison plots: how the five loop models differ, and where KB's criterion errs.
+"""Model comparison plots: how the five loop models differ, and where KB's criterion errs (drawing only: each takes its result).
 
 * `plot_critical_gain_vs_delay`: NV* against T/τ for every model and every
-  sampled structure (hold × compute delay). KB's eq (20) gives
-  NV* = 1/(τ + T).
-* `plot_kb_error_map`: NV*_KB/NV*_model − 1 over (kτ, T/τ) (`comparison.kb_error_map`):
+  sampled structure (hold × compute delay), `comparison.critical_gain_vs_delay`'s
+  `GainCurves` (also its ``.plot()``). KB's eq (20) gives NV* = 1/(τ + T).
+* `plot_kb_error_map`: NV*_KB/NV*_model − 1 over (kτ, T/τ) (`comparison.kb_error_map`, also ``KBErrorMap.plot()``):
   red where KB's criterion is optimistic (it calls stable a loop that
   oscillates), blue where it is conservative.
 * `plot_kb_error_maps`: one map per reference model, one colour bar.
 * `plot_model_comparison`: NV* versus k (`plots.rlocus.plot_critical_gain_vs_k`)
-  and versus T/τ side by side, one legend below.
+  and versus T/τ side by side, one legend below (both curve sets given).
 
 Model styles follow `plots.common.MODEL_STYLE`; the four sampled structures
 are told apart as in `plots.rlocus`: solid = command hold, dashed =
@@ -23,7 +23,6 @@ import math
 
 import numpy as np
 
-from ..analysis.comparison import GainCurve, KBErrorMap, critical_gain_vs_delay
 from .common import MODEL_ZORDER, figure_and_axes, model_label, model_style, outside_legend
 
 __all__ = [
@@ -37,31 +36,17 @@ _RATIO_LIMIT = 2.0
 """Colour scale of the error maps: log2(NV*_KB/NV*) clipped to ±2 (KB off by 4×)."""
 
 
-def plot_critical_gain_vs_delay(
-    tau: float,
-    k: float,
-    T_over_tau=None,
-    *,
-    curves: list[GainCurve] | None = None,
-    mark: float | None = None,
-    mark_label: str = "CARMEL",
-    ax=None,
-    legend: bool = True,
-):
+def plot_critical_gain_vs_delay(curves, *, mark: float | None = None, mark_label: str = "CARMEL", ax=None, legend: bool = True):
     """NV* (1/s) against the sampling period T/τ for all models (KB eq 20: NV* = 1/(τ + T)).
 
     Parameters
     ----------
-    tau : float
-        Steering time constant, s.
-    k : float
-        Steering gain, 1/s.
-    T_over_tau : array_like, optional
-        Default 60 log-spaced values in [0.01, 3].
-    curves : list of GainCurve, optional
-        Precomputed `comparison.critical_gain_vs_delay` (else computed here).
+    curves : comparison.GainCurves
+        `comparison.critical_gain_vs_delay` (τ and k are read from it).
     mark : float, optional
         A T/τ to mark with a vertical line (e.g. CARMEL's 0.065/0.3).
+    mark_label : str
+        Who is marked.
     ax : matplotlib Axes, optional
     legend : bool
         Draw the legend outside the axes, on the right.
@@ -71,9 +56,6 @@ def plot_critical_gain_vs_delay(
     matplotlib.figure.Figure
     """
     fig, ax = figure_and_axes(ax, (8.6, 4.6) if legend else (6.4, 4.6))
-    if curves is None:
-        T_over_tau = np.geomspace(0.01, 3.0, 60) if T_over_tau is None else T_over_tau
-        curves = critical_gain_vs_delay(tau, k, T_over_tau)
     for c in curves:
         values = np.where(np.isfinite(c.NV_critical) & (c.NV_critical > 0), c.NV_critical, np.nan)
         ax.plot(c.x, values, label=model_label(c.model), zorder=MODEL_ZORDER[c.model.name], **model_style(c.model))
@@ -84,6 +66,7 @@ def plot_critical_gain_vs_delay(
     ax.set_ylim(bottom=0)
     ax.set_xlabel("sampling period T/τ (dimensionless)")
     ax.set_ylabel("critical NV* (1/s)")
+    tau, k = curves[0].tau, curves[0].k
     ax.set_title(f"Critical gain vs sampling period: τ = {tau:g} s, k = {k:g} 1/s\nKB eq (20): NV* = 1/(τ + T)", fontsize=9)
     ax.grid(alpha=0.3, which="both")
     if legend:
@@ -95,7 +78,7 @@ def _percent(r: float) -> str:
     return "0" if abs(r) < 1e-12 else f"{100 * r:+.0f} %"
 
 
-def plot_kb_error_map(error_map: KBErrorMap, ax=None, *, mark: tuple[float, float] | None = None, mark_label: str = "CARMEL", colorbar: bool = True):
+def plot_kb_error_map(error_map, ax=None, *, mark: tuple[float, float] | None = None, mark_label: str = "CARMEL", colorbar: bool = True):
     """Where KB's criterion is optimistic (red) or conservative (blue) against one model.
 
     Colour: log2(NV*_KB/NV*_model), clipped to ±2; contours at 0 (KB exact),
@@ -104,7 +87,7 @@ def plot_kb_error_map(error_map: KBErrorMap, ax=None, *, mark: tuple[float, floa
 
     Parameters
     ----------
-    error_map : KBErrorMap
+    error_map : comparison.KBErrorMap
         From `comparison.kb_error_map`.
     ax : matplotlib Axes, optional
     mark : (k_tau, T_over_tau), optional
@@ -168,7 +151,7 @@ def _colorbar(fig, mesh, ax):
     return cb
 
 
-def plot_kb_error_maps(maps: list[KBErrorMap], *, mark: tuple[float, float] | None = None, mark_label: str = "CARMEL", ncols: int = 3):
+def plot_kb_error_maps(maps, *, mark: tuple[float, float] | None = None, mark_label: str = "CARMEL", ncols: int = 3):
     """One `plot_kb_error_map` per reference model, one colour bar; hatched: the model is never stable.
 
     Returns
@@ -212,21 +195,16 @@ def plot_kb_error_maps(maps: list[KBErrorMap], *, mark: tuple[float, float] | No
     return fig
 
 
-def plot_model_comparison(tau: float, T: float, k: float, *, ks=None, T_over_tau=None, pade_order: int = 3):
+def plot_model_comparison(by_k, by_delay):
     """NV* versus k and versus T/τ for all models, side by side, the operating point marked, one legend below.
 
     Parameters
     ----------
-    tau, T : float
-        Steering time constant and sampling period, s.
-    k : float
-        Steering gain, 1/s.
-    ks : array_like, optional
-        Steering gains of the left panel, 1/s.
-    T_over_tau : array_like, optional
-        Sampling periods of the right panel, in units of τ.
-    pade_order : int
-        Order m of the ``pade`` model.
+    by_k : comparison.GainCurves
+        `comparison.critical_gain_vs_k` at the robot's τ and T (the left panel).
+    by_delay : comparison.GainCurves
+        `comparison.critical_gain_vs_delay` at the robot's τ and k (the right panel).
+        The operating point is k (the right panel's) on the left, T/τ (the left panel's) on the right.
 
     Returns
     -------
@@ -236,10 +214,11 @@ def plot_model_comparison(tau: float, T: float, k: float, *, ks=None, T_over_tau
 
     from .rlocus import plot_critical_gain_vs_k
 
+    k, T, tau = by_delay[0].k, by_k[0].T, by_k[0].tau
     fig, (a, b) = plt.subplots(1, 2, figsize=(12, 5.4), layout="constrained")
-    plot_critical_gain_vs_k(tau, T, ks, pade_order=pade_order, ax=a, legend=False)
+    plot_critical_gain_vs_k(by_k, ax=a, legend=False)
     a.axvline(k, color="k", lw=0.9, ls=":")
     a.annotate(f"k = {k:g} 1/s", (k, 0.02), xycoords=("data", "axes fraction"), xytext=(4, 0), textcoords="offset points", fontsize=8)
-    plot_critical_gain_vs_delay(tau, k, T_over_tau, mark=T / tau, ax=b, legend=False)
+    plot_critical_gain_vs_delay(by_delay, mark=T / tau, ax=b, legend=False)
     fig.legend(*a.get_legend_handles_labels(), loc="outside lower center", ncol=4, fontsize=8, frameon=False)
     return fig

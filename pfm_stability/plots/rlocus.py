@@ -4,7 +4,7 @@ KB (Koren & Borenstein 1991) conclude from eq (20) that stability does not
 depend on the steering gain k. `plot_critical_gain_vs_k` shows NV* against k
 for every model: flat only for `continuous` and `kb_first_order`.
 `plot_root_locus` draws the closed-loop roots of the Padé(m) form of eq (18)
-as NV grows (python-control's ``root_locus_map``), with the imaginary-axis
+as NV grows (`comparison.root_locus`: python-control's ``root_locus_map``), with the imaginary-axis
 crossings of the `pade`, `exact_delay`, `sampled` and `kb_first_order`
 models marked; a model without a marker (NV* = 0 or infinite, or a crossing
 outside the view) says why in the legend. Legends sit outside the axes.
@@ -16,8 +16,6 @@ import math
 
 import numpy as np
 
-from ..analysis.comparison import GainCurve, RootLocus, critical_gain_vs_k, root_locus
-from ..models import Loop
 from .common import MODEL_STYLE, MODEL_ZORDER, figure_and_axes, model_label, model_style, outside_legend
 
 __all__ = ["plot_root_locus", "plot_critical_gain_vs_k", "crossing_text"]
@@ -72,8 +70,7 @@ def crossing_text(model, boundary, omega_max: float | None = None) -> tuple[str,
     return text + extra, True
 
 
-def plot_root_locus(loop: Loop | None = None, *, pade_order: int = 3, hold: str = "command", compute_delay: int = 0, NV_max=None,
-                    ax=None, locus: RootLocus | None = None):
+def plot_root_locus(locus, ax=None):
     """Root locus of the Padé(m) loop in NV with the critical crossings marked.
 
     Markers (concentric rings where they coincide): the Padé locus crossing
@@ -85,24 +82,14 @@ def plot_root_locus(loop: Loop | None = None, *, pade_order: int = 3, hold: str 
 
     Parameters
     ----------
-    loop : Loop
-        τ (s), T (s, > 0), k (1/s); not needed when `locus` is given.
-    pade_order : int
-        Order m of the Padé approximation of e^(−sT).
-    hold, compute_delay
-        Structure of the ``sampled`` model.
-    NV_max : float, optional
-        Largest loop gain of the locus, 1/s (default 2.5·NV* of ``exact_delay``).
+    locus : comparison.RootLocus
+        `comparison.root_locus` (also ``RootLocus.plot()``).
     ax : matplotlib Axes, optional
-    locus : RootLocus, optional
-        Precomputed `comparison.root_locus` (else computed from the other arguments).
 
     Returns
     -------
     matplotlib.figure.Figure
     """
-    if locus is None:
-        locus = root_locus(loop, pade_order=pade_order, hold=hold, compute_delay=compute_delay, NV_max=NV_max)
     loop, poles, zeros = locus.loop, locus.poles, locus.zeros
     fig, ax = figure_and_axes(ax, (10.0, 5.4))
     for branch in locus.loci.T:
@@ -138,31 +125,23 @@ def plot_root_locus(loop: Loop | None = None, *, pade_order: int = 3, hold: str 
     return fig
 
 
-def plot_critical_gain_vs_k(tau: float, T: float, ks=None, *, pade_order: int = 3, ax=None, legend: bool = True,
-                            curves: list[GainCurve] | None = None):
+def plot_critical_gain_vs_k(curves, ax=None, *, legend: bool = True):
     """NV* against k for all models: the k-dependence that KB's eq (20) hides.
 
     Parameters
     ----------
-    tau, T : float
-        Steering time constant and sampling period, s.
-    ks : array_like, optional
-        Steering gains, 1/s (default 60 log-spaced points in [0.2, 30]).
-    pade_order : int
-        Order m of the ``pade`` model.
+    curves : comparison.GainCurves
+        `comparison.critical_gain_vs_k` (τ and T are read from it; also its ``.plot()``).
     ax : matplotlib Axes, optional
     legend : bool
         Draw the legend outside the axes, on the right.
-    curves : list of GainCurve, optional
-        Precomputed `comparison.critical_gain_vs_k` (else computed here).
 
     Returns
     -------
     matplotlib.figure.Figure
     """
     fig, ax = figure_and_axes(ax, (8.6, 4.6) if legend else (6.4, 4.6))
-    if curves is None:
-        curves = critical_gain_vs_k(tau, T, np.geomspace(0.2, 30, 60) if ks is None else ks, pade_order=pade_order)
+    tau, T = curves[0].tau, curves[0].T
     for curve in curves:
         shown = np.where(np.isfinite(curve.NV_critical) & (curve.NV_critical > 0), curve.NV_critical, np.nan)
         ax.plot(curve.x, shown, label=model_label(curve.model), zorder=MODEL_ZORDER[curve.model.name], **model_style(curve.model))

@@ -1,24 +1,25 @@
-"""The report for the robot loop families and the velocity-aware and fuzzy laws.
+"""The robot loop families and the velocity-aware and fuzzy laws: their laws and their results (docs/velocity_and_fuzzy.md).
 
-`pfm_stability.report.stability.build_report` answers KB's steering robot with a static
-lateral law. `build_family_report` answers the rest of ``report --robot`` and
-``report --law`` (docs/velocity_and_fuzzy.md, docs/models.md "Robot loop families"):
+`report.stability.build_report` answers every robot family and law; for ``--robot`` and the laws of
+`parameters.FAMILY_LAWS` it takes each geometry's result from here (docs/models.md "Robot loop families"):
 
-* ``--robot kinematic`` (Ge & Cui 2002 §7: ω = K_s(θ_f − θ), no motor lag): KB's loop
-  with τ = 0 and k = K_s, any law;
-* ``--law velocity`` (GC2002's velocity attraction with Khatib's repulsion): on a
-  steering robot every equilibrium's N and heading gain c (N = N_static/(1 − q),
-  c = q/(1 − q)) enter the five steering models; on a holonomic robot (force =
-  acceleration, GC2002 §6) every equilibrium's κ and c_h enter the five holonomic
-  models, and the tracking error's ζ and ω_n (GC2002 eq 34–36) are added;
-* ``--law fuzzy`` (the DFAPF paper's fuzzy-scheduled repulsion): the total N and c
-  enter the steering models; N_frozen and the robust bracket are reported beside them;
+* ``--law velocity`` (GC2002's velocity attraction with Khatib's repulsion) and ``--law fuzzy``
+  (the DFAPF paper's fuzzy-scheduled repulsion) on a steering or kinematic robot: every
+  equilibrium's N and heading gain c enter the five steering models (`steering_results`;
+  velocity: N = N_static/(1 − q), c = q/(1 − q); fuzzy: the total N and c, N_frozen and the
+  robust bracket beside them in a `FuzzySchedule`);
+* ``--robot holonomic --law velocity`` (force = acceleration, GC2002 §6): every equilibrium's
+  κ and c_h enter the five models of the holonomic loop (`holonomic_results`), and the
+  tracking error's ζ and ω_n (GC2002 eq 34–36) are added;
 * ``--law velocity-gated`` (GC2002 eq 10–12): no smooth equilibrium, the verdict is
-  ``"non-smooth"`` with the Filippov rest band; the simulated limit cycle is added
-  above this level (`pfm_stability.validation.non_smooth`, which the CLI calls).
+  ``"non-smooth"`` with the Filippov rest band (`non_smooth_results`); the simulated limit
+  cycle comes from above this level (`pfm_stability.validation.non_smooth`, which the CLI
+  hands to `build_report`).
 
-The result is a `report.StabilityReport`, so the JSON (`to_dict`) and the text keep
-the static report's shape wherever it applies; what is new goes in its ``extras``.
+`FamilyLaw` is such a law with every parameter it takes (`make_family_law`). The results that only
+these families have are typed here and give their JSON themselves (``to_dicts``): `HolonomicScene`
+(`HolonomicEquilibrium`: every model's `models.holonomic.HolonomicVerdict`), `NonSmoothScene`; the
+fuzzy law's `FuzzySchedule` sits beside the steering analyses (`report.stability.StabilityReport`).
 """
 
 from __future__ import annotations
@@ -31,25 +32,15 @@ from ..checks import check_choice
 from ..analysis.critical import CorridorCritical, WallCritical
 from ..analysis.criteria import CorridorAnalysis, ModelVerdict, WallAnalysis, WallEquilibrium, check_loop_gain, model_verdicts
 from ..laws.fields import KhatibLaw
-from ..laws.fuzzy import DfapfControllers, load_dfapf
-from ..laws.fuzzy_law import FuzzyScheduledLaw
-from ..models import HEADING_GAIN_RANGE, Loop, interval_margin, interval_verdict, models_for
-from ..models.holonomic import HolonomicLoop
-from ..models.holonomic_delay import make_holonomic_model
-from ..laws.registry import FAMILY_CHOICE_DEFAULTS, FAMILY_DEFAULTS, FAMILY_LAW_CHOICES, FAMILY_LAW_PARAMETERS, FAMILY_LAWS, HOLONOMIC_LAWS
-from ..parameters import MODEL_NAMES, RANGES, ROBOT_FAMILIES, Controller, Corridor, Robot, Wall, check_parameter
-from .stability import UNITS, StabilityReport, build_report, kb_errors, remedies, remedies_by_key
+from ..models import HEADING_GAIN_RANGE, Loop
+from ..models.holonomic import HolonomicLoop, holonomic_verdict
+from ..laws.registry import FAMILY_CHOICE_DEFAULTS, FAMILY_DEFAULTS, FAMILY_LAW_CHOICES, FAMILY_LAW_PARAMETERS, FAMILY_LAWS
+from ..parameters import check_parameter
 from ..io.serialize import json_number
-from ..models.tracking import tracking_dynamics
-from ..laws.velocity_laws import HolonomicGains, VelocityAttraction, VelocityGatedRepulsion
+from ..laws.velocity_laws import VelocityAttraction, VelocityGatedRepulsion
 
-__all__ = ["FamilyLaw", "HolonomicVerdict", "make_family_law", "build_family_report", "holonomic_verdict", "KINEMATIC_TAU_SOURCE"]
-
-KINEMATIC_TAU_SOURCE = "not used (kinematic robot: no motor lag, tau = 0; --k is K_s)"
-"""The source the report gives τ for ``--robot kinematic``."""
-
-HOLONOMIC_UNUSED = "not used (holonomic robot)"
-"""The source the report gives τ, k (and f, n, W) for ``--robot holonomic``."""
+__all__ = ["FamilyLaw", "FuzzySchedule", "HolonomicEquilibrium", "HolonomicScene", "NonSmoothScene", "make_family_law", "steering_results",
+           "holonomic_results", "non_smooth_results"]
 
 _LIBRARY_VALUES = {"variant": {"paper-eq23": "paper_eq23"}, "symmetrize": {"none": False}}
 """The one place where a user-facing choice (`parameters.FAMILY_LAW_CHOICES`) is spelt as the library spells it:
@@ -65,8 +56,10 @@ _VARIANT_TEXT = {
 
 
 @lru_cache(maxsize=None)
-def _dfapf(symmetrize: str) -> DfapfControllers:
-    """The DFAPF controllers for ``--symmetrize`` (read once per value: the tables do not change)."""
+def _dfapf(symmetrize: str):
+    """The DFAPF controllers for ``--symmetrize`` (`fuzzy.DfapfControllers`, read once per value: the tables do not change)."""
+    from ..laws.fuzzy import load_dfapf
+
     return load_dfapf(symmetrize=_LIBRARY_VALUES["symmetrize"].get(symmetrize, symmetrize))
 
 _DESCRIPTIONS = {
@@ -126,14 +119,16 @@ class FamilyLaw:
         variant = self.choice("variant")
         return VelocityGatedRepulsion(p["eta"], p["rho0"], p["a_max"], variant=_LIBRARY_VALUES["variant"].get(variant, variant))
 
-    def fuzzy(self) -> FuzzyScheduledLaw:
-        """The fuzzy-scheduled law with attraction F_a and the DFAPF tables as ``symmetrize`` says (`fuzzy.load_dfapf`)."""
+    def fuzzy(self):
+        """The fuzzy-scheduled law (`fuzzy_law.FuzzyScheduledLaw`) with attraction F_a and the DFAPF tables as ``symmetrize`` says (`fuzzy.load_dfapf`)."""
+        from ..laws.fuzzy_law import FuzzyScheduledLaw
+
         p = self.parameters
         controllers = _dfapf(self.choice("symmetrize"))
         return FuzzyScheduledLaw(p["rho0"], self.attraction, p["goal_exponent"], p["goal_distance"], controllers=controllers)
 
     def described(self) -> dict:
-        """``law`` of the report: name, description (naming the law's choices), parameters."""
+        """``law`` of the report: name, description (naming the law's choices), parameters (JSON-ready)."""
         params = {**self.parameters, "attraction": self.attraction}
         return {"name": self.name, "description": _DESCRIPTIONS[self.name].format(tables=self._tables()) + self._choices_text(),
                 "parameters": {k: json_number(v) for k, v in params.items()}}
@@ -184,109 +179,20 @@ def make_family_law(name: str, choices: dict | None = None, **parameters) -> Fam
     return FamilyLaw(name, values, {key: picked.get(key, FAMILY_CHOICE_DEFAULTS[key]) for key in allowed})
 
 
-# ------------------------------------------------------------------ holonomic verdicts
+# ------------------------------------------------------------------ the families' results
 @dataclass(frozen=True)
-class HolonomicVerdict:
-    """One holonomic model's answer at one equilibrium: s² + (c_h s + κ)e^(−sT) (docs/models.md).
+class HolonomicEquilibrium:
+    """One holonomic equilibrium: its gains and every model's verdict there.
 
     Attributes
     ----------
-    model : str
-    kappa : float
-        κ, 1/s².
-    kappa_critical : float
-        κ*, 1/s²: stable for 0 < κ < κ* (``inf``: every κ > 0; 0: none).
-    omega_critical : float or None
-        rad/s at κ*.
-    margin : float
-        κ_edge/κ − 1 (as the steering gain margin, docs/models.md): > 0 stable, < 0 unstable.
-    verdict : str
-        "stable", "unstable" or "undecided" (within 1e-9 of an edge of the stable set).
-    T_critical : float
-        T*, s: stable for every delay / period in [0, T*) (0: unstable already at T = 0).
-    damping_range : tuple of (float, float)
-        Every interval of c_h (1/s) that makes this κ stable at the loop's T.
-    rightmost_root : complex or None
+    gains : velocity_laws.HolonomicGains
+        x0 (m), κ (1/s²) and c_h (1/s) of the equilibrium.
+    models : dict[str, models.holonomic.HolonomicVerdict]
     """
 
-    model: str
-    kappa: float
-    kappa_critical: float
-    omega_critical: float | None
-    margin: float
-    verdict: str
-    T_critical: float
-    damping_range: tuple
-    rightmost_root: complex | None
-
-    @property
-    def stable(self) -> bool:
-        """True only when the verdict is "stable"."""
-        return self.verdict == "stable"
-
-    def to_dict(self, T: float) -> dict:
-        """JSON-ready (SI units); ``stable_side`` of κ* and T* (below), ``to_stabilize`` the period T* when a shorter one helps."""
-        root = self.rightmost_root
-        fix = {}
-        if not self.stable and 0 < self.T_critical < T:
-            fix["T"] = {"to": self.T_critical, "direction": "lower", "change_percent": (self.T_critical / T - 1.0) * 100}
-        return {
-            "stable": self.stable,
-            "verdict": self.verdict,
-            "kappa": self.kappa,
-            "kappa_critical": json_number(self.kappa_critical),
-            "margin": json_number(self.margin),
-            "omega_critical": json_number(self.omega_critical),
-            "rightmost_root": {"sigma": json_number(root.real), "omega": json_number(abs(root.imag))} if root is not None else {"sigma": None, "omega": None},
-            "T_critical": json_number(self.T_critical),
-            "damping_range": [[json_number(lo), json_number(hi)] for lo, hi in self.damping_range],
-            "stable_side": {"kappa_critical": "below", "T_critical": "below"},  # stable for 0 < κ < κ*, for T in [0, T*)
-            "to_stabilize": fix,
-        }
-
-
-def _kappa_margin(kappa: float, boundary, stable: bool) -> tuple:
-    """(margin, verdict) of κ against the model's stable set: the steering report's `interval_margin`/`interval_verdict` in κ.
-
-    κ <= 0 (no restoring force) has margin −1; within 1e-9 of an edge the verdict is "undecided" with margin 0.
-    """
-    if kappa <= 0:
-        return -1.0, "stable" if stable else "unstable"
-    verdict = interval_verdict(kappa, boundary.stable_set, boundary.kappa_critical, stable)
-    if verdict == "undecided":
-        return 0.0, verdict
-    return interval_margin(kappa, boundary.stable_set, boundary.kappa_critical, stable), verdict
-
-
-def holonomic_verdict(name: str, kappa: float, c_h: float, controller: Controller, pade_order: int = 3) -> HolonomicVerdict:
-    """The holonomic model `name` at κ (1/s²) and c_h (1/s) with the controller's T and compute delay."""
-    return _verdict_of(make_holonomic_model(name, pade_order=pade_order, compute_delay=controller.compute_delay), kappa, c_h, controller)
-
-
-def _verdict_of(model, kappa: float, c_h: float, controller: Controller) -> HolonomicVerdict:
-    """`holonomic_verdict` for a model object (the report builds each model once)."""
-    name = model.name
-    loop = HolonomicLoop(controller.T, c_h)
-    boundary = model.boundary(loop)
-    stable = model.is_stable(kappa, loop)
-    margin, verdict = _kappa_margin(kappa, boundary, stable)
-    return HolonomicVerdict(name, kappa, boundary.kappa_critical, boundary.omega_critical, margin, verdict,
-                            model.critical_delay(kappa, loop), model.damping_range(kappa, loop), model.rightmost_root(kappa, loop))
-
-
-@dataclass(frozen=True)
-class HolonomicEquilibrium(HolonomicGains):
-    """Every holonomic model's verdict at one equilibrium, with its gains (`velocity_laws.HolonomicGains`: x0 m, κ 1/s², c_h 1/s).
-
-    Attributes
-    ----------
-    models : dict[str, HolonomicVerdict]
-    """
-
+    gains: object
     models: dict
-
-    def models_dict(self, T: float) -> dict:
-        return {name: v.to_dict(T) for name, v in self.models.items()}
 
 
 @dataclass(frozen=True)
@@ -302,27 +208,39 @@ class HolonomicScene:
     equilibria : tuple of HolonomicEquilibrium
     main : int
         Index of the equilibrium whose verdicts are the top-level ones.
-    T : float
-        The loop's period, s.
     """
 
     geometry: str
     value: float
     equilibria: tuple
     main: int
-    T: float
 
-    def to_dicts(self) -> tuple:
-        """(environment entry, top-level verdicts), JSON-ready."""
+    @property
+    def models(self) -> dict:
+        """The verdicts at the main equilibrium (model → `HolonomicVerdict`)."""
+        return self.equilibria[self.main].models
+
+    def keyed_verdicts(self) -> tuple:
+        """((geometry, i, model), verdict) for each wall equilibrium, ((geometry, model), verdict) for the main one."""
+        keyed = [((self.geometry, i, name), v) for i, e in enumerate(self.equilibria) for name, v in e.models.items()] if self.geometry == "wall" else []
+        return (*keyed, *(((self.geometry, name), v) for name, v in self.models.items()))
+
+    def to_dicts(self, report) -> tuple:
+        """(environment entry, top-level verdicts) as the report's JSON holds them, each verdict with its remedy
+        (`report.remedies`: (geometry, model), and (geometry, i, model) for each wall equilibrium)."""
+        geometry, fixes = self.geometry, report.remedies
         first = self.equilibria[self.main]
-        key, where = ("alpha_deg", "d0") if self.geometry == "wall" else ("L", "x0")
-        env = {key: self.value, "N": None, "NV": None, "kappa": first.kappa, "c_h": first.c_h}
-        if self.geometry == "wall":
-            env["d0"] = json_number(first.x0)
-        env["equilibria"] = [{where: json_number(e.x0), "N": None, "c": None, "kappa": e.kappa, "c_h": e.c_h,
-                              **({"NV": None, "models": e.models_dict(self.T)} if self.geometry == "wall" else {})}
-                             for e in self.equilibria]
-        return env, first.models_dict(self.T)
+        key, where = ("alpha_deg", "d0") if geometry == "wall" else ("L", "x0")
+        env = {key: self.value, "N": None, "NV": None, "kappa": first.gains.kappa, "c_h": first.gains.c_h}
+        if geometry == "wall":
+            env["d0"] = json_number(first.gains.x0)
+        env["equilibria"] = [
+            {where: json_number(e.gains.x0), "N": None, "c": None, "kappa": e.gains.kappa, "c_h": e.gains.c_h,
+             **({"NV": None, "models": {name: v.to_dict(fixes.get((geometry, i, name))) for name, v in e.models.items()}}
+                if geometry == "wall" else {})}
+            for i, e in enumerate(self.equilibria)
+        ]
+        return env, {name: v.to_dict(fixes.get((geometry, name))) for name, v in first.models.items()}
 
 
 @dataclass(frozen=True)
@@ -332,11 +250,13 @@ class NonSmoothScene:
     Attributes
     ----------
     geometry : str
+        ``"wall"`` or ``"corridor"``.
     value : float
         α (deg) or L (m).
     result : NonSmoothWall or NonSmoothCorridor
     cycle : dict or None
-        The simulated cycle (`validation.non_smooth.simulated_cycle`), filled above this level.
+        The simulated cycle of a wall (`validation.non_smooth.simulated_cycle`: mean and minimum distance,
+        peak-to-peak, heading amplitude, period, …); None when not simulated.
     """
 
     geometry: str
@@ -344,8 +264,12 @@ class NonSmoothScene:
     result: object
     cycle: dict | None = None
 
-    def to_dicts(self) -> tuple:
-        """(environment entry, top-level verdicts = {}): the verdict, the band and the cycle."""
+    def keyed_verdicts(self) -> tuple:
+        """No model decides a non-smooth loop: ``()``."""
+        return ()
+
+    def to_dicts(self, report) -> tuple:
+        """(environment entry, None): the verdict, the band (a wall's) or the friction levels (a corridor's), the cycle."""
         key = "alpha_deg" if self.geometry == "wall" else "L"
         env = {key: self.value, "N": None, "NV": None, "verdict": "non-smooth"}
         r = self.result
@@ -358,20 +282,40 @@ class NonSmoothScene:
         return env, None
 
 
+@dataclass(frozen=True)
+class FuzzySchedule:
+    """The fuzzy-scheduled law's gains beside the steering verdicts (docs/velocity_and_fuzzy.md).
+
+    Attributes
+    ----------
+    wall : tuple of fuzzy_law.ScheduledEquilibrium
+        Every wall equilibrium's frozen gain N_frozen, η, dη/dd and one-sided heading gains, as `WallAnalysis.equilibria`.
+    corridor : tuple of fuzzy_law.ScheduledEquilibrium
+        Every corridor equilibrium's N_frozen, as `CorridorAnalysis.equilibria`.
+    bracket : fuzzy_law.RobustBracket or None
+        N and d0 at a wall for η at both ends of the controller's output range.
+    """
+
+    wall: tuple = ()
+    corridor: tuple = ()
+    bracket: object | None = None
+
+
+
 # ------------------------------------------------------------------ steering with a heading gain
-def _steering_verdicts(controller, models, robot: Robot, e, NV: float, critical_values, geometry: dict, where: str, law: str) -> dict:
+def _steering_verdicts(controller, models, robot, e, NV: float, critical_values, geometry: dict, where: str, law: str) -> dict:
     """Every steering model at one (x0, N, c): the loop k(cs + NV)e^(−sT); with c beyond `models.HEADING_GAIN_RANGE` every
     verdict "undecided", its values null, with the reason (docs/velocity_and_fuzzy.md: no model decides that loop)."""
     low, high = HEADING_GAIN_RANGE
     if low <= e.c <= high:
-        return model_verdicts(controller, models, Loop(robot.tau, controller.T, robot.k, c=e.c), e.N, NV, critical_values, lambda _: geometry)
+        return model_verdicts(controller, models, Loop.of(robot, controller, c=e.c), e.N, NV, critical_values, lambda _: geometry)
     reason = (f"c = {e.c:.4g}: the heading gain of --law {law} at the {where} is outside the range the loop models take, "
               f"[{low:g}, {high:g}]; no model decides this loop (docs/velocity_and_fuzzy.md)")
     critical = critical_values(**geometry, V_critical=math.nan, T_critical=math.nan, k_critical=math.nan)
-    return {m.name: ModelVerdict(m.name, NV, math.nan, None, math.nan, "undecided", critical, None, reason) for m in models_for(controller, models)}
+    return {m.name: ModelVerdict(m.name, NV, math.nan, None, math.nan, "undecided", critical, None, reason) for m in models}
 
 
-def _steering_wall(robot: Robot, controller: Controller, wall: Wall, models, equilibria, fixed_V: bool, law: str) -> WallAnalysis:
+def _steering_wall(robot, controller, wall, models, equilibria, fixed_V: bool, law: str) -> WallAnalysis:
     """Every steering model at each (d0, N, c): the loop k(cs + NV)e^(−sT); α* is not followed (NaN)."""
     analyses = []
     for e in equilibria:
@@ -385,7 +329,7 @@ def _steering_wall(robot: Robot, controller: Controller, wall: Wall, models, equ
     return WallAnalysis(wall.alpha, first.d0, first.N, first.NV, first.models, first.c, tuple(analyses))
 
 
-def _steering_corridor(robot: Robot, controller: Controller, corridor: Corridor, models, equilibria, fixed_V: bool, law: str) -> CorridorAnalysis:
+def _steering_corridor(robot, controller, corridor, models, equilibria, fixed_V: bool, law: str) -> CorridorAnalysis:
     """Every steering model at the equilibrium nearest the centre line; L* is not followed (NaN)."""
     if not equilibria:
         raise ValueError(f"L = {corridor.L:g} m: the law has no lateral equilibrium in this corridor")
@@ -403,7 +347,47 @@ def _speed_free(verdicts: dict, fixed_V: bool) -> dict:
     return {name: replace(v, critical=replace(v.critical, V_critical=math.nan)) for name, v in verdicts.items()}
 
 
-def _holonomic_scene(geometry, value, gains, controller, model_objs, main) -> HolonomicScene:
+def steering_results(robot, controller, law: FamilyLaw, wall, corridor, models) -> tuple:
+    """(wall, corridor, schedule) of the velocity or fuzzy law on a steering robot: every model at each equilibrium's (N, c).
+
+    Parameters
+    ----------
+    robot, controller : Robot, Controller
+        A kinematic robot with τ = 0 already.
+    law : FamilyLaw
+        ``velocity`` or ``fuzzy``.
+    wall : parameters.Wall or None
+    corridor : parameters.Corridor or None
+    models : tuple of LoopModel
+        The steering models, built once (`models.models_for`).
+
+    Returns
+    -------
+    tuple
+        (`WallAnalysis` or None, `CorridorAnalysis` or None, `results.FuzzySchedule` or None: the fuzzy law's).
+    """
+    if law.name == "velocity":
+        att, rep, rho_g = law.velocity_attraction(), law.repulsion(), law.parameters["goal_distance"]
+        wall_eq = att.steering_wall_equilibria(rep, wall.alpha, robot.V, rho_g) if wall else None
+        corr_eq = att.steering_corridor_equilibria(rep, corridor.L, robot.V, rho_g) if corridor else None
+        bracket = None
+    else:
+        fuzzy = law.fuzzy()
+        wall_eq = fuzzy.wall_equilibria(wall.alpha, law.side) if wall else None
+        corr_eq = fuzzy.corridor_equilibria(corridor.L) if corridor else None
+        bracket = fuzzy.robust_bracket(wall.alpha) if wall else None
+    fixed_V = law.name == "fuzzy"
+    wall_result = _steering_wall(robot, controller, wall, models, wall_eq, fixed_V, law.name) if wall else None
+    corridor_result = _steering_corridor(robot, controller, corridor, models, corr_eq, fixed_V, law.name) if corridor else None
+    schedule = None
+    if law.name == "fuzzy":
+        schedule = FuzzySchedule(tuple(wall_eq or ()), tuple(corridor_result.equilibria) if corridor_result else (), bracket)
+    return wall_result, corridor_result, schedule
+
+
+# ------------------------------------------------------------------ holonomic
+def _holonomic_scene(geometry, value, gains, controller, models, main) -> HolonomicScene:
+    """Every holonomic model at each equilibrium's (κ, c_h) (`models.holonomic.holonomic_verdict`)."""
     if not gains:
         raise ValueError(f"{'alpha' if geometry == 'wall' else 'L'} = {value:g}: the law has no equilibrium here (it never balances the pull)")
     flat = [g.x0 for g in gains if g.kappa == 0.0]
@@ -411,189 +395,72 @@ def _holonomic_scene(geometry, value, gains, controller, model_objs, main) -> Ho
         raise ValueError(f"{'alpha' if geometry == 'wall' else 'L'} = {value:g}: no lateral stiffness at x0 = {flat[0]:g} m (kappa = 0: "
                          f"the repulsion does not reach there, rho0 too short); raise --rho0")
     equilibria = tuple(
-        HolonomicEquilibrium(g.x0, g.kappa, g.c_h, {m.name: _verdict_of(m, g.kappa, g.c_h, controller) for m in model_objs})
+        HolonomicEquilibrium(g, {m.name: holonomic_verdict(m, g.kappa, HolonomicLoop.of(controller, c_h=g.c_h)) for m in models})
         for g in gains
     )
     index = 0 if main == "first" else min(range(len(gains)), key=lambda i: abs(gains[i].x0))
-    return HolonomicScene(geometry, value, equilibria, index, controller.T)
+    return HolonomicScene(geometry, value, equilibria, index)
 
 
-# ------------------------------------------------------------------ the report
-def build_family_report(
-    robot: Robot,
-    controller: Controller,
-    *,
-    family: str = "steering",
-    law=None,
-    alpha_deg: float | None = None,
-    L: float | None = None,
-    models=MODEL_NAMES,
-    pade_order: int = 3,
-    mass: float = 1.0,
-    sources: dict | None = None,
-) -> StabilityReport:
-    """The report of any robot family and law (module docstring; docs/velocity_and_fuzzy.md).
+def holonomic_results(robot, controller, law: FamilyLaw, wall, corridor, models, mass: float) -> tuple:
+    """(wall, corridor, tracking) of the velocity law on a holonomic robot: κ, c_h and every model at each equilibrium.
 
     Parameters
     ----------
     robot, controller : Robot, Controller
-        ``--robot kinematic`` uses k as K_s and ignores τ; ``holonomic`` uses T, the
-        compute delay and V (which enters only through a velocity exponent n ≠ 2).
-    family : {"steering", "kinematic", "holonomic"}
-    law : ForceLaw or FamilyLaw, optional
-        A static law (`fields.make_law`; KB's power law by default) or a `FamilyLaw`
-        (`make_family_law`). A holonomic robot takes ``velocity`` or ``velocity-gated`` only.
-    alpha_deg : float, optional
-        Wall target angle, deg.
-    L : float, optional
-        Corridor half-width, m.
-    models, pade_order
-        As `report.build_report`.
+        V (which enters only through a velocity exponent n ≠ 2), T and the compute delay.
+    law : FamilyLaw
+        ``velocity``.
+    wall : parameters.Wall or None
+    corridor : parameters.Corridor or None
+    models : tuple of LoopModel
+        The models, built once; each decides the holonomic loop (`models.holonomic`).
     mass : float
-        The holonomic robot's mass, kg (κ = −F_x′/m, c_h = nα_v V^(n−2)/m).
-    sources : dict, optional
-        Provenance of each input.
+        The robot's mass, kg (κ = −F_x′/m, c_h = nα_v V^(n−2)/m).
 
     Returns
     -------
-    StabilityReport
-        With ``extras``: ``tracking`` (holonomic ``velocity``, m = n = 2), the
-        holonomic scenes and the non-smooth scenes (filled by `to_dict`).
-
-    Raises
-    ------
-    ValueError
-        An unknown family, a law the family does not take, no geometry, or any parameter out of range.
+    tuple
+        (`HolonomicScene` or None, `HolonomicScene` or None, `tracking.TrackingDynamics` or None: the tracking
+        error's ζ and ω_n when m = n = 2).
     """
-    check_choice("robot", family, ROBOT_FAMILIES)
-    if alpha_deg is None and L is None:
-        raise ValueError(f"alpha or L must be given: a wall (--alpha DEG, in {RANGES['alpha_deg'].describe()}) and/or a corridor (--L M)")
-    sources = dict(sources or {})
-    mass = check_parameter("mass", mass)
-    family_law = law if isinstance(law, FamilyLaw) else None
-    if family == "holonomic" and (family_law is None or family_law.name not in HOLONOMIC_LAWS):
-        shown = family_law.name if family_law is not None else getattr(law, "key", None) or "power"
-        raise ValueError(f"--robot holonomic takes --law velocity or velocity-gated (a force in newtons on a mass, Ge & Cui 2002 Sec 6); got --law {shown}")
-    if family == "kinematic":
-        robot = robot.replace(tau=0.0)
-        sources["tau"] = KINEMATIC_TAU_SOURCE
-    if family_law is None:
-        report = build_report(robot, controller, alpha_deg=alpha_deg, L=L, models=models, pade_order=pade_order, sources=sources, law=law)
-        return _with_family(report, family, sources)
-    models = tuple(dict.fromkeys(models))
-    for name in models:
-        check_choice("model", name, MODEL_NAMES)
-    wall = Wall.from_degrees(alpha_deg) if alpha_deg is not None else None
-    corridor = Corridor(L) if L is not None else None
-    inputs = _inputs(robot, controller, family, family_law, mass, pade_order, wall, corridor, sources)
-    if family_law.name == "velocity-gated":
-        return _non_smooth(inputs, family_law, wall, corridor)
-    model_objs = _model_objects(controller, models, pade_order, family)
-    if family == "holonomic":
-        return _holonomic(inputs, family_law, controller, robot, wall, corridor, model_objs, mass)
-    extras = {}
-    if family_law.name == "velocity":
-        att, rep, rho_g = family_law.velocity_attraction(), family_law.repulsion(), family_law.parameters["goal_distance"]
-        wall_eq = att.steering_wall_equilibria(rep, wall.alpha, robot.V, rho_g) if wall else None
-        corr_eq = att.steering_corridor_equilibria(rep, corridor.L, robot.V, rho_g) if corridor else None
-    else:
-        fuzzy = family_law.fuzzy()
-        wall_eq = fuzzy.wall_equilibria(wall.alpha, family_law.side) if wall else None
-        corr_eq = fuzzy.corridor_equilibria(corridor.L) if corridor else None
-        if wall:
-            bracket = fuzzy.robust_bracket(wall.alpha)
-            extras["environment"] = {"wall": {
-                "equilibria": [{"N_frozen": e.N_frozen, "eta": e.eta, "eta_d": e.eta_d, "c_plus": e.c_plus, "c_minus": e.c_minus} for e in wall_eq],
-                "robust_bracket": {"eta": list(bracket.eta), "N": list(bracket.N), "d0": list(bracket.d0)},
-            }}
-    fixed_V = family_law.name == "fuzzy"
-    wall_result = _steering_wall(robot, controller, wall, model_objs, wall_eq, fixed_V, family_law.name) if wall else None
-    corridor_result = _steering_corridor(robot, controller, corridor, model_objs, corr_eq, fixed_V, family_law.name) if corridor else None
-    if corridor and family_law.name == "fuzzy":
-        extras.setdefault("environment", {})["corridor"] = {"equilibria": [{"N_frozen": e.N_frozen} for e in corridor_result.equilibria]}
-    static = family_law.repulsion() if family_law.name == "velocity" else None
-    fixes = remedies_by_key(wall_result, corridor_result, lambda scenario, verdict: _loop_remedies(scenario, verdict, robot, controller, static))
-    options = {m.name: {"equation": m.equation, **m.options()} for m in model_objs}
-    errors = kb_errors(robot, controller, wall_result, corridor_result)
-    return StabilityReport(inputs, options, wall_result, corridor_result, errors[0] if errors else None, fixes, family_law.described(), None, extras,
-                           errors if len(errors) > 1 else ())
-
-
-def _loop_remedies(scenario: str, verdict, robot: Robot, controller: Controller, static) -> dict:
-    """`report.remedies` limited to what the verdict's critical values support (V, T, k)."""
-    from ..laws.force_law import PowerLaw
-
-    law = static if static is not None else PowerLaw(controller.f, controller.n, robot.W)
-    return {k: v for k, v in remedies(scenario, verdict, robot, controller, law).items() if k in ("V", "T", "k")}
-
-
-def _model_objects(controller: Controller, models, pade_order: int, family: str) -> tuple:
-    """The steering models (`models.models_for`, ``sampled`` as the controller samples) or the holonomic ones."""
-    if family == "holonomic":
-        return tuple(make_holonomic_model(name, pade_order=pade_order, compute_delay=controller.compute_delay) for name in models)
-    return tuple(models_for(controller, models, pade_order=pade_order))
-
-
-def _inputs(robot, controller, family, family_law, mass, pade_order, wall, corridor, sources) -> dict:
-    """The report's inputs: the robot family, the robot and controller, the law's parameters, the geometry."""
-    holonomic = family == "holonomic"
-    values = {"robot": family, "V": robot.V, "tau": robot.tau, "T": controller.T, "k": robot.k}
-    if holonomic:
-        values["mass"] = mass
-    values.update(family_law.parameters)
-    values.update(family_law.choices)
-    values.update({"hold": controller.hold, "compute_delay": controller.compute_delay, "pade_order": pade_order})
-    if wall is not None:
-        values["alpha_deg"] = wall.alpha_deg
-    if corridor is not None:
-        values["L"] = corridor.L
-    out = {}
-    for name, value in values.items():
-        source = sources.get(name, "default" if name in FAMILY_DEFAULTS or name in FAMILY_CHOICE_DEFAULTS else "user")
-        if holonomic and name in ("tau", "k", "hold"):
-            source = HOLONOMIC_UNUSED
-        out[name] = {"value": value, "unit": _unit(name), "source": source}
-    return out
-
-
-def _unit(name: str) -> str:
-    if name in UNITS:
-        return UNITS[name]
-    return RANGES[name].unit if name in RANGES else ""
-
-
-def _with_family(report: StabilityReport, family: str, sources: dict) -> StabilityReport:
-    """A static law's report with the robot family among its inputs (nothing added for KB's steering robot)."""
-    if family == "steering":
-        return report
-    inputs = {"robot": {"value": family, "unit": "", "source": sources.get("robot", "user")}, **report.inputs}
-    return replace(report, inputs=inputs)
-
-
-def _holonomic(inputs, family_law, controller, robot, wall, corridor, model_objs, mass) -> StabilityReport:
-    """κ, c_h and every holonomic model at each equilibrium; the tracking error's ζ, ω_n for m = n = 2."""
-    att, rep, rho_g = family_law.velocity_attraction(), family_law.repulsion(), family_law.parameters["goal_distance"]
-    scenes = {}
+    att, rep, rho_g = law.velocity_attraction(), law.repulsion(), law.parameters["goal_distance"]
+    wall_result = corridor_result = tracking = None
     if wall is not None:
         gains = att.holonomic_wall_gains(rep, wall.alpha, rho_g, mass, robot.V)
-        scenes["wall"] = _holonomic_scene("wall", wall.alpha_deg, gains, controller, model_objs, "first")
+        wall_result = _holonomic_scene("wall", wall.alpha_deg, gains, controller, models, "first")
     if corridor is not None:
         gains = att.holonomic_corridor_gains(rep, corridor.L, rho_g, mass, robot.V)
-        scenes["corridor"] = _holonomic_scene("corridor", corridor.L, gains, controller, model_objs, "middle")
-    extras = {"scenes": scenes}
+        corridor_result = _holonomic_scene("corridor", corridor.L, gains, controller, models, "middle")
     if att.m == 2.0 and att.n == 2.0:
-        t = tracking_dynamics(att.alpha_p, att.alpha_v, mass)
-        extras["tracking"] = {"damping_ratio": t.damping_ratio, "natural_frequency": t.natural_frequency, "regime": t.regime}
-    options = {m.name: {"equation": m.equation, **m.options()} for m in model_objs}
-    return StabilityReport(inputs, options, None, None, None, {}, family_law.described(), None, extras)
+        from ..models.tracking import tracking_dynamics
+
+        tracking = tracking_dynamics(att.alpha_p, att.alpha_v, mass)
+    return wall_result, corridor_result, tracking
 
 
-def _non_smooth(inputs, family_law, wall, corridor) -> StabilityReport:
-    """The non-smooth verdict: the rest band at a wall, the friction levels in a corridor; the cycle is filled above."""
-    gated = family_law.gated()
-    scenes = {}
+# ------------------------------------------------------------------ non-smooth
+def non_smooth_results(law: FamilyLaw, wall, corridor, cycle=None) -> tuple:
+    """(wall, corridor) of the velocity-gated law: the rest band at a wall, the friction levels in a corridor.
+
+    Parameters
+    ----------
+    law : FamilyLaw
+        ``velocity-gated``.
+    wall : parameters.Wall or None
+    corridor : parameters.Corridor or None
+    cycle : callable, optional
+        ``cycle(alpha) -> dict``: the simulated cycle beside the wall (rad in; None: not simulated).
+
+    Returns
+    -------
+    tuple
+        (`NonSmoothScene` or None, `NonSmoothScene` or None).
+    """
+    gated = law.gated()
+    wall_result = corridor_result = None
     if wall is not None:
-        scenes["wall"] = NonSmoothScene("wall", wall.alpha_deg, gated.non_smooth_wall(family_law.attraction, wall.alpha))
+        wall_result = NonSmoothScene("wall", wall.alpha_deg, gated.non_smooth_wall(law.attraction, wall.alpha), cycle(wall.alpha) if cycle else None)
     if corridor is not None:
-        scenes["corridor"] = NonSmoothScene("corridor", corridor.L, gated.non_smooth_corridor(corridor.L))
-    return StabilityReport(inputs, {}, None, None, None, {}, family_law.described(), None, {"scenes": scenes})
+        corridor_result = NonSmoothScene("corridor", corridor.L, gated.non_smooth_corridor(corridor.L))
+    return wall_result, corridor_result

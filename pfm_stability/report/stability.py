@@ -1,46 +1,64 @@
-"""The stability report: every model's verdict for a wall and/or a corridor.
+"""The stability report of every robot family and law: `build_report`, the one entry point, and `StabilityReport`.
 
-`build_report` runs the criteria of `pfm_stability.analysis.criteria` for the chosen
-models and adds what a user acts on: the margin, the critical value of every
-parameter, the change that would make the loop stable, and how far KB's
-criterion (Koren & Borenstein 1991 eq 20) is from the sampled loop
-(docs/models.md). The text and Markdown renderings live in
-`pfm_stability.cli.render`; `StabilityReport.to_dict` is the JSON form
-(infinite values become ``"inf"``: "no finite critical value").
+`build_report` takes the robot family (``steering``, ``kinematic``, ``holonomic``), the law (a
+static lateral law, `fields.make_law`, or a law of `parameters.FAMILY_LAWS`,
+`families.make_family_law`), the geometry (a wall, a corridor, a door) and the models; it builds
+the models once for the loop the family closes and returns a `StabilityReport` with one result
+per geometry, typed by the loop that decides it (docs/velocity_and_fuzzy.md, docs/models.md
+"Robot loop families"):
 
-Any `ForceLaw` may be given (docs/fields.md): its parameters join the inputs,
-``law`` names it, and a wall lists every equilibrium of the law
-(``environment.wall.equilibria``, each with every model's verdict); the
-top-level ``wall`` verdicts are those of the first (nearest) equilibrium.
+* a steering loop (KB's robot, kinematic steering; every law but the velocity-gated one):
+  `analysis.criteria.WallAnalysis` and `CorridorAnalysis`, every model's `ModelVerdict` at
+  each equilibrium (the fuzzy law's frozen gains beside them: `families.FuzzySchedule`);
+* a holonomic loop (``--robot holonomic --law velocity``): `families.HolonomicScene`, every
+  model's `models.holonomic.HolonomicVerdict` at each equilibrium;
+* no linear loop (``--law velocity-gated``): `families.NonSmoothScene`, the rest band and the
+  simulated cycle.
+
+What a user acts on is assembled once for every family: the margin and the critical value of
+every parameter (in the results), the change that would make the loop stable (`remedies`,
+held in `StabilityReport.remedies`), and how far KB's criterion (Koren & Borenstein 1991 eq 20)
+is from the sampled loop (`kb_errors`, docs/models.md). `StabilityReport.to_dict` is the JSON
+form (infinite values become ``"inf"``: "no finite critical value"); the text and Markdown
+renderings (`pfm_stability.cli.render`) dispatch on the results' types.
+
+Any `ForceLaw` may be given (docs/fields.md): its parameters join the inputs, ``law`` names it,
+and a wall lists every equilibrium of the law (``environment.wall.equilibria``, each with
+every model's verdict); the top-level ``wall`` verdicts are those of the first (nearest)
+equilibrium.
 """
-
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
+from functools import partial, singledispatch
 
-from ..checks import check_type
 from ..analysis.comparison import relative_error
-from ..analysis.criteria import CorridorAnalysis, WallAnalysis, analyze_corridor, analyze_wall, loop_of
-from ..laws.force_law import ForceLaw, law_in_force
-from ..models import HEADING_GAIN_RANGE, KBFirstOrder, Loop, Sampled, models_for
-from ..laws.registry import LAW_PARAMETERS
-from ..parameters import MODEL_NAMES, RANGES, Controller, Corridor, Robot, Wall, check_parameter
+from ..analysis.criteria import CorridorAnalysis, ModelVerdict, WallAnalysis, analyze_corridor, analyze_wall
+from ..checks import check_choice, check_type
 from ..io.serialize import SCHEMA_VERSION, json_number, json_ready
+from ..laws.force_law import ForceLaw, PowerLaw, law_in_force
+from ..models import HEADING_GAIN_RANGE, STEERING, KBFirstOrder, Loop, LoopFamily, Sampled, make_models, models_for
+from ..models.family import root_json
+from ..laws.registry import FAMILY_CHOICE_DEFAULTS, FAMILY_DEFAULTS, HOLONOMIC_LAWS, LAW_PARAMETERS
+from ..parameters import MODEL_NAMES, RANGES, ROBOT_FAMILIES, Controller, Corridor, Robot, Wall, check_parameter
 
-__all__ = ["StabilityReport", "KBError", "build_report", "remedies", "remedies_by_key", "kb_error", "kb_errors"]
+__all__ = ["StabilityReport", "KBError", "LawDescription", "build_report", "remedies", "kb_error", "kb_errors", "KINEMATIC_TAU_SOURCE"]
 
 LAW_INPUTS = ("cell_ratio", "cell_size", "window_cells", "xi", "eta", "rho0", "attraction_exponent", "goal_exponent", "goal_distance", "delta")
 """The law's own parameters, listed after W when the law takes them (`parameters.LAW_PARAMETERS`)."""
 
 INPUTS = ("V", "tau", "T", "k", "f", "n", "W", *LAW_INPUTS, "hold", "compute_delay", "pade_order", "alpha_deg", "L")
-"""The report's inputs, in the order it lists them (``alpha_deg`` and ``L`` when given; f and n for KB's laws only)."""
+"""The report's inputs for a static law, in the order it lists them (``alpha_deg`` and ``L`` when given; f and n for KB's laws only)."""
 
 UNITS = {name: RANGES[name].unit if name in RANGES else "" for name in INPUTS}
 """Unit of each input (`parameters.RANGES`; ``hold`` has none)."""
 
-REMEDY_PARAMETERS = ("V", "T", "k", "alpha_deg", "L", "f", "eta", "rho0", "xi")
-"""Parameters a remedy may change (one at a time), in the order they are listed."""
+KINEMATIC_TAU_SOURCE = "not used (kinematic robot: no motor lag, tau = 0; --k is K_s)"
+"""The source the report gives τ for ``--robot kinematic``."""
+
+HOLONOMIC_UNUSED = "not used (holonomic robot)"
+"""The source the report gives τ, k and the hold for ``--robot holonomic``."""
 
 
 @dataclass(frozen=True)
@@ -116,105 +134,149 @@ class KBError:
 
 
 @dataclass(frozen=True)
+class LawDescription:
+    """The force law a report analyses, as it lists it.
+
+    Attributes
+    ----------
+    name : str or None
+        The law's name (`parameters.FORCE_LAWS` or `parameters.FAMILY_LAWS`); None for a law built in code.
+    description : str
+        What the law is, in words.
+    parameters : dict
+        Parameter → value, JSON-ready (SI units).
+    """
+
+    name: str | None
+    description: str
+    parameters: dict
+
+    def to_dict(self) -> dict:
+        """``{"name", "description", "parameters"}``."""
+        return {"name": self.name, "description": self.description, "parameters": self.parameters}
+
+
+@dataclass(frozen=True)
 class StabilityReport:
-    """Everything `pfm-stability report` prints.
+    """Everything `pfm-stability report` prints, for every robot family and law (module docstring).
 
     Attributes
     ----------
     inputs : dict
         Parameter → {"value", "unit", "source"}.
-    model_options : dict
-        Model name → its equation and options.
-    wall : WallAnalysis or None
-    corridor : CorridorAnalysis or None
-    kb_error : KBError
+    models : tuple of LoopModel
+        The models run, each once.
+    family : LoopFamily
+        The loop family the models decide (`models.STEERING`, `models.holonomic.HOLONOMIC`): names their equations.
+    wall, corridor : WallAnalysis, CorridorAnalysis, families.HolonomicScene, families.NonSmoothScene or None
+        The result of each geometry, typed by the loop that decides it (module docstring).
     remedies : dict
-        (scenario, model) → `remedies` of the first wall equilibrium or the
-        corridor; ("wall", i, model) → those of wall equilibrium i.
-    law : dict or None
-        The law: ``name`` (`parameters.FORCE_LAWS`, or None for a law built in
-        code), ``description`` and ``parameters``.
+        (geometry, model) → the single-parameter changes that make the main
+        equilibrium's verdict stable (`stability.remedies`; a holonomic robot's: a
+        shorter period T*); (geometry, i, model) → those of wall equilibrium i.
+    law : LawDescription or None
     door : DoorPassage or None
         KB's problem 2 (Fig 4) for a door of the given width (`door.door_passage`).
-    extras : dict
-        What the other robot families and laws add (`family_report.build_family_report`):
-        ``scenes`` (geometry → a holonomic or non-smooth scene with ``to_dicts()``),
-        ``environment`` (geometry → keys merged into the environment entry, and
-        per-equilibrium keys under ``equilibria``), ``tracking``. Empty for KB's report.
     kb_errors : tuple of KBError
-        Every loop's KB error when the geometries close different loops (a heading
-        gain that differs between them); empty otherwise (`kb_error` is then the one).
+        KB's error for every loop the steering tables decide (one per heading gain, wall first);
+        empty for a holonomic robot and the non-smooth law.
+    schedule : families.FuzzySchedule or None
+        The fuzzy law's frozen gains and robust bracket.
+    tracking : models.tracking.TrackingDynamics or None
+        The tracking error's ζ and ω_n (a holonomic robot under the velocity law with m = n = 2).
     """
 
     inputs: dict
-    model_options: dict
-    wall: WallAnalysis | None = None
-    corridor: CorridorAnalysis | None = None
-    kb_error: KBError | None = None
+    models: tuple = ()
+    family: LoopFamily = STEERING
+    wall: object | None = None
+    corridor: object | None = None
     remedies: dict = field(default_factory=dict)
-    law: dict | None = None
+    law: LawDescription | None = None
     door: object | None = None
-    extras: dict = field(default_factory=dict)
     kb_errors: tuple = ()
+    schedule: object | None = None
+    tracking: object | None = None
+
+    @property
+    def kb_error(self) -> KBError | None:
+        """The first of `kb_errors` (the wall's loop when there is one); None without a steering table."""
+        return self.kb_errors[0] if self.kb_errors else None
+
+    @property
+    def model_options(self) -> dict:
+        """Model name → its equation (for the report's family) and options (`LoopFamily.describe`)."""
+        return {m.name: self.family.describe(m) for m in self.models}
+
+    def scenes(self):
+        """(geometry, result) of the wall, then of the corridor, for each one analysed."""
+        return tuple((geometry, scene) for geometry, scene in (("wall", self.wall), ("corridor", self.corridor)) if scene is not None)
 
     def to_dict(self) -> dict:
         """The fields as a JSON-ready dict (SI units; infinities as ``"inf"``, undefined as null)."""
         out = {"schema_version": SCHEMA_VERSION, "command": "report", "inputs": self.inputs, "models": self.model_options}
         if self.law is not None:
-            out["law"] = self.law
-        if self.wall is not None:
-            out.setdefault("environment", {})["wall"] = {
-                "alpha_deg": self.wall.alpha_deg,
-                "d0": json_number(self.wall.d0),
-                "N": self.wall.N,
-                "NV": self.wall.NV,
-                "c": self.wall.c,
-                "equilibria": [
-                    {"d0": json_number(e.d0), "N": e.N, "c": e.c, "NV": e.NV,
-                     "models": {name: _verdict_dict(v, self.remedies.get(("wall", i, name))) for name, v in e.models.items()}}
-                    for i, e in enumerate(self.wall.equilibria)
-                ],
-            }
-            out["wall"] = {name: _verdict_dict(v, self.remedies.get(("wall", name))) for name, v in self.wall.models.items()}
-        if self.corridor is not None:
-            c = self.corridor
-            env = {"L": c.L, "N": c.N, "NV": c.NV, "c": c.c, "equilibria": [{"x0": e.x0, "N": e.N, "c": e.c} for e in c.equilibria]}
-            if c.N_finite_goal is not None:
-                env["N_finite_goal"] = c.N_finite_goal
-            out.setdefault("environment", {})["corridor"] = env
-            out["corridor"] = {name: _verdict_dict(v, self.remedies.get(("corridor", name))) for name, v in c.models.items()}
-        if self.extras:
-            _merge_extras(out, self.extras)
+            out["law"] = self.law.to_dict()
+        for geometry, scene in self.scenes():
+            env, verdicts = _scene_json(scene, self)
+            out.setdefault("environment", {})[geometry] = env
+            if verdicts is not None:
+                out[geometry] = verdicts
+        if self.tracking is not None:
+            t = self.tracking
+            out["tracking"] = json_ready({"damping_ratio": t.damping_ratio, "natural_frequency": t.natural_frequency, "regime": t.regime})
         if self.door is not None:
             out["door"] = self.door.to_dict()
-        if self.kb_error is not None:
-            out["kb_error"] = self.kb_error.to_dict()
+        if self.kb_errors:
+            out["kb_error"] = self.kb_errors[0].to_dict()
         if len(self.kb_errors) > 1:
             out["kb_errors"] = [e.to_dict() for e in self.kb_errors]
         return out
 
 
-def _merge_extras(out: dict, extras: dict) -> None:
-    """Add `StabilityReport.extras` to its JSON form `out` (in place)."""
-    for geometry, scene in extras.get("scenes", {}).items():
-        env, verdicts = scene.to_dicts()
-        out.setdefault("environment", {})[geometry] = env
-        if verdicts is not None:
-            out[geometry] = verdicts
-    for geometry, added in extras.get("environment", {}).items():
-        entry = out["environment"][geometry]
-        for key, value in added.items():
-            if key == "equilibria":
-                for item, more in zip(entry["equilibria"], value):
-                    item.update({k: json_number(v) for k, v in more.items()})
-            else:
-                entry[key] = json_ready(value)
-    if "tracking" in extras:
-        out["tracking"] = json_ready(extras["tracking"])
+# ------------------------------------------------------------------ JSON of each result type
+@singledispatch
+def _scene_json(result, report: StabilityReport) -> tuple:
+    """(environment entry, top-level verdicts or None) of one geometry's result, JSON-ready, by the result's type: a steering
+    loop's here, another family's by its own ``to_dicts`` (`report.families`)."""
+    return result.to_dicts(report)
+
+
+@_scene_json.register
+def _(wall: WallAnalysis, report: StabilityReport) -> tuple:
+    """A steering loop beside a wall: every equilibrium with its verdicts (the fuzzy law's gains beside them), the first's on top."""
+    fixes, schedule = report.remedies, report.schedule
+    equilibria = []
+    for i, e in enumerate(wall.equilibria):
+        item = {"d0": json_number(e.d0), "N": e.N, "c": e.c, "NV": e.NV,
+                "models": {name: _verdict_dict(v, fixes.get(("wall", i, name))) for name, v in e.models.items()}}
+        if schedule is not None:
+            s = schedule.wall[i]
+            item.update({k: json_number(v) for k, v in (("N_frozen", s.N_frozen), ("eta", s.eta), ("eta_d", s.eta_d), ("c_plus", s.c_plus),
+                                                        ("c_minus", s.c_minus))})
+        equilibria.append(item)
+    env = {"alpha_deg": wall.alpha_deg, "d0": json_number(wall.d0), "N": wall.N, "NV": wall.NV, "c": wall.c, "equilibria": equilibria}
+    if schedule is not None and schedule.bracket is not None:
+        b = schedule.bracket
+        env["robust_bracket"] = json_ready({"eta": list(b.eta), "N": list(b.N), "d0": list(b.d0)})
+    return env, {name: _verdict_dict(v, fixes.get(("wall", name))) for name, v in wall.models.items()}
+
+
+@_scene_json.register
+def _(corridor: CorridorAnalysis, report: StabilityReport) -> tuple:
+    """A steering loop in a corridor: the equilibria (the fuzzy law's N_frozen beside them), the verdicts in the middle."""
+    equilibria = [{"x0": e.x0, "N": e.N, "c": e.c} for e in corridor.equilibria]
+    if report.schedule is not None:
+        for item, s in zip(equilibria, report.schedule.corridor):
+            item["N_frozen"] = json_number(s.N_frozen)
+    env = {"L": corridor.L, "N": corridor.N, "NV": corridor.NV, "c": corridor.c, "equilibria": equilibria}
+    if corridor.N_finite_goal is not None:
+        env["N_finite_goal"] = corridor.N_finite_goal
+    return env, {name: _verdict_dict(v, report.remedies.get(("corridor", name))) for name, v in corridor.models.items()}
 
 
 def _verdict_dict(v, remedy) -> dict:
-    root = v.rightmost_root
+    """A steering model's `ModelVerdict` with its remedy, JSON-ready."""
     out = {
         "stable": v.stable,
         "verdict": v.verdict,
@@ -222,7 +284,7 @@ def _verdict_dict(v, remedy) -> dict:
         "NV_critical": json_number(v.NV_critical),
         "margin": json_number(v.margin),
         "omega_critical": json_number(v.omega_critical),
-        "rightmost_root": {"sigma": json_number(root.real), "omega": json_number(abs(root.imag))} if root is not None else {"sigma": None, "omega": None},
+        "rightmost_root": root_json(v.rightmost_root),
     }
     out.update({key: json_number(value) for key, value in v.critical.items()})
     out["stable_side"] = {"NV_critical": None if math.isnan(v.NV_critical) else "below", **v.critical.stable_sides()}
@@ -232,14 +294,302 @@ def _verdict_dict(v, remedy) -> dict:
     return out
 
 
-def remedies(scenario: str, verdict, robot: Robot, controller: Controller, law: ForceLaw | None = None, at: float | None = None) -> dict:
-    """Single-parameter changes that make an unstable loop stable.
+# ------------------------------------------------------------------ the one entry point
+def build_report(
+    robot: Robot,
+    controller: Controller,
+    *,
+    family: str = "steering",
+    law=None,
+    alpha: float | None = None,
+    alpha_deg: float | None = None,
+    L: float | None = None,
+    models=MODEL_NAMES,
+    pade_order: int = 3,
+    mass: float = 1.0,
+    sources: dict | None = None,
+    door: float | None = None,
+    door_obstacle: str = "posts",
+    post_radius: float = 0.0,
+    simulate_cycle=None,
+) -> StabilityReport:
+    """The report of any robot family and law for a wall (α) and/or a corridor (L, m), and a door with a static law.
+
+    Parameters
+    ----------
+    robot, controller : Robot, Controller
+        ``family="kinematic"`` uses k as K_s and ignores τ; ``holonomic`` uses T, the
+        compute delay and V (which enters only through a velocity exponent n ≠ 2).
+    family : {"steering", "kinematic", "holonomic"}
+        The robot family (`parameters.ROBOT_FAMILIES`, docs/models.md "Robot loop families").
+    law : ForceLaw or families.FamilyLaw, optional
+        A static law (`fields.make_law` builds any law of `parameters.FORCE_LAWS`;
+        KB's power law by default): a law named in `parameters.LAW_PARAMETERS` lists
+        the parameters it takes among the inputs (f and n only where it uses them).
+        Or a law of `parameters.FAMILY_LAWS` (`families.make_family_law`); a
+        holonomic robot takes ``velocity`` or ``velocity-gated`` only.
+    alpha : float, optional
+        Wall target angle, rad, in [1e-6°, 90° − 1e-6°] (a steering robot with a static law).
+    alpha_deg : float, optional
+        The same in degrees (checked in degrees; `Wall.from_degrees`).
+    L : float, optional
+        Corridor half-width, m, > W/2.
+    models : sequence of str
+        Model names (`parameters.MODEL_NAMES`, docs/models.md); all by default.
+    pade_order : int
+        Order m of the ``pade`` model.
+    mass : float
+        The holonomic robot's mass, kg (κ = −F_x′/m, c_h = nα_v V^(n−2)/m).
+    sources : dict, optional
+        Provenance of each input (shown in the report).
+    door : float, optional
+        Door width, m (KB Fig 4, `door.door_passage`; a steering robot with a static law).
+    door_obstacle : {"posts", "walls"}
+        What bounds the door.
+    post_radius : float
+        Post radius or the walls' half-thickness, m.
+    simulate_cycle : callable, optional
+        The velocity-gated law's simulated cycle beside a wall,
+        ``simulate_cycle(family, robot, controller, law, alpha, mass=…) -> dict``
+        (`validation.non_smooth.simulated_cycle`, above this level); None: not simulated.
+
+    Returns
+    -------
+    StabilityReport
+
+    Raises
+    ------
+    ValueError
+        An unknown family, a law the family does not take, no geometry, a door with a
+        family or a law it does not apply to, any parameter out of range, or a wall where
+        the law has no equilibrium.
+    """
+    check_choice("robot", family, ROBOT_FAMILIES)
+    if law is not None and not isinstance(law, ForceLaw):
+        from .families import FamilyLaw
+
+        check_type("law", law, FamilyLaw, "a ForceLaw (fields.make_law) or a FamilyLaw (families.make_family_law)")
+        return _family_law_report(robot, controller, family, law, alpha, alpha_deg, L, models, pade_order, mass, sources, door, simulate_cycle)
+    if family == "steering":
+        return _static_report(robot, controller, law, alpha, alpha_deg, L, models, pade_order, sources, door, door_obstacle, post_radius)
+    shown = getattr(law, "key", None) or "power"
+    if door is not None:
+        raise ValueError(_DOOR_REFUSED.format(family=family, law=shown))
+    if alpha is None and alpha_deg is None and L is None:
+        raise ValueError(_NO_GEOMETRY)
+    if family == "holonomic":
+        raise ValueError(f"--robot holonomic takes --law velocity or velocity-gated (a force in newtons on a mass, Ge & Cui 2002 Sec 6); got --law {shown}")
+    sources = {**(sources or {}), "tau": KINEMATIC_TAU_SOURCE}
+    report = _static_report(robot.replace(tau=0.0), controller, law, alpha, alpha_deg, L, models, pade_order, sources, None, door_obstacle, post_radius)
+    return replace(report, inputs={"robot": {"value": family, "unit": "", "source": sources.get("robot", "user")}, **report.inputs})
+
+
+_NO_GEOMETRY = f"alpha or L must be given: a wall (--alpha DEG, in {RANGES['alpha_deg'].describe()}) and/or a corridor (--L M)"
+"""The message when a robot family's or a family law's report has no geometry."""
+
+_DOOR_REFUSED = "--door applies to --robot steering with a static law (power, grid, khatib, gnron), not to --robot {family} --law {law}"
+"""The message when a door is asked of a robot family or a family law."""
+
+
+# ------------------------------------------------------------------ a static law (steering and kinematic robots)
+def _static_report(robot, controller, law, alpha, alpha_deg, L, models, pade_order, sources, door, door_obstacle, post_radius) -> StabilityReport:
+    """A steering (or kinematic, τ = 0) robot with a static law: `analysis.criteria` at the wall and in the corridor, the door."""
+    if alpha is not None and alpha_deg is not None:
+        raise ValueError("give alpha (rad) or alpha_deg, not both")
+    if alpha is None and alpha_deg is None and L is None and door is None:
+        raise ValueError(
+            f"alpha or L must be given, or a door: a wall (--alpha DEG, in {RANGES['alpha_deg'].describe()}), "
+            f"a corridor (--L M, in (W/2, {RANGES['L'].high:g}] m) and/or a door (--door WIDTH, m)"
+        )
+    wall = Wall.from_degrees(alpha_deg) if alpha_deg is not None else (Wall(alpha) if alpha is not None else None)
+    corridor = Corridor(L) if L is not None else None
+    check_type("robot", robot, Robot, "a Robot")
+    check_type("controller", controller, Controller, "a Controller")
+    models = MODEL_NAMES if models is None else models
+    if isinstance(models, str) or not isinstance(models, (list, tuple)) or not all(isinstance(m, str) for m in models):
+        raise ValueError(f"models must be a list or tuple of model names ({', '.join(MODEL_NAMES)}); got {models!r}")
+    if sources is not None and not isinstance(sources, dict):
+        raise ValueError(f"sources must be a dict of parameter name to provenance; got {sources!r}")
+    model_objs = tuple(models_for(controller, tuple(dict.fromkeys(models)), pade_order=pade_order))
+    sources = sources or {}
+    values = {"V": robot.V, "tau": robot.tau, "T": controller.T, "k": robot.k, "f": controller.f, "n": controller.n, "W": robot.W,
+              "hold": controller.hold, "compute_delay": controller.compute_delay, "pade_order": pade_order}
+    law = law_in_force(robot, controller, law)
+    values = _law_inputs(values, law)
+    if wall is not None:
+        values["alpha_deg"] = wall.alpha_deg
+    if corridor is not None:
+        values["L"] = corridor.L
+    inputs = {name: {"value": value, "unit": UNITS[name], "source": sources.get(name, "user")} for name, value in values.items()}
+    wall_result = analyze_wall(robot, controller, wall, model_objs, law) if wall else None
+    corridor_result = analyze_corridor(robot, controller, corridor, model_objs, law) if corridor else None
+
+    def fix(geometry, verdict):
+        return remedies(geometry, verdict, robot, controller, law, wall.alpha_deg if geometry == "wall" else corridor.L)
+
+    passage = None
+    if door is not None:
+        from ..analysis.door import door_passage
+
+        passage = door_passage(law, check_parameter("door", door), obstacle=door_obstacle, post_radius=check_parameter("post_radius", post_radius),
+                               robot_width=robot.W, find_smallest=True, name="door")
+    return StabilityReport(inputs, model_objs, STEERING, wall_result, corridor_result, _remedies(wall_result, corridor_result, fix),
+                           LawDescription(law.key, law.name, json_ready(law.parameters())), passage,
+                           kb_errors(robot, controller, wall_result, corridor_result))
+
+
+def _law_inputs(values: dict, law: ForceLaw) -> dict:
+    """The inputs with the law's own parameters after W, and without f and n where a named law does not use them."""
+    taken = LAW_PARAMETERS.get(law.key)
+    if taken is None:
+        return values
+    own = {k: v for k, v in law.parameters().items() if k in LAW_INPUTS and k in taken}
+    out = {}
+    for name, value in values.items():
+        if name not in ("f", "n") or name in taken:
+            out[name] = value
+        if name == "W":
+            out.update(own)
+    return out
+
+
+# ------------------------------------------------------------------ a law of FAMILY_LAWS (every robot family)
+def _family_law_report(robot, controller, family, law, alpha, alpha_deg, L, models, pade_order, mass, sources, door, simulate_cycle) -> StabilityReport:
+    """The velocity, velocity-gated or fuzzy law (`families`): steering, holonomic or non-smooth results."""
+    from .families import holonomic_results, non_smooth_results, steering_results
+
+    if door is not None:
+        raise ValueError(_DOOR_REFUSED.format(family=family, law=law.name))
+    if alpha is not None and alpha_deg is not None:
+        raise ValueError("give alpha (rad) or alpha_deg, not both")
+    if alpha is None and alpha_deg is None and L is None:
+        raise ValueError(_NO_GEOMETRY)
+    sources = dict(sources or {})
+    mass = check_parameter("mass", mass)
+    if family == "holonomic" and law.name not in HOLONOMIC_LAWS:
+        raise ValueError(f"--robot holonomic takes --law velocity or velocity-gated (a force in newtons on a mass, Ge & Cui 2002 Sec 6); got --law {law.name}")
+    if family == "kinematic":
+        robot = robot.replace(tau=0.0)
+        sources["tau"] = KINEMATIC_TAU_SOURCE
+    models = tuple(dict.fromkeys(MODEL_NAMES if models is None else models))
+    for name in models:
+        check_choice("model", name, MODEL_NAMES)
+    wall = Wall.from_degrees(alpha_deg) if alpha_deg is not None else (Wall(alpha) if alpha is not None else None)
+    corridor = Corridor(L) if L is not None else None
+    inputs = _family_inputs(robot, controller, family, law, mass, pade_order, wall, corridor, sources)
+    if law.name == "velocity-gated":
+        cycle = None
+        if simulate_cycle is not None and controller.T != 0:  # T = 0: a continuous controller, nothing sampled to simulate
+            cycle = partial(simulate_cycle, family, robot, controller, law, mass=mass)
+        wall_result, corridor_result = non_smooth_results(law, wall, corridor, cycle)
+        return StabilityReport(inputs, (), STEERING, wall_result, corridor_result, law=LawDescription(**law.described()))
+    if family == "holonomic":
+        from ..models.holonomic import HOLONOMIC
+
+        model_objs = tuple(make_models(list(models), pade_order=pade_order, compute_delay=controller.compute_delay))
+        wall_result, corridor_result, tracking = holonomic_results(robot, controller, law, wall, corridor, model_objs, mass)
+        fixes = _remedies(wall_result, corridor_result, lambda geometry, v: _delay_remedy(v, controller.T))
+        return StabilityReport(inputs, model_objs, HOLONOMIC, wall_result, corridor_result, fixes, LawDescription(**law.described()),
+                               tracking=tracking)
+    model_objs = tuple(models_for(controller, models, pade_order=pade_order))
+    wall_result, corridor_result, schedule = steering_results(robot, controller, law, wall, corridor, model_objs)
+    static = law.repulsion() if law.name == "velocity" else PowerLaw(controller.f, controller.n, robot.W)
+
+    def fix(geometry, verdict):  # what the verdict's critical values support: V, T, k (the law's own are not followed)
+        return {k: v for k, v in remedies(geometry, verdict, robot, controller, static).items() if k in ("V", "T", "k")}
+
+    return StabilityReport(inputs, model_objs, STEERING, wall_result, corridor_result, _remedies(wall_result, corridor_result, fix),
+                           LawDescription(**law.described()), None, kb_errors(robot, controller, wall_result, corridor_result), schedule)
+
+
+def _family_inputs(robot, controller, family, law, mass, pade_order, wall, corridor, sources) -> dict:
+    """The report's inputs: the robot family, the robot and controller, the law's parameters and choices, the geometry."""
+    holonomic = family == "holonomic"
+    values = {"robot": family, "V": robot.V, "tau": robot.tau, "T": controller.T, "k": robot.k}
+    if holonomic:
+        values["mass"] = mass
+    values.update(law.parameters)
+    values.update(law.choices)
+    values.update({"hold": controller.hold, "compute_delay": controller.compute_delay, "pade_order": pade_order})
+    if wall is not None:
+        values["alpha_deg"] = wall.alpha_deg
+    if corridor is not None:
+        values["L"] = corridor.L
+    out = {}
+    for name, value in values.items():
+        source = sources.get(name, "default" if name in FAMILY_DEFAULTS or name in FAMILY_CHOICE_DEFAULTS else "user")
+        if holonomic and name in ("tau", "k", "hold"):
+            source = HOLONOMIC_UNUSED
+        out[name] = {"value": value, "unit": UNITS.get(name, RANGES[name].unit if name in RANGES else ""), "source": source}
+    return out
+
+
+# ------------------------------------------------------------------ remedies, once for every family
+def _remedies(wall, corridor, fix) -> dict:
+    """`StabilityReport.remedies`: ``fix(geometry, verdict)`` once for every verdict of each result, under each of its keys
+    (`_keyed_verdicts`)."""
+    out, fixed = {}, {}
+    for result in (wall, corridor):
+        for key, verdict in _keyed_verdicts(result) if result is not None else ():
+            if id(verdict) not in fixed:
+                fixed[id(verdict)] = fix(key[0], verdict)
+            out[key] = fixed[id(verdict)]
+    return out
+
+
+@singledispatch
+def _keyed_verdicts(result) -> tuple:
+    """((geometry, model) or (geometry, i, model), verdict) of every verdict of a result, by its type: a steering loop's here,
+    another family's by its own ``keyed_verdicts`` (`report.families`)."""
+    return result.keyed_verdicts()
+
+
+@_keyed_verdicts.register
+def _(wall: WallAnalysis) -> tuple:
+    """Each equilibrium's verdicts under ("wall", i, model), the first's also under ("wall", model)."""
+    keyed = [(("wall", i, name), v) for i, e in enumerate(wall.equilibria) for name, v in e.models.items()]
+    return (*keyed, *((("wall", name), v) for name, v in wall.equilibria[0].models.items()))
+
+
+@_keyed_verdicts.register
+def _(corridor: CorridorAnalysis) -> tuple:
+    """The verdicts under ("corridor", model)."""
+    return tuple((("corridor", name), v) for name, v in corridor.models.items())
+
+
+def _change(name: str, target: float, direction: str | None, now: float | None) -> dict | None:
+    """One remedy: move `name` from `now` to `target` ("raise" or "lower"), or None when that is no change that helps.
+
+    None when there is no direction, the target is not finite and positive (α* >= 90° is none
+    either), or it lies on the wrong side of the present value (on the boundary).
+    """
+    if direction is None or not math.isfinite(target) or target <= 0 or (name == "alpha_deg" and target >= 90):
+        return None
+    if now is not None and (target >= now if direction == "lower" else target <= now):
+        return None
+    entry = {"to": target, "direction": direction}
+    if now:
+        entry["change_percent"] = (target / now - 1.0) * 100
+    return entry
+
+
+def _delay_remedy(verdict, T: float) -> dict:
+    """A holonomic verdict's remedy: a period shorter than T* (`models.holonomic.HolonomicVerdict`), when it helps."""
+    if verdict.stable:
+        return {}
+    entry = _change("T", verdict.T_critical, "lower", T)
+    return {"T": entry} if entry is not None else {}
+
+
+def remedies(scenario: str, verdict: ModelVerdict, robot: Robot, controller: Controller, law: ForceLaw | None = None, at: float | None = None) -> dict:
+    """Single-parameter changes that make an unstable steering loop stable.
 
     Parameters
     ----------
     scenario : {"wall", "corridor"}
     verdict : criteria.ModelVerdict
-    robot, controller : the current parameters
+    robot, controller : Robot, Controller
+        The current parameters.
     law : ForceLaw, optional
         The law analysed (KB's power law by default). For a law that is not
         `monotone` the critical values of α, L and of the law's parameters are
@@ -274,34 +624,8 @@ def remedies(scenario: str, verdict, robot: Robot, controller: Controller, law: 
     if "f_critical" in c:
         wanted.append(("f", "f_critical", ("raise" if scenario == "wall" else "lower") if law.monotone else _towards(c.f_critical, current["f"], law)))
     wanted += [(name, f"{name}_critical", _towards(c[f"{name}_critical"], current[name], law)) for name in ("eta", "rho0", "xi") if f"{name}_critical" in c]
-    out = {}
-    for name, key, direction in wanted:
-        target = c[key]
-        if direction is None or not math.isfinite(target) or target <= 0 or (name == "alpha_deg" and target >= 90):
-            continue
-        now = current.get(name)
-        if now is not None and (target >= now if direction == "lower" else target <= now):
-            continue  # not a change in the helpful direction (on the boundary)
-        entry = {"to": target, "direction": direction}
-        if now:
-            entry["change_percent"] = (target / now - 1.0) * 100
-        out[name] = entry
-    return out
-
-
-def remedies_by_key(wall: WallAnalysis | None, corridor: CorridorAnalysis | None, fix) -> dict:
-    """`StabilityReport.remedies`: ``fix(scenario, verdict)`` for every verdict, under the report's keys.
-
-    ("wall", i, model) for wall equilibrium i, ("wall", model) for the first,
-    ("corridor", model) for the corridor.
-    """
-    out = {}
-    if wall is not None:
-        out.update({("wall", i, name): fix("wall", v) for i, e in enumerate(wall.equilibria) for name, v in e.models.items()})
-        out.update({("wall", name): out[("wall", 0, name)] for name in wall.models})
-    if corridor is not None:
-        out.update({("corridor", name): fix("corridor", v) for name, v in corridor.models.items()})
-    return out
+    changes = ((name, _change(name, c[key], direction, current.get(name))) for name, key, direction in wanted)
+    return {name: entry for name, entry in changes if entry is not None}
 
 
 def _towards(target: float, now: float | None, law: ForceLaw) -> str | None:
@@ -313,6 +637,7 @@ def _towards(target: float, now: float | None, law: ForceLaw) -> str | None:
     return "raise" if target > now else "lower"
 
 
+# ------------------------------------------------------------------ KB's error
 def kb_error(robot: Robot, controller: Controller, c: float = 0.0, where: tuple = ()) -> KBError:
     """KB's eq (20) against the `sampled` loop with the controller's structure, for the loop with heading gain `c`.
 
@@ -320,20 +645,18 @@ def kb_error(robot: Robot, controller: Controller, c: float = 0.0, where: tuple 
     with the heading gain, so both sides are the NV* the report's table prints
     for that loop; `where` names the geometries whose loop it is.
     """
-    loop = loop_of(robot, controller)
-    if c != 0.0:
-        loop = Loop(loop.tau, loop.T, loop.k, c=c)
+    loop = Loop.of(robot, controller, c=c)
     kb = KBFirstOrder().boundary(loop).NV_critical
     sampled = Sampled(controller.hold, controller.compute_delay).boundary(loop).NV_critical
     return KBError(relative_error(kb, sampled), kb, sampled, controller.hold, controller.compute_delay, c, tuple(where))
 
 
 def kb_errors(robot: Robot, controller: Controller, wall: WallAnalysis | None, corridor: CorridorAnalysis | None) -> tuple:
-    """`kb_error` for every loop the report's tables decide: one per heading gain c, naming its geometries, wall first.
+    """`kb_error` for every loop the report's steering tables decide: one per heading gain c, naming its geometries, wall first.
 
-    A static law gives one loop (c = 0, KB's own); a velocity or fuzzy law one per
-    heading gain, each compared as its table prints it. A loop whose c is beyond
-    the models (`models.HEADING_GAIN_RANGE`: no table value) has none.
+    A static law gives one loop (c = 0, KB's own; also without a wall or corridor: a door's
+    report); a velocity or fuzzy law one per heading gain, each compared as its table prints
+    it. A loop whose c is beyond the models (`models.HEADING_GAIN_RANGE`: no table value) has none.
     """
     loops = {}
     if wall is not None:
@@ -343,114 +666,3 @@ def kb_errors(robot: Robot, controller: Controller, wall: WallAnalysis | None, c
         loops.setdefault(corridor.c, []).append("corridor")
     low, high = HEADING_GAIN_RANGE
     return tuple(kb_error(robot, controller, c, tuple(where) if c != 0.0 else ()) for c, where in (loops or {0.0: []}).items() if low <= c <= high)
-
-
-def build_report(
-    robot: Robot,
-    controller: Controller,
-    *,
-    alpha: float | None = None,
-    L: float | None = None,
-    models=MODEL_NAMES,
-    pade_order: int = 3,
-    sources: dict | None = None,
-    law=None,
-    alpha_deg: float | None = None,
-    door: float | None = None,
-    door_obstacle: str = "posts",
-    post_radius: float = 0.0,
-) -> StabilityReport:
-    """Analyze a wall (α) and/or a corridor (L, m) with the chosen models.
-
-    Parameters
-    ----------
-    robot, controller : Robot, Controller
-    alpha : float, optional
-        Wall target angle, rad, in [1e-6°, 90° − 1e-6°].
-    alpha_deg : float, optional
-        The same in degrees (checked in degrees; `Wall.from_degrees`).
-    L : float, optional
-        Corridor half-width, m, > W/2.
-    models : sequence of str
-        Model names (`parameters.MODEL_NAMES`, docs/models.md); all by default.
-    pade_order : int
-        Order m of the ``pade`` model.
-    sources : dict, optional
-        Provenance of each input (shown in the report).
-    law : ForceLaw, optional
-        KB's power law by default (`fields.make_law` builds any law of
-        `parameters.FORCE_LAWS`). A law named in `parameters.LAW_PARAMETERS`
-        lists the parameters it takes among the inputs (f and n only where it
-        uses them).
-
-    Raises
-    ------
-    ValueError
-        Neither α nor L given, any parameter out of range, or a wall where the
-        law has no equilibrium.
-    """
-    if alpha is not None and alpha_deg is not None:
-        raise ValueError("give alpha (rad) or alpha_deg, not both")
-    if alpha is None and alpha_deg is None and L is None and door is None:
-        raise ValueError(
-            f"alpha or L must be given, or a door: a wall (--alpha DEG, in {RANGES['alpha_deg'].describe()}), "
-            f"a corridor (--L M, in (W/2, {RANGES['L'].high:g}] m) and/or a door (--door WIDTH, m)"
-        )
-    wall = Wall.from_degrees(alpha_deg) if alpha_deg is not None else (Wall(alpha) if alpha is not None else None)
-    corridor = Corridor(L) if L is not None else None
-    check_type("robot", robot, Robot, "a Robot")
-    check_type("controller", controller, Controller, "a Controller")
-    models = MODEL_NAMES if models is None else models
-    if isinstance(models, str) or not isinstance(models, (list, tuple)) or not all(isinstance(m, str) for m in models):
-        raise ValueError(f"models must be a list or tuple of model names ({', '.join(MODEL_NAMES)}); got {models!r}")
-    if sources is not None and not isinstance(sources, dict):
-        raise ValueError(f"sources must be a dict of parameter name to provenance; got {sources!r}")
-    model_objs = models_for(controller, tuple(dict.fromkeys(models)), pade_order=pade_order)
-    sources = sources or {}
-    values = {
-        "V": robot.V,
-        "tau": robot.tau,
-        "T": controller.T,
-        "k": robot.k,
-        "f": controller.f,
-        "n": controller.n,
-        "W": robot.W,
-        "hold": controller.hold,
-        "compute_delay": controller.compute_delay,
-        "pade_order": pade_order,
-    }
-    law = law_in_force(robot, controller, law)
-    values = _law_inputs(values, law)
-    if wall is not None:
-        values["alpha_deg"] = wall.alpha_deg
-    if corridor is not None:
-        values["L"] = corridor.L
-    inputs = {name: {"value": value, "unit": UNITS[name], "source": sources.get(name, "user")} for name, value in values.items()}
-    options = {m.name: {"equation": m.equation, **m.options()} for m in model_objs}
-    wall_result = analyze_wall(robot, controller, wall, model_objs, law) if wall else None
-    corridor_result = analyze_corridor(robot, controller, corridor, model_objs, law) if corridor else None
-    fixes = remedies_by_key(wall_result, corridor_result,
-                            lambda scenario, verdict: remedies(scenario, verdict, robot, controller, law, wall.alpha_deg if scenario == "wall" else corridor.L))
-    described = {"name": law.key, "description": law.name, "parameters": json_ready(law.parameters())}
-    passage = None
-    if door is not None:
-        from ..analysis.door import door_passage
-
-        passage = door_passage(law, check_parameter("door", door), obstacle=door_obstacle, post_radius=check_parameter("post_radius", post_radius),
-                               robot_width=robot.W, find_smallest=True, name="door")
-    return StabilityReport(inputs, options, wall_result, corridor_result, kb_error(robot, controller), fixes, described, passage)
-
-
-def _law_inputs(values: dict, law: ForceLaw) -> dict:
-    """The inputs with the law's own parameters after W, and without f and n where a named law does not use them."""
-    taken = LAW_PARAMETERS.get(law.key)
-    if taken is None:
-        return values
-    own = {k: v for k, v in law.parameters().items() if k in LAW_INPUTS and k in taken}
-    out = {}
-    for name, value in values.items():
-        if name not in ("f", "n") or name in taken:
-            out[name] = value
-        if name == "W":
-            out.update(own)
-    return out

@@ -126,6 +126,15 @@ def simulate_batch(
 def batch_scenarios(scenario: str, *, env: str = "grid", robot: Robot | None = None, controller: Controller | None = None, **parameters) -> list:
     """The member scenarios `simulate_batch` runs for these arguments (nothing is simulated).
 
+    Parameters
+    ----------
+    scenario : str
+        A name of `pfm_stability.sim.presets.SCENARIO_NAMES`.
+    env : {"grid", "analytic"}
+        The environment's kind.
+    robot, controller : Robot, Controller, optional
+        Base values (default CARMEL), overridden per member by `parameters` as in `simulate_batch`.
+
     Returns
     -------
     list of Scenario

@@ -68,6 +68,13 @@ def path_slack(length, chord):
     (The path lies in the ellipse with those foci and major axis ℓ, whose
     points are all within its semi-minor axis B of the segment between the
     foci.) Round-off that makes c > ℓ gives 0.
+
+    Parameters
+    ----------
+    length : ndarray or float
+        Path length ℓ, m.
+    chord : ndarray or float
+        Distance c between the path's ends, m.
     """
     length = np.asarray(length, dtype=float)
     chord = np.asarray(chord, dtype=float)
@@ -88,6 +95,13 @@ def point_wall_gap(walls: dict, px, py):
     """Distance from points (shape (…, 1)) to the nearest wall segment (last axis = walls), m; ``inf`` without walls.
 
     `walls` is `AnalyticEnvironment.arrays()` (optionally with a ``valid`` mask).
+
+    Parameters
+    ----------
+    walls : dict
+        `AnalyticEnvironment.arrays()` (optionally with a ``valid`` mask).
+    px, py : ndarray, shape (…, 1)
+        The points, m.
     """
     ax, ay = walls["p0x"], walls["p0y"]
     bx, by = ax + walls["length"] * walls["ux"], ay + walls["length"] * walls["uy"]
@@ -96,7 +110,15 @@ def point_wall_gap(walls: dict, px, py):
 
 
 def chord_wall_gap(walls: dict, ax, ay, bx, by):
-    """Distance from chords [a, b] (shape (…, 1)) to the nearest wall segment (last axis), m: 0 where they cross."""
+    """Distance from chords [a, b] (shape (…, 1)) to the nearest wall segment (last axis), m: 0 where they cross.
+
+    Parameters
+    ----------
+    walls : dict
+        `AnalyticEnvironment.arrays()` (optionally with a ``valid`` mask).
+    ax, ay, bx, by : ndarray, shape (…, 1)
+        The chords' ends, m.
+    """
     px, py = walls["p0x"], walls["p0y"]
     qx, qy = px + walls["length"] * walls["ux"], py + walls["length"] * walls["uy"]
     cross = lambda ox, oy, ux, uy, vx, vy: (ux - ox) * (vy - oy) - (uy - oy) * (vx - ox)
@@ -112,7 +134,17 @@ def chord_wall_gap(walls: dict, ax, ay, bx, by):
 
 
 def point_cell_gap(cx, cy, half, px, py):
-    """Distance from points (shape (…, 1)) to the nearest cell square (centres cx, cy, half-side `half`; last axis), m."""
+    """Distance from points (shape (…, 1)) to the nearest cell square (centres cx, cy, half-side `half`; last axis), m.
+
+    Parameters
+    ----------
+    cx, cy : ndarray
+        Cell centres (last axis), m.
+    half : float
+        Half the cell side, m.
+    px, py : ndarray, shape (…, 1)
+        The points, m.
+    """
     gx = np.maximum(np.abs(px - cx) - half, 0.0)
     gy = np.maximum(np.abs(py - cy) - half, 0.0)
     return np.sqrt(np.min(gx * gx + gy * gy, axis=-1, initial=math.inf))
@@ -124,6 +156,15 @@ def chord_cell_gap(cx, cy, half, ax, ay, bx, by):
     Two disjoint convex sets are nearest at a vertex of one of them: the
     chord's ends against the squares, the squares' corners against the chord;
     a chord that enters a square (slab test) is at distance 0.
+
+    Parameters
+    ----------
+    cx, cy : ndarray
+        Cell centres (last axis), m.
+    half : float
+        Half the cell side, m.
+    ax, ay, bx, by : ndarray, shape (…, 1)
+        The chords' ends, m.
     """
     dx, dy = bx - ax, by - ay
     with np.errstate(invalid="ignore", divide="ignore"):
@@ -212,7 +253,13 @@ class StepPath:
         return x_end, y_end, theta_end, omega_end
 
     def at(self, times):
-        """(x, y) at `times` s after the start of the period (0 < t <= h), m."""
+        """(x, y) at `times` s after the start of the period (0 < t <= h), m.
+
+        Parameters
+        ----------
+        times : ndarray
+            Times after the start of the period, s (0 < t <= h).
+        """
         times = np.atleast_1d(np.asarray(times, dtype=float))
         n = times.size
         start = lambda v: np.full(n, float(v))

@@ -30,6 +30,13 @@ def loop_order(robot, compute_delay: int) -> int:
 
     Point mass and differential drive: 2 (offset and its rate) + compute_delay; steering:
     (τ > 0) + 2 + compute_delay, as the `sampled` loop models count them.
+
+    Parameters
+    ----------
+    robot : Steering, PointMass or DiffDrive
+        The robot (`sim.planar_robots`).
+    compute_delay : int
+        Samples from measurement to actuation (0 or 1).
     """
     lag = 1 if isinstance(robot, Steering) and robot.tau > 0 else 0
     return 2 + lag + int(compute_delay)

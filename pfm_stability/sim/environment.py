@@ -100,7 +100,13 @@ class AnalyticEnvironment:
         return {key: np.array(value, dtype=float) for key, value in out.items()}
 
     def clearance(self, x, y) -> np.ndarray:
-        """Distance from points to the nearest wall segment, m (brute force)."""
+        """Distance from points to the nearest wall segment, m (brute force).
+
+        Parameters
+        ----------
+        x, y : array_like
+            Points, m.
+        """
         x = np.atleast_1d(np.asarray(x, float))
         if not self.walls:
             return np.full(x.shape, math.inf)
@@ -124,7 +130,17 @@ def segment_clearance(walls: dict, px, py) -> np.ndarray:
 
 
 def corridor_walls(L: float, y_from: float = -_LONG, y_to: float = _LONG, centre: float = 0.0) -> tuple:
-    """The two walls of a straight corridor along Y, half-width L (m), centred on X = `centre`."""
+    """The two walls of a straight corridor along Y, half-width L (m), centred on X = `centre`.
+
+    Parameters
+    ----------
+    L : float
+        Half-width, m.
+    y_from, y_to : float
+        Where the walls begin and end along Y, m.
+    centre : float
+        X of the corridor's axis, m.
+    """
     L = check_number("L", L, 0.0, unit="m")
     return (
         AnalyticWall((centre - L, y_from), (centre - L, y_to), free_side="right"),

@@ -67,6 +67,15 @@ class HistogramGrid:
 
         Then x = 0 is a cell centre: a robot there has a symmetric window, and
         walls drawn at x = ±L (L a multiple of c) sit on cell centres.
+
+        Parameters
+        ----------
+        x_lo, x_hi, y_lo, y_hi : float
+            The area to cover, m.
+        cell_size : float
+            Cell side c, m.
+        cv_max : int
+            Largest certainty value (`HistogramGrid`).
         """
         c = check_number("cell_size", cell_size, 0.0, unit="m")
         x0 = (math.floor(x_lo / c) - 0.5) * c
@@ -89,14 +98,26 @@ class HistogramGrid:
         return (self.x_min, self.x_min + nx * c, self.y_min, self.y_min + ny * c)
 
     def cell_index(self, x, y):
-        """(i, j) integer arrays of the cells containing the points (may lie outside the grid)."""
+        """(i, j) integer arrays of the cells containing the points (may lie outside the grid).
+
+        Parameters
+        ----------
+        x, y : array_like
+            Points, m.
+        """
         c = self.cell_size
         i = np.floor((np.asarray(x, dtype=float) - self.x_min) / c).astype(np.int64)
         j = np.floor((np.asarray(y, dtype=float) - self.y_min) / c).astype(np.int64)
         return i, j
 
     def cell_center(self, i, j):
-        """(x, y) of cell centres, m."""
+        """(x, y) of cell centres, m.
+
+        Parameters
+        ----------
+        i, j : array_like of int
+            Cell indices along x and y.
+        """
         c = self.cell_size
         return self.x_min + (np.asarray(i) + 0.5) * c, self.y_min + (np.asarray(j) + 0.5) * c
 
@@ -107,7 +128,13 @@ class HistogramGrid:
         return x, y, self.cv[i, j].astype(float)
 
     def occupied_at(self, x, y) -> np.ndarray:
-        """True where the point lies in an occupied cell (False outside the grid)."""
+        """True where the point lies in an occupied cell (False outside the grid).
+
+        Parameters
+        ----------
+        x, y : array_like
+            Points, m.
+        """
         i, j = self.cell_index(x, y)
         nx, ny = self.shape
         inside = (i >= 0) & (i < nx) & (j >= 0) & (j < ny)
@@ -120,6 +147,11 @@ class HistogramGrid:
 
         Exact and brute force (every occupied cell); the simulator uses the
         compiled near-cell lists of `pfm_stability.sim.window` instead.
+
+        Parameters
+        ----------
+        x, y : array_like
+            Points, m.
         """
         ox, oy, _ = self.occupied()
         x = np.atleast_1d(np.asarray(x, dtype=float))
@@ -166,18 +198,44 @@ class HistogramGrid:
         return self.cell_index(x0 + s * (x1 - x0), y0 + s * (y1 - y0))
 
     def draw_segment(self, p0, p1, cv=None) -> "HistogramGrid":
-        """Mark every cell the segment p0 → p1 (m) passes through: a wall of any orientation."""
+        """Mark every cell the segment p0 → p1 (m) passes through: a wall of any orientation.
+
+        Parameters
+        ----------
+        p0, p1 : (float, float)
+            The segment's ends, m.
+        cv : int, optional
+            Certainty value of its cells (default `cv_max`).
+        """
         self._mark(*self._segment_cells(p0, p1), self._cv_value(cv))
         return self
 
     def draw_polyline(self, points, cv=None) -> "HistogramGrid":
-        """`draw_segment` for each consecutive pair of points (a wall with corners)."""
+        """`draw_segment` for each consecutive pair of points (a wall with corners).
+
+        Parameters
+        ----------
+        points : sequence of (float, float)
+            The corners, m.
+        cv : int, optional
+            Certainty value of its cells (default `cv_max`).
+        """
         for p0, p1 in zip(points[:-1], points[1:]):
             self.draw_segment(p0, p1, cv)
         return self
 
     def draw_polygon(self, vertices, cv=None, filled=True) -> "HistogramGrid":
-        """Mark the outline of a polygon (m) and, if `filled`, every cell whose centre is inside."""
+        """Mark the outline of a polygon (m) and, if `filled`, every cell whose centre is inside.
+
+        Parameters
+        ----------
+        vertices : sequence of (float, float)
+            The polygon's corners, m.
+        cv : int, optional
+            Certainty value of its cells (default `cv_max`).
+        filled : bool
+            Fill the inside too.
+        """
         value = self._cv_value(cv)
         closed = list(vertices) + [vertices[0]]
         for p0, p1 in zip(closed[:-1], closed[1:]):
@@ -194,7 +252,17 @@ class HistogramGrid:
         return self
 
     def draw_rectangle(self, x0, y0, x1, y1, cv=None, filled=True) -> "HistogramGrid":
-        """An axis-aligned rectangle with corners (x0, y0), (x1, y1), m."""
+        """An axis-aligned rectangle with corners (x0, y0), (x1, y1), m.
+
+        Parameters
+        ----------
+        x0, y0, x1, y1 : float
+            Opposite corners, m.
+        cv : int, optional
+            Certainty value of its cells (default `cv_max`).
+        filled : bool
+            Fill the inside too.
+        """
         return self.draw_polygon([(x0, y0), (x1, y0), (x1, y1), (x0, y1)], cv, filled)
 
     def draw_protrusion(self, p0, p1, depth, cv=None, filled=False) -> "HistogramGrid":
@@ -202,6 +270,17 @@ class HistogramGrid:
 
         Drawn as its outline (two flanks and the front face, like a wall that
         juts out) unless `filled`.
+
+        Parameters
+        ----------
+        p0, p1 : (float, float)
+            The wall segment's ends, m.
+        depth : float
+            How far the bump juts out, m.
+        cv : int, optional
+            Certainty value of its cells (default `cv_max`).
+        filled : bool
+            Fill the bump rather than draw its outline.
         """
         depth = check_number("depth", depth, 0.0, unit="m")
         (x0, y0), (x1, y1) = p0, p1
@@ -215,12 +294,24 @@ class HistogramGrid:
         return self.draw_polyline(corners, cv)
 
     def draw_gap(self, p0, p1) -> "HistogramGrid":
-        """Clear the cells the segment p0 → p1 passes through (an opening in a wall)."""
+        """Clear the cells the segment p0 → p1 passes through (an opening in a wall).
+
+        Parameters
+        ----------
+        p0, p1 : (float, float)
+            The segment's ends, m.
+        """
         self._mark(*self._segment_cells(p0, p1), 0)
         return self
 
     def clear_rectangle(self, x0, y0, x1, y1) -> "HistogramGrid":
-        """Clear every cell of an axis-aligned rectangle (a wide opening)."""
+        """Clear every cell of an axis-aligned rectangle (a wide opening).
+
+        Parameters
+        ----------
+        x0, y0, x1, y1 : float
+            Opposite corners, m.
+        """
         return self.draw_rectangle(x0, y0, x1, y1, cv=0, filled=True)
 
     def __repr__(self) -> str:

@@ -154,6 +154,13 @@ def turning_points(x, hysteresis: float) -> np.ndarray:
     A zigzag filter: a maximum is confirmed once x has fallen `hysteresis`
     below it, a minimum once x has risen that much above it. The first sample
     is never a turning point.
+
+    Parameters
+    ----------
+    x : ndarray
+        The signal (e.g. the lateral offset, m).
+    hysteresis : float
+        Smallest swing that counts, in x's units.
     """
     x = np.asarray(x, dtype=float)
     points = []

@@ -24,7 +24,17 @@ __all__ = ["Ball", "Obstacle", "PointObstacle", "Pull", "Target", "Wall", "vecto
 
 
 def vector(name: str, value, *, unit: bool = False) -> tuple:
-    """A finite 2-vector (x, y) as a tuple of floats (unit: normalised, not 0); ValueError naming `name`."""
+    """A finite 2-vector (x, y) as a tuple of floats (unit: normalised, not 0); ValueError naming `name`.
+
+    Parameters
+    ----------
+    name : str
+        The name error messages give it.
+    value : sequence of two numbers
+        The vector.
+    unit : bool
+        Normalise it (a zero vector is then an error).
+    """
     try:
         v = np.asarray(value, dtype=float)
     except (TypeError, ValueError):
@@ -41,7 +51,15 @@ def vector(name: str, value, *, unit: bool = False) -> tuple:
 
 @dataclass(frozen=True)
 class Target:
-    """A target at `position` (m) at t = 0, moving at constant `velocity` (m/s); the field knows both."""
+    """A target at `position` (m) at t = 0, moving at constant `velocity` (m/s); the field knows both.
+
+    Attributes
+    ----------
+    position : (float, float)
+        Position at t = 0, m.
+    velocity : (float, float)
+        Constant velocity, m/s.
+    """
 
     position: tuple
     velocity: tuple = (0.0, 0.0)
@@ -51,14 +69,28 @@ class Target:
         object.__setattr__(self, "velocity", vector("target velocity", self.velocity))
 
     def at(self, t: float):
-        """(p_tar, v_tar) at time t (s), numpy 2-vectors."""
+        """(p_tar, v_tar) at time t (s), numpy 2-vectors.
+
+        Parameters
+        ----------
+        t : float
+            Time, s.
+        """
         v = np.array(self.velocity)
         return np.array(self.position) + v * t, v
 
 
 @dataclass(frozen=True)
 class Pull:
-    """A constant attraction towards a target at infinity: `magnitude` (N) along angle `direction` (rad from +x)."""
+    """A constant attraction towards a target at infinity: `magnitude` (N) along angle `direction` (rad from +x).
+
+    Attributes
+    ----------
+    magnitude : float
+        The force, N.
+    direction : float
+        Its direction, rad from +x.
+    """
 
     magnitude: float
     direction: float
@@ -80,7 +112,15 @@ class Obstacle:
     velocity: tuple
 
     def geometry(self, p, t: float):  # pragma: no cover - interface
-        """(clearance ρ_s in m, unit vector obstacle → robot, `where` for `evaluate`) at robot position p, time t."""
+        """(clearance ρ_s in m, unit vector obstacle → robot, `where` for `evaluate`) at robot position p, time t.
+
+        Parameters
+        ----------
+        p : ndarray, shape (2,)
+            The robot's position, m.
+        t : float
+            Time, s.
+        """
         raise NotImplementedError
 
 
@@ -89,6 +129,15 @@ class Wall(Obstacle):
     """A straight wall: the line through `point` (m, at t = 0) with unit `normal` towards the robot's side.
 
     The clearance is the signed distance (p − point(t))·normal; the robot lives where it is > 0.
+
+    Attributes
+    ----------
+    point : (float, float)
+        A point of the wall at t = 0, m.
+    normal : (float, float)
+        Unit normal towards the robot's side.
+    velocity : (float, float)
+        Constant velocity, m/s.
     """
 
     point: tuple
@@ -109,7 +158,15 @@ class Wall(Obstacle):
 
 @dataclass(frozen=True)
 class PointObstacle(Obstacle):
-    """A point obstacle at `position` (m, at t = 0) moving at `velocity` (m/s)."""
+    """A point obstacle at `position` (m, at t = 0) moving at `velocity` (m/s).
+
+    Attributes
+    ----------
+    position : (float, float)
+        Position at t = 0, m.
+    velocity : (float, float)
+        Constant velocity, m/s.
+    """
 
     position: tuple
     velocity: tuple = (0.0, 0.0)
@@ -134,6 +191,15 @@ class Ball(Obstacle):
 
     The repulsion's tangential part uses the centre distance (the true gradient,
     docs/velocity_and_fuzzy.md), which `VelocityGatedRepulsion.evaluate` does.
+
+    Attributes
+    ----------
+    position : (float, float)
+        Centre at t = 0, m.
+    radius : float
+        Radius, m.
+    velocity : (float, float)
+        Constant velocity, m/s.
     """
 
     position: tuple

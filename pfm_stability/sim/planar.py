@@ -126,7 +126,15 @@ class Field:
 
 @dataclass(frozen=True)
 class World:
-    """A target (needed by a `VelocityAttraction`) and obstacles (`sim.movers`)."""
+    """A target (needed by a `VelocityAttraction`) and obstacles (`sim.movers`).
+
+    Attributes
+    ----------
+    target : Target or None
+        The target.
+    obstacles : tuple
+        `sim.movers` obstacles (`Wall`, `PointObstacle`, `Ball`).
+    """
 
     target: Target | None = None
     obstacles: tuple = ()
@@ -145,6 +153,15 @@ class Start:
     """Initial state: `position` (m), `velocity` (m/s; a steering robot's speed is always V) and `heading`.
 
     `heading` (rad from +x) defaults to the velocity's direction, or 0 at rest.
+
+    Attributes
+    ----------
+    position : (float, float)
+        m.
+    velocity : (float, float)
+        m/s.
+    heading : float or None
+        rad from +x (None: the velocity's direction).
     """
 
     position: tuple
@@ -225,7 +242,13 @@ class PlanarRun:
     compute_delay: int
 
     def first_event(self, kind: str) -> PlanarEvent | None:
-        """The first event of a kind, or None."""
+        """The first event of a kind, or None.
+
+        Parameters
+        ----------
+        kind : str
+            The event's kind (`PlanarEvent.kind`).
+        """
         return next((e for e in self.events if e.kind == kind), None)
 
     def to_dict(self) -> dict:
@@ -498,7 +521,15 @@ def wall_cycle(repulsion, attraction, alpha, robot, *, T, compute_delay=1, durat
 
 
 def measure_wall_cycle(run: PlanarRun, mass: float = 1.0) -> WallCycle:
-    """`WallCycle` of a run beside the wall x = 0 travelling along +y (the second half of the run; `mass`, kg, of a point mass)."""
+    """`WallCycle` of a run beside the wall x = 0 travelling along +y (the second half of the run; `mass`, kg, of a point mass).
+
+    Parameters
+    ----------
+    run : PlanarRun
+        A run beside the wall x = 0 travelling along +y.
+    mass : float
+        The point mass's mass, kg.
+    """
     keep = run.t >= run.t[-1] / 2.0
     t, d = run.t[keep], run.p[keep, 0]
     span = float(d.max() - d.min())

@@ -28,7 +28,19 @@ def _wrap(a: float) -> float:
 
 
 def positive(name, value, unit, high=_BIG):
-    """`value` checked to lie in (0, high] (`unit` for the message)."""
+    """`value` checked to lie in (0, high] (`unit` for the message).
+
+    Parameters
+    ----------
+    name : str
+        The name the message gives it.
+    value : float
+        The value to check.
+    unit : str
+        Its unit, for the message.
+    high : float
+        The largest allowed value.
+    """
     return check_number(name, value, 0.0, high, high_open=False, unit=unit)
 
 

@@ -500,6 +500,19 @@ def barely_avoiding_ratio(
     `members` − 2 inside the current bracket; each keeps the interval between
     the largest colliding and the smallest avoiding ratio.
 
+    Parameters
+    ----------
+    robot, controller : Robot, Controller, optional
+        Default CARMEL.
+    window_cells : int
+        The active window's side, cells (odd).
+    cell_size : float
+        Cell side, m.
+    members : int
+        Ratios simulated per round.
+    rounds : int
+        Rounds of the bisection.
+
     Returns
     -------
     float

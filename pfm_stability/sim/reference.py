@@ -242,6 +242,11 @@ def _path_contact(s, sense, tau, start, applied, V, substepped, gap_start, switc
 def simulate_reference(s: Scenario):
     """Run one scenario in a per-robot Python loop.
 
+    Parameters
+    ----------
+    s : Scenario
+        The scenario to run.
+
     Returns
     -------
     (Trajectory, Event or None)

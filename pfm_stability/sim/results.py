@@ -42,7 +42,13 @@ class Trajectory:
     theta: np.ndarray
 
     def at_times(self, times) -> tuple[np.ndarray, np.ndarray]:
-        """(x, y) linearly interpolated at `times` (s) inside the run."""
+        """(x, y) linearly interpolated at `times` (s) inside the run.
+
+        Parameters
+        ----------
+        times : array_like
+            Times inside the run, s.
+        """
         return np.interp(times, self.t, self.x), np.interp(times, self.t, self.y)
 
     def to_dict(self) -> dict:
@@ -89,18 +95,35 @@ class RunResult:
     trajectory: Trajectory | None = None
 
     def event(self, kind: str) -> Event | None:
-        """The event of type `kind`, if it happened."""
+        """The event of type `kind`, if it happened.
+
+        Parameters
+        ----------
+        kind : str
+            The event's type (`Event.type`).
+        """
         return next((e for e in self.events if e.type == kind), None)
 
     @property
     def collided(self) -> bool:
         return self.event("collision") is not None
 
+    def plot(self, ax=None, **kwargs):
+        """`plots.trajectory.plot_trajectory` of this run (recorded with its trajectory); returns the figure."""
+        from ..plots.trajectory import plot_trajectory
+
+        return plot_trajectory(self, ax=ax, **kwargs)
+
     def to_dict(self, trajectory: bool = False) -> dict:
         """Events, metrics and inputs as a JSON-ready dict (SI units); the sampled trajectory too if asked.
 
         ``inputs.measure.along_from`` is ``"-inf"`` when the metrics use the
         whole run (a start that is infinitely far back, not an undefined one).
+
+        Parameters
+        ----------
+        trajectory : bool
+            Include the sampled trajectory.
         """
         inputs = json_ready(self.scenario.inputs())
         inputs["measure"]["along_from"] = json_number(self.scenario.measure.along_from)

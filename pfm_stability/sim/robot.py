@@ -154,7 +154,13 @@ def delay_split(T, compute_delay, dead_time):
 
 
 def gauss_legendre(nodes: int = NODES):
-    """Nodes as fractions of an interval (0, 1) and weights summing to 1."""
+    """Nodes as fractions of an interval (0, 1) and weights summing to 1.
+
+    Parameters
+    ----------
+    nodes : int
+        Nodes of the rule.
+    """
     x, w = legendre_nodes(nodes)
     return (x + 1) / 2, w / 2
 
@@ -165,13 +171,28 @@ def slow_rate(k, max_steering_rate, gain=1.0):
     A held command is k·wrap(δ − θ) clipped to ±ω_max, and a servo's command
     k(δ̃ − θ) starts within ±kπ; the motor turns at g times the command, and
     ω lags it (eq 6), so it stays within the same bound.
+
+    Parameters
+    ----------
+    k : array_like
+        Steering gain, 1/s.
+    max_steering_rate : array_like
+        Rate limit ω_max, rad/s (of the command, before the gain).
+    gain : array_like
+        Plant gain g (1: KB's motor).
     """
     bound = np.minimum(np.asarray(max_steering_rate, dtype=float), np.pi * np.asarray(k, dtype=float))
     return np.asarray(gain, dtype=float) * bound
 
 
 def constant_input_modes(tau):
-    """(|λ|, −Re λ) of the held-command solution, 1/s, shape (B, 1): λ = −1/τ (absent: |λ| = 0 for τ = 0)."""
+    """(|λ|, −Re λ) of the held-command solution, 1/s, shape (B, 1): λ = −1/τ (absent: |λ| = 0 for τ = 0).
+
+    Parameters
+    ----------
+    tau : array_like, shape (B,)
+        Steering lag τ per member, s.
+    """
     tau = np.asarray(tau, dtype=float)
     lag = tau > 0
     rate = np.where(lag, 1.0 / np.where(lag, tau, 1.0), 0.0)
@@ -184,6 +205,13 @@ def servo_modes(tau, k):
     τ > 0: the roots of τλ² + λ + k, real (fast, slow; slow = k/(τ·fast)
     without cancellation) or a complex pair (counted once); τ = 0: λ = −k.
     Absent modes have |λ| = 0.
+
+    Parameters
+    ----------
+    tau : array_like, shape (B,)
+        Steering lag τ per member, s.
+    k : array_like, shape (B,)
+        Steering gain per member, 1/s.
     """
     tau = np.asarray(tau, dtype=float)
     k = np.asarray(k, dtype=float)
@@ -246,7 +274,13 @@ class Rule:
     h: np.ndarray
 
     def take(self, index) -> "Rule":
-        """The rules of some members."""
+        """The rules of some members.
+
+        Parameters
+        ----------
+        index : int, slice or ndarray
+            Which members.
+        """
         return Rule(self.t[index], self.w[index], self.h[index])
 
 
@@ -292,6 +326,11 @@ def node_sum(a):
     position (which still agrees with its run alone to round-off only, as
     numpy's SIMD sin/cos round arrays of other shapes differently;
     docs/simulator.md, "Batches").
+
+    Parameters
+    ----------
+    a : ndarray, shape (B, J, …)
+        Values at the nodes.
     """
     return np.cumsum(a, axis=1)[:, -1]
 
@@ -314,7 +353,13 @@ class Coefficients:
     rule: Rule
 
     def take(self, index) -> "Coefficients":
-        """The coefficients of some members."""
+        """The coefficients of some members.
+
+        Parameters
+        ----------
+        index : int, slice or ndarray
+            Which members.
+        """
         return Coefficients(self.maps[index], self.rule.take(index))
 
 
@@ -407,6 +452,15 @@ def propagate(coef: Coefficients, theta0, omega0, v):
     """Over one interval: (Δ at the nodes (B, J), correction (B,), θ at the end (B,), ω at the end (B,)).
 
     The correction is ∫₀ʰ Δ dt − Σⱼ wⱼΔⱼ, rad·s (`Coefficients.maps`).
+
+    Parameters
+    ----------
+    coef : Coefficients
+        The interval's linear maps and rule.
+    theta0, omega0 : ndarray, shape (B,)
+        Heading (rad) and rate (rad/s) at the interval's start.
+    v : ndarray, shape (B,)
+        The held value: command (rad/s) or reference (rad).
     """
     c = coef.maps
     out = c[:, :, 0] * theta0[:, None] + c[:, :, 1] * omega0[:, None] + c[:, :, 2] * v[:, None]

@@ -69,12 +69,14 @@ def scenario_law(
     env : {"grid", "analytic"}
     robot, controller : Robot, Controller
         W; f and n.
-    window_cells, cell_size, cv
-        Grid window side (odd), cell size (m) and the wall cells' certainty value.
+    window_cells, cell_size
+        Grid window side (odd) and cell size (m).
     law : ForceLaw or {"power", "grid"}, optional
         Analytic walls' law (a grid's law is its cells: not allowed with ``env="grid"``).
     cell_ratio : float, optional
         ρ = F_cr/F_ct of the grid, or of the analytic ``law="grid"``.
+    cv : float
+        The wall cells' certainty value.
 
     Raises
     ------
@@ -98,7 +100,15 @@ def scenario_law(
 
 @dataclass(frozen=True)
 class Pose:
-    """Position (m) and heading θ (rad, from +Y towards +X)."""
+    """Position (m) and heading θ (rad, from +Y towards +X).
+
+    Attributes
+    ----------
+    x, y : float
+        Position, m.
+    theta : float
+        Heading θ, rad from +Y towards +X.
+    """
 
     x: float
     y: float
@@ -138,7 +148,15 @@ class Target:
 
     @classmethod
     def point(cls, x: float, y: float, radius: float = 0.2) -> "Target":
-        """A target at (x, y), m, reached within `radius` m."""
+        """A target at (x, y), m, reached within `radius` m.
+
+        Parameters
+        ----------
+        x, y : float
+            Position, m.
+        radius : float
+            Reached within this distance, m.
+        """
         return cls(
             x=check_number("target x", x, unit="m"),
             y=check_number("target y", y, unit="m"),
@@ -147,7 +165,15 @@ class Target:
 
     @classmethod
     def direction(cls, angle: float, finish: float | None = None) -> "Target":
-        """A target at infinity in direction `angle` (rad from +Y towards +X)."""
+        """A target at infinity in direction `angle` (rad from +Y towards +X).
+
+        Parameters
+        ----------
+        angle : float
+            Direction, rad from +Y towards +X.
+        finish : float, optional
+            Reached when the robot has advanced this far along the direction from its start, m (None: never).
+        """
         finish = None if finish is None else check_number("finish", finish, 0.0, unit="m")
         return cls(angle=check_number("target angle", angle, unit="rad"), finish=finish)
 
@@ -339,7 +365,13 @@ class Scenario:
         return scenario_law("analytic", self.robot, self.controller, law=self.law)
 
     def clearance(self, x, y) -> np.ndarray:
-        """Distance from robot centres to the nearest obstacle, m (minus W/2: < 0 = collision)."""
+        """Distance from robot centres to the nearest obstacle, m (minus W/2: < 0 = collision).
+
+        Parameters
+        ----------
+        x, y : array_like
+            Robot centres, m.
+        """
         return self.environment.clearance(x, y) - self.robot.W / 2
 
     def _check_start_and_target(self) -> None:

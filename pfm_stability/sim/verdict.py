@@ -40,6 +40,11 @@ def simulated_verdict(run) -> tuple[str, str]:
     few turning points and a rejected linear fit) the run's settled flag
     `OscillationMetrics.stable` decides.
 
+    Parameters
+    ----------
+    run : RunResult
+        One simulated run.
+
     Returns
     -------
     (str, str)
@@ -59,5 +64,10 @@ def linearly_stable(result) -> np.ndarray:
     """`simulated_verdict` == "stable" for every member of a `BatchResult` (bool array).
 
     Not `BatchResult.stable` (the runs that settled): see the module docstring.
+
+    Parameters
+    ----------
+    result : BatchResult
+        The simulated batch.
     """
     return np.array([simulated_verdict(run)[0] == "stable" for run in result.runs], dtype=bool)

@@ -46,12 +46,24 @@ __all__ = [
 
 
 def wrap_angle(a):
-    """Shortest rotational equivalent of `a` (rad), in [−π, π)."""
+    """Shortest rotational equivalent of `a` (rad), in [−π, π).
+
+    Parameters
+    ----------
+    a : array_like
+        Angles, rad.
+    """
     return np.mod(np.asarray(a, dtype=float) + math.pi, 2 * math.pi) - math.pi
 
 
 def direction_of(fx, fy):
-    """Direction (rad, from +Y towards +X) of the vector (fx, fy); 0 for the zero vector."""
+    """Direction (rad, from +Y towards +X) of the vector (fx, fy); 0 for the zero vector.
+
+    Parameters
+    ----------
+    fx, fy : array_like
+        The vector's components.
+    """
     return np.arctan2(fx, fy)
 
 
@@ -205,7 +217,19 @@ def measured_equilibrium(law, angle: float, force: float) -> float:
 
 
 def steering_command(delta, theta, k, max_rate):
-    """u = k·wrap(δ − θ) (KB eq 5), clipped to ±max_rate (rad/s)."""
+    """u = k·wrap(δ − θ) (KB eq 5), clipped to ±max_rate (rad/s).
+
+    Parameters
+    ----------
+    delta : array_like
+        Direction δ of the resultant force, rad.
+    theta : array_like
+        Heading θ, rad.
+    k : array_like
+        Steering gain, 1/s.
+    max_rate : array_like
+        Rate limit, rad/s.
+    """
     return np.clip(k * wrap_angle(delta - theta), -max_rate, max_rate)
 
 
@@ -214,6 +238,15 @@ def vff_speed(V_max, fx, fy, theta):
 
     φ is the angle between the repulsive resultant (fx, fy) and the travel
     direction θ; with no repulsion the robot travels at V_max.
+
+    Parameters
+    ----------
+    V_max : float
+        Top speed, m/s.
+    fx, fy : array_like
+        The repulsive resultant.
+    theta : array_like
+        Travel direction θ, rad (from +Y towards +X).
     """
     norm = np.hypot(fx, fy)
     cos_phi = np.where(norm > 0, (fx * np.sin(theta) + fy * np.cos(theta)) / np.where(norm > 0, norm, 1.0), 0.0)

@@ -190,7 +190,13 @@ def compile_window_table(
 
 
 def stack_tables(tables) -> WindowTable:
-    """Concatenate the tables of several grids into one (rows, cells and occupied indices offset)."""
+    """Concatenate the tables of several grids into one (rows, cells and occupied indices offset).
+
+    Parameters
+    ----------
+    tables : sequence of WindowTable
+        One table per grid.
+    """
     tables = list(tables)
     if len(tables) == 1:
         return tables[0]

@@ -175,6 +175,13 @@ def default_chunk_size(spec: SweepSpec, workers: int) -> int:
 
     The table does not depend on it (every point is evaluated on its own), and a
     resumed sweep takes the chunk size of the interrupted run.
+
+    Parameters
+    ----------
+    spec : SweepSpec
+        The sweep (its point count, whether it simulates, its environment).
+    workers : int
+        Worker threads or processes.
     """
     if spec.simulate:
         return SIMULATION_CHUNK[spec.env]
@@ -189,6 +196,15 @@ def plan_chunks(count: int, chunk_size: int, *, fine_tail: bool = False) -> list
     the workers finish together instead of one waiting for the other's last
     full chunk. The plan depends on `count` and `chunk_size` only (never on the
     number of workers): resumed and re-run sweeps see the same chunks.
+
+    Parameters
+    ----------
+    count : int
+        Points in the sweep.
+    chunk_size : int
+        Largest chunk, points.
+    fine_tail : bool
+        Quarter-size chunks at the end.
     """
     sizes, left = [], count
     small = max(1, -(-chunk_size // 4))
@@ -204,12 +220,24 @@ def plan_chunks(count: int, chunk_size: int, *, fine_tail: bool = False) -> list
 
 
 def parts_directory(out: str) -> str:
-    """``OUT.parts``: where the chunks are written before the output."""
+    """``OUT.parts``: where the chunks are written before the output.
+
+    Parameters
+    ----------
+    out : str
+        The output path.
+    """
     return f"{out}.parts"
 
 
 def check_output(out) -> str:
-    """`out` if a ``.parquet`` or ``.csv`` file can be written there (`checks.check_output_path`), else ValueError."""
+    """`out` if a ``.parquet`` or ``.csv`` file can be written there (`checks.check_output_path`), else ValueError.
+
+    Parameters
+    ----------
+    out : str
+        The output path.
+    """
     text = os.fspath(out) if isinstance(out, os.PathLike) else out
     suffix = ".csv" if isinstance(text, str) and text.lower().endswith(".csv") else ".parquet"
     try:

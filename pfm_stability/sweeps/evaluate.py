@@ -55,7 +55,13 @@ SIM_OFFSET = {"analytic": 1e-4, "grid": 0.01}
 
 
 def model_columns(model: str) -> tuple:
-    """``<model>_stable``, ``<model>_verdict``, ``<model>_NV_critical``, ``<model>_margin``."""
+    """``<model>_stable``, ``<model>_verdict``, ``<model>_NV_critical``, ``<model>_margin``.
+
+    Parameters
+    ----------
+    model : str
+        A model name.
+    """
     return tuple(f"{model}_{suffix}" for suffix in ("stable", "verdict", "NV_critical", "margin"))
 
 
@@ -161,6 +167,11 @@ def loop_groups(tau, T, k):
     on each column alone (one sort each: a column with more than n/2 distinct
     values makes as many distinct loops), which spares random samples of τ, T
     or k the sort of all three columns together.
+
+    Parameters
+    ----------
+    tau, T, k : ndarray
+        τ (s), T (s) and k (1/s) per point.
     """
     n = len(tau)
     for column in (T, tau, k):
@@ -188,6 +199,17 @@ def model_answers(model: str, tau, T, k, NV, *, groups=_GROUP, **options) -> tup
     set are decided by `loop_verdicts` at their own NV. With more than half as
     many distinct loops as points, every point goes to `loop_verdicts` directly.
     `groups` is `loop_groups(tau, T, k)` when the caller has it already.
+
+    Parameters
+    ----------
+    model : str
+        One of `parameters.MODEL_NAMES`.
+    tau, T, k, NV : ndarray
+        τ (s), T (s), k (1/s) and NV (1/s) per point.
+    groups : tuple or None, optional
+        `loop_groups(tau, T, k)` if the caller has it (None: no grouping); computed when not given.
+    **options
+        ``hold``, ``compute_delay``, ``pade_order`` (`vectorized.loop_verdicts`).
     """
     from ..vectorized import loop_verdicts
 

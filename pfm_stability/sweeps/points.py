@@ -28,7 +28,13 @@ __all__ = ["all_points", "axis_values", "check_points", "chunk_points", "grid_po
 
 
 def axis_values(axis: Axis) -> np.ndarray:
-    """The values of one grid axis: ``num`` values from ``from`` to ``to``, linear or log-spaced (both ends exact)."""
+    """The values of one grid axis: ``num`` values from ``from`` to ``to``, linear or log-spaced (both ends exact).
+
+    Parameters
+    ----------
+    axis : Axis
+        One grid axis.
+    """
     if axis.num == 1:
         return np.array([axis.start])
     values = np.geomspace(axis.start, axis.stop, axis.num) if axis.scale == "log" else np.linspace(axis.start, axis.stop, axis.num)
@@ -37,14 +43,28 @@ def axis_values(axis: Axis) -> np.ndarray:
 
 
 def grid_points(axes, start: int, stop: int) -> dict:
-    """Points ``start`` … ``stop − 1`` of the grid `axes` (C order): parameter → array."""
+    """Points ``start`` … ``stop − 1`` of the grid `axes` (C order): parameter → array.
+
+    Parameters
+    ----------
+    axes : sequence of Axis
+        The grid's axes.
+    start, stop : int
+        The first point and one past the last.
+    """
     shape = tuple(a.num for a in axes)
     index = np.unravel_index(np.arange(start, stop, dtype=np.int64), shape)
     return {a.name: axis_values(a)[i] for a, i in zip(axes, index)}
 
 
 def sample_points(spec: SweepSpec) -> dict:
-    """Every point of the spec's sample: parameter → array of ``n`` values (seeded, reproducible)."""
+    """Every point of the spec's sample: parameter → array of ``n`` values (seeded, reproducible).
+
+    Parameters
+    ----------
+    spec : SweepSpec
+        A sweep with a sample.
+    """
     s = spec.sample
     draw = sobol if s.method == "sobol" else latin_hypercube  # sobol: the balance note is `sobol_note`'s
     unit = draw(s.n, len(s.ranges), s.seed)
@@ -55,7 +75,13 @@ def sample_points(spec: SweepSpec) -> dict:
 
 
 def sobol_note(spec: SweepSpec) -> str | None:
-    """A note when a Sobol sample's n is not a power of two (its balance properties then do not hold), else None."""
+    """A note when a Sobol sample's n is not a power of two (its balance properties then do not hold), else None.
+
+    Parameters
+    ----------
+    spec : SweepSpec
+        The sweep.
+    """
     s = spec.sample
     if s is None or s.method != "sobol" or s.n & (s.n - 1) == 0:
         return None
@@ -64,12 +90,28 @@ def sobol_note(spec: SweepSpec) -> str | None:
 
 
 def all_points(spec: SweepSpec) -> dict | None:
-    """A sample's points (drawn once for the whole sweep), or None for a grid (its chunks compute their own)."""
+    """A sample's points (drawn once for the whole sweep), or None for a grid (its chunks compute their own).
+
+    Parameters
+    ----------
+    spec : SweepSpec
+        The sweep.
+    """
     return sample_points(spec) if spec.sample is not None else None
 
 
 def chunk_points(spec: SweepSpec, start: int, stop: int, sample: dict | None = None) -> dict:
-    """The varying parameters' values at points ``start`` … ``stop − 1``."""
+    """The varying parameters' values at points ``start`` … ``stop − 1``.
+
+    Parameters
+    ----------
+    spec : SweepSpec
+        The sweep.
+    start, stop : int
+        The chunk's first point and one past its last.
+    sample : dict, optional
+        The sample's points (`all_points`); None for a grid.
+    """
     if spec.sample is None:
         return grid_points(spec.axes, start, stop)
     return {name: values[start:stop] for name, values in sample.items()}
@@ -79,6 +121,13 @@ def check_points(spec: SweepSpec, sample: dict | None = None) -> None:
     """Raise ValueError (``spec FILE: …``) if a corridor point has L <= W/2 (the robot does not fit).
 
     Cheap: the extremes of L and W are enough (each varies on its own axis or range).
+
+    Parameters
+    ----------
+    spec : SweepSpec
+        The sweep.
+    sample : dict, optional
+        Its sample's points (`all_points`), if already drawn.
     """
     if spec.geometry != "corridor":
         return

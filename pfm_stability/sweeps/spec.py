@@ -186,7 +186,13 @@ class SweepSpec:
         return base + tuple(name for name in LAW_SWEPT if name in self.varying)
 
     def fixed_value(self, name: str) -> float:
-        """The fixed value of an input column (robot, controller or geometry)."""
+        """The fixed value of an input column (robot, controller or geometry).
+
+        Parameters
+        ----------
+        name : str
+            An input column's name.
+        """
         if name in ROBOT_SWEPT:
             return getattr(self.robot, name)
         if name in CONTROLLER_SWEPT:

@@ -84,6 +84,12 @@ class SweepFigureData:
     labels: tuple = ()
     matrix: np.ndarray | None = None
 
+    def plot(self, ax=None):
+        """`plots.sweep.plot_sweep_summary` of this figure's data; returns the figure."""
+        from ..plots.sweep import plot_sweep_summary
+
+        return plot_sweep_summary(self, ax=ax)
+
 
 def _label(name: str) -> str:
     unit = UNITS.get(name)
@@ -91,7 +97,13 @@ def _label(name: str) -> str:
 
 
 def map_axes(spec) -> tuple:
-    """The varying parameters by how much they vary: most grid values first, then the widest relative range, then spec order."""
+    """The varying parameters by how much they vary: most grid values first, then the widest relative range, then spec order.
+
+    Parameters
+    ----------
+    spec : SweepSpec
+        The sweep.
+    """
     if spec.sample is not None:
         spans = [(name, math.inf, (hi - lo) / (abs(hi) + abs(lo))) for name, lo, hi in spec.sample.ranges]
     else:
@@ -116,7 +128,13 @@ def _thin(count: int) -> np.ndarray:
 
 
 def summary_figure_data(summary) -> SweepFigureData:
-    """The figure's data from a finished sweep (its output file and spec)."""
+    """The figure's data from a finished sweep (its output file and spec).
+
+    Parameters
+    ----------
+    summary : SweepSummary
+        The finished sweep.
+    """
     spec = summary.spec
     models = tuple(spec.models)
     axes = map_axes(spec)

@@ -176,6 +176,19 @@ class ParameterRuns:
     ``runs(name, values, second=(name2, values2))`` → the batch's `RunResult`s;
     α is given in degrees and simulated in radians. ``runs.runs`` counts the
     simulations.
+
+    Parameters
+    ----------
+    scenario : str
+        The scenario's name (`sim.presets.SCENARIO_NAMES`).
+    env : {"grid", "analytic"}
+        The environment's kind.
+    robot, controller : Robot, Controller
+        The robot and its controller.
+    fixed : dict
+        Parameters held fixed unless varied (simulator units: α in rad).
+    common : dict
+        Options of every batch (offset, duration, the grid's window and cells).
     """
 
     def __init__(self, scenario, env, robot, controller, fixed, common):
@@ -203,7 +216,15 @@ class ParameterRuns:
 
 
 def run_value(run, name) -> float:
-    """The parameter value a run really used (reported units): grid corridors snap L to c/2."""
+    """The parameter value a run really used (reported units): grid corridors snap L to c/2.
+
+    Parameters
+    ----------
+    run : RunResult
+        A simulated run.
+    name : str
+        A parameter (`V`, `L`, `alpha` in degrees, `f`).
+    """
     s = run.scenario
     if name == "L":
         return float(s.analysis["L"])
@@ -215,7 +236,17 @@ def run_value(run, name) -> float:
 
 
 def simulated_point(run, name, x_name=None) -> SimulatedPoint:
-    """The `SimulatedPoint` of one run: its value of `name` (and `x_name`), verdict and σ."""
+    """The `SimulatedPoint` of one run: its value of `name` (and `x_name`), verdict and σ.
+
+    Parameters
+    ----------
+    run : RunResult
+        A simulated run.
+    name : str
+        The varied parameter.
+    x_name : str, optional
+        A second varied parameter (a stability map's x).
+    """
     verdict, basis = simulated_verdict(run)
     return SimulatedPoint(run_value(run, name), verdict, basis, run.metrics.growth_rate, run_value(run, x_name) if x_name else None)
 
@@ -304,7 +335,13 @@ def bisect_boundary(simulate, name, p, domain, *, stable_above, members, rtol, q
 
 
 def crossing(lo_pt: SimulatedPoint, hi_pt: SimulatedPoint) -> float:
-    """Zero of σ by linear interpolation between the bracket's ends (midpoint when σ is not usable)."""
+    """Zero of σ by linear interpolation between the bracket's ends (midpoint when σ is not usable).
+
+    Parameters
+    ----------
+    lo_pt, hi_pt : SimulatedPoint
+        The bracket's ends.
+    """
     a, b = lo_pt.growth_rate, hi_pt.growth_rate
     if lo_pt.basis == hi_pt.basis == "growth_rate" and a is not None and b is not None and a * b < 0:
         return lo_pt.value + (hi_pt.value - lo_pt.value) * a / (a - b)

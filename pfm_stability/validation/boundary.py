@@ -163,6 +163,13 @@ class BoundaryValidation:
     seconds: float = 0.0
     models: tuple = ()
 
+    def plot(self):
+        """`plots.validation.plot_validation`: the stability map's overlay (when there is one) and σ against the parameter;
+        returns the figure."""
+        from ..plots.validation import plot_validation
+
+        return plot_validation(self)
+
     def to_dict(self) -> dict:
         """JSON form: ``parameter``, ``simulated_boundary``, ``predicted_boundary``, ``relative_error``,
         ``inputs``, and the rest; wall-clock ``seconds`` under ``timing``.

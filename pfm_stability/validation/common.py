@@ -72,6 +72,11 @@ class ParameterSpec:
         L (KB eq 25) and α (eq 24): wider and shallower is stable; V (eq 20):
         slower is stable; f: a corridor is stable for weaker repulsion (N ∝ f),
         a wall for stronger (the equilibrium moves out to a flatter force).
+
+        Parameters
+        ----------
+        scenario : str
+            ``"corridor"`` or ``"wall"``.
         """
         if self.name == "V":
             return False
@@ -92,6 +97,13 @@ PARAMETERS = {
 def parameter_spec(scenario: str, parameter: str) -> ParameterSpec:
     """The spec of `parameter`, after checking it exists in `scenario`.
 
+    Parameters
+    ----------
+    scenario : str
+        ``"corridor"`` or ``"wall"``.
+    parameter : str
+        The parameter's name.
+
     Raises
     ------
     ValueError
@@ -104,12 +116,26 @@ def parameter_spec(scenario: str, parameter: str) -> ParameterSpec:
 
 
 def default_parameter(scenario: str) -> str:
-    """L for a corridor, α for a wall (the environment parameter of KB eq 25 and 24)."""
+    """L for a corridor, α for a wall (the environment parameter of KB eq 25 and 24).
+
+    Parameters
+    ----------
+    scenario : str
+        ``"corridor"`` or ``"wall"``.
+    """
     return "L" if scenario == "corridor" else "alpha"
 
 
 def validation_models(controller: Controller, pade_order: int = 3) -> list:
-    """The five models of docs/models.md, ``sampled`` with the controller's hold and compute delay."""
+    """The five models of docs/models.md, ``sampled`` with the controller's hold and compute delay.
+
+    Parameters
+    ----------
+    controller : Controller
+        Hold and compute delay of ``sampled``.
+    pade_order : int
+        Order of ``pade``.
+    """
     return [
         make_model(name, pade_order=pade_order, hold=controller.hold, compute_delay=controller.compute_delay)
         for name in MODEL_NAMES
@@ -153,7 +179,15 @@ def predicted_boundaries(
 
 
 def relative_errors(predicted: dict, simulated: float) -> dict:
-    """(predicted − simulated)/simulated per model; None where a prediction is not finite."""
+    """(predicted − simulated)/simulated per model; None where a prediction is not finite.
+
+    Parameters
+    ----------
+    predicted : dict
+        Model name → predicted boundary.
+    simulated : float
+        The simulated boundary.
+    """
     return {
         name: (value - simulated) / simulated if math.isfinite(value) and simulated != 0 else None
         for name, value in predicted.items()
@@ -161,7 +195,13 @@ def relative_errors(predicted: dict, simulated: float) -> dict:
 
 
 def f_av_of(law: ForceLaw) -> float:
-    """KB's f_av of a grid law (§4), or a power law's f (`ForceLaw.lumped_f`)."""
+    """KB's f_av of a grid law (§4), or a power law's f (`ForceLaw.lumped_f`).
+
+    Parameters
+    ----------
+    law : ForceLaw
+        A grid or power law.
+    """
     return law.lumped_f()
 
 
@@ -177,6 +217,23 @@ def parameter_domain(parameter: str, scenario: str, env: str, robot: Robot, cont
     stays inside the active window (d0 < reach − c) where the wall acts.
     V: (1 mm/s, 100 m/s]. A corridor's f: f·[1e-3, 1e3].
     `alpha` is the wall angle (rad) when f is the parameter.
+
+    Parameters
+    ----------
+    parameter : str
+        ``L``, ``alpha``, ``V`` or ``f``.
+    scenario : str
+        ``"corridor"`` or ``"wall"``.
+    env : {"grid", "analytic"}
+        The environment's kind.
+    robot, controller : Robot, Controller
+        The robot and its controller.
+    law : ForceLaw
+        The walls' law.
+    alpha : float or None
+        The wall angle, rad, when f is the parameter.
+    cell_size : float
+        Cell side c, m.
     """
     contact = robot.W / 2 + (cell_size / 2 if env == "grid" else 0.0)
     margin = max(0.01, 0.02 * robot.W)

@@ -37,7 +37,13 @@ Shorter records (1–1.5 periods) read σ's sign right on the synthetic corridor
 
 # ---------------------------------------------------------------- segments
 def number(value):
-    """A real number as float, or None (None, NaN, bool or not a number)."""
+    """A real number as float, or None (None, NaN, bool or not a number).
+
+    Parameters
+    ----------
+    value : object
+        Anything.
+    """
     if isinstance(value, bool) or not isinstance(value, numbers.Real):
         return None
     value = float(value)
@@ -45,7 +51,13 @@ def number(value):
 
 
 def predicted(segment) -> bool:
-    """True if the segment carries a verdict to check (finite geometry, margin and a bool `stable`)."""
+    """True if the segment carries a verdict to check (finite geometry, margin and a bool `stable`).
+
+    Parameters
+    ----------
+    segment : MapSegment
+        A segment of a map's analysis.
+    """
     geometry = [number(getattr(segment, k, None)) for k in ("x0", "y0", "x1", "y1", "length")]
     margin = number(getattr(segment, "margin", None))
     stable = getattr(segment, "stable", None)
@@ -58,7 +70,17 @@ def predicted(segment) -> bool:
 
 
 def periods_omega(segment, robot: Robot, controller: Controller, model: Sampled) -> tuple:
-    """(ω for the period in rad/s, σ of the dominant root at N·V or None, True if that root oscillates)."""
+    """(ω for the period in rad/s, σ of the dominant root at N·V or None, True if that root oscillates).
+
+    Parameters
+    ----------
+    segment : MapSegment
+        The segment (N, c).
+    robot, controller : Robot, Controller
+        The robot and its controller.
+    model : Sampled
+        The sampled model.
+    """
     N = number(segment.N)
     c = number(getattr(segment, "c", 0.0)) or 0.0
     try:
@@ -77,7 +99,21 @@ def periods_omega(segment, robot: Robot, controller: Controller, model: Sampled)
 
 def required_length(omega: float, V: float, end_margin: float, min_periods: float = MIN_PERIODS, sigma: float | None = None) -> float:
     """Segment length a measurement needs, m: 2·end_margin + V·(`min_periods` periods 2π/ω, rad/s), and,
-    given the σ (1/s) of a non-oscillating dominant root, at least `min_periods`/|σ| (its sign shows only in a slow drift)."""
+    given the σ (1/s) of a non-oscillating dominant root, at least `min_periods`/|σ| (its sign shows only in a slow drift).
+
+    Parameters
+    ----------
+    omega : float
+        Oscillation frequency, rad/s.
+    V : float
+        Speed, m/s.
+    end_margin : float
+        Length left out at each end, m.
+    min_periods : float
+        Periods the measurement needs.
+    sigma : float, optional
+        σ of a non-oscillating dominant root, 1/s.
+    """
     duration = min_periods * 2 * math.pi / omega
     if sigma:
         duration = max(duration, min_periods / abs(sigma))

@@ -91,7 +91,17 @@ for every |margin| > 10 % (docs/maps.md, "Validation")."""
 def short_record_fit(x, order: int, T: float):
     """(σ 1/s, ω rad/s, relative residual) of the dominant root of the order-`order` linear-prediction fit of the
     difference record `x` (m, step T s: `sim.metrics`' fit), or None when the fit fails, its residual exceeds
-    `SHORT_RESIDUAL`, or its dominant root does not oscillate (a monotone drift over a short record says nothing)."""
+    `SHORT_RESIDUAL`, or its dominant root does not oscillate (a monotone drift over a short record says nothing).
+
+    Parameters
+    ----------
+    x : ndarray
+        The difference record, m.
+    order : int
+        The fit's order (`sim.cycles.loop_order`).
+    T : float
+        Its step, s.
+    """
     fit = linear_prediction(np.asarray(x, dtype=float), order, T)
     if fit is None or not fit[2] < SHORT_RESIDUAL or not fit[1] > 0:
         return None
@@ -105,21 +115,51 @@ synthetic corridors of tests/test_map_validation.py (1–1.5 periods, straight a
 
 def resolution(duration: float, fitted: bool = False) -> float:
     """Smallest |σ| (1/s) a run of `duration` s resolves: max(`SIGMA_RESOLUTION`, `MIN_EFOLDS`/duration) (the peaks'
-    scatter); `FIT_RESOLUTION` for σ from `short_record_fit` (it reads the root, not the amplitudes: no e-fold)."""
+    scatter); `FIT_RESOLUTION` for σ from `short_record_fit` (it reads the root, not the amplitudes: no e-fold).
+
+    Parameters
+    ----------
+    duration : float
+        The run's length, s.
+    fitted : bool
+        σ comes from `short_record_fit`.
+    """
     if fitted:
         return FIT_RESOLUTION
     return max(SIGMA_RESOLUTION, MIN_EFOLDS / duration) if duration > 0 else math.inf
 
 
 def resolved(sigma: float, duration: float, fitted: bool = False) -> bool:
-    """True if a measured σ (1/s) is outside the run's `resolution` (its sign is read); else σ ≈ 0 (`contradicts`)."""
+    """True if a measured σ (1/s) is outside the run's `resolution` (its sign is read); else σ ≈ 0 (`contradicts`).
+
+    Parameters
+    ----------
+    sigma : float
+        The measured σ, 1/s.
+    duration : float
+        The run's length, s.
+    fitted : bool
+        σ comes from `short_record_fit`.
+    """
     return abs(sigma) >= resolution(duration, fitted)
 
 
 def contradicts(predicted: float | None, sigma: float, duration: float, fitted: bool = False) -> bool:
     """True if a measured σ within the resolution (no sign) contradicts the predicted σ̄ (1/s): they differ by more than
     the run's `resolution`, so the run would have shown the predicted growth or decay (a disagreement). False: the
-    prediction is within the resolution too, and the run decides nothing ("not measurable"; docs/maps.md, "Validation")."""
+    prediction is within the resolution too, and the run decides nothing ("not measurable"; docs/maps.md, "Validation").
+
+    Parameters
+    ----------
+    predicted : float or None
+        The predicted σ̄, 1/s.
+    sigma : float
+        The measured σ, 1/s.
+    duration : float
+        The run's length, s.
+    fitted : bool
+        σ comes from `short_record_fit`.
+    """
     return predicted is not None and math.isfinite(predicted) and abs(predicted - sigma) > resolution(duration, fitted)
 
 
@@ -270,14 +310,28 @@ class MapValidation:
 # ------------------------------------------------------------------- runs
 def linear_offset(robot: Robot, N: float) -> float:
     """Largest start offset that keeps the steering linear, m: the heading error N·δ it causes
-    asks k·N·δ of the steering, at most `LINEAR_FRACTION` of the robot's rate limit."""
+    asks k·N·δ of the steering, at most `LINEAR_FRACTION` of the robot's rate limit.
+
+    Parameters
+    ----------
+    robot : Robot
+        k (1/s) and its rate limit (rad/s).
+    N : float
+        The segment's gain, 1/m.
+    """
     if not N or not math.isfinite(N) or not math.isfinite(robot.max_steering_rate):
         return math.inf
     return LINEAR_FRACTION * robot.max_steering_rate / (robot.k * abs(N))
 
 
 def simulator_grid(hmap) -> HistogramGrid:
-    """The simulator's frozen `HistogramGrid` of a map's histogram grid (`maps.field.HistogramMap`: same cells, same origin)."""
+    """The simulator's frozen `HistogramGrid` of a map's histogram grid (`maps.field.HistogramMap`: same cells, same origin).
+
+    Parameters
+    ----------
+    hmap : HistogramMap
+        The map's histogram grid.
+    """
     nx, ny = hmap.shape
     c = hmap.cell_size
     grid = HistogramGrid(hmap.x_min, hmap.y_min, nx * c, ny * c, cell_size=c)
@@ -286,7 +340,15 @@ def simulator_grid(hmap) -> HistogramGrid:
 
 
 def crop_grid(grid: HistogramGrid, x_lo: float, x_hi: float, y_lo: float, y_hi: float) -> HistogramGrid:
-    """A frozen copy of the cells of `grid` covering [x_lo, x_hi] × [y_lo, y_hi] (m), aligned with its cells."""
+    """A frozen copy of the cells of `grid` covering [x_lo, x_hi] × [y_lo, y_hi] (m), aligned with its cells.
+
+    Parameters
+    ----------
+    grid : HistogramGrid
+        The whole grid.
+    x_lo, x_hi, y_lo, y_hi : float
+        The area to keep, m.
+    """
     c = grid.cell_size
     nx, ny = grid.shape
     i0 = min(max(math.floor((x_lo - grid.x_min) / c), 0), nx - 1)

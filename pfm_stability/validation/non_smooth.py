@@ -1,24 +1,20 @@
 """The simulated cycle of a non-smooth verdict (velocity-gated repulsion beside a wall).
 
 GC2002's velocity-gated repulsion exerts nothing parallel to a wall, so the report
-(`family_report.build_family_report`, level 8) can give only the non-smooth verdict
+(`report.stability.build_report`, below this level) can give only the non-smooth verdict
 and its Filippov rest band (docs/velocity_and_fuzzy.md). What the robot then does —
 rest, chatter or a limit cycle — only a simulation says: `simulated_cycle` runs the
 planar simulator (`sim.cycles.wall_cycle`) for the report's robot family and returns
-the cycle's measures (mean distance, peak-to-peak, heading amplitude, period, …), and
-`fill_cycles` puts them into a report. The CLI calls it (``report --law velocity-gated``,
-unless ``--no-simulate``).
+the cycle's measures (mean distance, peak-to-peak, heading amplitude, period, …). The
+CLI hands it to `build_report` (``report --law velocity-gated``, unless ``--no-simulate``).
 """
 
 from __future__ import annotations
 
-import math
-from dataclasses import replace
-
 from ..checks import check_choice
 from ..parameters import ROBOT_FAMILIES, Controller, Robot
 
-__all__ = ["CYCLE_DURATION", "simulated_cycle", "fill_cycles"]
+__all__ = ["CYCLE_DURATION", "simulated_cycle"]
 
 CYCLE_DURATION = 60.0
 """Simulated time of one cycle measurement, s."""
@@ -64,18 +60,3 @@ def simulated_cycle(family: str, robot: Robot, controller: Controller, law, alph
     planar = _planar_robot(family, robot, controller, mass, law.parameters["a_max"])
     cycle = wall_cycle(law.gated(), law.attraction, alpha, planar, T=controller.T, compute_delay=controller.compute_delay, duration=duration)
     return cycle.to_dict()
-
-
-def fill_cycles(report, family: str, robot: Robot, controller: Controller, law, *, mass: float = 1.0, duration: float = CYCLE_DURATION):
-    """`report` with the wall's non-smooth scene carrying its simulated cycle.
-
-    A corridor has none (the simulator measures wall cycles only), nor has a continuous
-    controller (T = 0): the cycle stays None there.
-    """
-    scenes = report.extras.get("scenes", {})
-    wall = scenes.get("wall")
-    if wall is None or not hasattr(wall, "cycle") or controller.T == 0:  # T = 0: a continuous controller, nothing sampled to simulate
-        return report
-    cycle = simulated_cycle(family, robot, controller, law, math.radians(wall.value), mass=mass, duration=duration)
-    extras = {**report.extras, "scenes": {**scenes, "wall": replace(wall, cycle=cycle)}}
-    return replace(report, extras=extras)

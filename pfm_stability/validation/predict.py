@@ -86,6 +86,17 @@ def model_answer(model: LoopModel, loop: Loop, NV: float | None = None, *, root:
     The verdict is `models.verdict_label` (within `UNDECIDED_RTOL` of an edge
     of the stable set: "undecided"); at NV = 0 the model judges its heading
     loop, as in `pfm_stability.analysis.criteria` (docs/models.md, "N = 0").
+
+    Parameters
+    ----------
+    model : LoopModel
+        The model.
+    loop : Loop
+        τ (s), T (s), k (1/s) and the heading gain c.
+    NV : float, optional
+        The operating loop gain, 1/s.
+    root : bool
+        Also the dominant root.
     """
     boundary = model.boundary(loop)
     if NV is None:
@@ -96,7 +107,17 @@ def model_answer(model: LoopModel, loop: Loop, NV: float | None = None, *, root:
 
 
 def environment_gain(kind: str, law: ForceLaw, geometry: float) -> float:
-    """N (1/m) of a corridor of half-width L = `geometry` (m) or a wall at α = `geometry` (rad), KB eq 11, 23, 25."""
+    """N (1/m) of a corridor of half-width L = `geometry` (m) or a wall at α = `geometry` (rad), KB eq 11, 23, 25.
+
+    Parameters
+    ----------
+    kind : {"corridor", "wall"}
+        The geometry.
+    law : ForceLaw
+        The walls' law.
+    geometry : float
+        L (m) or α (rad).
+    """
     return corridor_gain(law, geometry) if kind == "corridor" else wall_gain(law, geometry)[1]
 
 
@@ -135,7 +156,13 @@ def critical_value(parameter: str, kind: str, law: ForceLaw, V: float, NV_critic
 
 
 def lumped_law(law: ForceLaw) -> PowerLaw:
-    """KB's lumped law beside a grid law: f = the grid's f_av (KB §4); a power law is its own."""
+    """KB's lumped law beside a grid law: f = the grid's f_av (KB §4); a power law is its own.
+
+    Parameters
+    ----------
+    law : ForceLaw
+        A grid or power law.
+    """
     return law.lumped() if isinstance(law, GridWallLaw) else law
 
 
@@ -228,7 +255,13 @@ def _one(scenario: Scenario, model: LoopModel, law: ForceLaw) -> ModelPrediction
 
 
 def predict(scenario: Scenario) -> Prediction | None:
-    """Model predictions for `scenario` (None when no linear analysis applies)."""
+    """Model predictions for `scenario` (None when no linear analysis applies).
+
+    Parameters
+    ----------
+    scenario : Scenario
+        A simulated scenario.
+    """
     a = scenario.analysis
     if not a:
         return None

@@ -166,7 +166,7 @@ def stability_map(simulate, scenario, spec, env, robot, controller, law, geometr
     scenario : {"corridor", "wall"}
     spec : common.ParameterSpec
         The bisected parameter.
-    env, robot, controller, law, geometry, cell_size
+    env, robot, controller, law, geometry
         As in `validate_boundary` (geometry: L m or α rad).
     boundary : float
         The bisected boundary (reported units).
@@ -174,6 +174,8 @@ def stability_map(simulate, scenario, spec, env, robot, controller, law, geometr
         The simulable values of the bisected parameter.
     shape : (int, int)
         (nx, ny).
+    cell_size : float
+        As in `validate_boundary`: cell side c, m.
     models : list of LoopModel
     progress : callable or None
     """
@@ -258,6 +260,12 @@ class SimulatedBoundary:
     curves: dict | None = None
     lumped_curves: dict | None = None
     models: tuple = ()
+
+    def plot(self, ax=None, **kwargs):
+        """`plots.validation.plot_simulated_boundary` of these points; returns the figure."""
+        from ..plots.validation import plot_simulated_boundary
+
+        return plot_simulated_boundary(self, ax=ax, **kwargs)
 
     def to_dict(self) -> dict:
         """Plain JSON types (arrays as lists, non-finite values as None)."""

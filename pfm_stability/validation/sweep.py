@@ -215,11 +215,22 @@ class SweepResult:
     ranges: dict
     seconds: float
 
+    def plot(self, axes=None):
+        """`plots.validation.plot_sweep`: σ against NV/NV* of ``sampled``, and the other models' view; returns the figure."""
+        from ..plots.validation import plot_sweep
+
+        return plot_sweep(self, axes=axes)
+
     def to_dict(self, points: bool = False) -> dict:
         """Plain JSON form; every point only with ``points=True`` (the disagreements always).
 
         ``agreement`` and ``wrong_verdict_rate`` are null (undefined) when no
         set was included; wall-clock ``seconds`` is under ``timing``.
+
+        Parameters
+        ----------
+        points : bool
+            Every point, not only the disagreements.
         """
         out = {
             "count": int(self.count),
@@ -241,6 +252,15 @@ class SweepResult:
 
 def sweep_parameters(count: int, seed: int = 0, ranges: dict | None = None) -> dict:
     """The Latin-hypercube samples: arrays V, tau, T, k, f and geometry fraction u ∈ [0, 1), plus scenario and structure per member.
+
+    Parameters
+    ----------
+    count : int
+        Samples.
+    seed : int
+        Seed of the generator.
+    ranges : dict, optional
+        Overrides of `SWEEP_RANGES` (same keys).
 
     Returns
     -------
@@ -271,6 +291,17 @@ def simulation_duration(loop: Loop, hold: str, delay: int, env: str) -> float:
 
     8 periods of the sampled model's boundary oscillation (hold, compute
     delay), in [20 s (grid 30 s), 150 s], and at most `_MAX_SAMPLES` samples.
+
+    Parameters
+    ----------
+    loop : Loop
+        τ (s), T (s), k (1/s).
+    hold : str
+        The sampled model's hold.
+    delay : int
+        Its compute delay.
+    env : {"grid", "analytic"}
+        The environment's kind.
     """
     b = make_model("sampled", hold=hold, compute_delay=delay).boundary(loop)
     period = 2 * math.pi / b.omega_critical if b.omega_critical else 0.0

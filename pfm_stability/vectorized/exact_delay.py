@@ -104,6 +104,21 @@ def loop_gain_arrays(V, tau, T, k, f, n, W, *, alpha=None, L=None):
     N per KB's power law: wall N = (n/W) f^(−1/n) cos^((n+1)/n)α / sin α
     (eq 11 at the equilibrium of eq 23); corridor N = 2nfWⁿ/L^(n+1) (eq 25).
 
+    Parameters
+    ----------
+    V : array_like
+        Speed, m/s.
+    tau, T, k : array_like
+        τ (s), T (s) and k (1/s).
+    f, n : array_like
+        KB's power law: strength and exponent (dimensionless).
+    W : array_like
+        Robot width, m.
+    alpha : array_like, optional
+        Target angle to the wall, rad (a wall; give `alpha` or `L`).
+    L : array_like, optional
+        Corridor half-width, m (a corridor).
+
     Raises
     ------
     ValueError
@@ -171,7 +186,13 @@ def _run_chunks(func, arrays):
 
 
 def heading_gain_array(c) -> np.ndarray:
-    """c as a float array, every value finite and in `HEADING_GAIN_RANGE`; else `Loop`'s message and the point index."""
+    """c as a float array, every value finite and in `HEADING_GAIN_RANGE`; else `Loop`'s message and the point index.
+
+    Parameters
+    ----------
+    c : array_like
+        Heading gains (dimensionless).
+    """
     try:
         c = np.asarray(c, dtype=float)
     except (TypeError, ValueError):

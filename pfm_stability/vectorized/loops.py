@@ -163,6 +163,8 @@ def _fallback(points, options):
 def loop_verdicts(model, tau, T, k, NV, *, c=None, hold="command", compute_delay=0, pade_order=3, columns="all") -> LoopVerdicts:
     """One loop model's verdicts, NV* and margins for arrays of points.
 
+    All arrays broadcast together (scalars allowed).
+
     Parameters
     ----------
     model : str
@@ -189,8 +191,6 @@ def loop_verdicts(model, tau, T, k, NV, *, c=None, hold="command", compute_delay
         for ``sampled``, ``pade`` and ``exact_delay`` (no boundary search
         except at the few points near an edge, `_verdicts_only`); the other
         fields are then NaN (`regular`: False), not computed.
-
-    All arrays broadcast together (scalars allowed).
 
     Returns
     -------

@@ -32,7 +32,13 @@ _REAL_ROOT_TOL = 1e-7
 
 
 def leading_zeros(P) -> np.ndarray:
-    """Number of leading exact zeros of each row (the row's degree is width − 1 − this)."""
+    """Number of leading exact zeros of each row (the row's degree is width − 1 − this).
+
+    Parameters
+    ----------
+    P : ndarray, shape (N, width)
+        Coefficient rows, descending powers.
+    """
     nonzero = P != 0
     first = np.argmax(nonzero, axis=1)
     return np.where(nonzero.any(axis=1), first, P.shape[1])
@@ -122,6 +128,8 @@ def real_roots(c, low: float = 0.0) -> np.ndarray:
     ----------
     c : ndarray, shape (N, d + 1)
         Ascending coefficients; trailing zeros (a lower degree) allowed.
+    low : float
+        Only roots >= `low` are returned.
 
     Returns
     -------
@@ -187,7 +195,9 @@ def _newton(c, y, steps: int = 3):
 class GainSets:
     """Stable gain sets of rows of D + K·E (`affine_stable_sets`).
 
-    Attributes
+    Each parameter is kept as the attribute of the same name.
+
+    Parameters
     ----------
     K_critical : ndarray
         K*: the end of the stable interval (0, K*) (``inf``: stable for every
@@ -288,6 +298,11 @@ def hurwitz_columns(Q) -> np.ndarray:
     degree 4, q₁q₂q₃ > q₀q₃² + q₁²q₄ (the Hurwitz determinants Δ₂, Δ₃; Routh's
     first column is q₀, q₁, Δ₂/q₁, Δ₃/Δ₂, q₄). Rows whose leading
     coefficient is 0 or not finite (a lower degree) go to `hurwitz_stable`.
+
+    Parameters
+    ----------
+    Q : sequence of ndarray
+        The coefficient columns, descending powers: Q[i][r] is row r's coefficient of s^(len(Q) − 1 − i).
     """
     lead = Q[0]
     sign = np.sign(lead)

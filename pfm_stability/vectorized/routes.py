@@ -33,7 +33,19 @@ _NONE = np.zeros(0, dtype=np.int64)
 
 @dataclass
 class Answers:
-    """Per-point answers of an array route (flat arrays; NaN ω where the boundary has None)."""
+    """Per-point answers of an array route (flat arrays; NaN ω where the boundary has None).
+
+    Attributes
+    ----------
+    stable : ndarray of bool
+        The verdict at each point's NV.
+    NV_critical : ndarray
+        NV*, 1/s.
+    omega_critical : ndarray
+        ω*, rad/s.
+    regular : ndarray of bool
+        The stable set is (0, NV*) (or empty).
+    """
 
     stable: np.ndarray
     NV_critical: np.ndarray
@@ -65,7 +77,15 @@ def _neutral_columns(D, E, K):
 
 def continuous(points, options):
     """KB eq (17) with c: τs³ + s² + k(1 + c)s + K. Routh: stable ⇔ 0 < τK < k(1 + c) (K = 0: the heading
-    loop τs² + s + k(1 + c), stable); NV* = (1 + c)/τ, ω* = √(k(1 + c)/τ) (τ = 0: stable for every NV > 0)."""
+    loop τs² + s + k(1 + c), stable); NV* = (1 + c)/τ, ω* = √(k(1 + c)/τ) (τ = 0: stable for every NV > 0).
+
+    Parameters
+    ----------
+    points : tuple of ndarray
+        The flat, checked (τ, T, k, c, NV): s, s, 1/s, dimensionless, 1/s (`loops.loop_arrays`).
+    options : dict
+        ``hold``, ``compute_delay`` and ``pade_order`` (checked by `loops.loop_verdicts`).
+    """
     tau, T, k, c, NV = points
     kc = k * (1.0 + c)
     K = k * NV
@@ -86,6 +106,13 @@ def kb_first_order(points, options):
     a₁ <= 0: unstable at every NV. τ = 0: the quadratic a₁s² + … is stable
     for 0 < K < k(1 + c)/T when a₁ > 0. a₁ = 0 exactly (a degree drop) goes to
     the scalar model.
+
+    Parameters
+    ----------
+    points : tuple of ndarray
+        The flat, checked (τ, T, k, c, NV): s, s, 1/s, dimensionless, 1/s (`loops.loop_arrays`).
+    options : dict
+        ``hold``, ``compute_delay`` and ``pade_order`` (checked by `loops.loop_verdicts`).
     """
     tau, T, k, c, NV = points
     K = k * NV
@@ -107,6 +134,13 @@ def exact_delay(points, options):
     the boundary of those loops comes from the scalar model (cached per loop),
     the verdict still from the crossing count, which also decides K = 0 (the
     heading loop τs² + s + k + kc·e^(−sT)).
+
+    Parameters
+    ----------
+    points : tuple of ndarray
+        The flat, checked (τ, T, k, c, NV): s, s, 1/s, dimensionless, 1/s (`loops.loop_arrays`).
+    options : dict
+        ``hold``, ``compute_delay`` and ``pade_order`` (checked by `loops.loop_verdicts`).
     """
     tau, T, k, c, NV = points
     K = k * NV
@@ -144,7 +178,17 @@ def _kb_critical_gain(tau, T, k):
 
 
 def pade_polynomials(tau, T, k, c, order):
-    """Rows of D = (τs³ + s² + ks)·Q_m + kc·s·P_m and E = P_m (`models.pade.Pade.batch_polynomials` in arrays)."""
+    """Rows of D = (τs³ + s² + ks)·Q_m + kc·s·P_m and E = P_m (`models.pade.Pade.batch_polynomials` in arrays).
+
+    Parameters
+    ----------
+    tau, T, k : ndarray
+        τ (s), T (s, > 0) and k (1/s), one loop per element.
+    c : ndarray
+        Heading gain per loop (dimensionless).
+    order : int
+        Padé order m, 1 … 12.
+    """
     m = order
     coefficients = np.array([_pade_term(m, j) for j in range(m + 1)])
     powers = T[:, None] ** np.arange(m + 1)
@@ -164,7 +208,15 @@ def pade_polynomials(tau, T, k, c, order):
 
 
 def pade(points, options):
-    """KB eq (18) with Padé(m, m): Routh on D + K·E for the verdict, the crossing route for K*."""
+    """KB eq (18) with Padé(m, m): Routh on D + K·E for the verdict, the crossing route for K*.
+
+    Parameters
+    ----------
+    points : tuple of ndarray
+        The flat, checked (τ, T, k, c, NV): s, s, 1/s, dimensionless, 1/s (`loops.loop_arrays`).
+    options : dict
+        ``hold``, ``compute_delay`` and ``pade_order`` (checked by `loops.loop_verdicts`).
+    """
     tau, T, k, c, NV = points
     D, E = pade_polynomials(tau, T, k, c, options["pade_order"])
     stable = _neutral_stable(D, E, k * NV)
@@ -182,7 +234,15 @@ def sampled(points, options):
     (plus the degree drop, a pole through z = −1 at ω = π/T), frequencies mapped back by
     ω = 2·atan(ΩT/2)/T; T = 0 is the continuous loop (KB eq 17), as `models.sampled` takes it.
     K* from the Hurwitz conditions in K (`vectorized.hurwitz_gain`); the rows that route leaves
-    `unsure` from the crossings (`polynomial.affine_stable_sets`)."""
+    `unsure` from the crossings (`polynomial.affine_stable_sets`).
+
+    Parameters
+    ----------
+    points : tuple of ndarray
+        The flat, checked (τ, T, k, c, NV): s, s, 1/s, dimensionless, 1/s (`loops.loop_arrays`).
+    options : dict
+        ``hold``, ``compute_delay`` and ``pade_order`` (checked by `loops.loop_verdicts`).
+    """
     tau, T, k, c, NV = points
     answers, _, _ = continuous(points, options)
     for group in _sampled_groups(tau, T):
@@ -214,7 +274,19 @@ def _bracketed(tests):
 
 def sampled_stable(points, options, K, eps):
     """(stable, near) of the sampled loop at gains K: near where the test at K(1 ± ε) differs
-    (one polynomial per point, tested at three gains; T = 0: KB eq 17 by Routh)."""
+    (one polynomial per point, tested at three gains; T = 0: KB eq 17 by Routh).
+
+    Parameters
+    ----------
+    points : tuple of ndarray
+        The flat, checked (τ, T, k, c, NV): s, s, 1/s, dimensionless, 1/s (`loops.loop_arrays`).
+    options : dict
+        ``hold``, ``compute_delay`` and ``pade_order`` (checked by `loops.loop_verdicts`).
+    K : ndarray
+        The gains kNV at which to test, 1/s².
+    eps : float
+        Relative step ε of the neighbouring gains K(1 ± ε).
+    """
     tau, T, k, c, NV = points
     gains = (K, K * (1.0 - eps), K * (1.0 + eps))
     out = [(g >= 0) & (k * (1.0 + c) - tau * g > 0) for g in gains]
@@ -226,7 +298,19 @@ def sampled_stable(points, options, K, eps):
 
 
 def pade_stable(points, options, K, eps):
-    """(stable, near) of the Padé loop at gains K (Routh at K and K(1 ± ε))."""
+    """(stable, near) of the Padé loop at gains K (Routh at K and K(1 ± ε)).
+
+    Parameters
+    ----------
+    points : tuple of ndarray
+        The flat, checked (τ, T, k, c, NV): s, s, 1/s, dimensionless, 1/s (`loops.loop_arrays`).
+    options : dict
+        ``hold``, ``compute_delay`` and ``pade_order`` (checked by `loops.loop_verdicts`).
+    K : ndarray
+        The gains kNV at which to test, 1/s².
+    eps : float
+        Relative step ε of the neighbouring gains K(1 ± ε).
+    """
     tau, T, k, c, NV = points
     D, E = pade_polynomials(tau, T, k, c, options["pade_order"])
     return _bracketed([_neutral_stable(D, E, g) for g in (K, K * (1.0 - eps), K * (1.0 + eps))])
@@ -236,7 +320,19 @@ def exact_delay_stable(points, options, K, eps):
     """(stable, near) of KB eq (18) (with c) at gains K: one crossing by `single_crossing_verdicts`;
     three crossings flagged `near` (the caller decides them with the boundary, all chunks' in one
     call: a few per thousand random points); heading gains and K = 0 (the heading loop) by the crossing
-    count at K and K(1 ± ε)."""
+    count at K and K(1 ± ε).
+
+    Parameters
+    ----------
+    points : tuple of ndarray
+        The flat, checked (τ, T, k, c, NV): s, s, 1/s, dimensionless, 1/s (`loops.loop_arrays`).
+    options : dict
+        ``hold``, ``compute_delay`` and ``pade_order`` (checked by `loops.loop_verdicts`).
+    K : ndarray
+        The gains kNV at which to test, 1/s².
+    eps : float
+        Relative step ε of the neighbouring gains K(1 ± ε).
+    """
     tau, T, k, c, NV = points
     stable, near, three = single_crossing_verdicts(tau, T, k, K, eps)
     near |= three

@@ -34,6 +34,15 @@ def continuous_plants(tau, k, c, hold: str):
     """Stacks (A, B, F0, F1) of `models.sampled.continuous_plant` for one state size.
 
     τ > 0 everywhere (states ω, θ, y) or τ = 0 everywhere (θ, y).
+
+    Parameters
+    ----------
+    tau, k : ndarray
+        τ (s) and k (1/s), one loop per element.
+    c : ndarray
+        Heading gain per loop (dimensionless).
+    hold : {"command", "reference"}
+        What the computer holds (`parameters.HOLDS`).
     """
     N = tau.size
     lag = bool(tau.size) and tau[0] > 0
@@ -64,7 +73,15 @@ def continuous_plants(tau, k, c, hold: str):
 
 
 def delta_plants(A, B, T):
-    """(Ψ, G) for stacks A, B and periods T > 0, as `models.sampled.delta_plant` forms them."""
+    """(Ψ, G) for stacks A, B and periods T > 0, as `models.sampled.delta_plant` forms them.
+
+    Parameters
+    ----------
+    A, B : ndarray
+        Stacks of continuous-time plants (`continuous_plants`).
+    T : ndarray
+        Sampling periods, s (> 0).
+    """
     n = A.shape[-1]
     Phi, integral = zoh_blocks(A, T)
     t = T[:, None, None]
@@ -82,6 +99,17 @@ def delta_columns(tau, T, k, c, hold: str, compute_delay: int):
     f (k(1 + c) for the command hold, kc for the reference hold) and F1 only
     its y entry, so det(wI − Ψ) = w·det(wI − Ψ_servo) and the adjugate terms
     F·adj(wI − Ψ)·G reduce to the sums below (expanded symbolically once).
+
+    Parameters
+    ----------
+    tau, T, k : ndarray
+        τ (s), T (s, > 0) and k (1/s), one loop per element.
+    c : ndarray
+        Heading gain per loop (dimensionless).
+    hold : {"command", "reference"}
+        What the computer holds (`parameters.HOLDS`).
+    compute_delay : {0, 1}
+        Samples from measurement to actuation.
     """
     reference = hold == "reference"
     e = delta_entries(tau, T, k, reference)
@@ -109,14 +137,38 @@ def delta_columns(tau, T, k, c, hold: str, compute_delay: int):
 
 def bilinear_columns(tau, T, k, c, hold: str, compute_delay: int):
     """(D, E) in μ of `models.sampled.Sampled.bilinear_polynomials`, as lists of coefficient arrays
-    (descending, one length), rows with T > 0 and one state size."""
+    (descending, one length), rows with T > 0 and one state size.
+
+    Parameters
+    ----------
+    tau, T, k : ndarray
+        τ (s), T (s, > 0) and k (1/s), one loop per element.
+    c : ndarray
+        Heading gain per loop (dimensionless).
+    hold : {"command", "reference"}
+        What the computer holds (`parameters.HOLDS`).
+    compute_delay : {0, 1}
+        Samples from measurement to actuation.
+    """
     D, E = delta_columns(tau, T, k, c, hold, compute_delay)
     return _bilinear_columns(D, T), _bilinear_columns(E, T)
 
 
 def bilinear_polynomials(tau, T, k, c, hold: str, compute_delay: int):
     """(D, E) in μ (descending, one width) of `models.sampled.Sampled.bilinear_polynomials`, rows with T > 0
-    and one state size (τ > 0 everywhere or τ = 0 everywhere)."""
+    and one state size (τ > 0 everywhere or τ = 0 everywhere).
+
+    Parameters
+    ----------
+    tau, T, k : ndarray
+        τ (s), T (s, > 0) and k (1/s), one loop per element.
+    c : ndarray
+        Heading gain per loop (dimensionless).
+    hold : {"command", "reference"}
+        What the computer holds (`parameters.HOLDS`).
+    compute_delay : {0, 1}
+        Samples from measurement to actuation.
+    """
     D, E = bilinear_columns(tau, T, k, c, hold, compute_delay)
     return np.stack(D, axis=1), np.stack(E, axis=1)
 

@@ -112,6 +112,13 @@ def delta_entries(tau, T, k, reference: bool):
 
     τ > 0 everywhere (3 states ω, θ, y) or τ = 0 everywhere (θ, y).
 
+    Parameters
+    ----------
+    tau, T, k : ndarray
+        τ (s), T (s, > 0) and k (1/s), one loop per element.
+    reference : bool
+        The reference hold (True) or the command hold.
+
     Returns
     -------
     dict
