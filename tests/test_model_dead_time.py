@@ -126,8 +126,10 @@ def test_sampled_fractional_delay_equals_the_augmented_matrix_built_in_the_test(
 
 def test_sampled_refuses_a_dead_time_with_a_held_reference():
     """The same refusal as the simulator's (`Scenario`): one line naming both; the report exits 2 with it."""
-    with pytest.raises(ValueError, match=r"^dead_time must be 0 with hold=reference .*got dead_time = 0\.05 s with hold=reference$"):
+    with pytest.raises(ValueError, match=r"^dead_time must be 0 with hold=reference .*; got 0\.05$"):
         Sampled("reference", 0).boundary(Loop(0.3, 0.1, 2.0, dead_time=0.05))
+    with pytest.raises(ValueError, match=r"^dead_time must be at most 63 sampling periods, 4\.095 s with T = 0\.065 s .*; got 5\.0$"):
+        Sampled("command", 1).boundary(Loop(0.3, 0.065, 2.0, dead_time=5.0))  # more commands on their way than MAX_DELAY_STATES
     code, out, err = run(["report", "--L", "0.9", "--hold", "reference", "--dead-time", "0.05"])
     assert code == 2 and out == "" and err.count("\n") == 1 and "dead_time must be 0 with hold=reference" in err
 
@@ -243,7 +245,8 @@ def test_predicted_corridor_boundary_with_g_and_d_matches_the_simulated_bisectio
 # ---------------------------------------------------------------- the report
 def test_report_lists_g_and_d_only_when_given():
     """The report's inputs carry D and g (after k, with their sources) only when they differ from KB's robot or were
-    typed/filed, so the recorded reports keep their keys; a holonomic robot marks them unused."""
+    typed, so the recorded reports (and a file stating KB's D = 0, g = 1) keep their keys; a holonomic robot marks them
+    unused."""
     plain = build_report(CARMEL.robot, CARMEL.controller, L=0.9)
     assert "dead_time" not in plain.inputs and "plant_gain" not in plain.inputs
     given = build_report(CARMEL.robot.replace(dead_time=0.07), CARMEL.controller, L=0.9, sources={"plant_gain": "user"})

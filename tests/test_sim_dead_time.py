@@ -312,7 +312,7 @@ def test_default_plant_is_the_simulator_before_g_and_D(hold, delay):
 # ---------------------------------------------------------------- refusals and pass-through
 def test_dead_time_with_a_held_reference_is_refused():
     """A dead time inside the continuous servo is a delay differential equation: one line naming both."""
-    with pytest.raises(ValueError, match=r"^dead_time must be 0 with hold=reference .*got dead_time = 0\.05 s with hold=reference$"):
+    with pytest.raises(ValueError, match=r"^dead_time must be 0 with hold=reference .*; got 0\.05$"):
         make_scenario("corridor", robot=CARMEL.robot.replace(dead_time=0.05), controller=CARMEL.controller.replace(hold="reference"))
 
 

@@ -125,8 +125,7 @@ def continuous_plant(loop: Characteristic, hold: str):
     check_choice("hold", hold, HOLDS)
     if loop.dead_time > 0 and hold == "reference":
         raise ValueError(f"dead_time must be 0 with hold=reference (a dead time inside the continuous steering servo is a delay "
-                         f"differential equation, which the sampled model does not solve; docs/models.md); got dead_time = "
-                         f"{loop.dead_time:g} s with hold=reference")
+                         f"differential equation, which the sampled model does not solve; docs/models.md); got {loop.dead_time}")
     return loop.state_space(hold)
 
 
@@ -196,9 +195,10 @@ def dead_time_plant(loop: Characteristic, hold: str, compute_delay: int):
     m, eps = dead_time_split(T, compute_delay, loop.dead_time)
     lines = m + (eps > 0)
     if lines > MAX_DELAY_STATES:
-        raise ValueError(f"dead_time must be at most {MAX_DELAY_STATES} sampling periods for the sampled model "
-                         f"(d·T + D = {m} periods and {eps:g} s; a longer dead time is a delay loop: exact_delay); got dead_time = "
-                         f"{loop.dead_time:g} s with T = {T:g} s")
+        most = (MAX_DELAY_STATES - compute_delay) * T
+        raise ValueError(f"dead_time must be at most {MAX_DELAY_STATES - compute_delay} sampling periods, {most:g} s with T = {T:g} s and "
+                         f"compute_delay {compute_delay}, for the sampled model (a longer dead time is a delay loop: exact_delay); "
+                         f"got {loop.dead_time}")
     n = Psi.shape[0]
     after = zoh_blocks(A, T - eps)[1] @ B / T if eps > 0 else G  # Γ(T − ε)/T
     before = G - after  # (Γ(T) − Γ(T − ε))/T = Φ(T − ε)Γ(ε)/T

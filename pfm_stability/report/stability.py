@@ -51,7 +51,7 @@ LAW_INPUTS = ("cell_ratio", "cell_size", "window_cells", "xi", "eta", "rho0", "a
 
 PLANT_INPUTS = ("dead_time", "plant_gain")
 """The steering plant's dead time D and gain g (`parameters.Robot`), listed after k only when given: a value other than
-the default (D = 0, g = 1) or one the user or a file gave (`plant_inputs`), so reports without them are as before."""
+the default (D = 0, g = 1) or one the user typed (`plant_inputs`), so reports without them are as before."""
 
 INPUTS = ("V", "tau", "T", "k", *PLANT_INPUTS, "f", "n", "W", *LAW_INPUTS, "hold", "compute_delay", "pade_order", "alpha_deg", "L")
 """The report's inputs for a static law, in the order it lists them (``alpha_deg`` and ``L`` when given; f and n for KB's laws only)."""
@@ -510,10 +510,10 @@ def _family_law_report(robot, controller, family, law, alpha, alpha_deg, L, mode
 def plant_inputs(robot: Robot, sources: dict | None) -> dict:
     """{name: value} of the steering plant's D and g that the report lists (`PLANT_INPUTS`).
 
-    Each is listed when it differs from KB's robot (D = 0, g = 1) or when its
-    source is neither a preset nor absent (``user``, ``config FILE``, ``ASSUMED …``:
-    `cli.options.resolve_parameters`), so every report that does not give them
-    keeps its inputs (and its JSON keys) as before.
+    Each is listed when it differs from KB's robot (D = 0, g = 1) or when it was
+    typed (source ``user``: `cli.options.resolve_parameters`), so every report
+    that does not give them — a file that states KB's values included — keeps
+    its inputs (and its JSON keys) as before.
 
     Parameters
     ----------
@@ -527,7 +527,7 @@ def plant_inputs(robot: Robot, sources: dict | None) -> dict:
     shown = {}
     for name in PLANT_INPUTS:
         value, source = getattr(robot, name), sources.get(name)
-        if value != defaults[name] or (source is not None and not source.startswith("preset")):
+        if value != defaults[name] or source == "user":
             shown[name] = value
     return shown
 

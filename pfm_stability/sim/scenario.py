@@ -299,8 +299,7 @@ class Scenario:
         check_parameter("T_sampled", self.controller.T)
         if self.robot.dead_time > 0 and self.controller.hold == "reference":
             raise ValueError(f"dead_time must be 0 with hold=reference (a dead time inside the continuous steering servo is a delay "
-                             f"differential equation, which the simulator does not solve; docs/simulator.md); got dead_time = "
-                             f"{self.robot.dead_time:g} s with hold=reference")
+                             f"differential equation, which the simulator does not solve; docs/simulator.md); got {self.robot.dead_time}")
         object.__setattr__(self, "duration", check_number("duration", self.duration, 0.0, 1e6, unit="s"))
         samples = self.duration / self.controller.T
         if samples > MAX_SAMPLES:
