@@ -100,6 +100,9 @@ class _Batch:
         self.split = self.switch > 0
         self.order = _array(scenarios, lambda s: s.loop_order(), np.int64)  # the sampled loop's state
         self.history = int(np.max(np.minimum(self.lag, self.steps))) + 2  # the delay line's length (`_DelayLine`)
+        self.shared_lag = int(self.lag[0]) if self.lag.size and np.all(self.lag == self.lag[0]) else None
+        self.any_split = bool(self.split.any())
+        self.unit_gain = bool(np.all(self.gain == 1.0))
         self._compile_targets()
         self._compile_measure()
         self._compile_grids()
@@ -353,6 +356,8 @@ def _advance_commands(b, theta, omega, earlier, later, V, x, y):
     `earlier` and `later` are the commands the motor sees before and after the switch (rad/s, per command member).
     """
     w, s = b.whole_idx, b.split_idx
+    if s.size == 0 and b.unit_gain:  # KB's motor: the command itself (no product, as before g and D)
+        return _advance_command(b.command_coef, theta, omega, later, V, x, y)
     g = b.gain[b.command_idx]
     if s.size == 0:
         return _advance_command(b.command_coef, theta, omega, g * later, V, x, y)
@@ -367,24 +372,27 @@ def _advance_commands(b, theta, omega, earlier, later, V, x, y):
 class _DelayLine:
     """The values computed at t_0 … t_k, as far back as the loop's delay reaches (`robot.delay_split`).
 
-    A ring of `_Batch.history` columns; a value asked for from before t_0 is
-    u_0 (the robot starts as if it had been running).
+    A ring of `_Batch.history` rows; a value asked for from before t_0 is
+    u_0 (the robot starts as if it had been running). A lag shared by every
+    member (an int: KB's robots, one compute delay) reads one row.
     """
 
     def __init__(self, size: int, length: int):
-        self.ring = np.zeros((size, length))
+        self.ring = np.zeros((length, size))
         self.members = np.arange(size)
         self.first = None
 
     def push(self, k: int, value):
         if self.first is None:
             self.first = value.copy()
-        self.ring[:, k % self.ring.shape[1]] = value
+        self.ring[k % self.ring.shape[0]] = value
 
     def back(self, k: int, lag):
-        """The value computed at t_(k − lag) (per member), u_0 before t_0."""
+        """The value computed at t_(k − lag) (per member; `lag` an int or an int array), u_0 before t_0."""
         j = k - lag
-        return np.where(j >= 0, self.ring[self.members, j % self.ring.shape[1]], self.first)
+        if isinstance(j, int):
+            return self.ring[j % self.ring.shape[0]].copy() if j >= 0 else self.first.copy()
+        return np.where(j >= 0, self.ring[j % self.ring.shape[0], self.members], self.first)
 
 
 def _advance_reference(b, theta, omega, ref, V, x, y):
@@ -496,7 +504,8 @@ def run_batch(scenarios, *, record: str = "trajectory", metrics: bool = True, pr
         if k == 0:
             pending_V = speed
         line.push(k, value)
-        applied, earlier = line.back(k, b.lag), line.back(k, b.lag + 1)  # the motor's input after and before the switch
+        applied = line.back(k, b.shared_lag if b.shared_lag is not None else b.lag)  # the motor's input after the switch
+        earlier = line.back(k, b.lag + 1) if b.any_split else applied  # and before it (only split members read it)
         applied_V = np.where(b.delayed, pending_V, speed)
         pending_V = speed
         # advance over [t_k, t_k+1)
