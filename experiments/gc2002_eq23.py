@@ -10,7 +10,7 @@ A: η/D² (the gradient, journal eq 19), B: η(1/D − 1/ρ0)², C: η³(1/D −
 (as printed in eq 23 and the conference form's eq 19); D = ρ_TO − x − ẋ²/(2a_max)
 (docs/velocity_and_fuzzy.md). The robot is the planar simulator's point mass
 (`pfm_stability.sim.planar`) with |a| ≤ a_max (the conference form's eq 22),
-T = 0.01 s.
+T = 0.01 s; the runs are stepped together in batches (`simulate_planar_batch`).
 
 * **Stall bands** (`velocity_laws.stall_band`): where the robot rests short of
   the target (Filippov equilibria on ẋ = 0).
@@ -42,20 +42,30 @@ from _common import output_dir, row, save_figure, script_main, write_json  # noq
 ALPHA_P, ALPHA_V, ETA, RHO0 = 0.005, 0.1, 0.2, 2.0
 BALL_X, BALL_R, X0 = 0.8, 0.3, -1.5
 RHO_TO = BALL_X - BALL_R
+LEVELS_PER_ROUND = 3
+"""Bisection steps per batch of simulations (`smallest_landing_speeds`)."""
 READINGS = (("A", "gradient"), ("B", "squared"), ("C", "paper_eq23"))
 A_MAX = (0.5, 1.0, 2.0)
 PAPER_BANDS = {"A": -1.5, "B": -0.90344, "C": -0.35650}
 PAPER_VMIN = {"C": (0.330, 0.324, 0.322), "B": (None, 0.956, 0.781), "A": (None, None, 1.292)}
 
 
-def simulate(variant: str, a_max: float, v0: float, T: float, duration: float):
+def member(variant: str, a_max: float, v0: float, T: float, duration: float):
+    """The eq (23) run as a member of a planar batch (`pfm_stability.sim.planar.PlanarMember`)."""
     from pfm_stability.sim.movers import Ball, Target
-    from pfm_stability.sim.planar import Field, PointMass, Start, World, simulate_planar
+    from pfm_stability.sim.planar import Field, PlanarMember, PointMass, Start, World
     from pfm_stability.laws.velocity_laws import VelocityAttraction, VelocityGatedRepulsion
 
     field = Field(VelocityAttraction(ALPHA_P, ALPHA_V), VelocityGatedRepulsion(ETA, RHO0, a_max, variant))
     world = World(Target((0.0, 0.0)), (Ball((BALL_X, 0.0), BALL_R),))
-    return simulate_planar(PointMass(1.0, a_max), field, world, T=T, duration=duration, start=Start((X0, 0.0), (v0, 0.0)))
+    return PlanarMember(PointMass(1.0, a_max), field, world, Start((X0, 0.0), (v0, 0.0)), T=T, duration=duration)
+
+
+def simulate_all(members: list) -> list:
+    """The runs of many members, stepped together (`simulate_planar_batch`)."""
+    from pfm_stability.sim.planar import simulate_planar_batch
+
+    return list(simulate_planar_batch(members).runs)
 
 
 def outcome(run) -> str:
@@ -67,23 +77,53 @@ def outcome(run) -> str:
     return "undefined" if bad is not None else "stalls"
 
 
-def smallest_landing_speed(variant: str, a_max: float, T: float, duration: float, scan: int, iterations: int) -> dict:
-    """The smallest v0 that reaches the target: a scan of (0, v_undefined) and bisection of the first change."""
-    v_undef = math.sqrt(2 * a_max * (RHO_TO - X0))
-    grid = np.linspace(0.0, v_undef, scan + 1)[1:-1]
-    results = [outcome(simulate(variant, a_max, v, T, duration)) for v in grid]
-    lands = [v for v, r in zip(grid, results) if r == "lands"]
-    if not lands:
-        return {"v_min": None, "scan": list(zip(grid.tolist(), results))}
-    i = int(np.flatnonzero(np.array(results) == "lands")[0])
-    lo, hi = (float(grid[i - 1]) if i else 0.0), float(grid[i])
-    for _ in range(iterations):
-        mid = 0.5 * (lo + hi)
-        if outcome(simulate(variant, a_max, mid, T, duration)) == "lands":
-            hi = mid
+def _subtree(lo: float, hi: float, depth: int) -> list:
+    """Every midpoint `depth` steps of bisection of [lo, hi] may visit (2^depth − 1 values, computed as the bisection does)."""
+    if depth == 0:
+        return []
+    mid = 0.5 * (lo + hi)
+    return [mid] + _subtree(lo, mid, depth - 1) + _subtree(mid, hi, depth - 1)
+
+
+def smallest_landing_speeds(combos: list, T: float, duration: float, scan: int, iterations: int) -> list:
+    """The smallest v0 that reaches the target, for each (variant, a_max) of `combos`: a scan of
+    (0, v_undefined) and `iterations` bisection steps of the first change.
+
+    Every combination's scan is one batch of the planar simulator; the bisections advance
+    together, `LEVELS_PER_ROUND` steps per batch: the batch holds every midpoint those steps
+    may visit (7 per combination), and the steps then look their outcomes up — the same
+    midpoints, hence the same bracket, as one step at a time, in a third of the batches.
+    """
+    grids = [np.linspace(0.0, math.sqrt(2 * a_max * (RHO_TO - X0)), scan + 1)[1:-1] for _, a_max in combos]
+    runs = simulate_all([member(variant, a_max, float(v), T, duration) for (variant, a_max), grid in zip(combos, grids) for v in grid])
+    results, brackets, out = [], [], []
+    for c, grid in enumerate(grids):
+        res = [outcome(r) for r in runs[c * grid.size:(c + 1) * grid.size]]
+        results.append(res)
+        lands = np.flatnonzero(np.array(res) == "lands")
+        if lands.size == 0:
+            brackets.append(None)
         else:
-            lo = mid
-    return {"v_min": hi, "bracket": [lo, hi], "scan": list(zip(grid.tolist(), results))}
+            i = int(lands[0])
+            brackets.append([(float(grid[i - 1]) if i else 0.0), float(grid[i])])
+    open_ = [c for c, b in enumerate(brackets) if b is not None]
+    done = 0
+    while open_ and done < iterations:
+        depth = min(LEVELS_PER_ROUND, iterations - done)
+        points = [_subtree(*brackets[c], depth) for c in open_]
+        runs = simulate_all([member(*combos[c], v, T, duration) for c, vs in zip(open_, points) for v in vs])
+        at = 0
+        for c, vs in zip(open_, points):
+            lands = {v: outcome(r) == "lands" for v, r in zip(vs, runs[at:at + len(vs)])}
+            at += len(vs)
+            for _ in range(depth):  # the bisection's own steps, each midpoint looked up
+                mid = 0.5 * (brackets[c][0] + brackets[c][1])
+                brackets[c][int(lands[mid])] = mid  # lands: the new upper end
+        done += depth
+    for grid, res, bracket in zip(grids, results, brackets):
+        scan_rows = list(zip(grid.tolist(), res))
+        out.append({"v_min": None, "scan": scan_rows} if bracket is None else {"v_min": bracket[1], "bracket": bracket, "scan": scan_rows})
+    return out
 
 
 def bands() -> dict:
@@ -96,11 +136,11 @@ def bands() -> dict:
 
 def undefined_at_once(T: float) -> list:
     """v0 at which D ≤ 0 at the start, and the simulator's event just above / no event just below it."""
+    speeds = [math.sqrt(2 * a_max * (RHO_TO - X0)) for a_max in A_MAX]
+    runs = simulate_all([member("gradient", a_max, v * factor, T, 2 * T) for a_max, v in zip(A_MAX, speeds) for factor in (1.001, 0.999)])
     out = []
-    for a_max in A_MAX:
-        v = math.sqrt(2 * a_max * (RHO_TO - X0))
-        above = simulate("gradient", a_max, v * 1.001, T, 2 * T).first_event("collision_unavoidable")
-        below = simulate("gradient", a_max, v * 0.999, T, 2 * T).first_event("collision_unavoidable")
+    for i, (a_max, v) in enumerate(zip(A_MAX, speeds)):
+        above, below = (runs[2 * i + j].first_event("collision_unavoidable") for j in (0, 1))
         out.append({"a_max": a_max, "v_undefined": v, "event_above_at": above.time if above else None, "event_below": below is not None})
     return out
 
@@ -155,20 +195,20 @@ def run(out, quick: bool = False) -> dict:
     combos = [("C", 1.0)] if quick else [(n, a) for n, _ in READINGS for a in A_MAX]
     variants = dict(READINGS)
     vmin, details = {n: {} for n, _ in READINGS}, []
-    for name, a_max in combos:
-        res = smallest_landing_speed(variants[name], a_max, T, duration, 6 if quick else 12, 6 if quick else 9)
+    landing = smallest_landing_speeds([(variants[name], a_max) for name, a_max in combos], T, duration, 6 if quick else 12, 6 if quick else 9)
+    for (name, a_max), res in zip(combos, landing):
         vmin[name][a_max] = res["v_min"]
         details.append({"reading": name, "a_max": a_max, **res})
     a_runs = 1.0
+    cases = [(name, variant, kind, v0) for name, variant in READINGS
+             for kind, v0 in (("slow", 0.2), ("fast", 1.0 if name != "A" else 1.9)) if not (quick and name != "C")]
+    a_of = lambda name: 2.0 if name == "A" else a_runs  # noqa: E731
+    simulated = simulate_all([member(variant, a_of(name), v0, T, duration) for name, variant, _, v0 in cases])
     runs = []
-    for name, variant in READINGS:
-        for kind, v0 in (("slow", 0.2), ("fast", 1.0 if name != "A" else 1.9)):
-            if quick and name != "C":
-                continue
-            r = simulate(variant, 2.0 if name == "A" else a_runs, v0, T, duration)
-            step = max(1, r.t.size // 400)
-            runs.append({"reading": name, "kind": kind, "v0": v0, "a_max": 2.0 if name == "A" else a_runs, "outcome": outcome(r),
-                         "x_final": float(r.p[-1, 0]), "t": r.t[::step].tolist(), "x": r.p[::step, 0].tolist()})
+    for (name, _, kind, v0), r in zip(cases, simulated):
+        step = max(1, r.t.size // 400)
+        runs.append({"reading": name, "kind": kind, "v0": v0, "a_max": a_of(name), "outcome": outcome(r),
+                     "x_final": float(r.p[-1, 0]), "t": r.t[::step].tolist(), "x": r.p[::step, 0].tolist()})
     draw(out / "gc2002_eq23.png", band, runs, vmin, undefined, a_runs)
 
     def v(name):

@@ -53,16 +53,20 @@ PAPER = {  # the papers' claims with the reference numbers of the analysis (docs
 }
 
 
-def simulate(alpha_p, alpha_v, m, n, T, duration):
+def simulate(cases, T) -> list:
+    """Every (alpha_p, alpha_v, m, n, duration) of `cases` in one planar batch: [(t, e, ė)]."""
     from pfm_stability.sim.movers import Target
-    from pfm_stability.sim.planar import Field, PointMass, Start, World, simulate_planar
+    from pfm_stability.sim.planar import Field, PlanarMember, PointMass, Start, World, simulate_planar_batch
     from pfm_stability.laws.velocity_laws import VelocityAttraction
 
-    run = simulate_planar(PointMass(1.0), Field(VelocityAttraction(alpha_p, alpha_v, m, n)), World(Target(TARGET_P, TARGET_V)),
-                          T=T, duration=duration, start=Start(ROBOT_P))
-    e = np.asarray(TARGET_P) + run.t[:, None] * np.asarray(TARGET_V) - run.p
-    de = np.asarray(TARGET_V) - run.v
-    return run.t, e, de
+    members = [PlanarMember(PointMass(1.0), Field(VelocityAttraction(alpha_p, alpha_v, m, n)), World(Target(TARGET_P, TARGET_V)),
+                            Start(ROBOT_P), T=T, duration=duration) for alpha_p, alpha_v, m, n, duration in cases]
+    out = []
+    for run in simulate_planar_batch(members).runs:
+        e = np.asarray(TARGET_P) + run.t[:, None] * np.asarray(TARGET_V) - run.p
+        de = np.asarray(TARGET_V) - run.v
+        out.append((run.t, e, de))
+    return out
 
 
 def measures(t, e, de) -> dict:
@@ -93,11 +97,9 @@ def run(out, quick: bool = False) -> dict:
     out = output_dir(out)
     T = 0.04 if quick else 0.01
     results, curves = [], []
-    for fig_name, label, ap, av, m, n, full, short in CASES:
-        duration = short if quick else full
-        if duration is None:
-            continue
-        t, e, de = simulate(ap, av, m, n, T, duration)
+    cases = [c for c in CASES if (c[7] if quick else c[6]) is not None]
+    runs = simulate([(ap, av, m, n, short if quick else full) for _, _, ap, av, m, n, full, short in cases], T)
+    for (fig_name, label, ap, av, m, n, full, short), (t, e, de) in zip(cases, runs):
         res = {"figure": fig_name, "label": label, "alpha_p": ap, "alpha_v": av, "m": m, "n": n, "T": T, **measures(t, e, de),
                "paper": PAPER[label]}
         if m == 1.0:

@@ -124,13 +124,13 @@ def simulated_points(ms: dict, quick: bool) -> list:
     from pfm_stability.models.holonomic import HolonomicLoop
     from pfm_stability.sim.cycles import lateral_metrics
     from pfm_stability.sim.movers import Target, Wall
-    from pfm_stability.sim.planar import Field, PointMass, Start, World, simulate_planar
+    from pfm_stability.sim.planar import Field, PlanarMember, PointMass, Start, World, simulate_planar_batch
     from pfm_stability.laws.velocity_laws import VelocityAttraction
 
     law = KhatibLaw(1.0, ETA, RHO0, 2.0, 1.0)  # η(1/d − 1/ρ0)/d² newtons with repulsion_scale 1
     world = World(Target((0.0, 0.0)), (Wall((-L_HALF, 0.0), (1.0, 0.0)), Wall((L_HALF, 0.0), (-1.0, 0.0))))
     robot = PointMass(1.0)
-    out = []
+    points, members = [], []
     for key, alpha_v, T in (SIM_POINTS[:1] + SIM_POINTS[4:5] if quick else SIM_POINTS):
         kappa = corridor_kappa(alpha_v)[0] + 2 * 0.005
         compute_delay = 1 if key == "sampled_zoh_delay" else 0
@@ -138,8 +138,11 @@ def simulated_points(ms: dict, quick: bool) -> list:
         duration = max(8.0, 300 * T)
         if root.real > 0:
             duration = min(duration, 5.0 / root.real)  # growth e^5 from 0.1 mm: 15 mm, before the walls make it non-linear
-        run = simulate_planar(robot, Field(VelocityAttraction(0.005, alpha_v), law), world, T=T, compute_delay=compute_delay,
-                              duration=duration, start=Start((1e-4, 0.0)))
+        points.append((key, alpha_v, T, kappa, root))
+        members.append(PlanarMember(robot, Field(VelocityAttraction(0.005, alpha_v), law), world, Start((1e-4, 0.0)), T=T,
+                                    duration=duration, compute_delay=compute_delay))
+    out = []
+    for (key, alpha_v, T, kappa, root), run in zip(points, simulate_planar_batch(members).runs):  # one batch
         m = lateral_metrics(run, (1.0, 0.0), robot=robot)
         out.append({"model": key, "alpha_v": alpha_v, "T": T, "kappa": kappa, "predicted_sigma": root.real, "predicted_omega": abs(root.imag),
                     "simulated_sigma": m.growth_rate, "simulated_omega": m.angular_frequency, "method": m.method, "collided": run.collision,

@@ -89,7 +89,8 @@ def khatib(duration: float) -> dict:
 def run(out, quick: bool = False) -> dict:
     import matplotlib.pyplot as plt
 
-    from pfm_stability.sim.cycles import wall_cycle
+    from pfm_stability.sim.cycles import measure_wall_cycle
+    from pfm_stability.sim.planar import simulate_planar_batch, wall_member
     from pfm_stability.laws.velocity_laws import VelocityGatedRepulsion
 
     out = output_dir(out)
@@ -97,16 +98,18 @@ def run(out, quick: bool = False) -> dict:
     rep = VelocityGatedRepulsion(ETA, RHO0, A_MAX)
     alpha = math.radians(ALPHA_DEG)
     band = rep.non_smooth_wall(F_A, alpha)
-    cycles, runs = {}, {}
-    for cd in (1, 0):
-        cycles[cd] = wall_cycle(rep, F_A, alpha, robot(), T=T, compute_delay=cd, duration=duration).to_dict()
-        runs[cd] = wall_run(rep, T, cd, duration, band.d_s)
     kh = khatib(duration)
     harmonic = {"T_d_1.5T": first_harmonic_period(1.5 * T), "T_d_0.5T": first_harmonic_period(0.5 * T)}
     sweep_T = (0.02, 0.065, 0.13) if quick else (0.01, 0.02, 0.04, 0.065, 0.1, 0.13)
+    # one batch: the two delays at T (kept whole for the plots) and the sweep of T
+    members = [wall_member(rep, F_A, alpha, robot(), T=T, compute_delay=cd, duration=duration) for cd in (1, 0)]
+    members += [wall_member(rep, F_A, alpha, robot(), T=Ti, compute_delay=1, duration=max(duration, 40 * Ti)) for Ti in sweep_T]
+    simulated = simulate_planar_batch(members).runs
+    runs = dict(zip((1, 0), simulated[:2]))
+    cycles = {cd: measure_wall_cycle(r).to_dict() for cd, r in runs.items()}
     sweep = []
-    for Ti in sweep_T:
-        c = wall_cycle(rep, F_A, alpha, robot(), T=Ti, compute_delay=1, duration=max(duration, 40 * Ti))
+    for Ti, r in zip(sweep_T, simulated[2:]):
+        c = measure_wall_cycle(r)
         sweep.append({"T": Ti, **c.to_dict(), "peak_to_peak_over_T": c.peak_to_peak / Ti,
                       "heading_amplitude_over_T": (c.heading_amplitude or 0.0) / Ti})
 

@@ -83,11 +83,12 @@ def curve(n: int) -> dict:
     return out
 
 
-def corridor_run(q: float, duration: float):
-    """The steering robot (CARMEL, command hold, 1-sample delay) in the Khatib corridor with velocity attraction q."""
+def corridor_member(q: float, duration: float):
+    """The steering robot (CARMEL, command hold, 1-sample delay) in the Khatib corridor with velocity attraction q:
+    (robot, its `PlanarMember`)."""
     from pfm_stability.laws.fields import KhatibLaw
     from pfm_stability.sim.movers import Target, Wall
-    from pfm_stability.sim.planar import Field, Start, Steering, World, simulate_planar
+    from pfm_stability.sim.planar import Field, PlanarMember, Start, Steering, World
     from pfm_stability.laws.velocity_laws import VelocityAttraction
 
     F_a = 1.0
@@ -95,9 +96,8 @@ def corridor_run(q: float, duration: float):
     law = KhatibLaw(1.0, SIM_ETA, SIM_RHO0, 2.0, 1.0)  # η(1/d − 1/ρ0)/d² in units of F_a
     world = World(Target((0.0, SIM_RHO_G)), (Wall((-SIM_L, 0.0), (1.0, 0.0)), Wall((SIM_L, 0.0), (-1.0, 0.0))))
     robot = Steering(V, TAU, K, hold="command")
-    run = simulate_planar(robot, Field(attraction, law, repulsion_scale=F_a), world, T=T, compute_delay=1,
-                          duration=duration, start=Start((0.01, 0.0), heading=math.pi / 2))
-    return robot, run
+    return robot, PlanarMember(robot, Field(attraction, law, repulsion_scale=F_a), world, Start((0.01, 0.0), heading=math.pi / 2),
+                               T=T, duration=duration, compute_delay=1)
 
 
 def simulated(quick: bool) -> list:
@@ -106,15 +106,17 @@ def simulated(quick: bool) -> list:
     from pfm_stability.models import make_model
     from pfm_stability.models.base import Loop
     from pfm_stability.sim.cycles import lateral_metrics
+    from pfm_stability.sim.planar import simulate_planar_batch
 
     N_kb = corridor_gain(KhatibLaw(1.0, SIM_ETA, SIM_RHO0, 2.0, 1.0), SIM_L) + 1.0 / SIM_RHO_G  # the finite goal adds 1/ρ_g
     sa = make_model("sampled", hold="command", compute_delay=1)
     out = []
-    for q in SIM_Q:
+    cases = [corridor_member(q, 12.0 if quick else 16.0) for q in SIM_Q]
+    runs = simulate_planar_batch([member for _, member in cases]).runs  # every q in one batch
+    for q, (robot, _), run in zip(SIM_Q, cases, runs):
         c = q / (1 - q)
         loop = Loop(TAU, T, K, c=c)
         root = sa.rightmost_root(N_kb / (1 - q) * V, loop)
-        robot, run = corridor_run(q, 12.0 if quick else 16.0)
         m = lateral_metrics(run, (1.0, 0.0), robot=robot)
         out.append({"q": q, "c": c, "N_KB_V": N_kb * V, "NV": N_kb / (1 - q) * V,
                     "NV_critical_sampled": sa.boundary(loop).NV_critical,

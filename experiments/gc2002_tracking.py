@@ -60,17 +60,20 @@ def first_within(alpha_v: float, level: float, t_max: float) -> float | None:
     return bisect_root(f, float(t[i - 1]), float(t[i]), rtol=1e-12)
 
 
-def simulate(alpha_v: float, T: float, duration: float):
-    """The Fig 8 run in the planar simulator: (t, e(t), robot positions, target positions)."""
+def simulate(alpha_vs, T: float, duration: float) -> dict:
+    """The Fig 8 runs in the planar simulator, one batch: {α_v: (t, e(t), robot positions, target positions)}."""
     from pfm_stability.sim.movers import Target
-    from pfm_stability.sim.planar import Field, PointMass, Start, World, simulate_planar
+    from pfm_stability.sim.planar import Field, PlanarMember, PointMass, Start, World, simulate_planar_batch
     from pfm_stability.laws.velocity_laws import VelocityAttraction
 
     target = Target(TARGET_P, TARGET_V)
-    run = simulate_planar(PointMass(1.0), Field(VelocityAttraction(ALPHA_P, alpha_v)), World(target),
-                          T=T, duration=duration, start=Start(ROBOT_P))
-    p_tar = np.asarray(TARGET_P) + run.t[:, None] * np.asarray(TARGET_V)
-    return run.t, p_tar - run.p, run.p, p_tar
+    members = [PlanarMember(PointMass(1.0), Field(VelocityAttraction(ALPHA_P, alpha_v)), World(target), Start(ROBOT_P), T=T, duration=duration)
+               for alpha_v in alpha_vs]
+    out = {}
+    for alpha_v, run in zip(alpha_vs, simulate_planar_batch(members).runs):
+        p_tar = np.asarray(TARGET_P) + run.t[:, None] * np.asarray(TARGET_V)
+        out[alpha_v] = (run.t, p_tar - run.p, run.p, p_tar)
+    return out
 
 
 def run(out, quick: bool = False) -> dict:
@@ -83,6 +86,7 @@ def run(out, quick: bool = False) -> dict:
     t = np.linspace(0.0, DURATION, 8001)
     cases = []
     sims = {}
+    simulated = simulate([av for av in ALPHA_V if not quick or av == 0.1], T, DURATION if not quick else 80.0)
     for av in ALPHA_V:
         dyn = tracking_dynamics(ALPHA_P, av)
         e = closed_form(av, t)
@@ -90,7 +94,7 @@ def run(out, quick: bool = False) -> dict:
         case = {"alpha_v": av, "zeta": dyn.damping_ratio, "omega_n": dyn.natural_frequency, "regime": dyn.regime,
                 "first_within_0.1": first_within(av, 0.1, DURATION)}
         if not quick or av == 0.1:
-            ts, es, p, _ = simulate(av, T, DURATION if not quick else 80.0)
+            ts, es, p, _ = simulated[av]
             closed = closed_form(av, ts)
             rs = np.hypot(*es.T)
             hit = np.flatnonzero(rs <= 0.1)

@@ -21,7 +21,15 @@ __all__ = ["check_number", "check_choice", "check_integer", "check_output_path",
 
 
 def describe_range(low: float, high: float, low_open: bool, high_open: bool) -> str:
-    """Interval notation, e.g. ``(0, 100]``."""
+    """Interval notation, e.g. ``(0, 100]``.
+
+    Parameters
+    ----------
+    low, high : float
+        Interval bounds.
+    low_open, high_open : bool
+        Whether each bound is excluded.
+    """
     left = "(" if low_open else "["
     right = ")" if high_open else "]"
     return f"{left}{_fmt(low)}, {_fmt(high)}{right}"
@@ -89,6 +97,15 @@ def _number_message(name, value, low, high, low_open, high_open, unit) -> str:
 def check_integer(name: str, value, low: int, high: int) -> int:
     """Return `value` as an int after checking ``low <= value <= high``.
 
+    Parameters
+    ----------
+    name : str
+        Parameter name as the user knows it.
+    value : object
+        The value to check (an integral number; bools and non-integral floats are rejected).
+    low, high : int
+        Closed bounds.
+
     Raises
     ------
     ValueError
@@ -104,6 +121,15 @@ def check_integer(name: str, value, low: int, high: int) -> int:
 
 def check_choice(name: str, value, choices) -> str:
     """Return `value` after checking it is one of `choices`.
+
+    Parameters
+    ----------
+    name : str
+        Parameter name as the user knows it.
+    value : object
+        The value to check.
+    choices : sequence
+        The allowed values.
 
     Raises
     ------
@@ -181,6 +207,13 @@ def check_output_dir(name: str, path) -> str:
     take new entries. A temporary file is created there and removed
     (`files.check_writable`).
 
+    Parameters
+    ----------
+    name : str
+        Option name as the user knows it (``--out``).
+    path : str or path-like
+        The directory (created if missing).
+
     Raises
     ------
     ValueError
@@ -233,6 +266,15 @@ def check_positive_axis(name: str, values, unit: str = ""):
 
     For the axes of curves and maps (speeds, periods, gains). numpy is imported
     here, not at module level, so the CLI can check scalars before loading it.
+
+    Parameters
+    ----------
+    name : str
+        Parameter name as the user knows it.
+    values : array_like
+        The axis values.
+    unit : str, optional
+        Unit shown in the message.
 
     Raises
     ------

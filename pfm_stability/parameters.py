@@ -157,6 +157,11 @@ def to_degrees(angle):
 
     Bit for bit ``math.degrees`` and ``numpy.degrees`` (both multiply by 180/π),
     without importing numpy here.
+
+    Parameters
+    ----------
+    angle : float or ndarray
+        Angle, rad.
     """
     return angle * DEGREES_PER_RADIAN
 
@@ -166,13 +171,28 @@ def to_radians(angle_deg):
 
     Bit for bit ``math.radians`` and ``numpy.radians`` (both multiply by π/180).
     Unchecked: a single wall angle goes through `Wall.from_degrees`, which checks it.
+
+    Parameters
+    ----------
+    angle_deg : float or ndarray
+        Angle, degrees.
     """
     return angle_deg * RADIANS_PER_DEGREE
 
 
 @dataclass(frozen=True)
 class Range:
-    """Allowed values of one parameter (bounds, openness, unit)."""
+    """Allowed values of one parameter (bounds, openness, unit).
+
+    Attributes
+    ----------
+    low, high : float
+        Bounds, in `unit`.
+    low_open, high_open : bool
+        Whether each bound is excluded.
+    unit : str
+        Unit shown in messages and help.
+    """
 
     low: float
     high: float
@@ -321,7 +341,13 @@ SHOWN_AS = {"alpha_deg": "alpha", "T_sampled": "T"}
 
 
 def describe_parameter(key: str) -> str:
-    """``RANGES[key]`` for a help text, e.g. ``(0, 100] m/s``; an integer range exactly, ``[3, 1001] cells``."""
+    """``RANGES[key]`` for a help text, e.g. ``(0, 100] m/s``; an integer range exactly, ``[3, 1001] cells``.
+
+    Parameters
+    ----------
+    key : str
+        A key of `RANGES`.
+    """
     r = RANGES[key]
     if isinstance(r.low, int) and isinstance(r.high, int):
         return f"[{r.low}, {r.high}]" + (f" {r.unit}" if r.unit else "")
@@ -333,6 +359,13 @@ def check_parameter(name: str, value) -> float:
 
     The message names the parameter as the user knows it (``alpha_deg`` is
     reported as ``alpha``), the range with its unit, and the value.
+
+    Parameters
+    ----------
+    name : str
+        A key of `RANGES`.
+    value : object
+        The value to check.
     """
     r = RANGES[name]
     shown = SHOWN_AS.get(name, name)
@@ -440,7 +473,13 @@ class Wall:
 
     @classmethod
     def from_degrees(cls, alpha_deg: float) -> "Wall":
-        """Build from α in degrees, with the range stated in degrees on error."""
+        """Build from α in degrees, with the range stated in degrees on error.
+
+        Parameters
+        ----------
+        alpha_deg : float
+            Target angle from the wall normal, degrees.
+        """
         alpha_deg = check_parameter("alpha_deg", alpha_deg)
         r = RANGES["alpha"]
         return cls(min(max(to_radians(alpha_deg), r.low), r.high))  # round-off at the ends
@@ -469,6 +508,13 @@ class Corridor:
 
 def check_corridor_fits(corridor: Corridor, robot: Robot) -> None:
     """Raise ValueError unless the robot fits: L > W/2.
+
+    Parameters
+    ----------
+    corridor : Corridor
+        The corridor (L, m).
+    robot : Robot
+        The robot (W, m).
 
     Raises
     ------
@@ -573,6 +619,11 @@ PRESETS = _Presets(PRESET_DIRECTORY)
 
 def get_preset(name: str) -> Preset:
     """Return the preset called `name` (``"carmel"``), read from ``data/presets/<name>.yaml``.
+
+    Parameters
+    ----------
+    name : str
+        A preset of `PRESETS`.
 
     Raises
     ------

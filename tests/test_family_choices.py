@@ -164,12 +164,15 @@ def test_bad_choices_exit_2_naming_the_option(argv, message):
 
 
 def test_library_refuses_bad_choices():
-    """`make_family_law`: ValueError naming the choice and its values, or the law it applies to."""
+    """`make_family_law`: ValueError naming the choice and its values, or the laws it applies to (the registry's one
+    wording, `laws.registry.refusal`, as a file's ``law.<key>`` is refused)."""
     cases = [
         (("velocity-gated", {"variant": "paper_eq23"}), {}, "variant must be one of gradient, squared, paper-eq23; got 'paper_eq23'"),
-        (("fuzzy", {"variant": "squared"}), {}, "variant applies to law velocity-gated, not to law fuzzy"),
+        (("fuzzy", {"variant": "squared"}), {}, "variant applies to velocity-gated, not to law fuzzy"),
         (("fuzzy",), {"symmetrize": True}, "symmetrize must be one of none, negative, positive; got True"),
-        (("velocity", {"colour": "red"}), {}, "colour is not a choice of law velocity (it takes none)"),
+        (("velocity", {"colour": "red"}), {}, "colour is not a parameter of any law (see the laws in docs/fields.md and docs/velocity_and_fuzzy.md), given to law velocity"),
+        (("velocity",), {"xi": 1.0}, "xi applies to khatib or gnron, not to law velocity"),
+        (("fuzzy",), {"eta": 1.0}, "eta applies to velocity or velocity-gated, not to law fuzzy"),
         (("fuzzy", {"side": "up"}), {}, "side must be one of left, right; got 'up'"),
     ]
     for args, kwargs, message in cases:

@@ -88,10 +88,24 @@ class GainCurve:
 
 
 class GainCurves(list):
-    """Every model's `GainCurve` against one loop parameter (T/τ or k): what `critical_gain_vs_delay` and `critical_gain_vs_k` return."""
+    """Every model's `GainCurve` against one loop parameter (T/τ or k): what `critical_gain_vs_delay` and `critical_gain_vs_k` return.
+
+    Parameters
+    ----------
+    iterable : iterable of GainCurve
+        One curve per model, each against the same loop parameter.
+    """
 
     def plot(self, ax=None, **kwargs):
-        """`plots.comparison.plot_critical_gain_vs_delay` (x = T/τ) or `plots.rlocus.plot_critical_gain_vs_k` (x = k); returns the figure."""
+        """`plots.comparison.plot_critical_gain_vs_delay` (x = T/τ) or `plots.rlocus.plot_critical_gain_vs_k` (x = k); returns the figure.
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes, optional
+            Axes to draw on; None: a new figure.
+        **kwargs
+            Passed on to the plotting function.
+        """
         if self[0].x_name == "k":
             from ..plots.rlocus import plot_critical_gain_vs_k
 
@@ -171,7 +185,15 @@ class KBErrorMap:
         )
 
     def plot(self, ax=None, **kwargs):
-        """`plots.comparison.plot_kb_error_map` of this map; returns the figure."""
+        """`plots.comparison.plot_kb_error_map` of this map; returns the figure.
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes, optional
+            Axes to draw on; None: a new figure.
+        **kwargs
+            Passed on to `plots.comparison.plot_kb_error_map`.
+        """
         from ..plots.comparison import plot_kb_error_map
 
         return plot_kb_error_map(self, ax=ax, **kwargs)
@@ -367,7 +389,13 @@ class RootLocus:
     omega_scale: float
 
     def plot(self, ax=None):
-        """`plots.rlocus.plot_root_locus` of this locus; returns the figure."""
+        """`plots.rlocus.plot_root_locus` of this locus; returns the figure.
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes, optional
+            Axes to draw on; None: a new figure.
+        """
         from ..plots.rlocus import plot_root_locus
 
         return plot_root_locus(self, ax=ax)

@@ -35,7 +35,7 @@ import numpy as np
 from ..checks import check_number, check_type
 from .critical import CorridorBranches, CorridorCritical, CriticalValues, WallBranches, WallCritical, in_user_f, is_field_law
 from ..laws.fields import finite_goal_gain
-from ..laws.force_law import Equilibrium, ForceLaw, PowerLaw, corridor_equilibria, corridor_gain, law_in_force, wall_equilibria, wall_gain
+from ..laws.force_law import Equilibrium, ForceLaw, PowerLaw, corridor_equilibria, corridor_gain, law_in_force, wall_equilibria, wall_gain, _wall_gain
 from ..models import Loop, LoopModel, check_loop_gain, judge, models_for
 from ..parameters import RANGES, Controller, Corridor, Robot, Wall, check_corridor_fits, check_parameter, to_degrees
 from ..numerics.solve import bisect_root, expand_bracket
@@ -204,7 +204,15 @@ class CorridorAnalysis:
 
 
 def loop_of(robot: Robot, controller: Controller) -> Loop:
-    """The (τ, T, k) every model needs (`Loop.of`, after checking the types)."""
+    """The (τ, T, k) every model needs (`Loop.of`, after checking the types).
+
+    Parameters
+    ----------
+    robot : Robot
+        The robot (τ, s; k, 1/s).
+    controller : Controller
+        The controller (T, s).
+    """
     check_type("robot", robot, Robot, "a Robot")
     check_type("controller", controller, Controller, "a Controller")
     return Loop.of(robot, controller)
@@ -328,8 +336,8 @@ def critical_alpha(law: ForceLaw, V: float, NV_critical: float) -> float:
         return math.pi / 2
     target = NV_critical / V
 
-    def excess(alpha):
-        return wall_gain(law, alpha)[1] - target
+    def excess(alpha):  # α in RANGES["alpha"], the law checked above
+        return _wall_gain(law, alpha)[1] - target
 
     lo, hi = RANGES["alpha"].low, RANGES["alpha"].high
     if excess(lo) <= 0:

@@ -133,6 +133,16 @@ def _boundaries(models, loop: Loop):
     return [(m, m.boundary(loop)) for m in models]
 
 
+def _over_speed(NV_critical: float, V, solve, unstable: float = math.inf):
+    """A critical value y*(V) over the speeds V for a model's NV*: `unstable` where NV* = 0 (no V is stable: f*, L*
+    infinite, α* = π/2), 0 where NV* = inf (every V is), else ``solve(NV*)``."""
+    if NV_critical == 0:
+        return np.full(V.shape, unstable)
+    if math.isinf(NV_critical):
+        return np.zeros(V.shape)
+    return solve(NV_critical)
+
+
 # ------------------------------------------------------------- wall curves
 def wall_f_curves(robot: Robot, controller: Controller, alpha: float, V, models=None, law: ForceLaw | None = None) -> list[BoundaryCurve]:
     """f*(V) along a wall at target angle α, one curve per model (KB eq 24 generalized).
@@ -161,19 +171,13 @@ def wall_f_curves(robot: Robot, controller: Controller, alpha: float, V, models=
     V = check_positive_axis("V", V, "m/s")
     models = default_models(controller) if models is None else list(models)
     law = law_in_force(robot, controller, law)
-    out = []
-    for model, b in _boundaries(models, loop_of(robot, controller)):
-        NVs = b.NV_critical
-        if NVs == 0:
-            y = np.full(V.shape, np.inf)
-        elif math.isinf(NVs):
-            y = np.zeros(V.shape)
-        elif isinstance(law, PowerLaw):
-            y = math.cos(alpha) * (law.n * V / (law.W * NVs * math.tan(alpha))) ** law.n
-        else:
-            y = _wall_scale_general(law, alpha, V, NVs)
-        out.append(BoundaryCurve(model, NVs, b.omega_critical, "V", "m/s", "f", "", V, y, "above"))
-    return out
+    def solve(NVs):
+        if isinstance(law, PowerLaw):
+            return math.cos(alpha) * (law.n * V / (law.W * NVs * math.tan(alpha))) ** law.n
+        return _wall_scale_general(law, alpha, V, NVs)
+
+    return [BoundaryCurve(model, b.NV_critical, b.omega_critical, "V", "m/s", "f", "", V, _over_speed(b.NV_critical, V, solve), "above")
+            for model, b in _boundaries(models, loop_of(robot, controller))]
 
 
 def _check_decreasing(law: ForceLaw, g, lo: float, what: str, hi: float = math.inf) -> None:
@@ -240,19 +244,14 @@ def wall_alpha_curves(robot: Robot, controller: Controller, V, models=None, law:
     _check_decreasing(law, lambda d: wall_gain_at_distance(law, d)[1], lo, "N against the equilibrium distance d0")
     # α = 0: the law alone balances the full target force
     d_contact = law.distance_for(1.0) if not law.has_goal_part else wall_equilibria(law, RANGES["alpha"].low)[0].x0
-    out = []
-    for model, b in _boundaries(models, loop_of(robot, controller)):
-        NVs = b.NV_critical
-        if NVs == 0:
-            y = np.full(V.shape, math.pi / 2)
-        elif math.isinf(NVs):
-            y = np.zeros(V.shape)
-        else:
-            d0 = invert_decreasing(lambda d: wall_gain_at_distance(law, d)[1], NVs / V, d_contact * (1 + 1e-12), max(2 * d_contact, 1.0))
-            y = np.where(np.isinf(d0), math.pi / 2, wall_gain_at_distance(law, np.where(np.isfinite(d0), d0, d_contact * 2))[0])
-            y = np.where(np.isnan(d0), 0.0, y)
-        out.append(BoundaryCurve(model, NVs, b.omega_critical, "V", "m/s", "alpha", "rad", V, y, "above"))
-    return out
+    def solve(NVs):
+        d0 = invert_decreasing(lambda d: wall_gain_at_distance(law, d)[1], NVs / V, d_contact * (1 + 1e-12), max(2 * d_contact, 1.0))
+        y = np.where(np.isinf(d0), math.pi / 2, wall_gain_at_distance(law, np.where(np.isfinite(d0), d0, d_contact * 2))[0])
+        return np.where(np.isnan(d0), 0.0, y)
+
+    return [BoundaryCurve(model, b.NV_critical, b.omega_critical, "V", "m/s", "alpha", "rad", V,
+                          _over_speed(b.NV_critical, V, solve, unstable=math.pi / 2), "above")
+            for model, b in _boundaries(models, loop_of(robot, controller))]
 
 
 # --------------------------------------------------------- corridor curves
@@ -339,20 +338,14 @@ def corridor_L_curves(robot: Robot, controller: Controller, V, models=None, law:
     V = check_positive_axis("V", V, "m/s")
     models = default_models(controller) if models is None else list(models)
     law = law_in_force(robot, controller, law)
-    out = []
-    for model, b in _boundaries(models, loop_of(robot, controller)):
-        NVs = b.NV_critical
-        if NVs == 0:
-            y = np.full(V.shape, np.inf)
-        elif math.isinf(NVs):
-            y = np.zeros(V.shape)
-        elif isinstance(law, PowerLaw):
-            y = (2 * law.n * law.W**law.n * V * law.f / NVs) ** (1 / (law.n + 1))
-        else:
-            lo = max(law.domain()[0], 1e-9)
-            _check_decreasing(law, lambda d: corridor_gain(law, d), max(lo, robot.W / 2), "N against the corridor half-width L")
-            y = invert_decreasing(lambda d: corridor_gain(law, d), NVs / V, lo, 1.0)
-        out.append(BoundaryCurve(model, NVs, b.omega_critical, "V", "m/s", "L", "m", V, y, "above"))
-    return out
+    def solve(NVs):
+        if isinstance(law, PowerLaw):
+            return (2 * law.n * law.W**law.n * V * law.f / NVs) ** (1 / (law.n + 1))
+        lo = max(law.domain()[0], 1e-9)
+        _check_decreasing(law, lambda d: corridor_gain(law, d), max(lo, robot.W / 2), "N against the corridor half-width L")
+        return invert_decreasing(lambda d: corridor_gain(law, d), NVs / V, lo, 1.0)
+
+    return [BoundaryCurve(model, b.NV_critical, b.omega_critical, "V", "m/s", "L", "m", V, _over_speed(b.NV_critical, V, solve), "above")
+            for model, b in _boundaries(models, loop_of(robot, controller))]
 
 

@@ -87,7 +87,15 @@ many samples (speed: the final fit uses every sample)."""
 # ------------------------------------------------------------------------------------------ results
 @dataclass(frozen=True)
 class Estimate:
-    """A parameter and its 95 % interval [low, high] (the parameter's unit)."""
+    """A parameter and its 95 % interval [low, high] (the parameter's unit).
+
+    Attributes
+    ----------
+    value : float
+        The estimate (the parameter's unit).
+    low, high : float
+        Its 95 % interval (the parameter's unit).
+    """
 
     value: float
     low: float
@@ -102,9 +110,20 @@ class Estimate:
 class ControllerTiming:
     """The controller's real period from its command stamps.
 
-    T (s) the median interval, p5 and p95 (s) its 5th and 95th percentiles (the jitter), missed the number of
-    intervals longer than `MISSED_FACTOR`·T, messages the number of commands, rate (Hz) the achieved rate
-    (messages − 1 over their span) and nominal (Hz) = 1/T.
+    Attributes
+    ----------
+    T : float
+        Median interval between commands, s.
+    p5, p95 : float
+        5th and 95th percentiles of the intervals (the jitter), s.
+    missed : int
+        Intervals longer than `MISSED_FACTOR`·T.
+    messages : int
+        Number of commands.
+    rate : float
+        Achieved rate, Hz: messages − 1 over their span.
+    nominal : float
+        1/T, Hz.
     """
 
     T: float
@@ -124,8 +143,15 @@ class ControllerTiming:
 
 @dataclass(frozen=True)
 class FitWarning:
-    """Something the model does not explain: `kind` (``rate_limit``, ``deadband``, ``second_order``, ``poor_fit``,
-    ``dead_time_at_bound``, ``negative_dead_time``) and a one-line `message`."""
+    """Something the model does not explain: its `kind` and a one-line `message`.
+
+    Attributes
+    ----------
+    kind : str
+        ``rate_limit``, ``deadband``, ``second_order``, ``poor_fit``, ``dead_time_at_bound`` or ``negative_dead_time``.
+    message : str
+        One line for the user.
+    """
 
     kind: str
     message: str
@@ -139,11 +165,30 @@ class FitWarning:
 class FitQuality:
     """How well the model explains the samples it was fitted to.
 
-    nrmse (−) rms residual over the samples' standard deviation, r2 (−) 1 − SSR/SST, lag1 (−) the residuals'
-    autocorrelation at one sample, outside (−) the fraction of lags 1–20 whose autocorrelation is outside
-    ±1.96/√n, white (outside ≤ 0.2), samples and effective_samples (n over the residuals' integrated
-    autocorrelation), windows (count) and excited (s, their total length), bias (rad/s, the fitted offset b),
-    hac_lags (L of the interval's covariance).
+    Attributes
+    ----------
+    nrmse : float
+        Rms residual over the samples' standard deviation, dimensionless.
+    r2 : float
+        1 − SSR/SST, dimensionless.
+    lag1 : float
+        The residuals' autocorrelation at one sample, dimensionless.
+    outside : float
+        Fraction of lags 1–20 whose autocorrelation is outside ±1.96/√n.
+    white : bool
+        outside <= 0.2.
+    samples : int
+        Samples fitted.
+    effective_samples : float
+        Samples over the residuals' integrated autocorrelation.
+    windows : int
+        Excited windows fitted.
+    excited : float
+        Their total length, s.
+    bias : float
+        The fitted offset b, rad/s.
+    hac_lags : int
+        L of the interval's covariance (HAC lags).
     """
 
     nrmse: float
@@ -168,8 +213,22 @@ class FitQuality:
 
 @dataclass(frozen=True)
 class PlantFit:
-    """The fitted plant g·e^(−sD)/(τs + 1): g (−), tau (s), dead_time (s), each with its 95 % interval; the fit's
-    quality and what the model does not explain."""
+    """The fitted plant g·e^(−sD)/(τs + 1), each parameter with its 95 % interval; the fit's quality and what the
+    model does not explain.
+
+    Attributes
+    ----------
+    g : Estimate
+        Plant gain, dimensionless.
+    tau : Estimate
+        Time constant, s.
+    dead_time : Estimate
+        Dead time D, s.
+    quality : FitQuality
+        How well the model explains the samples.
+    warnings : tuple of FitWarning
+        What the model does not explain.
+    """
 
     g: Estimate
     tau: Estimate
@@ -180,8 +239,23 @@ class PlantFit:
 
 @dataclass(frozen=True)
 class LogSummary:
-    """What was read: path, format, duration (s), the command's and the rate's topics, the rate's source
-    (`RATE_SOURCES`) and where the command's times come from (``header``, ``receive``, ``csv``)."""
+    """What was read: the log, the topics used and where the rate and the command's times come from.
+
+    Attributes
+    ----------
+    path : str
+        The log as given.
+    format : str
+        Its format (`io.logs.log_format`).
+    duration : float
+        Length of the log, s.
+    command_topic, rate_topic : str
+        The command's and the rate's topics.
+    rate_source : str
+        Where the rate comes from (`RATE_SOURCES`).
+    command_stamps : str
+        Where the command's times come from: ``header``, ``receive`` or ``csv``.
+    """
 
     path: str
     format: str
@@ -200,7 +274,21 @@ class LogSummary:
 
 @dataclass(frozen=True)
 class Identification:
-    """What `identify` found: the controller's timing always; the plant when `identified`, else the `reason`."""
+    """What `identify` found: the controller's timing always; the plant when `identified`, else the `reason`.
+
+    Attributes
+    ----------
+    identified : bool
+        Whether the plant was identified.
+    reason : str or None
+        Why not, when it was not.
+    controller : ControllerTiming
+        The controller's timing (always).
+    plant : PlantFit or None
+        The fitted plant when `identified`.
+    log : LogSummary
+        What was read.
+    """
 
     identified: bool
     reason: str | None

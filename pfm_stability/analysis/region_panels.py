@@ -80,14 +80,28 @@ class RegionPanel:
 
     def plot(self, ax=None, **kwargs):
         """The panel (`plots.regions.PANELS`: `plot_wall_f_region`, `plot_wall_alpha_critical`, `plot_corridor_region`,
-        `plot_corridor_L_critical`); returns the figure."""
+        `plot_corridor_L_critical`); returns the figure.
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes, optional
+            Axes to draw on; None: a new figure.
+        **kwargs
+            Passed on to the panel's plotting function.
+        """
         from ..plots.regions import PANELS
 
         return PANELS[self.kind](self, ax=ax, **kwargs)
 
 
 class RegionPanels(list):
-    """The panels of one figure (`wall_panels`: (V, f) at each α and α*(V); `corridor_panels`: (L, V) and L*(V))."""
+    """The panels of one figure (`wall_panels`: (V, f) at each α and α*(V); `corridor_panels`: (L, V) and L*(V)).
+
+    Parameters
+    ----------
+    iterable : iterable of RegionPanel
+        The figure's panels, in drawing order.
+    """
 
     def plot(self):
         """`plots.regions.plot_wall_regions` or `plot_corridor_regions`: the panels side by side, one legend; returns the figure."""

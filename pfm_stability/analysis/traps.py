@@ -152,7 +152,15 @@ class TrapAnalysis:
         return head + "; ".join(f"trap at ({p.x:.6g}, {p.y:.6g})" for p in self.traps)
 
     def plot(self, ax=None, **kwargs):
-        """`plots.traps.plot_traps` of this analysis; returns the figure."""
+        """`plots.traps.plot_traps` of this analysis; returns the figure.
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes, optional
+            Axes to draw on; None: a new figure.
+        **kwargs
+            Passed on to `plots.traps.plot_traps`.
+        """
         from ..plots.traps import plot_traps
 
         return plot_traps(self, ax=ax, **kwargs)

@@ -84,6 +84,13 @@ def unknown_options(extras, parser) -> str:
 
     Options are case-sensitive (``--V`` speed, ``--v`` nothing); an option that differs from a real one
     only in case, or is close to one, is named (``--v`` → ``--V``, ``--tua`` → ``--tau``).
+
+    Parameters
+    ----------
+    extras : list of str
+        The arguments no option took.
+    parser : argparse.ArgumentParser
+        The (sub)command's parser.
     """
     options = [o for o in parser._option_string_actions if o.startswith("--")]
     hints, case = [], False
@@ -116,7 +123,13 @@ numpy is imported, unless the user set them."""
 
 
 def main(argv=None) -> int:
-    """Run the CLI; returns the exit status (0 ok, 2 user error)."""
+    """Run the CLI; returns the exit status (0 ok, 2 user error).
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        The arguments (default ``sys.argv[1:]``).
+    """
     for variable in BLAS_THREAD_VARIABLES:
         os.environ.setdefault(variable, "1")
     parser = build_parser()
@@ -136,7 +149,3 @@ def main(argv=None) -> int:
     except OSError as exc:  # the environment, not the code: a full disk, a vanished file, a device error
         where = f" ({exc.filename})" if getattr(exc, "filename", None) else ""
         return _fail(f"{exc.strerror or exc}{where}")
-
-
-def entry_point() -> None:  # pragma: no cover - thin wrapper
-    sys.exit(main())

@@ -8,7 +8,15 @@ __all__ = ["number", "percent", "table"]
 
 
 def number(x, digits: int = 4) -> str:
-    """A JSON number as text: ``digits`` significant digits, "-" undefined (None), "inf"/"-inf", strings as they are."""
+    """A JSON number as text: ``digits`` significant digits, "-" undefined (None), "inf"/"-inf", strings as they are.
+
+    Parameters
+    ----------
+    x : float, str or None
+        A JSON number (``"inf"``, ``"-inf"``, None) or any string.
+    digits : int, optional
+        Significant digits.
+    """
     if x is None:
         return "-"
     if isinstance(x, str):
@@ -19,14 +27,30 @@ def number(x, digits: int = 4) -> str:
 
 
 def percent(x) -> str:
-    """A JSON ratio as a signed percentage with one decimal ("-" undefined, "inf" infinite)."""
+    """A JSON ratio as a signed percentage with one decimal ("-" undefined, "inf" infinite).
+
+    Parameters
+    ----------
+    x : float, str or None
+        A JSON ratio (1 = 100 %).
+    """
     if x is None or isinstance(x, str):
         return number(x)
     return f"{x * 100:+.1f}%"
 
 
 def table(header, rows, sep: str = "  ") -> list[str]:
-    """Aligned text table: the first column left-aligned, the others right-aligned; one string per line."""
+    """Aligned text table: the first column left-aligned, the others right-aligned; one string per line.
+
+    Parameters
+    ----------
+    header : sequence of str
+        Column titles.
+    rows : sequence of sequence of str
+        The cells, one sequence per row.
+    sep : str, optional
+        Text between columns.
+    """
     widths = [max(len(str(r[i])) for r in [header] + rows) for i in range(len(header))]
 
     def line(cells):

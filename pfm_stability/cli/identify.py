@@ -33,7 +33,13 @@ _TOPIC = re.compile(r"^(~/|/)?[A-Za-z_][A-Za-z0-9_]*(/[A-Za-z0-9_]+)*$")
 
 
 def topic(name: str):
-    """An argparse ``type=`` for the topic option `name`: a ROS topic name (``/cmd_vel``, ``robot1/odom``)."""
+    """An argparse ``type=`` for the topic option `name`: a ROS topic name (``/cmd_vel``, ``robot1/odom``).
+
+    Parameters
+    ----------
+    name : str
+        The option's name, for the error message.
+    """
 
     def parse(text: str) -> str:
         if not _TOPIC.match(text):
@@ -47,7 +53,13 @@ def topic(name: str):
 
 
 def add_parser(sub) -> None:
-    """Add the ``identify`` subcommand to `sub` (argparse subparsers)."""
+    """Add the ``identify`` subcommand to `sub` (argparse subparsers).
+
+    Parameters
+    ----------
+    sub : argparse._SubParsersAction
+        The command's subparsers.
+    """
     from .options import output_path
 
     p = sub.add_parser(
@@ -70,7 +82,13 @@ def add_parser(sub) -> None:
 
 
 def run(args) -> int:
-    """Read the log, identify, write ``--out`` and print the result; returns the exit status (0)."""
+    """Read the log, identify, write ``--out`` and print the result; returns the exit status (0).
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed ``identify`` options.
+    """
     from ..analysis.identification import identify
     from ..extras import require
     from ..io.logs import LogTopics, log_format, read_log
@@ -130,7 +148,13 @@ def _quality(q) -> str:
 
 
 def render_text(result) -> str:
-    """The text output of ``identify`` (an `Identification`)."""
+    """The text output of ``identify`` (an `Identification`).
+
+    Parameters
+    ----------
+    result : Identification
+        What `identify` found.
+    """
     parts = _lines(result)
     out = [f"log: {parts['source']}", "", f"controller (from {result.log.command_topic})",
            f"  T       {parts['T']}", f"  jitter  {parts['jitter']}", f"  missed  {parts['missed']}", ""]
@@ -145,7 +169,13 @@ def render_text(result) -> str:
 
 
 def render_markdown(result) -> str:
-    """The Markdown output of ``identify`` (an `Identification`)."""
+    """The Markdown output of ``identify`` (an `Identification`).
+
+    Parameters
+    ----------
+    result : Identification
+        What `identify` found.
+    """
     parts = _lines(result)
     out = ["## Identified from the log", "", f"Log: {parts['source']}.", "", "| controller | |", "| --- | --- |",
            f"| T | {parts['T']} |", f"| jitter | {parts['jitter']} |", f"| missed | {parts['missed']} |", ""]
@@ -160,7 +190,13 @@ def render_markdown(result) -> str:
 
 
 def robot_yaml(result) -> str:
-    """The configuration file ``--out`` writes: ``robot: {tau, dead_time, plant_gain}``, ``controller: {T}``, commented."""
+    """The configuration file ``--out`` writes: ``robot: {tau, dead_time, plant_gain}``, ``controller: {T}``, commented.
+
+    Parameters
+    ----------
+    result : Identification
+        What `identify` found (identified: its plant is written).
+    """
     plant, c, log = result.plant, result.controller, result.log
     name = os.path.basename(os.path.normpath(log.path))
     D = max(plant.dead_time.value, 0.0)

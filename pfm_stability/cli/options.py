@@ -47,7 +47,13 @@ def _shown(key: str) -> str:
 
 
 def describe(key: str) -> str:
-    """``RANGES[key]`` for a help text, e.g. ``(0, 100] m/s`` or ``[3, 1000]`` (integers exactly): `parameters.describe_parameter`."""
+    """``RANGES[key]`` for a help text, e.g. ``(0, 100] m/s`` or ``[3, 1000]`` (integers exactly): `parameters.describe_parameter`.
+
+    Parameters
+    ----------
+    key : str
+        A key of ``RANGES``.
+    """
     return describe_parameter(key)
 
 
@@ -58,13 +64,26 @@ def check(key: str, value) -> float:
     `parameters.check_parameter` words it), naming the parameter as the user
     knows it (``alpha_deg`` → ``alpha``, ``T_sampled`` → ``T``) with the range
     in the units the user typed, so every subcommand states one range per option.
+
+    Parameters
+    ----------
+    key : str
+        A key of ``RANGES``.
+    value : object
+        The value to check.
     """
     r = RANGES[key]
     return check_number(_shown(key), value, r.low, r.high, low_open=r.low_open, high_open=r.high_open, unit=r.unit)
 
 
 def number(key: str):
-    """An argparse ``type=`` that parses a float and checks it against ``RANGES[key]`` (`check`)."""
+    """An argparse ``type=`` that parses a float and checks it against ``RANGES[key]`` (`check`).
+
+    Parameters
+    ----------
+    key : str
+        A key of ``RANGES``.
+    """
 
     def parse(text: str) -> float:
         try:
@@ -86,6 +105,13 @@ def integer(key: str, *, odd: bool = False):
 
     Message: ``"<key> must be an [odd ]integer in [low, high]; got '<text>'"``,
     as `checks.check_integer` (and `effective_force.check_window_cells`) word it.
+
+    Parameters
+    ----------
+    key : str
+        A key of ``RANGES`` with an integer range.
+    odd : bool, optional
+        Whether the integer must be odd.
     """
     r = RANGES[key]
     low, high = int(r.low), int(r.high)
@@ -107,7 +133,15 @@ def integer(key: str, *, odd: bool = False):
 
 
 def output_path(name: str, suffix: str = ".png"):
-    """An argparse ``type=`` for an output file, checked before any work (`checks.check_output_path`)."""
+    """An argparse ``type=`` for an output file, checked before any work (`checks.check_output_path`).
+
+    Parameters
+    ----------
+    name : str
+        The option's name, for the error message.
+    suffix : str, optional
+        The file's required suffix.
+    """
 
     def parse(text: str) -> str:
         try:
@@ -129,14 +163,28 @@ class Default(str):
 
 
 def typed(args, name: str) -> bool:
-    """Whether the user gave option `name` (not None and not a `Default`)."""
+    """Whether the user gave option `name` (not None and not a `Default`).
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed options.
+    name : str
+        The option's destination name.
+    """
     value = getattr(args, name, None)
     return value is not None and not isinstance(value, Default)
 
 
 def input_file(name: str):
     """An argparse ``type=`` for a file to read: non-empty text; whether it can be read is the reader's to say
-    (`pfm_stability.io.config.load_config`: ``config FILE: cannot read the file (…)``)."""
+    (`pfm_stability.io.config.load_config`: ``config FILE: cannot read the file (…)``).
+
+    Parameters
+    ----------
+    name : str
+        The option's name, for the error message.
+    """
 
     def parse(text: str) -> str:
         if not text.strip() or "\0" in text:
@@ -153,6 +201,17 @@ def shipped_or_given(name: str, folder: str, shipped, kind: str) -> str:
 
     Used by ``map`` (shipped maps) and ``traps`` (shipped scenes); `kind` ("map", "scene") names them in the error.
     A name with a directory or an extension is a path, left to the file's reader (which names a missing file).
+
+    Parameters
+    ----------
+    name : str
+        A shipped name or a file's path.
+    folder : str
+        The folder of ``pfm_stability/data`` holding the shipped files.
+    shipped : sequence of str
+        The shipped names.
+    kind : str
+        What they are ("map", "scene"), for the error message.
 
     Raises
     ------
@@ -178,6 +237,13 @@ def add_parameter_options(parser: argparse.ArgumentParser, *, sampled: bool = Fa
 
     With ``sampled=True`` (the simulator and the validation, which sample),
     ``--T`` takes ``RANGES["T_sampled"]``: (0, 100] s.
+
+    Parameters
+    ----------
+    parser : argparse.ArgumentParser
+        The subcommand's parser.
+    sampled : bool, keyword only
+        Whether the command samples (``--T`` then in (0, 100] s).
     """
     group = parser.add_argument_group("robot and controller (override the configuration file and the preset)")
     group.add_argument("--config", metavar="FILE", type=input_file("config"),
@@ -248,6 +314,13 @@ def resolve_parameters(args, *, fill=None) -> ResolvedParameters:
     ``args.alpha`` / ``args.L`` where the command has them and the user typed
     none (only the options of `fill`, if given: a command whose scenario takes
     no L says so); its notes (Nav2 keys not found) go to stderr.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed options.
+    fill : tuple of str, keyword only, optional
+        The scenario options a configuration file may fill (None: every one the command has).
     """
     config = None
     if getattr(args, "config", None) is not None:
@@ -304,7 +377,17 @@ def _fields(obj) -> dict:
 def add_law_options(parser: argparse.ArgumentParser, laws=LAW_NAMES, default: str = "power") -> None:
     """--law (one of `laws`, `default` unless a configuration file names one) and an option for every parameter and
     choice of those laws, all as the law registry declares them (`laws.registry`: help, default, range); each applies
-    to the laws that take it (`resolve_law`, `resolve_family`). The help names only `laws`."""
+    to the laws that take it (`resolve_law`, `resolve_family`). The help names only `laws`.
+
+    Parameters
+    ----------
+    parser : argparse.ArgumentParser
+        The subcommand's parser.
+    laws : tuple of str, optional
+        The laws the command offers (`laws.registry.laws_for`).
+    default : str, optional
+        The command's default law.
+    """
     title, text = law_help(laws, default)
     group = parser.add_argument_group(title)
     ordered = (default, *(name for name in laws if name != default))
@@ -345,6 +428,13 @@ def resolve_law(args, params: ResolvedParameters):
     A configuration file's law parameters apply when its law is the one in force;
     an option typed beats them.
 
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed options.
+    params : ResolvedParameters
+        The robot and controller (`resolve_parameters`).
+
     Raises
     ------
     ValueError
@@ -372,7 +462,13 @@ def resolve_law(args, params: ResolvedParameters):
 
 # ------------------------------------------------------------------ robot families (report)
 def add_family_options(parser: argparse.ArgumentParser) -> None:
-    """--robot, --mass and --no-simulate (``report`` only; the laws' options are `add_law_options`')."""
+    """--robot, --mass and --no-simulate (``report`` only; the laws' options are `add_law_options`').
+
+    Parameters
+    ----------
+    parser : argparse.ArgumentParser
+        The ``report`` subcommand's parser.
+    """
     group = parser.add_argument_group("robot family (docs/velocity_and_fuzzy.md)")
     group.add_argument("--robot", choices=ROBOT_FAMILIES, default=Default("steering"),
                        help="loop family: KB's steering robot (default), kinematic steering (tau = 0, --k is K_s) "
@@ -410,6 +506,13 @@ def resolve_family(args, params: ResolvedParameters) -> ResolvedFamily:
     ``robot.family``, ``robot.mass`` and ``law`` (docs/config.md) > the defaults.
     The file's mass applies when its family (holonomic) is the one in force, its
     law's parameters and choices (``variant``, ``side``, ``symmetrize``) when its law is the one in force.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed options.
+    params : ResolvedParameters
+        The robot and controller (`resolve_parameters`).
 
     Raises
     ------

@@ -273,7 +273,13 @@ def _kb_error_line(report) -> list[str]:
 
 
 def render_text(report) -> str:
-    """Readable plain-text report: inputs, per-model table, remedies, KB's error."""
+    """Readable plain-text report: inputs, per-model table, remedies, KB's error.
+
+    Parameters
+    ----------
+    report : StabilityReport
+        The report.
+    """
     data = report.to_dict()
     lines = ["pfm-stability report (Koren & Borenstein 1991 robot-environment loop)", "", "Inputs"]
     for name, entry in data["inputs"].items():
@@ -300,7 +306,13 @@ def render_text(report) -> str:
 
 
 def render_door_text(passage) -> str:
-    """The door passage (KB Fig 4; a `door.DoorPassage` or its `to_dict()`): geometry, verdict, stop, lateral stiffness, smallest width."""
+    """The door passage (KB Fig 4; a `door.DoorPassage` or its `to_dict()`): geometry, verdict, stop, lateral stiffness, smallest width.
+
+    Parameters
+    ----------
+    passage : DoorPassage or dict
+        The door analysis or its JSON form.
+    """
     d = passage.to_dict() if hasattr(passage, "to_dict") else passage
     g = d["geometry"]
     kind = "two posts" if g["obstacle"] == "posts" else "two wall ends"
@@ -330,7 +342,13 @@ def render_door_text(passage) -> str:
 
 
 def render_markdown(report) -> str:
-    """The same content as `render_text`, as Markdown tables."""
+    """The same content as `render_text`, as Markdown tables.
+
+    Parameters
+    ----------
+    report : StabilityReport
+        The report.
+    """
     data = report.to_dict()
     lines = ["# pfm-stability report", "", "| input | value | unit | source |", "| --- | --- | --- | --- |"]
     for name, entry in data["inputs"].items():
@@ -358,7 +376,15 @@ def _derivation_heading(law: str) -> str:
 
 
 def render_derivation_text(steps, law: str) -> str:
-    """Steps as plain text: a numbered heading, the pretty-printed result, the explanation."""
+    """Steps as plain text: a numbered heading, the pretty-printed result, the explanation.
+
+    Parameters
+    ----------
+    steps : sequence of Step
+        The derivation (`analysis.derivation`).
+    law : str
+        The law derived, named in the heading.
+    """
     import sympy as sp
 
     lines = [
@@ -375,7 +401,15 @@ def render_derivation_text(steps, law: str) -> str:
 
 
 def render_derivation_latex(steps, law: str) -> str:
-    """Steps as a LaTeX fragment (amsmath): a paragraph and an ``equation*`` per step."""
+    """Steps as a LaTeX fragment (amsmath): a paragraph and an ``equation*`` per step.
+
+    Parameters
+    ----------
+    steps : sequence of Step
+        The derivation (`analysis.derivation`).
+    law : str
+        The law derived, named in the heading.
+    """
     import sympy as sp
 
     lines = [f"% {_derivation_heading(law)}; needs amsmath.", ""]
@@ -402,7 +436,13 @@ def _or_dash(x) -> str:
 
 
 def render_traps_text(analysis) -> str:
-    """The text output: stationary points, goal verdict, bounds and the conclusion."""
+    """The text output: stationary points, goal verdict, bounds and the conclusion.
+
+    Parameters
+    ----------
+    analysis : TrapAnalysis
+        The scene's stationary points and bounds.
+    """
     scene = analysis.scene
     lines = [f"law: {scene.law.describe()}", f"goal: ({scene.goal[0]:g}, {scene.goal[1]:g}); {len(scene.obstacles)} obstacle(s); "
              f"region [{scene.region[0][0]:g}, {scene.region[1][0]:g}] x [{scene.region[0][1]:g}, {scene.region[1][1]:g}] m; "
@@ -440,7 +480,15 @@ def _share(x) -> str:
 
 
 def render_parameter_sweep_text(summary, plot=None) -> str:
-    """``pfm-stability sweep``'s summary: points, time, rate, each model's stable fraction, the agreement matrix, where the output went."""
+    """``pfm-stability sweep``'s summary: points, time, rate, each model's stable fraction, the agreement matrix, where the output went.
+
+    Parameters
+    ----------
+    summary : SweepSummary
+        The sweep's statistics and specification.
+    plot : str, optional
+        Path of the summary figure written, if any.
+    """
     s = summary.statistics
     spec = summary.spec
     models = list(s.agreement)
@@ -477,7 +525,13 @@ MAP_ROWS = 15
 
 
 def render_map_text(data: dict) -> str:
-    """``pfm-stability map``: the map, the robot, the worst segments (lowest margin first), a summary, validation, outputs."""
+    """``pfm-stability map``: the map, the robot, the worst segments (lowest margin first), a summary, validation, outputs.
+
+    Parameters
+    ----------
+    data : dict
+        The map analysis's JSON form.
+    """
     m, i, s = data["map"], data["inputs"], data["summary"]
     lines = [
         f"map {m['name']}: {m['width']} x {m['height']} cells of {m['resolution']:g} m, origin {m['origin'][:2]}; "

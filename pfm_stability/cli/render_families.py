@@ -38,7 +38,19 @@ _CYCLE = (("mean_distance", "mean distance", "m"), ("peak_to_peak", "peak-to-pea
 
 
 def holonomic_sections(scene, env: dict, verdicts: dict, report):
-    """Yield the (title, header, rows, remedies, notes) of a holonomic robot's geometry (`report.families.HolonomicScene`)."""
+    """Yield the (title, header, rows, remedies, notes) of a holonomic robot's geometry (`report.families.HolonomicScene`).
+
+    Parameters
+    ----------
+    scene : HolonomicScene
+        The geometry's result.
+    env : dict
+        Its environment entry of the report's JSON.
+    verdicts : dict
+        Model name → its verdict entry of the report's JSON.
+    report : StabilityReport
+        The whole report.
+    """
     scenario = scene.geometry
     where = f"alpha = {number(env['alpha_deg'])} deg" if scenario == "wall" else f"L = {number(env['L'])} m"
     name = "Wall" if scenario == "wall" else "Corridor"
@@ -59,7 +71,19 @@ def holonomic_sections(scene, env: dict, verdicts: dict, report):
 
 
 def non_smooth_sections(scene, env: dict, verdicts: None, report):
-    """Yield the section of a non-smooth geometry (`report.families.NonSmoothScene`): the rest band and the simulated cycle."""
+    """Yield the section of a non-smooth geometry (`report.families.NonSmoothScene`): the rest band and the simulated cycle.
+
+    Parameters
+    ----------
+    scene : NonSmoothScene
+        The geometry's result.
+    env : dict
+        Its environment entry of the report's JSON.
+    verdicts : None
+        A non-smooth geometry has no model verdicts.
+    report : StabilityReport
+        The whole report.
+    """
     scenario = scene.geometry
     where = f"alpha = {number(env['alpha_deg'])} deg" if scenario == "wall" else f"L = {number(env['L'])} m"
     name = "Wall" if scenario == "wall" else "Corridor"
@@ -93,7 +117,13 @@ def _non_smooth_table(scenario: str, env: dict):
 
 
 def equilibrium_notes(e: dict) -> list[str]:
-    """The fuzzy law's frozen-gain N and the one-sided heading gains at one equilibrium (its JSON form)."""
+    """The fuzzy law's frozen-gain N and the one-sided heading gains at one equilibrium (its JSON form).
+
+    Parameters
+    ----------
+    e : dict
+        One equilibrium's JSON entry.
+    """
     line = f"  fuzzy-scheduled gains: N total {number(e['N'])} 1/m (used), N frozen {number(e['N_frozen'])} 1/m"
     if "c_plus" in e:
         line += f"; c = {number(e['c'])} (c- {number(e['c_minus'])}, c+ {number(e['c_plus'])}); eta = {number(e['eta'])}, d eta/dd = {number(e['eta_d'])} 1/m"
@@ -101,7 +131,15 @@ def equilibrium_notes(e: dict) -> list[str]:
 
 
 def family_tail(report, data: dict) -> list[str]:
-    """Lines after the geometries: the fuzzy law's robust bracket and the tracking error's dynamics (values from the JSON `data`)."""
+    """Lines after the geometries: the fuzzy law's robust bracket and the tracking error's dynamics (values from the JSON `data`).
+
+    Parameters
+    ----------
+    report : StabilityReport
+        The report.
+    data : dict
+        Its JSON form.
+    """
     lines = []
     if report.schedule is not None and report.schedule.bracket is not None:
         bracket = data["environment"]["wall"]["robust_bracket"]

@@ -14,7 +14,17 @@ def _quantity(value, unit="", digits=4):
 
 
 def render_simulation_text(result, prediction, plot_path=None) -> str:
-    """The human-readable report of one run."""
+    """The human-readable report of one run.
+
+    Parameters
+    ----------
+    result : RunResult
+        The run.
+    prediction : dict
+        The models' answers for its scenario.
+    plot_path : str, optional
+        Path of the figure written, if any.
+    """
     s, m = result.scenario, result.metrics
     r, c = s.robot, s.controller
     simulated = f"{s.duration:g} s simulated"
@@ -73,7 +83,19 @@ def _pct(value):
 
 
 def render_validation_text(v, sweep=None, sources=None, plot=None, sweep_plot=None) -> str:
-    """Human-readable validation report: boundaries, errors, oscillation checks, sweep."""
+    """Human-readable validation report: boundaries, errors, oscillation checks, sweep.
+
+    Parameters
+    ----------
+    v : Validation
+        The simulated boundary against every model.
+    sweep : SweepResult, optional
+        A random sweep run with it.
+    sources : dict, optional
+        Parameter → provenance (``ASSUMED …`` ones are listed).
+    plot, sweep_plot : str, optional
+        Paths of the figures written, if any.
+    """
     i = v.inputs
     unit = f" {v.unit}" if v.unit else ""
     name = {"L": "L*", "alpha": "alpha*", "V": "V*", "f": "f*"}[v.parameter]
@@ -119,7 +141,13 @@ def render_validation_text(v, sweep=None, sources=None, plot=None, sweep_plot=No
 
 
 def render_sweep_text(sweep) -> str:
-    """The sweep's agreement, each model's wrong-verdict rate, and every disagreement."""
+    """The sweep's agreement, each model's wrong-verdict rate, and every disagreement.
+
+    Parameters
+    ----------
+    sweep : SweepResult
+        The random sweep.
+    """
     lines = [
         f"random sweep: {sweep.count} Latin-hypercube sets ({sweep.env}, seed {sweep.seed}), {sweep.included} outside "
         f"+-{100 * sweep.exclude:g} % of the sampled boundary (in NV), {sweep.seconds:.1f} s",

@@ -37,7 +37,15 @@ def _reason(exc: OSError) -> str:
 
 
 def open_new(path: str, mode: str):
-    """Open the new (temporary) file `path` for writing in `mode` ("w" text UTF-8, or "wb")."""
+    """Open the new (temporary) file `path` for writing in `mode` ("w" text UTF-8, or "wb").
+
+    Parameters
+    ----------
+    path : str
+        The new file's path.
+    mode : str
+        ``"w"`` (text, UTF-8) or ``"wb"``.
+    """
     return open(path, mode, encoding="utf-8") if "b" not in mode else open(path, mode)
 
 
@@ -79,13 +87,35 @@ def atomic_file(path, mode: str = "wb", *, what: str = "output"):
 
 
 def write_text(path, text: str, *, what: str = "output") -> None:
-    """Write `text` (UTF-8) to `path` atomically (`atomic_file`)."""
+    """Write `text` (UTF-8) to `path` atomically (`atomic_file`).
+
+    Parameters
+    ----------
+    path : str or path-like
+        The file.
+    text : str
+        Its content.
+    what : str, optional
+        What the file is, for the error message.
+    """
     with atomic_file(path, "w", what=what) as handle:
         handle.write(text)
 
 
 def save_figure(fig, path, *, dpi: int = 110, what: str = "plot") -> None:
-    """Save a matplotlib figure atomically, in the format of `path`'s suffix (``.png``); then close it."""
+    """Save a matplotlib figure atomically, in the format of `path`'s suffix (``.png``); then close it.
+
+    Parameters
+    ----------
+    fig : matplotlib.figure.Figure
+        The figure.
+    path : str or path-like
+        The image file.
+    dpi : int, optional
+        Resolution, dots per inch.
+    what : str, optional
+        What the file is, for the error message.
+    """
     import matplotlib.pyplot as plt
 
     fmt = os.path.splitext(os.fspath(path))[1].lstrip(".").lower() or "png"
@@ -104,6 +134,15 @@ def atomic_directory(out_dir, names, *, what: str = "outputs"):
     (created if missing), so each rename is atomic. On any failure the staging
     directory, and `out_dir` if it was created here and is left empty, are
     removed: a failure leaves nothing behind. An ``OSError`` becomes `OutputError`.
+
+    Parameters
+    ----------
+    out_dir : str or path-like
+        The output directory.
+    names : sequence of str
+        The files' names in it.
+    what : str, optional
+        What the files are, for the error message.
     """
     out_dir = os.fspath(out_dir)
     created = not os.path.exists(out_dir)
@@ -131,6 +170,11 @@ def check_writable(directory: str) -> str | None:
 
     Creates and removes one empty temporary file: `os.access` alone says yes to
     root in ``/proc`` and ``/sys``, where nothing can be created.
+
+    Parameters
+    ----------
+    directory : str
+        An existing directory.
     """
     try:
         fd, probe = tempfile.mkstemp(prefix=".pfm-stability-probe-", dir=directory)

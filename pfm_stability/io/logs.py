@@ -70,7 +70,13 @@ class LogError(ValueError):
 
 @dataclass(frozen=True)
 class LogTopics:
-    """The topic of each series (defaults: ``/cmd_vel``, ``/odom``, ``/imu``, ``/scan``)."""
+    """The topic of each series (defaults: ``/cmd_vel``, ``/odom``, ``/imu``, ``/scan``).
+
+    Attributes
+    ----------
+    command, odometry, imu, scan : str
+        The topic of each series.
+    """
 
     command: str = "/cmd_vel"
     odometry: str = "/odom"
@@ -78,7 +84,13 @@ class LogTopics:
     scan: str = "/scan"
 
     def of(self, series: str) -> str:
-        """The topic of `series` (one of `SERIES`)."""
+        """The topic of `series` (one of `SERIES`).
+
+        Parameters
+        ----------
+        series : str
+            One of `SERIES`.
+        """
         return getattr(self, series)
 
 
@@ -88,6 +100,19 @@ class TimeSeries:
 
     `stamps` says where the times come from: ``"header"`` (the message's header stamp), ``"receive"`` (the bag's
     receive time: a ``Twist`` has no stamp) or ``"csv"``.
+
+    Attributes
+    ----------
+    topic : str
+        The topic.
+    msgtype : str
+        Its message type.
+    t : ndarray
+        Times since the log's start, s, non-decreasing.
+    value : ndarray
+        One value per message, rad/s.
+    stamps : str
+        Where the times come from: ``"header"``, ``"receive"`` or ``"csv"``.
     """
 
     topic: str
@@ -104,7 +129,21 @@ class TimeSeries:
 
 @dataclass(frozen=True)
 class Scan:
-    """One laser scan as handed to a reducer: `t` (s since the log's start), the beam angles (rad) and `ranges` (m)."""
+    """One laser scan as handed to a reducer: `t` (s since the log's start), the beam angles (rad) and `ranges` (m).
+
+    Attributes
+    ----------
+    t : float
+        Time since the log's start, s.
+    angle_min : float
+        Angle of the first beam, rad.
+    angle_increment : float
+        Angle between beams, rad.
+    range_min, range_max : float
+        The scanner's valid range, m.
+    ranges : ndarray
+        One range per beam, m.
+    """
 
     t: float
     angle_min: float
@@ -116,7 +155,17 @@ class Scan:
 
 @dataclass(frozen=True)
 class ScanSeries:
-    """The scans of one topic, reduced: `t` (s) and `values`, the reducer's result per scan (an array if they are numbers)."""
+    """The scans of one topic, reduced: `t` (s) and `values`, the reducer's result per scan (an array if they are numbers).
+
+    Attributes
+    ----------
+    topic : str
+        The scan topic.
+    t : ndarray
+        Times since the log's start, s.
+    values : ndarray or list
+        The reducer's result per scan (an array if they are numbers).
+    """
 
     topic: str
     t: np.ndarray
@@ -127,9 +176,22 @@ class ScanSeries:
 class LogData:
     """What `read_log` read: the series asked for (None when not asked for) and what the log holds.
 
-    `path` as given, `format` (``"ros2-sqlite3"``, ``"ros2-mcap"``, ``"ros1"``, ``"csv"``), `start` (epoch s of the
-    first message), `duration` (s, first to last message of the whole log), `topics` ((topic, message type) of every
-    topic in the log, sorted).
+    Attributes
+    ----------
+    path : str
+        The log as given.
+    format : str
+        ``"ros2-sqlite3"``, ``"ros2-mcap"``, ``"ros1"`` or ``"csv"``.
+    start : float
+        Epoch time of the first message, s.
+    duration : float
+        First to last message of the whole log, s.
+    topics : tuple of (str, str)
+        (topic, message type) of every topic in the log, sorted.
+    command, odometry, imu : TimeSeries or None
+        The series asked for (None when not asked for).
+    scan : ScanSeries or None
+        The reduced scans, when asked for.
     """
 
     path: str

@@ -79,14 +79,28 @@ class Nav2Value:
 
 @dataclass(frozen=True)
 class Nav2Values:
-    """What a Nav2 file gives: ``values`` (name → `Nav2Value`) and ``notes`` (what was not found)."""
+    """What a Nav2 file gives: ``values`` (name → `Nav2Value`) and ``notes`` (what was not found).
+
+    Attributes
+    ----------
+    values : dict
+        Parameter name → `Nav2Value`.
+    notes : tuple of str
+        What was not found.
+    """
 
     values: dict
     notes: tuple
 
 
 def is_nav2(data) -> bool:
-    """Whether `data` (a parsed YAML document) is a Nav2 parameters file: a node with ``ros__parameters``."""
+    """Whether `data` (a parsed YAML document) is a Nav2 parameters file: a node with ``ros__parameters``.
+
+    Parameters
+    ----------
+    data : object
+        A parsed YAML document.
+    """
     if not isinstance(data, dict):
         return False
     nodes = [v for v in data.values() if isinstance(v, dict)]

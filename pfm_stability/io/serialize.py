@@ -31,7 +31,13 @@ SCHEMA_VERSION = "1.0"
 
 
 def json_number(x):
-    """``float(x)`` if finite, ``"inf"``/``"-inf"`` if infinite, None if undefined (NaN or None)."""
+    """``float(x)`` if finite, ``"inf"``/``"-inf"`` if infinite, None if undefined (NaN or None).
+
+    Parameters
+    ----------
+    x : float or None
+        A number.
+    """
     if x is None:
         return None
     x = float(x)
@@ -43,14 +49,26 @@ def json_number(x):
 
 
 def parse_json_number(value) -> float:
-    """The float a `json_number` stands for (None → NaN)."""
+    """The float a `json_number` stands for (None → NaN).
+
+    Parameters
+    ----------
+    value : float, str or None
+        A `json_number`.
+    """
     if value is None:
         return math.nan
     return float(value)
 
 
 def json_array(a):
-    """Nested lists of `json_number` values for an array of any dimension."""
+    """Nested lists of `json_number` values for an array of any dimension.
+
+    Parameters
+    ----------
+    a : array_like
+        Numbers.
+    """
     a = np.asarray(a, dtype=float)
     if a.ndim == 0:
         return json_number(a)
@@ -65,6 +83,11 @@ def json_ready(value):
     Dicts keep their keys (as str), lists and tuples become lists, numpy
     arrays nested lists (`json_array`), bools and integers (numpy's too) stay
     exact, other numbers go through `json_number`; str and None are kept.
+
+    Parameters
+    ----------
+    value : object
+        Numbers, strings, None and (nested) dicts, lists, tuples and arrays of them.
 
     Raises
     ------
@@ -91,6 +114,11 @@ def json_ready(value):
 def json_default(value):
     """`json.dumps` ``default=``: numpy scalars as Python numbers (floats through `json_number`).
 
+    Parameters
+    ----------
+    value : object
+        What `json.dumps` could not write.
+
     Raises
     ------
     TypeError
@@ -106,5 +134,11 @@ def json_default(value):
 
 
 def dumps(data) -> str:
-    """`data` as the commands print it: strict JSON, indent 2, numpy scalars by `json_default`."""
+    """`data` as the commands print it: strict JSON, indent 2, numpy scalars by `json_default`.
+
+    Parameters
+    ----------
+    data : object
+        JSON-ready data (`json_ready`).
+    """
     return json.dumps(data, indent=2, allow_nan=False, default=json_default)

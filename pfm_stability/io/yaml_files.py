@@ -90,6 +90,11 @@ def leading_key(message: str) -> str | None:
     """The key a message starts with (``law.rho0`` of ``law.rho0 must be …``), or None.
 
     For readers whose checks word their messages key first (scenes, map metadata) and raise a plain ValueError.
+
+    Parameters
+    ----------
+    message : str
+        An error message.
     """
     match = _LEADING_KEY.match(message)
     return match.group(0) if match else None
@@ -128,6 +133,11 @@ class YamlFile:
 
         A key that starts with the file's kind (``scene.region`` in a scene) is looked up without it.
         None for a mapping given in code.
+
+        Parameters
+        ----------
+        key : str or tuple
+            A dotted key (``"grid.V.from"``) or a tuple of keys.
         """
         if not self.lines:
             return None
@@ -140,12 +150,28 @@ class YamlFile:
         return self.lines.get(parts)
 
     def error(self, detail: str, key=None) -> InputError:
-        """An `InputError` about `key` (a dotted key, a tuple, or None for the whole file), at its line."""
+        """An `InputError` about `key` (a dotted key, a tuple, or None for the whole file), at its line.
+
+        Parameters
+        ----------
+        detail : str
+            What is wrong.
+        key : str or tuple, optional
+            A dotted key or a tuple of keys; None: the whole file.
+        """
         return InputError(detail, origin=self.origin, key=None if key is None else str(key), line=self.line_of(key))
 
     def refuse(self, exc: ValueError, key=None) -> InputError:
         """`exc` (a check's plain ValueError) as an `InputError` of this file, at the line of `key`
-        (default: the key its message starts with, `leading_key`). An `InputError` of this file is kept."""
+        (default: the key its message starts with, `leading_key`). An `InputError` of this file is kept.
+
+        Parameters
+        ----------
+        exc : ValueError
+            A check's error.
+        key : str or tuple, optional
+            The key it is about; None: the key its message starts with.
+        """
         if isinstance(exc, InputError) and exc.origin == self.origin:
             return exc
         message = str(exc)
@@ -153,7 +179,15 @@ class YamlFile:
 
 
 def mapping_source(data, origin: str | None) -> YamlFile:
-    """A mapping given in code as a `YamlFile` without lines, so that readers word its errors as a file's."""
+    """A mapping given in code as a `YamlFile` without lines, so that readers word its errors as a file's.
+
+    Parameters
+    ----------
+    data : dict
+        The mapping.
+    origin : str or None
+        What to call it in messages.
+    """
     return YamlFile(data, origin)
 
 
@@ -190,6 +224,13 @@ def read_yaml(path, kind: str) -> YamlFile:
 
 def parse_yaml(text: str, origin: str | None = None):
     """The YAML document in `text` (a value embedded in a file, e.g. Nav2's footprint string), by the file rule.
+
+    Parameters
+    ----------
+    text : str
+        The YAML text.
+    origin : str, optional
+        What to call it in messages (the file and key it came from).
 
     Raises
     ------

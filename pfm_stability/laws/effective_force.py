@@ -61,6 +61,11 @@ DEFAULT_CV = 15
 def check_window_cells(window_cells) -> int:
     """Return the window side w_s after checking it is an odd integer >= 3 (KB §2: 33).
 
+    Parameters
+    ----------
+    window_cells : int
+        The active window's side, cells.
+
     Raises
     ------
     ValueError
@@ -160,7 +165,13 @@ class GridWallLaw(ForceLaw):
 
     # ------------------------------------------------------- ForceLaw API
     def force(self, d):
-        """F_r(d)/F_ct: the window sum for d <= `reach`, the C¹ tail beyond."""
+        """F_r(d)/F_ct: the window sum for d <= `reach`, the C¹ tail beyond.
+
+        Parameters
+        ----------
+        d : float or ndarray
+            Distance to the wall, m.
+        """
         d = np.asarray(d, dtype=float)
         R = self.reach
         inside = self._window_force(np.minimum(d, R))
@@ -168,7 +179,13 @@ class GridWallLaw(ForceLaw):
         return np.where(d <= R, inside, tail)
 
     def slope(self, d):
-        """dF_r/dd, 1/m (negative everywhere)."""
+        """dF_r/dd, 1/m (negative everywhere).
+
+        Parameters
+        ----------
+        d : float or ndarray
+            Distance to the wall, m.
+        """
         d = np.asarray(d, dtype=float)
         R = self.reach
         inside = self._window_slope(np.minimum(d, R))
@@ -177,12 +194,24 @@ class GridWallLaw(ForceLaw):
         return np.where(d <= R, inside, tail)
 
     def window_force(self, d):
-        """The grid's true averaged force: `force` for d <= `reach`, 0 beyond."""
+        """The grid's true averaged force: `force` for d <= `reach`, 0 beyond.
+
+        Parameters
+        ----------
+        d : float or ndarray
+            Distance to the wall, m.
+        """
         d = np.asarray(d, dtype=float)
         return np.where(d <= self.reach, self._window_force(np.minimum(d, self.reach)), 0.0)
 
     def with_scale(self, scale: float) -> "GridWallLaw":
-        """The same wall with cell ratio ρ = `scale`."""
+        """The same wall with cell ratio ρ = `scale`.
+
+        Parameters
+        ----------
+        scale : float
+            Cell ratio ρ = F_cr/F_ct.
+        """
         return GridWallLaw(scale, self.n, self.W, self.cell_size, self.window_cells, self.cv)
 
     def parameters(self) -> dict:
@@ -201,7 +230,13 @@ class GridWallLaw(ForceLaw):
         return f_average(self)
 
     def lumped(self, f: float | None = None) -> PowerLaw:
-        """KB's lumped law with this law's n and W and f (default: `lumped_f`, the grid's f_av)."""
+        """KB's lumped law with this law's n and W and f (default: `lumped_f`, the grid's f_av).
+
+        Parameters
+        ----------
+        f : float, optional
+            KB's f; default `lumped_f`.
+        """
         return PowerLaw(self.lumped_f() if f is None else f, self.n, self.W)
 
 
@@ -210,6 +245,15 @@ def working_range(W: float, cell_size: float = 0.1, window_cells: int = 33) -> t
 
     From contact, d = (W + c)/2 (robot disc touching the wall cells), to the
     window's reach (h + ½)c. KB's f_av (§4) is the mean of f(d) over this range.
+
+    Parameters
+    ----------
+    W : float
+        Robot width, m.
+    cell_size : float, optional
+        Grid cell size, m.
+    window_cells : int, optional
+        Active window side, cells.
     """
     lo = (W + cell_size) / 2
     hi = (check_window_cells(window_cells) // 2 + 0.5) * cell_size
@@ -273,6 +317,15 @@ def corridor_lateral_force(law: ForceLaw, L: float, x):
 
     F_x = F_r(L + x) − F_r(L − x) (the left wall pushes right, the right wall
     left); linearized, F_x ≈ 2F_r′(L)·x = −N·F_ct·x (docs/theory.md).
+
+    Parameters
+    ----------
+    law : ForceLaw
+        The wall's law.
+    L : float
+        Corridor half-width, m.
+    x : float or ndarray
+        Offset from the middle, m, towards the right wall.
     """
     x = np.asarray(x, dtype=float)
     return law.force(L + x) - law.force(L - x)

@@ -172,10 +172,12 @@ class GnronLaw(_FieldLaw):
 
     Parameters
     ----------
-    xi, eta, rho0, m, rho_g : float
+    xi, eta, rho0, m : float
         As in `KhatibLaw`.
     n : float
         Goal exponent, [0, 10].
+    rho_g : float
+        As in `KhatibLaw`.
     delta : float
         Surface offset δ of eq (40), m (default 0).
     """
@@ -214,6 +216,13 @@ def finite_goal_gain(law: ForceLaw, N: float) -> float | None:
     The goal-directed forces (attraction and Q) then point at the goal, so at
     a lateral offset x they have a lateral part −(1 + 2Q)·x/ρ_g, which adds
     1/ρ_g to N = −∂F_x/∂x / F_y. KB's frozen direction (the report's N) leaves it out.
+
+    Parameters
+    ----------
+    law : ForceLaw
+        The law (its goal distance ρ_g, m, if it has one).
+    N : float
+        The corridor's gain with the target at infinity, 1/m.
     """
     rho_g = law.goal_distance
     return None if rho_g is None else N + 1.0 / rho_g
@@ -230,6 +239,17 @@ def make_law(name: str, robot: Robot, controller: Controller, **parameters) -> F
     their defaults are the law registry's (`pfm_stability.laws.registry`: the grid's
     0.1 m cells and 33-cell window, KB §2; GC2000 Sec VI's ξ = 1, η = 0.1, ρ0 = 0.8 m,
     m = n = 2, and δ = 0). A parameter given as None is not given.
+
+    Parameters
+    ----------
+    name : str
+        The law (`registry.FORCE_LAWS`).
+    robot : Robot
+        W (m).
+    controller : Controller
+        f and n of KB's laws.
+    **parameters
+        The law's own parameters (`registry.LAWS`), over its defaults.
 
     Raises
     ------
@@ -280,6 +300,13 @@ def _follow(previous: Equilibrium, before, now):
 class Branch:
     """One equilibrium followed as a parameter p moves from p0 to both ends of its range.
 
+    The points are scanned lazily and shared by every threshold asked
+    (`nearest_crossing`). Where the number of equilibria changes between two
+    points the step is halved (down to 2⁻¹⁰ of it), so that a pair born or
+    merging is resolved before the followed one is matched. Where the
+    equilibrium vanishes (a fold: N → 0 there) the branch ends and N counts
+    as 0 beyond.
+
     Parameters
     ----------
     equilibria_at : callable
@@ -287,7 +314,9 @@ class Branch:
         (sorted; a ValueError means none); ``polish=False`` may return them
         to ~1e-3 (`force_law.wall_equilibria`), for the scan.
     p0 : float
-        The current value; `start` the equilibrium followed (one of ``equilibria_at(p0, True)``).
+        The current value.
+    start : Equilibrium
+        The equilibrium followed (one of ``equilibria_at(p0, True)``).
     lo, hi : float
         The range of p.
     log : bool
@@ -299,13 +328,6 @@ class Branch:
         `force_law.ForceLaw.breakpoints`): the scan steps onto each from both
         sides (a relative 1e-9 away), so a band that ends at one is never
         stepped over.
-
-    The points are scanned lazily and shared by every threshold asked
-    (`nearest_crossing`). Where the number of equilibria changes between two
-    points the step is halved (down to 2⁻¹⁰ of it), so that a pair born or
-    merging is resolved before the followed one is matched. Where the
-    equilibrium vanishes (a fold: N → 0 there) the branch ends and N counts
-    as 0 beyond.
     """
 
     _FINEST = 2.0**-10
@@ -358,7 +380,15 @@ class Branch:
             self._scale[side] = min(1.0, 2 * self._scale[side])
 
     def point(self, side: int, k: int):
-        """(p, N) of the k-th scanned point on `side` (+1 towards hi, −1 towards lo); None past the end; N = 0 past a fold."""
+        """(p, N) of the k-th scanned point on `side` (+1 towards hi, −1 towards lo); None past the end; N = 0 past a fold.
+
+        Parameters
+        ----------
+        side : int
+            +1 (towards hi) or −1 (towards lo).
+        k : int
+            Index of the scanned point.
+        """
         points = self._points[side]
         while len(points) <= k and not self._done[side]:
             self._advance(side)
@@ -368,7 +398,17 @@ class Branch:
         return p, (eq.N if eq is not None else 0.0)
 
     def gain(self, side: int, k: int, p: float) -> float:
-        """N, exact, of the followed equilibrium at p, between the points k and k + 1 of `side` (0 if it has vanished)."""
+        """N, exact, of the followed equilibrium at p, between the points k and k + 1 of `side` (0 if it has vanished).
+
+        Parameters
+        ----------
+        side : int
+            +1 (towards hi) or −1 (towards lo).
+        k : int
+            Index of the scanned point before p.
+        p : float
+            The parameter, between points k and k + 1.
+        """
         _, eq, before = self._points[side][k]
         nxt = _follow(eq, before, self._equilibria(p, True)) if eq is not None else None
         return nxt.N if nxt is not None else 0.0
@@ -410,6 +450,13 @@ class Branch:
         `rtol` (a safeguarded Newton step on a forward difference, bisection
         where it does not converge: a law with a kink, e.g. at ρ0, is bracketed
         too); the scan stops once no nearer crossing can follow.
+
+        Parameters
+        ----------
+        threshold : float
+            The value of N, 1/m.
+        rtol : float, optional
+            Relative tolerance of p*.
         """
         above = self.start.N > threshold
         k = {+1: 0, -1: 0}

@@ -91,19 +91,43 @@ class ForceLaw:
     goal_distance: float | None = None
 
     def force(self, d):
-        """P(d) = F_r(d)/F_a (dimensionless)."""
+        """P(d) = F_r(d)/F_a (dimensionless).
+
+        Parameters
+        ----------
+        d : float or ndarray
+            Distance to the wall, m.
+        """
         raise NotImplementedError  # pragma: no cover - interface
 
     def slope(self, d):
-        """P′(d) = d(F_r/F_a)/dd, 1/m."""
+        """P′(d) = d(F_r/F_a)/dd, 1/m.
+
+        Parameters
+        ----------
+        d : float or ndarray
+            Distance to the wall, m.
+        """
         raise NotImplementedError  # pragma: no cover - interface
 
     def goal_force(self, d):
-        """Q(d): the repulsion's component towards the goal over the attraction (0 by default)."""
+        """Q(d): the repulsion's component towards the goal over the attraction (0 by default).
+
+        Parameters
+        ----------
+        d : float or ndarray
+            Distance to the wall, m.
+        """
         return np.zeros(np.shape(d))
 
     def goal_slope(self, d):
-        """Q′(d), 1/m (0 by default)."""
+        """Q′(d), 1/m (0 by default).
+
+        Parameters
+        ----------
+        d : float or ndarray
+            Distance to the wall, m.
+        """
         return np.zeros(np.shape(d))
 
     @property
@@ -112,14 +136,26 @@ class ForceLaw:
         return type(self).goal_force is not ForceLaw.goal_force
 
     def wall_ratio(self, d):
-        """R(d) = P/(1 + Q): the wall equilibria solve R(d0) = cos α (P itself when Q = 0)."""
+        """R(d) = P/(1 + Q): the wall equilibria solve R(d0) = cos α (P itself when Q = 0).
+
+        Parameters
+        ----------
+        d : float or ndarray
+            Distance to the wall, m.
+        """
         if not self.has_goal_part:
             return self.force(d)
         with np.errstate(invalid="ignore", over="ignore"):
             return np.asarray(self.force(d), dtype=float) / (1.0 + np.asarray(self.goal_force(d), dtype=float))
 
     def wall_ratio_slope(self, d):
-        """R′(d) = (P′(1 + Q) − P Q′)/(1 + Q)², 1/m (P′ when Q = 0); N = −R′(d0)/sin α."""
+        """R′(d) = (P′(1 + Q) − P Q′)/(1 + Q)², 1/m (P′ when Q = 0); N = −R′(d0)/sin α.
+
+        Parameters
+        ----------
+        d : float or ndarray
+            Distance to the wall, m.
+        """
         if not self.has_goal_part:
             return self.slope(d)
         P, dP = np.asarray(self.force(d), dtype=float), np.asarray(self.slope(d), dtype=float)
@@ -128,11 +164,23 @@ class ForceLaw:
             return (dP * G - P * dQ) / (G * G)
 
     def wall_balance(self, d):
-        """(R, R′) at d in one evaluation (`wall_ratio`, `wall_ratio_slope`): what the wall's root search needs."""
+        """(R, R′) at d in one evaluation (`wall_ratio`, `wall_ratio_slope`): what the wall's root search needs.
+
+        Parameters
+        ----------
+        d : float or ndarray
+            Distance to the wall, m.
+        """
         return np.asarray(self.wall_ratio(d), dtype=float), np.asarray(self.wall_ratio_slope(d), dtype=float)
 
     def with_scale(self, scale: float) -> "ForceLaw":
-        """The same law with strength `scale` (force ∝ scale)."""
+        """The same law with strength `scale` (force ∝ scale).
+
+        Parameters
+        ----------
+        scale : float
+            The law's strength (`scale`).
+        """
         raise NotImplementedError  # pragma: no cover - interface
 
     def parameters(self) -> dict:
@@ -164,6 +212,11 @@ class ForceLaw:
 
         Bisection on a decreasing law over its `domain` (module `solve`); a law
         that is not `monotone` has `wall_equilibria` instead.
+
+        Parameters
+        ----------
+        force : float
+            The force ratio F_r/F_a, dimensionless.
         """
         lo, hi = self.domain()
         if self.force(lo) <= force:
@@ -178,12 +231,28 @@ class ForceLaw:
         return bisect_root(lambda d: float(self.force(d)) - force, lo, hi, rtol=1e-14)
 
     def local_exponent(self, d):
-        """Local exponent ν = −d·F′/F (n for the power law); N = cot α·ν(d0)/d0 at a wall when Q = 0."""
+        """Local exponent ν = −d·F′/F (n for the power law); N = cot α·ν(d0)/d0 at a wall when Q = 0.
+
+        Parameters
+        ----------
+        d : float or ndarray
+            Distance to the wall, m.
+        """
         d = np.asarray(d, dtype=float)
         return -d * self.slope(d) / self.force(d)
 
     def equivalent_f(self, d, n: float, W: float):
-        """KB's lumped f that gives this law's force at d: F_r(d)·(d/W)^n (KB §4 f_av)."""
+        """KB's lumped f that gives this law's force at d: F_r(d)·(d/W)^n (KB §4 f_av).
+
+        Parameters
+        ----------
+        d : float or ndarray
+            Distance to the wall, m.
+        n : float
+            KB's exponent.
+        W : float
+            Robot width, m.
+        """
         d = np.asarray(d, dtype=float)
         return self.force(d) * (d / W) ** n
 
@@ -259,7 +328,13 @@ class PowerLaw(ForceLaw):
         return {"f": self.f, "n": self.n, "W": self.W}
 
     def distance_for(self, force: float) -> float:
-        """KB eq (23): d0 = W (f/F)^(1/n) (``inf`` where it overflows: no finite equilibrium)."""
+        """KB eq (23): d0 = W (f/F)^(1/n) (``inf`` where it overflows: no finite equilibrium).
+
+        Parameters
+        ----------
+        force : float
+            The force ratio F_r/F_a, dimensionless.
+        """
         with np.errstate(over="ignore"):
             return float(self.W * np.power(self.f / force, 1.0 / self.n))
 
@@ -299,6 +374,15 @@ def wall_equilibria(law: ForceLaw, alpha: float, *, polish: bool = True) -> tupl
     1.037 in d) are not resolved. ``polish=False`` interpolates d0 and N
     linearly between the grid points instead (one evaluation of the law; N
     to ~1e-3 relative): a cheap scan for following an equilibrium (`fields.Branch`).
+
+    Parameters
+    ----------
+    law : ForceLaw
+        The wall's law.
+    alpha : float
+        Target angle from the wall normal, rad.
+    polish : bool, optional
+        Refine each root by Newton's method.
 
     Returns
     -------
@@ -379,6 +463,15 @@ def corridor_equilibria(law: ForceLaw, L: float, W: float = 0.0) -> tuple:
     (−(L − W/2), L − W/2) (the robot of width W fits) are found by a scan and
     `solve.newton_increasing`, and come in pairs ±x0. Where F_x vanishes on
     a whole band (both walls beyond a finite reach) only the middle is listed.
+
+    Parameters
+    ----------
+    law : ForceLaw
+        The walls' law.
+    L : float
+        Corridor half-width, m.
+    W : float, optional
+        Robot width, m (equilibria closer than W/2 to a wall are left out).
     """
     middle = Equilibrium(0.0, corridor_gain(law, L))
     W = check_number("W", W, 0.0, math.inf, low_open=False, unit="m")
@@ -411,6 +504,13 @@ def wall_gain(law: ForceLaw, alpha) -> tuple:
     first of `wall_equilibria`. An array of α (rad) gives arrays
     (`wall_gain_arrays`, unchecked).
 
+    Parameters
+    ----------
+    law : ForceLaw
+        The wall's law.
+    alpha : float or ndarray
+        Target angle from the wall normal, rad.
+
     Raises
     ------
     ValueError
@@ -421,8 +521,14 @@ def wall_gain(law: ForceLaw, alpha) -> tuple:
     check_type("law", law, ForceLaw, _LAW)
     if np.ndim(alpha) > 0:
         return wall_gain_arrays(law, alpha)
+    check_parameter("alpha", alpha)
+    return _wall_gain(law, alpha)
+
+
+def _wall_gain(law: ForceLaw, alpha: float) -> tuple:
+    """`wall_gain` of a checked law at a checked scalar α, rad (a search over α in range: `critical_alpha`)."""
     if law.monotone:
-        d0 = law.distance_for(math.cos(check_parameter("alpha", alpha)))
+        d0 = law.distance_for(math.cos(alpha))
         if math.isinf(d0):
             return d0, 0.0
         N = float(-law.slope(d0) / math.sin(alpha)) if d0 > 0 else math.inf
@@ -455,6 +561,15 @@ def wall_gain_arrays(law: ForceLaw, alpha, scale_factor=1.0):
     the caller checks its axes. A law that is not `monotone` takes the first
     of `wall_equilibria` element by element where c = 1; force multipliers
     c ≠ 1 assume a decreasing law without a goal part (ValueError for one with).
+
+    Parameters
+    ----------
+    law : ForceLaw
+        The wall's law.
+    alpha : ndarray
+        Target angles from the wall normal, rad.
+    scale_factor : float or ndarray, optional
+        Force multipliers c (broadcast with `alpha`).
     """
     alpha, c = np.broadcast_arrays(np.asarray(alpha, dtype=float), np.asarray(scale_factor, dtype=float))
     if not law.monotone and law.has_goal_part and np.any(c != 1.0):
@@ -480,6 +595,13 @@ def wall_gain_at_distance(law: ForceLaw, d0):
 
     The parametric form of `wall_gain`: R(d0) = cos α gives α (R = P/(1 + Q),
     F_r/F_a for KB's laws), and N = −R′(d0)/sin α with sin α = √(1 − R²). Unchecked.
+
+    Parameters
+    ----------
+    law : ForceLaw
+        The wall's law.
+    d0 : float or ndarray
+        Equilibrium distance, m.
     """
     d0 = np.asarray(d0, dtype=float)
     F = np.asarray(law.wall_ratio(d0), dtype=float)
@@ -494,6 +616,13 @@ def corridor_gain(law: ForceLaw, L):
 
     A number is checked against its range and gives a float; an array of L
     (m) gives an array, evaluated as it is (the caller checks its axis).
+
+    Parameters
+    ----------
+    law : ForceLaw
+        The walls' law.
+    L : float or ndarray
+        Corridor half-width, m.
 
     Raises
     ------
@@ -520,13 +649,33 @@ def _middle_gain(law: ForceLaw, L):
 
 def power_law_wall_gain(f, n, W, alpha):
     """N, 1/m, of KB's power law at the wall equilibrium, for numbers or arrays (broadcast):
-    N = (n/W) f^(−1/n) cos^((n+1)/n) α / sin α (KB eq 11 at the equilibrium of eq 23). Unchecked."""
+    N = (n/W) f^(−1/n) cos^((n+1)/n) α / sin α (KB eq 11 at the equilibrium of eq 23). Unchecked.
+
+    Parameters
+    ----------
+    f, n : float or ndarray
+        KB's strength and exponent.
+    W : float or ndarray
+        Robot width, m.
+    alpha : float or ndarray
+        Target angle from the wall normal, rad.
+    """
     return (n / W) * f ** (-1.0 / n) * np.cos(alpha) ** ((n + 1.0) / n) / np.sin(alpha)
 
 
 def power_law_corridor_gain(f, n, W, L):
     """N, 1/m, of KB's power law in the middle of a corridor, for numbers or arrays (broadcast):
-    N = 2nfWⁿ/L^(n+1) (KB eq 25). Unchecked."""
+    N = 2nfWⁿ/L^(n+1) (KB eq 25). Unchecked.
+
+    Parameters
+    ----------
+    f, n : float or ndarray
+        KB's strength and exponent.
+    W : float or ndarray
+        Robot width, m.
+    L : float or ndarray
+        Corridor half-width, m.
+    """
     return 2.0 * n * f * W**n / L ** (n + 1.0)
 
 

@@ -114,7 +114,13 @@ class FuzzyVariable:
         return FWHM_FRACTION * self.spacing * _SIGMA_PER_FWHM
 
     def offsets(self, x):
-        """x − centre for every set, shape x.shape + (n_sets,) (wrapped to [−period/2, period/2) when periodic)."""
+        """x − centre for every set, shape x.shape + (n_sets,) (wrapped to [−period/2, period/2) when periodic).
+
+        Parameters
+        ----------
+        x : float or ndarray
+            Values, in the variable's unit.
+        """
         x = np.asarray(x, dtype=float)[..., None]
         dx = x - np.asarray(self.centres, dtype=float)
         if self.periodic:
@@ -122,18 +128,36 @@ class FuzzyVariable:
         return dx
 
     def memberships(self, x):
-        """Membership of x in every set, shape x.shape + (n_sets,), in [0, 1]."""
+        """Membership of x in every set, shape x.shape + (n_sets,), in [0, 1].
+
+        Parameters
+        ----------
+        x : float or ndarray
+            Values, in the variable's unit.
+        """
         dx = self.offsets(x)
         return np.exp(-0.5 * (dx / self.sigma) ** 2)
 
     def membership_slopes(self, x):
-        """(μ, dμ/dx) for every set, each of shape x.shape + (n_sets,); dμ/dx in 1/`unit`."""
+        """(μ, dμ/dx) for every set, each of shape x.shape + (n_sets,); dμ/dx in 1/`unit`.
+
+        Parameters
+        ----------
+        x : float or ndarray
+            Values, in the variable's unit.
+        """
         dx = self.offsets(x)
         mu = np.exp(-0.5 * (dx / self.sigma) ** 2)
         return mu, -dx / self.sigma**2 * mu
 
     def clip(self, x):
-        """x limited to the universe (a periodic universe is never clipped)."""
+        """x limited to the universe (a periodic universe is never clipped).
+
+        Parameters
+        ----------
+        x : float or ndarray
+            Values, in the variable's unit.
+        """
         x = np.asarray(x, dtype=float)
         return x if self.periodic else np.clip(x, self.low, self.high)
 
@@ -204,7 +228,13 @@ class FuzzySystem:
         return W, G1, G2
 
     def evaluate(self, x1, x2):
-        """The crisp output at (x1, x2) (arrays broadcast); inputs outside a non-periodic universe are clipped to it."""
+        """The crisp output at (x1, x2) (arrays broadcast); inputs outside a non-periodic universe are clipped to it.
+
+        Parameters
+        ----------
+        x1, x2 : float or ndarray
+            The two inputs, in their variables' units.
+        """
         return self.evaluate_with_gradient(x1, x2, slopes=False)[0]
 
     def evaluate_with_gradient(self, x1, x2, *, slopes: bool = True):
@@ -215,6 +245,13 @@ class FuzzySystem:
         output set's own membership is. Derivatives are one-sided at the (measure-zero)
         points where two branches tie, and 0 in an input clipped to its universe.
         Arrays broadcast; they are evaluated in chunks of `_CHUNK` points (memory).
+
+        Parameters
+        ----------
+        x1, x2 : float or ndarray
+            The two inputs, in their variables' units.
+        slopes : bool, optional
+            Whether to return the partial derivatives (False: None in their place).
         """
         a, b = np.broadcast_arrays(np.asarray(x1, dtype=float), np.asarray(x2, dtype=float))
         fa, fb = a.ravel(), b.ravel()
@@ -248,7 +285,13 @@ class FuzzySystem:
         return out, np.where(inside1, grads[0], 0.0), np.where(inside2, grads[1], 0.0)
 
     def output_range(self, samples: int = 61) -> tuple[float, float]:
-        """(min, max) of the output over a `samples` × `samples` grid of the inputs (R6: the centroid compresses the universe)."""
+        """(min, max) of the output over a `samples` × `samples` grid of the inputs (R6: the centroid compresses the universe).
+
+        Parameters
+        ----------
+        samples : int, optional
+            Grid points per input.
+        """
         a = np.linspace(self.first.low, self.first.high, samples)
         b = np.linspace(self.second.low, self.second.high, samples)
         out = self.evaluate(a[:, None], b[None, :])
@@ -263,6 +306,13 @@ def symmetrized_rows(rows: dict, side: str) -> dict:
     with ``side="positive"`` the reverse. NH (±180°) and Z (0°) mirror onto
     themselves. The columns (distance, ΔV) are not mirrored: neither changes sign
     when the obstacle is mirrored about the direction of motion.
+
+    Parameters
+    ----------
+    rows : dict
+        The table's rule rows by bearing set.
+    side : str
+        ``"negative"`` or ``"positive"``: whose rows are kept.
     """
     check_choice("symmetrize", side, ("negative", "positive"))
     out = dict(rows)
@@ -293,16 +343,40 @@ class DfapfControllers:
     symmetrize: str | None = None
 
     def eta_of(self, d, theta):
-        """η at distance d (m) and bearing θ (rad, counter-clockwise positive)."""
+        """η at distance d (m) and bearing θ (rad, counter-clockwise positive).
+
+        Parameters
+        ----------
+        d : float or ndarray
+            Distance, m.
+        theta : float or ndarray
+            Bearing, rad, counter-clockwise positive.
+        """
         return self.eta.evaluate(np.degrees(theta), d)
 
     def eta_with_slopes(self, d, theta):
-        """(η, ∂η/∂d in 1/m, ∂η/∂θ in 1/rad) at d (m), θ (rad)."""
+        """(η, ∂η/∂d in 1/m, ∂η/∂θ in 1/rad) at d (m), θ (rad).
+
+        Parameters
+        ----------
+        d : float or ndarray
+            Distance, m.
+        theta : float or ndarray
+            Bearing, rad, counter-clockwise positive.
+        """
         y, g_theta, g_d = self.eta.evaluate_with_gradient(np.degrees(theta), d)
         return y, g_d, g_theta * (180.0 / math.pi)
 
     def K_V_of(self, dV, theta):
-        """K_V at normalised relative speed ΔV (clipped to [−1, 1], R7) and bearing θ (rad)."""
+        """K_V at normalised relative speed ΔV (clipped to [−1, 1], R7) and bearing θ (rad).
+
+        Parameters
+        ----------
+        dV : float or ndarray
+            Normalised relative speed ΔV, dimensionless.
+        theta : float or ndarray
+            Bearing, rad.
+        """
         return self.K_V.evaluate(np.degrees(theta), dV)
 
 

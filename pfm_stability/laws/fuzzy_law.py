@@ -130,7 +130,13 @@ class FuzzyScheduledLaw:
         return self.rho_g**self.n
 
     def shape(self, d):
-        """(p, p′) at d (m): p = (1/d − 1/ρ0)/d² for 0 < d < ρ0, else 0; p′ in 1/m⁴."""
+        """(p, p′) at d (m): p = (1/d − 1/ρ0)/d² for 0 < d < ρ0, else 0; p′ in 1/m⁴.
+
+        Parameters
+        ----------
+        d : float or ndarray
+            Distance, m.
+        """
         d = np.asarray(d, dtype=float)
         inside = (d > 0) & (d < self.rho0)
         with np.errstate(divide="ignore", invalid="ignore"):
@@ -142,7 +148,19 @@ class FuzzyScheduledLaw:
         return 1.0 if check_choice("side", side, ("left", "right")) == "left" else -1.0
 
     def wall_force(self, d, psi, alpha: float, side: str = "left"):
-        """(F_x, F_y), N, at distance d (m) and heading deviation ψ (rad, positive away from the wall)."""
+        """(F_x, F_y), N, at distance d (m) and heading deviation ψ (rad, positive away from the wall).
+
+        Parameters
+        ----------
+        d : float or ndarray
+            Distance to the wall, m.
+        psi : float or ndarray
+            Heading deviation, rad, positive away from the wall.
+        alpha : float
+            Target angle from the wall normal, rad.
+        side : str, optional
+            The wall's side, ``"left"`` or ``"right"``.
+        """
         s = self._side(side)
         p, _ = self.shape(d)
         eta = self.controllers.eta_of(d, s * (0.5 * math.pi + np.asarray(psi, dtype=float)))
@@ -154,6 +172,13 @@ class FuzzyScheduledLaw:
 
         Roots of F_x(d, 0) on (0, ρ0), found by a geometric scan of 801 points and
         `solve.bisect_root`; at each, N (total), N_frozen and c (module docstring).
+
+        Parameters
+        ----------
+        alpha : float
+            Target angle from the wall normal, rad.
+        side : str, optional
+            The wall's side, ``"left"`` or ``"right"``.
         """
         alpha = check_parameter("alpha", alpha)
         s = self._side(side)
@@ -203,6 +228,15 @@ class FuzzyScheduledLaw:
 
         The left wall is at distance L + x and bearing π/2 + θ; the right wall at
         L − x and bearing −π/2 + θ.
+
+        Parameters
+        ----------
+        L : float
+            Corridor half-width, m.
+        x : float or ndarray
+            Offset from the middle, m, towards the right wall.
+        theta : float or ndarray, optional
+            Heading, rad, positive towards the right wall.
         """
         return self._corridor_terms(L, np.asarray(x, dtype=float), np.asarray(theta, dtype=float))[0]
 
@@ -212,6 +246,13 @@ class FuzzyScheduledLaw:
         x0 is the offset towards the right wall; N = −F_x′(x0)/F_y (total), N_frozen,
         c = −∂F_x/∂θ/F_y, with F_y = `forward` (N; the attraction F_a by default).
         The asymmetric tables move x0 off the centre line.
+
+        Parameters
+        ----------
+        L : float
+            Corridor half-width, m.
+        forward : float, optional
+            Forward pull F_a, N (default the law's).
         """
         L = check_parameter("L", L)
         Fy = self.attraction if forward is None else check_number("forward", forward, 0.0, 1e9, unit="N")
@@ -230,7 +271,13 @@ class FuzzyScheduledLaw:
         return tuple(out)
 
     def robust_bracket(self, alpha: float) -> RobustBracket:
-        """Frozen-gain N and d0 at a wall for η at both ends of the controller's output range."""
+        """Frozen-gain N and d0 at a wall for η at both ends of the controller's output range.
+
+        Parameters
+        ----------
+        alpha : float
+            Target angle from the wall normal, rad.
+        """
         alpha = check_parameter("alpha", alpha)
         lo, hi = self.controllers.eta.output_range()
         Fy = self.attraction * math.sin(alpha)

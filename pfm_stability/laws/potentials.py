@@ -99,12 +99,31 @@ def attraction_potential(rho_g, xi, m=2):
 
 
 def attraction_force(rho_g, xi, m=2):
-    """|F_att| = dU_att/dρ_g = (m/2) ξ ρ_g^(m−1), directed at the goal (eq 2, 17); m = 1 gives ξ/2."""
+    """|F_att| = dU_att/dρ_g = (m/2) ξ ρ_g^(m−1), directed at the goal (eq 2, 17); m = 1 gives ξ/2.
+
+    Parameters
+    ----------
+    rho_g : float or ndarray
+        Distance to the goal, m.
+    xi : float
+        Attractive scaling factor ξ.
+    m : float, optional
+        Attraction exponent.
+    """
     return attraction_derivatives(rho_g, xi, m)[1]
 
 
 def attraction_derivatives(rho_g, xi, m=2):
     """U_att, dU_att/dρ_g and d²U_att/dρ_g² at distances `rho_g` (m).
+
+    Parameters
+    ----------
+    rho_g : float or ndarray
+        Distance to the goal, m.
+    xi : float
+        Attractive scaling factor ξ.
+    m : float, optional
+        Attraction exponent.
 
     Returns
     -------
@@ -172,17 +191,57 @@ def repulsion_derivatives(rho, rho_g, eta, rho0, n=0.0, delta=0.0):
 
 
 def khatib_potential(rho, eta, rho0, delta=0.0):
-    """Khatib's repulsion U = ½ η (1/ρ − 1/ρ0)² for ρ <= ρ0, else 0 (eq 3; δ as eq 40), at distances `rho` (m)."""
+    """Khatib's repulsion U = ½ η (1/ρ − 1/ρ0)² for ρ <= ρ0, else 0 (eq 3; δ as eq 40), at distances `rho` (m).
+
+    Parameters
+    ----------
+    rho : float or ndarray
+        Distance to the obstacle, m.
+    eta : float
+        Repulsive scaling factor η.
+    rho0 : float
+        Influence distance, m.
+    delta : float, optional
+        Surface offset δ, m (eq 40).
+    """
     return repulsion_derivatives(rho, 1.0, eta, rho0, 0.0, delta)[0]
 
 
 def khatib_force(rho, eta, rho0, delta=0.0):
-    """Magnitude of Khatib's repulsion, η (1/ρ − 1/ρ0)/ρ² (eq 4), along n_OR; 0 beyond ρ0."""
+    """Magnitude of Khatib's repulsion, η (1/ρ − 1/ρ0)/ρ² (eq 4), along n_OR; 0 beyond ρ0.
+
+    Parameters
+    ----------
+    rho : float or ndarray
+        Distance to the obstacle, m.
+    eta : float
+        Repulsive scaling factor η.
+    rho0 : float
+        Influence distance, m.
+    delta : float, optional
+        Surface offset δ, m (eq 40).
+    """
     return -repulsion_derivatives(rho, 1.0, eta, rho0, 0.0, delta)[1]
 
 
 def gnron_potential(rho, rho_g, eta, rho0, n, delta=0.0):
-    """Goal-aware repulsion U = ½ η (1/ρ − 1/ρ0)² ρ_gⁿ for ρ <= ρ0, else 0 (eq 8; δ as eq 40)."""
+    """Goal-aware repulsion U = ½ η (1/ρ − 1/ρ0)² ρ_gⁿ for ρ <= ρ0, else 0 (eq 8; δ as eq 40).
+
+    Parameters
+    ----------
+    rho : float or ndarray
+        Distance to the obstacle, m.
+    rho_g : float or ndarray
+        Distance to the goal, m.
+    eta : float
+        Repulsive scaling factor η.
+    rho0 : float
+        Influence distance, m.
+    n : float
+        Goal exponent.
+    delta : float, optional
+        Surface offset δ, m (eq 40).
+    """
     return repulsion_derivatives(rho, rho_g, eta, rho0, n, delta)[0]
 
 
@@ -192,6 +251,21 @@ def gnron_forces(rho, rho_g, eta, rho0, n, delta=0.0):
     F_rep1 = η (1/ρ − 1/ρ0) ρ_gⁿ/ρ², F_rep2 = (n/2) η (1/ρ − 1/ρ0)² ρ_g^(n−1),
     both 0 beyond ρ0 (with δ: ρ → ρ + δ, ρ0 → ρ0 + δ). F_rep2 is infinite at
     the goal for n < 1 (eq 12–13).
+
+    Parameters
+    ----------
+    rho : float or ndarray
+        Distance to the obstacle, m.
+    rho_g : float or ndarray
+        Distance to the goal, m.
+    eta : float
+        Repulsive scaling factor η.
+    rho0 : float
+        Influence distance, m.
+    n : float
+        Goal exponent.
+    delta : float, optional
+        Surface offset δ, m (eq 40).
     """
     d = repulsion_derivatives(rho, rho_g, eta, rho0, n, delta)
     return -d[1], d[2]
@@ -271,6 +345,13 @@ def k2_closed_form(r, rho0):
 
     Evaluated in the equivalent form (2/(9ρ0²))(s − 2)²/(s − 1), s = √(1 + 3ρ0/r),
     attained at ρ* = 3ρ0/(1 + s).
+
+    Parameters
+    ----------
+    r : float
+        Distance from the goal to the obstacle, m.
+    rho0 : float
+        Influence distance, m.
 
     Returns
     -------
@@ -408,6 +489,25 @@ def ray_stationary_points(r, xi, eta, rho0, n=0.0, m=2.0, delta=0.0, *, scan=400
     roots of `ray_force`, found by a scan (geometric towards the goal and
     the influence edge, uniform between) and bisection. Beyond ρ0 − r only
     the attraction acts, so there is none.
+
+    Parameters
+    ----------
+    r : float
+        Distance from the goal to the obstacle, m.
+    xi : float
+        Attractive scaling factor ξ.
+    eta : float
+        Repulsive scaling factor η.
+    rho0 : float
+        Influence distance, m.
+    n : float, optional
+        Goal exponent (0: Khatib's law).
+    m : float, optional
+        Attraction exponent.
+    delta : float, optional
+        Surface offset δ, m (eq 40).
+    scan : int, optional
+        Points of the scan along the ray before the roots are refined.
 
     Returns
     -------

@@ -223,18 +223,36 @@ class Law:
         return tuple(s.key for s in self.settings)
 
     def takes(self, key: str) -> bool:
-        """Whether `key` (a parameter, a choice, ``f`` or ``n``) is one the law takes."""
+        """Whether `key` (a parameter, a choice, ``f`` or ``n``) is one the law takes.
+
+        Parameters
+        ----------
+        key : str
+            A parameter, a choice, ``f`` or ``n``.
+        """
         return key in self.parameters or key in self.controller or any(c.key == key for c in self.choices)
 
     def setting(self, key: str) -> Setting:
-        """The `Setting` of parameter `key` (KeyError if the law does not take it)."""
+        """The `Setting` of parameter `key` (KeyError if the law does not take it).
+
+        Parameters
+        ----------
+        key : str
+            The parameter's key (`PARAMETERS`).
+        """
         for setting in self.settings:
             if setting.key == key:
                 return setting
         raise KeyError(key)
 
     def choice(self, key: str) -> Choice:
-        """The `Choice` `key` (KeyError if the law has no such choice)."""
+        """The `Choice` `key` (KeyError if the law has no such choice).
+
+        Parameters
+        ----------
+        key : str
+            The choice's key.
+        """
         for choice in self.choices:
             if choice.key == key:
                 return choice
@@ -307,55 +325,106 @@ declared beside the laws that put a force on it (``velocity``, ``velocity-gated`
 
 
 def get_law(name: str) -> Law:
-    """The `Law` called `name`; ValueError ``law must be one of power, grid, …; got 'x'`` for another."""
+    """The `Law` called `name`; ValueError ``law must be one of power, grid, …; got 'x'`` for another.
+
+    Parameters
+    ----------
+    name : str
+        The law's name.
+    """
     if name not in _BY_NAME:
         raise ValueError(f"law must be one of {', '.join(LAW_NAMES)}; got {name!r}")
     return _BY_NAME[name]
 
 
 def laws_for(command: str) -> tuple:
-    """The names of the laws `command` (of `COMMANDS`) offers, its default (`DEFAULT_LAW`) first, then in table order."""
+    """The names of the laws `command` (of `COMMANDS`) offers, its default (`DEFAULT_LAW`) first, then in table order.
+
+    Parameters
+    ----------
+    command : str
+        A command (`COMMANDS`).
+    """
     offered = [law.name for law in LAWS if command in law.commands]
     default = DEFAULT_LAW[command]
     return (default, *(name for name in offered if name != default))
 
 
 def laws_of_family(family: str) -> tuple:
-    """The names of the laws a robot family (`parameters.ROBOT_FAMILIES`) takes, in table order."""
+    """The names of the laws a robot family (`parameters.ROBOT_FAMILIES`) takes, in table order.
+
+    Parameters
+    ----------
+    family : str
+        A robot family (`parameters.ROBOT_FAMILIES`).
+    """
     return tuple(law.name for law in LAWS if family in law.families)
 
 
 def parameter_keys(laws=LAW_NAMES) -> tuple:
-    """The keys of `PARAMETERS` that any of `laws` (names) takes, in `PARAMETERS` order."""
+    """The keys of `PARAMETERS` that any of `laws` (names) takes, in `PARAMETERS` order.
+
+    Parameters
+    ----------
+    laws : tuple of str, optional
+        The laws' names considered; default all (`LAW_NAMES`).
+    """
     entries = [_BY_NAME[name] for name in laws]
     return tuple(key for key in PARAMETERS if any(key in law.parameters for law in entries))
 
 
 def choice_keys(laws=LAW_NAMES) -> tuple:
-    """The choices any of `laws` (names) has, in table order."""
+    """The choices any of `laws` (names) has, in table order.
+
+    Parameters
+    ----------
+    laws : tuple of str, optional
+        The laws' names considered; default all (`LAW_NAMES`).
+    """
     return tuple(dict.fromkeys(c.key for name in laws for c in _BY_NAME[name].choices))
 
 
 def takers(key: str, laws=LAW_NAMES) -> tuple:
-    """The names of `laws` that take `key` (a parameter, a choice, ``f`` or ``n``), in table order."""
+    """The names of `laws` that take `key` (a parameter, a choice, ``f`` or ``n``), in table order.
+
+    Parameters
+    ----------
+    key : str
+        A parameter, a choice, ``f`` or ``n``.
+    laws : tuple of str, optional
+        The laws' names considered; default all (`LAW_NAMES`).
+    """
     return tuple(name for name in LAW_NAMES if name in laws and _BY_NAME[name].takes(key))
 
 
 def either(names) -> str:
-    """``a``, ``a or b``, ``a, b or c``."""
+    """``a``, ``a or b``, ``a, b or c``.
+
+    Parameters
+    ----------
+    names : sequence of str
+        The names joined.
+    """
     names = list(names)
     return names[0] if len(names) == 1 else f"{', '.join(names[:-1])} or {names[-1]}"
 
 
 def option_name(key: str) -> str:
-    """The command-line option of a parameter: ``goal_distance`` → ``--goal-distance``."""
+    """The command-line option of a parameter: ``goal_distance`` → ``--goal-distance``.
+
+    Parameters
+    ----------
+    key : str
+        The parameter's key.
+    """
     return "--" + key.replace("_", "-")
 
 
 def refusal(key: str, law_shown: str, *, shown: str | None = None, laws=LAW_NAMES) -> ValueError:
     """The one message for a parameter given to a law that does not take it.
 
-    ``<shown> applies to <the laws of `laws` that take it>, not to <law_shown>``. On the command line
+    ``<shown> applies to <the laws of `laws` that take it>, not to <law_shown>`` (a name no law takes:
+    ``<shown> is not a parameter of any law …, given to <law_shown>``). On the command line
     (`shown` an option) the laws are named as options: ``--xi applies to --law khatib or gnron, not to
     --law power``; in files and the library by name: ``law.xi applies to khatib or gnron, not to law power``.
 
@@ -376,8 +445,11 @@ def refusal(key: str, law_shown: str, *, shown: str | None = None, laws=LAW_NAME
         To be raised by the caller.
     """
     shown = shown or key
-    names = either(takers(key, laws) or takers(key) or ("no law",))
-    return ValueError(f"{shown} applies to {'--law ' if shown.startswith('--') else ''}{names}, not to {law_shown}")
+    laws_taking = takers(key, laws) or takers(key)
+    if not laws_taking:  # a name no law declares: a typo, not a parameter of another law
+        return ValueError(f"{shown} is not a parameter of any law (see the laws in docs/fields.md and docs/velocity_and_fuzzy.md), "
+                          f"given to {law_shown}")
+    return ValueError(f"{shown} applies to {'--law ' if shown.startswith('--') else ''}{either(laws_taking)}, not to {law_shown}")
 
 
 def check_parameters(name: str, given, *, shown=None, law_shown: str | None = None, laws=LAW_NAMES, required: bool = True) -> Law:
@@ -427,6 +499,13 @@ def option_help(key: str, laws=LAW_NAMES) -> str:
 
     E.g. ``khatib/gnron: repulsive scaling factor eta (default 0.1), [1e-06, 1e+06]``; defaults that differ
     between the laws are given per law (``required for khatib, gnron; default 1 for velocity, …``).
+
+    Parameters
+    ----------
+    key : str
+        The parameter's key (`PARAMETERS`).
+    laws : tuple of str, optional
+        The laws' names considered; default all (`LAW_NAMES`).
     """
     p = PARAMETERS[key]
     names = takers(key, laws)
@@ -446,7 +525,15 @@ def option_help(key: str, laws=LAW_NAMES) -> str:
 
 
 def choice_help(key: str, laws=LAW_NAMES) -> str:
-    """The help of a choice's option: who takes it, what it chooses, its default."""
+    """The help of a choice's option: who takes it, what it chooses, its default.
+
+    Parameters
+    ----------
+    key : str
+        The choice's key.
+    laws : tuple of str, optional
+        The laws' names considered; default all (`LAW_NAMES`).
+    """
     names = takers(key, laws)
     choice = _BY_NAME[names[0]].choice(key)
     return f"{_names_for_help(names)}: {choice.text} (default {choice.default})"
@@ -457,6 +544,13 @@ def law_help(laws, default: str) -> tuple:
 
     The laws documented where the default is are named by their titles, the others by name with their documentation:
     ``lateral force law: KB's power law f(W/d)^n (default, …), … or …; velocity, velocity-gated, fuzzy: docs/velocity_and_fuzzy.md``.
+
+    Parameters
+    ----------
+    laws : tuple of str
+        The laws' names the command offers.
+    default : str
+        The command's default law.
     """
     main = _BY_NAME[default].doc
     here = [law for law in LAWS if law.name in laws and law.doc == main]

@@ -56,6 +56,23 @@ class FieldLaw:
     Attributes: `name` "khatib" (n = 0) or "gnron" (n in (0, 10]); `xi`, `eta`
     (ξ, η > 0); `rho0` (ρ0 > 0, m); `m` (attraction exponent, 1: constant pull
     ξ/2, 2: spring); `n` (goal exponent); `delta` (δ >= 0 of eq 40, m).
+
+    Attributes
+    ----------
+    name : str
+        ``"khatib"`` or ``"gnron"``.
+    xi : float
+        Attractive scaling factor ξ.
+    eta : float
+        Repulsive scaling factor η.
+    rho0 : float
+        Influence distance ρ0, m.
+    m : float
+        Attraction exponent.
+    n : float
+        Goal exponent (0 for khatib).
+    delta : float
+        Surface offset δ, m (eq 40).
     """
 
     name: str
@@ -80,7 +97,13 @@ class FieldLaw:
 
     @classmethod
     def from_dict(cls, data) -> FieldLaw:
-        """The law from a scene's ``law:`` mapping (keys `LAW_KEYS`; goal_exponent only for gnron)."""
+        """The law from a scene's ``law:`` mapping (keys `LAW_KEYS`; goal_exponent only for gnron).
+
+        Parameters
+        ----------
+        data : dict
+            A scene's ``law:`` mapping.
+        """
         required = ("name", "xi", "eta", "rho0", "attraction_exponent") + (("goal_exponent",) if isinstance(data, dict) and data.get("name") == "gnron" else ())
         d = _mapping("law", data, LAW_KEYS, required)
         return cls(d["name"], d["xi"], d["eta"], d["rho0"], d["attraction_exponent"], d.get("goal_exponent", 0.0), d.get("delta", 0.0))
@@ -112,14 +135,28 @@ def _edge_geometry(q, a, b, inside):
 
 @dataclass(frozen=True)
 class Circle:
-    """A disc of `radius` (m) about `center` (m); ρ = |q − c| − R, 0 inside."""
+    """A disc of `radius` (m) about `center` (m); ρ = |q − c| − R, 0 inside.
+
+    Attributes
+    ----------
+    center : tuple of float
+        Centre (x, y), m.
+    radius : float
+        Radius, m.
+    """
 
     center: tuple
     radius: float
     kind = "circle"
 
     def geometry(self, q):
-        """(ρ, ∇ρ, κ) at points q (N, 2): distance, unit normal from the surface, curvature factor of ∇²ρ."""
+        """(ρ, ∇ρ, κ) at points q (N, 2): distance, unit normal from the surface, curvature factor of ∇²ρ.
+
+        Parameters
+        ----------
+        q : ndarray, shape (N, 2)
+            Points, m.
+        """
         v = q - np.asarray(self.center)
         dc = np.linalg.norm(v, axis=1)
         return np.maximum(dc - self.radius, 0.0), v / np.where(dc > 0, dc, 1.0)[:, None], 1.0 / np.where(dc > 0, dc, 1.0)
@@ -131,14 +168,26 @@ class Circle:
 
 @dataclass(frozen=True)
 class Segment:
-    """A straight wall from `start` to `end` (m), no thickness."""
+    """A straight wall from `start` to `end` (m), no thickness.
+
+    Attributes
+    ----------
+    start, end : tuple of float
+        The wall's ends (x, y), m.
+    """
 
     start: tuple
     end: tuple
     kind = "segment"
 
     def geometry(self, q):
-        """(ρ, ∇ρ, κ) at points q (N, 2), as `Circle.geometry`."""
+        """(ρ, ∇ρ, κ) at points q (N, 2), as `Circle.geometry`.
+
+        Parameters
+        ----------
+        q : ndarray, shape (N, 2)
+            Points, m.
+        """
         return _edge_geometry(q, np.asarray([self.start]), np.asarray([self.end]), np.zeros(q.shape[0], dtype=bool))
 
     def to_dict(self) -> dict:
@@ -148,13 +197,25 @@ class Segment:
 
 @dataclass(frozen=True)
 class Polygon:
-    """A closed polygon (the last vertex joins the first), m; ρ = 0 inside (even–odd rule)."""
+    """A closed polygon (the last vertex joins the first), m; ρ = 0 inside (even–odd rule).
+
+    Attributes
+    ----------
+    vertices : tuple of (float, float)
+        The corners, m, in order.
+    """
 
     vertices: tuple
     kind = "polygon"
 
     def contains(self, q):
-        """True where points q (N, 2) lie inside the polygon (even–odd rule)."""
+        """True where points q (N, 2) lie inside the polygon (even–odd rule).
+
+        Parameters
+        ----------
+        q : ndarray, shape (N, 2)
+            Points, m.
+        """
         a, x, y = np.asarray(self.vertices), q[:, :1], q[:, 1:]
         b = np.roll(a, -1, axis=0)
         straddle = (a[None, :, 1] > y) != (b[None, :, 1] > y)
@@ -163,7 +224,13 @@ class Polygon:
         return np.count_nonzero(straddle & (x < cross), axis=1) % 2 == 1
 
     def geometry(self, q):
-        """(ρ, ∇ρ, κ) at points q (N, 2), as `Circle.geometry`."""
+        """(ρ, ∇ρ, κ) at points q (N, 2), as `Circle.geometry`.
+
+        Parameters
+        ----------
+        q : ndarray, shape (N, 2)
+            Points, m.
+        """
         return _edge_geometry(q, np.asarray(self.vertices), np.roll(self.vertices, -1, axis=0), self.contains(q))
 
     def to_dict(self) -> dict:
@@ -211,6 +278,17 @@ class Scene:
     Build it with `Scene.from_dict` (a scene file's content) or `Scene.load`
     (a YAML file); both check everything and raise one-line ValueErrors that
     name the field (docs/traps.md, "Scene files").
+
+    Attributes
+    ----------
+    goal : tuple of float
+        The goal (x, y), m.
+    obstacles : tuple
+        The `Circle`, `Segment` and `Polygon` obstacles.
+    law : FieldLaw
+        The potential field.
+    region : tuple
+        The search region [[xmin, ymin], [xmax, ymax]], m.
     """
 
     goal: tuple
@@ -220,7 +298,13 @@ class Scene:
 
     @classmethod
     def from_dict(cls, data) -> Scene:
-        """The scene from a mapping with keys law, goal, obstacles, region."""
+        """The scene from a mapping with keys law, goal, obstacles, region.
+
+        Parameters
+        ----------
+        data : dict
+            The scene's mapping (keys law, goal, obstacles, region).
+        """
         d = _mapping("scene", data, SCENE_KEYS, SCENE_KEYS)
         law = FieldLaw.from_dict(d["law"])
         goal = _point("goal", d["goal"])
@@ -243,6 +327,11 @@ class Scene:
     def load(cls, path) -> Scene:
         """The scene in the YAML file `path`, read by the package's one YAML reader (`pfm_stability.io.yaml_files`).
 
+        Parameters
+        ----------
+        path : str or path-like
+            The scene's YAML file.
+
         Raises
         ------
         ValueError
@@ -263,7 +352,13 @@ class Scene:
                 "region": [list(self.region[0]), list(self.region[1])]}
 
     def grid(self, points: int):
-        """(xs, ys, h): a grid over the region with `points` nodes along its longer side, and that side's spacing h, m."""
+        """(xs, ys, h): a grid over the region with `points` nodes along its longer side, and that side's spacing h, m.
+
+        Parameters
+        ----------
+        points : int
+            Nodes along the region's longer side.
+        """
         (x0, y0), (x1, y1) = self.region
         h = max(x1 - x0, y1 - y0) / (points - 1)
         return np.linspace(x0, x1, max(2, round((x1 - x0) / h) + 1)), np.linspace(y0, y1, max(2, round((y1 - y0) / h) + 1)), h
@@ -281,6 +376,15 @@ def field(scene: Scene, q, hessian: bool = True):
     `scale` sums the magnitudes of the cancelling forces (|∇U| is measured
     against it); `free` is False inside an obstacle (values there are
     meaningless) and at the goal itself (ρ_g = 0, handled by `_goal_point`).
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene.
+    q : ndarray, shape (N, 2)
+        Points, m.
+    hessian : bool, optional
+        Whether to compute ∇²U (False: None).
     """
     q, law, eye = np.atleast_2d(np.asarray(q, dtype=float)), scene.law, np.eye(2)
     dg = q - np.asarray(scene.goal)

@@ -106,6 +106,13 @@ class VelocityAttraction:
         """F_att, N (2-vector): mα_p‖e‖^(m−1) e/‖e‖ + nα_v‖ė‖^(n−1) ė/‖ė‖, e = p_tar − p, ė = v_tar − v.
 
         A part whose error is exactly 0 is 0 (for m ≤ 1 or n ≤ 1 the force is discontinuous there).
+
+        Parameters
+        ----------
+        p, v : 2-vector
+            Robot position (m) and velocity (m/s).
+        p_tar, v_tar : 2-vector, optional
+            Target position (m) and velocity (m/s).
         """
         e = _vector("p_tar", p_tar) - _vector("p", p)
         de = _vector("v_tar", v_tar) - _vector("v", v)
@@ -117,21 +124,45 @@ class VelocityAttraction:
         return out
 
     def position_force(self, rho_g: float) -> float:
-        """F_a = mα_p ρ_g^(m−1), N: the position part's magnitude at goal distance ρ_g (m)."""
+        """F_a = mα_p ρ_g^(m−1), N: the position part's magnitude at goal distance ρ_g (m).
+
+        Parameters
+        ----------
+        rho_g : float
+            Distance to the goal, m.
+        """
         return self.m * self.alpha_p * check_parameter("goal_distance", rho_g) ** (self.m - 1.0)
 
     def velocity_force(self, V: float) -> float:
-        """nα_v V^(n−1), N: the velocity part's magnitude at speed V (m/s), stationary target."""
+        """nα_v V^(n−1), N: the velocity part's magnitude at speed V (m/s), stationary target.
+
+        Parameters
+        ----------
+        V : float
+            Speed, m/s.
+        """
         return self.n * self.alpha_v * check_parameter("V", V) ** (self.n - 1.0)
 
     def damping_ratio(self, mass: float = 1.0) -> float:
-        """ζ = α′_v/√(2α′_p), α′ = α/m_rob (GC2002 eq 34–36; for m = n = 2)."""
+        """ζ = α′_v/√(2α′_p), α′ = α/m_rob (GC2002 eq 34–36; for m = n = 2).
+
+        Parameters
+        ----------
+        mass : float, optional
+            Robot mass m_rob, kg.
+        """
         mass = check_parameter("mass", mass)
         self._require_quadratic()
         return (self.alpha_v / mass) / math.sqrt(2.0 * self.alpha_p / mass)
 
     def natural_frequency(self, mass: float = 1.0) -> float:
-        """ω_n = √(2α′_p), rad/s (GC2002 eq 36; for m = n = 2)."""
+        """ω_n = √(2α′_p), rad/s (GC2002 eq 36; for m = n = 2).
+
+        Parameters
+        ----------
+        mass : float, optional
+            Robot mass m_rob, kg.
+        """
         mass = check_parameter("mass", mass)
         self._require_quadratic()
         return math.sqrt(2.0 * self.alpha_p / mass)
@@ -173,6 +204,17 @@ class VelocityAttraction:
         is and gives F_y = F_a(1 + Q(d0)) sin α − nα_v V^(n−1), so with
         q = nα_v V^(n−1)/(F_a(1 + Q) sin α): N = N_static/(1 − q), c = q/(1 − q).
         ValueError when q ≥ 1 (no forward force).
+
+        Parameters
+        ----------
+        law : ForceLaw
+            The wall's repulsion.
+        alpha : float
+            Target angle from the wall normal, rad.
+        V : float
+            Speed, m/s.
+        rho_g : float
+            Distance to the goal, m.
         """
         check_type("law", law, ForceLaw, _LAW)
         Fa = self.position_force(rho_g)
@@ -189,6 +231,17 @@ class VelocityAttraction:
         """Every corridor equilibrium (target straight ahead) of a steering robot at speed V: (x0, N, c).
 
         F_y = F_a(1 + Q(L + x0) + Q(L − x0)) − nα_v V^(n−1); N and c as for a wall.
+
+        Parameters
+        ----------
+        law : ForceLaw
+            The walls' repulsion.
+        L : float
+            Corridor half-width, m.
+        V : float
+            Speed, m/s.
+        rho_g : float
+            Distance to the goal, m.
         """
         check_type("law", law, ForceLaw, _LAW)
         Fa = self.position_force(rho_g)
@@ -206,16 +259,33 @@ class VelocityAttraction:
             raise ValueError(f"V must be > 0 m/s for n != 2 (the damping nα_v V^(n-2) is 0 or infinite at rest); got {V!r}")
         return self.n * self.alpha_v * V ** (self.n - 2.0) / mass
 
+    def _holonomic_inputs(self, law, rho_g: float, mass: float, V: float) -> tuple:
+        """(F_a in N, m_rob in kg, c_h in 1/s) of a holonomic robot's equilibria, after checking the law, ρ_g, the mass and V."""
+        check_type("law", law, ForceLaw, _LAW)
+        Fa, mass = self.position_force(rho_g), check_parameter("mass", mass)
+        return Fa, mass, self._damping(check_number("V", V, 0.0, 100.0, low_open=False, unit="m/s"), mass)
+
     def holonomic_wall_gains(self, law: ForceLaw, alpha: float, rho_g: float, mass: float = 1.0, V: float = 0.0) -> tuple:
         """(x0 = d0, κ, c_h) at every wall equilibrium of a holonomic robot (GC2002 §6: force = acceleration).
 
         κ = −F_a(P′(d0) − Q′(d0) cos α)/m_rob with `law` in units of F_a = mα_p ρ_g^(m−1);
         c_h = nα_v V^(n−2)/m_rob (2α_v/m_rob for n = 2, whatever V, m/s).
+
+        Parameters
+        ----------
+        law : ForceLaw
+            The wall's repulsion.
+        alpha : float
+            Target angle from the wall normal, rad.
+        rho_g : float
+            Distance to the goal, m.
+        mass : float, optional
+            Robot mass m_rob, kg.
+        V : float, optional
+            Speed along the wall, m/s.
         """
-        check_type("law", law, ForceLaw, _LAW)
-        Fa, mass = self.position_force(rho_g), check_parameter("mass", mass)
         alpha = check_parameter("alpha", alpha)
-        c_h = self._damping(check_number("V", V, 0.0, 100.0, low_open=False, unit="m/s"), mass)
+        Fa, mass, c_h = self._holonomic_inputs(law, rho_g, mass, V)
         out = []
         for eq in wall_equilibria(law, alpha):
             if math.isfinite(eq.x0):
@@ -224,11 +294,23 @@ class VelocityAttraction:
         return tuple(out)
 
     def holonomic_corridor_gains(self, law: ForceLaw, L: float, rho_g: float, mass: float = 1.0, V: float = 0.0) -> tuple:
-        """(x0, κ, c_h) at every corridor equilibrium of a holonomic robot: κ = −F_a(P′(L + x0) + P′(L − x0))/m_rob."""
-        check_type("law", law, ForceLaw, _LAW)
-        Fa, mass = self.position_force(rho_g), check_parameter("mass", mass)
+        """(x0, κ, c_h) at every corridor equilibrium of a holonomic robot: κ = −F_a(P′(L + x0) + P′(L − x0))/m_rob.
+
+        Parameters
+        ----------
+        law : ForceLaw
+            The walls' repulsion.
+        L : float
+            Corridor half-width, m.
+        rho_g : float
+            Distance to the goal, m.
+        mass : float, optional
+            Robot mass m_rob, kg.
+        V : float, optional
+            Speed along the corridor, m/s.
+        """
         L = check_parameter("L", L)
-        c_h = self._damping(check_number("V", V, 0.0, 100.0, low_open=False, unit="m/s"), mass)
+        Fa, mass, c_h = self._holonomic_inputs(law, rho_g, mass, V)
         out = []
         for eq in corridor_equilibria(law, L):
             slope = float(law.slope(L + eq.x0)) + float(law.slope(L - eq.x0))
@@ -371,11 +453,24 @@ class VelocityGatedRepulsion:
         """D = (distance − ρ_rob) − v_RO²/(2a_max), m: the clearance left after braking at a_max (eq 11, 12, 12′).
 
         `distance` is to the obstacle's surface (m), `closing_speed` v_RO (m/s, > 0 approaching).
+
+        Parameters
+        ----------
+        distance : float or ndarray
+            Distance to the obstacle, m.
+        closing_speed : float or ndarray
+            Speed towards it v_RO, m/s.
         """
         return distance - self.robot_radius - closing_speed * closing_speed / (2.0 * self.a_max)
 
     def magnitude(self, D):
-        """The repulsion's magnitude factor at braked clearance D (m): η/D², η(1/D − 1/ρ0)² or η³(1/D − 1/ρ0)²."""
+        """The repulsion's magnitude factor at braked clearance D (m): η/D², η(1/D − 1/ρ0)² or η³(1/D − 1/ρ0)².
+
+        Parameters
+        ----------
+        D : float or ndarray
+            Braked clearance, m.
+        """
         D = np.asarray(D, dtype=float)
         with np.errstate(divide="ignore"):
             if self.variant == "gradient":
@@ -386,20 +481,26 @@ class VelocityGatedRepulsion:
     def evaluate(self, p, v, obstacle: str, where, radius: float = 0.0, v_obs=(0.0, 0.0)) -> RepulsionResult:
         """The repulsion on a robot at p (m) with velocity v (m/s) from one obstacle.
 
-        Parameters
-        ----------
-        obstacle : str
-            ``"point"`` (at `where`), ``"ball"`` (centre `where`, `radius` m) or
-            ``"wall"`` (`where` = (point on the line, unit normal): a 2×2 array, the
-            normal pointing to the robot's side).
-        v_obs : 2-vector
-            The obstacle's velocity, m/s.
-
         The force is F_rep1 + F_rep2 with F_rep1 = −M(D)(1 + v_RO/a_max) n_RO and
         F_rep2 = M(D) v_RO v_RO⊥/(a_max R) n_RO⊥, M the `magnitude`, R the distance to
         the point or the ball's centre (not ρ_s: the true gradient), F_rep2 ≡ 0 for a
         wall (n_RO is constant). Events: at v_RO = 0 and at D = ρ0 the force jumps
         (``"inactive"`` beyond); D ≤ 0 while approaching is ``"collision"``.
+
+        Parameters
+        ----------
+        p, v : 2-vector
+            Robot position (m) and velocity (m/s).
+        obstacle : str
+            ``"point"`` (at `where`), ``"ball"`` (centre `where`, `radius` m) or
+            ``"wall"`` (`where` = (point on the line, unit normal): a 2×2 array, the
+            normal pointing to the robot's side).
+        where : array_like
+            The point, the ball's centre, or the wall's point and normal, m.
+        radius : float, optional
+            A ball's radius, m.
+        v_obs : 2-vector, optional
+            The obstacle's velocity, m/s.
         """
         check_choice("obstacle", obstacle, OBSTACLE_KINDS)
         p, v, v_obs = _vector("p", p), _vector("v", v), _vector("v_obs", v_obs)
@@ -435,21 +536,49 @@ class VelocityGatedRepulsion:
         return RepulsionResult("active", force, self.eta * (1.0 / D - 1.0 / self.rho0), rho_s, v_ro, D)
 
     def potential(self, p, v, obstacle: str, where, radius: float = 0.0, v_obs=(0.0, 0.0)) -> float:
-        """U_rep, J (eq 12): η(1/D − 1/ρ0) while active, 0 otherwise; ValueError on a collision state."""
+        """U_rep, J (eq 12): η(1/D − 1/ρ0) while active, 0 otherwise; ValueError on a collision state.
+
+        Parameters
+        ----------
+        p, v : 2-vector
+            Robot position (m) and velocity (m/s).
+        obstacle : str
+            ``"point"``, ``"ball"`` or ``"wall"`` (`evaluate`).
+        where : array_like
+            The obstacle's position (a wall: a point on it and its unit normal).
+        radius : float, optional
+            A ball's radius, m.
+        v_obs : 2-vector, optional
+            The obstacle's velocity, m/s.
+        """
         r = self.evaluate(p, v, obstacle, where, radius, v_obs)
         if r.collision:
             raise ValueError("p, v: collision unavoidable (D <= 0 while approaching): the potential is undefined")
         return r.potential
 
     def at_rest_force(self, d):
-        """The repulsion at v_RO = 0⁺ and clearance d (m): M(d) for 0 < d < ρ0, else 0, N."""
+        """The repulsion at v_RO = 0⁺ and clearance d (m): M(d) for 0 < d < ρ0, else 0, N.
+
+        Parameters
+        ----------
+        d : float or ndarray
+            Clearance, m.
+        """
         d = np.asarray(d, dtype=float)
         inside = (d > 0) & (d < self.rho0)
         with np.errstate(divide="ignore", invalid="ignore"):
             return np.where(inside, self.magnitude(np.where(inside, d, 1.0)), 0.0)
 
     def non_smooth_wall(self, attraction: float, alpha: float) -> NonSmoothWall:
-        """The non-smooth verdict beside a wall, target at angle α (rad) from the wall normal, pull F_a (N)."""
+        """The non-smooth verdict beside a wall, target at angle α (rad) from the wall normal, pull F_a (N).
+
+        Parameters
+        ----------
+        attraction : float
+            The target's pull F_a, N.
+        alpha : float
+            Target angle from the wall normal, rad.
+        """
         Fa = check_number("attraction", attraction, 0.0, 1e9, unit="N")
         alpha = check_parameter("alpha", alpha)
         pull = Fa * math.cos(alpha)
@@ -467,7 +596,15 @@ class VelocityGatedRepulsion:
         return bisect_root(excess, self.rho0 * 1e-9, hi, rtol=1e-14)
 
     def non_smooth_corridor(self, L: float, offsets=None) -> NonSmoothCorridor:
-        """The non-smooth verdict in a corridor of half-width L (m): friction levels of both walls at offsets x."""
+        """The non-smooth verdict in a corridor of half-width L (m): friction levels of both walls at offsets x.
+
+        Parameters
+        ----------
+        L : float
+            Corridor half-width, m.
+        offsets : array_like, optional
+            Offsets x from the middle, m, inside (−L, L) (default 19 points across 90 % of it).
+        """
         L = check_parameter("L", L)
         x = np.linspace(-0.9 * L, 0.9 * L, 19) if offsets is None else np.asarray(offsets, dtype=float)
         if x.size == 0 or not np.all(np.isfinite(x)) or np.any(np.abs(x) >= L):
@@ -483,6 +620,15 @@ def stall_band(repulsion: VelocityGatedRepulsion, attraction: VelocityAttraction
     the repulsion is at least the pull (and 0 < D < ρ0) the robot rests (a Filippov
     equilibrium on ẋ = 0). The band is searched on x ∈ (ρ_TO − ρ0, 0) by a scan of 4001
     points and `solve.bisect_root`.
+
+    Parameters
+    ----------
+    repulsion : VelocityGatedRepulsion
+        The obstacle's repulsion.
+    attraction : VelocityAttraction
+        The target's pull.
+    rho_to : float
+        Distance from the target to the obstacle's surface ρ_TO, m.
     """
     check_type("repulsion", repulsion, VelocityGatedRepulsion, "a VelocityGatedRepulsion")
     check_type("attraction", attraction, VelocityAttraction, "a VelocityAttraction")

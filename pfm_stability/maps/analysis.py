@@ -227,7 +227,15 @@ class MapAnalysis:
         return min(values) if values else None
 
     def plot(self, ax=None, **kwargs):
-        """`plots.map.plot_map_stability` of this analysis; returns the figure."""
+        """`plots.map.plot_map_stability` of this analysis; returns the figure.
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes, optional
+            Axes to draw on; None: a new figure.
+        **kwargs
+            Passed on to `plots.map.plot_map_stability`.
+        """
         from ..plots.map import plot_map_stability
 
         return plot_map_stability(self, ax=ax, **kwargs)
@@ -425,7 +433,19 @@ def analyze_map(occupancy: OccupancyMap, robot: Robot, controller: Controller, l
 def sample_verdict(N: float, V: float, boundary, heading_stable: bool) -> Judgement:
     """The verdict of one sample with gain N (1/m) at speed V (m/s): `models.verdicts.judge`, stable inside the
     model's stable set, or at N = 0 by `heading_stable`, the model's verdict at NV = 0 (``model.is_stable(0.0, loop)``:
-    its heading loop; module docstring)."""
+    its heading loop; module docstring).
+
+    Parameters
+    ----------
+    N : float
+        Environment gain, 1/m.
+    V : float
+        Speed, m/s.
+    boundary : Boundary
+        The model's boundary for the loop (`LoopModel.boundary`).
+    heading_stable : bool
+        The model's verdict at NV = 0 (its heading loop).
+    """
     return judge(N * V, N, boundary, bool(heading_stable) if N == 0 else (lambda NV: inside(boundary, NV)))
 
 

@@ -32,6 +32,7 @@ import numpy as np
 
 from ..laws.effective_force import DEFAULT_CV, GridWallLaw
 from .occupancy import OccupancyMap
+from ..numerics.cells import CellGrid
 
 __all__ = ["CHUNK_ENTRIES", "UNKNOWN_AS", "HistogramMap", "centre_field", "histogram_of", "window_force"]
 
@@ -42,7 +43,7 @@ CHUNK_ENTRIES = 4_000_000
 
 
 @dataclass(frozen=True)
-class HistogramMap:
+class HistogramMap(CellGrid):
     """The robot's histogram grid of a map.
 
     Attributes
@@ -70,28 +71,6 @@ class HistogramMap:
         """Occupied cells, shape (nx, ny)."""
         return self.cv > 0
 
-    def cell_index(self, x, y):
-        """(i, j) of the cells containing the points (may lie outside the grid).
-
-        Parameters
-        ----------
-        x, y : array_like
-            Points, m.
-        """
-        c = self.cell_size
-        return (np.floor((np.asarray(x, dtype=float) - self.x_min) / c).astype(np.int64),
-                np.floor((np.asarray(y, dtype=float) - self.y_min) / c).astype(np.int64))
-
-    def cell_center(self, i, j):
-        """(x, y) of cell centres, m.
-
-        Parameters
-        ----------
-        i, j : array_like of int
-            Cell indices along x and y.
-        """
-        c = self.cell_size
-        return self.x_min + (np.asarray(i) + 0.5) * c, self.y_min + (np.asarray(j) + 0.5) * c
 
     def clearance(self) -> np.ndarray:
         """Distance from each cell centre to the nearest occupied cell square, m, shape (nx, ny).

@@ -47,7 +47,7 @@ from ..checks import check_choice, check_number
 from ..parameters import HOLDS, RANGES, T_RESOLUTION, TAU_RESOLUTION, check_parameter
 from ..numerics.crossings import Crossing, StabilityInterval, affine_crossings, stable_interval, stable_set, verdict_at
 from ..io.serialize import json_number
-from .family import Characteristic, LoopFamily, StableSet
+from .family import Characteristic, LoopFamily, StableSet, _unchecked
 from .verdicts import NV_MAX
 
 __all__ = [
@@ -82,6 +82,13 @@ def neutral_quotient(p, domain: str = "s") -> np.ndarray:
 
     Every affine model's D has the root there exactly (D(0) = 0: the s⁰ coefficient is a product with
     the plant's zero constant term), so the s quotient drops that coefficient without arithmetic.
+
+    Parameters
+    ----------
+    p : array_like
+        The polynomial, descending.
+    domain : str, optional
+        ``"s"`` or ``"z"``.
     """
     p = np.trim_zeros(np.asarray(p, dtype=float), "f")
     if domain == "s":
@@ -109,17 +116,11 @@ class Loop(Characteristic):
         δ = −N·(x − x0) − c·θ, so the gain term of every model becomes
         k(cs + NV) (delayed by e^(−sT) with the rest of the sensor data);
         docs/models.md, "The heading gain".
-    plant_gain : float, keyword only
-        Plant gain g of the steering motor τω̇ + ω = g·u(t − D), dimensionless,
-        in [10⁻³, 100] (`parameters.Robot.plant_gain`); default 1 (KB's
-        robot). The loop's steering gain is g·k (`steering_gain`) wherever k
-        multiplies the command; `k` stays the controller's gain, so k*
-        (`critical_gain_k`) is in the user's k.
-    dead_time : float, keyword only
-        Dead time D of the steering motor, s, in [0, 10]; default 0. The
-        continuous-time models see the delay T + D (`delay`); the sampled
-        model a command that reaches the motor d·T + D after its data
-        (docs/models.md, "Plant gain and dead time").
+    plant_gain, dead_time : float, keyword only
+        g (in [10⁻³, 100], default 1) and D (s, in [0, 10], default 0) of the motor
+        τω̇ + ω = g·u(t − D) (docs/models.md, "Plant gain and dead time"): the loop's
+        steering gain is g·k (`steering_gain`; `k` stays the controller's, k* is in it),
+        the continuous-time models' delay T + D (`delay`).
     """
 
     tau: float
@@ -132,10 +133,8 @@ class Loop(Characteristic):
     def __post_init__(self):
         for name in ("tau", "T", "k"):
             object.__setattr__(self, name, check_parameter(name, getattr(self, name)))
-        for name, default in (("plant_gain", 1.0), ("dead_time", 0.0)):
-            value = getattr(self, name)
-            if value.__class__ is not float or value != default:
-                object.__setattr__(self, name, check_parameter(name, value))
+        for name in [n for n, d in (("plant_gain", 1.0), ("dead_time", 0.0)) if getattr(self, n).__class__ is not float or getattr(self, n) != d]:
+            object.__setattr__(self, name, check_parameter(name, getattr(self, name)))
         if self.tau * self.steering_gain < TAU_RESOLUTION:  # a lag 10⁹ times faster than the steering loop: an ideal motor
             object.__setattr__(self, "tau", 0.0)
         if self.T < T_RESOLUTION:  # faster than a picosecond: a continuous controller
@@ -145,9 +144,7 @@ class Loop(Characteristic):
 
     @classmethod
     def of(cls, robot, controller, *, c: float = 0.0) -> "Loop":
-        """The loop of a robot and its controller (τ, k; T), with heading gain `c`: the one constructor from them.
-
-        The robot's plant gain g and dead time D come along (`plant_gain`, `dead_time`).
+        """The loop of a robot and its controller (τ, k, g, D; T), with heading gain `c`: the one constructor from them.
 
         Parameters
         ----------
@@ -200,27 +197,75 @@ class Loop(Characteristic):
         return np.array([self.tau, 1.0, k * (1.0 + self.c), 0.0]) if self.tau > 0 else np.array([1.0, k * (1.0 + self.c), 0.0])
 
     def loop_gain(self, NV: float) -> float:
-        """K = gkNV, 1/s² (g = 1: KB's kNV)."""
+        """K = gkNV, 1/s² (g = 1: KB's kNV).
+
+        Parameters
+        ----------
+        NV : float
+            Loop gain N·V, 1/s.
+        """
         return self.steering_gain * NV
 
     def gain_of(self, K: float) -> float:
-        """NV = K/(gk), 1/s."""
+        """NV = K/(gk), 1/s.
+
+        Parameters
+        ----------
+        K : float
+            Loop gain K, 1/s².
+        """
         return K / self.steering_gain
 
     def check_gain(self, NV) -> float:
-        """NV (1/s) as a float in [−`NV_MAX`, `NV_MAX`] (−0.0 becomes 0.0), or ValueError naming NV."""
+        """NV (1/s) as a float in [−`NV_MAX`, `NV_MAX`] (−0.0 becomes 0.0), or ValueError naming NV.
+
+        Parameters
+        ----------
+        NV : float
+            Loop gain N·V, 1/s.
+        """
         return check_number("NV", NV, -NV_MAX, NV_MAX, low_open=False, high_open=False, unit="1/s") + 0.0
 
     def boundary_from(self, model: str, interval: StabilityInterval) -> "Boundary":
-        """`Boundary` in NV (K/(gk))."""
+        """`Boundary` in NV (K/(gk)).
+
+        Parameters
+        ----------
+        model : str
+            The model's name (`parameters.MODEL_NAMES`).
+        interval : StabilityInterval
+            The stable loop gains K, 1/s², with K* and ω*.
+        """
         return Boundary.from_interval(model, interval, self.steering_gain)
 
     def with_delay(self, T: float) -> "Loop":
-        """τ, k, c, g and D with delay / period T, s (the dead time stays: T* is the controller's)."""
+        """τ, k, c, g and D with delay / period T, s (the dead time stays: T* is the controller's).
+
+        Parameters
+        ----------
+        T : float
+            Delay / sampling period, s, >= 0.
+        """
         return Loop(self.tau, T, self.k, c=self.c, plant_gain=self.plant_gain, dead_time=self.dead_time)
 
+    def _with_delay(self, T: float) -> "Loop":
+        """`with_delay` unchecked (a probe of T in range, `Characteristic._with_delay`); T < `T_RESOLUTION` is 0."""
+        T = float(T)
+        return _unchecked(Loop, **{**vars(self), "T": T if T >= T_RESOLUTION else 0.0})  # τ, k, c, g and D kept
+
+    def _with_steering_gain(self, k: float) -> "Loop":
+        """τ, T and c with steering gain k, 1/s, unchecked (a probe of k in `gain_range`); τ with τk < 10⁻⁹ is 0."""
+        k = float(k)
+        return _unchecked(Loop, **{**vars(self), "tau": self.tau if self.tau * self.plant_gain * k >= TAU_RESOLUTION else 0.0, "k": k})
+
     def delay_search(self, NV: float) -> tuple:
-        """T* searched from 1 % of the loop's fastest time scale to 1e-7 relative (a report shows 4 digits)."""
+        """T* searched from 1 % of the loop's fastest time scale to 1e-7 relative (a report shows 4 digits).
+
+        Parameters
+        ----------
+        NV : float
+            Loop gain N·V, 1/s.
+        """
         scale = _time_scale(self, NV)
         return scale * 1e-2, _DELAY_RTOL, 1e-12 * scale
 
@@ -228,8 +273,16 @@ class Loop(Characteristic):
         """(A, B, F0, F1) of the sampled steering loop (`models.sampled`): states (ω, θ, y), (θ, y) for τ = 0; y = x/V.
 
         The held input is v_k = −(F0 + K·F1)·state_k; the heading gain c adds kc to F0's θ entry.
+
+        Parameters
+        ----------
+        hold : str
+            What the computer holds between samples: ``"command"`` or ``"reference"`` (`parameters.HOLDS`).
         """
-        check_choice("hold", hold, HOLDS)
+        return self._state_space(check_choice("hold", hold, HOLDS))
+
+    def _state_space(self, hold: str) -> tuple:
+        """`state_space` for a `hold` already checked (`Characteristic._state_space`)."""
         tau, k = self.tau, self.steering_gain
         if tau > 0:
             if hold == "command":
@@ -274,23 +327,24 @@ class Loop(Characteristic):
         return bool(stable[0]), int(Z[0]), float(margin[0])
 
     def delay_stable(self, K: float) -> bool:
-        """The crossing count Z(T) = 0 (`delay.delay_verdicts_from_gain`; K = 0: the heading loop's)."""
-        return self._count(K)[0]
-
-    def delay_margin(self, K: float) -> float:
-        """T*, s, of the crossing count (`delay.delay_verdicts_from_gain`): the margin of the delay T + D less D (`period_margin`)."""
-        return self.period_margin(self._count(K)[2])
-
-    def dead_time_margin(self, K: float) -> float:
-        """D*, s, of the crossing count: the margin of the delay T + D less T (0 if T alone exceeds it; ``inf`` stays).
+        """The crossing count Z(T) = 0 (`delay.delay_verdicts_from_gain`; K = 0: the heading loop's).
 
         Parameters
         ----------
         K : float
-            Loop gain g·k·NV, 1/s².
+            Loop gain K = kNV, 1/s².
         """
-        margin = self._count(K)[2]
-        return margin if math.isinf(margin) else max(margin - self.T, 0.0)
+        return self._count(K)[0]
+
+    def delay_margin(self, K: float) -> float:
+        """T*, s, of the crossing count (`delay.delay_verdicts_from_gain`): the margin of the delay T + D less D (`period_margin`).
+
+        Parameters
+        ----------
+        K : float
+            Loop gain K = g·k·NV, 1/s².
+        """
+        return self.period_margin(self._count(K)[2])
 
 
 def _one(x) -> np.ndarray:
@@ -342,7 +396,17 @@ class Boundary(StableSet):
 
     @classmethod
     def from_interval(cls, model: str, interval, k: float) -> "Boundary":
-        """From a `crossings.StabilityInterval` in gain K = kNV."""
+        """From a `crossings.StabilityInterval` in gain K = kNV.
+
+        Parameters
+        ----------
+        model : str
+            The model's name (`parameters.MODEL_NAMES`).
+        interval : StabilityInterval
+            The stable loop gains K, 1/s², with K* and ω*.
+        k : float
+            Steering gain, 1/s.
+        """
         intervals = tuple((lo / k, hi / k) for lo, hi in interval.intervals)
         return cls(model, interval.gain / k, interval.frequency, interval.gain, intervals)
 
@@ -363,7 +427,13 @@ def _check_NV(NV) -> float:
 
 
 def check_heading_gain(c) -> float:
-    """c as a float if it is finite and in `HEADING_GAIN_RANGE`, else ValueError (with the reason for c <= −1)."""
+    """c as a float if it is finite and in `HEADING_GAIN_RANGE`, else ValueError (with the reason for c <= −1).
+
+    Parameters
+    ----------
+    c : float
+        Heading gain, dimensionless.
+    """
     low, high = HEADING_GAIN_RANGE
     try:
         return check_number("c", c, low, high, low_open=False, high_open=False)
@@ -387,6 +457,11 @@ def checked(method):
     checked beyond the last crossing gain, may go further); NV < 0 is accepted
     (N < 0, `divergent_reason`), and NV = 0 (N = 0: the heading loop is judged,
     `neutral_reason`). κ for a holonomic loop (non-zero).
+
+    Parameters
+    ----------
+    method : callable
+        A model method ``method(self, gain, loop, ...)``.
     """
 
     @functools.wraps(method)
@@ -429,16 +504,36 @@ class LoopModel:
         return {}
 
     def boundary(self, loop: Characteristic):
-        """The critical gain (NV* or κ*), the boundary frequency and the stable set for the loop (cached)."""
+        """The critical gain (NV* or κ*), the boundary frequency and the stable set for the loop (cached).
+
+        Parameters
+        ----------
+        loop : Characteristic
+            The loop judged (`Loop`, `HolonomicLoop`).
+        """
         return _cached_boundary(self, _check_loop(loop))
 
     def compute_boundary(self, loop: Characteristic):  # pragma: no cover - interface
-        """`boundary`, uncached."""
+        """`boundary`, uncached.
+
+        Parameters
+        ----------
+        loop : Characteristic
+            The loop judged (`Loop`, `HolonomicLoop`).
+        """
         raise NotImplementedError
 
     @checked
     def is_stable(self, gain: float, loop: Characteristic) -> bool:
-        """Verdict at the gain (NV 1/s, κ 1/s²) by a route independent of `boundary`."""
+        """Verdict at the gain (NV 1/s, κ 1/s²) by a route independent of `boundary`.
+
+        Parameters
+        ----------
+        gain : float
+            The family's loop gain: NV (1/s) or κ (1/s²).
+        loop : Characteristic
+            The loop judged (`Loop`, `HolonomicLoop`).
+        """
         return self._stable(gain, loop)
 
     def _stable(self, gain: float, loop: Characteristic) -> bool:  # pragma: no cover - interface
@@ -447,17 +542,35 @@ class LoopModel:
 
     @checked
     def rightmost_root(self, gain: float, loop: Characteristic) -> complex:  # pragma: no cover - interface
-        """Dominant root σ + jω (1/s, rad/s, ω >= 0); sampled models map z by ln(z)/T."""
+        """Dominant root σ + jω (1/s, rad/s, ω >= 0); sampled models map z by ln(z)/T.
+
+        Parameters
+        ----------
+        gain : float
+            The family's loop gain: NV (1/s) or κ (1/s²).
+        loop : Characteristic
+            The loop judged (`Loop`, `HolonomicLoop`).
+        """
         raise NotImplementedError
 
     def growth_rates(self, gain: float, loops) -> np.ndarray:
         """Real part of the dominant root, 1/s, at the gain for each loop of a sequence.
 
         At NV = 0 the heading loop's (`neutral_reason`: the neutral lateral
-        root left out), as `rightmost_root`. Models override this with a
-        vectorized version where they can.
+        root left out), as `rightmost_root`. Models override `_growth_rates`
+        with a vectorized version where they can.
+
+        Parameters
+        ----------
+        gain : float
+            The family's loop gain: NV (1/s) or κ (1/s²).
+        loops : sequence of Characteristic
+            The loops, one growth rate each.
         """
-        gain = _check_NV(gain)
+        return self._growth_rates(_check_NV(gain), loops)
+
+    def _growth_rates(self, gain: float, loops) -> np.ndarray:
+        """`growth_rates` of a gain already checked (the searches of `critical_delay` and `critical_gain_k`)."""
         return np.array([self.rightmost_root(gain, loop).real for loop in loops])
 
     @checked
@@ -472,15 +585,21 @@ class LoopModel:
         bisection to the family's tolerance, `Characteristic.delay_search`:
         1e-7 relative for a steering loop, 1e-9 for a holonomic one); models
         with an exact route override it.
+
+        Parameters
+        ----------
+        gain : float
+            The family's loop gain: NV (1/s) or κ (1/s²).
+        loop : Characteristic
+            The loop judged; its own T, s, is replaced by the searched ones.
         """
         from ..numerics.solve import first_crossing
 
-        gain = _check_NV(gain)
-        if gain < 0 or self._searched_growth_rates(gain, [loop.with_delay(0.0)])[0] >= 0:
+        if gain < 0 or self._searched_growth_rates(gain, [loop._with_delay(0.0)])[0] >= 0:
             return 0.0
 
-        def measure(Ts):
-            return self._searched_growth_rates(gain, [loop.with_delay(float(T)) for T in Ts])
+        def measure(Ts):  # probes of the checked loop: T in [start, RANGES["T"].high]
+            return self._searched_growth_rates(gain, [loop._with_delay(T) for T in Ts])
 
         start, rtol, atol = loop.delay_search(gain)
         return first_crossing(measure, start, RANGES["T"].high, rtol=rtol, atol=atol)
@@ -492,35 +611,33 @@ class LoopModel:
         Stable for every k in (0, k*): lowering k below k* is a remedy that
         works. 0 if no k is small enough; ``inf`` if NV stays stable up to the
         largest allowed k (10⁴ 1/s). Same search as `critical_delay`, over k.
+
+        Parameters
+        ----------
+        NV : float
+            Loop gain N·V, 1/s.
+        loop : Loop
+            The steering loop judged; its own k is replaced by the searched ones.
         """
         from ..numerics.solve import first_crossing
 
         loop = _steering(loop, "critical_gain_k")
-        NV = _check_NV(NV)
         lo, hi = gain_range(loop)
-        if NV < 0 or self._searched_growth_rates(NV, [loop.replace(k=lo)])[0] >= 0:
+        if NV < 0 or self._searched_growth_rates(NV, [loop._with_steering_gain(lo)])[0] >= 0:
             return 0.0
 
-        def measure(ks):
-            return self._searched_growth_rates(NV, [loop.replace(k=float(k)) for k in ks])
+        def measure(ks):  # probes of the checked loop: k in gain_range
+            return self._searched_growth_rates(NV, [loop._with_steering_gain(k) for k in ks])
 
         return first_crossing(measure, lo, hi, start=lo, rtol=_DELAY_RTOL, atol=1e-12 * lo)
 
     def _searched_growth_rates(self, gain: float, loops) -> np.ndarray:
-        """The growth rates (1/s) the searches for T*, k* and D* measure: `growth_rates` (`sampled` stands in the
-        delay loop where it carries too many delayed commands)."""
-        return self.growth_rates(gain, loops)
+        """The growth rates (1/s) the searches for T*, k* and D* measure: `_growth_rates` (`sampled`'s has a stand-in)."""
+        return self._growth_rates(gain, loops)
 
     @checked
     def critical_dead_time(self, gain: float, loop: Loop) -> float:
-        """D*: the largest dead time of the steering plant that the gain tolerates, T and the rest fixed, s.
-
-        Stable for every D in [0, D*) (docs/models.md, "Plant gain and dead time"):
-        0 if the gain is unstable already without a dead time; ``inf`` if it stays
-        stable up to the largest allowed D (10 s). Found as T* is
-        (`critical_delay`: the dominant growth rate on a geometric grid of D,
-        refined to 1e-7 relative); `exact_delay` has the exact route (its delay
-        margin less T), `continuous` does not depend on D.
+        """D*: the largest dead time of the steering plant the gain tolerates, T fixed, s (`dead_time.search_dead_time`).
 
         Parameters
         ----------
@@ -529,22 +646,21 @@ class LoopModel:
         loop : Loop
             τ, T, k, c and g (its own D is replaced).
         """
-        from ..numerics.solve import first_crossing
+        from .dead_time import search_dead_time
 
-        loop = _steering(loop, "critical_dead_time")
-        gain = _check_NV(gain)
-        if gain < 0 or self._searched_growth_rates(gain, [loop.replace(dead_time=0.0)])[0] >= 0:
-            return 0.0
-
-        def measure(Ds):
-            return self._searched_growth_rates(gain, [loop.replace(dead_time=float(D)) for D in Ds])
-
-        start, rtol, atol = loop.delay_search(gain)
-        return first_crossing(measure, start, RANGES["dead_time"].high, rtol=rtol, atol=atol)
+        return search_dead_time(self, gain, _steering(loop, "critical_dead_time"))
 
     @checked
     def damping_range(self, gain: float, loop: Characteristic) -> tuple:  # pragma: no cover - interface
-        """Every interval of the damping δ (the holonomic c_h, 1/s) that makes the gain stable at the loop's T."""
+        """Every interval of the damping δ (the holonomic c_h, 1/s) that makes the gain stable at the loop's T.
+
+        Parameters
+        ----------
+        gain : float
+            The family's loop gain (κ, 1/s², of a holonomic loop).
+        loop : Characteristic
+            The loop judged; its T, s, is kept and its own damping ignored.
+        """
         raise NotImplementedError
 
     def __repr__(self) -> str:
@@ -568,6 +684,11 @@ def gain_range(loop: Loop) -> tuple[float, float]:
 
     k_lo = 1e-3·k, but never below the smallest allowed k (a loop with a k
     outside its range cannot be built: the search would fail on its own probe).
+
+    Parameters
+    ----------
+    loop : Loop
+        The steering loop (its k, 1/s, sets the search's lower end).
     """
     return max(1e-3 * loop.k, RANGES["k"].low), RANGES["k"].high
 
@@ -594,16 +715,36 @@ class AffineGainModel(LoopModel):
     domain = "s"
 
     def polynomials(self, loop: Characteristic):  # pragma: no cover - interface
-        """(D, E), descending coefficients: the characteristic polynomial is D + K·E."""
+        """(D, E), descending coefficients: the characteristic polynomial is D + K·E.
+
+        Parameters
+        ----------
+        loop : Characteristic
+            The loop judged (`Loop`, `HolonomicLoop`).
+        """
         raise NotImplementedError
 
     def parts(self, loop: Characteristic):  # pragma: no cover - interface
-        """(P0, P1, P2), descending, one length: the characteristic polynomial P0 + δ·P1 + K·P2 (s; μ for `sampled`)."""
+        """(P0, P1, P2), descending, one length: the characteristic polynomial P0 + δ·P1 + K·P2 (s; μ for `sampled`).
+
+        Parameters
+        ----------
+        loop : Characteristic
+            The loop judged (`Loop`, `HolonomicLoop`).
+        """
         raise NotImplementedError
 
     @checked
     def characteristic(self, gain: float, loop: Characteristic) -> np.ndarray:
-        """Characteristic polynomial D + K·E, descending coefficients."""
+        """Characteristic polynomial D + K·E, descending coefficients.
+
+        Parameters
+        ----------
+        gain : float
+            The family's loop gain: NV (1/s) or κ (1/s²).
+        loop : Characteristic
+            The loop judged (`Loop`, `HolonomicLoop`).
+        """
         d, e = _aligned(*self.polynomials(loop))
         return np.trim_zeros(d + loop.loop_gain(_check_NV(gain)) * e, "f")
 
@@ -634,7 +775,13 @@ class AffineGainModel(LoopModel):
         return StabilityInterval(0.0, None, (), ()) if crossings is None else stable_interval(crossings, stable)
 
     def stable_gains(self, loop: Characteristic) -> StabilityInterval:
-        """Every stable loop gain K (1/s²), K* and ω*, uncached (`boundary` gives them in the family's gain)."""
+        """Every stable loop gain K (1/s²), K* and ω*, uncached (`boundary` gives them in the family's gain).
+
+        Parameters
+        ----------
+        loop : Characteristic
+            The loop judged (`Loop`, `HolonomicLoop`).
+        """
         d, e = self.polynomials(loop)
         return self._interval(d, e, lambda K: verdict_at(d, e, K, self.domain), loop)
 
@@ -654,6 +801,13 @@ class AffineGainModel(LoopModel):
 
         A holonomic loop's c_h (`HolonomicLoop`; ``loop.c_h`` itself is ignored);
         ``()`` when no damping helps (a negative gain, or a delay too long for it).
+
+        Parameters
+        ----------
+        gain : float
+            The family's loop gain (κ, 1/s², of a holonomic loop).
+        loop : Characteristic
+            The loop judged; its T, s, is kept and its own damping ignored.
         """
         loop.with_damping(0.0)  # a family whose damping is a parameter of its own
         if gain < 0:
@@ -666,23 +820,36 @@ class AffineGainModel(LoopModel):
 
     @checked
     def roots(self, gain: float, loop: Characteristic) -> np.ndarray:
-        """All roots of the characteristic polynomial (s or z)."""
+        """All roots of the characteristic polynomial (s or z).
+
+        Parameters
+        ----------
+        gain : float
+            The family's loop gain: NV (1/s) or κ (1/s²).
+        loop : Characteristic
+            The loop judged (`Loop`, `HolonomicLoop`).
+        """
         return np.roots(self.characteristic(gain, loop))
 
     def batch_polynomials(self, loops):
-        """(D, E) of each loop as two arrays of rows of one length (descending; leading zeros allowed)."""
+        """(D, E) of each loop as two arrays of rows of one length (descending; leading zeros allowed).
+
+        Parameters
+        ----------
+        loops : sequence of Characteristic
+            The loops, one row each.
+        """
         pairs = [self.polynomials(loop) for loop in loops]
         width = max(max(len(d), len(e)) for d, e in pairs)
         D = np.array([np.pad(d, (width - len(d), 0)) for d, _ in pairs])
         E = np.array([np.pad(e, (width - len(e), 0)) for _, e in pairs])
         return D, E
 
-    def growth_rates(self, gain: float, loops) -> np.ndarray:
+    def _growth_rates(self, gain: float, loops) -> np.ndarray:
         """max Re s (1/s) at the gain for each loop: eigenvalues of the companion matrices, batched by degree
         (NV = 0: of D/s, the heading loop; −inf for a constant)."""
         loops = list(loops)
         D, E = self.batch_polynomials(loops)
-        gain = _check_NV(gain)
         P = D + np.array([loop.loop_gain(gain) for loop in loops])[:, None] * E
         if gain == 0:  # D(0) = 0 exactly: drop the neutral lateral root
             P = P[:, :-1]
@@ -703,7 +870,15 @@ class AffineGainModel(LoopModel):
     @checked
     def rightmost_root(self, gain: float, loop: Characteristic) -> complex:
         """Dominant root σ + jω (1/s, rad/s; of a pair the one with ω > 0); NV = 0: the heading loop's (−inf when only
-        the neutral root is left)."""
+        the neutral root is left).
+
+        Parameters
+        ----------
+        gain : float
+            The family's loop gain: NV (1/s) or κ (1/s²).
+        loop : Characteristic
+            The loop judged (`Loop`, `HolonomicLoop`).
+        """
         if gain == 0:
             roots = np.roots(neutral_quotient(self.characteristic(gain, loop), self.domain))
             if roots.size == 0:

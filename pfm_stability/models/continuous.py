@@ -33,19 +33,47 @@ class Continuous(AffineGainModel):
     name = "continuous"
 
     def polynomials(self, loop: Characteristic):
-        """D = a(s) + δs, E = 1 (descending powers of s): τs³ + s² + k(1 + c)s (c = 0: KB eq 17); s² + c_h s."""
+        """D = a(s) + δs, E = 1 (descending powers of s): τs³ + s² + k(1 + c)s (c = 0: KB eq 17); s² + c_h s.
+
+        Parameters
+        ----------
+        loop : Characteristic
+            The loop judged (`Loop`, `HolonomicLoop`).
+        """
         return loop.closed_plant, np.array([1.0])
 
     def parts(self, loop: Characteristic):
-        """(a(s), s, 1)."""
+        """(a(s), s, 1).
+
+        Parameters
+        ----------
+        loop : Characteristic
+            The loop judged (`Loop`, `HolonomicLoop`).
+        """
         return _aligned(loop.plant, [1.0, 0.0], [1.0])
 
     @checked
     def critical_delay(self, gain: float, loop: Characteristic) -> float:
-        """T does not enter: ``inf`` if the loop is stable (`is_stable`; steering: τNV < 1 + c, NV >= 0), else 0 (s)."""
+        """T does not enter: ``inf`` if the loop is stable (`is_stable`; steering: τNV < 1 + c, NV >= 0), else 0 (s).
+
+        Parameters
+        ----------
+        gain : float
+            The family's loop gain: NV (1/s) or κ (1/s²).
+        loop : Characteristic
+            The loop judged (its T is not used).
+        """
         return math.inf if self._stable(gain, loop) else 0.0
 
     @checked
     def critical_gain_k(self, NV: float, loop) -> float:
-        """k cancels from Routh's condition 0 <= τNV < 1 + c (`is_stable`): ``inf`` if it holds, else 0 (1/s)."""
+        """k cancels from Routh's condition 0 <= τNV < 1 + c (`is_stable`): ``inf`` if it holds, else 0 (1/s).
+
+        Parameters
+        ----------
+        NV : float
+            Loop gain N·V, 1/s.
+        loop : Loop
+            The steering loop judged (τ, T, k, c).
+        """
         return math.inf if self._stable(NV, _steering(loop, "critical_gain_k")) else 0.0

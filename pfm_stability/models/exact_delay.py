@@ -65,12 +65,24 @@ class ExactDelay(LoopModel):
 
     @staticmethod
     def quasi_polynomial(loop: Characteristic) -> DelayLoop:
-        """The quasi-polynomial a(s) + (δs + K)·e^(−sT) (δ = 0: a(s) + K e^(−sT))."""
+        """The quasi-polynomial a(s) + (δs + K)·e^(−sT) (δ = 0: a(s) + K e^(−sT)).
+
+        Parameters
+        ----------
+        loop : Characteristic
+            The loop judged (`Loop`, `HolonomicLoop`).
+        """
         return loop.quasi_polynomial()
 
     @staticmethod
     def heading_quasi_polynomial(loop: Characteristic) -> DelayLoop:
-        """Gain 0 (N = 0): the quasi-polynomial divided by s, a(s)/s + δ·e^(−sT) (its gain is δ)."""
+        """Gain 0 (N = 0): the quasi-polynomial divided by s, a(s)/s + δ·e^(−sT) (its gain is δ).
+
+        Parameters
+        ----------
+        loop : Characteristic
+            The loop judged (`Loop`, `HolonomicLoop`).
+        """
         return DelayLoop(loop.plant[:-1], loop.delay)
 
     def _quasi(self, gain: float, loop: Characteristic):
@@ -78,7 +90,13 @@ class ExactDelay(LoopModel):
         return (self.heading_quasi_polynomial(loop), loop.damping) if gain == 0 else (self.quasi_polynomial(loop), loop.loop_gain(gain))
 
     def compute_boundary(self, loop: Characteristic):
-        """The family's crossing structure (`Characteristic.delay_interval`) in its gain."""
+        """The family's crossing structure (`Characteristic.delay_interval`) in its gain.
+
+        Parameters
+        ----------
+        loop : Characteristic
+            The loop judged (`Loop`, `HolonomicLoop`).
+        """
         return loop.boundary_from(self.name, loop.delay_interval())
 
     def _stable(self, gain: float, loop: Characteristic) -> bool:
@@ -87,7 +105,15 @@ class ExactDelay(LoopModel):
 
     @checked
     def unstable_root_count(self, gain: float, loop: Characteristic) -> int | None:
-        """Roots with Re s > 0 (None when a root is on the imaginary axis; NV = 0: the heading loop's)."""
+        """Roots with Re s > 0 (None when a root is on the imaginary axis; NV = 0: the heading loop's).
+
+        Parameters
+        ----------
+        gain : float
+            The family's loop gain: NV (1/s) or κ (1/s²).
+        loop : Characteristic
+            The loop judged (`Loop`, `HolonomicLoop`).
+        """
         q, K = self._quasi(gain, loop)
         return q.unstable_root_count(K)
 
@@ -95,7 +121,15 @@ class ExactDelay(LoopModel):
     def rightmost_root(self, gain: float, loop: Characteristic) -> complex | None:
         """Dominant root σ + jω (1/s, rad/s, ω >= 0); None where the pseudospectral method cannot resolve
         it (|s|·T in the thousands: `DelayLoop.rightmost_roots`). The verdict does not need it.
-        NV = 0: the heading loop's (`heading_quasi_polynomial`)."""
+        NV = 0: the heading loop's (`heading_quasi_polynomial`).
+
+        Parameters
+        ----------
+        gain : float
+            The family's loop gain: NV (1/s) or κ (1/s²).
+        loop : Characteristic
+            The loop judged (`Loop`, `HolonomicLoop`).
+        """
         q, K = self._quasi(gain, loop)
         for nodes in (40, 160):
             roots = q.rightmost_roots(K, count=2, nodes=nodes)
@@ -105,12 +139,20 @@ class ExactDelay(LoopModel):
 
     @checked
     def critical_delay(self, gain: float, loop: Characteristic) -> float:
-        """Delay margin: the smallest T at which the gain loses stability (the rest fixed), s."""
+        """Delay margin: the smallest T at which the gain loses stability (the rest fixed), s.
+
+        Parameters
+        ----------
+        gain : float
+            The family's loop gain: NV (1/s) or κ (1/s²).
+        loop : Characteristic
+            The loop judged; its own T, s, is replaced by the searched ones.
+        """
         return loop.delay_margin(loop.loop_gain(gain))
 
     @checked
     def critical_dead_time(self, gain: float, loop: Characteristic) -> float:
-        """D*: the delay margin of T + D less T (`Loop.dead_time_margin`), s; exact, as T*.
+        """D*: the crossing count's margin of the whole delay T + D (the loop with T = D = 0), less T, s; exact, as T*.
 
         Parameters
         ----------
@@ -120,12 +162,23 @@ class ExactDelay(LoopModel):
             τ, T, k, c and g.
         """
         loop = _steering(loop, "critical_dead_time")
-        return 0.0 if gain < 0 else loop.dead_time_margin(loop.loop_gain(gain))
+        if gain < 0:
+            return 0.0
+        margin = loop.replace(T=0.0, dead_time=0.0).delay_margin(loop.loop_gain(gain))
+        return margin if math.isinf(margin) else max(margin - loop.T, 0.0)
 
     @checked
     def damping_range(self, gain: float, loop: Characteristic) -> tuple:
         """Every interval of the damping δ (the holonomic c_h, 1/s) that makes the gain stable at the loop's T
-        (`HolonomicLoop.delay_damping_range`: the closed form of docs/models.md); ``()`` for a negative gain."""
+        (`HolonomicLoop.delay_damping_range`: the closed form of docs/models.md); ``()`` for a negative gain.
+
+        Parameters
+        ----------
+        gain : float
+            The family's loop gain (κ, 1/s², of a holonomic loop).
+        loop : Characteristic
+            The loop judged; its T, s, is kept and its own damping ignored.
+        """
         loop.with_damping(0.0)  # a family whose damping is a parameter of its own
         if gain < 0:
             return ()
@@ -181,12 +234,14 @@ class ExactDelay(LoopModel):
         """k* for c ≠ 0 (`critical_gain_k`): first sign change of the signed measure over k."""
         from ..numerics.solve import first_crossing
 
+        pade = Pade(6)  # one model for every probe
+
         def measure(ks):
-            loops = [loop.replace(k=float(k)) for k in ks]
+            loops = [loop._with_steering_gain(k) for k in ks]
             arrays = (np.array([getattr(x, name) for x in loops]) for name in ("tau", "delay", "steering_gain"))
             tau, T, k = arrays
             stable = delay_verdicts_from_gain(tau, T, k, k * NV, np.full(k.shape, loop.c))[0]
-            size = np.abs(Pade(6).growth_rates(NV, loops)) + 1e-300
+            size = np.abs(pade._growth_rates(NV, loops)) + 1e-300
             return np.where(stable, -size, size)
 
         lo, hi = gain_range(loop)

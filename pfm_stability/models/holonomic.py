@@ -71,7 +71,7 @@ from ..io.serialize import json_number
 from .base import Loop, LoopModel
 from .verdicts import interval_margin, interval_verdict
 from .continuous import Continuous
-from .family import Characteristic, LoopFamily, StableSet, root_json
+from .family import Characteristic, LoopFamily, StableSet, _unchecked, root_json
 
 __all__ = [
     "BEST_CURVATURE_PRODUCT",
@@ -113,7 +113,13 @@ HOLONOMIC = LoopFamily(
 
 
 def check_kappa(kappa) -> float:
-    """κ (1/s²) as a float: finite, in ``RANGES["kappa"]``, non-zero (κ = 0 puts a root at s = 0)."""
+    """κ (1/s²) as a float: finite, in ``RANGES["kappa"]``, non-zero (κ = 0 puts a root at s = 0).
+
+    Parameters
+    ----------
+    kappa : float
+        Stiffness κ, 1/s².
+    """
     kappa = check_parameter("kappa", kappa)
     if kappa == 0.0:
         raise ValueError("kappa must be a finite non-zero number 1/s^2 (kappa = 0: no force gradient, a root at s = 0); got 0.0")
@@ -177,7 +183,15 @@ class HolonomicLoop(Characteristic):
 
     @classmethod
     def of(cls, controller, *, c_h: float) -> "HolonomicLoop":
-        """The loop of a controller (its T) at an equilibrium of damping c_h, 1/s: the one constructor from them."""
+        """The loop of a controller (its T) at an equilibrium of damping c_h, 1/s: the one constructor from them.
+
+        Parameters
+        ----------
+        controller : Controller
+            The controller; its period / delay T, s, is the loop's.
+        c_h : float, keyword only
+            Damping of the equilibrium, 1/s.
+        """
         return cls(controller.T, c_h)
 
     @property
@@ -201,38 +215,92 @@ class HolonomicLoop(Characteristic):
         return np.array([1.0, self.c_h, 0.0])
 
     def loop_gain(self, kappa: float) -> float:
-        """K = κ, 1/s²."""
+        """K = κ, 1/s².
+
+        Parameters
+        ----------
+        kappa : float
+            Stiffness κ, 1/s².
+        """
         return kappa
 
     def gain_of(self, K: float) -> float:
-        """κ = K, 1/s²."""
+        """κ = K, 1/s².
+
+        Parameters
+        ----------
+        K : float
+            Loop gain K, 1/s².
+        """
         return K
 
     def check_gain(self, kappa) -> float:
-        """`check_kappa`."""
+        """`check_kappa`.
+
+        Parameters
+        ----------
+        kappa : float
+            Stiffness κ, 1/s².
+        """
         return check_kappa(kappa)
 
     def boundary_from(self, model: str, interval: StabilityInterval) -> HolonomicBoundary:
-        """`HolonomicBoundary` in κ (= K)."""
+        """`HolonomicBoundary` in κ (= K).
+
+        Parameters
+        ----------
+        model : str
+            The model's name (`parameters.MODEL_NAMES`).
+        interval : StabilityInterval
+            The stable loop gains K = κ, 1/s², with K* and ω*.
+        """
         return HolonomicBoundary(model, interval.gain, interval.frequency, tuple(interval.intervals))
 
     def with_delay(self, T: float) -> "HolonomicLoop":
-        """c_h with delay / period T, s."""
+        """c_h with delay / period T, s.
+
+        Parameters
+        ----------
+        T : float
+            Delay / sampling period, s, >= 0.
+        """
         return replace(self, T=T)
 
+    def _with_delay(self, T: float) -> "HolonomicLoop":
+        """`with_delay` unchecked (a probe of T in range, `Characteristic._with_delay`); T < `T_RESOLUTION` is 0."""
+        T = float(T)
+        return _unchecked(HolonomicLoop, T=T if T >= T_RESOLUTION else 0.0, c_h=self.c_h)
+
     def with_damping(self, damping: float) -> "HolonomicLoop":
-        """T with damping c_h = `damping`, 1/s."""
+        """T with damping c_h = `damping`, 1/s.
+
+        Parameters
+        ----------
+        damping : float
+            Damping c_h, 1/s.
+        """
         return replace(self, c_h=damping)
 
     def delay_search(self, kappa: float) -> tuple:
         """T* searched from 10⁻³ of the loop's time scale min(1/|c_h|, 1/√|κ|) to 1e-9 relative, however small T* is:
         a delay below `T_RESOLUTION` is T = 0, so T* >= 10⁻¹² s and the bracket's absolute floor, 10⁻⁹·10⁻¹² s,
-        never decides first."""
+        never decides first.
+
+        Parameters
+        ----------
+        kappa : float
+            Stiffness κ, 1/s².
+        """
         scale = min(1.0 / abs(self.c_h), 1.0 / math.sqrt(abs(kappa)))
         return scale * 1e-3, _DELAY_RTOL, _DELAY_RTOL * T_RESOLUTION
 
     def state_space(self, hold: str) -> tuple:
         """(A, B, F0, F1) of the double integrator, states (v, x), the acceleration held: v_k = −(c_h v_k + κ x_k).
+
+        Parameters
+        ----------
+        hold : str
+            What the computer holds between samples; only ``"command"`` (the acceleration) applies.
 
         Raises
         ------
@@ -258,7 +326,13 @@ class HolonomicLoop(Characteristic):
 
     def delay_damping_range(self, kappa: float) -> tuple:
         """Every interval of c_h (1/s) stable at κ in the exact delay loop: one interval whose ends solve ω² cos ωT = κ on
-        either side of the peak of ω² cos ωT, c_h = ω sin ωT there; ``()`` when κT² >= `BEST_CURVATURE_PRODUCT`."""
+        either side of the peak of ω² cos ωT, c_h = ω sin ωT there; ``()`` when κT² >= `BEST_CURVATURE_PRODUCT`.
+
+        Parameters
+        ----------
+        kappa : float
+            Stiffness κ, 1/s².
+        """
         if self.T == 0:
             return Continuous().damping_range(kappa, self)
         T = self.T
@@ -334,7 +408,13 @@ class HolonomicVerdict:
         return self.verdict == "stable"
 
     def to_dict(self, remedy: dict | None = None) -> dict:
-        """The fields as a JSON-ready dict (SI units) with `remedy` (``to_stabilize``); κ* and T* are stable below."""
+        """The fields as a JSON-ready dict (SI units) with `remedy` (``to_stabilize``); κ* and T* are stable below.
+
+        Parameters
+        ----------
+        remedy : dict, optional
+            What would stabilize the loop (the report's ``to_stabilize``); None: no remedy key's value.
+        """
         return {
             "stable": self.stable,
             "verdict": self.verdict,
@@ -356,6 +436,15 @@ def holonomic_verdict(model: LoopModel, kappa: float, loop: HolonomicLoop) -> Ho
     The margin and the verdict are the steering report's rules in κ (`models.interval_margin`,
     `models.interval_verdict`); κ < 0 (no restoring force) has margin −1 and, within 1e-9 of an
     edge of the stable set, the verdict is "undecided" with margin 0.
+
+    Parameters
+    ----------
+    model : LoopModel
+        The model judging the loop.
+    kappa : float
+        Stiffness κ, 1/s².
+    loop : HolonomicLoop
+        The holonomic loop (T, s; c_h, 1/s).
     """
     boundary = model.boundary(loop)
     stable = model.is_stable(kappa, loop)

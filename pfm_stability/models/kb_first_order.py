@@ -47,7 +47,13 @@ class KBFirstOrder(AffineGainModel):
     name = "kb_first_order"
 
     def polynomials(self, loop: Characteristic):
-        """D = a(s) + δs(1 − sT), E = 1 − sT (descending powers of s): τs³ + (1 − kcT)s² + k(1 + c)s (c = 0: KB eq 19)."""
+        """D = a(s) + δs(1 − sT), E = 1 − sT (descending powers of s): τs³ + (1 − kcT)s² + k(1 + c)s (c = 0: KB eq 19).
+
+        Parameters
+        ----------
+        loop : Characteristic
+            The loop judged (`Loop`, `HolonomicLoop`).
+        """
         T = loop.delay  # T + D (docs/models.md, "Plant gain and dead time")
         if loop.damping == 0.0:
             return loop.plant, np.array([-T, 1.0])
@@ -56,7 +62,13 @@ class KBFirstOrder(AffineGainModel):
         return D, np.array([-T, 1.0])
 
     def parts(self, loop: Characteristic):
-        """(a(s), s(1 − sT), 1 − sT)."""
+        """(a(s), s(1 − sT), 1 − sT).
+
+        Parameters
+        ----------
+        loop : Characteristic
+            The loop judged (`Loop`, `HolonomicLoop`).
+        """
         return _aligned(loop.plant, [-loop.delay, 1.0, 0.0], [-loop.delay, 1.0])
 
     @checked
@@ -71,6 +83,13 @@ class KBFirstOrder(AffineGainModel):
         (`LoopModel.critical_delay`). With a dead time D these are the margins of
         the delay T + D, and T* is that less D (`Characteristic.period_margin`);
         k is the loop's g·k (`Loop.steering_gain`).
+
+        Parameters
+        ----------
+        NV : float
+            Loop gain N·V, 1/s.
+        loop : Characteristic
+            The loop judged; its own T, s, is replaced by T*.
         """
         if loop.family is not STEERING:
             return LoopModel.critical_delay(self, NV, loop)

@@ -85,12 +85,24 @@ class Pade(AffineGainModel):
         self.order = check_integer("pade_order", order, 1, MAX_PADE_ORDER)
 
     def polynomials(self, loop: Characteristic):
-        """D = a(s)·Q_m + δ·s·P_m, E = P_m (descending powers of s; Q_m(0) = P_m(0) = 1)."""
+        """D = a(s)·Q_m + δ·s·P_m, E = P_m (descending powers of s; Q_m(0) = P_m(0) = 1).
+
+        Parameters
+        ----------
+        loop : Characteristic
+            The loop judged (`Loop`, `HolonomicLoop`).
+        """
         D, E = self.batch_polynomials([loop])
         return np.trim_zeros(D[0], "f"), np.trim_zeros(E[0], "f")
 
     def parts(self, loop: Characteristic):
-        """(a(s)·Q_m, s·P_m, P_m), one length."""
+        """(a(s)·Q_m, s·P_m, P_m), one length.
+
+        Parameters
+        ----------
+        loop : Characteristic
+            The loop judged (`Loop`, `HolonomicLoop`).
+        """
         aQ, sP, P = self._rows([loop])
         return aQ[0], sP[0], P[0]
 
@@ -114,7 +126,13 @@ class Pade(AffineGainModel):
         return aQ, sP, P
 
     def batch_polynomials(self, loops):
-        """`polynomials` of many loops at once: rows of D = a(s)·Q_m + δ·s·P_m and E = P_m."""
+        """`polynomials` of many loops at once: rows of D = a(s)·Q_m + δ·s·P_m and E = P_m.
+
+        Parameters
+        ----------
+        loops : sequence of Characteristic
+            The loops, one row each.
+        """
         D, sP, E = self._rows(loops)
         damping = np.array([loop.damping for loop in loops])
         rows = np.flatnonzero(damping)

@@ -96,7 +96,7 @@ from ..checks import check_choice, check_integer
 from ..numerics.matrix_exponential import zoh_blocks
 from ..parameters import HOLDS, RANGES, dead_time_split
 from ..numerics.routh import schur_cohn_stable
-from .base import AffineGainModel, _check_NV, checked
+from .base import AffineGainModel, checked
 from .continuous import Continuous
 from .family import Characteristic
 
@@ -122,11 +122,11 @@ def continuous_plant(loop: Characteristic, hold: str):
     -------
     A, B, F0, F1 : ndarray
     """
-    check_choice("hold", hold, HOLDS)
+    hold = check_choice("hold", hold, HOLDS)
     if loop.dead_time > 0 and hold == "reference":
         raise ValueError(f"dead_time must be 0 with hold=reference (a dead time inside the continuous steering servo is a delay "
                          f"differential equation, which the sampled model does not solve; docs/models.md); got {loop.dead_time}")
-    return loop.state_space(hold)
+    return loop._state_space(hold)
 
 
 def discretize(A, B, T: float):
@@ -346,7 +346,13 @@ class Sampled(AffineGainModel):
         return np.polyadd(lead, _rank_one(Psi, G, F0)), np.trim_zeros(e, "f") if np.any(e) else np.zeros(1)
 
     def bilinear_polynomials(self, loop: Characteristic):
-        """(D, E) in μ (z = (1 + Tμ/2)/(1 − Tμ/2)): stable ⇔ D + K·E is Hurwitz, descending, one length."""
+        """(D, E) in μ (z = (1 + Tμ/2)/(1 − Tμ/2)): stable ⇔ D + K·E is Hurwitz, descending, one length.
+
+        Parameters
+        ----------
+        loop : Characteristic
+            The loop judged (`Loop`, `HolonomicLoop`); T > 0, s.
+        """
         d, e = self.delta_polynomials(loop)
         degree = len(np.trim_zeros(d, "f")) - 1
         return bilinear_polynomial(d, degree, loop.T), bilinear_polynomial(e, degree, loop.T)
@@ -355,6 +361,11 @@ class Sampled(AffineGainModel):
         """(P0, P1, P2) in μ: the characteristic polynomial P0 + δ·P1 + K·P2 (Tustin's map of the δ form; T = 0: `continuous`'s).
 
         P1 is the rank-one term of the unit damping row (the family's F0 at δ = 1 less at δ = 0).
+
+        Parameters
+        ----------
+        loop : Characteristic
+            The loop judged (`Loop`, `HolonomicLoop`).
         """
         if loop.T == 0:
             return Continuous().parts(loop)
@@ -382,7 +393,13 @@ class Sampled(AffineGainModel):
     # --------------------------------------------------------------- queries
     def stable_gains(self, loop: Characteristic):
         """Every stable loop gain K: the crossings of the bilinear polynomials, each stretch decided by the eigenvalues
-        (T = 0: the continuous loop, KB eq 17 for the steering robot, exactly)."""
+        (T = 0: the continuous loop, KB eq 17 for the steering robot, exactly).
+
+        Parameters
+        ----------
+        loop : Characteristic
+            The loop judged (`Loop`, `HolonomicLoop`).
+        """
         if loop.T == 0:
             return loop.delay_interval() if loop.dead_time > 0 else Continuous().stable_gains(loop)
         d, e = self.bilinear_polynomials(loop)
@@ -396,11 +413,6 @@ class Sampled(AffineGainModel):
         """A pole passing through z = −1 when Q's degree drops: ω = π/T."""
         return math.pi / loop.T
 
-    @checked
-    def delta_eigenvalues(self, gain: float, loop: Characteristic) -> np.ndarray:
-        """Eigenvalues λ of (Φ_cl − I)/T (poles z = 1 + Tλ; T = 0: the continuous poles)."""
-        return self._delta_eigenvalues(gain, loop)
-
     def _delta_eigenvalues(self, gain: float, loop: Characteristic) -> np.ndarray:
         return np.linalg.eigvals(_delta_matrix(loop, loop.loop_gain(gain), self.hold, self.compute_delay))
 
@@ -413,19 +425,30 @@ class Sampled(AffineGainModel):
         return np.linalg.eigvals(np.delete(np.delete(matrix, y, axis=0), y, axis=1))
 
     @checked
-    def closed_loop(self, gain: float, loop: Characteristic) -> np.ndarray:
-        """Φ_cl at the gain (NV 1/s, κ 1/s²)."""
-        return closed_loop_matrix(loop, loop.loop_gain(_check_NV(gain)), self.hold, self.compute_delay)
-
-    @checked
     def eigenvalues(self, gain: float, loop: Characteristic) -> np.ndarray:
-        """Closed-loop poles z (T > 0), as 1 + Tλ."""
+        """Closed-loop poles z (T > 0), as 1 + Tλ.
+
+        Parameters
+        ----------
+        gain : float
+            The family's loop gain: NV (1/s) or κ (1/s²).
+        loop : Characteristic
+            The loop judged (`Loop`, `HolonomicLoop`).
+        """
         return 1.0 + loop.T * self._delta_eigenvalues(gain, loop)
 
     @checked
     def is_stable(self, gain: float, loop: Characteristic) -> bool:
         """Every pole strictly inside the unit circle: 2 Re λ + T|λ|² < 0 (T = 0: the continuous loop by Routh;
-        NV = 0: every pole but the neutral z = 1, `_judged_eigenvalues`)."""
+        NV = 0: every pole but the neutral z = 1, `_judged_eigenvalues`).
+
+        Parameters
+        ----------
+        gain : float
+            The family's loop gain: NV (1/s) or κ (1/s²).
+        loop : Characteristic
+            The loop judged (`Loop`, `HolonomicLoop`).
+        """
         return self._stable(gain, loop)
 
     def _stable(self, gain: float, loop: Characteristic) -> bool:
@@ -437,14 +460,30 @@ class Sampled(AffineGainModel):
 
     @checked
     def jury_stable(self, gain: float, loop: Characteristic) -> bool:
-        """Schur–Cohn (Jury) verdict on det(zI − Φ_cl), independent of the eigenvalues (T = 0: the continuous loop's)."""
+        """Schur–Cohn (Jury) verdict on det(zI − Φ_cl), independent of the eigenvalues (T = 0: the continuous loop's).
+
+        Parameters
+        ----------
+        gain : float
+            The family's loop gain: NV (1/s) or κ (1/s²).
+        loop : Characteristic
+            The loop judged (`Loop`, `HolonomicLoop`).
+        """
         if loop.T == 0:
             return self._stable(gain, loop)
         return schur_cohn_stable(self.characteristic(gain, loop))
 
     @checked
     def rightmost_root(self, gain: float, loop: Characteristic) -> complex:
-        """Dominant pole as s = ln(z)/T: σ = ln|z|/T (1/s), ω = arg(z)/T in [0, π/T] (rad/s); NV = 0: the heading loop's."""
+        """Dominant pole as s = ln(z)/T: σ = ln|z|/T (1/s), ω = arg(z)/T in [0, π/T] (rad/s); NV = 0: the heading loop's.
+
+        Parameters
+        ----------
+        gain : float
+            The family's loop gain: NV (1/s) or κ (1/s²).
+        loop : Characteristic
+            The loop judged (`Loop`, `HolonomicLoop`).
+        """
         if loop.T == 0:
             return _limit(loop).rightmost_root(gain, loop)
         lam = self._judged_eigenvalues(gain, loop)
@@ -456,7 +495,15 @@ class Sampled(AffineGainModel):
 
     @checked
     def roots(self, gain: float, loop: Characteristic) -> np.ndarray:
-        """All closed-loop poles z (T > 0); the continuous roots s at T = 0."""
+        """All closed-loop poles z (T > 0); the continuous roots s at T = 0.
+
+        Parameters
+        ----------
+        gain : float
+            The family's loop gain: NV (1/s) or κ (1/s²).
+        loop : Characteristic
+            The loop judged (`Loop`, `HolonomicLoop`).
+        """
         return self._delta_eigenvalues(gain, loop) if loop.T == 0 else 1.0 + loop.T * self._delta_eigenvalues(gain, loop)
 
     def _searched_growth_rates(self, gain: float, loops) -> np.ndarray:
@@ -470,7 +517,7 @@ class Sampled(AffineGainModel):
         """
         loops = list(loops)
         if not any(loop.dead_time > 0 for loop in loops):
-            return self.growth_rates(gain, loops)
+            return self._growth_rates(gain, loops)
         return np.array([self._searched_growth(gain, loop) for loop in loops])
 
     def _searched_growth(self, gain: float, loop: Characteristic) -> float:
@@ -479,7 +526,7 @@ class Sampled(AffineGainModel):
         if loop.T > 0:
             m, eps = dead_time_split(loop.T, self.compute_delay, loop.dead_time)
             if m + (eps > 0) <= MAX_DELAY_STATES:
-                return float(self.growth_rates(gain, [loop])[0])
+                return float(self._growth_rates(gain, [loop])[0])
         from .exact_delay import ExactDelay
 
         exact = ExactDelay()
@@ -487,11 +534,10 @@ class Sampled(AffineGainModel):
         root = exact.rightmost_root(gain, near)
         return root.real if root is not None else (-1.0 if exact._stable(gain, near) else 1.0)
 
-    def growth_rates(self, NV: float, loops) -> np.ndarray:
+    def _growth_rates(self, NV: float, loops) -> np.ndarray:
         """σ = max ln|z|/T (1/s) at the gain for each loop, all exponentials and eigenvalues in one batch
         (loops with a dead time one by one, `rightmost_root`)."""
         loops = list(loops)
-        NV = _check_NV(NV)
         late = [i for i, loop in enumerate(loops) if loop.dead_time > 0]
         if late:
             sigma = np.empty(len(loops))
@@ -500,11 +546,11 @@ class Sampled(AffineGainModel):
                 sigma[i] = root.real if root is not None else math.nan
             rest = [i for i in range(len(loops)) if i not in set(late)]
             if rest:
-                sigma[rest] = self.growth_rates(NV, [loops[i] for i in rest])
+                sigma[rest] = self._growth_rates(NV, [loops[i] for i in rest])
             return sigma
         K = np.array([loop.loop_gain(NV) for loop in loops])
         T = np.array([loop.T for loop in loops])
-        plants = [continuous_plant(loop, self.hold) for loop in loops]
+        plants = [loop._state_space(self.hold) for loop in loops]
         A, B, F0, F1 = (np.stack([p[i] for p in plants]) for i in range(4))
         n = A.shape[-1]
         Psi, G = A.copy(), B.copy()

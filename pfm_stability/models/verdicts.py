@@ -119,6 +119,11 @@ def divergent_reason(NV: float) -> str | None:
     further right, in a loop unstable at every NV anyway), `gain_margin` is
     −1 and `verdict_label` "unstable". A verdict can show this string as the
     reason (docs/models.md, "N < 0").
+
+    Parameters
+    ----------
+    NV : float
+        Loop gain N·V, 1/s.
     """
     return DIVERGENT_REASON if NV < 0 else None
 
@@ -132,7 +137,21 @@ def _edges(stable_set, critical: float):
 
 
 def interval_verdict(gain: float, stable_set, critical: float, stable: bool, rtol: float = UNDECIDED_RTOL) -> str:
-    """"stable", "unstable" or "undecided" (within `rtol` of an edge of `stable_set`) for any loop gain (NV, κ)."""
+    """"stable", "unstable" or "undecided" (within `rtol` of an edge of `stable_set`) for any loop gain (NV, κ).
+
+    Parameters
+    ----------
+    gain : float
+        The loop gain: NV (1/s) or κ (1/s²).
+    stable_set : sequence of (float, float)
+        Stable intervals of the gain, ascending; empty: only `critical` is an edge.
+    critical : float
+        The critical gain (NV* or κ*).
+    stable : bool
+        The model's own verdict at the gain.
+    rtol : float, optional
+        Relative distance to an edge reported as "undecided"; default `UNDECIDED_RTOL`.
+    """
     if any(abs(gain / edge - 1.0) <= rtol for edge in _edges(stable_set, critical)):
         return "undecided"
     return "stable" if stable else "unstable"
@@ -149,6 +168,17 @@ def interval_margin(gain: float, stable_set, critical: float, stable: bool) -> f
 
     Gain 0 (N = 0, `neutral_reason`): ``inf`` when stable, −1 when not — the
     limits of critical/gain − 1 as the gain → 0+ (no gain below 0 exists).
+
+    Parameters
+    ----------
+    gain : float
+        The loop gain: NV (1/s) or κ (1/s²).
+    stable_set : sequence of (float, float)
+        Stable intervals of the gain, ascending; empty: (0, `critical`) is assumed.
+    critical : float
+        The critical gain (NV* or κ*).
+    stable : bool
+        The model's own verdict at the gain.
     """
     if gain == 0:
         return math.inf if stable else -1.0
@@ -163,24 +193,62 @@ def interval_margin(gain: float, stable_set, critical: float, stable: bool) -> f
 
 
 def verdict_label(NV: float, boundary: Boundary, stable: bool, rtol: float = UNDECIDED_RTOL) -> str:
-    """"stable", "unstable" or "undecided" (within `rtol` of an edge of the stable set): `interval_verdict` in NV."""
+    """"stable", "unstable" or "undecided" (within `rtol` of an edge of the stable set): `interval_verdict` in NV.
+
+    Parameters
+    ----------
+    NV : float
+        Loop gain N·V, 1/s.
+    boundary : Boundary
+        The model's boundary for the loop (`LoopModel.boundary`).
+    stable : bool
+        The model's own verdict at NV.
+    rtol : float, optional
+        Relative distance to an edge reported as "undecided"; default `UNDECIDED_RTOL`.
+    """
     return interval_verdict(NV, boundary.stable_set, boundary.NV_critical, stable, rtol)
 
 
 def gain_margin(NV: float, boundary: Boundary, stable: bool) -> float:
-    """NV_edge/NV − 1 (`interval_margin` in NV): with the usual stable set (0, NV*), NV*/NV − 1."""
+    """NV_edge/NV − 1 (`interval_margin` in NV): with the usual stable set (0, NV*), NV*/NV − 1.
+
+    Parameters
+    ----------
+    NV : float
+        Loop gain N·V, 1/s.
+    boundary : Boundary
+        The model's boundary for the loop (`LoopModel.boundary`).
+    stable : bool
+        The model's own verdict at NV.
+    """
     return interval_margin(NV, boundary.stable_set, boundary.NV_critical, stable)
 
 
 def beyond_reason(NV: float, where: str | None = None) -> str:
-    """Why a loop gain beyond `NV_MAX` (or not finite) gets no verdict; `where` names the geometry (the report's message)."""
+    """Why a loop gain beyond `NV_MAX` (or not finite) gets no verdict; `where` names the geometry (the report's message).
+
+    Parameters
+    ----------
+    NV : float
+        Loop gain N·V, 1/s.
+    where : str, optional
+        The geometry the gain belongs to (e.g. "wall"); None: not named.
+    """
     at = f" at the {where}" if where else ""
     return (f"N*V = {NV:g} 1/s{at} exceeds what the loop models represent (<= {NV_MAX:g} 1/s); "
             f"choose a less extreme force law (f, n), angle or width")
 
 
 def check_loop_gain(NV: float, where: str) -> float:
-    """NV after checking it is finite and |NV| <= `NV_MAX`; otherwise ValueError (`beyond_reason`, naming the geometry)."""
+    """NV after checking it is finite and |NV| <= `NV_MAX`; otherwise ValueError (`beyond_reason`, naming the geometry).
+
+    Parameters
+    ----------
+    NV : float
+        Loop gain N·V, 1/s.
+    where : str
+        The geometry the gain belongs to, named in the error.
+    """
     if not (math.isfinite(NV) and abs(NV) <= NV_MAX):
         raise ValueError(beyond_reason(NV, where))
     return NV
@@ -188,7 +256,17 @@ def check_loop_gain(NV: float, where: str) -> float:
 
 def critical_speed(N: float, NV_critical: float, stable: bool) -> float:
     """V* = NV*/N, m/s, for a gain N (1/m): 0 when N < 0 (no speed helps); at N = 0 ``inf`` when the heading loop
-    is `stable` and 0 when not (NV = 0 at every speed)."""
+    is `stable` and 0 when not (NV = 0 at every speed).
+
+    Parameters
+    ----------
+    N : float
+        Environment gain, 1/m.
+    NV_critical : float
+        Critical loop gain NV*, 1/s.
+    stable : bool
+        The model's verdict (used at N = 0: the heading loop's).
+    """
     if N > 0:
         return NV_critical / N
     return math.inf if N == 0 and stable else 0.0
@@ -212,7 +290,15 @@ def in_stable_set(stable_set, NV) -> np.ndarray:
 
 
 def inside(boundary, NV: float) -> bool:
-    """NV strictly inside the boundary's stable set, or in (0, NV*) when the boundary has no set."""
+    """NV strictly inside the boundary's stable set, or in (0, NV*) when the boundary has no set.
+
+    Parameters
+    ----------
+    boundary : Boundary
+        The model's boundary for the loop (`LoopModel.boundary`).
+    NV : float
+        Loop gain N·V, 1/s.
+    """
     if boundary.stable_set:
         return boundary.contains(NV)
     return 0 < NV < boundary.NV_critical

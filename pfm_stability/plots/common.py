@@ -36,18 +36,36 @@ def _with_options(model, formats: dict) -> str:
 
 
 def model_label(model) -> str:
-    """Legend text: the model name plus its options (`LoopModel.options`): ``sampled (command, cd=1)``, ``pade (m=3)``."""
+    """Legend text: the model name plus its options (`LoopModel.options`): ``sampled (command, cd=1)``, ``pade (m=3)``.
+
+    Parameters
+    ----------
+    model : LoopModel
+        The model.
+    """
     return _with_options(model, {"order": "m={order}", "hold": "{hold}, cd={compute_delay}"})
 
 
 def model_description(model) -> str:
-    """Longer text for titles and captions: ``sampled (command hold, compute delay 1)``, ``pade (order 3)``."""
+    """Longer text for titles and captions: ``sampled (command hold, compute delay 1)``, ``pade (order 3)``.
+
+    Parameters
+    ----------
+    model : LoopModel
+        The model.
+    """
     return _with_options(model, {"order": "order {order}", "hold": "{hold} hold, compute delay {compute_delay}"})
 
 
 def model_style(model) -> dict:
     """Line style of `model`: `MODEL_STYLE`, the four sampled structures told
-    apart (command solid, reference dashed; compute delay 1 thinner)."""
+    apart (command solid, reference dashed; compute delay 1 thinner).
+
+    Parameters
+    ----------
+    model : LoopModel
+        The model.
+    """
     style = dict(MODEL_STYLE[model.name])
     options = model.options()
     if "hold" in options:
@@ -58,7 +76,15 @@ def model_style(model) -> dict:
 
 
 def figure_and_axes(ax=None, size=(6.0, 4.5)):
-    """(figure, axes): the given axes' figure, or a new constrained-layout figure."""
+    """(figure, axes): the given axes' figure, or a new constrained-layout figure.
+
+    Parameters
+    ----------
+    ax : matplotlib Axes, optional
+        Axes to draw on; None: a new figure.
+    size : (float, float), optional
+        Size of a new figure, inches.
+    """
     import matplotlib.pyplot as plt
 
     if ax is not None:

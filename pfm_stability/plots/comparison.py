@@ -92,6 +92,8 @@ def plot_kb_error_map(error_map, ax=None, *, mark: tuple[float, float] | None = 
     ax : matplotlib Axes, optional
     mark : (k_tau, T_over_tau), optional
         A robot to mark, with its exact relative error.
+    mark_label : str, optional
+        Who is marked.
     colorbar : bool
 
     Returns
@@ -153,6 +155,17 @@ def _colorbar(fig, mesh, ax):
 
 def plot_kb_error_maps(maps, *, mark: tuple[float, float] | None = None, mark_label: str = "CARMEL", ncols: int = 3):
     """One `plot_kb_error_map` per reference model, one colour bar; hatched: the model is never stable.
+
+    Parameters
+    ----------
+    maps : sequence of KBErrorMap
+        One map per reference model (`comparison.kb_error_maps`).
+    mark : (float, float), optional
+        An operating point (kτ, T/τ) to mark.
+    mark_label : str, optional
+        Who is marked.
+    ncols : int, optional
+        Panels per row.
 
     Returns
     -------

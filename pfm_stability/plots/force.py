@@ -77,6 +77,15 @@ def plot_force_laws(law: GridWallLaw, lumped: PowerLaw | None = None, ax=None, d
 def plot_equivalent_f(law: GridWallLaw, ax=None, d=None):
     """KB's equivalent f(d) = F_r(d)(d/W)^n of the grid wall, its f_av, and the local exponent.
 
+    Parameters
+    ----------
+    law : GridWallLaw
+        The grid wall.
+    ax : matplotlib Axes, optional
+        Axes to draw on; None: a new figure.
+    d : array_like, optional
+        Distances, m (default 400 from about W/2 to 1.25 times the window's reach; those beyond the reach are dropped).
+
     Returns
     -------
     matplotlib.figure.Figure
@@ -104,7 +113,15 @@ def plot_equivalent_f(law: GridWallLaw, ax=None, d=None):
 
 
 def plot_force_summary(law: GridWallLaw, lumped: PowerLaw | None = None):
-    """Both panels side by side; returns the figure."""
+    """Both panels side by side; returns the figure.
+
+    Parameters
+    ----------
+    law : GridWallLaw
+        The grid wall.
+    lumped : PowerLaw, optional
+        KB's law; default f = the grid's f_av (KB §4), as `plot_force_laws`.
+    """
     import matplotlib.pyplot as plt
 
     fig, (a, b) = plt.subplots(1, 2, figsize=(11, 4.3), layout="constrained")

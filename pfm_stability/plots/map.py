@@ -34,7 +34,13 @@ def _no_verdict_kind(verdict: str) -> str:
 
 
 def map_greys(occupancy) -> np.ndarray:
-    """RGB image (height, width, 3) of a map, row 0 at the top: free white, unknown light grey, occupied dark."""
+    """RGB image (height, width, 3) of a map, row 0 at the top: free white, unknown light grey, occupied dark.
+
+    Parameters
+    ----------
+    occupancy : OccupancyMap
+        The map.
+    """
     grey = np.full(occupancy.values.shape, UNKNOWN_GREY)
     grey[occupancy.free] = FREE_GREY
     grey[occupancy.occupied] = OCCUPIED_GREY
@@ -46,6 +52,13 @@ def known_extent(occupancy, margin: float = 1.0) -> tuple:
 
     A map recorded in a large unknown frame (tb3_sandbox: a 5 m room in a 19 m image) is
     drawn around what is known; the whole map when nothing is known.
+
+    Parameters
+    ----------
+    occupancy : OccupancyMap
+        The map.
+    margin : float, optional
+        Margin around the known cells, m.
     """
     x0, x1, y0, y1 = occupancy.extent
     known = occupancy.free | occupancy.occupied

@@ -25,7 +25,15 @@ def _fraction_colormap():
 
 
 def plot_sweep_summary(data, ax=None):
-    """Draw `data` (a `SweepFigureData`) and return the figure."""
+    """Draw `data` (a `SweepFigureData`) and return the figure.
+
+    Parameters
+    ----------
+    data : SweepFigureData
+        The figure's data.
+    ax : matplotlib Axes, optional
+        Axes to draw on; None: a new figure.
+    """
     if data.kind == "agreement":
         return _agreement(data, ax)
     return _map(data, ax)

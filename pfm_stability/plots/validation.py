@@ -105,6 +105,13 @@ def plot_growth_rate(validation, ax=None):
     σ = 0 at the bisected boundary (★). Vertical lines: each model's
     prediction with the run's own law (the model styles of `plots.common`).
 
+    Parameters
+    ----------
+    validation : Validation
+        The simulated boundary and every model's.
+    ax : matplotlib Axes, optional
+        Axes to draw on; None: a new figure.
+
     Returns
     -------
     matplotlib.figure.Figure
@@ -143,6 +150,11 @@ def plot_growth_rate(validation, ax=None):
 
 def plot_validation(validation):
     """Two panels: `plot_boundary_overlay` (when a map exists) and `plot_growth_rate`.
+
+    Parameters
+    ----------
+    validation : Validation
+        The simulated boundary and every model's.
 
     Returns
     -------
@@ -285,11 +297,13 @@ def plot_simulated_boundary(sim, ax=None, *, label: str | None = None, color="k"
     ax : matplotlib Axes, optional
     label : str, optional
         Legend label of the points.
-    color, marker, **style
+    color, marker
         Style of the points.
     curves : bool
         Also draw the model curves the result carries (``sim.curves``; KB's
         lumped law dotted in the grid), for a figure without region plots.
+    **style
+        More matplotlib style of the points.
 
     Returns
     -------

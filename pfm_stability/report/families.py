@@ -34,7 +34,8 @@ from ..analysis.criteria import CorridorAnalysis, ModelVerdict, WallAnalysis, Wa
 from ..laws.fields import KhatibLaw
 from ..models import HEADING_GAIN_RANGE, Loop
 from ..models.holonomic import HolonomicLoop, holonomic_verdict
-from ..laws.registry import FAMILY_CHOICE_DEFAULTS, FAMILY_DEFAULTS, FAMILY_LAW_CHOICES, FAMILY_LAW_PARAMETERS, FAMILY_LAWS
+from ..laws.registry import (FAMILY_CHOICE_DEFAULTS, FAMILY_DEFAULTS, FAMILY_LAW_CHOICES, FAMILY_LAW_PARAMETERS, FAMILY_LAWS,
+                             check_parameters)
 from ..parameters import check_parameter
 from ..io.serialize import json_number
 from ..laws.velocity_laws import VelocityAttraction, VelocityGatedRepulsion
@@ -89,7 +90,13 @@ class FamilyLaw:
     choices: dict = field(default_factory=dict)
 
     def choice(self, key: str) -> str:
-        """The value of the choice `key` (`parameters.FAMILY_CHOICE_DEFAULTS` when not given)."""
+        """The value of the choice `key` (`parameters.FAMILY_CHOICE_DEFAULTS` when not given).
+
+        Parameters
+        ----------
+        key : str
+            A choice of `parameters.FAMILY_CHOICE_DEFAULTS`.
+        """
         return self.choices.get(key, FAMILY_CHOICE_DEFAULTS[key])
 
     @property
@@ -153,6 +160,15 @@ def make_family_law(name: str, choices: dict | None = None, **parameters) -> Fam
     `choices` (`parameters.FAMILY_LAW_CHOICES`, e.g. ``{"side": "right"}``) go over
     `parameters.FAMILY_CHOICE_DEFAULTS`; a choice may also be a keyword (``symmetrize="negative"``).
 
+    Parameters
+    ----------
+    name : str
+        A law of `FAMILY_LAWS`.
+    choices : dict, optional
+        Choice → value (e.g. ``{"side": "right"}``).
+    **parameters
+        The law's parameters (over `FAMILY_DEFAULTS`), or choices as keywords.
+
     Raises
     ------
     ValueError
@@ -163,18 +179,11 @@ def make_family_law(name: str, choices: dict | None = None, **parameters) -> Fam
     allowed = FAMILY_LAW_CHOICES[name]
     named = {k: v for k, v in parameters.items() if k in FAMILY_CHOICE_DEFAULTS and v is not None}
     picked = {**{k: v for k, v in (choices or {}).items() if v is not None}, **named}
+    given = {k: v for k, v in parameters.items() if v is not None and k not in FAMILY_CHOICE_DEFAULTS}
+    check_parameters(name, [*picked, *given], law_shown=f"law {name}", laws=FAMILY_LAWS, required=False)  # `refusal`
     for key, value in picked.items():
-        if key not in allowed:
-            takers = [law for law in FAMILY_LAWS if key in FAMILY_LAW_CHOICES[law]]
-            if not takers:
-                raise ValueError(f"{key} is not a choice of law {name} (it takes {', '.join(allowed) or 'none'})")
-            raise ValueError(f"{key} applies to law {' or '.join(takers)}, not to law {name}")
         check_choice(key, value, allowed[key])
     taken = FAMILY_LAW_PARAMETERS[name]
-    given = {k: v for k, v in parameters.items() if v is not None and k not in FAMILY_CHOICE_DEFAULTS}
-    for key in given:
-        if key not in taken:
-            raise ValueError(f"{key} is not a parameter of law {name} (it takes {', '.join(taken)})")
     values = {key: check_parameter(key, given.get(key, FAMILY_DEFAULTS[key])) for key in taken}
     return FamilyLaw(name, values, {key: picked.get(key, FAMILY_CHOICE_DEFAULTS[key]) for key in allowed})
 
@@ -227,7 +236,13 @@ class HolonomicScene:
 
     def to_dicts(self, report) -> tuple:
         """(environment entry, top-level verdicts) as the report's JSON holds them, each verdict with its remedy
-        (`report.remedies`: (geometry, model), and (geometry, i, model) for each wall equilibrium)."""
+        (`report.remedies`: (geometry, model), and (geometry, i, model) for each wall equilibrium).
+
+        Parameters
+        ----------
+        report : StabilityReport
+            The report holding this geometry (its remedies).
+        """
         geometry, fixes = self.geometry, report.remedies
         first = self.equilibria[self.main]
         key, where = ("alpha_deg", "d0") if geometry == "wall" else ("L", "x0")
@@ -269,7 +284,13 @@ class NonSmoothScene:
         return ()
 
     def to_dicts(self, report) -> tuple:
-        """(environment entry, None): the verdict, the band (a wall's) or the friction levels (a corridor's), the cycle."""
+        """(environment entry, None): the verdict, the band (a wall's) or the friction levels (a corridor's), the cycle.
+
+        Parameters
+        ----------
+        report : StabilityReport
+            The report holding this geometry (unused: no remedies).
+        """
         key = "alpha_deg" if self.geometry == "wall" else "L"
         env = {key: self.value, "N": None, "NV": None, "verdict": "non-smooth"}
         r = self.result

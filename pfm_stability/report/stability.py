@@ -40,14 +40,15 @@ from ..io.serialize import SCHEMA_VERSION, json_number, json_ready
 from ..laws.force_law import ForceLaw, PowerLaw, law_in_force
 from ..models import HEADING_GAIN_RANGE, STEERING, KBFirstOrder, Loop, LoopFamily, Sampled, make_models, models_for
 from ..models.family import root_json
-from ..laws.registry import FAMILY_CHOICE_DEFAULTS, FAMILY_DEFAULTS, HOLONOMIC_LAWS, LAW_PARAMETERS
+from ..laws.registry import FAMILY_CHOICE_DEFAULTS, FAMILY_DEFAULTS, FORCE_LAWS, HOLONOMIC_LAWS, LAW_PARAMETERS, parameter_keys
 from ..parameters import MODEL_NAMES, RANGES, ROBOT_FAMILIES, Controller, Corridor, Robot, Wall, check_parameter
 
 __all__ = ["StabilityReport", "KBError", "LawDescription", "build_report", "remedies", "kb_error", "kb_errors", "KINEMATIC_TAU_SOURCE",
            "PLANT_INPUTS", "plant_inputs"]
 
-LAW_INPUTS = ("cell_ratio", "cell_size", "window_cells", "xi", "eta", "rho0", "attraction_exponent", "goal_exponent", "goal_distance", "delta")
-"""The law's own parameters, listed after W when the law takes them (`parameters.LAW_PARAMETERS`)."""
+LAW_INPUTS = parameter_keys(FORCE_LAWS)
+"""The static laws' own parameters, listed after W when the law takes them (`laws.registry.parameter_keys`: in
+`laws.registry.PARAMETERS` order)."""
 
 PLANT_INPUTS = ("dead_time", "plant_gain")
 """The steering plant's dead time D and gain g (`parameters.Robot`), listed after k only when given: a value other than
@@ -440,7 +441,7 @@ def _static_report(robot, controller, law, alpha, alpha_deg, L, models, pade_ord
                                robot_width=robot.W, find_smallest=True, name="door")
     return StabilityReport(inputs, model_objs, STEERING, wall_result, corridor_result, _remedies(wall_result, corridor_result, fix),
                            LawDescription(law.key, law.name, json_ready(law.parameters())), passage,
-                           kb_errors(robot, controller, wall_result, corridor_result))
+                           kb_errors(robot, controller, wall_result, corridor_result, model_objs))
 
 
 def _law_inputs(values: dict, law: ForceLaw) -> dict:
@@ -504,7 +505,7 @@ def _family_law_report(robot, controller, family, law, alpha, alpha_deg, L, mode
         return {k: v for k, v in remedies(geometry, verdict, robot, controller, static).items() if k in ("V", "T", "k")}
 
     return StabilityReport(inputs, model_objs, STEERING, wall_result, corridor_result, _remedies(wall_result, corridor_result, fix),
-                           LawDescription(**law.described()), None, kb_errors(robot, controller, wall_result, corridor_result), schedule)
+                           LawDescription(**law.described()), None, kb_errors(robot, controller, wall_result, corridor_result, model_objs), schedule)
 
 
 def plant_inputs(robot: Robot, sources: dict | None) -> dict:
@@ -671,25 +672,57 @@ def _towards(target: float, now: float | None, law: ForceLaw) -> str | None:
 
 
 # ------------------------------------------------------------------ KB's error
-def kb_error(robot: Robot, controller: Controller, c: float = 0.0, where: tuple = ()) -> KBError:
+def kb_error(robot: Robot, controller: Controller, c: float = 0.0, where: tuple = (), models: tuple = ()) -> KBError:
     """KB's eq (20) against the `sampled` loop with the controller's structure, for the loop with heading gain `c`.
 
     With c ≠ 0 (a velocity or fuzzy law) KB's criterion is `kb_first_order`'s
     with the heading gain, so both sides are the NV* the report's table prints
     for that loop; `where` names the geometries whose loop it is.
+
+    Parameters
+    ----------
+    robot : Robot
+        τ (s) and k (1/s).
+    controller : Controller
+        T (s) and the sampled structure (hold, compute_delay).
+    c : float, optional
+        Heading gain of the loop, dimensionless (0: KB's loop).
+    where : tuple of str, optional
+        The geometries whose loop it is.
+    models : tuple of LoopModel, optional
+        The report's models: its ``kb_first_order`` and its ``sampled`` of the controller's structure are used
+        (their boundaries are the ones the report computed) instead of new ones.
     """
     loop = Loop.of(robot, controller, c=c)
-    kb = KBFirstOrder().boundary(loop).NV_critical
-    sampled = Sampled(controller.hold, controller.compute_delay).boundary(loop).NV_critical
+    structure = {"hold": controller.hold, "compute_delay": controller.compute_delay}
+    kb_model = next((m for m in models if m.name == "kb_first_order"), None) or KBFirstOrder()
+    sampled_model = (next((m for m in models if m.name == "sampled" and m.options() == structure), None)
+                     or Sampled(controller.hold, controller.compute_delay))
+    kb = kb_model.boundary(loop).NV_critical
+    sampled = sampled_model.boundary(loop).NV_critical
     return KBError(relative_error(kb, sampled), kb, sampled, controller.hold, controller.compute_delay, c, tuple(where))
 
 
-def kb_errors(robot: Robot, controller: Controller, wall: WallAnalysis | None, corridor: CorridorAnalysis | None) -> tuple:
+def kb_errors(robot: Robot, controller: Controller, wall: WallAnalysis | None, corridor: CorridorAnalysis | None,
+              models: tuple = ()) -> tuple:
     """`kb_error` for every loop the report's steering tables decide: one per heading gain c, naming its geometries, wall first.
 
     A static law gives one loop (c = 0, KB's own; also without a wall or corridor: a door's
     report); a velocity or fuzzy law one per heading gain, each compared as its table prints
     it. A loop whose c is beyond the models (`models.HEADING_GAIN_RANGE`: no table value) has none.
+
+    Parameters
+    ----------
+    robot : Robot
+        τ (s) and k (1/s).
+    controller : Controller
+        T (s) and the sampled structure.
+    wall : WallAnalysis or None
+        The wall's analysis (its equilibria's heading gains).
+    corridor : CorridorAnalysis or None
+        The corridor's analysis.
+    models : tuple of LoopModel, optional
+        The report's models, reused (`kb_error`).
     """
     loops = {}
     if wall is not None:
@@ -698,4 +731,5 @@ def kb_errors(robot: Robot, controller: Controller, wall: WallAnalysis | None, c
     if corridor is not None:
         loops.setdefault(corridor.c, []).append("corridor")
     low, high = HEADING_GAIN_RANGE
-    return tuple(kb_error(robot, controller, c, tuple(where) if c != 0.0 else ()) for c, where in (loops or {0.0: []}).items() if low <= c <= high)
+    return tuple(kb_error(robot, controller, c, tuple(where) if c != 0.0 else (), models)
+                 for c, where in (loops or {0.0: []}).items() if low <= c <= high)

@@ -49,6 +49,8 @@ Library API
     events at v_RO = 0, D = ρ0 and D ≤ 0 (docs/simulator.md, "Planar robots").
 ``wall_cycle(repulsion, attraction, alpha, robot, *, T, …) -> WallCycle``
     The limit cycle (or rest) of a robot beside a wall with velocity-gated repulsion.
+``simulate_planar_batch(members) -> PlanarBatch``
+    Many `PlanarMember` runs stepped together in arrays (the two above are batches of one).
 
 Predictions for a scenario (`predict`) and the simulated stability boundary
 (`boundary_by_bisection`) join simulations with the models: they are in
@@ -66,7 +68,7 @@ of the active windows), `vff` (KB eq 1–5, the measured wall force), `robot`
 walls), `scenario` (and `scenario_law`), `presets`, `engine` (batched
 stepping), `events`, `metrics` (docs/simulator.md, measuring oscillation),
 `verdict`, `results`, `api`, `reference`; the planar simulator: `planar`,
-`planar_robots`, `movers`, `cycles`.
+`planar_batch` (batched stepping), `planar_field`, `planar_robots`, `movers`, `cycles`.
 """
 
 from .api import simulate, simulate_batch
@@ -75,7 +77,7 @@ from .environment import AnalyticEnvironment, AnalyticWall
 from .events import Event
 from .grid import HistogramGrid
 from .metrics import OscillationMetrics, oscillation_metrics
-from .planar import DiffDrive, PlanarRun, PointMass, Steering, WallCycle, simulate_planar, wall_cycle
+from .planar import DiffDrive, PlanarBatch, PlanarMember, PlanarRun, PointMass, Steering, WallCycle, simulate_planar, simulate_planar_batch, wall_cycle
 from .presets import SCENARIO_NAMES, barely_avoiding_ratio, make_scenario
 from .reference import simulate_reference
 from .results import BatchResult, RunResult, Trajectory
@@ -93,6 +95,8 @@ __all__ = [
     "HistogramGrid",
     "MeasureAxis",
     "OscillationMetrics",
+    "PlanarBatch",
+    "PlanarMember",
     "PlanarRun",
     "PointMass",
     "Pose",
@@ -112,6 +116,7 @@ __all__ = [
     "simulate",
     "simulate_batch",
     "simulate_planar",
+    "simulate_planar_batch",
     "simulate_reference",
     "simulated_verdict",
     "wall_cycle",

@@ -11,7 +11,8 @@ repulsion vanishes, so there is no equilibrium to linearise
 (`velocity_laws.NonSmoothWall`). A steering robot settles on a relay limit cycle,
 a holonomic one comes to rest inside the Filippov band d ≤ d_s
 (docs/velocity_and_fuzzy.md). The run is simulated, its first half discarded as
-the transient, and the second half measured (`WallCycle`).
+the transient, and the second half measured (`WallCycle`). Many wall runs at once:
+`planar.wall_member` for each, `planar.simulate_planar_batch`, `measure_wall_cycle` of each run.
 """
 
 from __future__ import annotations

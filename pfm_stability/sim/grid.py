@@ -26,13 +26,14 @@ import numpy as np
 
 from ..checks import check_integer, check_number
 from ..laws.effective_force import DEFAULT_CV
+from ..numerics.cells import CellGrid
 
 __all__ = ["HistogramGrid"]
 
 _SEGMENT_SAMPLES_PER_CELL = 16
 
 
-class HistogramGrid:
+class HistogramGrid(CellGrid):
     """A rectangular histogram grid of certainty values.
 
     Parameters
@@ -97,29 +98,6 @@ class HistogramGrid:
         c = self.cell_size
         return (self.x_min, self.x_min + nx * c, self.y_min, self.y_min + ny * c)
 
-    def cell_index(self, x, y):
-        """(i, j) integer arrays of the cells containing the points (may lie outside the grid).
-
-        Parameters
-        ----------
-        x, y : array_like
-            Points, m.
-        """
-        c = self.cell_size
-        i = np.floor((np.asarray(x, dtype=float) - self.x_min) / c).astype(np.int64)
-        j = np.floor((np.asarray(y, dtype=float) - self.y_min) / c).astype(np.int64)
-        return i, j
-
-    def cell_center(self, i, j):
-        """(x, y) of cell centres, m.
-
-        Parameters
-        ----------
-        i, j : array_like of int
-            Cell indices along x and y.
-        """
-        c = self.cell_size
-        return self.x_min + (np.asarray(i) + 0.5) * c, self.y_min + (np.asarray(j) + 0.5) * c
 
     def occupied(self):
         """Centres and CVs of the occupied cells: (x, y, cv) float arrays, ordered by (i, j)."""

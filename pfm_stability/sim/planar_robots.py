@@ -1,9 +1,13 @@
-"""The robots of the planar simulator and their exact motion over one sampling period (docs/simulator.md).
+"""The robots of the planar simulator and their exact motion over one sampling period, in arrays (docs/simulator.md).
 
-`PointMass`, `Steering` and `DiffDrive` are the parameter sets (`sim.planar` describes them);
-the private dynamics classes hold one robot's state and advance it exactly under a held
-command: constant acceleration, KB's steering solution of `sim.robot` (in KB's axes), or the
-unicycle's arc.
+`PointMass`, `Steering` and `DiffDrive` are the parameter sets (`sim.planar` describes them).
+`robot_groups` sorts a batch's members into groups of one kind (`MassGroup`, `SteeringGroup`
+per hold, `DiffDriveGroup`), each holding its members' parameters as arrays; a group reads
+and writes its members' rows of the batch's `PlanarState` and advances them exactly under
+the held command: constant acceleration, KB's steering solution of `sim.robot` (in KB's
+axes), or the unicycle's arc. Every operation is element-wise in the member (a member's
+steering quadrature rule is its own, padded with zero weights summed last), so a member
+moves alike alone or in any batch, to round-off (docs/simulator.md, "Batches").
 """
 
 from __future__ import annotations
@@ -16,15 +20,14 @@ import numpy as np
 from ..checks import check_choice, check_number
 from ..parameters import HOLDS, TAU_RESOLUTION
 from .robot import advance_position, constant_input, constant_input_modes, graded_rule, propagate, servo, servo_modes, slow_rate
+from .vff import wrap_angle
 
-__all__ = ["ROBOTS", "DiffDrive", "PointMass", "Steering", "positive"]
+__all__ = [
+    "ROBOTS", "DiffDrive", "DiffDriveGroup", "MassGroup", "PlanarState", "PointMass", "RobotGroup", "Steering", "SteeringGroup", "positive",
+    "robot_groups",
+]
 
 _BIG = 1e6
-
-
-def _wrap(a: float) -> float:
-    """a wrapped to [−π, π)."""
-    return (a + math.pi) % (2.0 * math.pi) - math.pi
 
 
 def positive(name, value, unit, high=_BIG):
@@ -135,91 +138,304 @@ class DiffDrive:
 ROBOTS = (PointMass, Steering, DiffDrive)
 
 
-class _MassDynamics:
-    def __init__(self, robot: PointMass, T, start):
-        self.r, self.T = robot, T
-        self.p, self.v = np.array(start.position), np.array(start.velocity)
-        self.theta = None
+class PlanarState:
+    """The state of a batch's members at a sample, arrays of shape (B,) (a group writes its members' rows).
 
-    def velocity(self):
-        return self.v
+    Attributes
+    ----------
+    px, py : ndarray
+        Position, m.
+    vx, vy : ndarray
+        Velocity, m/s (a point mass's state; the others' V(cos θ, sin θ), refreshed by `velocity`).
+    theta : ndarray
+        Heading, rad from +x (unwrapped; 0 for a point mass).
+    omega : ndarray
+        Turning rate, rad/s (steering robots).
+    speed : ndarray
+        Speed, m/s (differential drive: the held speed of the last period).
 
-    def command(self, force, clearance):
-        a = force / self.r.mass
-        norm = math.hypot(*a)
-        if norm > self.r.a_max:
-            a = a * (self.r.a_max / norm)
-        return a
+    Parameters
+    ----------
+    position, velocity : ndarray, shape (B, 2)
+        Start positions (m) and velocities (m/s).
+    heading : ndarray, shape (B,)
+        Start headings, rad.
+    """
 
-    def advance(self, a):
-        T = self.T
-        self.p = self.p + self.v * T + 0.5 * a * T * T
-        self.v = self.v + a * T
+    __slots__ = ("px", "py", "vx", "vy", "theta", "omega", "speed")
+
+    def __init__(self, position, velocity, heading):
+        position, velocity = np.asarray(position, dtype=float), np.asarray(velocity, dtype=float)
+        self.px, self.py = position[:, 0].copy(), position[:, 1].copy()
+        self.vx, self.vy = velocity[:, 0].copy(), velocity[:, 1].copy()
+        self.theta = np.asarray(heading, dtype=float).copy()
+        self.omega = np.zeros_like(self.theta)
+        self.speed = np.hypot(self.vx, self.vy)
+
+    def finite(self) -> np.ndarray:
+        """True per member whose state is finite."""
+        return np.isfinite(self.px) & np.isfinite(self.py) & np.isfinite(self.vx) & np.isfinite(self.vy) & np.isfinite(self.theta) & np.isfinite(self.omega)
 
 
-class _SteeringDynamics:
-    """KB's steering solution over one period (`sim.robot`), in KB's axes (x' = y, y' = x: ẋ' = V sin θ, ẏ' = V cos θ)."""
+def _array(robots, name):
+    return np.array([float(getattr(r, name)) for r in robots])
 
-    def __init__(self, robot: Steering, T, start):
-        self.r, self.T = robot, T
-        one = lambda value: np.array([float(value)])
-        tau = robot.tau if robot.tau * robot.k >= TAU_RESOLUTION else 0.0
-        slow = slow_rate(one(robot.k), one(robot.max_rate if robot.max_rate < math.inf else _BIG))
-        if robot.hold == "command":
-            self.rule = graded_rule(one(T), *constant_input_modes(one(tau)), slow)
-            self.coef = constant_input(one(tau), self.rule)
+
+def _keep(running, new, old):
+    """`new` where the member runs, else `old` (running None: every member runs)."""
+    return new if running is None else np.where(running, new, old)
+
+
+def _direction(fx, fy, theta):
+    """The force's direction (rad from +x), or θ where the force is exactly 0."""
+    return np.where((fx != 0.0) | (fy != 0.0), np.arctan2(fy, fx), theta)
+
+
+class RobotGroup:
+    """Members of a batch with robots of one kind: their parameters as arrays, their command and exact motion.
+
+    A group reads the force of its members from the batch's arrays and returns the value it
+    holds over the next period as two arrays (`command`); `advance` applies the batch's
+    applied values (the command of this sample or, with a compute delay, of the previous one)
+    to the running members. Subclasses: `MassGroup`, `SteeringGroup`, `DiffDriveGroup`.
+
+    Parameters
+    ----------
+    index : ndarray of int or slice
+        The group's members in the batch.
+    robots : sequence
+        Their parameters (`PointMass`, `Steering` of one hold, or `DiffDrive`).
+    T : ndarray, shape (n,)
+        Their sampling periods, s.
+    """
+
+    heading = True
+    """Whether the robot has a heading (recorded as θ; a point mass has none)."""
+
+    def __init__(self, index, robots, T):
+        self.index = index
+        self.T = np.asarray(T, dtype=float)
+        self._compile(list(robots))
+
+    def _compile(self, robots):  # pragma: no cover - interface
+        raise NotImplementedError
+
+    def _rows(self, first, second, running):
+        """The group's rows of the batch's applied values and running mask."""
+        i = self.index
+        return first[i], second[i], (None if running is None else running[i])
+
+    def velocity(self, state: PlanarState) -> None:
+        """Write the members' velocity (m/s) into the state's velocity rows, from their heading and speed.
+
+        Parameters
+        ----------
+        state : PlanarState
+            The batch's state.
+        """
+        i = self.index
+        theta, speed = state.theta[i], self._speed(state)
+        state.vx[i], state.vy[i] = speed * np.cos(theta), speed * np.sin(theta)
+
+    def command(self, state: PlanarState, fx, fy, clearance):  # pragma: no cover - interface
+        """The value held over the next period, as two arrays of the group's members.
+
+        Parameters
+        ----------
+        state : PlanarState
+            The batch's state.
+        fx, fy : ndarray, shape (B,)
+            The field's force on every member, N.
+        clearance : ndarray, shape (B,)
+            Every member's nearest clearance ρ, m (inf without obstacles).
+        """
+        raise NotImplementedError
+
+    def advance(self, state: PlanarState, first, second, running) -> None:  # pragma: no cover - interface
+        """Advance the running members over one period under the applied values (the state updated in place).
+
+        Parameters
+        ----------
+        state : PlanarState
+            The batch's state.
+        first, second : ndarray, shape (B,)
+            The batch's applied values (`command`'s two arrays).
+        running : ndarray of bool, shape (B,), or None
+            Which members advance (None: all).
+        """
+        raise NotImplementedError
+
+
+class MassGroup(RobotGroup):
+    """Point masses (`PointMass`): a = F/m scaled down to |a| = a_max beyond it (the conference paper's eq 22),
+    held; p += vT + aT²/2 and v += aT, exact under the constant acceleration. The command is (a_x, a_y), m/s².
+
+    Parameters
+    ----------
+    index : ndarray of int or slice
+        The group's members in the batch.
+    robots : sequence of PointMass
+        Their parameters.
+    T : ndarray, shape (n,)
+        Their sampling periods, s.
+    """
+
+    heading = False
+
+    def _compile(self, robots):
+        self.mass, self.a_max = _array(robots, "mass"), _array(robots, "a_max")
+        self.saturates = bool(np.any(np.isfinite(self.a_max)))
+
+    def velocity(self, state: PlanarState) -> None:
+        pass  # a point mass's velocity is its state
+
+    def command(self, state: PlanarState, fx, fy, clearance):
+        i = self.index
+        ax, ay = fx[i] / self.mass, fy[i] / self.mass
+        if self.saturates:
+            norm = np.hypot(ax, ay)
+            over = norm > self.a_max
+            if np.any(over):
+                scale = self.a_max / np.where(over, norm, 1.0)
+                ax, ay = np.where(over, ax * scale, ax), np.where(over, ay * scale, ay)
+        return ax, ay
+
+    def advance(self, state: PlanarState, first, second, running) -> None:
+        i, T = self.index, self.T
+        first, second, running = self._rows(first, second, running)
+        px, py, vx, vy = state.px[i], state.py[i], state.vx[i], state.vy[i]
+        state.px[i] = _keep(running, px + vx * T + 0.5 * first * T * T, px)
+        state.py[i] = _keep(running, py + vy * T + 0.5 * second * T * T, py)
+        state.vx[i] = _keep(running, vx + first * T, vx)
+        state.vy[i] = _keep(running, vy + second * T, vy)
+
+
+class SteeringGroup(RobotGroup):
+    """KB's steering robots of one hold (`Steering`) at constant speed V: the exact solutions of `sim.robot`.
+
+    The command is (u, 0) with u = k·wrap(δ − θ) clipped to ±max_rate (``hold="command"``) or
+    (δ̃, 0) with δ̃ = θ + wrap(δ − θ), closed by the servo u = k(δ̃ − θ) (``hold="reference"``),
+    δ the force's direction. KB's axes swap x and y (ẋ' = V sin θ, ẏ' = V cos θ with θ from
+    +y'); with x' = y and y' = x the heading from +x is the same θ.
+
+    Parameters
+    ----------
+    index : ndarray of int or slice
+        The group's members in the batch.
+    robots : sequence of Steering
+        Their parameters (one hold).
+    T : ndarray, shape (n,)
+        Their sampling periods, s.
+    """
+
+    def _compile(self, robots):
+        self.hold = robots[0].hold
+        self.V, self.k, self.max_rate = _array(robots, "V"), _array(robots, "k"), _array(robots, "max_rate")
+        tau = _array(robots, "tau")
+        tau = np.where(tau * self.k >= TAU_RESOLUTION, tau, 0.0)  # an ideal motor, as the models take it
+        slow = slow_rate(self.k, np.where(np.isfinite(self.max_rate), self.max_rate, _BIG))
+        if self.hold == "command":
+            self.coef = constant_input(tau, graded_rule(self.T, *constant_input_modes(tau), slow))
         else:
-            self.rule = graded_rule(one(T), *servo_modes(one(tau), one(robot.k)), slow)
-            self.coef = servo(one(tau), one(robot.k), self.rule)
-        self.p = np.array(start.position)
-        self.theta, self.omega = float(start.heading), 0.0
+            self.coef = servo(tau, self.k, graded_rule(self.T, *servo_modes(tau, self.k), slow))
+        self.clips = bool(np.any(np.isfinite(self.max_rate)))
 
-    def velocity(self):
-        return self.r.V * np.array([math.cos(self.theta), math.sin(self.theta)])
+    def _speed(self, state):
+        return self.V
 
-    def command(self, force, clearance):
-        fx, fy = force
-        delta = math.atan2(fy, fx) if (fx or fy) else self.theta
-        error = _wrap(delta - self.theta)
-        if self.r.hold == "command":
-            return min(max(self.r.k * error, -self.r.max_rate), self.r.max_rate)
-        return self.theta + error
+    def command(self, state: PlanarState, fx, fy, clearance):
+        i = self.index
+        theta = state.theta[i]
+        error = wrap_angle(_direction(fx[i], fy[i], theta) - theta)
+        if self.hold == "command":
+            value = self.k * error
+            if self.clips:
+                value = np.minimum(np.maximum(value, -self.max_rate), self.max_rate)
+        else:
+            value = theta + error
+        return value, np.zeros_like(value)
 
-    def advance(self, value):
-        arr = lambda x: np.array([float(x)])
-        delta, correction, theta, omega = propagate(self.coef, arr(self.theta), arr(self.omega), arr(value))
-        y, x = advance_position(arr(self.p[1]), arr(self.p[0]), arr(self.r.V), self.rule, arr(self.theta), delta, correction)
-        self.p = np.array([float(x[0]), float(y[0])])
-        self.theta, self.omega = float(theta[0]), float(omega[0])
-
-
-class _DiffDriveDynamics:
-    def __init__(self, robot: DiffDrive, T, start):
-        self.r, self.T = robot, T
-        self.p = np.array(start.position)
-        self.theta = float(start.heading)
-        self.speed = math.hypot(*start.velocity)
-
-    def velocity(self):
-        return self.speed * np.array([math.cos(self.theta), math.sin(self.theta)])
-
-    def command(self, force, clearance):
-        fx, fy = force
-        heading = math.atan2(fy, fx) if (fx or fy) else self.theta
-        omega = self.r.K_s * _wrap(heading - self.theta)
-        speed = self.r.v_opt * min(1.0, clearance / self.r.rho0_speed)
-        return max(speed, 0.0), omega
-
-    def advance(self, command):
-        speed, omega = command
-        turn = omega * self.T
-        chord = speed * self.T * float(np.sinc(turn / (2.0 * math.pi)))
-        mid = self.theta + 0.5 * turn
-        self.p = self.p + chord * np.array([math.cos(mid), math.sin(mid)])
-        self.theta += turn
-        self.speed = speed
+    def advance(self, state: PlanarState, first, second, running) -> None:
+        i = self.index
+        first, second, running = self._rows(first, second, running)
+        theta, omega, px, py = state.theta[i], state.omega[i], state.px[i], state.py[i]
+        delta, correction, theta_end, omega_end = propagate(self.coef, theta, omega, first)
+        y, x = advance_position(py, px, self.V, self.coef.rule, theta, delta, correction)
+        state.px[i], state.py[i] = _keep(running, x, px), _keep(running, y, py)
+        state.theta[i], state.omega[i] = _keep(running, theta_end, theta), _keep(running, omega_end, omega)
 
 
-_DYNAMICS = {PointMass: _MassDynamics, Steering: _SteeringDynamics, DiffDrive: _DiffDriveDynamics}
+class DiffDriveGroup(RobotGroup):
+    """GC2002 §7's differential-drive robots (`DiffDrive`): (v, ω) held, the unicycle's arc exact.
+
+    The command is v = v_opt·min(1, ρ/ρ0) ≥ 0 (eq 41, ρ the nearest clearance) and
+    ω = K_s·wrap(θ_f − θ) (eq 42–43); over a period the robot moves along the chord
+    vT·sinc(ωT/2π) in the direction θ + ωT/2 and turns by ωT.
+
+    Parameters
+    ----------
+    index : ndarray of int or slice
+        The group's members in the batch.
+    robots : sequence of DiffDrive
+        Their parameters.
+    T : ndarray, shape (n,)
+        Their sampling periods, s.
+    """
+
+    def _compile(self, robots):
+        self.K_s, self.v_opt = _array(robots, "K_s"), _array(robots, "v_opt")
+        self.rho0, self.axle = _array(robots, "rho0_speed"), _array(robots, "axle")
+
+    def _speed(self, state):
+        return state.speed[self.index]
+
+    def command(self, state: PlanarState, fx, fy, clearance):
+        i = self.index
+        theta = state.theta[i]
+        omega = self.K_s * wrap_angle(_direction(fx[i], fy[i], theta) - theta)
+        speed = self.v_opt * np.minimum(1.0, clearance[i] / self.rho0)
+        return np.maximum(speed, 0.0), omega
+
+    def wheels(self, speed, omega):
+        """(v_l, v_r) = v ∓ Lω/2 of the group's members, m/s (GC2002 eq 40, rows in counter-clockwise order).
+
+        Parameters
+        ----------
+        speed, omega : ndarray, shape (B,)
+            The applied speed (m/s) and turning rate (rad/s) of the batch.
+        """
+        speed, omega = speed[self.index], omega[self.index]
+        return speed - self.axle * omega / 2.0, speed + self.axle * omega / 2.0
+
+    def advance(self, state: PlanarState, first, second, running) -> None:
+        i, T = self.index, self.T
+        first, second, running = self._rows(first, second, running)
+        theta, px, py = state.theta[i], state.px[i], state.py[i]
+        turn = second * T
+        chord = first * T * np.sinc(turn / (2.0 * math.pi))
+        mid = theta + 0.5 * turn
+        state.px[i], state.py[i] = _keep(running, px + chord * np.cos(mid), px), _keep(running, py + chord * np.sin(mid), py)
+        state.theta[i] = _keep(running, theta + turn, theta)
+        state.speed[i] = _keep(running, first, state.speed[i])
 
 
+def robot_groups(robots, T) -> tuple:
+    """The batch's members sorted into groups of one kind (and one hold), each with its parameters as arrays.
+
+    A group covering the whole batch indexes it with ``slice(None)`` (views, no copies).
+
+    Parameters
+    ----------
+    robots : sequence of PointMass, Steering or DiffDrive
+        One per member.
+    T : ndarray, shape (B,)
+        The members' sampling periods, s.
+    """
+    keys = [(type(r), getattr(r, "hold", "")) for r in robots]
+    makers = {PointMass: MassGroup, Steering: SteeringGroup, DiffDrive: DiffDriveGroup}
+    groups = []
+    for key in dict.fromkeys(keys):
+        members = np.array([m for m, k in enumerate(keys) if k == key])
+        index = slice(None) if members.size == len(robots) else members
+        groups.append(makers[key[0]](index, [robots[m] for m in members], np.asarray(T, dtype=float)[members]))
+    return tuple(groups)

@@ -105,6 +105,7 @@ class _Steering:
 
     def __init__(self, tau, k, h, max_rate, solutions, gain=1.0):
         self.tau, self.k, self.h = tau, gain * k, h
+        self.gain, self.command_gain = gain, k  # the servo command k(ref − θ) is clipped before the plant gain
         self.times, self.weights = _steering_rule(tau, k, h, max_rate, solutions, gain)
         self.const = [_constant_input(tau, t) for t in self.times + [h]]
         lagged = tau * (h - self.const[-1][0])
@@ -127,6 +128,17 @@ class _Steering:
         P, Q, R, S = self.servo[-1]
         iP, iQ = self.servo_integral
         return delta, (iP - self.h) * e + iQ * omega, ref + P * e + Q * omega, R * e + S * omega
+
+    def servo_step(self, x, y, V, theta, omega, ref, max_rate):
+        """(x, y, θ, ω) at the end of the interval for a held reference whose servo command k(ref − θ) is taken at
+        its start and saturated at ±`max_rate` (the constant command then) — one substep of a saturating servo."""
+        u = self.command_gain * (ref - theta)
+        if abs(u) > max_rate:  # the motor turns at g times the clipped command
+            nodes, integral, theta_end, omega_end = self.constant(theta, omega, self.gain * min(max(u, -max_rate), max_rate))
+        else:
+            nodes, integral, theta_end, omega_end = self.reference(theta, omega, ref)
+        x, y = self.move(x, y, V, theta, nodes, integral)
+        return x, y, theta_end, omega_end
 
     def move(self, x, y, V, theta, delta, integral):
         """x + V∫sin θ, y + V∫cos θ: ∫Δ exact, the residuals sin Δ − Δ and cos Δ − 1 by quadrature."""
@@ -209,14 +221,7 @@ def _position_after(s, tau, t, theta, omega, applied, V, x, y, substepped, switc
     for length in [part] * whole + [t - whole * part]:
         if length <= 0:
             break
-        one = _Steering(tau, k, length, wmax, ("servo", "constant"), g)
-        u = k * (applied - theta)
-        if abs(u) > wmax:
-            nodes, integral, theta2, omega2 = one.constant(theta, omega, g * min(max(u, -wmax), wmax))
-        else:
-            nodes, integral, theta2, omega2 = one.reference(theta, omega, applied)
-        x, y = one.move(x, y, V, theta, nodes, integral)
-        theta, omega = theta2, omega2
+        x, y, theta, omega = _Steering(tau, k, length, wmax, ("servo", "constant"), g).servo_step(x, y, V, theta, omega, applied, wmax)
     return x, y
 
 
@@ -336,13 +341,7 @@ def simulate_reference(s: Scenario):
                 substepped = True
                 theta_end, omega_end = theta, omega
                 for _ in range(SUBSTEPS):
-                    u = k * (applied - theta_end)
-                    if abs(u) > wmax:
-                        nodes, integral, th2, om2 = sub.constant(theta_end, omega_end, g * min(max(u, -wmax), wmax))
-                    else:
-                        nodes, integral, th2, om2 = sub.reference(theta_end, omega_end, applied)
-                    x, y = sub.move(x, y, V, theta_end, nodes, integral)
-                    theta_end, omega_end = th2, om2
+                    x, y, theta_end, omega_end = sub.servo_step(x, y, V, theta_end, omega_end, applied, wmax)
         theta, omega = theta_end, omega_end
         xs.append(x), ys.append(y), ths.append(theta)
         contact = _path_contact(s, sense, tau, start, applied, V, substepped, gap, switch, earlier)

@@ -109,7 +109,15 @@ class RunResult:
         return self.event("collision") is not None
 
     def plot(self, ax=None, **kwargs):
-        """`plots.trajectory.plot_trajectory` of this run (recorded with its trajectory); returns the figure."""
+        """`plots.trajectory.plot_trajectory` of this run (recorded with its trajectory); returns the figure.
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes, optional
+            Axes to draw on; None: a new figure.
+        **kwargs
+            Passed on to `plots.trajectory.plot_trajectory`.
+        """
         from ..plots.trajectory import plot_trajectory
 
         return plot_trajectory(self, ax=ax, **kwargs)

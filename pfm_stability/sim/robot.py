@@ -320,7 +320,12 @@ def node_sum(a):
     a : ndarray, shape (B, J, …)
         Values at the nodes.
     """
-    return np.cumsum(a, axis=1)[:, -1]
+    if a.shape[1] > 32:
+        return np.cumsum(a, axis=1)[:, -1]
+    total = a[:, 0].copy()  # the same additions in the same order as cumsum, a column at a time: for short rules
+    for j in range(1, a.shape[1]):  # numpy's accumulate along a short inner axis costs ~15 ns per element, this ~1
+        total += a[:, j]
+    return total
 
 
 @dataclass(frozen=True)

@@ -335,7 +335,7 @@ def _run_local(todo, spec, sample, paths, parts, fail_once, workers, report):
                               _fail_marker(parts, index, fail_once)),)
         sizes[key] = stop - start
 
-    def finished(key, result, dsk, state, worker_id) -> None:
+    def finished(key, result, _dsk, _state, _worker_id) -> None:  # dask's posttask callback signature
         if result is None:
             report(sizes[key])
 

@@ -262,7 +262,7 @@ def _verdict_columns(spec: SweepSpec, inputs: dict, NV: np.ndarray, reasons: np.
     return names, arrays, reasons
 
 
-def _simulation_columns(spec: SweepSpec, inputs: dict, N_reasons: np.ndarray) -> list:
+def _simulation_columns(spec: SweepSpec, inputs: dict) -> list:
     """The simulator's σ and verdict for every point (`validation.sweep.simulate_members`)."""
     from ..laws.fields import make_law
     from ..models import Loop
@@ -339,5 +339,5 @@ def evaluate_chunk(spec: SweepSpec, start: int, stop: int, sample: dict | None =
     arrays += model_arrays + [reasons]
     if spec.simulate:
         names += list(SIM_COLUMNS)
-        arrays += _simulation_columns(spec, inputs, reasons)
+        arrays += _simulation_columns(spec, inputs)
     return ChunkColumns(tuple(names), tuple(arrays))

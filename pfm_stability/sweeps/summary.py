@@ -85,7 +85,13 @@ class SweepFigureData:
     matrix: np.ndarray | None = None
 
     def plot(self, ax=None):
-        """`plots.sweep.plot_sweep_summary` of this figure's data; returns the figure."""
+        """`plots.sweep.plot_sweep_summary` of this figure's data; returns the figure.
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes, optional
+            Axes to draw on; None: a new figure.
+        """
         from ..plots.sweep import plot_sweep_summary
 
         return plot_sweep_summary(self, ax=ax)

@@ -262,7 +262,15 @@ class SimulatedBoundary:
     models: tuple = ()
 
     def plot(self, ax=None, **kwargs):
-        """`plots.validation.plot_simulated_boundary` of these points; returns the figure."""
+        """`plots.validation.plot_simulated_boundary` of these points; returns the figure.
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes, optional
+            Axes to draw on; None: a new figure.
+        **kwargs
+            Passed on to `plots.validation.plot_simulated_boundary`.
+        """
         from ..plots.validation import plot_simulated_boundary
 
         return plot_simulated_boundary(self, ax=ax, **kwargs)

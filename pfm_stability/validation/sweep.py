@@ -216,7 +216,13 @@ class SweepResult:
     seconds: float
 
     def plot(self, axes=None):
-        """`plots.validation.plot_sweep`: σ against NV/NV* of ``sampled``, and the other models' view; returns the figure."""
+        """`plots.validation.plot_sweep`: σ against NV/NV* of ``sampled``, and the other models' view; returns the figure.
+
+        Parameters
+        ----------
+        axes : (Axes, Axes), optional
+            The two axes to draw on (left, right); None: a new figure.
+        """
         from ..plots.validation import plot_sweep
 
         return plot_sweep(self, axes=axes)
