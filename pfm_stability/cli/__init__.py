@@ -103,7 +103,7 @@ def unknown_options(extras, parser) -> str:
         if close:
             hints.append((name, close[0]))
             case = case or bool(same_letters)
-    message = f"unrecognized arguments: {' '.join(extras)}"
+    message = f"unrecognized arguments: {' '.join(t if t.isprintable() else repr(t) for t in extras)}"  # a control character quoted: one line
     if len(hints) == 1:
         message += f"; did you mean {hints[0][1]}?"
     elif hints:

@@ -35,6 +35,7 @@ judges the other roots, the heading loop (`neutral_reason`, docs/models.md
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import math
 from dataclasses import dataclass, field
@@ -115,17 +116,26 @@ class Loop(Characteristic):
         δ = −N·(x − x0) − c·θ, so the gain term of every model becomes
         k(cs + NV) (delayed by e^(−sT) with the rest of the sensor data);
         docs/models.md, "The heading gain".
+    plant_gain, dead_time : float, keyword only
+        g (in [10⁻³, 100], default 1) and D (s, in [0, 10], default 0) of the motor
+        τω̇ + ω = g·u(t − D) (docs/models.md, "Plant gain and dead time"): the loop's
+        steering gain is g·k (`steering_gain`; `k` stays the controller's, k* is in it),
+        the continuous-time models' delay T + D (`delay`).
     """
 
     tau: float
     T: float
     k: float
     c: float = field(default=0.0, kw_only=True)
+    plant_gain: float = field(default=1.0, kw_only=True)
+    dead_time: float = field(default=0.0, kw_only=True)
 
     def __post_init__(self):
         for name in ("tau", "T", "k"):
             object.__setattr__(self, name, check_parameter(name, getattr(self, name)))
-        if self.tau * self.k < TAU_RESOLUTION:  # a lag 10⁹ times faster than the steering loop: an ideal motor
+        for name in [n for n, d in (("plant_gain", 1.0), ("dead_time", 0.0)) if getattr(self, n).__class__ is not float or getattr(self, n) != d]:
+            object.__setattr__(self, name, check_parameter(name, getattr(self, name)))
+        if self.tau * self.steering_gain < TAU_RESOLUTION:  # a lag 10⁹ times faster than the steering loop: an ideal motor
             object.__setattr__(self, "tau", 0.0)
         if self.T < T_RESOLUTION:  # faster than a picosecond: a continuous controller
             object.__setattr__(self, "T", 0.0)
@@ -134,7 +144,7 @@ class Loop(Characteristic):
 
     @classmethod
     def of(cls, robot, controller, *, c: float = 0.0) -> "Loop":
-        """The loop of a robot and its controller (τ, k; T), with heading gain `c`: the one constructor from them.
+        """The loop of a robot and its controller (τ, k, g, D; T), with heading gain `c`: the one constructor from them.
 
         Parameters
         ----------
@@ -143,7 +153,16 @@ class Loop(Characteristic):
         c : float
             Heading gain of the equilibrium (0: a static law, KB's loop).
         """
-        return cls(robot.tau, controller.T, robot.k, c=c)
+        return cls(robot.tau, controller.T, robot.k, c=c, plant_gain=robot.plant_gain, dead_time=robot.dead_time)
+
+    @property
+    def steering_gain(self) -> float:
+        """g·k, 1/s: the loop's steering gain, the motor's rate per radian of heading error (k for KB's robot, g = 1)."""
+        return self.plant_gain * self.k
+
+    def replace(self, **changes) -> "Loop":
+        """A copy with `changes` (field name → value), checked as the constructor checks."""
+        return dataclasses.replace(self, **changes)
 
     @property
     def family(self) -> LoopFamily:
@@ -153,12 +172,13 @@ class Loop(Characteristic):
     @property
     def plant(self) -> np.ndarray:
         """a(s) = τs³ + s² + ks, descending (KB eq 17 without the gain term)."""
-        return np.array([self.tau, 1.0, self.k, 0.0]) if self.tau > 0 else np.array([1.0, self.k, 0.0])
+        k = self.steering_gain
+        return np.array([self.tau, 1.0, k, 0.0]) if self.tau > 0 else np.array([1.0, k, 0.0])
 
     @property
     def heading(self) -> float:
-        """kc, 1/s: the s-coefficient of the gain term k(cs + NV) (0 for KB's loop)."""
-        return self.k * self.c
+        """g·kc, 1/s: the s-coefficient of the gain term gk(cs + NV) (0 for KB's loop)."""
+        return self.steering_gain * self.c
 
     @property
     def damping(self) -> float:
@@ -173,27 +193,28 @@ class Loop(Characteristic):
         """
         if self.c == 0.0:
             return self.plant
-        return np.array([self.tau, 1.0, self.k * (1.0 + self.c), 0.0]) if self.tau > 0 else np.array([1.0, self.k * (1.0 + self.c), 0.0])
+        k = self.steering_gain
+        return np.array([self.tau, 1.0, k * (1.0 + self.c), 0.0]) if self.tau > 0 else np.array([1.0, k * (1.0 + self.c), 0.0])
 
     def loop_gain(self, NV: float) -> float:
-        """K = kNV, 1/s².
+        """K = gkNV, 1/s² (g = 1: KB's kNV).
 
         Parameters
         ----------
         NV : float
             Loop gain N·V, 1/s.
         """
-        return self.k * NV
+        return self.steering_gain * NV
 
     def gain_of(self, K: float) -> float:
-        """NV = K/k, 1/s.
+        """NV = K/(gk), 1/s.
 
         Parameters
         ----------
         K : float
             Loop gain K, 1/s².
         """
-        return K / self.k
+        return K / self.steering_gain
 
     def check_gain(self, NV) -> float:
         """NV (1/s) as a float in [−`NV_MAX`, `NV_MAX`] (−0.0 becomes 0.0), or ValueError naming NV.
@@ -206,7 +227,7 @@ class Loop(Characteristic):
         return check_number("NV", NV, -NV_MAX, NV_MAX, low_open=False, high_open=False, unit="1/s") + 0.0
 
     def boundary_from(self, model: str, interval: StabilityInterval) -> "Boundary":
-        """`Boundary` in NV (K/k).
+        """`Boundary` in NV (K/(gk)).
 
         Parameters
         ----------
@@ -215,27 +236,27 @@ class Loop(Characteristic):
         interval : StabilityInterval
             The stable loop gains K, 1/s², with K* and ω*.
         """
-        return Boundary.from_interval(model, interval, self.k)
+        return Boundary.from_interval(model, interval, self.steering_gain)
 
     def with_delay(self, T: float) -> "Loop":
-        """τ, k and c with delay / period T, s.
+        """τ, k, c, g and D with delay / period T, s (the dead time stays: T* is the controller's).
 
         Parameters
         ----------
         T : float
             Delay / sampling period, s, >= 0.
         """
-        return Loop(self.tau, T, self.k, c=self.c)
+        return Loop(self.tau, T, self.k, c=self.c, plant_gain=self.plant_gain, dead_time=self.dead_time)
 
     def _with_delay(self, T: float) -> "Loop":
         """`with_delay` unchecked (a probe of T in range, `Characteristic._with_delay`); T < `T_RESOLUTION` is 0."""
         T = float(T)
-        return _unchecked(Loop, tau=self.tau, T=T if T >= T_RESOLUTION else 0.0, k=self.k, c=self.c)
+        return _unchecked(Loop, **{**vars(self), "T": T if T >= T_RESOLUTION else 0.0})  # τ, k, c, g and D kept
 
     def _with_steering_gain(self, k: float) -> "Loop":
         """τ, T and c with steering gain k, 1/s, unchecked (a probe of k in `gain_range`); τ with τk < 10⁻⁹ is 0."""
         k = float(k)
-        return _unchecked(Loop, tau=self.tau if self.tau * k >= TAU_RESOLUTION else 0.0, T=self.T, k=k, c=self.c)
+        return _unchecked(Loop, **{**vars(self), "tau": self.tau if self.tau * self.plant_gain * k >= TAU_RESOLUTION else 0.0, "k": k})
 
     def delay_search(self, NV: float) -> tuple:
         """T* searched from 1 % of the loop's fastest time scale to 1e-7 relative (a report shows 4 digits).
@@ -262,7 +283,7 @@ class Loop(Characteristic):
 
     def _state_space(self, hold: str) -> tuple:
         """`state_space` for a `hold` already checked (`Characteristic._state_space`)."""
-        tau, k = self.tau, self.k
+        tau, k = self.tau, self.steering_gain
         if tau > 0:
             if hold == "command":
                 A = np.array([[-1 / tau, 0, 0], [1, 0, 0], [0, 1, 0]], dtype=float)
@@ -291,10 +312,10 @@ class Loop(Characteristic):
         if self.c != 0.0:
             from .heading import kb_heading_interval  # only with a heading gain: KB's reports never compile it
 
-            return kb_heading_interval(self.tau, self.T, self.k, self.c)
+            return kb_heading_interval(self.tau, self.delay, self.steering_gain, self.c)
         from ..numerics.delay import kb_critical_gain
 
-        K, w = (float(x[0]) for x in kb_critical_gain(_one(self.tau), _one(self.T), _one(self.k)))
+        K, w = (float(x[0]) for x in kb_critical_gain(_one(self.tau), _one(self.delay), _one(self.steering_gain)))
         return StabilityInterval(K, w if math.isfinite(K) else None, (), ((0.0, K),))
 
     def _count(self, K: float):
@@ -302,7 +323,7 @@ class Loop(Characteristic):
         from ..numerics.delay import delay_verdicts_from_gain
 
         heading = () if self.c == 0.0 else (_one(self.c),)
-        stable, Z, margin = delay_verdicts_from_gain(_one(self.tau), _one(self.T), _one(self.k), _one(K), *heading)
+        stable, Z, margin = delay_verdicts_from_gain(_one(self.tau), _one(self.delay), _one(self.steering_gain), _one(K), *heading)
         return bool(stable[0]), int(Z[0]), float(margin[0])
 
     def delay_stable(self, K: float) -> bool:
@@ -316,14 +337,14 @@ class Loop(Characteristic):
         return self._count(K)[0]
 
     def delay_margin(self, K: float) -> float:
-        """T*, s, of the crossing count (`delay.delay_verdicts_from_gain`).
+        """T*, s, of the crossing count (`delay.delay_verdicts_from_gain`): the margin of the delay T + D less D (`period_margin`).
 
         Parameters
         ----------
         K : float
-            Loop gain K = kNV, 1/s².
+            Loop gain K = g·k·NV, 1/s².
         """
-        return self._count(K)[2]
+        return self.period_margin(self._count(K)[2])
 
 
 def _one(x) -> np.ndarray:
@@ -574,11 +595,11 @@ class LoopModel:
         """
         from ..numerics.solve import first_crossing
 
-        if gain < 0 or self._growth_rates(gain, [loop._with_delay(0.0)])[0] >= 0:
+        if gain < 0 or self._searched_growth_rates(gain, [loop._with_delay(0.0)])[0] >= 0:
             return 0.0
 
         def measure(Ts):  # probes of the checked loop: T in [start, RANGES["T"].high]
-            return self._growth_rates(gain, [loop._with_delay(T) for T in Ts])
+            return self._searched_growth_rates(gain, [loop._with_delay(T) for T in Ts])
 
         start, rtol, atol = loop.delay_search(gain)
         return first_crossing(measure, start, RANGES["T"].high, rtol=rtol, atol=atol)
@@ -602,13 +623,32 @@ class LoopModel:
 
         loop = _steering(loop, "critical_gain_k")
         lo, hi = gain_range(loop)
-        if NV < 0 or self._growth_rates(NV, [loop._with_steering_gain(lo)])[0] >= 0:
+        if NV < 0 or self._searched_growth_rates(NV, [loop._with_steering_gain(lo)])[0] >= 0:
             return 0.0
 
         def measure(ks):  # probes of the checked loop: k in gain_range
-            return self._growth_rates(NV, [loop._with_steering_gain(k) for k in ks])
+            return self._searched_growth_rates(NV, [loop._with_steering_gain(k) for k in ks])
 
         return first_crossing(measure, lo, hi, start=lo, rtol=_DELAY_RTOL, atol=1e-12 * lo)
+
+    def _searched_growth_rates(self, gain: float, loops) -> np.ndarray:
+        """The growth rates (1/s) the searches for T*, k* and D* measure: `_growth_rates` (`sampled`'s has a stand-in)."""
+        return self._growth_rates(gain, loops)
+
+    @checked
+    def critical_dead_time(self, gain: float, loop: Loop) -> float:
+        """D*: the largest dead time of the steering plant the gain tolerates, T fixed, s (`dead_time.search_dead_time`).
+
+        Parameters
+        ----------
+        gain : float
+            Loop gain NV, 1/s.
+        loop : Loop
+            τ, T, k, c and g (its own D is replaced).
+        """
+        from .dead_time import search_dead_time
+
+        return search_dead_time(self, gain, _steering(loop, "critical_dead_time"))
 
     @checked
     def damping_range(self, gain: float, loop: Characteristic) -> tuple:  # pragma: no cover - interface
@@ -635,7 +675,7 @@ class LoopModel:
 
 def _time_scale(loop: Loop, NV: float) -> float:
     """The loop's fastest time scale, s: min(τ, 1/k, 1/NV) (τ counts when > 0, 1/NV when NV != 0)."""
-    scales = [1.0 / loop.k] + ([1.0 / abs(NV)] if NV != 0 else []) + ([loop.tau] if loop.tau > 0 else [])
+    scales = [1.0 / loop.steering_gain] + ([1.0 / abs(NV)] if NV != 0 else []) + ([loop.tau] if loop.tau > 0 else [])
     return min(scales)
 
 

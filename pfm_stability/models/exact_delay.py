@@ -83,7 +83,7 @@ class ExactDelay(LoopModel):
         loop : Characteristic
             The loop judged (`Loop`, `HolonomicLoop`).
         """
-        return DelayLoop(loop.plant[:-1], loop.T)
+        return DelayLoop(loop.plant[:-1], loop.delay)
 
     def _quasi(self, gain: float, loop: Characteristic):
         """(quasi-polynomial, K) of the roots the verdict judges: the loop's at its K, the heading loop's at gain 0."""
@@ -151,6 +151,23 @@ class ExactDelay(LoopModel):
         return loop.delay_margin(loop.loop_gain(gain))
 
     @checked
+    def critical_dead_time(self, gain: float, loop: Characteristic) -> float:
+        """D*: the crossing count's margin of the whole delay T + D (the loop with T = D = 0), less T, s; exact, as T*.
+
+        Parameters
+        ----------
+        gain : float
+            Loop gain NV, 1/s.
+        loop : Loop
+            τ, T, k, c and g.
+        """
+        loop = _steering(loop, "critical_dead_time")
+        if gain < 0:
+            return 0.0
+        margin = loop.replace(T=0.0, dead_time=0.0).delay_margin(loop.loop_gain(gain))
+        return margin if math.isinf(margin) else max(margin - loop.T, 0.0)
+
+    @checked
     def damping_range(self, gain: float, loop: Characteristic) -> tuple:
         """Every interval of the damping δ (the holonomic c_h, 1/s) that makes the gain stable at the loop's T
         (`HolonomicLoop.delay_damping_range`: the closed form of docs/models.md); ``()`` for a negative gain.
@@ -198,16 +215,17 @@ class ExactDelay(LoopModel):
             return 0.0
         if NV == 0 and loop.c == 0.0:
             return math.inf
-        if loop.T == 0:
+        if loop.delay == 0:
             return super().critical_gain_k(NV, loop)
-        if NV * (loop.tau + loop.T) >= 1.0 + loop.c:
+        if NV * (loop.tau + loop.delay) >= 1.0 + loop.c:
             return 0.0
         if loop.c != 0.0:
             return self._heading_gain_k(NV, loop)
+        g = loop.plant_gain
 
-        def measure(ks):
-            K_star = kb_critical_gain(loop.tau, loop.T, ks)[0]
-            return math.log(NV) + np.log(ks) - np.log(K_star)  # a sum of logs: NV·k underflows for subnormal NV
+        def measure(ks):  # the loop's steering gain is g·k (`Loop.steering_gain`); k* is the controller's k
+            K_star = kb_critical_gain(loop.tau, loop.delay, g * ks)[0]
+            return math.log(NV) + np.log(g * ks) - np.log(K_star)  # a sum of logs: NV·k underflows for subnormal NV
 
         lo, hi = gain_range(loop)
         return first_crossing(measure, lo, hi, start=lo)
@@ -220,7 +238,7 @@ class ExactDelay(LoopModel):
 
         def measure(ks):
             loops = [loop._with_steering_gain(k) for k in ks]
-            arrays = (np.array([getattr(x, name) for x in loops]) for name in ("tau", "T", "k"))
+            arrays = (np.array([getattr(x, name) for x in loops]) for name in ("tau", "delay", "steering_gain"))
             tau, T, k = arrays
             stable = delay_verdicts_from_gain(tau, T, k, k * NV, np.full(k.shape, loop.c))[0]
             size = np.abs(pade._growth_rates(NV, loops)) + 1e-300

@@ -118,7 +118,8 @@ def plot_root_locus(locus, ax=None):
     ax.set_ylim(-omega_max, omega_max)
     ax.set_xlabel("Re s (1/s)")
     ax.set_ylabel("Im s (rad/s)")
-    ax.set_title(f"Root locus in NV, Padé({locus.pade_order}) of KB eq (18): τ = {loop.tau:g} s, T = {loop.T:g} s, k = {loop.k:g} 1/s",
+    plant = (f", g = {loop.plant_gain:g}" if loop.plant_gain != 1.0 else "") + (f", D = {loop.dead_time:g} s" if loop.dead_time > 0 else "")
+    ax.set_title(f"Root locus in NV, Padé({locus.pade_order}) of KB eq (18): τ = {loop.tau:g} s, T = {loop.T:g} s, k = {loop.k:g} 1/s{plant}",
                  fontsize=9)
     outside_legend(ax)
     ax.grid(alpha=0.3)
