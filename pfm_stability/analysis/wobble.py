@@ -534,12 +534,12 @@ class _GainTable:
 
 
 @functools.lru_cache(maxsize=32)
-def _gain_table(model: str, hold: str, compute_delay: int, tau: float, T: float, k: float) -> _GainTable:
+def _gain_table(model: str, hold: str, compute_delay: int, tau: float, T: float, k: float, dead_time: float = 0.0) -> _GainTable:
     """The `_GainTable` of one loop, shared by its wall and corridor branches (64 model boundaries)."""
     loop_model = make_model(model, hold=hold, compute_delay=compute_delay)
 
     def boundary(gain_factor: float):
-        b = loop_model.boundary(Loop(tau, T, k * gain_factor))
+        b = loop_model.boundary(Loop(tau, T, k * gain_factor, dead_time=dead_time))
         return b.NV_critical, b.omega_critical
 
     return _GainTable(boundary)
@@ -586,10 +586,13 @@ def corridor_branch(robot, controller, law: ForceLaw, L: float, *, model: str = 
 def _branch(robot, controller, delta, N: float, A, Nf, clearance: float, model: str, beta_f: float) -> WobbleBranch:
     """The branch V(A) for the field's describing function `Nf` at amplitudes `A` (module docstring)."""
     loop_model = make_model(model, hold=controller.hold, compute_delay=controller.compute_delay)
-    tau, k, T, M = robot.tau, robot.k, controller.T, robot.max_steering_rate
+    # in the motor's units: the plant gain g scales the command after the rate limit (docs/simulator.md), so
+    # g·sat_M(u) = sat_gM(g·u): a robot (k, M, g) is the robot (g·k, g·M, 1); the dead time D stays in the loop
+    g, D = robot.plant_gain, robot.dead_time
+    tau, k, T, M = robot.tau, g * robot.k, controller.T, g * robot.max_steering_rate
 
     def boundary(gain_factor: float):
-        b = loop_model.boundary(Loop(tau, T, k * gain_factor))
+        b = loop_model.boundary(Loop(tau, T, k * gain_factor, dead_time=D))
         return b.NV_critical, b.omega_critical
 
     NV0, w0 = boundary(1.0)
@@ -605,7 +608,7 @@ def _branch(robot, controller, delta, N: float, A, Nf, clearance: float, model: 
             continue
         theta, w, factor = a * w0 * nf / NV0, w0, 1.0
         if theta * w0 * math.hypot(1.0, w0 * tau) > M:  # the rate limit bites: solve for the steering gain's factor
-            table = table or _gain_table(model, controller.hold, controller.compute_delay, tau, T, k)
+            table = table or _gain_table(model, controller.hold, controller.compute_delay, tau, T, k, D)
             factor = table.factor(a * nf, tau, M)
             if factor is None:
                 continue
