@@ -8,4 +8,10 @@ model: the engine must not agree with the predictions by construction. MuJoCo is
 ``mujoco`` (`pfm_stability.extras`), imported only when a function here runs.
 """
 
-__all__: list[str] = []
+__all__ = ["ROBOT_MODELS", "ENGINES"]
+
+ROBOT_MODELS = {"diffdrive": "diffdrive.xml", "diffdrive-heavy": "diffdrive_heavy.xml"}
+"""The shipped robots: name → file under ``pfm_stability/data/robots`` (numpy-free, for the command line)."""
+
+ENGINES = ("sim", "mujoco")
+"""What runs a validation's simulations: the package's simulator, or MuJoCo (``validate --engine``)."""

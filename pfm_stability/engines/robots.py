@@ -30,13 +30,13 @@ from pathlib import Path
 
 import numpy as np
 
+from . import ROBOT_MODELS
+
 __all__ = [
     "ROBOT_MODELS", "RobotModel", "DriveCheck", "robot_model_path", "load_robot_model", "check_drives", "corridor_world",
     "place", "heading", "wheel_speeds", "WALL_GROUP", "MAX_TIMESTEP",
 ]
 
-ROBOT_MODELS = {"diffdrive": "diffdrive.xml", "diffdrive-heavy": "diffdrive_heavy.xml"}
-"""The shipped robots: name → file under ``pfm_stability/data/robots``."""
 
 WALL_GROUP = 3
 """The geom group of the walls the engine adds: the only group the range sensor's rays see."""
@@ -245,7 +245,7 @@ def corridor_world(path: str, L: float, y0: float, y1: float, caster_friction: f
         Where the walls start and end, m.
     caster_friction : float, optional
         Replaces the sliding friction of every geom whose name starts with ``caster`` (0: frictionless
-        casters; an ablation, docs/mujoco.md).
+        contacts, condim 1; an ablation, docs/mujoco.md).
     torque_limit : float, optional
         Replaces the wheel actuators' torque limit, N m (inf: none; an ablation).
     """
@@ -262,6 +262,8 @@ def corridor_world(path: str, L: float, y0: float, y1: float, caster_friction: f
         for g in range(model.ngeom):
             if (mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_GEOM, g) or "").startswith("caster"):
                 model.geom_friction[g, 0] = caster_friction
+                if caster_friction == 0:  # a frictionless contact (a zero friction cone is degenerate)
+                    model.geom_condim[g] = 1
     if torque_limit is not None:
         for side in ("left", "right"):
             a = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_ACTUATOR, side)
