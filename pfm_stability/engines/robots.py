@@ -320,8 +320,19 @@ def heading(quaternion) -> float:
 
 @dataclass(frozen=True)
 class DriveCheck:
-    """What `check_drives` measured: the straight run's distance (m) and drift (m), the turn's mean yaw rate (rad/s,
-    the package's sign), the largest tilt (deg)."""
+    """What `check_drives` measured.
+
+    Attributes
+    ----------
+    distance : float
+        The straight run's distance, m.
+    drift : float
+        Its sideways drift, m.
+    turn_rate : float
+        The turn's mean turning rate θ̇, rad/s (the package's sign).
+    tilt : float
+        The largest tilt of the base, deg.
+    """
 
     distance: float
     drift: float
