@@ -4,10 +4,12 @@
 
 For each shipped robot (``diffdrive``, ``diffdrive-heavy``):
 
-1. **Identify** its steering plant as a user would: drive it open loop at 0.8 m/s with a small
-   yaw-rate command (0.1 rad/s steps, then a chirp; `engines.mujoco.drive_log`), write the log as a CSV
-   (``DIR/<robot>_identify.csv``, docs/diagnose.md) and run the package's identification on it
-   (`analysis.identification.identify`, the gyro's rate): g, τ, D.
+1. **Identify** its steering plant as a user would: drive it open loop with a small yaw-rate command
+   (0.1 rad/s steps, then a chirp; `engines.mujoco.drive_log`), write the log as a CSV
+   (``DIR/<robot>_V<speed>_identify.csv``, docs/diagnose.md) and run the package's identification on it
+   (`analysis.identification.identify`, the gyro's rate): g, τ, D. The plant depends on the speed
+   (the gain falls from 0.88 at 0.5 m/s to 0.76 at 1.2 m/s for ``diffdrive``), so it is identified at
+   0.8 m/s, then again at the speed of the boundary that plant predicts, twice (`identify_at_boundary`).
 2. **Predict and bisect** V* in corridors L ∈ {0.7, 0.9, 1.2} m with T ∈ {0.065, 0.1} s (k = 2 1/s,
    f = 3, n = 2, command hold, one sample of compute delay): `validation.validate_boundary` with the
    MuJoCo runner (`engines.mujoco.MujocoRuns`) bisects MuJoCo's V* and sets every model's prediction
@@ -41,27 +43,43 @@ CORRIDORS = (0.7, 0.9, 1.2)
 PERIODS = (0.065, 0.1)
 K, F, N = 2.0, 3.0, 2.0
 IDENTIFY = dict(profile="both", V=0.8, T=0.05, amplitude=0.1, duration=60.0)
+IDENTIFY_ROUNDS = 2
+"""Identifications at the predicted boundary's speed after the first at 0.8 m/s (`identify_at_boundary`)."""
 BISECTION = dict(rtol=0.01, members=7)
 MODELS = ("continuous", "kb_first_order", "pade", "exact_delay", "sampled")
 
 
-def identify_robot(name: str, out_dir: str, options: dict | None = None) -> dict:
-    """Drive, log as CSV, identify: {g, tau, dead_time (value, low, high), r2, warnings, csv}."""
+def identify_robot(name: str, out_dir: str, options: dict | None = None, V: float = 0.8) -> dict:
+    """Drive at V (m/s), log as CSV, identify: {g, tau, dead_time (value, low, high), r2, warnings, csv, V}."""
     from pfm_stability.analysis.identification import identify
     from pfm_stability.engines.mujoco import EngineOptions, drive_log, write_csv_log
     from pfm_stability.io.logs import read_log
 
     opts = EngineOptions(robot_model=name, **(options or {}))
-    log = drive_log(options=opts, **IDENTIFY)
+    log = drive_log(options=opts, **{**IDENTIFY, "V": V})
     suffix = "" if not options else "_" + "_".join(f"{k}{v}" for k, v in sorted(options.items()))
-    path = os.path.join(out_dir, f"{name}{suffix}_identify.csv")
+    path = os.path.join(out_dir, f"{name}{suffix}_V{V:.2f}_identify.csv")
     write_csv_log(log, path)
     result = identify(read_log(path, need=("command", "imu")), "imu")
     if not result.identified:
         raise RuntimeError(f"{name}: nothing identified: {result.reason}")
     p = result.plant
     return {"g": p.g.to_dict(), "tau": p.tau.to_dict(), "dead_time": p.dead_time.to_dict(), "r2": p.quality.r2,
-            "warnings": [w.kind for w in p.warnings], "csv": os.path.basename(path), "T": result.controller.T}
+            "warnings": [w.kind for w in p.warnings], "csv": os.path.basename(path), "T": result.controller.T, "V": V}
+
+
+def identify_at_boundary(name: str, L: float, T: float, out_dir: str, options: dict | None = None, rounds: int = IDENTIFY_ROUNDS) -> dict:
+    """The plant identified at the speed of the predicted boundary: identify at 0.8 m/s, predict V* (`sampled`),
+    identify again at that speed, `rounds` times (the plant's gain and lag depend on the speed; docs/mujoco.md)."""
+    from pfm_stability.validation.common import predicted_boundaries, scenario_law, validation_models
+
+    plant = identify_robot(name, out_dir, options, IDENTIFY["V"])
+    for _ in range(rounds):
+        robot, controller, _ = predicted_pair(name, plant, T)
+        law = scenario_law("grid", robot, controller)
+        V = predicted_boundaries("corridor", "V", robot, controller, law, L, validation_models(controller))["sampled"]
+        plant = identify_robot(name, out_dir, options, round(V, 2))
+    return plant
 
 
 def predicted_pair(name: str, plant: dict, T: float):
@@ -74,12 +92,15 @@ def predicted_pair(name: str, plant: dict, T: float):
     return provisional_prediction(robot, controller, plant["g"]["value"], max(plant["dead_time"]["value"], 0.0))
 
 
-def bisect_case(name: str, plant: dict, L: float, T: float, duration: float | None, engine: dict | None = None,
-                simulator: bool = False) -> dict:
-    """MuJoCo's V* (or, with `simulator`, the package simulator's) and every model's prediction for one corridor."""
+def bisect_case(name: str, plant: dict | None, L: float, T: float, duration: float | None, engine: dict | None = None,
+                simulator: bool = False, out_dir: str = ".") -> dict:
+    """MuJoCo's V* (or, with `simulator`, the package simulator's) and every model's prediction for one corridor; the
+    plant identified at the predicted boundary's speed when `plant` is None."""
     from pfm_stability.engines.mujoco import EngineOptions, MujocoRuns
     from pfm_stability.validation import validate_boundary
 
+    if plant is None:
+        plant = identify_at_boundary(name, L, T, out_dir, {k: v for k, v in (engine or {}).items() if k == "caster_friction"})
     robot, controller, note = predicted_pair(name, plant, T)
     runner = None if simulator else MujocoRuns.factory(EngineOptions(robot_model=name, command_gain=K, **(engine or {})))
     started = time.perf_counter()
@@ -90,6 +111,7 @@ def bisect_case(name: str, plant: dict, L: float, T: float, duration: float | No
         "relative_error": {m: v.relative_error[m] for m in MODELS},
         "runs": v.runs, "duration": v.inputs["duration"], "seconds": time.perf_counter() - started, "prediction_note": note,
         "engine": "sim" if simulator else {k: ("inf" if v == math.inf else v) for k, v in (engine or {}).items()},
+        "plant": plant,
     }
 
 
@@ -205,39 +227,35 @@ def main(argv=None) -> int:
     corridors, periods = ((0.9,), (0.065,)) if args.quick else (CORRIDORS, PERIODS)
     duration = 20.0 if args.quick else None
     with ProcessPoolExecutor(max_workers=args.workers) as pool:
-        plants = dict(zip(names, pool.map(_call, [(identify_robot, (n, args.out_dir), {}) for n in names])))
-        for n in names:
-            p = plants[n]
-            print(f"{n}: g = {p['g']['value']:.4f}, tau = {p['tau']['value']:.4f} s, D = {1000 * p['dead_time']['value']:.1f} ms "
-                  f"(R2 {p['r2']:.4f})", file=sys.stderr)
-        jobs = [(bisect_case, (n, plants[n], L, T, duration), {}) for n in names for L in corridors for T in periods]
+        jobs = [(bisect_case, (n, None, L, T, duration), {"out_dir": args.out_dir}) for n in names for L in corridors for T in periods]
         cases = list(pool.map(_call, jobs))
         for c in cases:
-            print(f"{c['robot']} L={c['L']} T={c['T']}: V* MuJoCo {c['V_mujoco']:.3f}, sampled {c['predicted']['sampled']:.3f} "
+            p = c["plant"]
+            print(f"{c['robot']} L={c['L']} T={c['T']}: plant at {p['V']:.2f} m/s g = {p['g']['value']:.4f}, tau = {p['tau']['value']:.4f} s, "
+                  f"D = {1000 * p['dead_time']['value']:.1f} ms; V* MuJoCo {c['V_mujoco']:.3f}, sampled {c['predicted']['sampled']:.3f} "
                   f"({100 * c['relative_error']['sampled']:+.1f} %), {c['runs']} runs, {c['seconds']:.0f} s", file=sys.stderr)
         ablation = None
         if not args.quick:
             worst = max(cases, key=lambda c: abs(c["relative_error"]["sampled"]))
-            n, L, T = worst["robot"], worst["L"], worst["T"]
-            frictionless = identify_robot(n, args.out_dir, {"caster_friction": 0.0})
+            n, L, T, plant = worst["robot"], worst["L"], worst["T"], worst["plant"]
             jobs = [
-                (bisect_case, (n, plants[n], L, T, duration), {"engine": {"torque_limit": math.inf}}),
-                (bisect_case, (n, frictionless, L, T, duration), {"engine": {"caster_friction": 0.0}}),
-                (bisect_case, (n, plants[n], L, T, duration), {"engine": {"sensing": "drawn"}}),
-                (bisect_case, (n, plants[n], L, T, duration), {"simulator": True}),
+                (bisect_case, (n, plant, L, T, duration), {"engine": {"torque_limit": math.inf}}),
+                (bisect_case, (n, None, L, T, duration), {"engine": {"caster_friction": 0.0}, "out_dir": args.out_dir}),
+                (bisect_case, (n, plant, L, T, duration), {"engine": {"sensing": "drawn"}}),
+                (bisect_case, (n, plant, L, T, duration), {"simulator": True}),
             ]
             effects = ("rate limit (no torque limit)", "caster drag (frictionless casters, plant re-identified)",
                        "sensing (the drawn grid instead of ray casts)", "lag not first order (the package's simulator with the identified first-order plant)")
             runs = list(pool.map(_call, jobs))
             ablation = {"case": {"robot": n, "L": L, "T": T, "sampled_gap": worst["relative_error"]["sampled"]},
-                        "frictionless_plant": frictionless,
+                        "frictionless_plant": runs[1]["plant"],
                         "runs": [{"removed": e, "V": r["V_mujoco"], "sampled": r["predicted"]["sampled"],
                                   "sampled_gap": r["relative_error"]["sampled"]} for e, r in zip(effects, runs)]}
             for r in ablation["runs"]:
                 print(f"  without {r['removed']}: V* {r['V']:.3f}, sampled {r['sampled']:.3f} ({100 * r['sampled_gap']:+.1f} %)", file=sys.stderr)
     kb = [c["relative_error"]["kb_first_order"] for c in cases]
     out = {
-        "identification": plants, "controller": {"k": K, "f": F, "n": N, "hold": "command", "compute_delay": 1},
+        "identification": {f"{c['robot']} L={c['L']:g} T={c['T']:g}": c["plant"] for c in cases}, "controller": {"k": K, "f": F, "n": N, "hold": "command", "compute_delay": 1},
         "bisection": BISECTION, "cases": cases, "ablation": ablation,
         "kb_error": {"min": min(kb), "max": max(kb), "mean": sum(kb) / len(kb)},
         "sampled_within_10_percent": all(abs(c["relative_error"]["sampled"]) <= 0.10 for c in cases),
@@ -249,7 +267,7 @@ def main(argv=None) -> int:
     text = table(cases)
     write_text(os.path.join(args.out_dir, "mujoco_corridor.md"), text)
     corridor_figure(cases, os.path.join(args.out_dir, "mujoco_corridor.png"))
-    robot_figure(names, plants, os.path.join(args.out_dir, "mujoco_robots.png"))
+    robot_figure(names, {n: identify_robot(n, args.out_dir) for n in names}, os.path.join(args.out_dir, "mujoco_robots.png"))
     print(text, end="")
     print(f"KB's criterion (kb_first_order) against MuJoCo: {100 * out['kb_error']['min']:+.1f} % to {100 * out['kb_error']['max']:+.1f} %; "
           f"sampled within 10 % in every case: {out['sampled_within_10_percent']}; {out['seconds']:.0f} s")

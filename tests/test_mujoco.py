@@ -68,6 +68,29 @@ def test_drives_straight_and_turns_without_side_slip(name):
     assert abs(local[1]) < 0.01 * local[0]
 
 
+@pytest.mark.parametrize("name", list(ROBOT_MODELS))
+def test_small_turns_are_linear(name):
+    """The yaw-rate gain of a steady turn is the same for 0.01 and 0.3 rad/s commands (to 0.5 %) and the rate is
+    steady (its spread below 1 % of the command): no deadband, no rocking — what the loop models assume of a small
+    oscillation. (Flat cylinder tyres or a second caster break both: docs/mujoco.md, "Robot files".)"""
+    robot = load_robot_model(name)
+    model = corridor_world(robot.path, math.inf, 0.0, 0.0)
+    data = mujoco.MjData(model)
+    gains = []
+    for command in (0.01, 0.3):
+        place(model, data, robot, 0.0, 0.0, 0.0, 1.0)
+        data.ctrl[:] = robot.wheel_speeds(1.0, -command)
+        mujoco.mj_step(model, data, nstep=1500)
+        rates = []
+        for _ in range(100):
+            mujoco.mj_step(model, data, nstep=10)
+            rates.append(float(data.qvel[5]))
+        gains.append(np.mean(rates) / command)
+        assert np.std(rates) < 0.01 * command
+    assert gains[0] == pytest.approx(gains[1], rel=0.005)
+    assert 0.5 < gains[0] < 1.0
+
+
 def test_heading_and_wheel_speeds_follow_the_package_frames():
     """θ = π/2 − ψ: a base yawed by ψ = π/2 (facing +Y) has θ = 0, by ψ = 0 (facing +X) θ = π/2; a positive θ̇
     (clockwise) makes the left wheel faster: (V ± θ̇·b/2)/r, by hand."""
@@ -131,8 +154,8 @@ def test_runs_are_deterministic_and_measured_like_the_simulator():
 
 def test_a_narrow_fast_corridor_collides_and_a_slow_one_settles():
     """Far beyond the boundary (V = 3 m/s in L = 0.7 m) the robot swings into a wall — a MuJoCo contact, the
-    collision event, unstable — while at V = 0.3 m/s it settles (σ < 0); the sampled model (τ = 0.26 s, k_eff = 1.7)
-    puts V* near 0.6 m/s in this corridor, so both lie far from the boundary."""
+    collision event, unstable — while at V = 0.3 m/s it settles (σ < 0); MuJoCo's V* in this corridor is about
+    1 m/s (experiments/mujoco_corridor.py), so both lie far from the boundary."""
     from pfm_stability.sim.verdict import simulated_verdict
 
     fast = make_scenario("corridor", env="grid", robot=ROBOT.replace(V=3.0), controller=CONTROLLER, L=0.7, offset=0.05, duration=15)
@@ -179,22 +202,37 @@ def test_provisional_prediction_folds_the_plant():
 
 
 @pytest.mark.slow
+def test_the_sampled_model_predicts_mujocos_boundary():
+    """The suite's reduced experiment: one corridor (L = 0.9 m, T = 0.065 s), 10-s runs, a 10 % bracket. MuJoCo's V*
+    bisected with the engine's k = 2 1/s lies within 15 % of the sampled model's with the plant of this robot identified
+    near that speed (g = 0.695, τ = 0.1185 s at 1.66 m/s: experiments/mujoco_corridor.py, the provisional folding
+    k_eff = g·k); 10 % in the full experiment, which has 30-s runs and a 1 % bracket."""
+    from pfm_stability.engines.mujoco import MujocoRuns
+    from pfm_stability.validation import validate_boundary
+
+    robot, controller, _ = provisional_prediction(Robot(V=1.5, tau=0.1185, k=2.0, W=0.5), CONTROLLER, 0.695, 0.0)
+    v = validate_boundary("corridor", "V", robot=robot, controller=controller, env="grid", L=0.9, duration=10.0, rtol=0.1, members=4,
+                          runner=MujocoRuns.factory(EngineOptions(command_gain=2.0)))
+    assert v.bracket[0] < v.simulated_boundary < v.bracket[1]
+    assert abs(v.relative_error["sampled"]) < 0.15, v.relative_error
+    assert v.relative_error["kb_first_order"] > 0.15  # KB's criterion: far more optimistic than MuJoCo
+
+
+@pytest.mark.slow
 def test_validate_with_the_mujoco_engine(tmp_path):
-    """The suite's reduced experiment: one corridor (L = 0.9 m, T = 0.065 s), short runs, wide bracket. The command
-    prints the validate JSON with MuJoCo's boundary bracketed and every model's prediction beside it; the sampled
-    model with the identified plant of this robot (g = 0.86, τ = 0.26 s: experiments/mujoco_corridor.py) lies within
-    15 % of it (10 % in the full experiment; here 10-s runs and a 10 % bracket)."""
+    """``validate --engine mujoco`` prints the validate JSON (valid against the shipped schema) with MuJoCo's boundary
+    inside its bracket, every model's prediction beside it and the engine in the notes (a short, coarse bisection:
+    the accuracy is the previous test's)."""
     config = tmp_path / "robot.yaml"
-    config.write_text("robot: {V: 1.0, tau: 0.258, k: 1.72, W: 0.5}\ncontroller: {T: 0.065, f: 3.0, n: 2, hold: command, compute_delay: 1}\n")
+    config.write_text("robot: {V: 1.5, tau: 0.12, k: 2.0, W: 0.5}\ncontroller: {T: 0.065, f: 3.0, n: 2, hold: command, compute_delay: 1}\n")
     code, out, err = run_cli(["validate", "--engine", "mujoco", "--config", str(config), "--scenario", "corridor", "--parameter", "V",
-                              "--L", "0.9", "--members", "4", "--rtol", "0.1", "--duration", "10", "--format", "json", "--quiet"])
+                              "--L", "0.9", "--members", "3", "--rtol", "0.2", "--duration", "6", "--format", "json", "--quiet"])
     assert code == 0, err
     d = json.loads(out)
     assert not list(VALIDATOR.iter_errors(d))
     assert d["command"] == "validate" and "MuJoCo" in d["notes"]["engine"]
     lo, hi = d["bracket"]
-    assert lo < d["simulated_boundary"] < hi
-    assert abs(d["relative_error"]["sampled"]) < 0.15
+    assert lo <= d["simulated_boundary"] <= hi
     assert set(d["predicted_boundary"]) == {"continuous", "kb_first_order", "pade", "exact_delay", "sampled"}
 
 
@@ -205,7 +243,7 @@ BAD = {
         "is not a velocity actuator"),
     "no lidar": (lambda s: re.sub(r'<site name="lidar"[^>]*/>', "", s), "no site named 'lidar'"),
     "not XML": (lambda s: s[: len(s) // 2], "MuJoCo cannot read it"),
-    "falls over": (lambda s: re.sub(r'\s*<geom name="caster_(front|back)"[^>]*/>', "", s).replace('size="0.25 0.04" pos="0 0 0.03"', 'size="0.05 0.3" pos="0.02 0 0.3"'),
+    "falls over": (lambda s: re.sub(r'\s*<geom name="caster_front"[^>]*/>', "", s).replace('size="0.25 0.04" pos="0.06 0 0.03"', 'size="0.05 0.3" pos="0.02 0 0.3"'),
                    "cannot drive: it fell over"),
     "wheels about the wrong axis": (lambda s: s.replace('axis="0 1 0"', 'axis="0 -1 0"'), "cannot drive: it moved -"),
 }

@@ -100,7 +100,7 @@ class EngineOptions:
         if self.caster_friction is not None:
             object.__setattr__(self, "caster_friction", check_number("caster_friction", self.caster_friction, 0.0, 10.0, low_open=False))
         if self.torque_limit is not None:
-            object.__setattr__(self, "torque_limit", check_number("torque_limit", self.torque_limit, 0.0, math.inf, high_open=False, unit="N m"))
+            object.__setattr__(self, "torque_limit", (math.inf if self.torque_limit == math.inf else check_number("torque_limit", self.torque_limit, 0.0, 1e6, unit="N m")))
         if self.command_gain is not None:
             object.__setattr__(self, "command_gain", check_number("command_gain", self.command_gain, 0.0, 1e4, unit="1/s"))
 

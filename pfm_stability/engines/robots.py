@@ -12,9 +12,9 @@ the two wheel bodies across the base. `load_robot_model` refuses (one-line `Valu
 cannot read or compile and a robot missing a convention; `check_drives` refuses one that cannot drive
 (it falls over, does not move, drifts off a straight line or turns the wrong way).
 
-The shipped robots (``data/robots/*.xml``, `ROBOT_MODELS`): ``diffdrive`` (a 0.5 m disc of 13.5 kg on
+The shipped robots (``data/robots/*.xml``, `ROBOT_MODELS`): ``diffdrive`` (a 0.5 m disc of 13.3 kg on
 0.075 m wheels 0.40 m apart) and ``diffdrive-heavy`` (0.6 m, 42 kg, 0.10 m wheels 0.50 m apart, a
-stiffer motor): two driven wheels, ball casters front and back.
+stiffer motor): two driven wheels with rounded tyres, one ball caster in front.
 
 Frames: the package's angles are measured from +Y towards +X (docs/theory.md, notation); MuJoCo's yaw
 ψ from +X towards +Y, so a heading θ is the yaw ψ = π/2 − θ, and a turning rate θ̇ is the yaw rate −ψ̇.
