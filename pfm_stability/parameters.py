@@ -57,6 +57,8 @@ __all__ = [
     "to_radians",
     "TAU_RESOLUTION",
     "T_RESOLUTION",
+    "DEAD_TIME_RESOLUTION",
+    "dead_time_split",
     "check_corridor_fits",
 ]
 
@@ -64,6 +66,46 @@ TAU_RESOLUTION = 1e-9
 """τ with τ·k below this is taken as 0, an ideal steering motor, by the models and the simulator
 alike: the lag is 10⁹ times faster than the steering loop, below the resolution of either, and its
 pole at −1/τ would leave floating point."""
+
+DEAD_TIME_RESOLUTION = 1e-9
+"""A dead time within this fraction of a period of a whole number of periods is taken as that whole number
+(`dead_time_split`): D/T is rarely exact in floating point (0.1/0.05 is 2 to round-off, or just under), and a
+sub-interval of 1e-9·T moves the robot by 1e-9 of a step while it adds a mode at z = 0 that the
+simulator's linear-prediction fit and the sampled model would have to carry."""
+
+
+def dead_time_split(T: float, compute_delay: int, dead_time: float) -> tuple:
+    """(m, ε): a command computed at t_k reaches the motor at t_k + d·T + D = t_k + m·T + ε, 0 <= ε < T.
+
+    Over [t_k, t_k+1) the motor then sees u_(k−m−1) for the first ε seconds and
+    u_(k−m) for the rest: the one rule of the simulator (`sim.robot.delay_split`) and
+    of the `sampled` model (docs/models.md, "Plant gain and dead time"). ε within
+    `DEAD_TIME_RESOLUTION`·T of 0 or of T is snapped to a whole period.
+
+    Parameters
+    ----------
+    T : float
+        Sampling period, s (> 0).
+    compute_delay : int
+        d, samples (0 or 1).
+    dead_time : float
+        D, s (>= 0).
+
+    Returns
+    -------
+    m : int
+        Whole periods, d included.
+    eps : float
+        The fraction of a period, s, in [0, T).
+    """
+    whole = math.floor(dead_time / T)
+    eps = max(dead_time - whole * T, 0.0)
+    if eps > (1.0 - DEAD_TIME_RESOLUTION) * T:
+        whole, eps = whole + 1, 0.0
+    elif eps < DEAD_TIME_RESOLUTION * T:
+        eps = 0.0
+    return int(compute_delay) + int(whole), eps
+
 
 T_RESOLUTION = 1e-12
 """A loop delay / sampling period T (s) below this is taken as 0, a continuous controller, by the
@@ -162,6 +204,8 @@ RANGES = {
     "alpha_deg": Range(_ALPHA_MARGIN_DEG, 90.0 - _ALPHA_MARGIN_DEG, low_open=False, unit="deg"),
     "L": Range(0.0, 1e4, unit="m"),
     "max_steering_rate": Range(0.0, math.inf, high_open=True, unit="rad/s"),
+    "dead_time": Range(0.0, 10.0, low_open=False, unit="s"),
+    "plant_gain": Range(1e-3, 100.0, low_open=False),
     # where a computation needs a narrower range than the parameter's own
     "T_sampled": Range(0.0, 100.0, unit="s"),
     # simulator and validation options
@@ -209,6 +253,16 @@ Lower bounds are physical (V > 0, τ >= 0, a steering gain of at least
 10⁻⁶ 1/s, a width of at least 1 mm, f >= 10⁻⁶, n >= 0.01 …); upper bounds
 are generous caps (100 m/s, 100 s, 10⁴ 1/s …). Both keep every computation
 inside floating point (f^(1/n) and Wⁿ of an equilibrium, a scan over k).
+
+``dead_time``, ``plant_gain``
+    The steering plant g·e^(−sD)/(τs + 1) of a real robot (docs/simulator.md,
+    "Plant gain and dead time"): D in [0, 10] s — causal (``identify`` writes a
+    negative estimate as 0), and 10 s is ten times the longest dead time
+    ``identify`` searches, far past any steering robot; g in [10⁻³, 100] —
+    achieved over commanded turning rate, positive (g <= 0 turns the other way
+    or not at all: a sign error in the log, not a robot; ``identify`` refuses
+    |g| < 0.05 as "did not follow the commands"), and the ends keep the loop
+    gain g·k within [10⁻⁹, 10⁶] 1/s, inside floating point for every model.
 
 Entries beyond the robot, controller and geometry:
 
@@ -288,7 +342,7 @@ def check_parameter(name: str, value) -> float:
 
 @dataclass(frozen=True)
 class Robot:
-    """A synchro-drive robot with a first-order steering-rate lag (KB eq 6).
+    """A synchro-drive robot with a first-order steering-rate lag (KB eq 6), a plant gain and a dead time.
 
     Parameters
     ----------
@@ -301,8 +355,16 @@ class Robot:
     W : float
         Robot width, m, in [10⁻³, 100] (KB eq 1).
     max_steering_rate : float
-        Largest steering rate |ω|, rad/s, > 0 (CARMEL: 120°/s). Used by the
-        simulator only; the linear analysis assumes no saturation.
+        Largest commanded steering rate |u|, rad/s, > 0 (CARMEL: 120°/s). Used by the
+        simulator only; the linear analysis assumes no saturation. It limits the
+        command, before the plant gain: the motor reaches at most g·max_steering_rate.
+    dead_time : float
+        Dead time D of the steering plant, s, in [0, 10]: a command reaches the
+        motor D after the controller applies it (docs/simulator.md, "Plant gain
+        and dead time"; 0 = KB's robot).
+    plant_gain : float
+        Plant gain g, achieved over commanded turning rate, in [10⁻³, 100]
+        (1 = KB's robot): the motor is τω̇ + ω = g·u(t − D).
     """
 
     V: float
@@ -310,9 +372,11 @@ class Robot:
     k: float
     W: float
     max_steering_rate: float = math.radians(120.0)
+    dead_time: float = 0.0
+    plant_gain: float = 1.0
 
     def __post_init__(self):
-        for name in ("V", "tau", "k", "W", "max_steering_rate"):
+        for name in ("V", "tau", "k", "W", "max_steering_rate", "dead_time", "plant_gain"):
             object.__setattr__(self, name, check_parameter(name, getattr(self, name)))
 
     def replace(self, **changes) -> "Robot":

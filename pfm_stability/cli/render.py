@@ -49,6 +49,8 @@ _LABELS = {
     "tau": "tau (steering time constant)",
     "T": "T (sampling period)",
     "k": "k (steering gain)",
+    "dead_time": "D (steering plant dead time)",
+    "plant_gain": "g (steering plant gain)",
     "f": "f (force ratio)",
     "n": "n (repulsion exponent)",
     "W": "W (robot width)",

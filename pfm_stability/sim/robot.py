@@ -15,6 +15,18 @@ the heading). Over one hold interval of length h the input is one of
 Both are exact: θ(t) and ω(t) are linear in (θ₀, ω₀, held value) with
 coefficients that depend only on (τ, k, h), precomputed once per member.
 
+Plant gain and dead time (docs/simulator.md, "Plant gain and dead time"). A
+real motor is τω̇ + ω = g·u(t − D): the held command's solution above takes
+v = g·u, and the servo's takes k → g·k (τθ̈ + θ̇ + gkθ = gkδ̃). A command
+computed from the data of t_k is applied at t_k + d·T (compute delay d) and
+reaches the motor D later, at t_k + m·T + ε with 0 <= ε < T (`delay_split`):
+over [t_k, t_k+1) the motor sees g·u_(k−m−1) for the first ε and g·u_(k−m)
+after, two constant inputs, so the engine splits the period at ε into two
+intervals of this module's kind, each exact, each with its own graded rule
+on its own length (ε and T − ε). A dead time in a continuous servo loop
+(``hold="reference"``) is a delay differential equation, not a sequence of
+such intervals: the simulator refuses it (`Scenario`).
+
 Positions (eq 14). With θ(t) = θ₀ + Δ(t),
 
     ∫₀ʰ sin θ dt = sin θ₀ ∫cos Δ dt + cos θ₀ ∫sin Δ dt,
@@ -83,9 +95,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..numerics.solve import gauss_legendre as legendre_nodes
+from ..parameters import dead_time_split
 
 __all__ = [
-    "NODES", "RESOLUTION", "MAX_PANELS", "gauss_legendre", "slow_rate", "constant_input_modes", "servo_modes",
+    "NODES", "RESOLUTION", "MAX_PANELS", "delay_split", "gauss_legendre", "slow_rate", "constant_input_modes", "servo_modes",
     "panel_count", "graded_rule", "node_sum", "Rule", "Coefficients", "constant_input", "servo", "propagate",
     "advance_position",
 ]
@@ -101,6 +114,33 @@ MAX_PANELS = 64
 at most 2·NODES + 1 = 9 rad, so any T/τ and |θ̇|·T up to ~45 rad); beyond, the panels widen."""
 
 
+def delay_split(T, compute_delay, dead_time):
+    """(m, ε) per member: `parameters.dead_time_split` (the one rule, shared with the `sampled` model) on arrays.
+
+    Over [t_k, t_k+1) the motor sees u_(k−m−1) for the first ε seconds and
+    u_(k−m) for the rest (module docstring).
+
+    Parameters
+    ----------
+    T : ndarray, shape (B,)
+        Sampling period, s (> 0).
+    compute_delay : ndarray of int, shape (B,)
+        d, samples (0 or 1).
+    dead_time : ndarray, shape (B,)
+        D, s (>= 0).
+
+    Returns
+    -------
+    m : ndarray of int, shape (B,)
+        Whole periods, d included.
+    eps : ndarray, shape (B,)
+        The fraction of a period, s, in [0, T).
+    """
+    pairs = [dead_time_split(float(t), int(d), float(D)) for t, d, D in
+             zip(np.ravel(T), np.ravel(compute_delay), np.ravel(dead_time))]
+    return np.array([m for m, _ in pairs], dtype=np.int64), np.array([e for _, e in pairs], dtype=float)
+
+
 def gauss_legendre(nodes: int = NODES):
     """Nodes as fractions of an interval (0, 1) and weights summing to 1.
 
@@ -113,21 +153,24 @@ def gauss_legendre(nodes: int = NODES):
     return (x + 1) / 2, w / 2
 
 
-def slow_rate(k, max_steering_rate):
-    """Bound ω_s on |θ̇|, rad/s: min(ω_max, kπ).
+def slow_rate(k, max_steering_rate, gain=1.0):
+    """Bound ω_s on |θ̇|, rad/s: g·min(ω_max, kπ).
 
     A held command is k·wrap(δ − θ) clipped to ±ω_max, and a servo's command
-    k(δ̃ − θ) starts within ±kπ; ω lags the command (eq 6), so it stays within
-    the same bound.
+    k(δ̃ − θ) starts within ±kπ; the motor turns at g times the command, and
+    ω lags it (eq 6), so it stays within the same bound.
 
     Parameters
     ----------
     k : array_like
         Steering gain, 1/s.
     max_steering_rate : array_like
-        Rate limit ω_max, rad/s.
+        Rate limit ω_max, rad/s (of the command, before the gain).
+    gain : array_like
+        Plant gain g (1: KB's motor).
     """
-    return np.minimum(np.asarray(max_steering_rate, dtype=float), np.pi * np.asarray(k, dtype=float))
+    bound = np.minimum(np.asarray(max_steering_rate, dtype=float), np.pi * np.asarray(k, dtype=float))
+    return np.asarray(gain, dtype=float) * bound
 
 
 def constant_input_modes(tau):
