@@ -13,8 +13,7 @@ For each shipped robot (``diffdrive``, ``diffdrive-heavy``):
 2. **Predict and bisect** V* in corridors L ∈ {0.7, 0.9, 1.2} m with T ∈ {0.065, 0.1} s (k = 2 1/s,
    f = 3, n = 2, command hold, one sample of compute delay): `validation.validate_boundary` with the
    MuJoCo runner (`engines.mujoco.MujocoRuns`) bisects MuJoCo's V* and sets every model's prediction
-   beside it, the models given the identified plant (provisionally g folded into k and D into the
-   compute delay: `engines.mujoco.provisional_prediction`).
+   beside it, the models given the identified plant (`Robot.plant_gain`, `Robot.dead_time`, τ).
 3. **Explain the largest gap** of the ``sampled`` model by runs that each remove one effect: the
    wheel motors' torque limit (rate limit), the casters' friction (caster drag; the plant
    re-identified), the ray-cast sensing (the drawn grid instead), and MuJoCo's plant altogether (the
@@ -75,7 +74,7 @@ def identify_at_boundary(name: str, L: float, T: float, out_dir: str, options: d
 
     plant = identify_robot(name, out_dir, options, IDENTIFY["V"])
     for _ in range(rounds):
-        robot, controller, _ = predicted_pair(name, plant, T)
+        robot, controller = predicted_pair(name, plant, T)
         law = scenario_law("grid", robot, controller)
         V = predicted_boundaries("corridor", "V", robot, controller, law, L, validation_models(controller))["sampled"]
         plant = identify_robot(name, out_dir, options, round(V, 2))
@@ -83,13 +82,12 @@ def identify_at_boundary(name: str, L: float, T: float, out_dir: str, options: d
 
 
 def predicted_pair(name: str, plant: dict, T: float):
-    """The predictions' robot and controller from the identified plant (provisional folding) and the controller's k."""
-    from pfm_stability.engines.mujoco import provisional_prediction
+    """The predictions' robot (the identified τ, plant gain g and dead time D; the controller's k) and controller."""
     from pfm_stability.parameters import Controller, Robot
 
-    robot = Robot(V=1.0, tau=plant["tau"]["value"], k=K, W=ROBOTS[name])
-    controller = Controller(f=F, n=N, T=T, hold="command", compute_delay=1)
-    return provisional_prediction(robot, controller, plant["g"]["value"], max(plant["dead_time"]["value"], 0.0))
+    robot = Robot(V=1.0, tau=plant["tau"]["value"], k=K, W=ROBOTS[name], plant_gain=plant["g"]["value"],
+                  dead_time=max(plant["dead_time"]["value"], 0.0))
+    return robot, Controller(f=F, n=N, T=T, hold="command", compute_delay=1)
 
 
 def bisect_case(name: str, plant: dict | None, L: float, T: float, duration: float | None, engine: dict | None = None,
@@ -101,15 +99,15 @@ def bisect_case(name: str, plant: dict | None, L: float, T: float, duration: flo
 
     if plant is None:
         plant = identify_at_boundary(name, L, T, out_dir, {k: v for k, v in (engine or {}).items() if k == "caster_friction"})
-    robot, controller, note = predicted_pair(name, plant, T)
-    runner = None if simulator else MujocoRuns.factory(EngineOptions(robot_model=name, command_gain=K, **(engine or {})))
+    robot, controller = predicted_pair(name, plant, T)
+    runner = None if simulator else MujocoRuns.factory(EngineOptions(robot_model=name, **(engine or {})))
     started = time.perf_counter()
     v = validate_boundary("corridor", "V", robot=robot, controller=controller, env="grid", L=L, duration=duration, runner=runner, **BISECTION)
     return {
         "robot": name, "L": L, "T": T, "V_mujoco": v.simulated_boundary, "bracket": list(v.bracket),
         "predicted": {m: v.predicted_boundary[m] for m in MODELS},
         "relative_error": {m: v.relative_error[m] for m in MODELS},
-        "runs": v.runs, "duration": v.inputs["duration"], "seconds": time.perf_counter() - started, "prediction_note": note,
+        "runs": v.runs, "duration": v.inputs["duration"], "seconds": time.perf_counter() - started,
         "engine": "sim" if simulator else {k: ("inf" if v == math.inf else v) for k, v in (engine or {}).items()},
         "plant": plant,
     }

@@ -14,7 +14,7 @@ import pytest
 mujoco = pytest.importorskip("mujoco", reason="the optional extra 'mujoco' is not installed (pip install 'pfm-stability[mujoco]')")
 
 from pfm_stability.engines import ROBOT_MODELS  # noqa: E402
-from pfm_stability.engines.mujoco import EngineOptions, drive_log, engine_timestep, provisional_prediction, run_scenario, write_csv_log  # noqa: E402
+from pfm_stability.engines.mujoco import EngineOptions, drive_log, engine_timestep, run_scenario, write_csv_log  # noqa: E402
 from pfm_stability.engines.robots import check_drives, corridor_world, heading, load_robot_model, place, robot_model_path  # noqa: E402
 from pfm_stability.parameters import Controller, Robot  # noqa: E402
 from pfm_stability.sim.presets import make_scenario  # noqa: E402
@@ -193,26 +193,18 @@ def test_identified_from_a_bag_and_the_command_dead_time_shows():
     assert results[1]["dead_time"]["value"] - results[0]["dead_time"]["value"] == pytest.approx(0.05, abs=0.005)
 
 
-def test_provisional_prediction_folds_the_plant():
-    """g multiplies k (the loop gain g·k·NV); D rounds to whole periods of compute delay, at most one (by hand)."""
-    robot, controller, note = provisional_prediction(ROBOT, CONTROLLER.replace(compute_delay=0), 0.8, 0.04)
-    assert robot.k == pytest.approx(1.6, rel=1e-15) and controller.compute_delay == 1 and "provisional" in note
-    _, controller, _ = provisional_prediction(ROBOT, CONTROLLER.replace(compute_delay=0), 0.8, 0.02)
-    assert controller.compute_delay == 0
-
-
 @pytest.mark.slow
 def test_the_sampled_model_predicts_mujocos_boundary():
     """The suite's reduced experiment: one corridor (L = 0.9 m, T = 0.065 s), 10-s runs, a 10 % bracket. MuJoCo's V*
     bisected with the engine's k = 2 1/s lies within 15 % of the sampled model's with the plant of this robot identified
-    near that speed (g = 0.695, τ = 0.1185 s at 1.66 m/s: experiments/mujoco_corridor.py, the provisional folding
-    k_eff = g·k); 10 % in the full experiment, which has 30-s runs and a 1 % bracket."""
+    near that speed (g = 0.695, τ = 0.1185 s at 1.66 m/s: experiments/mujoco_corridor.py; `Robot.plant_gain`); 10 % in
+    the full experiment, which has 30-s runs and a 1 % bracket."""
     from pfm_stability.engines.mujoco import MujocoRuns
     from pfm_stability.validation import validate_boundary
 
-    robot, controller, _ = provisional_prediction(Robot(V=1.5, tau=0.1185, k=2.0, W=0.5), CONTROLLER, 0.695, 0.0)
-    v = validate_boundary("corridor", "V", robot=robot, controller=controller, env="grid", L=0.9, duration=10.0, rtol=0.1, members=4,
-                          runner=MujocoRuns.factory(EngineOptions(command_gain=2.0)))
+    robot = Robot(V=1.5, tau=0.1185, k=2.0, W=0.5, plant_gain=0.695)
+    v = validate_boundary("corridor", "V", robot=robot, controller=CONTROLLER, env="grid", L=0.9, duration=10.0, rtol=0.1, members=4,
+                          runner=MujocoRuns.factory(EngineOptions()))
     assert v.bracket[0] < v.simulated_boundary < v.bracket[1]
     assert abs(v.relative_error["sampled"]) < 0.15, v.relative_error
     assert v.relative_error["kb_first_order"] > 0.15  # KB's criterion: far more optimistic than MuJoCo
@@ -220,11 +212,13 @@ def test_the_sampled_model_predicts_mujocos_boundary():
 
 @pytest.mark.slow
 def test_validate_with_the_mujoco_engine(tmp_path):
-    """``validate --engine mujoco`` prints the validate JSON (valid against the shipped schema) with MuJoCo's boundary
-    inside its bracket, every model's prediction beside it and the engine in the notes (a short, coarse bisection:
-    the accuracy is the previous test's)."""
+    """``validate --engine mujoco --config`` with an identified plant (``plant_gain``, ``dead_time``: what ``identify
+    --out`` writes) prints the validate JSON (valid against the shipped schema) with MuJoCo's boundary inside its
+    bracket, every model's prediction beside it, the plant gain in the inputs and the engine in the notes (a short,
+    coarse bisection: the accuracy is the previous test's)."""
     config = tmp_path / "robot.yaml"
-    config.write_text("robot: {V: 1.5, tau: 0.12, k: 2.0, W: 0.5}\ncontroller: {T: 0.065, f: 3.0, n: 2, hold: command, compute_delay: 1}\n")
+    config.write_text("robot: {V: 1.5, tau: 0.12, k: 2.0, W: 0.5, plant_gain: 0.7, dead_time: 0.0}\n"
+                      "controller: {T: 0.065, f: 3.0, n: 2, hold: command, compute_delay: 1}\n")
     code, out, err = run_cli(["validate", "--engine", "mujoco", "--config", str(config), "--scenario", "corridor", "--parameter", "V",
                               "--L", "0.9", "--members", "3", "--rtol", "0.2", "--duration", "6", "--format", "json", "--quiet"])
     assert code == 0, err
@@ -234,6 +228,7 @@ def test_validate_with_the_mujoco_engine(tmp_path):
     lo, hi = d["bracket"]
     assert lo <= d["simulated_boundary"] <= hi
     assert set(d["predicted_boundary"]) == {"continuous", "kb_first_order", "pade", "exact_delay", "sampled"}
+    assert d["inputs"]["plant_gain"] == 0.7
 
 
 BAD = {

@@ -170,24 +170,16 @@ def _check_mujoco(args) -> None:
 
 
 def _mujoco(args, params):
-    """(robot, controller, runner) of a MuJoCo validation: the predictions' robot and controller, and MuJoCo's runner.
-
-    The robot file is read and driven first (a bad file or a robot that cannot drive: one line, exit 2).
-    TODO(Robot.dead_time): until the loop models take the plant gain and dead time, the predictions fold them
-    (`engines.mujoco.provisional_prediction`); the controller keeps its own k.
-    """
-    from ..engines.mujoco import EngineOptions, MujocoRuns, provisional_prediction
+    """MuJoCo's runner for the validation, after reading and driving the robot file (a bad file or a robot that cannot
+    drive: one line, exit 2). The robot's τ, plant gain and dead time are the predictions' (``identify --out``)."""
+    from ..engines.mujoco import EngineOptions, MujocoRuns
     from ..engines.robots import check_drives, load_robot_model
 
-    robot, controller = params.robot, params.controller
-    if controller.hold != "command":
+    if params.controller.hold != "command":
         raise ValueError("--engine mujoco holds the turning-rate command between samples (--hold command); got --hold reference")
-    check_drives(load_robot_model(args.robot_model or "diffdrive").path)
-    options = EngineOptions(robot_model=args.robot_model or "diffdrive", command_gain=robot.k)
-    g, D = getattr(robot, "plant_gain", 1.0), getattr(robot, "dead_time", 0.0)
-    if g != 1.0 or D != 0.0:
-        robot, controller, _ = provisional_prediction(robot, controller, g, D)
-    return robot, controller, MujocoRuns.factory(options)
+    name = args.robot_model or "diffdrive"
+    check_drives(load_robot_model(name).path)
+    return MujocoRuns.factory(EngineOptions(robot_model=name))
 
 
 def _work(args, params, progress):
@@ -201,15 +193,13 @@ def _work(args, params, progress):
     from .simulate import config_law
 
     law = config_law(args, params)
-    robot, controller, runner = params.robot, params.controller, None
-    if args.engine == "mujoco":
-        robot, controller, runner = _mujoco(args, params)
+    runner = _mujoco(args, params) if args.engine == "mujoco" else None
 
     validation = validate_boundary(
         args.scenario,
         args.parameter,
-        robot=robot,
-        controller=controller,
+        robot=params.robot,
+        controller=params.controller,
         env=args.env,
         L=args.L,
         alpha=Wall.from_degrees(args.alpha).alpha if args.alpha is not None else None,  # rad, inside RANGES['alpha']

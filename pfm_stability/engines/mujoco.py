@@ -34,12 +34,11 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 
 from ..checks import check_choice, check_integer, check_number
-from ..parameters import Controller, Robot
 from ..sim.events import Event
 from ..sim.grid import HistogramGrid
 from ..sim.metrics import oscillation_metrics
@@ -48,7 +47,7 @@ from ..sim.vff import cell_repulsion, direction_of, steering_command, wrap_angle
 from .robots import WALL_GROUP, check_drives, corridor_world, heading, load_robot_model, place
 
 __all__ = ["EngineOptions", "run_scenario", "run_scenarios", "MujocoRuns", "DriveLog", "drive_log", "write_csv_log",
-           "provisional_prediction", "SENSING", "PROFILES", "engine_timestep"]
+           "SENSING", "PROFILES", "engine_timestep"]
 
 SENSING = ("rays", "drawn")
 """Where the controller's grid comes from: MuJoCo's ray casts (default) or the scenario's drawn grid (an ablation:
@@ -78,9 +77,6 @@ class EngineOptions:
         Replaces the casters' sliding friction (0: no caster drag); None keeps the file's.
     torque_limit : float, optional
         Replaces the wheel motors' torque limit, N m (inf: no rate limit); None keeps the file's.
-    command_gain : float, optional
-        The steering gain k the controller uses, 1/s, when it differs from the robot's k (the
-        predictions' k folded with the plant gain until the models take it: `provisional_prediction`).
     """
 
     robot_model: str = "diffdrive"
@@ -90,7 +86,6 @@ class EngineOptions:
     sensing: str = "rays"
     caster_friction: float | None = None
     torque_limit: float | None = None
-    command_gain: float | None = None
 
     def __post_init__(self):
         object.__setattr__(self, "command_delay", check_number("command_delay", self.command_delay, 0.0, 1.0, low_open=False, unit="s"))
@@ -101,8 +96,6 @@ class EngineOptions:
             object.__setattr__(self, "caster_friction", check_number("caster_friction", self.caster_friction, 0.0, 10.0, low_open=False))
         if self.torque_limit is not None:
             object.__setattr__(self, "torque_limit", (math.inf if self.torque_limit == math.inf else check_number("torque_limit", self.torque_limit, 0.0, 1e6, unit="N m")))
-        if self.command_gain is not None:
-            object.__setattr__(self, "command_gain", check_number("command_gain", self.command_gain, 0.0, 1e4, unit="1/s"))
 
 
 def engine_timestep(file_timestep: float, T: float) -> float:
@@ -153,7 +146,8 @@ def run_scenario(scenario, options: EngineOptions = EngineOptions(), *, record: 
     scenario : Scenario
         A ``corridor`` scenario in the grid (`pfm_stability.sim.presets.make_scenario`): robot (V, k, W,
         steering-rate limit), controller (f → cell ratio, n, T, compute delay), the corridor's walls, the
-        start, the measurement axis and the duration. The robot's τ is not used: the lag is MuJoCo's.
+        start, the measurement axis and the duration. The robot's τ, plant gain and dead time are not
+        used: the plant is MuJoCo's (they are what the predictions assume of it).
     options : EngineOptions
         The robot file and the engine's settings.
     record : {"offset", "trajectory"}
@@ -192,7 +186,6 @@ def run_scenario(scenario, options: EngineOptions = EngineOptions(), *, record: 
     walls = {mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, f"wall_{s}") for s in ("left", "right")}
     q = model.jnt_qposadr[model.body_jntadr[base]]
 
-    k_cmd = options.command_gain if options.command_gain is not None else r.k
     scale = scenario.cell_ratio * r.W ** c.n
     h = scenario.window_cells // 2
     ax, ay = math.sin(scenario.target.angle), math.cos(scenario.target.angle)
@@ -243,7 +236,7 @@ def run_scenario(scenario, options: EngineOptions = EngineOptions(), *, record: 
                 grid.add_readings(pnt[0] + dist[hit] * vec[hit, 0], pnt[1] + dist[hit] * vec[hit, 1])
         fx, fy = _window_force(grid, x, y, h, scale, c.n)
         delta = float(direction_of(fx + ax, fy + ay))
-        u = float(steering_command(delta, theta, k_cmd, r.max_steering_rate))
+        u = float(steering_command(delta, theta, r.k, r.max_steering_rate))
         if pending is None:  # the robot starts as if it had been running
             pending = u
             data.ctrl[left], data.ctrl[right] = robot.wheel_speeds(r.V, u)
@@ -333,7 +326,7 @@ class MujocoRuns:
             f"({o.sensing} sensing), command dead time {1000 * o.command_delay:g} ms"
             + (f", caster friction {o.caster_friction:g}" if o.caster_friction is not None else "")
             + (f", torque limit {o.torque_limit:g} N m" if o.torque_limit is not None else "")
-            + (f", the controller's k = {o.command_gain:g} 1/s" if o.command_gain is not None else "")
+            + "; the robot's tau, plant gain and dead time are the predictions' (MuJoCo's plant is its own)"
         )}
 
     @classmethod
@@ -366,39 +359,6 @@ def _mujoco_version() -> str:
     import mujoco
 
     return mujoco.__version__
-
-
-def provisional_prediction(robot: Robot, controller: Controller, plant_gain: float, dead_time: float) -> tuple[Robot, Controller, str]:
-    """The robot and controller the loop models are given for a plant g·e^(−sD)/(τs + 1), until they take g and D.
-
-    TODO(Robot.dead_time): provisional. The models see KB's plant 1/(τs + 1) only, so g is folded into the
-    steering gain (k_eff = g·k: the loop gain is g·k·NV) and D is rounded to whole periods of compute
-    delay (a controller without compute delay gets one when D >= T/2). Once `Robot.dead_time` and
-    `Robot.plant_gain` reach the models, pass them on the robot instead and drop this function.
-
-    Parameters
-    ----------
-    robot : Robot
-        The robot with its identified τ and the controller's k.
-    controller : Controller
-        The controller (T, compute delay).
-    plant_gain : float
-        g, achieved over commanded turning rate.
-    dead_time : float
-        D, s.
-
-    Returns
-    -------
-    (Robot, Controller, str)
-        The predictions' robot and controller, and a note saying what was folded.
-    """
-    g = check_number("plant_gain", plant_gain, 0.0, 100.0)
-    D = check_number("dead_time", dead_time, 0.0, 10.0, low_open=False, unit="s")
-    extra = int(round(D / controller.T))
-    delay = min(1, controller.compute_delay + extra)
-    note = (f"provisional: plant gain g = {g:.4g} folded into k (k_eff = {g * robot.k:.4g} 1/s), dead time D = {1000 * D:.1f} ms "
-            f"rounded to a compute delay of {delay} period(s) (the models do not take g and D yet)")
-    return robot.replace(k=g * robot.k), replace(controller, compute_delay=delay), note
 
 
 # ----------------------------------------------------------------------------------- open-loop logs
