@@ -10,6 +10,7 @@ import xml.etree.ElementTree as ET
 
 import numpy as np
 import pytest
+import yaml
 
 mujoco = pytest.importorskip("mujoco", reason="the optional extra 'mujoco' is not installed (pip install 'pfm-stability[mujoco]')")
 
@@ -167,8 +168,9 @@ def test_a_narrow_fast_corridor_collides_and_a_slow_one_settles():
 
 @pytest.mark.slow
 def test_identified_from_a_bag_and_the_command_dead_time_shows():
-    """A MuJoCo drive logged as a ROS 2 bag (tests/log_helpers' writer) and read by ``pfm-stability identify``: g and
-    τ equal the CSV route's to 1e-6 (the same samples), and a command-path dead time of 50 ms adds 50 ms ± 5 ms to the
+    """A MuJoCo drive logged as a ROS 2 bag (tests/log_helpers' writer) and read by ``pfm-stability identify --out``: g
+    and τ equal the CSV route's to 1e-6 (the same samples), the written configuration carries g (``plant_gain``) and
+    the command's period, and a command-path dead time of 50 ms adds 50 ms ± 5 ms to the
     identified D (the truth: the configured delay; 5 ms is the fit's spread on a 24 s log)."""
     import tempfile
 
@@ -181,9 +183,12 @@ def test_identified_from_a_bag_and_the_command_dead_time_shows():
             synthetic = SyntheticLog(Plant(), Recording(T=0.05), log.cmd_t, log.cmd_wz, log.cmd_vx,
                                      log.odom_t, log.odom_wz, log.imu_t, log.imu_wz)
             bag = write_ros2(synthetic, f"{tmp}/bag{delay}")
-            code, out, err = run_cli(["identify", str(bag), "--rate-source", "imu", "--format", "json"])
+            code, out, err = run_cli(["identify", str(bag), "--rate-source", "imu", "--format", "json", "--out", f"{tmp}/robot{delay}.yaml"])
             assert code == 0, err
             results.append(json.loads(out)["plant"])
+            config = yaml.safe_load(open(f"{tmp}/robot{delay}.yaml"))  # what report/validate --config read
+            assert config["robot"]["plant_gain"] == pytest.approx(results[-1]["g"]["value"], rel=1e-5)
+            assert config["controller"]["T"] == pytest.approx(0.05, rel=1e-5)  # bag stamps in ns, written to 6 digits
             write_csv_log(log, f"{tmp}/log{delay}.csv")
             code, out, err = run_cli(["identify", f"{tmp}/log{delay}.csv", "--rate-source", "imu", "--format", "json"])
             csv_plant = json.loads(out)["plant"]
