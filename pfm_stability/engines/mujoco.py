@@ -21,7 +21,8 @@ The engine's timestep is the file's (at most 2 ms), shortened so that T is a who
 (docs/mujoco.md, "Timestep"). The run is recorded like the package's simulator: the lateral offset at
 the sample instants along the scenario's measurement axis, measured by
 `pfm_stability.sim.metrics.oscillation_metrics`, the project's one estimator; a contact between the
-robot and a wall is a collision and ends the run. The result is a `pfm_stability.sim.results.RunResult`,
+robot and a wall is a collision and ends the run, and so does a tilt beyond 45° (the robot falls);
+a state MuJoCo cannot integrate (non-finite) is a one-line `ValueError`. The result is a `pfm_stability.sim.results.RunResult`,
 so the validation's bisection (`pfm_stability.validation`) treats MuJoCo's runs as its own
 (`MujocoRuns`).
 
@@ -96,6 +97,10 @@ class EngineOptions:
             object.__setattr__(self, "caster_friction", check_number("caster_friction", self.caster_friction, 0.0, 10.0, low_open=False))
         if self.torque_limit is not None:
             object.__setattr__(self, "torque_limit", (math.inf if self.torque_limit == math.inf else check_number("torque_limit", self.torque_limit, 0.0, 1e6, unit="N m")))
+
+
+_UPRIGHT = math.cos(math.radians(45.0))
+"""A run ends as a collision when the base tilts by more than 45° (the robot falls onto the floor)."""
 
 
 def engine_timestep(file_timestep: float, T: float) -> float:
@@ -255,8 +260,11 @@ def run_scenario(scenario, options: EngineOptions = EngineOptions(), *, record: 
             if data.ncon and any(int(g) in walls for pair in data.contact.geom[: data.ncon] for g in pair):
                 event = Event("collision", float(data.time), float(data.qpos[q]), float(data.qpos[q + 1]))
                 break
-        if event is None and not np.all(np.isfinite(data.qpos)):
-            raise FloatingPointError(f"the MuJoCo robot reached a non-finite state at t = {data.time:.3f} s")
+        if not np.all(np.isfinite(data.qpos)):
+            raise ValueError(f"robot model {robot.name}: MuJoCo's state became non-finite at t = {data.time:.3f} s "
+                             f"(V = {r.V:g} m/s, T = {c.T:g} s): beyond what this robot can drive")
+        if event is None and data.xmat[base][8] < _UPRIGHT:  # on its side: it hit the floor
+            event = Event("collision", float(data.time), float(data.qpos[q]), float(data.qpos[q + 1]))
         now = end
     n = done + 1
     t = np.arange(n) * c.T
