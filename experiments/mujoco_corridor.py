@@ -154,7 +154,7 @@ def robot_figure(names, plants, path):
         fit = np.where(ts > D, g * step * (1 - np.exp(-(ts - D) / tau)), 0.0)
         line = a2.plot(ts, np.asarray(wz) / step, label=f"{name} (MuJoCo)")[0]
         a2.plot(ts, fit / step, "--", color=line.get_color(), label=f"identified g={g:.3f}, τ={tau:.3f} s")
-    a1.set(xlabel="t (s)", ylabel="lateral drift (mm)", title="straight run at 0.8 m/s")
+    a1.set(xlabel="t (s)", ylabel="lateral drift (mm)", title="straight run at 0.8 m/s (drift: round-off)")
     a1.legend(fontsize=8)
     a2.set(xlabel="t (s)", ylabel="yaw rate / command", title="yaw-rate step of 0.1 rad/s at 0.8 m/s")
     a2.legend(fontsize=8)
@@ -173,28 +173,29 @@ def corridor_figure(cases, path):
 
     from pfm_stability.io.files import save_figure
 
-    fig, (a1, a2) = plt.subplots(1, 2, figsize=(12, 4.6))
+    fig, (a1, a2) = plt.subplots(1, 2, figsize=(13, 5.2), gridspec_kw={"width_ratios": [1, 1.4]})
     v = np.array([c["V_mujoco"] for c in cases])
     markers = dict(zip(MODELS, "o^sdv"))
+    low, high = 0.8 * v.min(), 1.25 * max(max(c["predicted"].values()) for c in cases)
+    line = np.geomspace(low, high, 50)
+    a1.fill_between(line, 0.9 * line, 1.1 * line, color="0.85", label="±10 %", zorder=0)
+    a1.plot(line, line, "k-", lw=0.8, zorder=1)
     for m in MODELS:
-        a1.scatter(v, [c["predicted"][m] for c in cases], marker=markers[m], label=m, alpha=0.8)
-    top = 1.1 * max(max(c["predicted"].values()) for c in cases)
-    line = np.array([0.0, top])
-    a1.plot(line, line, "k-", lw=0.8)
-    a1.fill_between(line, 0.9 * line, 1.1 * line, color="0.85", label="±10 %")
-    a1.set(xlim=(0, 1.1 * v.max()), ylim=(0, top), xlabel="V* bisected in MuJoCo (m/s)", ylabel="predicted V* (m/s)",
-           title="corridor boundary: predicted against MuJoCo")
-    a1.legend(fontsize=8)
-    labels = [f"{c['robot'].replace('diffdrive', 'dd')}\nL={c['L']:g} T={c['T']:g}" for c in cases]
+        a1.scatter(v, [c["predicted"][m] for c in cases], marker=markers[m], label=m, alpha=0.85, zorder=3,
+                   s=45 if m == "sampled" else 30, edgecolors="k" if m == "sampled" else "none")
+    a1.set(xscale="log", yscale="log", xlim=(low, high), ylim=(low, high), xlabel="V* bisected in MuJoCo (m/s)",
+           ylabel="predicted V* (m/s)", title="corridor boundary: every model against MuJoCo")
+    a1.legend(fontsize=8, loc="upper left")
+    labels = [f"{'heavy' if 'heavy' in c['robot'] else 'light'} L={c['L']:g} T={c['T']:g}" for c in cases]
     x = np.arange(len(cases))
     width = 0.8 / len(MODELS)
     for i, m in enumerate(MODELS):
         a2.bar(x + (i - 2) * width, [100 * c["relative_error"][m] for c in cases], width, label=m)
     a2.axhspan(-10, 10, color="0.85", zorder=0)
     a2.axhline(0, color="k", lw=0.8)
-    a2.set_xticks(x, labels, fontsize=7)
-    a2.set(ylabel="(predicted − MuJoCo)/MuJoCo (%)", title="each model's gap")
-    a2.legend(fontsize=7, ncol=2)
+    a2.set_xticks(x, labels, fontsize=8, rotation=40, ha="right")
+    a2.set(ylabel="(predicted − MuJoCo)/MuJoCo (%)", title="each model's gap (grey: ±10 %)")
+    a2.legend(fontsize=8, ncol=3)
     fig.tight_layout()
     save_figure(fig, path, dpi=110, what="figure")
 
