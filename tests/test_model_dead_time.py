@@ -290,3 +290,42 @@ def test_region_maps_take_g_and_d():
         grid = corridor_region(robot, controller, L, V, model=model.name)
         expected = np.array([[model.is_stable(float(NV), loop) for NV in row] for row in grid.NV])
         assert np.array_equal(grid.stable, expected) and expected.any() and not expected.all()
+
+
+def test_report_gives_d_star_and_the_remedy_only_with_a_plant():
+    """A robot with D or g: every verdict carries D* (``dead_time_critical``, the model's `critical_dead_time` on
+    `Loop.of`), the table a ``D* s`` column and the footnote its meaning, and an unstable verdict whose D* is below D
+    suggests lowering the dead time to D*; KB's robot has none of them (the recorded reports' keys)."""
+    plain = build_report(CARMEL.robot, CARMEL.controller, L=1.1).to_dict()
+    assert not any("dead_time_critical" in v for v in plain["corridor"].values())
+    robot = CARMEL.robot.replace(dead_time=0.25, plant_gain=0.85)
+    report = build_report(robot, CARMEL.controller, L=1.1)
+    data = report.to_dict()["corridor"]
+    loop = Loop.of(robot, CARMEL.controller)
+    sampled = Sampled(CARMEL.controller.hold, CARMEL.controller.compute_delay)
+    assert data["sampled"]["dead_time_critical"] == pytest.approx(sampled.critical_dead_time(data["sampled"]["NV"], loop), rel=1e-12)
+    assert data["sampled"]["verdict"] == "unstable" and data["sampled"]["dead_time_critical"] < 0.25
+    assert data["sampled"]["to_stabilize"]["dead_time"] == {"to": data["sampled"]["dead_time_critical"], "direction": "lower",
+                                                            "change_percent": pytest.approx((data["sampled"]["dead_time_critical"] / 0.25 - 1) * 100)}
+    assert data["exact_delay"]["stable_side"]["dead_time_critical"] == "below"
+    code, out, _ = run(["report", "--L", "1.1", "--dead-time", "0.25", "--plant-gain", "0.85"])
+    assert code == 0 and "D* s" in out and "lower dead_time to <= " in out and "D* is the largest dead time" in out
+    code, out, _ = run(["report", "--L", "1.1"])
+    assert code == 0 and "D* s" not in out and "dead time" not in out
+
+
+def test_outputs_with_a_plant_validate_against_the_schema():
+    """`report` (wall and corridor, D* and the dead-time remedy) and `simulate` with D and g: their JSON validates
+    against the published schema (`io.schema`), the new keys included."""
+    from jsonschema import Draft202012Validator
+
+    from pfm_stability.io.schema import load_schema
+
+    validator = Draft202012Validator(load_schema())
+    for argv in (["report", "--alpha", "30", "--L", "1.1", "--dead-time", "0.25", "--plant-gain", "0.85"],
+                 ["simulate", "--scenario", "corridor", "--env", "analytic", "--duration", "3", "--dead-time", "0.05", "--plant-gain", "0.8"]):
+        code, out, err = run([*argv, "--format", "json"])
+        assert code == 0, err
+        data = json.loads(out)
+        assert not list(validator.iter_errors(data)), argv
+        assert data["inputs"]["dead_time"] in (0.25, 0.05) or data["inputs"]["dead_time"]["value"] == 0.25

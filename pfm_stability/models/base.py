@@ -476,11 +476,11 @@ class LoopModel:
         from ..numerics.solve import first_crossing
 
         gain = _check_NV(gain)
-        if gain < 0 or self.growth_rates(gain, [loop.with_delay(0.0)])[0] >= 0:
+        if gain < 0 or self._searched_growth_rates(gain, [loop.with_delay(0.0)])[0] >= 0:
             return 0.0
 
         def measure(Ts):
-            return self.growth_rates(gain, [loop.with_delay(float(T)) for T in Ts])
+            return self._searched_growth_rates(gain, [loop.with_delay(float(T)) for T in Ts])
 
         start, rtol, atol = loop.delay_search(gain)
         return first_crossing(measure, start, RANGES["T"].high, rtol=rtol, atol=atol)
@@ -498,13 +498,18 @@ class LoopModel:
         loop = _steering(loop, "critical_gain_k")
         NV = _check_NV(NV)
         lo, hi = gain_range(loop)
-        if NV < 0 or self.growth_rates(NV, [loop.replace(k=lo)])[0] >= 0:
+        if NV < 0 or self._searched_growth_rates(NV, [loop.replace(k=lo)])[0] >= 0:
             return 0.0
 
         def measure(ks):
-            return self.growth_rates(NV, [loop.replace(k=float(k)) for k in ks])
+            return self._searched_growth_rates(NV, [loop.replace(k=float(k)) for k in ks])
 
         return first_crossing(measure, lo, hi, start=lo, rtol=_DELAY_RTOL, atol=1e-12 * lo)
+
+    def _searched_growth_rates(self, gain: float, loops) -> np.ndarray:
+        """The growth rates (1/s) the searches for T*, k* and D* measure: `growth_rates` (`sampled` stands in the
+        delay loop where it carries too many delayed commands)."""
+        return self.growth_rates(gain, loops)
 
     @checked
     def critical_dead_time(self, gain: float, loop: Loop) -> float:
@@ -528,11 +533,11 @@ class LoopModel:
 
         loop = _steering(loop, "critical_dead_time")
         gain = _check_NV(gain)
-        if gain < 0 or self.growth_rates(gain, [loop.replace(dead_time=0.0)])[0] >= 0:
+        if gain < 0 or self._searched_growth_rates(gain, [loop.replace(dead_time=0.0)])[0] >= 0:
             return 0.0
 
         def measure(Ds):
-            return self.growth_rates(gain, [loop.replace(dead_time=float(D)) for D in Ds])
+            return self._searched_growth_rates(gain, [loop.replace(dead_time=float(D)) for D in Ds])
 
         start, rtol, atol = loop.delay_search(gain)
         return first_crossing(measure, start, RANGES["dead_time"].high, rtol=rtol, atol=atol)

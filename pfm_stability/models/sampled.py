@@ -96,7 +96,7 @@ from ..checks import check_choice, check_integer
 from ..numerics.matrix_exponential import zoh_blocks
 from ..parameters import HOLDS, RANGES, dead_time_split
 from ..numerics.routh import schur_cohn_stable
-from .base import AffineGainModel, LoopModel, _check_NV, checked
+from .base import AffineGainModel, _check_NV, checked
 from .continuous import Continuous
 from .family import Characteristic
 
@@ -459,66 +459,19 @@ class Sampled(AffineGainModel):
         """All closed-loop poles z (T > 0); the continuous roots s at T = 0."""
         return self._delta_eigenvalues(gain, loop) if loop.T == 0 else 1.0 + loop.T * self._delta_eigenvalues(gain, loop)
 
-    @checked
-    def critical_delay(self, gain: float, loop: Characteristic) -> float:
-        """T*: the smallest period at which the gain loses stability, D fixed (`LoopModel.critical_delay`), s.
+    def _searched_growth_rates(self, gain: float, loops) -> np.ndarray:
+        """The growth rates the searches for T*, k* and D* measure (`LoopModel._searched_growth_rates`): `growth_rates`,
+        and for a loop with a dead time `_searched_growth` (the delay loop in place of one with too many delay states).
 
-        With a dead time D the loop at T → 0 is the exact delay loop with delay D
-        (0 if it is unstable there). The search over T (`LoopModel.critical_delay`'s)
-        runs on the sampled loop wherever it carries the commands on their way
-        (at most `MAX_DELAY_STATES`, i.e. T >= ~D/63); at shorter periods it takes
-        the delay loop with the hold's mean delay, D + (d + 1/2)·T, in its place
-        (`_searched_growth`; docs/models.md, "Plant gain and dead time").
-
-        Parameters
-        ----------
-        gain : float
-            Loop gain NV, 1/s (κ for a holonomic loop).
-        loop : Loop
-            τ, T, k, c, g and D.
+        T* with a dead time D (docs/models.md, "Plant gain and dead time"): at T → 0 the loop is the exact delay
+        loop with delay D (T* = 0 if that is unstable); the sampled loop is searched wherever it carries the
+        commands on their way (at most `MAX_DELAY_STATES`, i.e. T >= ~D/63), the delay loop with the hold's mean
+        delay D + (d + 1/2)·T at shorter periods; D* beyond 64 periods likewise.
         """
-        if loop.dead_time == 0:
-            return LoopModel.critical_delay.__wrapped__(self, gain, loop)
-        from ..numerics.solve import first_crossing
-        from .exact_delay import ExactDelay
-
-        gain = _check_NV(gain)
-        if gain < 0 or not ExactDelay()._stable(gain, loop.with_delay(0.0)):
-            return 0.0
-
-        def measure(Ts):
-            return np.array([self._searched_growth(gain, loop.with_delay(float(T))) for T in Ts])
-
-        start, rtol, atol = loop.delay_search(gain)
-        return first_crossing(measure, start, RANGES["T"].high, rtol=rtol, atol=atol)
-
-    @checked
-    def critical_dead_time(self, gain: float, loop: Characteristic) -> float:
-        """D*: the largest dead time the gain tolerates at the loop's T (`LoopModel.critical_dead_time`), s.
-
-        Dead times of more than `MAX_DELAY_STATES` periods are judged on the delay
-        loop with the hold's mean delay in place of the sampled loop (`_searched_growth`).
-
-        Parameters
-        ----------
-        gain : float
-            Loop gain NV, 1/s.
-        loop : Loop
-            τ, T, k, c and g (its own D is replaced).
-        """
-        from ..numerics.solve import first_crossing
-        from .base import _steering
-
-        loop = _steering(loop, "critical_dead_time")
-        gain = _check_NV(gain)
-        if gain < 0 or self._searched_growth(gain, loop.replace(dead_time=0.0)) >= 0:
-            return 0.0
-
-        def measure(Ds):
-            return np.array([self._searched_growth(gain, loop.replace(dead_time=float(D))) for D in Ds])
-
-        start, rtol, atol = loop.delay_search(gain)
-        return first_crossing(measure, start, RANGES["dead_time"].high, rtol=rtol, atol=atol)
+        loops = list(loops)
+        if not any(loop.dead_time > 0 for loop in loops):
+            return self.growth_rates(gain, loops)
+        return np.array([self._searched_growth(gain, loop) for loop in loops])
 
     def _searched_growth(self, gain: float, loop: Characteristic) -> float:
         """The growth rate (1/s) a search over T or D measures: the sampled loop's where it carries the commands on their

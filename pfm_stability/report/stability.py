@@ -647,6 +647,9 @@ def remedies(scenario: str, verdict: ModelVerdict, robot: Robot, controller: Con
     c = verdict.critical
     current = {**law.parameters(), "V": robot.V, "f": law.lumped_f(), "T": controller.T, "k": robot.k}  # f: the user's (a grid's f_av)
     wanted = [("V", "V_critical", "lower"), ("T", "T_critical", "lower"), ("k", "k_critical", "lower")]  # (parameter, critical key, direction)
+    if "dead_time_critical" in c:  # a robot with a dead time or a plant gain (docs/models.md, "Plant gain and dead time")
+        current["dead_time"] = robot.dead_time
+        wanted.append(("dead_time", "dead_time_critical", "lower"))
     if scenario == "wall":
         wanted.append(("alpha_deg", "alpha_critical_deg", _towards(c.alpha_critical_deg, at, law)))
     else:
