@@ -1,5 +1,5 @@
-"""`HistogramGrid.add_readings`, the VFF update the MuJoCo engine's range sensor uses (KB §2; docs/mujoco.md).
-No MuJoCo needed."""
+"""What the MuJoCo engine needs without MuJoCo: `HistogramGrid.add_readings`, the VFF update its range sensor uses
+(KB §2; docs/mujoco.md), and the one-line refusal when the extra is missing."""
 
 from __future__ import annotations
 
@@ -35,3 +35,23 @@ def test_readings_on_a_frozen_grid_or_with_a_bad_increment_are_refused():
     grid.freeze()
     with pytest.raises(ValueError, match="frozen"):
         grid.add_readings([0.5], [0.5])
+
+
+def test_without_the_extra_validate_engine_mujoco_exits_2_naming_it(monkeypatch):
+    """Without MuJoCo installed (its import made to fail here) ``validate --engine mujoco`` exits 2 with one line that
+    names the extra and how to install it, before any work; the default engine does not need it."""
+    import importlib
+
+    from cli_helpers import run
+
+    real = importlib.import_module
+
+    def no_mujoco(name, *args, **kwargs):
+        if name == "mujoco":
+            raise ImportError("No module named 'mujoco'")
+        return real(name, *args, **kwargs)
+
+    monkeypatch.setattr("pfm_stability.extras.importlib.import_module", no_mujoco)
+    code, out, err = run(["validate", "--engine", "mujoco", "--scenario", "corridor", "--quiet"])
+    assert code == 2 and out == "" and err.count("\n") == 1
+    assert "optional extra 'mujoco'" in err and "pip install 'pfm-stability[mujoco]'" in err
