@@ -11,6 +11,7 @@ extra    packages                     needed by
 sweep    dask[distributed], pyarrow   ``pfm-stability sweep``
 maps     scikit-image, Pillow         ``pfm-stability map`` (reading map images, the corridors)
 logs     rosbags                      ``pfm-stability identify`` (reading ROS 1 and ROS 2 bags)
+mujoco   mujoco                       ``pfm-stability validate --engine mujoco`` (docs/mujoco.md)
 ======== ============================ ===================================
 
 `require` is called before any work; without the extra it raises
@@ -28,6 +29,7 @@ EXTRAS = {
     "sweep": {"dask": "dask[distributed]", "pyarrow": "pyarrow"},
     "maps": {"skimage": "scikit-image", "PIL": "Pillow"},
     "logs": {"rosbags": "rosbags"},
+    "mujoco": {"mujoco": "mujoco"},
 }
 """Extra → {module imported: the package that provides it}."""
 

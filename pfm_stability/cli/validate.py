@@ -3,12 +3,16 @@
     pfm-stability validate --scenario corridor --env grid --plot corridor.png
     pfm-stability validate --scenario wall --env analytic --hold reference --compute-delay 0 --format json
     pfm-stability validate --scenario corridor --parameter V --L 0.8 --sweep 200
+    pfm-stability validate --engine mujoco --robot-model diffdrive --config robot.yaml --scenario corridor --parameter V --L 0.9
 
 Bisects the boundary of a straight corridor (in L, V or f) or wall (in α, V
 or f) in the simulator, compares it with each model's prediction (with the
 simulated environment's own force law; in the grid also with KB's lumped law
 at the grid's f_av), and checks σ and ω near it against the matching
-`sampled` model. ``--sweep N`` also simulates N random parameter sets and
+`sampled` model. ``--engine mujoco`` runs the corridor's simulations in MuJoCo
+instead: the package's VFF controller on an MJCF robot (``--robot-model``),
+sensing by ray casts (docs/mujoco.md); the JSON is the same, with the engine
+in ``notes``. ``--sweep N`` also simulates N random parameter sets and
 reports how often each model's verdict agrees with the simulation. A
 ``--config`` file's ``power`` or ``grid`` law is the walls' law (with
 ``--env analytic``; a grid law's cell ratio in either environment), by the
@@ -33,10 +37,24 @@ otherwise (a log of a long validation keeps them).
 
 from __future__ import annotations
 
+from ..engines import ENGINES, ROBOT_MODELS
 from .options import PADE_ORDER, add_parameter_options, describe, integer, number, output_path, resolve_parameters
 from .progress import line_progress
 
 SCENARIO_CHOICES = ("corridor", "wall")
+
+
+def robot_model(text: str) -> str:
+    """An argparse ``type=`` for ``--robot-model``: a shipped robot's name or an existing ``.xml`` file (checked when run)."""
+    import argparse
+    import os
+
+    if text in ROBOT_MODELS or (text.lower().endswith(".xml") and os.path.isfile(text)):
+        return text
+    raise argparse.ArgumentTypeError(f"robot-model must be one of {', '.join(ROBOT_MODELS)} or an existing MJCF .xml file; got {text!r}")
+
+
+robot_model.kind = "path"  # for tests/test_cli_fuzz.py: every option has a checked type
 PARAMETER_CHOICES = ("L", "alpha", "V", "f")
 
 
@@ -66,6 +84,12 @@ def add_parser(sub) -> None:
     s.add_argument("--sweep", type=integer("sweep"), metavar="N",
                    help=f"also simulate N Latin-hypercube parameter sets, N in {describe('sweep')}, and report each model's verdict agreement")
     s.add_argument("--seed", type=integer("seed"), default=0, help=f"seed of the sweep, {describe('seed')} (default 0)")
+    e = p.add_argument_group("engine")
+    e.add_argument("--engine", choices=ENGINES, default="sim",
+                   help="what runs the simulations: the package's simulator (default) or MuJoCo (the corridor, the VFF "
+                   "controller on an MJCF robot; needs the extra 'mujoco', docs/mujoco.md)")
+    e.add_argument("--robot-model", type=robot_model, metavar="NAME|FILE.xml",
+                   help=f"with --engine mujoco: a shipped robot ({', '.join(ROBOT_MODELS)}; default diffdrive) or an MJCF file")
     out = p.add_argument_group("output")
     out.add_argument("--plot", type=output_path("plot"), metavar="PNG",
                      help="write the overlay: model boundary curves with simulated stable/unstable runs (a .png file)")
@@ -90,6 +114,10 @@ def run(args) -> int:
         raise ValueError("sweep-plot needs --sweep N")
     if args.no_map and not args.plot:
         raise ValueError("no-map applies to --plot only")
+    if args.robot_model is not None and args.engine != "mujoco":
+        raise ValueError("robot-model applies to --engine mujoco only")
+    if args.engine == "mujoco":
+        _check_mujoco(args)
     fill = ({"corridor": "L", "wall": "alpha"}[args.scenario],) if args.parameter in ("V", "f") else ()  # the fixed geometry
     params = resolve_parameters(args, fill=fill)
     if args.scenario == "corridor" and args.L is not None and args.parameter in ("V", "f"):  # the report's words
@@ -130,6 +158,30 @@ def run(args) -> int:
     return 0
 
 
+def _check_mujoco(args) -> None:
+    """The MuJoCo engine runs the corridor in the grid with a held command, without a sweep; its extra is installed."""
+    from ..extras import require
+
+    if args.scenario != "corridor" or args.env != "grid":
+        raise ValueError(f"--engine mujoco runs the corridor scenario with --env grid; got --scenario {args.scenario} --env {args.env}")
+    if args.sweep:
+        raise ValueError("--sweep runs the package's simulator; not with --engine mujoco")
+    require("mujoco", "pfm-stability validate --engine mujoco")
+
+
+def _mujoco(args, params):
+    """MuJoCo's runner for the validation, after reading and driving the robot file (a bad file or a robot that cannot
+    drive: one line, exit 2). The robot's τ, plant gain and dead time are the predictions' (``identify --out``)."""
+    from ..engines.mujoco import EngineOptions, MujocoRuns
+    from ..engines.robots import check_drives, load_robot_model
+
+    if params.controller.hold != "command":
+        raise ValueError("--engine mujoco holds the turning-rate command between samples (--hold command); got --hold reference")
+    name = args.robot_model or "diffdrive"
+    check_drives(load_robot_model(name).path)
+    return MujocoRuns.factory(EngineOptions(robot_model=name))
+
+
 def _work(args, params, progress):
     """The bisection (and the sweep): (BoundaryValidation, SweepResult or None).
 
@@ -141,6 +193,7 @@ def _work(args, params, progress):
     from .simulate import config_law
 
     law = config_law(args, params)
+    runner = _mujoco(args, params) if args.engine == "mujoco" else None
 
     validation = validate_boundary(
         args.scenario,
@@ -160,6 +213,7 @@ def _work(args, params, progress):
         **law,
         stability_map=(7, 9) if args.plot and not args.no_map else None,
         progress=progress,
+        runner=runner,
     )
     sweep = None
     if args.sweep:

@@ -10,7 +10,9 @@ Drawing helpers mark the cells an obstacle occupies: `draw_segment` (a wall
 of any orientation, one cell thick: every cell the segment passes through,
 found by sampling it every c/16), `draw_polyline`, `draw_rectangle` and
 `draw_polygon` (filled by cell centre, outline always marked), `draw_protrusion`
-(a bump on a wall), and `draw_gap` / `clear_rectangle` (openings). A segment
+(a bump on a wall), and `draw_gap` / `clear_rectangle` (openings). `add_readings` is the VFF update
+from a range sensor (KB §2: each reading adds 1 to the CV of the cell it falls
+in, up to `cv_max`; the MuJoCo engine's ray casts, docs/mujoco.md). A segment
 lying exactly on a cell boundary marks the cells on its +X / +Y side; put walls
 on cell centres (`HistogramGrid.centred`) for symmetric corridors.
 
@@ -174,6 +176,29 @@ class HistogramGrid(CellGrid):
         count = max(2, math.ceil(length / self.cell_size * _SEGMENT_SAMPLES_PER_CELL) + 1)
         s = np.linspace(0.0, 1.0, count)
         return self.cell_index(x0 + s * (x1 - x0), y0 + s * (y1 - y0))
+
+    def add_readings(self, x, y, increment: int = 1) -> "HistogramGrid":
+        """The VFF update (KB §2): each range reading at (x, y) adds `increment` to its cell's CV, capped at `cv_max`.
+
+        Several readings in one cell add up; readings outside the grid are ignored.
+
+        Parameters
+        ----------
+        x, y : array_like
+            Where the readings fell (the sensor's hit points), m.
+        increment : int
+            CV added per reading (KB: 1).
+        """
+        if self.frozen:
+            raise ValueError("grid is frozen (a shared preset grid); draw on grid.copy()")
+        increment = check_integer("increment", increment, 1, self.cv_max)
+        i, j = self.cell_index(np.ravel(x), np.ravel(y))
+        nx, ny = self.shape
+        keep = (i >= 0) & (i < nx) & (j >= 0) & (j < ny)
+        cells, counts = np.unique(np.ravel_multi_index((i[keep], j[keep]), self.shape), return_counts=True)
+        flat = self.cv.reshape(-1)  # a view: the grid's cells in (i, j) order
+        flat[cells] = np.minimum(flat[cells].astype(np.int64) + increment * counts, self.cv_max)
+        return self
 
     def draw_segment(self, p0, p1, cv=None) -> "HistogramGrid":
         """Mark every cell the segment p0 → p1 (m) passes through: a wall of any orientation.

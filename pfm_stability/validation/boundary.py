@@ -280,6 +280,7 @@ def validate_boundary(
     probe: float = 0.03,
     stability_map: tuple | None = None,
     progress=None,
+    runner=None,
 ) -> BoundaryValidation:
     """Bisect the simulated stability boundary and compare it with every model.
 
@@ -329,6 +330,11 @@ def validate_boundary(
         L/α when V is bisected) and compute every model's boundary curve.
     progress : callable, optional
         Called with one line of text after each batch.
+    runner : callable, optional
+        ``runner(scenario, env, robot, controller, fixed, common)`` builds what simulates the runs
+        (`bisection.ParameterRuns`'s interface); default the package's simulator. The MuJoCo engine's is
+        `pfm_stability.engines.mujoco.MujocoRuns.factory` (docs/mujoco.md); its ``notes`` attribute, if
+        any, is added to the notes.
 
     Returns
     -------
@@ -424,7 +430,7 @@ def validate_boundary(
             common["law"] = "grid"
         if cell_ratio is not None:
             common["cell_ratio"] = cell_ratio
-    simulate = ParameterRuns(scenario, env, robot, controller, fixed, common)
+    simulate = (runner or ParameterRuns)(scenario, env, robot, controller, fixed, common)
 
     if progress:
         progress(f"validate {scenario} ({env}): bisecting {parameter} around the sampled prediction {p:.6g} {spec.unit}".rstrip())
@@ -449,6 +455,7 @@ def validate_boundary(
         smap = simulate_stability_map(simulate, scenario, spec, env, robot, controller, law, geometry, simulated, domain, shape, cell_size, models, progress)
 
     notes = dict(notes)
+    notes.update(getattr(simulate, "notes", {}))
     notes["verdict"] = "sign of the measured growth rate sigma (collision: unstable); boundary where sigma crosses 0, interpolated linearly between the final bracket's ends"
     if quantum is not None:
         notes["quantization"] = (

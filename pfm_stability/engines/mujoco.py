@@ -1,0 +1,502 @@
+"""The project's VFF controller on a MuJoCo robot: MuJoCo's dynamics and sensing, the package's controller (docs/mujoco.md).
+
+Every sampling period T (`run_scenario`):
+
+1. **Sense.** `rays` horizontal rays from the robot's ``lidar`` site (`mujoco.mj_multiRay`, seeing the walls'
+   geom group only, up to `sensor_range`) give hit points; each adds 1 to the certainty value of its
+   cell of the robot's own histogram grid (`pfm_stability.sim.grid.HistogramGrid.add_readings`, KB §2),
+   which starts empty and has the geometry of the scenario's drawn grid.
+2. **Force and command.** The occupied cells of the active window around the robot's cell push it
+   (`pfm_stability.sim.vff.cell_repulsion`, KB eq 1–2, with the scenario's cell ratio); the target
+   pulls (eq 3); δ is the resultant's direction (eq 4) and u = sat(k·wrap(δ − θ)) (eq 5,
+   `pfm_stability.sim.vff.steering_command`).
+3. **Hold and delays.** u is held over the period (zero-order hold); with ``compute_delay = 1`` the
+   value applied over [t_k, t_k+1) is the one computed at t_k−1; a dead time `command_delay` more
+   passes before the wheels receive it (the command path's latency; rounded to the engine's timestep).
+4. **Drive.** The turning rate becomes wheel speeds, (V ∓ ψ̇·b/2)/r with ψ̇ = −u (`robots.wheel_speeds`),
+   set as the ``left`` and ``right`` velocity actuators' targets; MuJoCo steps the robot (wheel
+   servos with their torque limits, tyre and caster contacts, the chassis' inertia).
+
+The engine's timestep is the file's (at most 2 ms), shortened so that T is a whole number of steps
+(docs/mujoco.md, "Timestep"). The run is recorded like the package's simulator: the lateral offset at
+the sample instants along the scenario's measurement axis, measured by
+`pfm_stability.sim.metrics.oscillation_metrics`, the project's one estimator; a contact between the
+robot and a wall is a collision and ends the run, and so does a tilt beyond 45° (the robot falls);
+a state MuJoCo cannot integrate (non-finite) is a one-line `ValueError`. The result is a `pfm_stability.sim.results.RunResult`,
+so the validation's bisection (`pfm_stability.validation`) treats MuJoCo's runs as its own
+(`MujocoRuns`).
+
+`drive_log` drives the robot open loop with a step or chirp yaw-rate command and records what a robot's
+log holds (the command, the wheel odometry's yaw rate, the gyro's), for ``pfm-stability identify``;
+`write_csv_log` writes it as a CSV log (docs/diagnose.md, "Logs").
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..checks import check_choice, check_integer, check_number
+from ..sim.events import Event
+from ..sim.grid import HistogramGrid
+from ..sim.metrics import oscillation_metrics
+from ..sim.results import BatchResult, RunResult, Trajectory
+from ..sim.vff import cell_repulsion, direction_of, steering_command, wrap_angle
+from .robots import WALL_GROUP, check_drives, corridor_world, heading, load_robot_model, place
+
+__all__ = ["EngineOptions", "run_scenario", "run_scenarios", "MujocoRuns", "DriveLog", "drive_log", "write_csv_log",
+           "SENSING", "PROFILES", "engine_timestep"]
+
+SENSING = ("rays", "drawn")
+"""Where the controller's grid comes from: MuJoCo's ray casts (default) or the scenario's drawn grid (an ablation:
+perfect sensing)."""
+
+PROFILES = ("steps", "chirp", "both")
+"""Open-loop yaw-rate commands of `drive_log`: random steps, a chirp, or steps then a chirp (half the time each)."""
+
+
+@dataclass(frozen=True)
+class EngineOptions:
+    """How MuJoCo runs the robot (docs/mujoco.md).
+
+    Attributes
+    ----------
+    robot_model : str
+        A shipped robot's name (``diffdrive``, ``diffdrive-heavy``) or an MJCF file.
+    command_delay : float
+        Dead time on the command path, s, in [0, 1] (rounded to the engine's timestep).
+    rays : int
+        Rays per scan, in [8, 10000], evenly spread over 360°.
+    sensor_range : float
+        The rays' reach, m, in (0, 100].
+    sensing : {"rays", "drawn"}
+        The controller's grid: filled by the rays, or the scenario's drawn grid (perfect sensing).
+    caster_friction : float, optional
+        Replaces the casters' sliding friction (0: no caster drag); None keeps the file's.
+    torque_limit : float, optional
+        Replaces the wheel motors' torque limit, N m (inf: no rate limit); None keeps the file's.
+    """
+
+    robot_model: str = "diffdrive"
+    command_delay: float = 0.0
+    rays: int = 720
+    sensor_range: float = 6.0
+    sensing: str = "rays"
+    caster_friction: float | None = None
+    torque_limit: float | None = None
+
+    def __post_init__(self):
+        object.__setattr__(self, "command_delay", check_number("command_delay", self.command_delay, 0.0, 1.0, low_open=False, unit="s"))
+        object.__setattr__(self, "rays", check_integer("rays", self.rays, 8, 10_000))
+        object.__setattr__(self, "sensor_range", check_number("sensor_range", self.sensor_range, 0.0, 100.0, unit="m"))
+        check_choice("sensing", self.sensing, SENSING)
+        if self.caster_friction is not None:
+            object.__setattr__(self, "caster_friction", check_number("caster_friction", self.caster_friction, 0.0, 10.0, low_open=False))
+        if self.torque_limit is not None:
+            object.__setattr__(self, "torque_limit", (math.inf if self.torque_limit == math.inf else check_number("torque_limit", self.torque_limit, 0.0, 1e6, unit="N m")))
+
+
+_UPRIGHT = math.cos(math.radians(45.0))
+"""A run ends as a collision when the base tilts by more than 45° (the robot falls onto the floor)."""
+
+
+def engine_timestep(file_timestep: float, T: float) -> float:
+    """The engine's timestep, s: the file's, shortened so that T is a whole number of steps.
+
+    Parameters
+    ----------
+    file_timestep : float
+        The robot file's timestep, s.
+    T : float
+        The controller's period, s.
+    """
+    return T / math.ceil(T / file_timestep - 1e-9)
+
+
+def _check_scenario(scenario) -> None:
+    if scenario.target.is_point or scenario.env != "grid":
+        raise ValueError(f"the MuJoCo engine runs the corridor scenario in the grid (a target at infinity); got {scenario.name!r} ({scenario.env})")
+    if scenario.controller.hold != "command":
+        raise ValueError("the MuJoCo engine holds the turning-rate command between samples (hold=command); got hold=reference")
+    if scenario.speed_law or scenario.damping:
+        raise ValueError("the MuJoCo engine drives at constant speed without damping (no speed law, damping 0)")
+    if not scenario.analysis or scenario.analysis.get("kind") != "corridor":
+        raise ValueError(f"the MuJoCo engine runs the corridor scenario only; got {scenario.name!r}")
+
+
+def _window_force(grid: HistogramGrid, x: float, y: float, h: int, scale: float, n: float):
+    """The repulsion (F_ct) of the occupied cells of the (2h+1)² window around the robot's cell (KB eq 1–2)."""
+    i, j = (int(v) for v in grid.cell_index(x, y))
+    nx, ny = grid.shape
+    i0, i1, j0, j1 = max(i - h, 0), min(i + h + 1, nx), max(j - h, 0), min(j + h + 1, ny)
+    if i0 >= i1 or j0 >= j1:
+        return 0.0, 0.0
+    block = grid.cv[i0:i1, j0:j1]
+    ii, jj = np.nonzero(block)
+    if ii.size == 0:
+        return 0.0, 0.0
+    cx, cy = grid.cell_center(ii + i0, jj + j0)
+    fx, fy = cell_repulsion(np.array([[x]]), np.array([[y]]), cx[None, :], cy[None, :], block[ii, jj][None, :].astype(float), n)
+    return scale * float(fx[0]), scale * float(fy[0])
+
+
+def run_scenario(scenario, options: EngineOptions = EngineOptions(), *, record: str = "offset", metrics: bool = True) -> RunResult:
+    """One corridor run of the package's VFF controller on the MuJoCo robot (module docstring).
+
+    Parameters
+    ----------
+    scenario : Scenario
+        A ``corridor`` scenario in the grid (`pfm_stability.sim.presets.make_scenario`): robot (V, k, W,
+        steering-rate limit), controller (f → cell ratio, n, T, compute delay), the corridor's walls, the
+        start, the measurement axis and the duration. The robot's τ, plant gain and dead time are not
+        used: the plant is MuJoCo's (they are what the predictions assume of it).
+    options : EngineOptions
+        The robot file and the engine's settings.
+    record : {"offset", "trajectory"}
+        Keep the lateral offset only, or every sample's pose too.
+    metrics : bool
+        Measure the oscillation (`oscillation_metrics`).
+
+    Returns
+    -------
+    RunResult
+        Events (a wall contact is a ``collision``), metrics, the offset in the measurement window.
+
+    Raises
+    ------
+    ValueError
+        A scenario the engine does not run (module docstring), a robot file that cannot be read or cannot drive.
+    """
+    import mujoco
+
+    _check_scenario(scenario)
+    robot = load_robot_model(options.robot_model)
+    check_drives(robot.path)
+    r, c = scenario.robot, scenario.controller
+    grid0 = scenario.environment
+    L = float(scenario.analysis["L"])
+    x_lo, x_hi, y_lo, y_hi = grid0.extent
+    model = corridor_world(robot.path, L, y_lo, y_hi, options.caster_friction, options.torque_limit)
+    data = mujoco.MjData(model)
+    dt = engine_timestep(robot.timestep, c.T)
+    model.opt.timestep = dt
+    per_period = int(round(c.T / dt))
+    delay_steps = int(round(options.command_delay / dt))
+    base = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, "base")
+    lidar = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, "lidar")
+    left, right = (mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_ACTUATOR, s) for s in ("left", "right"))
+    walls = {mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, f"wall_{s}") for s in ("left", "right")}
+    q = model.jnt_qposadr[model.body_jntadr[base]]
+
+    scale = scenario.cell_ratio * r.W ** c.n
+    h = scenario.window_cells // 2
+    ax, ay = math.sin(scenario.target.angle), math.cos(scenario.target.angle)
+    if options.sensing == "drawn":
+        grid = grid0
+    else:
+        grid = grid0.copy()
+        grid.cv[:] = 0
+    angles = 2 * math.pi * np.arange(options.rays) / options.rays
+    group = np.zeros(6, dtype=np.uint8)
+    group[WALL_GROUP] = 1
+    geomid = np.zeros(options.rays, dtype=np.int32)
+    dist = np.zeros(options.rays)
+
+    place(model, data, robot, scenario.start.x, scenario.start.y, scenario.start.theta, r.V)
+    steps = int(math.ceil(scenario.duration / c.T - 1e-9))
+    lat, along = scenario.measure.lateral_unit, scenario.measure.along_unit
+    ox_, oy_ = scenario.measure.origin
+    off = np.zeros(steps + 1)
+    alg = np.zeros(steps + 1)
+    pose = np.zeros((steps + 1, 3)) if record == "trajectory" else None
+    theta = scenario.start.theta
+    pending = None
+    queue = []  # (engine step when it reaches the wheels, left, right)
+    now = 0
+    event = None
+    done = steps
+    for k in range(steps + 1):
+        x, y = float(data.qpos[q]), float(data.qpos[q + 1])
+        theta = theta + float(wrap_angle(heading(data.qpos[q + 3:q + 7]) - theta))  # unwrapped
+        off[k] = (x - ox_) * lat[0] + (y - oy_) * lat[1]
+        alg[k] = (x - ox_) * along[0] + (y - oy_) * along[1]
+        if pose is not None:
+            pose[k] = (x, y, theta)
+        if event is not None:
+            done = k
+            break
+        if k == steps:
+            break
+        # sense (KB eq 1–4) and compute the command (eq 5)
+        if options.sensing == "rays":
+            yaw = math.pi / 2 - theta
+            vec = np.column_stack([np.cos(yaw + angles), np.sin(yaw + angles), np.zeros(options.rays)])
+            pnt = data.site_xpos[lidar].copy()
+            mujoco.mj_multiRay(model, data, pnt, vec.ravel(), group, 1, base, geomid, dist, None, options.rays, options.sensor_range)
+            hit = geomid >= 0
+            if np.any(hit):
+                grid.add_readings(pnt[0] + dist[hit] * vec[hit, 0], pnt[1] + dist[hit] * vec[hit, 1])
+        fx, fy = _window_force(grid, x, y, h, scale, c.n)
+        delta = float(direction_of(fx + ax, fy + ay))
+        u = float(steering_command(delta, theta, r.k, r.max_steering_rate))
+        if pending is None:  # the robot starts as if it had been running
+            pending = u
+            data.ctrl[left], data.ctrl[right] = robot.wheel_speeds(r.V, u)
+        applied = pending if c.compute_delay == 1 else u
+        pending = u
+        queue.append((now + delay_steps, *robot.wheel_speeds(r.V, applied)))
+        # advance one period, switching the wheels' targets when a command arrives
+        end = now + per_period
+        while now < end:
+            if queue and queue[0][0] <= now:
+                _, data.ctrl[left], data.ctrl[right] = queue.pop(0)
+                continue
+            nxt = min(end, queue[0][0]) if queue else end
+            mujoco.mj_step(model, data, nstep=nxt - now)
+            now = nxt
+            if data.ncon and any(int(g) in walls for pair in data.contact.geom[: data.ncon] for g in pair):
+                event = Event("collision", float(data.time), float(data.qpos[q]), float(data.qpos[q + 1]))
+                break
+        if not np.all(np.isfinite(data.qpos)):
+            raise ValueError(f"robot model {robot.name}: MuJoCo's state became non-finite at t = {data.time:.3f} s "
+                             f"(V = {r.V:g} m/s, T = {c.T:g} s): beyond what this robot can drive")
+        if event is None and data.xmat[base][8] < _UPRIGHT:  # on its side: it hit the floor
+            event = Event("collision", float(data.time), float(data.qpos[q]), float(data.qpos[q + 1]))
+        now = end
+    n = done + 1
+    t = np.arange(n) * c.T
+    window = alg[:n] >= scenario.measure.along_from
+    if np.any(window):
+        window[np.argmax(window):] = True
+    offset_t, offset = t[window], off[:n][window]
+    order = (r.tau > 0) + 2 + c.compute_delay
+    m = oscillation_metrics(offset_t, offset, c.T, order=int(order), collision_time=event.t if event else None) if metrics else None
+    trajectory = Trajectory(t, pose[:n, 0].copy(), pose[:n, 1].copy(), pose[:n, 2].copy()) if pose is not None else None
+    clearance = float(L - np.max(np.abs(off[:n] + scenario.measure.origin[0] * lat[0]))) - r.W / 2 if n else None
+    return RunResult(scenario, (event,) if event else (), m, done * c.T, done, offset_t, offset.copy(), clearance, trajectory)
+
+
+def run_scenarios(scenarios, options: EngineOptions = EngineOptions(), *, record: str = "offset", metrics: bool = True) -> BatchResult:
+    """`run_scenario` for each scenario in turn (MuJoCo is deterministic: the same batch gives the same runs).
+
+    Parameters
+    ----------
+    scenarios : sequence of Scenario
+        Corridor scenarios in the grid.
+    options : EngineOptions
+        The robot file and the engine's settings.
+    record : {"offset", "trajectory"}
+        What to keep of each run.
+    metrics : bool
+        Measure each run's oscillation.
+    """
+    started = time.perf_counter()
+    runs = tuple(run_scenario(s, options, record=record, metrics=metrics) for s in scenarios)
+    return BatchResult(runs, int(sum(r.steps for r in runs)), time.perf_counter() - started)
+
+
+class MujocoRuns:
+    """The validation's runner (`pfm_stability.validation.bisection.ParameterRuns`'s interface) with MuJoCo's runs.
+
+    ``runs(name, values)`` → the `RunResult`s of the corridor at each value of `name` (``V``, ``L`` or
+    ``f``); ``runs.runs`` counts them. Build one with `MujocoRuns.factory(options)`, the callable
+    `pfm_stability.validation.validate_boundary` takes as ``runner``.
+
+    Parameters
+    ----------
+    scenario : str
+        ``"corridor"``.
+    env : str
+        ``"grid"``: the controller's grid.
+    robot, controller : Robot, Controller
+        The robot and controller of the scenarios.
+    fixed : dict
+        Parameters held fixed unless varied.
+    common : dict
+        Options of every scenario (offset, duration, window, cells).
+    options : EngineOptions
+        The robot file and the engine's settings.
+    """
+
+    def __init__(self, scenario, env, robot, controller, fixed, common, options: EngineOptions = EngineOptions()):
+        if scenario != "corridor" or env != "grid":
+            raise ValueError(f"the MuJoCo engine runs the corridor scenario with env grid; got scenario {scenario}, env {env}")
+        self.scenario, self.env = scenario, env
+        self.robot, self.controller = robot, controller
+        self.fixed, self.common, self.options = fixed, common, options
+        self.runs = 0
+        o = options
+        self.notes = {"engine": (
+            f"MuJoCo {_mujoco_version()}: robot model {load_robot_model(o.robot_model).name}, {o.rays} rays to {o.sensor_range:g} m "
+            f"({o.sensing} sensing), command dead time {1000 * o.command_delay:g} ms"
+            + (f", caster friction {o.caster_friction:g}" if o.caster_friction is not None else "")
+            + (f", torque limit {o.torque_limit:g} N m" if o.torque_limit is not None else "")
+            + "; the robot's tau, plant gain and dead time are the predictions' (MuJoCo's plant is its own)"
+        )}
+
+    @classmethod
+    def factory(cls, options: EngineOptions):
+        """A runner builder with these options: ``factory(options)(scenario, env, robot, controller, fixed, common)``.
+
+        Parameters
+        ----------
+        options : EngineOptions
+            The robot file and the engine's settings.
+        """
+        return lambda scenario, env, robot, controller, fixed, common: cls(scenario, env, robot, controller, fixed, common, options)
+
+    def __call__(self, name, values, second=None):
+        from ..sim.api import batch_scenarios
+
+        arrays = {name: np.asarray(values, dtype=float)}
+        if second is not None:
+            arrays[second[0]] = np.asarray(second[1], dtype=float)
+        if "alpha" in arrays:
+            raise ValueError("the MuJoCo engine runs the corridor scenario only (no alpha)")
+        fixed = {k: v for k, v in self.fixed.items() if k not in arrays}
+        scenarios = batch_scenarios(self.scenario, env=self.env, robot=self.robot, controller=self.controller, **fixed, **self.common, **arrays)
+        batch = run_scenarios(scenarios, self.options)
+        self.runs += len(batch)
+        return batch.runs
+
+
+def _mujoco_version() -> str:
+    import mujoco
+
+    return mujoco.__version__
+
+
+# ----------------------------------------------------------------------------------- open-loop logs
+@dataclass(frozen=True)
+class DriveLog:
+    """An open-loop drive recorded as a robot's log (times in s from the start).
+
+    Attributes
+    ----------
+    cmd_t, cmd_wz, cmd_vx : ndarray
+        The command's times (every T), yaw rate (rad/s, ROS sign: counter-clockwise positive) and forward speed (m/s).
+    odom_t, odom_wz : ndarray
+        The wheel odometry's yaw rate, (ω_right − ω_left)·r/b (rad/s), at its rate.
+    imu_t, imu_wz : ndarray
+        The gyro's yaw rate (the base's angular velocity about its z axis, rad/s), at the same instants.
+    """
+
+    cmd_t: np.ndarray
+    cmd_wz: np.ndarray
+    cmd_vx: np.ndarray
+    odom_t: np.ndarray
+    odom_wz: np.ndarray
+    imu_t: np.ndarray
+    imu_wz: np.ndarray
+
+
+def _profile(name: str, t: np.ndarray, amplitude: float, duration: float, seed: int) -> np.ndarray:
+    if name == "both":
+        half = duration / 2
+        first = t < half
+        return np.where(first, _profile("steps", t, amplitude, half, seed), _profile("chirp", t - half, amplitude, half, seed))
+    if name == "steps":
+        rng = np.random.default_rng(seed)
+        edges, levels = [0.0], [0.0]
+        while edges[-1] < duration:
+            edges.append(edges[-1] + rng.uniform(1.0, 2.5))
+            levels.append(rng.uniform(-amplitude, amplitude))
+        return np.asarray(levels)[np.searchsorted(edges, t, side="right") - 1]
+    f0, f1 = 0.05, 2.0  # chirp, Hz
+    return amplitude * np.sin(2 * np.pi * (f0 * t + (f1 - f0) * t**2 / (2 * duration)))
+
+
+def drive_log(profile: str = "both", *, options: EngineOptions = EngineOptions(), V: float = 0.8, T: float = 0.05, amplitude: float = 0.1,
+              duration: float = 60.0, rate: float = 50.0, seed: int = 0) -> DriveLog:
+    """Drive the MuJoCo robot open loop at speed V with a yaw-rate command every T and record it as a log.
+
+    Parameters
+    ----------
+    profile : {"steps", "chirp", "both"}
+        Random steps (levels held 1–2.5 s, seeded), a chirp from 0.05 to 2 Hz, or steps then a chirp.
+    options : EngineOptions
+        The robot file, the command path's dead time and the ablations.
+    V : float
+        Forward speed, m/s.
+    T : float
+        The command's period, s.
+    amplitude : float
+        The yaw-rate command's amplitude, rad/s (small: the loop models describe small oscillations,
+        and MuJoCo's contacts make the lag depend on the amplitude; docs/mujoco.md).
+    duration : float
+        s.
+    rate : float
+        The odometry's and the gyro's rate, Hz.
+    seed : int
+        Seed of the steps.
+
+    Returns
+    -------
+    DriveLog
+    """
+    import mujoco
+
+    check_choice("profile", profile, PROFILES)
+    V = check_number("V", V, 0.0, 100.0, unit="m/s")
+    T = check_number("T", T, 0.0, 10.0, unit="s")
+    duration = check_number("duration", duration, 0.0, 1e5, unit="s")
+    robot = load_robot_model(options.robot_model)
+    check_drives(robot.path)
+    model = corridor_world(robot.path, math.inf, 0.0, 0.0, options.caster_friction, options.torque_limit)
+    data = mujoco.MjData(model)
+    dt = engine_timestep(robot.timestep, T)
+    model.opt.timestep = dt
+    place(model, data, robot, 0.0, 0.0, 0.0, V)
+    cmd_t = np.arange(int(math.floor(duration / T + 1e-9))) * T
+    cmd_wz = _profile(profile, cmd_t, amplitude, duration, seed)
+    every = max(1, int(round(1.0 / (rate * dt))))
+    cmd_step = np.round(cmd_t / dt).astype(np.int64) + int(round(options.command_delay / dt))
+    total = int(round(duration / dt))
+    base = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, "base")
+    dof = model.jnt_dofadr[model.body_jntadr[base]]
+    left, right = (mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_ACTUATOR, s) for s in ("left", "right"))
+    wl, wr = (model.jnt_dofadr[model.actuator_trnid[a, 0]] for a in (left, right))
+    events = sorted(set(cmd_step.tolist()) | set(range(0, total, every)))
+    odom_t, odom_wz, imu_wz = [], [], []
+    j, now = 0, 0
+    for step in events:
+        if step > total:
+            break
+        if step > now:
+            mujoco.mj_step(model, data, nstep=step - now)
+            now = step
+        while j < cmd_step.size and cmd_step[j] <= now:
+            data.ctrl[left], data.ctrl[right] = robot.wheel_speeds(V, -cmd_wz[j])  # ROS yaw rate = −θ̇
+            j += 1
+        if now % every == 0:
+            odom_t.append(now * dt)
+            odom_wz.append((data.qvel[wr] - data.qvel[wl]) * robot.wheel_radius / robot.track)
+            imu_wz.append(float(data.qvel[dof + 5]))
+    odom_t = np.asarray(odom_t)
+    return DriveLog(cmd_t, cmd_wz, np.full_like(cmd_t, V), odom_t, np.asarray(odom_wz), odom_t.copy(), np.asarray(imu_wz))
+
+
+def write_csv_log(log: DriveLog, path) -> None:
+    """Write `log` as a CSV log (``t, cmd_wz, odom_wz, imu_wz``: one row per time, blank where a series has no value;
+    docs/diagnose.md), atomically.
+
+    Parameters
+    ----------
+    log : DriveLog
+        The recorded drive.
+    path : str or os.PathLike
+        The CSV file.
+    """
+    from ..io.files import atomic_file
+
+    rows = {}
+    for column, (ts, vs) in enumerate(((log.cmd_t, log.cmd_wz), (log.odom_t, log.odom_wz), (log.imu_t, log.imu_wz))):
+        for t_, v in zip(ts.tolist(), vs.tolist()):
+            rows.setdefault(round(t_, 9), ["", "", ""])[column] = repr(v)
+    with atomic_file(path, "w", what="log") as fh:
+        fh.write("t,cmd_wz,odom_wz,imu_wz\n")
+        for t_ in sorted(rows):
+            fh.write(f"{t_!r}," + ",".join(rows[t_]) + "\n")
