@@ -10,7 +10,13 @@ command       ``geometry_msgs/msg/Twist``                   ``angular.z`` (rad/s
 odometry      ``nav_msgs/msg/Odometry``                     ``twist.twist.angular.z`` the header stamp
 imu           ``sensor_msgs/msg/Imu``                       ``angular_velocity.z``  the header stamp
 scan          ``sensor_msgs/msg/LaserScan``                 a caller's reduction    the header stamp
+pose          ``nav_msgs/msg/Odometry`` (the odometry topic) x, y, yaw, linear.x    the header stamp
 ============= ============================================= ======================= ===================
+
+The pose (`PoseSeries`: position x, y in m, the yaw in rad from the orientation's quaternion, the forward speed
+``twist.twist.linear.x`` in m/s) is in the odometry's frame; `pose_at` interpolates it at other times (a scan's),
+which is how a scan's sensor-frame reduction is placed in the odometry frame (the laser is taken to sit at the base's
+origin, looking forward: a bag without ``/tf_static`` says nothing else).
 
 Times are seconds since the log's first message (`LogData.start`, epoch seconds, says when that was).
 A log is a ROS 2 bag (its directory, or one ``.db3``/``.mcap`` file of it), a ROS 1 ``.bag`` or a CSV
@@ -46,10 +52,10 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["LogTopics", "TimeSeries", "Scan", "ScanSeries", "LogData", "LogError", "read_log", "log_format",
-           "SERIES", "MESSAGE_TYPES", "CSV_COLUMNS"]
+__all__ = ["LogTopics", "TimeSeries", "Scan", "ScanSeries", "PoseSeries", "LogData", "LogError", "read_log", "log_format",
+           "pose_at", "SERIES", "MESSAGE_TYPES", "CSV_COLUMNS"]
 
-SERIES = ("command", "odometry", "imu", "scan")
+SERIES = ("command", "odometry", "imu", "scan", "pose")
 """The series a log can give (`LogData`'s fields of the same names)."""
 
 MESSAGE_TYPES = {
@@ -57,6 +63,7 @@ MESSAGE_TYPES = {
     "odometry": ("nav_msgs/msg/Odometry",),
     "imu": ("sensor_msgs/msg/Imu",),
     "scan": ("sensor_msgs/msg/LaserScan",),
+    "pose": ("nav_msgs/msg/Odometry",),
 }
 """Series → the message types accepted on its topic."""
 
@@ -78,8 +85,8 @@ class LogTopics:
     scan: str = "/scan"
 
     def of(self, series: str) -> str:
-        """The topic of `series` (one of `SERIES`)."""
-        return getattr(self, series)
+        """The topic of `series` (one of `SERIES`; the pose is the odometry topic's)."""
+        return self.odometry if series == "pose" else getattr(self, series)
 
 
 @dataclass(frozen=True)
@@ -124,6 +131,38 @@ class ScanSeries:
 
 
 @dataclass(frozen=True)
+class PoseSeries:
+    """The odometry's pose, one per message: `t` (s), `x`, `y` (m), `yaw` (rad, in (−π, π]) and `vx` (m/s, forward)."""
+
+    topic: str
+    t: np.ndarray
+    x: np.ndarray
+    y: np.ndarray
+    yaw: np.ndarray
+    vx: np.ndarray
+
+    @property
+    def count(self) -> int:
+        """The number of messages."""
+        return int(self.t.size)
+
+
+def pose_at(pose: PoseSeries, t) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(x, y, yaw) of `pose` linearly interpolated at the times `t` (s; the yaw unwrapped first, then wrapped).
+
+    Parameters
+    ----------
+    pose : PoseSeries
+        The odometry's pose.
+    t : array_like
+        Times, s since the log's start (clamped to the pose's span).
+    """
+    yaw = np.unwrap(pose.yaw)
+    angle = np.interp(t, pose.t, yaw)
+    return np.interp(t, pose.t, pose.x), np.interp(t, pose.t, pose.y), np.angle(np.exp(1j * angle))
+
+
+@dataclass(frozen=True)
 class LogData:
     """What `read_log` read: the series asked for (None when not asked for) and what the log holds.
 
@@ -141,6 +180,7 @@ class LogData:
     odometry: TimeSeries | None = None
     imu: TimeSeries | None = None
     scan: ScanSeries | None = field(default=None)
+    pose: PoseSeries | None = None
 
 
 # ----------------------------------------------------------------------------------------- the yaw rate in the bytes
@@ -175,6 +215,41 @@ def _cdr_value(raw, spec: _Field) -> tuple[int | None, float]:
             pos += 4 + n
     pos = ((pos + 7) & ~7) + 8 * spec.index
     return stamp, struct.unpack_from(endian + "d", raw, 4 + pos)[0]
+
+
+_POSE = _Field(True, 1, 0)
+"""Where an Odometry's pose starts: position x, y, z (0–2), orientation x, y, z, w (3–6); twist.linear.x is number 43."""
+
+
+def _pose_numbers(x: float, y: float, qx: float, qy: float, qz: float, qw: float, vx: float) -> tuple:
+    return x, y, math.atan2(2.0 * (qw * qz + qx * qy), 1.0 - 2.0 * (qy * qy + qz * qz)), vx
+
+
+def _cdr_pose(raw) -> tuple[int, tuple]:
+    """(header stamp ns, (x, y, yaw, vx)) of a ROS 2 (CDR) Odometry."""
+    endian = "<" if raw[1] & 1 else ">"
+    sec, nsec = struct.unpack_from(endian + "iI", raw, 4)
+    pos = 8
+    for _ in range(2):
+        pos = (pos + 3) & ~3
+        (n,) = struct.unpack_from(endian + "I", raw, 4 + pos)
+        pos += 4 + n
+    pos = (pos + 7) & ~7
+    x, y, _, qx, qy, qz, qw = struct.unpack_from(endian + "7d", raw, 4 + pos)
+    (vx,) = struct.unpack_from(endian + "d", raw, 4 + pos + 8 * 43)
+    return sec * 1_000_000_000 + nsec, _pose_numbers(x, y, qx, qy, qz, qw, vx)
+
+
+def _ros1_pose(raw) -> tuple[int, tuple]:
+    """(header stamp ns, (x, y, yaw, vx)) of a ROS 1 Odometry."""
+    _, sec, nsec = struct.unpack_from("<III", raw, 0)
+    pos = 12
+    for _ in range(2):
+        (n,) = struct.unpack_from("<I", raw, pos)
+        pos += 4 + n
+    x, y, _, qx, qy, qz, qw = struct.unpack_from("<7d", raw, pos)
+    (vx,) = struct.unpack_from("<d", raw, pos + 8 * 43)
+    return sec * 1_000_000_000 + nsec, _pose_numbers(x, y, qx, qy, qz, qw, vx)
 
 
 def _ros1_value(raw, spec: _Field) -> tuple[int | None, float]:
@@ -253,8 +328,9 @@ def read_log(path, topics: LogTopics = LogTopics(), *, need: Sequence[str] = ("c
         raise LogError("reading scans needs a scan_reducer (scans are reduced as they are read, never held)")
     kind = log_format(path)
     if kind == "csv":
-        if "scan" in need:
-            raise LogError(f"{path}: a CSV log has no scans (its columns: t, {', '.join(CSV_COLUMNS.values())})")
+        for series in ("scan", "pose"):
+            if series in need:
+                raise LogError(f"{path}: a CSV log has no {series}s (its columns: t, {', '.join(CSV_COLUMNS.values())})")
         return _read_csv(path, need)
     from ..extras import require
 
@@ -314,14 +390,22 @@ def _stream(reader, path: str, kind: str, topics: LogTopics, need: tuple[str, ..
             if c.msgtype not in MESSAGE_TYPES[series]:
                 raise LogError(f"topic {topic} of {path} carries {c.msgtype}; the {series} must be "
                                f"{' or '.join(MESSAGE_TYPES[series])}")
-            role_of[c.id] = series
+            role_of.setdefault(c.id, []).append(series)
     start_ns = reader.start_time
     times = {s: array("q") for s in need}  # packed 8-byte numbers, not Python objects: 16 bytes a message
     values = {s: [] if s == "scan" else array("d") for s in need}
     msgtypes = {}
     decode = _ros1_value if ros1 else _cdr_value
+    decode_pose = _ros1_pose if ros1 else _cdr_pose
     for connection, received_ns, raw in reader.messages(connections=[c for c in reader.connections if c.id in role_of]):
-        series = role_of[connection.id]
+        roles = role_of[connection.id]
+        if "pose" in roles:
+            stamp, numbers = decode_pose(raw)
+            times["pose"].append(stamp)
+            values["pose"].extend(numbers)
+            if len(roles) == 1:
+                continue
+        series = next(r for r in roles if r != "pose")
         msgtypes[series] = connection.msgtype
         if series == "scan":
             msg = reader.deserialize(raw, connection.msgtype)
@@ -347,6 +431,9 @@ def _stream(reader, path: str, kind: str, topics: LogTopics, need: tuple[str, ..
         _check_order(t, topic, path)
         if series == "scan":
             result[series] = ScanSeries(topic, t, _stack(values[series]))
+        elif series == "pose":
+            x, y, yaw, vx = np.frombuffer(values[series], dtype=float).reshape(-1, 4).T.copy()
+            result[series] = PoseSeries(topic, t, x, y, yaw, vx)
         else:
             stamps = "header" if _FIELDS[msgtypes[series]].header else "receive"
             result[series] = TimeSeries(topic, msgtypes[series], t, np.frombuffer(values[series], dtype=float).copy(), stamps)
