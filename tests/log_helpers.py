@@ -438,8 +438,9 @@ class Leg:
     """One part of a driven log: the project's VFF simulator in a corridor or beside a wall, or a manoeuvre.
 
     kind "corridor" (half-width L, m), "wall" (target angle alpha, rad, from the wall normal), "still" (the robot
-    stands) or "turn" (it turns in place at `rate` rad/s); duration (s); offset (m, the simulator's start offset
-    from the equilibrium line); length (m of wall drawn beyond the leg's path at each end).
+    stands), "turn" (it turns in place at `rate` rad/s) or "steps" (step turns up to ±`rate` rad/s at 0.3 m/s in the
+    open, which show the plant to `identify`); duration (s); offset (m, the simulator's start offset
+    from the equilibrium line); length (m of wall drawn beyond the leg's end; 0.3 m before its start).
     """
 
     kind: str
@@ -501,8 +502,8 @@ def _sim_leg(leg: Leg, robot, controller):
     for k in range(applied.size):
         omega[k + 1] = applied[k] + (omega[k] - applied[k]) * e
     geometry = leg.L if leg.kind == "corridor" else wall_equilibrium(PowerLaw(f, n, W), leg.alpha)
-    walls = ([(-leg.L, -leg.length), (-leg.L, tr.y[-1] + leg.length)], [(leg.L, -leg.length), (leg.L, tr.y[-1] + leg.length)]) \
-        if leg.kind == "corridor" else ([(0.0, -leg.length), (0.0, tr.y[-1] + leg.length)],)
+    walls = ([(-leg.L, -0.3), (-leg.L, tr.y[-1] + leg.length)], [(leg.L, -0.3), (leg.L, tr.y[-1] + leg.length)]) \
+        if leg.kind == "corridor" else ([(0.0, -0.3), (0.0, tr.y[-1] + leg.length)],)
     return tr, omega, applied, run, geometry, walls
 
 
@@ -574,16 +575,33 @@ def drive(legs, robot=None, controller=None, *, odom_rate: float = 50.0, scan_ra
             vx = np.full(t.size, robot.V)
             truth.append(LegTruth(leg.kind, t0, t0 + t[-1], run.metrics, geometry, robot.V))
             wz = -w
-        else:
+        else:  # a manoeuvre in the open: held yaw-rate commands through the lag, exactly; the position by the trapezoid rule
             t = np.arange(0.0, leg.duration, dt)
-            rate = leg.rate if leg.kind == "turn" else 0.0
             cmd_t = np.arange(0.0, leg.duration - T / 2, T)
-            cmd = (cmd_t, np.full(cmd_t.size, rate), np.zeros(cmd_t.size))
-            e = np.exp(-t / robot.tau)
-            wz = rate * (1 - e)
-            yaw = pyaw + rate * (t - robot.tau * (1 - e))
-            ox, oy, vx = np.full(t.size, px), np.full(t.size, py), np.zeros(t.size)
-            truth.append(LegTruth(leg.kind, t0, t0 + t[-1], None, None, 0.0))
+            speed = 0.3 if leg.kind == "steps" else 0.0
+            if leg.kind == "steps":  # a step turn of a random size every 1–2.5 s, both ways, with stops between
+                edges = np.cumsum(rng.uniform(1.0, 2.5, int(leg.duration) + 2))
+                levels = np.where(rng.random(edges.size) < 0.3, 0.0, rng.uniform(-leg.rate, leg.rate, edges.size))
+                u = levels[np.searchsorted(edges, cmd_t)]
+            else:
+                u = np.full(cmd_t.size, leg.rate if leg.kind == "turn" else 0.0)
+            e = math.exp(-T / robot.tau)
+            w_k = np.zeros(cmd_t.size + 1)
+            yaw_k = np.zeros(cmd_t.size + 1)
+            for j in range(cmd_t.size):
+                w_k[j + 1] = u[j] + (w_k[j] - u[j]) * e
+                yaw_k[j + 1] = yaw_k[j] + u[j] * T + (w_k[j] - u[j]) * robot.tau * (1 - e)
+            j = np.minimum((t / T).astype(int), cmd_t.size - 1)
+            s_ = t - j * T
+            decay = np.exp(-s_ / robot.tau)
+            wz = u[j] + (w_k[j] - u[j]) * decay
+            yaw = pyaw + yaw_k[j] + u[j] * s_ + (w_k[j] - u[j]) * robot.tau * (1 - decay)
+            cmd = (cmd_t, u, np.full(cmd_t.size, speed))
+            cx, cy = speed * np.cos(yaw), speed * np.sin(yaw)
+            ox = px + np.concatenate([[0.0], np.cumsum((cx[1:] + cx[:-1]) * dt / 2)])
+            oy = py + np.concatenate([[0.0], np.cumsum((cy[1:] + cy[:-1]) * dt / 2)])
+            vx = np.full(t.size, speed)
+            truth.append(LegTruth(leg.kind, t0, t0 + t[-1], None, None, speed))
         parts.append((t0 + t, ox, oy, yaw, wz, vx, t0 + cmd[0], cmd[1], cmd[2]))
         t0, px, py, pyaw = t0 + t[-1] + dt, float(ox[-1]), float(oy[-1]), float(yaw[-1])
     ft, fx, fy, fyaw, fwz, fvx = (np.concatenate([p[i] for p in parts]) for i in range(6))

@@ -4,7 +4,7 @@ Each laser scan is reduced as it streams past (`wall_lines`, a scan reducer for 
 beams on each side of the robot within `WINDOW` m ahead and behind are fitted with one straight line (total
 least squares, trimmed twice of the points farther than max(3·1.4826·MAD, `TRIM`) from it), kept when it
 runs alongside (its direction within `ALONGSIDE` of the heading), holds `MIN_POINTS` points and fits them to
-`MAX_RMS` m. A line is (ρ, φ): the distance from the sensor (m) and the direction of its normal in the sensor
+`MAX_RMS` m, and reaches `COVER` m ahead of and behind the sensor. A line is (ρ, φ): the distance from the sensor (m) and the direction of its normal in the sensor
 frame (rad); the laser is taken to sit at the base's origin looking forward.
 
 `find_stretches` places every scan's lines in the odometry frame with the pose at the scan's time
@@ -31,13 +31,16 @@ from ..io.logs import PoseSeries, Scan, pose_at
 from ..io.serialize import json_number
 
 __all__ = ["WallLine", "Stretch", "LateralOffset", "wall_lines", "find_stretches", "lateral_offset", "travel_speed",
-           "WINDOW", "ALONGSIDE", "MIN_POINTS", "MAX_RMS", "TRIM", "MIN_SPEED", "SAME_ANGLE", "SAME_OFFSET", "GAP",
+           "WINDOW", "COVER", "ALONGSIDE", "MIN_POINTS", "MAX_RMS", "TRIM", "MIN_SPEED", "SAME_ANGLE", "SAME_OFFSET", "GAP",
            "MIN_DURATION", "MIN_LISTED", "BIN", "LINE_FIELDS"]
 
 WINDOW = 2.0
 """Beams whose point is within this distance (m) ahead of or behind the sensor are fitted."""
 ALONGSIDE = math.radians(40.0)
 """A fitted line runs alongside when its direction is within this angle (rad) of the heading."""
+COVER = 0.3
+"""A line's points must reach at least this far (m) both ahead of and behind the sensor: a wall beside the robot, not
+one it approaches or has left."""
 MIN_POINTS = 12
 """A side needs this many points for a line."""
 MAX_RMS = 0.05
@@ -87,6 +90,8 @@ def _fit(px: np.ndarray, py: np.ndarray) -> tuple[float, float, float] | None:
     if rho < 0:
         nx, ny, rho = -nx, -ny, -rho
     rms = float(np.sqrt(np.mean(residual[keep] ** 2)))
+    if px[keep].min() > -COVER or px[keep].max() < COVER:  # the wall must run past the robot, not only ahead or behind it
+        return None
     return rho, math.atan2(ny, nx), rms
 
 
