@@ -20,7 +20,7 @@ from pathlib import Path
 import numpy as np
 
 __all__ = ["Plant", "Recording", "SyntheticLog", "simulate", "write_ros2", "write_ros1", "write_csv", "write_log",
-           "random_plant", "bad_log", "BAD_LOGS", "Leg", "LegTruth", "DrivenLog", "drive", "ray_cast"]
+           "random_plant", "bad_log", "BAD_LOGS", "Leg", "LegTruth", "DrivenLog", "drive", "ray_cast", "random_corridor", "corridor_run"]
 
 
 @dataclass(frozen=True)
@@ -637,3 +637,45 @@ def drive(legs, robot=None, controller=None, *, odom_rate: float = 50.0, scan_ra
     log = SyntheticLog(Plant(g=1.0, tau=robot.tau, dead_time=0.0), recording, cmd_t[keep_c], cmd_wz[keep_c], cmd_vx[keep_c],
                        odom_t, owz, scan_t=scan_t, odom_x=ox, odom_y=oy, odom_yaw=oyaw, odom_vx=at(odom_t, fvx), scan_ranges=ranges)
     return DrivenLog(log, walls, tuple(truth))
+
+
+def random_corridor(rng: np.random.Generator, *, away: float = 0.05):
+    """(robot, controller, L, sampled margin) of a random corridor whose ``sampled`` verdict is at least `away` from the boundary.
+
+    V 0.3–1.2 m/s, τ 0.1–0.5 s, k 1–4 1/s, W 0.5–0.8 m, f 0.5–1.5, n 2, T 0.02–0.1 s, compute delay 0 or 1 (the
+    command held), L from W/2 + 0.2 to W/2 + 0.7 m; drawn again until |margin| > `away` and the predicted growth keeps
+    the robot off the walls for 8 periods (σ·8·2π/ω < 2.5) and makes at least 6 swings before it decays by e³.
+    """
+    from pfm_stability.parameters import Controller, Robot
+    from pfm_stability.report.stability import build_report
+
+    while True:
+        robot = Robot(V=rng.uniform(0.3, 1.2), tau=rng.uniform(0.1, 0.5), k=rng.uniform(1.0, 4.0), W=rng.uniform(0.5, 0.8))
+        controller = Controller(f=rng.uniform(0.5, 1.5), n=2.0, T=rng.uniform(0.02, 0.1), hold="command",
+                                compute_delay=int(rng.integers(0, 2)))
+        L = robot.W / 2 + rng.uniform(0.2, 0.7)
+        verdict = build_report(robot, controller, L=L, models=("sampled",)).corridor.models["sampled"]
+        root = verdict.rightmost_root
+        if root is None or abs(verdict.margin) <= away or root.imag <= 0.2:
+            continue
+        period = 2 * math.pi / root.imag
+        if root.real * 8 * period < 2.5 and -root.real * 6 * period < 3.0:
+            return robot, controller, L, float(verdict.margin)
+
+
+def corridor_run(seed: int, directory, *, duration: float | None = None):
+    """A random corridor (`random_corridor`, from `seed`) driven and written as an MCAP bag under `directory`.
+
+    Returns (path, robot, controller, L, margin, truth): the simulator's own metrics of the corridor leg in `truth`.
+    """
+    rng = np.random.default_rng(seed)
+    robot, controller, L, margin = random_corridor(rng)
+    from pfm_stability.report.stability import build_report
+
+    root = build_report(robot, controller, L=L, models=("sampled",)).corridor.models["sampled"].rightmost_root
+    period = 2 * math.pi / root.imag
+    length = duration or float(np.clip(10 * period, 20.0, 60.0))
+    offset = min(0.08, 0.5 * (L - robot.W / 2))
+    log = drive([Leg("corridor", length, L=L, offset=offset)], robot, controller, seed=seed, drop=0.02)
+    path = write_ros2(log.log, Path(directory) / f"corridor_{seed}", storage="mcap")
+    return path, robot, controller, L, margin, log.truth[0]
