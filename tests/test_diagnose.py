@@ -1,0 +1,242 @@
+"""`pfm-stability diagnose` (`validation.diagnose`, `analysis.stretches`, the pose in `io.logs`): the oscillation measured
+on synthetic logs of the project's VFF simulator (`log_helpers.drive`: corridors and a wall driven by `sim`, scans
+ray-cast against the walls, odometry pose at 50 Hz, the held commands) against the simulator's own truth.
+
+Tolerances: the measured ω within 5 % of the simulator's (`oscillation_metrics` on the exact offset at every sample;
+measured 0.04–0.6 % over 40 random corridors, experiments/diagnose_agreement.py), σ within 0.01 1/s of it (the same
+estimator on the offset seen through noisy odometry and fitted walls: measured ≤ 0.002 1/s), L and d0 within 2 cm
+(the walls are fitted to 1 cm range noise; the binned offset's median), and the predicted verdict equal to the sign of
+the measured growth on every random corridor of the reduced set (|margin| > 5 %).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import json
+import math
+
+import numpy as np
+import pytest
+from jsonschema import Draft202012Validator
+
+from log_helpers import Leg, bad_log, corridor_run, drive, ray_cast, write_ros1, write_ros2
+from pfm_stability.analysis.stretches import find_stretches, lateral_offset, wall_lines
+from pfm_stability.cli import main
+from pfm_stability.io.logs import LogError, Scan, read_log
+from pfm_stability.io.schema import load_schema
+from pfm_stability.parameters import CARMEL
+from pfm_stability.validation.diagnose import diagnose, missing_parameters
+
+pytestmark = pytest.mark.xdist_group("diagnose")
+VALIDATOR = Draft202012Validator(load_schema())
+LEGS = (Leg("corridor", 30.0, L=0.9), Leg("still", 3.0), Leg("turn", 4.0), Leg("wall", 30.0, offset=0.1),
+        Leg("turn", 2.6, rate=0.6), Leg("steps", 30.0))
+CONFIG = "robot: {k: 2.0, W: 0.8}\ncontroller: {f: 0.8, n: 2}\n"
+
+
+def run(argv) -> tuple[int, str, str]:
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        code = main(argv)
+    return code, out.getvalue(), err.getvalue()
+
+
+@pytest.fixture(scope="module")
+def driven(tmp_path_factory):
+    """The log of CARMEL driving an unstable corridor (L = 0.9 m), standing, turning, along a stable wall and turning in
+    steps, with 5 % of the messages dropped, as an MCAP bag; and a configuration with k, W, f, n."""
+    directory = tmp_path_factory.mktemp("driven")
+    log = drive(LEGS, seed=1, drop=0.05)
+    path = write_ros2(log.log, directory / "bag", storage="mcap")
+    config = directory / "robot.yaml"
+    config.write_text(CONFIG)
+    return log, path, config
+
+
+# ------------------------------------------------------------------------------ reading
+def test_the_pose_is_read_from_the_message_bytes(driven, tmp_path):
+    """x, y, yaw and the forward speed read from the bytes equal what rosbags serialized (ROS 2 and ROS 1), to round-off."""
+    log, path, _ = driven
+    for where in (path, write_ros1(log.log, tmp_path / "log.bag")):
+        pose = read_log(where, need=("pose",)).pose
+        np.testing.assert_allclose(pose.x, log.log.odom_x, atol=1e-12)
+        np.testing.assert_allclose(pose.y, log.log.odom_y, atol=1e-12)
+        np.testing.assert_allclose(np.angle(np.exp(1j * (pose.yaw - log.log.odom_yaw))), 0.0, atol=1e-12)
+        np.testing.assert_allclose(pose.vx, log.log.odom_vx, atol=1e-12)
+
+
+def test_a_csv_has_no_pose(tmp_path):
+    path = tmp_path / "log.csv"
+    path.write_text("t,cmd_wz,odom_wz\n0,0,\n0.1,,0\n")
+    with pytest.raises(LogError, match="a CSV log has no poses"):
+        read_log(path, need=("pose",))
+
+
+# ------------------------------------------------------------------------------ walls from one scan
+@pytest.mark.parametrize("yaw, half_width, shift", [(0.0, 0.9, 0.0), (0.3, 0.6, 0.2), (-0.5, 1.5, -0.4)])
+def test_wall_lines_finds_both_walls_of_a_corridor(yaw, half_width, shift):
+    """A scan ray-cast (the helpers' own intersection) in a corridor y = ±L from a robot at lateral `shift`, heading `yaw`:
+    each side's distance is the perpendicular one, L ∓ shift (whatever the heading), to 2 cm (1 cm range noise, 360 beams), and
+    its normal is ±90° − yaw to 1°."""
+    rng = np.random.default_rng(0)
+    walls = (((-20.0, half_width), (20.0, half_width)), ((-20.0, -half_width), (20.0, -half_width)))
+    angles = -math.pi + 2 * math.pi * np.arange(360) / 360
+    ranges = ray_cast(0.0, shift, yaw, angles, walls) + rng.normal(0.0, 0.01, 360)
+    line = wall_lines(Scan(0.0, -math.pi, 2 * math.pi / 360, 0.05, 30.0, ranges))
+    assert line[0] == pytest.approx(half_width - shift, abs=0.02)
+    assert line[3] == pytest.approx(half_width + shift, abs=0.02)
+    assert math.degrees(abs(math.remainder(line[1] - (math.pi / 2 - yaw), 2 * math.pi))) < 1.0
+    assert math.degrees(abs(math.remainder(line[4] - (-math.pi / 2 - yaw), 2 * math.pi))) < 1.0
+
+
+def test_wall_lines_ignores_a_wall_across_the_path_and_empty_space():
+    """A wall straight ahead (normal along the heading) is no wall alongside; no echo at all gives no line."""
+    angles = -math.pi + 2 * math.pi * np.arange(360) / 360
+    ahead = ray_cast(0.0, 0.0, 0.0, angles, (((1.5, -10.0), (1.5, 10.0)),))
+    assert np.isnan(wall_lines(Scan(0.0, -math.pi, 2 * math.pi / 360, 0.05, 30.0, ahead))).all()
+    assert np.isnan(wall_lines(Scan(0.0, -math.pi, 2 * math.pi / 360, 0.05, 30.0, np.full(360, np.inf)))).all()
+
+
+# ------------------------------------------------------------------------------ stretches and measurement
+@pytest.fixture(scope="module")
+def read(driven):
+    return read_log(driven[1], need=("command", "odometry", "pose", "scan"), scan_reducer=wall_lines)
+
+
+def test_stretches_are_the_corridor_and_the_wall(driven, read):
+    """The judged stretches lie inside the corridor and wall legs and cover most of them; standing, turning in place and
+    step turns in the open give none of 5 s or more; L and d0 are the simulator's to 2 cm."""
+    log = driven[0]
+    stretches = find_stretches(read.scan.t, read.scan.values, read.pose)
+    long = [s for s in stretches if s.duration >= 5.0]
+    assert [s.kind for s in long] == ["corridor", "wall"]
+    for s, truth in zip(long, (log.truth[0], log.truth[3])):
+        assert truth.t_start - 0.2 <= s.start and s.end <= truth.t_end + 0.2
+        assert s.duration > 0.8 * (truth.t_end - truth.t_start)
+        assert lateral_offset(s, read.pose).geometry == pytest.approx(truth.geometry, abs=0.02)
+
+
+def test_measured_oscillation_is_the_simulators(driven, read):
+    """On both legs the measured ω is the simulator's within 5 % and σ within 0.01 1/s (module docstring)."""
+    log = driven[0]
+    result = diagnose(read, CARMEL.robot, CARMEL.controller)
+    judged = [s for s in result.stretches if s.judged]
+    assert [s.stretch.kind for s in judged] == ["corridor", "wall"]
+    for s, truth in zip(judged, (log.truth[0], log.truth[3])):
+        assert s.measured.omega == pytest.approx(truth.metrics.angular_frequency, rel=0.05)
+        assert s.measured.sigma == pytest.approx(truth.metrics.growth_rate, abs=0.01)
+        assert s.V == pytest.approx(truth.V, rel=0.01)
+    corridor, wall = judged
+    assert not corridor.measured.stable and wall.measured.stable
+    assert result.verdict == "oscillating" and result.worst == corridor.stretch.index
+    assert corridor.predicted["sampled"].stable is False and wall.predicted["sampled"].stable is True
+    assert corridor.matching == "sampled" and corridor.remedies["V"]["direction"] == "lower"
+    for s in result.stretches:
+        assert s.judged or s.reason
+        if s.stretch.duration < 5.0:
+            assert not s.judged and s.reason.startswith("shorter than 5 s")
+
+
+@pytest.mark.slow
+def test_verdicts_agree_on_random_corridors(tmp_path):
+    """8 random corridors away from the boundary (|margin| > 5 %; the full set of 40 is experiments/diagnose_agreement.py):
+    the ``sampled`` verdict is the sign of the measured growth, and ω is the simulator's within 5 %."""
+    for seed in range(100, 108):
+        path, robot, controller, L, margin, truth = corridor_run(seed, tmp_path, duration=20.0)
+        result = diagnose(read_log(path, need=("pose", "scan"), scan_reducer=wall_lines), robot, controller)
+        s = result.judged
+        assert s is not None, result.reason
+        assert s.predicted["sampled"].stable == s.measured.stable == (margin > 0), (seed, margin, s.measured)
+        assert s.measured.omega == pytest.approx(truth.metrics.angular_frequency, rel=0.05)
+        assert s.geometry == pytest.approx(L, abs=0.02)
+
+
+# ------------------------------------------------------------------------------ nothing to diagnose
+def test_standing_still_and_turning_in_place_is_nothing_to_diagnose(tmp_path):
+    """A robot that stands and turns in place beside walls it saw before has no stretch: exit 0 and the reason."""
+    log = drive((Leg("still", 8.0), Leg("turn", 8.0)), seed=2)
+    path = write_ros2(log.log, tmp_path / "bag", storage="mcap")
+    config = tmp_path / "robot.yaml"
+    config.write_text(CONFIG)
+    code, out, err = run(["diagnose", str(path), "--config", str(config), "--tau", "0.3", "--T", "0.065", "--format", "json"])
+    data = json.loads(out)
+    assert code == 0 and err == "" and data["verdict"] == "nothing to diagnose" and "no wall in view" in data["reason"]
+    assert data["measured"] is None and data["stretches"] == [] and list(VALIDATOR.iter_errors(data)) == []
+
+
+def test_a_settled_corridor_is_stable_without_an_oscillation(tmp_path):
+    """A robot on the centre line of a corridor far from its boundary (CARMEL, L = 1.2 m, no start offset) shows no
+    oscillation and settles: judged stable, no σ."""
+    log = drive((Leg("corridor", 15.0, L=1.2, offset=0.0),), seed=3, pose_noise=0.0)
+    path = write_ros2(log.log, tmp_path / "bag", storage="mcap")
+    result = diagnose(read_log(path, need=("pose", "scan"), scan_reducer=wall_lines), CARMEL.robot, CARMEL.controller)
+    assert result.verdict == "stable" and result.judged.measured.stable
+
+
+# ------------------------------------------------------------------------------ the command
+@pytest.mark.slow
+def test_json_validates_and_answers_for_the_whole_log_and_each_stretch(driven, tmp_path):
+    """JSON: measured {omega, sigma, amplitude, stretch} and predicted.<model> {stable, V_critical, margin, omega, sigma} on
+    top (the worst stretch) and in each stretch; the schema holds; τ and T came from the log; the PNG is written."""
+    _, path, config = driven
+    png = tmp_path / "d.png"
+    code, out, err = run(["diagnose", str(path), "--config", str(config), "--format", "json", "--plot", str(png)])
+    assert code == 0 and err == ""
+    data = json.loads(out)
+    assert [f"{list(e.absolute_path)}: {e.message}" for e in VALIDATOR.iter_errors(data)] == []
+    assert data["command"] == "diagnose" and data["verdict"] == "oscillating"
+    assert set(data["predicted"]) == {"continuous", "kb_first_order", "pade", "exact_delay", "sampled"}
+    top = data["stretches"][data["measured"]["stretch"]]
+    assert top["measured"] == data["measured"] and top["predicted"] == data["predicted"]
+    assert data["parameters"]["tau"]["source"].startswith("identified from") and data["identification"]["identified"]
+    assert data["parameters"]["tau"]["value"] == pytest.approx(0.3, rel=0.15)
+    assert data["critical"]["V"] == pytest.approx(data["predicted"][data["matching_model"]]["V_critical"])
+    assert png.stat().st_size > 10_000
+    bad = dict(data, measured={"omega": 1.0})
+    assert list(VALIDATOR.iter_errors(bad))
+
+
+def test_text_and_markdown(driven):
+    _, path, config = driven
+    code, text, _ = run(["diagnose", str(path), "--config", str(config), "--tau", "0.3", "--T", "0.065"])
+    assert code == 0 and "verdict: oscillating" in text and "matching model: sampled" in text and "to stabilize: lower V" in text
+    assert "not judged: shorter than 5 s" in text
+    code, md, _ = run(["diagnose", str(path), "--config", str(config), "--tau", "0.3", "--T", "0.065", "--format", "markdown"])
+    assert code == 0 and "**Verdict: oscillating**" in md and "| sampled | unstable |" in md
+
+
+def test_what_a_log_cannot_show_is_refused_by_name(driven, tmp_path):
+    """Without k, W, f, n the command names them and where to give them (exit 2, one line); given as options it runs."""
+    _, path, _ = driven
+    code, out, err = run(["diagnose", str(path)])
+    assert code == 2 and out == "" and err.count("\n") == 1
+    assert "diagnose needs k, W, f, n" in err and "robot.k, robot.W, controller.f, controller.n in --config" in err
+    partial = tmp_path / "partial.yaml"
+    partial.write_text("robot: {k: 2.0}\n")
+    code, _, err = run(["diagnose", str(path), "--config", str(partial)])
+    assert code == 2 and "diagnose needs W, f, n" in err
+    code, _, err = run(["diagnose", str(path), "--k", "2", "--W", "0.8", "--f", "0.8", "--n", "2", "--tau", "0.3", "--T", "0.065"])
+    assert code == 0, err
+
+
+def test_missing_parameters_reads_the_sources():
+    sources = {"k": "config a.yaml", "W": "preset carmel", "f": "ASSUMED (preset carmel): why", "n": "user"}
+    assert missing_parameters(sources) == ("W", "f")
+
+
+@pytest.mark.parametrize("kind", ["truncated mcap", "renamed topic", "corrupt db3", "csv missing column", "missing path"])
+def test_bad_logs_are_one_line(kind, tmp_path):
+    path = bad_log(kind, tmp_path)
+    code, out, err = run(["diagnose", str(path), "--k", "2", "--W", "0.8", "--f", "0.8", "--n", "2"])
+    assert code == 2 and out == "" and err.count("\n") == 1 and err.startswith("pfm-stability: error:")
+
+
+def test_a_renamed_scan_topic_is_found_with_the_option(tmp_path):
+    log = drive((Leg("corridor", 12.0, L=0.9),), seed=4)
+    path = write_ros2(log.log, tmp_path / "bag", storage="mcap", topics={"scan": "/robot/scan"})
+    args = ["diagnose", str(path), "--k", "2", "--W", "0.8", "--f", "0.8", "--n", "2", "--tau", "0.3", "--T", "0.065"]
+    code, _, err = run(args)
+    assert code == 2 and "has no scan topic /scan" in err and "/robot/scan" in err
+    code, out, err = run(args + ["--scan-topic", "/robot/scan", "--format", "json"])
+    assert code == 0 and json.loads(out)["verdict"] == "oscillating"
