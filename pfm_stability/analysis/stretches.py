@@ -131,7 +131,15 @@ def wall_lines(scan: Scan) -> np.ndarray:
 
 @dataclass(frozen=True)
 class WallLine:
-    """A wall in the odometry frame: the points p with n·p = offset, n = (cos normal, sin normal) (m, rad)."""
+    """A wall in the odometry frame: the points p with n·p = offset, n = (cos normal, sin normal).
+
+    Attributes
+    ----------
+    normal : float
+        The direction of the normal pointing from the robot to the wall, rad.
+    offset : float
+        The wall's distance from the frame's origin along the normal, m.
+    """
 
     normal: float
     offset: float

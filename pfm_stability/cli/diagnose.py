@@ -31,7 +31,13 @@ _KEYS = {"k": "robot.k", "W": "robot.W", "f": "controller.f", "n": "controller.n
 
 
 def add_parser(sub) -> None:
-    """Add the ``diagnose`` subcommand to `sub` (argparse subparsers)."""
+    """Add the ``diagnose`` subcommand to `sub`.
+
+    Parameters
+    ----------
+    sub : argparse._SubParsersAction
+        The command's subparsers.
+    """
     from .options import add_parameter_options, output_path
 
     p = sub.add_parser(
@@ -53,7 +59,13 @@ def add_parser(sub) -> None:
 
 
 def run(args) -> int:
-    """Read the log, identify what the user did not give, diagnose and print; returns the exit status (0)."""
+    """Read the log, identify what the user did not give, diagnose and print; returns the exit status (0).
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line.
+    """
     from ..analysis.identification import identify
     from ..analysis.stretches import wall_lines
     from ..extras import require
@@ -98,7 +110,15 @@ def run(args) -> int:
 
 
 def parameters_table(result, sources: dict) -> dict:
-    """Parameter → {value, unit, source} of the robot and controller predicted with (V: the judged stretch's)."""
+    """Parameter → {value, unit, source} of the robot and controller predicted with (V: the judged stretch's).
+
+    Parameters
+    ----------
+    result : validation.diagnose.Diagnosis
+        The diagnosis.
+    sources : dict
+        Parameter → provenance.
+    """
     from ..parameters import RANGES
 
     r, c = result.robot, result.controller
@@ -148,7 +168,17 @@ def _remedies(remedies: dict) -> list[str]:
 
 
 def render_text(result, sources: dict, info: dict) -> str:
-    """The text output of ``diagnose`` (a `validation.diagnose.Diagnosis`)."""
+    """The text output of ``diagnose``.
+
+    Parameters
+    ----------
+    result : validation.diagnose.Diagnosis
+        The diagnosis.
+    sources : dict
+        Parameter → provenance.
+    info : dict
+        The log's path, format, duration and topics.
+    """
     out = [f"log: {info['path']} ({info['format']}, {info['duration']:.1f} s)", f"verdict: {result.verdict} — {result.reason}", ""]
     table = parameters_table(result, sources)
     out.append("parameters: " + ", ".join(f"{k} = {_num(v['value'], '.4g') if isinstance(v['value'], float) else v['value']}"
@@ -169,7 +199,17 @@ def render_text(result, sources: dict, info: dict) -> str:
 
 
 def render_markdown(result, sources: dict, info: dict) -> str:
-    """The Markdown output of ``diagnose`` (a `validation.diagnose.Diagnosis`)."""
+    """The Markdown output of ``diagnose``.
+
+    Parameters
+    ----------
+    result : validation.diagnose.Diagnosis
+        The diagnosis.
+    sources : dict
+        Parameter → provenance.
+    info : dict
+        The log's path, format, duration and topics.
+    """
     out = ["## Diagnosis from the log", "", f"Log: {info['path']} ({info['format']}, {info['duration']:.1f} s).", "",
            f"**Verdict: {result.verdict}** — {result.reason}.", "", "| parameter | value | source |", "| --- | --- | --- |"]
     for name, v in parameters_table(result, sources).items():

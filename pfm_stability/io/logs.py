@@ -77,7 +77,13 @@ class LogError(ValueError):
 
 @dataclass(frozen=True)
 class LogTopics:
-    """The topic of each series (defaults: ``/cmd_vel``, ``/odom``, ``/imu``, ``/scan``)."""
+    """The topic of each series.
+
+    Attributes
+    ----------
+    command, odometry, imu, scan : str
+        The topics (defaults: ``/cmd_vel``, ``/odom``, ``/imu``, ``/scan``); the pose is the odometry's.
+    """
 
     command: str = "/cmd_vel"
     odometry: str = "/odom"
@@ -85,16 +91,31 @@ class LogTopics:
     scan: str = "/scan"
 
     def of(self, series: str) -> str:
-        """The topic of `series` (one of `SERIES`; the pose is the odometry topic's)."""
+        """The topic of `series` (the pose is the odometry topic's).
+
+        Parameters
+        ----------
+        series : str
+            One of `SERIES`.
+        """
         return self.odometry if series == "pose" else getattr(self, series)
 
 
 @dataclass(frozen=True)
 class TimeSeries:
-    """One topic's values: `t` (s since the log's start, non-decreasing) and `value` (rad/s), one per message.
+    """One topic's values, one per message.
 
-    `stamps` says where the times come from: ``"header"`` (the message's header stamp), ``"receive"`` (the bag's
-    receive time: a ``Twist`` has no stamp) or ``"csv"``.
+    Attributes
+    ----------
+    topic, msgtype : str
+        The topic and its message type.
+    t : numpy.ndarray
+        s since the log's start, non-decreasing.
+    value : numpy.ndarray
+        The yaw rate, rad/s.
+    stamps : str
+        Where the times come from: ``"header"`` (the message's header stamp), ``"receive"`` (the bag's receive
+        time: a ``Twist`` has no stamp) or ``"csv"``.
     """
 
     topic: str
@@ -111,7 +132,19 @@ class TimeSeries:
 
 @dataclass(frozen=True)
 class Scan:
-    """One laser scan as handed to a reducer: `t` (s since the log's start), the beam angles (rad) and `ranges` (m)."""
+    """One laser scan as handed to a reducer.
+
+    Attributes
+    ----------
+    t : float
+        s since the log's start.
+    angle_min, angle_increment : float
+        The first beam's angle and the step between beams, rad (sensor frame).
+    range_min, range_max : float
+        The valid ranges, m.
+    ranges : numpy.ndarray
+        One range per beam, m.
+    """
 
     t: float
     angle_min: float
@@ -123,7 +156,16 @@ class Scan:
 
 @dataclass(frozen=True)
 class ScanSeries:
-    """The scans of one topic, reduced: `t` (s) and `values`, the reducer's result per scan (an array if they are numbers)."""
+    """The scans of one topic, reduced.
+
+    Attributes
+    ----------
+    topic : str
+    t : numpy.ndarray
+        s since the log's start.
+    values : numpy.ndarray or tuple
+        The reducer's result per scan (an array if they are numbers).
+    """
 
     topic: str
     t: np.ndarray
@@ -132,7 +174,21 @@ class ScanSeries:
 
 @dataclass(frozen=True)
 class PoseSeries:
-    """The odometry's pose, one per message: `t` (s), `x`, `y` (m), `yaw` (rad, in (−π, π]) and `vx` (m/s, forward)."""
+    """The odometry's pose, one per message.
+
+    Attributes
+    ----------
+    topic : str
+        The odometry's topic.
+    t : numpy.ndarray
+        s since the log's start.
+    x, y : numpy.ndarray
+        The position in the odometry frame, m.
+    yaw : numpy.ndarray
+        The heading from the orientation's quaternion, rad in (−π, π].
+    vx : numpy.ndarray
+        The forward speed ``twist.twist.linear.x``, m/s.
+    """
 
     topic: str
     t: np.ndarray
@@ -166,9 +222,21 @@ def pose_at(pose: PoseSeries, t) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 class LogData:
     """What `read_log` read: the series asked for (None when not asked for) and what the log holds.
 
-    `path` as given, `format` (``"ros2-sqlite3"``, ``"ros2-mcap"``, ``"ros1"``, ``"csv"``), `start` (epoch s of the
-    first message), `duration` (s, first to last message of the whole log), `topics` ((topic, message type) of every
-    topic in the log, sorted).
+    Attributes
+    ----------
+    path : str
+        As given.
+    format : str
+        ``"ros2-sqlite3"``, ``"ros2-mcap"``, ``"ros1"`` or ``"csv"``.
+    start : float
+        Epoch s of the first message.
+    duration : float
+        s, first to last message of the whole log.
+    topics : tuple
+        (topic, message type) of every topic in the log, sorted.
+    command, odometry, imu : TimeSeries or None
+    scan : ScanSeries or None
+    pose : PoseSeries or None
     """
 
     path: str
