@@ -162,6 +162,8 @@ RANGES = {
     "alpha_deg": Range(_ALPHA_MARGIN_DEG, 90.0 - _ALPHA_MARGIN_DEG, low_open=False, unit="deg"),
     "L": Range(0.0, 1e4, unit="m"),
     "max_steering_rate": Range(0.0, math.inf, high_open=True, unit="rad/s"),
+    "dead_time": Range(0.0, 10.0, low_open=False, unit="s"),
+    "plant_gain": Range(1e-3, 100.0, low_open=False),
     # where a computation needs a narrower range than the parameter's own
     "T_sampled": Range(0.0, 100.0, unit="s"),
     # simulator and validation options
@@ -209,6 +211,16 @@ Lower bounds are physical (V > 0, τ >= 0, a steering gain of at least
 10⁻⁶ 1/s, a width of at least 1 mm, f >= 10⁻⁶, n >= 0.01 …); upper bounds
 are generous caps (100 m/s, 100 s, 10⁴ 1/s …). Both keep every computation
 inside floating point (f^(1/n) and Wⁿ of an equilibrium, a scan over k).
+
+``dead_time``, ``plant_gain``
+    The steering plant g·e^(−sD)/(τs + 1) of a real robot (docs/simulator.md,
+    "Plant gain and dead time"): D in [0, 10] s — causal (``identify`` writes a
+    negative estimate as 0), and 10 s is ten times the longest dead time
+    ``identify`` searches, far past any steering robot; g in [10⁻³, 100] —
+    achieved over commanded turning rate, positive (g <= 0 turns the other way
+    or not at all: a sign error in the log, not a robot; ``identify`` refuses
+    |g| < 0.05 as "did not follow the commands"), and the ends keep the loop
+    gain g·k within [10⁻⁹, 10⁶] 1/s, inside floating point for every model.
 
 Entries beyond the robot, controller and geometry:
 
@@ -288,7 +300,7 @@ def check_parameter(name: str, value) -> float:
 
 @dataclass(frozen=True)
 class Robot:
-    """A synchro-drive robot with a first-order steering-rate lag (KB eq 6).
+    """A synchro-drive robot with a first-order steering-rate lag (KB eq 6), a plant gain and a dead time.
 
     Parameters
     ----------
@@ -301,8 +313,16 @@ class Robot:
     W : float
         Robot width, m, in [10⁻³, 100] (KB eq 1).
     max_steering_rate : float
-        Largest steering rate |ω|, rad/s, > 0 (CARMEL: 120°/s). Used by the
-        simulator only; the linear analysis assumes no saturation.
+        Largest commanded steering rate |u|, rad/s, > 0 (CARMEL: 120°/s). Used by the
+        simulator only; the linear analysis assumes no saturation. It limits the
+        command, before the plant gain: the motor reaches at most g·max_steering_rate.
+    dead_time : float
+        Dead time D of the steering plant, s, in [0, 10]: a command reaches the
+        motor D after the controller applies it (docs/simulator.md, "Plant gain
+        and dead time"; 0 = KB's robot).
+    plant_gain : float
+        Plant gain g, achieved over commanded turning rate, in [10⁻³, 100]
+        (1 = KB's robot): the motor is τω̇ + ω = g·u(t − D).
     """
 
     V: float
@@ -310,9 +330,11 @@ class Robot:
     k: float
     W: float
     max_steering_rate: float = math.radians(120.0)
+    dead_time: float = 0.0
+    plant_gain: float = 1.0
 
     def __post_init__(self):
-        for name in ("V", "tau", "k", "W", "max_steering_rate"):
+        for name in ("V", "tau", "k", "W", "max_steering_rate", "dead_time", "plant_gain"):
             object.__setattr__(self, name, check_parameter(name, getattr(self, name)))
 
     def replace(self, **changes) -> "Robot":

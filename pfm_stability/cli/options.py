@@ -174,7 +174,7 @@ PADE_ORDER = integer("pade_order")
 
 
 def add_parameter_options(parser: argparse.ArgumentParser, *, sampled: bool = False) -> None:
-    """--config, --preset, --V, --tau, --T, --k, --f, --n, --W, --hold, --compute-delay.
+    """--config, --preset, --V, --tau, --T, --k, --f, --n, --W, --dead-time, --plant-gain, --hold, --compute-delay.
 
     With ``sampled=True`` (the simulator and the validation, which sample),
     ``--T`` takes ``RANGES["T_sampled"]``: (0, 100] s.
@@ -193,17 +193,19 @@ def add_parameter_options(parser: argparse.ArgumentParser, *, sampled: bool = Fa
         "f": "force-constant ratio F_cr/F_ct",
         "n": "repulsion exponent",
         "W": "robot width",
+        "dead_time": "dead time D of the steering plant g e^(-sD)/(tau s + 1) (pfm-stability identify measures it)",
+        "plant_gain": "plant gain g, achieved over commanded turning rate",
     }
     for name, text in helps.items():
         key = "T_sampled" if sampled and name == "T" else name
-        group.add_argument(f"--{name}", type=number(key), help=f"{text}, {describe(key)}")
+        group.add_argument(f"--{name.replace('_', '-')}", type=number(key), help=f"{text}, {describe(key)}")
     group.add_argument("--hold", choices=HOLDS, help="sampled structure: what is held between samples")
     group.add_argument(
         "--compute-delay", type=integer("compute_delay"), help=f"samples from measurement to actuation, {describe('compute_delay')}"
     )
 
 
-_ROBOT_FIELDS = ("V", "tau", "k", "W")
+_ROBOT_FIELDS = ("V", "tau", "k", "W", "dead_time", "plant_gain")
 _CONTROLLER_FIELDS = ("f", "n", "T", "hold", "compute_delay")
 
 

@@ -3,7 +3,7 @@
 ``--config FILE`` on every command reads such a file (docs/config.md)::
 
     preset: carmel            # the base; default carmel
-    robot: {V: 0.8, tau: 0.2, k: 2.0, W: 0.6}  # report also: family, mass
+    robot: {V: 0.8, tau: 0.2, k: 2.0, W: 0.6, dead_time: 0.07, plant_gain: 0.85}  # report also: family, mass
     controller: {T: 0.1, f: 1.0, n: 2, hold: command, compute_delay: 1}
     law: {name: grid, cell_size: 0.1, window_cells: 33}   # or law: grid; report also: velocity, velocity-gated, fuzzy
     scenario: {wall: {alpha: 20}, corridor: {L: 0.9}}
@@ -58,8 +58,9 @@ __all__ = [
 DEFAULT_PRESET = "carmel"
 """The base of a file without a ``preset`` key."""
 
-ROBOT_KEYS = ("V", "tau", "k", "W", "max_steering_rate")
-"""Keys of ``robot:`` (`parameters.Robot`; ``max_steering_rate`` in deg/s)."""
+ROBOT_KEYS = ("V", "tau", "k", "W", "max_steering_rate", "dead_time", "plant_gain")
+"""Keys of ``robot:`` (`parameters.Robot`; ``max_steering_rate`` in deg/s, ``dead_time`` in s, ``plant_gain``
+dimensionless: what ``pfm-stability identify --out`` writes)."""
 
 FAMILY_ROBOT_KEYS = ("family", "mass")
 """Keys of ``robot:`` beyond `ROBOT_KEYS`, read by ``report`` only: the loop family
@@ -78,7 +79,7 @@ SCENARIO_KEYS = {"wall": ("alpha",), "corridor": ("L",)}
 TOP_KEYS = ("preset", "name", "source", "robot", "controller", "law", "scenario", "assumed")
 """Top-level keys of a configuration file (docs/config.md)."""
 
-PARAMETER_KEYS = ("V", "tau", "k", "W", "f", "n", "T", "hold", "compute_delay")
+PARAMETER_KEYS = ("V", "tau", "k", "W", "dead_time", "plant_gain", "f", "n", "T", "hold", "compute_delay")
 """The parameters whose provenance `Config.sources` records (as the command line's `resolve_parameters`)."""
 
 _STEERING_RATE_DEG = (0.0, math.inf)  # deg/s, open at both ends: RANGES["max_steering_rate"] in degrees
@@ -377,6 +378,8 @@ NAV2_ASSUMED = {
     "tau": "a Nav2 file does not give the steering lag; this is the preset's robot's (measure yours: docs/config.md)",
     "f": "a Nav2 file has no VFF force ratio; this is the preset's",
     "n": "a Nav2 file has no repulsion exponent; this is the preset's",
+    "dead_time": "a Nav2 file does not give the steering plant's dead time; this is the preset's (measure yours: pfm-stability identify, docs/diagnose.md)",
+    "plant_gain": "a Nav2 file does not give the steering plant's gain; this is the preset's (measure yours: pfm-stability identify, docs/diagnose.md)",
 }
 """Why a loop parameter a Nav2 file cannot give is an assumption (marked ASSUMED in the report)."""
 

@@ -1,7 +1,8 @@
 """Time-domain simulator of the VFF algorithm driving a CARMEL-like robot (docs/simulator.md).
 
 Koren & Borenstein 1991 (KB) §2 (VFF on a histogram grid, eq 1–5) drives the
-synchro-drive robot of §3–4 (steering lag eq 6, |ω| <= 120°/s), sampled
+synchro-drive robot of §3–4 (steering lag eq 6, |u| <= 120°/s; a real
+robot's plant gain g and dead time D too, τω̇ + ω = g·u(t − D)), sampled
 exactly as the `sampled` loop model (docs/models.md: ``hold="command"`` or
 ``"reference"``, ``compute_delay`` 0 or 1), so that in the linear regime the
 simulated σ and ω equal the model's dominant pole to round-off. The
@@ -14,7 +15,7 @@ Library API
     One run; ``options`` go to `make_scenario`.
 ``simulate_batch(name, *, env="grid", robot=None, controller=None, record="offset", metrics=True, **arrays) -> BatchResult``
     Many parameter sets at once: each of ``V, tau, k, W, max_steering_rate,
-    f, n, T, hold, compute_delay, L, alpha (rad), offset, duration,
+    dead_time, plant_gain, f, n, T, hold, compute_delay, L, alpha (rad), offset, duration,
     cell_ratio, law, window_cells, cell_size, speed_law, seed,
     start_jitter`` may be a scalar or a 1-D array (one entry per member).
     ``BatchResult.stable / .oscillating / .collided`` are bool arrays

@@ -20,7 +20,7 @@ from .scenario import Scenario
 
 __all__ = ["simulate", "simulate_batch", "batch_scenarios", "ROBOT_PARAMETERS", "CONTROLLER_PARAMETERS", "SCENARIO_PARAMETERS"]
 
-ROBOT_PARAMETERS = ("V", "tau", "k", "W", "max_steering_rate")
+ROBOT_PARAMETERS = ("V", "tau", "k", "W", "max_steering_rate", "dead_time", "plant_gain")
 CONTROLLER_PARAMETERS = ("f", "n", "T", "hold", "compute_delay")
 SCENARIO_PARAMETERS = (
     "L", "alpha", "offset", "duration", "cell_ratio", "law", "window_cells", "cell_size",
@@ -100,7 +100,7 @@ def simulate_batch(
         ``progress(step, total)`` every 1024 samples (`run_batch`).
     **parameters
         Scalars or equal-length 1-D arrays, one entry per member:
-        robot fields ``V, tau, k, W, max_steering_rate``; controller fields
+        robot fields ``V, tau, k, W, max_steering_rate, dead_time, plant_gain``; controller fields
         ``f, n, T, hold, compute_delay``; scenario options ``L, alpha`` (rad),
         ``offset, duration, cell_ratio, law, window_cells, cell_size,
         speed_law, seed, start_jitter`` (see `make_scenario`).

@@ -203,11 +203,18 @@ class StepPath:
     theta, omega : float
         Heading (rad) and rate (rad/s) at the start.
     value : float
-        The held command (rad/s) or reference (rad).
+        The held command (rad/s, before the plant gain) or reference (rad).
     V : float
         Speed, m/s.
     x, y : float
         Position at the start, m.
+    gain : float
+        Plant gain g: the motor's input is g times the command (the servo closes g·k(δ̃ − θ)).
+    switch : float
+        ε, s: a held command whose dead time ends within the period (`robot.delay_split`) drives
+        the motor with `earlier` over [0, ε) and with `value` after; 0: `value` throughout.
+    earlier : float
+        The command before the switch, rad/s (before the plant gain).
     """
 
     tau: float
@@ -223,12 +230,18 @@ class StepPath:
     V: float
     x: float
     y: float
+    gain: float = 1.0
+    switch: float = 0.0
+    earlier: float = 0.0
 
     def _advance(self, solution, times, theta, omega, value, x, y):
-        """(x, y, θ, ω) after `times` (s, shape (n,)) from states (n,) under the "constant" or "servo" solution."""
+        """(x, y, θ, ω) after `times` (s, shape (n,)) from states (n,) under the "constant" or "servo" solution.
+
+        `value` is the motor's input (g·u) for "constant", the reference for "servo" (closed with g·k).
+        """
         n = times.size
-        tau, k = np.full(n, self.tau), np.full(n, self.k)
-        slow = slow_rate(k, np.full(n, self.max_rate))
+        tau, k = np.full(n, self.tau), np.full(n, self.gain * self.k)
+        slow = slow_rate(np.full(n, self.k), np.full(n, self.max_rate), self.gain)
         if self.substepped:  # the sub-steps' rules resolve both solutions
             modes = tuple(np.concatenate(pair, axis=1) for pair in zip(servo_modes(tau, k), constant_input_modes(tau)))
         else:
@@ -250,8 +263,22 @@ class StepPath:
         times = np.atleast_1d(np.asarray(times, dtype=float))
         n = times.size
         start = lambda v: np.full(n, float(v))
+        if not self.reference and self.switch > 0:  # the dead time ends at ε: g·earlier before, g·value after
+            before = times <= self.switch
+            out_x, out_y = np.empty(n), np.empty(n)
+            m = int(np.count_nonzero(before))
+            if m:
+                out_x[before], out_y[before], _, _ = self._advance(
+                    "constant", times[before], *(np.full(m, v) for v in (self.theta, self.omega, self.gain * self.earlier, self.x, self.y)))
+            if m < n:
+                one = lambda v: np.array([float(v)])
+                sx, sy, st, so = self._advance("constant", one(self.switch), *(one(v) for v in (self.theta, self.omega, self.gain * self.earlier, self.x, self.y)))
+                r = n - m
+                out_x[~before], out_y[~before], _, _ = self._advance(
+                    "constant", times[~before] - self.switch, *(np.full(r, float(v[0])) for v in (st, so, one(self.gain * self.value), sx, sy)))
+            return out_x, out_y
         if not self.reference:
-            return self._advance("constant", times, start(self.theta), start(self.omega), start(self.value), start(self.x), start(self.y))[:2]
+            return self._advance("constant", times, start(self.theta), start(self.omega), start(self.gain * self.value), start(self.x), start(self.y))[:2]
         if not self.substepped:
             return self._advance("servo", times, start(self.theta), start(self.omega), start(self.value), start(self.x), start(self.y))[:2]
         # the engine's sub-steps: equal parts of h, each saturated (±max_rate) or servo, decided at its start
@@ -260,7 +287,7 @@ class StepPath:
         for _ in range(self.substeps):
             u = self.k * (self.value - theta)
             clipped = abs(u) > self.max_rate
-            states.append((x, y, theta, omega, clipped, min(max(u, -self.max_rate), self.max_rate)))
+            states.append((x, y, theta, omega, clipped, self.gain * min(max(u, -self.max_rate), self.max_rate)))
             one = np.array([part])
             if clipped:
                 xs, ys, ts, ws = self._advance("constant", one, *(np.array([v]) for v in (theta, omega, states[-1][5], x, y)))

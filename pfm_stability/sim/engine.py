@@ -18,14 +18,21 @@ One step, for every member still running (the `sampled` model, docs/models.md):
    (eq 5, saturated at the steering-rate limit); ``hold="reference"``:
    δ̃_k = θ_k + wrap(δ_k − θ_k). With ``compute_delay = 1`` the value
    applied over [t_k, t_k+1) is the one computed at t_k−1 (at k = 0, the
-   value computed at t_0: the robot starts as if it had been running).
+   value computed at t_0: the robot starts as if it had been running, and
+   every value "computed" before t_0 is u_0). With a dead time D the command
+   reaches the motor at t_k + d·T + D = t_k + m·T + ε (`robot.delay_split`):
+   a delay line of the computed values gives u_(k−m−1) for the first ε of the
+   period and u_(k−m) for the rest. The speed is delayed by the compute delay
+   only (the dead time is the steering motor's).
 4. **Advance** over [t_k, t_k+1) exactly (`pfm_stability.sim.robot`):
-   held command → constant-input solution of eq (6); held reference → servo
-   solution of eq (7). Saturation: a held command is clipped to
-   ±ω_max, and since ω moves monotonically from ω_k towards u, |ω| <= ω_max
-   stays exact. A servo whose command k(δ̃ − θ(t)) would exceed ±ω_max at the
+   held command → constant-input solution of eq (6) with input g·u, in two
+   intervals [t_k, t_k + ε) and [t_k + ε, t_k+1) when ε > 0, each with its
+   own graded rule; held reference → servo solution of eq (7) with gain g·k
+   (no dead time: `Scenario` refuses it). Saturation: a held command is
+   clipped to ±ω_max before the gain, and since ω moves monotonically from
+   ω_k towards g·u, |ω| <= g·ω_max stays exact. A servo whose command k(δ̃ − θ(t)) would exceed ±ω_max at the
    start, a quadrature node or the end of the period is instead advanced in
-   `SUBSTEPS` equal sub-intervals, each either saturated (constant ±ω_max)
+   `SUBSTEPS` equal sub-intervals, each either saturated (constant ±g·ω_max)
    or linear (servo), decided at its start — exact whenever the servo is not
    saturated, first-order in the sub-interval where it switches.
    Positions: the part linear in Δ = θ − θ_k in closed form, the residual by
@@ -53,7 +60,7 @@ from .environment import segment_clearance, wall_coordinates
 from .events import Event
 from .metrics import oscillation_metrics
 from .results import BatchResult, RunResult, Trajectory
-from .robot import advance_position, constant_input, constant_input_modes, graded_rule, propagate, servo, servo_modes, slow_rate
+from .robot import advance_position, constant_input, constant_input_modes, delay_split, graded_rule, propagate, servo, servo_modes, slow_rate
 from .vff import cell_repulsion, direction_of, steering_command, vff_speed, wrap_angle
 from .window import compile_window_table, stack_tables
 
@@ -78,17 +85,21 @@ class _Batch:
         robot = lambda name: _array(scenarios, lambda s: getattr(s.robot, name))
         ctrl = lambda name: _array(scenarios, lambda s: getattr(s.controller, name))
         self.V, self.tau, self.k, self.W = robot("V"), robot("tau"), robot("k"), robot("W")
-        self.tau = np.where(self.tau * self.k < TAU_RESOLUTION, 0.0, self.tau)  # an ideal motor, as the models take it
+        self.gain = robot("plant_gain")
+        self.tau = np.where(self.tau * self.gain * self.k < TAU_RESOLUTION, 0.0, self.tau)  # an ideal motor, as the models take it
         self.max_rate = robot("max_steering_rate")
         self.n, self.T, self.f = ctrl("n"), ctrl("T"), ctrl("f")
         self.reference = _array(scenarios, lambda s: s.controller.hold == "reference", bool)
         self.delayed = _array(scenarios, lambda s: s.controller.compute_delay == 1, bool)
+        self.lag, self.switch = delay_split(self.T, self.delayed.astype(np.int64), robot("dead_time"))
         self.speed_law = _array(scenarios, lambda s: s.speed_law, bool)
         self.damping = _array(scenarios, lambda s: s.damping)
         self.any_damping = bool(np.any(self.damping != 0.0))
         self.any_speed_law = bool(self.speed_law.any())
         self.steps = np.ceil(_array(scenarios, lambda s: s.duration) / self.T - 1e-9).astype(np.int64)
-        self.order = (self.tau > 0).astype(int) + 2 + self.delayed.astype(int)
+        self.split = self.switch > 0
+        self.order = _array(scenarios, lambda s: s.loop_order(), np.int64)  # the sampled loop's state
+        self.history = int(np.max(np.minimum(self.lag, self.steps))) + 2  # the delay line's length (`_DelayLine`)
         self._compile_targets()
         self._compile_measure()
         self._compile_grids()
@@ -99,16 +110,28 @@ class _Batch:
 
     # ----------------------------------------------------------- compilation
     def _compile_steering(self):
-        """Steering coefficients and quadrature rules of the held-command and the servo members (`robot`)."""
-        slow = slow_rate(self.k, self.max_rate)
+        """Steering coefficients and quadrature rules of the held-command and the servo members (`robot`).
+
+        Held-command members whose command reaches the motor within a period
+        (ε > 0, `robot.delay_split`) take two intervals, [0, ε) and [ε, T),
+        each with its own coefficients and graded rule; the others one of length T.
+        """
+        slow = slow_rate(self.k, self.max_rate, self.gain)
         self.command_idx = c = np.flatnonzero(~self.reference)
         self.reference_idx = r = np.flatnonzero(self.reference)
-        self.command_coef = constant_input(self.tau[c], graded_rule(self.T[c], *constant_input_modes(self.tau[c]), slow[c]))
-        modes = servo_modes(self.tau[r], self.k[r])
-        self.servo_coef = servo(self.tau[r], self.k[r], graded_rule(self.T[r], *modes, slow[r]))
+        command_rule = lambda h, idx: constant_input(self.tau[idx], graded_rule(h, *constant_input_modes(self.tau[idx]), slow[idx]))
+        self.whole_idx = np.flatnonzero(~self.split[c])  # positions within the command members
+        self.split_idx = np.flatnonzero(self.split[c])
+        whole, split = c[self.whole_idx], c[self.split_idx]
+        self.command_coef = command_rule(self.T[whole], whole)
+        self.before_coef = command_rule(self.switch[split], split)
+        self.after_coef = command_rule(self.T[split] - self.switch[split], split)
+        gk = self.gain[r] * self.k[r]  # the servo closes g·k(δ̃ − θ)
+        modes = servo_modes(self.tau[r], gk)
+        self.servo_coef = servo(self.tau[r], gk, graded_rule(self.T[r], *modes, slow[r]))
         both = tuple(np.concatenate(pair, axis=1) for pair in zip(modes, constant_input_modes(self.tau[r])))
         sub = graded_rule(self.T[r] / SUBSTEPS, *both, slow[r])  # shared: each sub-interval takes either solution
-        self.servo_sub = servo(self.tau[r], self.k[r], sub)
+        self.servo_sub = servo(self.tau[r], gk, sub)
         self.saturated_sub = constant_input(self.tau[r], sub)
 
     def _compile_targets(self):
@@ -324,10 +347,53 @@ def _advance_command(coef, theta, omega, u, V, x, y):
     return x, y, theta_end, omega_end
 
 
+def _advance_commands(b, theta, omega, earlier, later, V, x, y):
+    """The held-command members over one period: motor input g·u, the split members in two intervals (ε, T − ε).
+
+    `earlier` and `later` are the commands the motor sees before and after the switch (rad/s, per command member).
+    """
+    w, s = b.whole_idx, b.split_idx
+    g = b.gain[b.command_idx]
+    if s.size == 0:
+        return _advance_command(b.command_coef, theta, omega, g * later, V, x, y)
+    x_new, y_new, th_new, om_new = x.copy(), y.copy(), theta.copy(), omega.copy()
+    if w.size:
+        x_new[w], y_new[w], th_new[w], om_new[w] = _advance_command(b.command_coef, theta[w], omega[w], g[w] * later[w], V[w], x[w], y[w])
+    xs, ys, ts, os_ = _advance_command(b.before_coef, theta[s], omega[s], g[s] * earlier[s], V[s], x[s], y[s])
+    x_new[s], y_new[s], th_new[s], om_new[s] = _advance_command(b.after_coef, ts, os_, g[s] * later[s], V[s], xs, ys)
+    return x_new, y_new, th_new, om_new
+
+
+class _DelayLine:
+    """The values computed at t_0 … t_k, as far back as the loop's delay reaches (`robot.delay_split`).
+
+    A ring of `_Batch.history` columns; a value asked for from before t_0 is
+    u_0 (the robot starts as if it had been running).
+    """
+
+    def __init__(self, size: int, length: int):
+        self.ring = np.zeros((size, length))
+        self.members = np.arange(size)
+        self.first = None
+
+    def push(self, k: int, value):
+        if self.first is None:
+            self.first = value.copy()
+        self.ring[:, k % self.ring.shape[1]] = value
+
+    def back(self, k: int, lag):
+        """The value computed at t_(k − lag) (per member), u_0 before t_0."""
+        j = k - lag
+        return np.where(j >= 0, self.ring[self.members, j % self.ring.shape[1]], self.first)
+
+
 def _advance_reference(b, theta, omega, ref, V, x, y):
-    """Servo members over one period; saturated ones in SUBSTEPS sub-intervals (returned: which, bool per member)."""
+    """Servo members over one period; saturated ones in SUBSTEPS sub-intervals (returned: which, bool per member).
+
+    The servo closes g·k(δ̃ − θ); a saturated sub-interval holds g·clip(k(δ̃ − θ), ±ω_max).
+    """
     r = b.reference_idx
-    k, wmax = b.k[r], b.max_rate[r]
+    k, wmax, g = b.k[r], b.max_rate[r], b.gain[r]
     delta, correction, theta_end, omega_end = propagate(b.servo_coef, theta, omega, ref)
     x_new, y_new = advance_position(x, y, V, b.servo_coef.rule, theta, delta, correction)
     heading = np.concatenate([theta[:, None], theta[:, None] + delta, theta_end[:, None]], axis=1)
@@ -340,7 +406,7 @@ def _advance_reference(b, theta, omega, ref, V, x, y):
             u = k[s] * (ref[s] - th)
             clipped = np.abs(u) > wmax[s]
             d1, c1, e1, o1 = propagate(lin, th, om, ref[s])
-            d2, c2, e2, o2 = propagate(cst, th, om, np.clip(u, -wmax[s], wmax[s]))
+            d2, c2, e2, o2 = propagate(cst, th, om, g[s] * np.clip(u, -wmax[s], wmax[s]))
             d, c = np.where(clipped[:, None], d2, d1), np.where(clipped, c2, c1)
             xs, ys = advance_position(xs, ys, V[s], lin.rule, th, d, c)
             th, om = np.where(clipped, e2, e1), np.where(clipped, o2, o1)
@@ -381,7 +447,7 @@ def run_batch(scenarios, *, record: str = "trajectory", metrics: bool = True, pr
     x0, y0 = x.copy(), y.copy()
     omega = np.zeros(B)
     alive = np.ones(B, dtype=bool)
-    pending = np.zeros(B)
+    line = _DelayLine(B, b.history)
     pending_V = b.V.copy()
     best = b.progress(x, y, x0, y0, b.target_distance(x, y))
     best_t = np.zeros(B)
@@ -428,22 +494,24 @@ def run_batch(scenarios, *, record: str = "trajectory", metrics: bool = True, pr
         value = np.where(b.reference, theta + wrap_angle(delta - theta), steering_command(delta, theta, b.k, b.max_rate))
         speed = np.where(b.speed_law, vff_speed(b.V, fx, fy, theta), b.V) if b.any_speed_law else b.V
         if k == 0:
-            pending, pending_V = value, speed
-        applied = np.where(b.delayed, pending, value)
+            pending_V = speed
+        line.push(k, value)
+        applied, earlier = line.back(k, b.lag), line.back(k, b.lag + 1)  # the motor's input after and before the switch
         applied_V = np.where(b.delayed, pending_V, speed)
-        pending, pending_V = value, speed
+        pending_V = speed
         # advance over [t_k, t_k+1)
         substepped = np.zeros(B, dtype=bool)
         if b.all_command:
-            x_new, y_new, th_new, om_new = _advance_command(b.command_coef, theta, omega, applied, applied_V, x, y)
+            x_new, y_new, th_new, om_new = _advance_commands(b, theta, omega, earlier, applied, applied_V, x, y)
         else:
             x_new, y_new, th_new, om_new = x.copy(), y.copy(), theta.copy(), omega.copy()
             c, r = b.command_idx, b.reference_idx
             if c.size:
-                x_new[c], y_new[c], th_new[c], om_new[c] = _advance_command(b.command_coef, theta[c], omega[c], applied[c], applied_V[c], x[c], y[c])
+                x_new[c], y_new[c], th_new[c], om_new[c] = _advance_commands(b, theta[c], omega[c], earlier[c], applied[c], applied_V[c], x[c], y[c])
             if r.size:
                 x_new[r], y_new[r], th_new[r], om_new[r], substepped[r] = _advance_reference(b, theta[r], omega[r], applied[r], applied_V[r], x[r], y[r])
-        step = dict(running=running, x=x, y=y, theta=theta, omega=omega, value=applied, V=applied_V, gap=gap, rows=rows, substepped=substepped)
+        step = dict(running=running, x=x, y=y, theta=theta, omega=omega, value=applied, earlier=earlier, V=applied_V, gap=gap, rows=rows,
+                    substepped=substepped)
         x, y = np.where(running, x_new, x), np.where(running, y_new, y)
         theta, omega = np.where(running, th_new, theta), np.where(running, om_new, omega)
         k += 1
@@ -463,8 +531,8 @@ def run_batch(scenarios, *, record: str = "trajectory", metrics: bool = True, pr
 def _swept_contacts(b, step, x, y, gap) -> dict:
     """Members whose disc touched an obstacle on their exact path over the last period: {member: Contact}.
 
-    `step` holds the period's start (positions, heading, rate, held value,
-    speed, gaps, grid rows, sub-stepped servos). A member is cleared by the
+    `step` holds the period's start (positions, heading, rate, held values
+    before and after the dead time's switch, speed, gaps, grid rows, sub-stepped servos). A member is cleared by the
     Lipschitz bound on its gaps at both ends, then by its chord
     (`pfm_stability.sim.contact`); the rest are searched along the path with
     `first_contact`. Gaps are lower bounds: a grid member's near list holds
@@ -501,7 +569,7 @@ def _swept_contacts(b, step, x, y, gap) -> dict:
         path = StepPath(
             float(b.tau[m]), float(b.k[m]), float(b.max_rate[m]), float(b.T[m]), bool(b.reference[m]), bool(step["substepped"][m]),
             SUBSTEPS, float(step["theta"][m]), float(step["omega"][m]), float(step["value"][m]), float(step["V"][m]),
-            float(ax[m]), float(ay[m]),
+            float(ax[m]), float(ay[m]), gain=float(b.gain[m]), switch=float(b.switch[m]), earlier=float(step["earlier"][m]),
         )
         contact = first_contact(path, (float(x[m]), float(y[m])), *_obstacles(b, step, m, float(length[m])), float(b.W[m]) / 2)
         if contact is not None:

@@ -13,6 +13,12 @@ from the engine's closed form. It shares no stepping code with the batch
 engine, so the tests compare the two trajectories (`tests/test_sim_engine.py`,
 `tests/test_sim_accuracy.py`), and `benchmarks/bench_simulator.py` times both.
 
+The plant gain g and dead time D (docs/simulator.md, "Plant gain and dead
+time") take the route of the model, not of the engine's arrays: a list of the
+values computed so far, the motor's input g·u_(k−m−1) for the first ε of a
+period and g·u_(k−m) after (m and ε: `robot.delay_split`, the one rule), each
+piece its own `_Steering` interval; the servo closes g·k(δ̃ − θ).
+
 Collisions between samples take their own route too: a period that starts
 within its length V·T of an obstacle (the only ones the disc can touch) is
 walked at `PATH_SAMPLES` instants, each position computed afresh from the
@@ -34,7 +40,7 @@ from .engine import SUBSTEPS
 from .events import Event
 from .grid import HistogramGrid
 from .results import Trajectory
-from .robot import constant_input_modes, graded_rule, servo_modes, slow_rate
+from .robot import constant_input_modes, delay_split, graded_rule, servo_modes, slow_rate
 from .scenario import Scenario
 
 __all__ = ["simulate_reference", "PATH_SAMPLES"]
@@ -78,12 +84,12 @@ def _servo_integral(tau, k, h):
     return -math.expm1(-k * h) / k, 0.0
 
 
-def _steering_rule(tau, k, h, max_rate, solutions):
-    """(node times, weights) of `robot.graded_rule` for one robot, resolving the modes of `solutions`."""
+def _steering_rule(tau, k, h, max_rate, solutions, gain=1.0):
+    """(node times, weights) of `robot.graded_rule` for one robot, resolving the modes of `solutions` (the servo's with g·k)."""
     one = lambda v: np.array([float(v)])
-    found = {"constant": constant_input_modes(one(tau)), "servo": servo_modes(one(tau), one(k))}
+    found = {"constant": constant_input_modes(one(tau)), "servo": servo_modes(one(tau), one(gain * k))}
     modes = tuple(np.concatenate(part, axis=1) for part in zip(*(found[name] for name in solutions)))
-    slow = slow_rate(one(k), one(max_rate))
+    slow = slow_rate(one(k), one(max_rate), gain)
     rule = graded_rule(one(h), *modes, slow)
     return rule.t[0].tolist(), rule.w[0].tolist()
 
@@ -93,18 +99,19 @@ class _Steering:
 
     `solutions` names the solutions used over the interval, "constant"
     (held command) and/or "servo" (held reference); the quadrature rule
-    resolves all of them.
+    resolves all of them. The servo closes g·k(δ̃ − θ) (`gain` g); `constant`
+    takes the motor's input (g·u).
     """
 
-    def __init__(self, tau, k, h, max_rate, solutions):
-        self.tau, self.k, self.h = tau, k, h
-        self.times, self.weights = _steering_rule(tau, k, h, max_rate, solutions)
+    def __init__(self, tau, k, h, max_rate, solutions, gain=1.0):
+        self.tau, self.k, self.h = tau, gain * k, h
+        self.times, self.weights = _steering_rule(tau, k, h, max_rate, solutions, gain)
         self.const = [_constant_input(tau, t) for t in self.times + [h]]
         lagged = tau * (h - self.const[-1][0])
         self.const_integral = (lagged, h * h / 2 - lagged)
         if "servo" in solutions:
-            self.servo = [_servo_matrix(tau, k, t) for t in self.times + [h]]
-            self.servo_integral = _servo_integral(tau, k, h)
+            self.servo = [_servo_matrix(tau, gain * k, t) for t in self.times + [h]]
+            self.servo_integral = _servo_integral(tau, gain * k, h)
 
     def constant(self, theta, omega, u):
         """(Δ at the nodes, ∫Δ dt, θ at the end, ω at the end) for a held command u."""
@@ -176,15 +183,25 @@ def _wall_sense(s: Scenario, x, y):
     return fx, fy, gap - s.robot.W / 2, goal
 
 
-def _position_after(s, tau, t, theta, omega, applied, V, x, y, substepped):
-    """(x, y) t seconds into a period that starts at (x, y, θ, ω) with `applied` held (`simulate_reference`'s motion)."""
-    k, wmax, T = s.robot.k, s.robot.max_steering_rate, s.controller.T
+def _position_after(s, tau, t, theta, omega, applied, V, x, y, substepped, switch=0.0, earlier=0.0):
+    """(x, y) t seconds into a period that starts at (x, y, θ, ω) with `applied` held (`simulate_reference`'s motion).
+
+    A held command whose dead time ends at `switch` (ε > 0) holds `earlier` before it; commands are before the plant gain.
+    """
+    k, wmax, T, g = s.robot.k, s.robot.max_steering_rate, s.controller.T, s.robot.plant_gain
     if s.controller.hold == "command":
-        one = _Steering(tau, k, t, wmax, ("constant",))
-        nodes, integral, _, _ = one.constant(theta, omega, applied)
+        if 0 < switch < t:
+            first = _Steering(tau, k, switch, wmax, ("constant",), g)
+            nodes, integral, theta2, omega2 = first.constant(theta, omega, g * earlier)
+            x, y = first.move(x, y, V, theta, nodes, integral)
+            t, theta, omega = t - switch, theta2, omega2
+        else:
+            applied = earlier if switch > 0 else applied
+        one = _Steering(tau, k, t, wmax, ("constant",), g)
+        nodes, integral, _, _ = one.constant(theta, omega, g * applied)
         return one.move(x, y, V, theta, nodes, integral)
     if not substepped:
-        one = _Steering(tau, k, t, wmax, ("servo",))
+        one = _Steering(tau, k, t, wmax, ("servo",), g)
         nodes, integral, _, _ = one.reference(theta, omega, applied)
         return one.move(x, y, V, theta, nodes, integral)
     part = T / SUBSTEPS
@@ -192,10 +209,10 @@ def _position_after(s, tau, t, theta, omega, applied, V, x, y, substepped):
     for length in [part] * whole + [t - whole * part]:
         if length <= 0:
             break
-        one = _Steering(tau, k, length, wmax, ("servo", "constant"))
+        one = _Steering(tau, k, length, wmax, ("servo", "constant"), g)
         u = k * (applied - theta)
         if abs(u) > wmax:
-            nodes, integral, theta2, omega2 = one.constant(theta, omega, min(max(u, -wmax), wmax))
+            nodes, integral, theta2, omega2 = one.constant(theta, omega, g * min(max(u, -wmax), wmax))
         else:
             nodes, integral, theta2, omega2 = one.reference(theta, omega, applied)
         x, y = one.move(x, y, V, theta, nodes, integral)
@@ -203,7 +220,7 @@ def _position_after(s, tau, t, theta, omega, applied, V, x, y, substepped):
     return x, y
 
 
-def _path_contact(s, sense, tau, start, applied, V, substepped, gap_start):
+def _path_contact(s, sense, tau, start, applied, V, substepped, gap_start, switch=0.0, earlier=0.0):
     """The first instant (s into the period) and place where the disc touches an obstacle, or None."""
     x, y, theta, omega = start
     T = s.controller.T
@@ -211,13 +228,13 @@ def _path_contact(s, sense, tau, start, applied, V, substepped, gap_start):
         gap_start = min(gap_start, (s.window_cells // 2) * s.environment.cell_size - s.robot.W / 2)
     if gap_start > V * T:  # the clearance is 1-Lipschitz: no point of a path of length V·T gets closer
         return None
-    gap_at = lambda t: sense(s, *_position_after(s, tau, t, theta, omega, applied, V, x, y, substepped))[2]
+    gap_at = lambda t: sense(s, *_position_after(s, tau, t, theta, omega, applied, V, x, y, substepped, switch, earlier))[2]
     before = 0.0
     for i in range(1, PATH_SAMPLES + 1):
         t = T * i / PATH_SAMPLES
         if gap_at(t) <= 0:
             hit = bisect_root(gap_at, before, t, rtol=1e-14)
-            return (hit, *_position_after(s, tau, hit, theta, omega, applied, V, x, y, substepped))
+            return (hit, *_position_after(s, tau, hit, theta, omega, applied, V, x, y, substepped, switch, earlier))
         before = t
     return None
 
@@ -235,12 +252,17 @@ def simulate_reference(s: Scenario):
     (Trajectory, Event or None)
     """
     r, c = s.robot, s.controller
-    T, k, wmax = c.T, r.k, r.max_steering_rate
+    T, k, wmax, g = c.T, r.k, r.max_steering_rate, r.plant_gain
     sense = _grid_sense if s.env == "grid" else _wall_sense
     servo = c.hold == "reference"
-    tau = r.tau if r.tau * k >= TAU_RESOLUTION else 0.0  # an ideal motor, as the engine and the models take it
-    full = _Steering(tau, k, T, wmax, ("servo",) if servo else ("constant",))
-    sub = _Steering(tau, k, T / SUBSTEPS, wmax, ("servo", "constant")) if servo else None
+    tau = r.tau if r.tau * g * k >= TAU_RESOLUTION else 0.0  # an ideal motor, as the engine and the models take it
+    lag, switch = (float(v[0]) for v in delay_split(np.array([T]), np.array([c.compute_delay]), np.array([r.dead_time])))
+    lag = int(lag)
+    full = _Steering(tau, k, T, wmax, ("servo",) if servo else ("constant",), g)
+    sub = _Steering(tau, k, T / SUBSTEPS, wmax, ("servo", "constant"), g) if servo else None
+    if switch > 0:  # the dead time ends within the period: two intervals of the held command
+        before, after = _Steering(tau, k, switch, wmax, ("constant",), g), _Steering(tau, k, T - switch, wmax, ("constant",), g)
+    computed = []  # every value computed so far; before t_0, u_0
     x, y, theta = s.start.x, s.start.y, s.start.theta
     if s.start_jitter > 0:
         shift = float(np.random.default_rng(s.seed).normal(0.0, s.start_jitter))
@@ -250,7 +272,7 @@ def simulate_reference(s: Scenario):
     tgt = s.target
     steps = math.ceil(s.duration / T - 1e-9)
     xs, ys, ths = [x], [y], [theta]
-    pending = None
+    pending_V = None
     best, best_t, last_gap = None, 0.0, math.inf
     event = None
     for step in range(steps + 1):
@@ -289,13 +311,21 @@ def simulate_reference(s: Scenario):
             speed = r.V * (1 - abs(cos_phi))
         else:
             speed = r.V
-        if pending is None:
-            pending = (value, speed)
-        applied, V = pending if c.compute_delay == 1 else (value, speed)
-        pending = (value, speed)
+        if pending_V is None:
+            pending_V = speed
+        V = pending_V if c.compute_delay == 1 else speed  # the speed: the compute delay only
+        pending_V = speed
+        computed.append(value)
+        applied = computed[max(step - lag, 0)]
+        earlier = computed[max(step - lag - 1, 0)]
         start, substepped = (x, y, theta, omega), False
-        if c.hold == "command":
-            nodes, integral, theta_end, omega_end = full.constant(theta, omega, applied)
+        if c.hold == "command" and switch > 0:
+            nodes, integral, theta_mid, omega_mid = before.constant(theta, omega, g * earlier)
+            x, y = before.move(x, y, V, theta, nodes, integral)
+            nodes, integral, theta_end, omega_end = after.constant(theta_mid, omega_mid, g * applied)
+            x, y = after.move(x, y, V, theta_mid, nodes, integral)
+        elif c.hold == "command":
+            nodes, integral, theta_end, omega_end = full.constant(theta, omega, g * applied)
             x, y = full.move(x, y, V, theta, nodes, integral)
         else:
             nodes, integral, theta_end, omega_end = full.reference(theta, omega, applied)
@@ -308,14 +338,14 @@ def simulate_reference(s: Scenario):
                 for _ in range(SUBSTEPS):
                     u = k * (applied - theta_end)
                     if abs(u) > wmax:
-                        nodes, integral, th2, om2 = sub.constant(theta_end, omega_end, min(max(u, -wmax), wmax))
+                        nodes, integral, th2, om2 = sub.constant(theta_end, omega_end, g * min(max(u, -wmax), wmax))
                     else:
                         nodes, integral, th2, om2 = sub.reference(theta_end, omega_end, applied)
                     x, y = sub.move(x, y, V, theta_end, nodes, integral)
                     theta_end, omega_end = th2, om2
         theta, omega = theta_end, omega_end
         xs.append(x), ys.append(y), ths.append(theta)
-        contact = _path_contact(s, sense, tau, start, applied, V, substepped, gap)
+        contact = _path_contact(s, sense, tau, start, applied, V, substepped, gap, switch, earlier)
         if contact is not None:  # the run ends at the sample after the touch, as the engine's does
             hit, cx, cy = contact
             event = Event("collision", step * T + hit, cx, cy)

@@ -15,6 +15,18 @@ the heading). Over one hold interval of length h the input is one of
 Both are exact: θ(t) and ω(t) are linear in (θ₀, ω₀, held value) with
 coefficients that depend only on (τ, k, h), precomputed once per member.
 
+Plant gain and dead time (docs/simulator.md, "Plant gain and dead time"). A
+real motor is τω̇ + ω = g·u(t − D): the held command's solution above takes
+v = g·u, and the servo's takes k → g·k (τθ̈ + θ̇ + gkθ = gkδ̃). A command
+computed from the data of t_k is applied at t_k + d·T (compute delay d) and
+reaches the motor D later, at t_k + m·T + ε with 0 <= ε < T (`delay_split`):
+over [t_k, t_k+1) the motor sees g·u_(k−m−1) for the first ε and g·u_(k−m)
+after, two constant inputs, so the engine splits the period at ε into two
+intervals of this module's kind, each exact, each with its own graded rule
+on its own length (ε and T − ε). A dead time in a continuous servo loop
+(``hold="reference"``) is a delay differential equation, not a sequence of
+such intervals: the simulator refuses it (`Scenario`).
+
 Positions (eq 14). With θ(t) = θ₀ + Δ(t),
 
     ∫₀ʰ sin θ dt = sin θ₀ ∫cos Δ dt + cos θ₀ ∫sin Δ dt,
@@ -85,7 +97,7 @@ import numpy as np
 from ..numerics.solve import gauss_legendre as legendre_nodes
 
 __all__ = [
-    "NODES", "RESOLUTION", "MAX_PANELS", "gauss_legendre", "slow_rate", "constant_input_modes", "servo_modes",
+    "NODES", "RESOLUTION", "MAX_PANELS", "DEAD_TIME_RESOLUTION", "delay_split", "gauss_legendre", "slow_rate", "constant_input_modes", "servo_modes",
     "panel_count", "graded_rule", "node_sum", "Rule", "Coefficients", "constant_input", "servo", "propagate",
     "advance_position",
 ]
@@ -101,6 +113,46 @@ MAX_PANELS = 64
 at most 2·NODES + 1 = 9 rad, so any T/τ and |θ̇|·T up to ~45 rad); beyond, the panels widen."""
 
 
+DEAD_TIME_RESOLUTION = 1e-9
+"""A dead time within this fraction of a period of a whole number of periods is taken as that whole number
+(`delay_split`): D/T is rarely exact in floating point (0.1/0.05 is 2 to round-off, or just under), and a
+sub-interval of 1e-9·T moves the robot by 1e-9 of a step while it adds a mode at z = 0 that the
+linear-prediction fit of the metrics (`sim.metrics`) would have to carry."""
+
+
+def delay_split(T, compute_delay, dead_time):
+    """(m, ε): a command computed at t_k reaches the motor at t_k + d·T + D = t_k + m·T + ε, 0 <= ε < T.
+
+    Over [t_k, t_k+1) the motor then sees u_(k−m−1) for the first ε seconds
+    and u_(k−m) for the rest (module docstring). ε within
+    `DEAD_TIME_RESOLUTION`·T of 0 or of T is snapped to a whole period.
+
+    Parameters
+    ----------
+    T : ndarray, shape (B,)
+        Sampling period, s (> 0).
+    compute_delay : ndarray of int, shape (B,)
+        d, samples (0 or 1).
+    dead_time : ndarray, shape (B,)
+        D, s (>= 0).
+
+    Returns
+    -------
+    m : ndarray of int, shape (B,)
+        Whole periods, d included.
+    eps : ndarray, shape (B,)
+        The fraction of a period, s, in [0, T).
+    """
+    T = np.asarray(T, dtype=float)
+    D = np.asarray(dead_time, dtype=float)
+    whole = np.floor(D / T)
+    eps = np.maximum(D - whole * T, 0.0)
+    up = eps > (1.0 - DEAD_TIME_RESOLUTION) * T
+    whole = np.where(up, whole + 1.0, whole)
+    eps = np.where(up | (eps < DEAD_TIME_RESOLUTION * T), 0.0, eps)
+    return np.asarray(compute_delay, dtype=np.int64) + whole.astype(np.int64), eps
+
+
 def gauss_legendre(nodes: int = NODES):
     """Nodes as fractions of an interval (0, 1) and weights summing to 1.
 
@@ -113,21 +165,24 @@ def gauss_legendre(nodes: int = NODES):
     return (x + 1) / 2, w / 2
 
 
-def slow_rate(k, max_steering_rate):
-    """Bound ω_s on |θ̇|, rad/s: min(ω_max, kπ).
+def slow_rate(k, max_steering_rate, gain=1.0):
+    """Bound ω_s on |θ̇|, rad/s: g·min(ω_max, kπ).
 
     A held command is k·wrap(δ − θ) clipped to ±ω_max, and a servo's command
-    k(δ̃ − θ) starts within ±kπ; ω lags the command (eq 6), so it stays within
-    the same bound.
+    k(δ̃ − θ) starts within ±kπ; the motor turns at g times the command, and
+    ω lags it (eq 6), so it stays within the same bound.
 
     Parameters
     ----------
     k : array_like
         Steering gain, 1/s.
     max_steering_rate : array_like
-        Rate limit ω_max, rad/s.
+        Rate limit ω_max, rad/s (of the command, before the gain).
+    gain : array_like
+        Plant gain g (1: KB's motor).
     """
-    return np.minimum(np.asarray(max_steering_rate, dtype=float), np.pi * np.asarray(k, dtype=float))
+    bound = np.minimum(np.asarray(max_steering_rate, dtype=float), np.pi * np.asarray(k, dtype=float))
+    return np.asarray(gain, dtype=float) * bound
 
 
 def constant_input_modes(tau):

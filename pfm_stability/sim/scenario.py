@@ -27,9 +27,10 @@ import numpy as np
 from ..checks import check_choice, check_number
 from ..laws.effective_force import DEFAULT_CV, GridWallLaw, calibrate_cell_ratio, check_window_cells, working_range
 from ..laws.force_law import ForceLaw, law_in_force
-from ..parameters import Controller, Robot, check_parameter
+from ..parameters import TAU_RESOLUTION, Controller, Robot, check_parameter
 from .environment import AnalyticEnvironment
 from .grid import HistogramGrid
+from .robot import delay_split
 
 __all__ = ["Pose", "Target", "MeasureAxis", "Scenario", "MAX_SAMPLES", "LAW_NAMES", "scenario_law"]
 
@@ -234,7 +235,9 @@ class Scenario:
     ----------
     name : str
     robot : Robot
-        V, τ, k, W, max steering rate (KB eq 5–6; §4).
+        V, τ, k, W, max steering rate (KB eq 5–6; §4), plant gain g and dead
+        time D (the motor τω̇ + ω = g·u(t − D); D > 0 only with a held command:
+        docs/simulator.md, "Plant gain and dead time").
     controller : Controller
         f, n, T, hold, compute_delay (T must be > 0: the simulator samples).
         In the grid, f is KB's f_av used to calibrate `cell_ratio` when that
@@ -294,6 +297,10 @@ class Scenario:
 
     def __post_init__(self):
         check_parameter("T_sampled", self.controller.T)
+        if self.robot.dead_time > 0 and self.controller.hold == "reference":
+            raise ValueError(f"dead_time must be 0 with hold=reference (a dead time inside the continuous steering servo is a delay "
+                             f"differential equation, which the simulator does not solve; docs/simulator.md); got dead_time = "
+                             f"{self.robot.dead_time:g} s with hold=reference")
         object.__setattr__(self, "duration", check_number("duration", self.duration, 0.0, 1e6, unit="s"))
         samples = self.duration / self.controller.T
         if samples > MAX_SAMPLES:
@@ -326,6 +333,19 @@ class Scenario:
     def env(self) -> str:
         """"grid" or "analytic"."""
         return "grid" if isinstance(self.environment, HistogramGrid) else "analytic"
+
+    def loop_order(self) -> int:
+        """State dimension of the sampled loop this run follows: the linear-prediction order of its metrics (`sim.metrics`).
+
+        (τ > 0) + 2 + m + (ε > 0): lateral offset, heading and (with a lag) the
+        steering rate, and the delay line's m + (ε > 0) commands, where a
+        command reaches the motor m·T + ε after its data (`robot.delay_split`:
+        d·T + D). τ counts as 0 when τ·g·k is below `parameters.TAU_RESOLUTION`,
+        as the engine and the models take it.
+        """
+        r, c = self.robot, self.controller
+        m, eps = delay_split(np.array([c.T]), np.array([c.compute_delay]), np.array([r.dead_time]))
+        return int(r.tau * r.plant_gain * r.k >= TAU_RESOLUTION) + 2 + int(m[0]) + int(eps[0] > 0)
 
     def calibrated_ratio(self) -> float:
         """ρ giving the grid's f_av = controller.f over the working range (KB §4; `scenario_law`)."""
@@ -382,6 +402,8 @@ class Scenario:
             "k": r.k,
             "W": r.W,
             "max_steering_rate_deg": math.degrees(r.max_steering_rate),
+            "dead_time": r.dead_time,
+            "plant_gain": r.plant_gain,
             "f": c.f,
             "n": c.n,
             "T": c.T,

@@ -468,6 +468,8 @@ def validate_boundary(
         "parameter": parameter,
         **{k: getattr(robot, k) for k in ("V", "tau", "k", "W")},
         "max_steering_rate_deg": math.degrees(robot.max_steering_rate),
+        "dead_time": robot.dead_time,
+        "plant_gain": robot.plant_gain,
         **{k: getattr(controller, k) for k in ("f", "n", "T", "hold", "compute_delay")},
         "L": geometry if scenario == "corridor" and parameter != "L" else None,
         "alpha_deg": math.degrees(geometry) if scenario == "wall" and parameter != "alpha" else None,

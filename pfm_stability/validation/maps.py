@@ -48,7 +48,7 @@ import numpy as np
 from ..checks import check_integer, check_number, check_type
 from ..laws.effective_force import check_window_cells
 from ..models import Sampled
-from ..parameters import TAU_RESOLUTION, Controller, Robot
+from ..parameters import Controller, Robot
 from ..io.serialize import json_number, json_ready
 from ..sim.engine import run_batch
 from ..sim.grid import HistogramGrid
@@ -482,8 +482,8 @@ def _measured(run: _Run, plus, minus) -> MapCase:
 
 
 def _order(scenario: Scenario) -> int:
-    """State dimension of the sampled loop, (τ > 0) + 2 + compute_delay: the linear-prediction order (`sim.metrics`)."""
-    return (scenario.robot.tau * scenario.robot.k >= TAU_RESOLUTION) + 2 + scenario.controller.compute_delay
+    """State dimension of the sampled loop, the linear-prediction order (`sim.metrics`): `Scenario.loop_order`."""
+    return scenario.loop_order()
 
 
 def _batches(runs: list) -> list:
