@@ -439,7 +439,8 @@ class Leg:
 
     kind "corridor" (half-width L, m), "wall" (target angle alpha, rad, from the wall normal), "still" (the robot
     stands), "turn" (it turns in place at `rate` rad/s) or "steps" (step turns up to ±`rate` rad/s at 0.3 m/s in the
-    open, which show the plant to `identify`); duration (s); offset (m, the simulator's start offset
+    open, which show the plant to `identify`); a manoeuvre longer than 3 s is told to stop turning for its last 1.5 s
+    (a simulator's leg starts at rest) and starts from the yaw rate the last leg ended with; duration (s); offset (m, the simulator's start offset
     from the equilibrium line); length (m of wall drawn beyond the leg's end; 0.3 m before its start).
     """
 
@@ -478,7 +479,7 @@ class LegTruth:
 
 
 def _sim_leg(leg: Leg, robot, controller):
-    """(t, θ at every period, ω at every period, applied command u per period, x, y (sim frame), metrics, geometry)."""
+    """(trajectory, the command computed at every sample, the run, L or d0, the walls (simulator frame)) of one leg."""
     from pfm_stability.laws.force_law import PowerLaw, wall_equilibrium
     from pfm_stability.sim.api import simulate as sim_run
     from pfm_stability.sim.vff import direction_of, steering_command
@@ -495,31 +496,34 @@ def _sim_leg(leg: Leg, robot, controller):
         fx = -f * (W / -tr.x) ** n + math.cos(leg.alpha)
         fy = math.sin(leg.alpha)
     value = steering_command(direction_of(fx, fy), tr.theta, robot.k, robot.max_steering_rate)
-    applied = np.concatenate([[value[0]], value[:-1]]) if controller.compute_delay else value
-    applied = applied[: tr.t.size - 1]
-    e = math.exp(-controller.T / robot.tau)
-    omega = np.zeros(tr.t.size)
-    for k in range(applied.size):
-        omega[k + 1] = applied[k] + (omega[k] - applied[k]) * e
     geometry = leg.L if leg.kind == "corridor" else wall_equilibrium(PowerLaw(f, n, W), leg.alpha)
     walls = ([(-leg.L, -0.3), (-leg.L, tr.y[-1] + leg.length)], [(leg.L, -0.3), (leg.L, tr.y[-1] + leg.length)]) \
         if leg.kind == "corridor" else ([(0.0, -0.3), (0.0, tr.y[-1] + leg.length)],)
-    return tr, omega, applied, run, geometry, walls
+    return tr, value, run, geometry, walls
 
 
-def _fine(tr, omega, applied, tau: float, T: float, V: float, dt: float):
-    """(t, x, y, θ, ω) on a grid of step dt between the simulator's samples: θ and ω exact, x and y by the trapezoid rule."""
+def _fine(tr, value, robot, controller, dt: float):
+    """(t, x, y, θ, ω) on a grid of step dt: the command computed at t_k reaches the motor at t_k + d·T + D with gain g
+    (u_0 before, as the simulator starts); θ and ω exact between those instants, x and y by the trapezoid rule."""
+    T, tau, g = controller.T, robot.tau, robot.plant_gain
+    switch = np.concatenate([[0.0], tr.t[:-1] + controller.compute_delay * T + robot.dead_time])
+    v = g * np.concatenate([[value[0]], value[:-1]])
+    omega, theta = np.zeros(switch.size), np.full(switch.size, tr.theta[0])
+    for j in range(switch.size - 1):
+        span = switch[j + 1] - switch[j]
+        e = math.exp(-span / tau)
+        omega[j + 1] = v[j] + (omega[j] - v[j]) * e
+        theta[j + 1] = theta[j] + v[j] * span + (omega[j] - v[j]) * tau * (1 - e)
     t = np.arange(0.0, tr.t[-1], dt)
-    k = np.minimum((t / T).astype(int), applied.size - 1)
-    s = t - tr.t[k]
-    u, w0 = applied[k], omega[k]
+    j = np.searchsorted(switch, t, side="right") - 1
+    s = t - switch[j]
     decay = np.exp(-s / tau)
-    w = u + (w0 - u) * decay
-    theta = tr.theta[k] + u * s + (w0 - u) * tau * (1 - decay)
-    vx, vy = V * np.sin(theta), V * np.cos(theta)
+    w = v[j] + (omega[j] - v[j]) * decay
+    th = theta[j] + v[j] * s + (omega[j] - v[j]) * tau * (1 - decay)
+    vx, vy = robot.V * np.sin(th), robot.V * np.cos(th)
     x = tr.x[0] + np.concatenate([[0.0], np.cumsum((vx[1:] + vx[:-1]) * dt / 2)])
     y = tr.y[0] + np.concatenate([[0.0], np.cumsum((vy[1:] + vy[:-1]) * dt / 2)])
-    return t, x, y, theta, w
+    return t, x, y, th, w
 
 
 def ray_cast(x: float, y: float, yaw: float, angles: np.ndarray, walls) -> np.ndarray:
@@ -545,7 +549,8 @@ def drive(legs, robot=None, controller=None, *, odom_rate: float = 50.0, scan_ra
     Commands at every controller period T (the held command: what the base is told over the period), odometry at
     `odom_rate` (pose and yaw rate, with noise), scans of `beams` ranges at `scan_rate` ray-cast against every wall with
     noise `range_noise`; `drop` is the probability that any odometry, scan or command message is lost. The odometry
-    frame is the simulator's rotated by `frame_angle` (default: a random angle). τ > 0, hold "command" only.
+    frame is the simulator's rotated by `frame_angle` (default: a random angle). The robot's plant gain g and dead time D
+    act as in the simulator (the motor sees g·u(t − D)); τ > 0, hold "command" only.
     """
     from pfm_stability.parameters import CARMEL
 
@@ -558,10 +563,11 @@ def drive(legs, robot=None, controller=None, *, odom_rate: float = 50.0, scan_ra
     parts, walls, truth = [], [], []
     t0, px, py, pyaw = 0.0, 0.0, 0.0, 0.0  # where the next leg starts: time, pose in the odometry frame
     T = controller.T
+    carried = (0.0, 0.0)
     for leg in legs:
         if leg.kind in ("corridor", "wall"):
-            tr, omega, applied, run, geometry, leg_walls = _sim_leg(leg, robot, controller)
-            t, x, y, theta, w = _fine(tr, omega, applied, robot.tau, T, robot.V, dt)
+            tr, value, run, geometry, leg_walls = _sim_leg(leg, robot, controller)
+            t, x, y, theta, w = _fine(tr, value, robot, controller, dt)
             # the simulator's frame (X lateral, Y forward, θ from +Y towards +X) → odometry: yaw = π/2 − θ, rotated to start at pyaw
             rot = pyaw - (math.pi / 2 - tr.theta[0])
             cr, sr = math.cos(rot), math.sin(rot)
@@ -570,8 +576,8 @@ def drive(legs, robot=None, controller=None, *, odom_rate: float = 50.0, scan_ra
             for (ax, ay), (bx, by) in leg_walls:
                 walls.append(tuple((px + cr * (wx - x[0]) - sr * (wy - y[0]), py + sr * (wx - x[0]) + cr * (wy - y[0]))
                                    for wx, wy in ((ax, ay), (bx, by))))
-            cmd_t = tr.t[:-1]
-            cmd = (cmd_t, -applied, np.full(applied.size, robot.V))  # yaw rate = −dθ/dt
+            cmd_t = tr.t[:-1] + controller.compute_delay * T  # published when computed: after the compute delay
+            cmd = (cmd_t, -value[:-1], np.full(cmd_t.size, robot.V))  # yaw rate = −dθ/dt
             vx = np.full(t.size, robot.V)
             truth.append(LegTruth(leg.kind, t0, t0 + t[-1], run.metrics, geometry, robot.V))
             wz = -w
@@ -585,17 +591,22 @@ def drive(legs, robot=None, controller=None, *, odom_rate: float = 50.0, scan_ra
                 u = levels[np.searchsorted(edges, cmd_t)]
             else:
                 u = np.full(cmd_t.size, leg.rate if leg.kind == "turn" else 0.0)
-            e = math.exp(-T / robot.tau)
-            w_k = np.zeros(cmd_t.size + 1)
-            yaw_k = np.zeros(cmd_t.size + 1)
-            for j in range(cmd_t.size):
-                w_k[j + 1] = u[j] + (w_k[j] - u[j]) * e
-                yaw_k[j + 1] = yaw_k[j] + u[j] * T + (w_k[j] - u[j]) * robot.tau * (1 - e)
-            j = np.minimum((t / T).astype(int), cmd_t.size - 1)
-            s_ = t - j * T
+            if leg.duration > 3.0:  # the last 1.5 s told to stop turning: the next leg (a simulator's) starts at rest
+                u = np.where(cmd_t > leg.duration - 1.5, 0.0, u)
+            switch = np.concatenate([[0.0], cmd_t + robot.dead_time])  # the motor: g·u(t − D), the last leg's input before
+            v = np.concatenate([[carried[1]], robot.plant_gain * u])
+            w_k, yaw_k = np.zeros(switch.size), np.zeros(switch.size)
+            w_k[0] = carried[0]
+            for j in range(switch.size - 1):
+                span = switch[j + 1] - switch[j]
+                e = math.exp(-span / robot.tau)
+                w_k[j + 1] = v[j] + (w_k[j] - v[j]) * e
+                yaw_k[j + 1] = yaw_k[j] + v[j] * span + (w_k[j] - v[j]) * robot.tau * (1 - e)
+            j = np.searchsorted(switch, t, side="right") - 1
+            s_ = t - switch[j]
             decay = np.exp(-s_ / robot.tau)
-            wz = u[j] + (w_k[j] - u[j]) * decay
-            yaw = pyaw + yaw_k[j] + u[j] * s_ + (w_k[j] - u[j]) * robot.tau * (1 - decay)
+            wz = v[j] + (w_k[j] - v[j]) * decay
+            yaw = pyaw + yaw_k[j] + v[j] * s_ + (w_k[j] - v[j]) * robot.tau * (1 - decay)
             cmd = (cmd_t, u, np.full(cmd_t.size, speed))
             cx, cy = speed * np.cos(yaw), speed * np.sin(yaw)
             ox = px + np.concatenate([[0.0], np.cumsum((cx[1:] + cx[:-1]) * dt / 2)])
@@ -603,6 +614,7 @@ def drive(legs, robot=None, controller=None, *, odom_rate: float = 50.0, scan_ra
             vx = np.full(t.size, speed)
             truth.append(LegTruth(leg.kind, t0, t0 + t[-1], None, None, speed))
         parts.append((t0 + t, ox, oy, yaw, wz, vx, t0 + cmd[0], cmd[1], cmd[2]))
+        carried = (float(wz[-1]), robot.plant_gain * float(cmd[1][-1]))  # yaw rate and motor input where the leg ends
         t0, px, py, pyaw = t0 + t[-1] + dt, float(ox[-1]), float(oy[-1]), float(yaw[-1])
     ft, fx, fy, fyaw, fwz, fvx = (np.concatenate([p[i] for p in parts]) for i in range(6))
     cmd_t, cmd_wz, cmd_vx = (np.concatenate([p[i] for p in parts]) for i in (6, 7, 8))
@@ -634,7 +646,7 @@ def drive(legs, robot=None, controller=None, *, odom_rate: float = 50.0, scan_ra
     owz = at(odom_t, fwz) + rng.normal(0, rate_noise, odom_t.size)
     recording = Recording(T=T, jitter=0.0, drop=drop, profile="vff", duration=duration, odom_rate=odom_rate,
                           odom_noise=rate_noise, scan_rate=scan_rate, beams=beams, start=start, seed=seed)
-    log = SyntheticLog(Plant(g=1.0, tau=robot.tau, dead_time=0.0), recording, cmd_t[keep_c], cmd_wz[keep_c], cmd_vx[keep_c],
+    log = SyntheticLog(Plant(g=robot.plant_gain, tau=robot.tau, dead_time=robot.dead_time), recording, cmd_t[keep_c], cmd_wz[keep_c], cmd_vx[keep_c],
                        odom_t, owz, scan_t=scan_t, odom_x=ox, odom_y=oy, odom_yaw=oyaw, odom_vx=at(odom_t, fvx), scan_ranges=ranges)
     return DrivenLog(log, walls, tuple(truth))
 

@@ -122,7 +122,7 @@ def parameters_table(result, sources: dict) -> dict:
     from ..parameters import RANGES
 
     r, c = result.robot, result.controller
-    values = {"V": r.V, "tau": r.tau, "k": r.k, "W": r.W, "T": c.T, "f": c.f, "n": c.n, "hold": c.hold, "compute_delay": c.compute_delay}
+    values = {"V": r.V, "tau": r.tau, "dead_time": r.dead_time, "plant_gain": r.plant_gain, "k": r.k, "W": r.W, "T": c.T, "f": c.f, "n": c.n, "hold": c.hold, "compute_delay": c.compute_delay}
     return {name: {"value": value, "unit": RANGES[name].unit if name in RANGES else "", "source": sources.get(name, "")}
             for name, value in values.items()}
 

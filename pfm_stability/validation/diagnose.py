@@ -43,8 +43,9 @@ __all__ = ["Measured", "Predicted", "StretchDiagnosis", "Diagnosis", "diagnose",
 
 USER_PARAMETERS = ("k", "W", "f", "n")
 """What no log shows: the steering gain, the robot's width and KB's law (f, n): the user's (``--config`` or options)."""
-LOG_PARAMETERS = ("tau", "T")
-"""What the log shows (`analysis.identification`): the steering lag and the controller's period, unless the user gives them."""
+LOG_PARAMETERS = ("tau", "T", "dead_time", "plant_gain")
+"""What the log shows (`analysis.identification`): the steering lag, the controller's period, the plant's dead time and
+gain, unless the user gives them."""
 MATCH = 0.15
 """A model matches when its root is within this relative distance of the measured σ + jω (and its verdict agrees)."""
 MAX_GAP = 1.0
@@ -275,7 +276,7 @@ def missing_parameters(sources: dict) -> tuple[str, ...]:
 
 
 def complete_from_log(robot: Robot, controller: Controller, sources: dict, identification) -> tuple[Robot, Controller, dict]:
-    """τ and T from the identification where the user gave neither (their source is a preset); the new sources.
+    """τ, T, D and g from the identification where the user did not give them (their source is a preset); the new sources.
 
     Parameters
     ----------
@@ -289,28 +290,28 @@ def complete_from_log(robot: Robot, controller: Controller, sources: dict, ident
     Raises
     ------
     ValueError
-        τ is needed and the plant was not identified (the line says why and which key to give).
+        τ, D or g is needed and the plant was not identified (the line says why and which keys to give).
     """
     sources = dict(sources)
     from_preset = {name for name in LOG_PARAMETERS if str(sources.get(name, "")).startswith(("preset ", "ASSUMED (preset "))}
     if not from_preset or identification is None:
         return robot, controller, sources
     if "T" in from_preset:
-        controller = controller.replace(T=identification.controller.T) if hasattr(controller, "replace") else \
-            Controller(**{**_fields(controller), "T": identification.controller.T})
+        controller = controller.replace(T=identification.controller.T)
         sources["T"] = f"identified from {identification.log.path} (median period of {identification.log.command_topic})"
-    if "tau" in from_preset:
-        if not identification.identified:
-            raise ValueError(f"the steering lag could not be identified from {identification.log.path}: {identification.reason}; "
-                             "give robot.tau in --config (or --tau)")
-        tau = identification.plant.tau
-        robot = robot.replace(tau=tau.value)
-        sources["tau"] = f"identified from {identification.log.path} ({tau.low:.4g} to {tau.high:.4g} s)"
+    plant = [name for name in ("tau", "dead_time", "plant_gain") if name in from_preset]
+    if plant and not identification.identified:
+        raise ValueError(f"the steering plant could not be identified from {identification.log.path}: {identification.reason}; "
+                         f"give {', '.join('robot.' + name for name in plant)} in --config "
+                         f"(or {' '.join('--' + name.replace('_', '-') for name in plant)})")
+    fit = identification.plant
+    estimates = {"tau": (fit.tau, "s"), "dead_time": (fit.dead_time, "s"), "plant_gain": (fit.g, "")} if plant else {}
+    for name in plant:
+        estimate, unit = estimates[name]
+        value = max(estimate.value, 0.0) if name == "dead_time" else estimate.value  # a negative D: clocks differ (identify warns)
+        robot = robot.replace(**{name: value})
+        sources[name] = f"identified from {identification.log.path} ({estimate.low:.4g} to {estimate.high:.4g}{' ' + unit if unit else ''})"
     return robot, controller, sources
-
-
-def _fields(obj) -> dict:
-    return {name: getattr(obj, name) for name in obj.__dataclass_fields__}
 
 
 # ------------------------------------------------------------------------------------------ judging
