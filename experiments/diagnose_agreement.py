@@ -21,12 +21,12 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 def check(seed: int, directory) -> dict:
     """One run: the measured and true ω, the measured σ, the predicted verdict and the margin."""
     from log_helpers import corridor_run
-    from pfm_stability.analysis.stretches import wall_lines
+    from pfm_stability.analysis.stretches import wall_lines_batch
     from pfm_stability.io.logs import read_log
     from pfm_stability.validation.diagnose import diagnose
 
     path, robot, controller, L, margin, truth = corridor_run(seed, directory)
-    log = read_log(path, need=("pose", "scan"), scan_reducer=wall_lines)
+    log = read_log(path, need=("pose", "scan"), scan_reducer=wall_lines_batch, scan_batch=256)
     result = diagnose(log, robot, controller)
     s = result.judged
     row = {"seed": seed, "margin": margin, "true_omega": truth.metrics.angular_frequency, "true_sigma": truth.metrics.growth_rate,

@@ -636,8 +636,14 @@ def drive(legs, robot=None, controller=None, *, odom_rate: float = 50.0, scan_ra
     sx, sy, syaw = at(scan_t, fx), at(scan_t, fy), at(scan_t, fyaw)
     angles = -math.pi + 2 * math.pi * np.arange(beams) / beams
     ranges = np.empty((scan_t.size, beams), dtype=np.float32)
+    ends = np.array(walls, dtype=float).reshape(-1, 4)
     for i in range(scan_t.size):
-        r = ray_cast(sx[i], sy[i], syaw[i], angles, walls)
+        # only the walls within 30 m (the range) of the sensor
+        px, py = sx[i], sy[i]
+        ex, ey = ends[:, 2] - ends[:, 0], ends[:, 3] - ends[:, 1]
+        q = np.clip(((px - ends[:, 0]) * ex + (py - ends[:, 1]) * ey) / (ex * ex + ey * ey), 0.0, 1.0)
+        near = np.hypot(ends[:, 0] + q * ex - px, ends[:, 1] + q * ey - py) < 30.0
+        r = ray_cast(px, py, syaw[i], angles, [((a, b), (c, d)) for a, b, c, d in ends[near]])
         ranges[i] = np.where(np.isfinite(r) & (r < 30.0), r + rng.normal(0.0, range_noise, beams), np.inf)
     odom_t, scan_t, ranges = odom_t[keep_o], scan_t[keep_s], ranges[keep_s]
     ox = at(odom_t, fx) + rng.normal(0, pose_noise, odom_t.size)

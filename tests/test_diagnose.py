@@ -260,3 +260,15 @@ def test_dead_time_and_plant_gain_are_measured_through_and_identified(tmp_path):
     p = data["parameters"]
     assert p["dead_time"]["value"] == pytest.approx(0.07, abs=0.02) and p["dead_time"]["source"].startswith("identified from")
     assert p["plant_gain"]["value"] == pytest.approx(0.85, rel=0.05) and p["plant_gain"]["source"].startswith("identified from")
+
+
+def test_batched_reduction_is_the_scan_by_scan_one(driven, read):
+    """Scans reduced in batches of 7 (`scan_batch`; the last batch short) give the numbers of one scan at a time, and the
+    scans' numbers read from the bytes are those rosbags serialized (the ranges as float32)."""
+    from pfm_stability.analysis.stretches import wall_lines_batch
+
+    batched = read_log(driven[1], need=("scan",), scan_reducer=wall_lines_batch, scan_batch=7).scan
+    np.testing.assert_array_equal(batched.t, read.scan.t)
+    np.testing.assert_allclose(batched.values, read.scan.values, rtol=0, atol=1e-12)
+    first = read_log(driven[1], need=("scan",), scan_reducer=lambda s: s.ranges.copy()).scan.values[0]
+    np.testing.assert_array_equal(first, driven[0].log.scan_ranges[0])

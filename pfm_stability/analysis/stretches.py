@@ -1,8 +1,9 @@
 """Where a robot drove along a wall or through a corridor, from its log's scans and odometry (docs/diagnose.md, "Stretches").
 
-Each laser scan is reduced as it streams past (`wall_lines`, a scan reducer for `io.logs.read_log`): the
+Each laser scan is reduced as it streams past (`wall_lines`, a scan reducer for `io.logs.read_log`, or
+`wall_lines_batch` on batches of scans at once: the same numbers, much faster): the
 beams on each side of the robot within `WINDOW` m ahead and behind are fitted with one straight line (total
-least squares, trimmed twice of the points farther than max(3·1.4826·MAD, `TRIM`) from it), kept when it
+least squares, refitted twice without the points farther than max(`SPREAD`·rms, `TRIM`) from it), kept when it
 runs alongside (its direction within `ALONGSIDE` of the heading), holds `MIN_POINTS` points and fits them to
 `MAX_RMS` m, and reaches `COVER` m ahead of and behind the sensor. A line is (ρ, φ): the distance from the sensor (m) and the direction of its normal in the sensor
 frame (rad); the laser is taken to sit at the base's origin looking forward.
@@ -30,8 +31,8 @@ import numpy as np
 from ..io.logs import PoseSeries, Scan, pose_at
 from ..io.serialize import json_number
 
-__all__ = ["WallLine", "Stretch", "LateralOffset", "wall_lines", "find_stretches", "lateral_offset", "travel_speed",
-           "WINDOW", "COVER", "ALONGSIDE", "MIN_POINTS", "MAX_RMS", "TRIM", "MIN_SPEED", "SAME_ANGLE", "SAME_OFFSET", "GAP",
+__all__ = ["WallLine", "Stretch", "LateralOffset", "wall_lines", "wall_lines_batch", "find_stretches", "lateral_offset", "travel_speed",
+           "WINDOW", "COVER", "ALONGSIDE", "MIN_POINTS", "MAX_RMS", "TRIM", "SPREAD", "MIN_SPEED", "SAME_ANGLE", "SAME_OFFSET", "GAP",
            "MIN_DURATION", "MIN_LISTED", "BIN", "LINE_FIELDS"]
 
 WINDOW = 2.0
@@ -46,7 +47,9 @@ MIN_POINTS = 12
 MAX_RMS = 0.05
 """A line must fit its kept points to this rms distance (m)."""
 TRIM = 0.03
-"""Points farther than max(3·1.4826·MAD, TRIM) m from a fitted line are dropped before refitting."""
+SPREAD = 2.5
+"""Points farther than max(SPREAD·rms, TRIM) m from a fitted line (rms: of the points it was fitted to) are dropped
+before refitting; three fits."""
 MIN_SPEED = 0.05
 """A robot moving slower than this (m/s) is not driving along anything (standing, turning in place)."""
 SAME_ANGLE = math.radians(8.0)
@@ -66,33 +69,65 @@ LINE_FIELDS = ("rho_left", "phi_left", "rms_left", "rho_right", "phi_right", "rm
 """The six numbers `wall_lines` returns per scan (NaN where a side has no line)."""
 
 
-def _fit(px: np.ndarray, py: np.ndarray) -> tuple[float, float, float] | None:
-    """(ρ, φ, rms) of the line through the points (normal pointing away from the origin), trimmed twice; None if unfit."""
-    keep = np.ones(px.size, dtype=bool)
+def _fit_lines(px: np.ndarray, py: np.ndarray, mask: np.ndarray) -> np.ndarray:
+    """(ρ, φ, rms) per row of the points (px, py)[mask] (rows: scans), refitted twice; NaN where a row has no line.
+
+    Total least squares through the masked points' moments (the covariance's main axis), the normal pointing away from
+    the origin; points farther than max(`SPREAD`·rms, `TRIM`) are dropped and the line refitted (module docstring).
+    """
+    keep = mask
     for _ in range(3):
-        if keep.sum() < MIN_POINTS:
-            return None
-        mx, my = px[keep].mean(), py[keep].mean()
-        dx, dy = px[keep] - mx, py[keep] - my
-        sxx, syy, sxy = float(dx @ dx), float(dy @ dy), float(dx @ dy)
-        angle = 0.5 * math.atan2(2 * sxy, sxx - syy)  # the line's direction: the covariance's main axis
-        nx, ny = -math.sin(angle), math.cos(angle)
-        residual = (px - mx) * nx + (py - my) * ny
-        spread = np.abs(residual[keep])
-        limit = max(3 * 1.4826 * float(np.median(spread)), TRIM)
-        new = np.abs(residual) <= limit
-        if np.array_equal(new, keep):
-            break
-        keep = new
-    if keep.sum() < MIN_POINTS:
-        return None
+        w = keep.astype(float)
+        n = np.maximum(w.sum(axis=1), 1.0)
+        mx, my = (w * px).sum(axis=1) / n, (w * py).sum(axis=1) / n
+        dx, dy = (px - mx[:, None]) * w, (py - my[:, None]) * w
+        sxx, syy, sxy = (dx * dx).sum(axis=1), (dy * dy).sum(axis=1), (dx * dy).sum(axis=1)
+        angle = 0.5 * np.arctan2(2 * sxy, sxx - syy)  # the line's direction
+        nx, ny = -np.sin(angle), np.cos(angle)
+        residual = (px - mx[:, None]) * nx[:, None] + (py - my[:, None]) * ny[:, None]
+        rms = np.sqrt((w * residual * residual).sum(axis=1) / n)
+        keep = mask & (np.abs(residual) <= np.maximum(SPREAD * rms, TRIM)[:, None])
+    count = keep.sum(axis=1)
     rho = mx * nx + my * ny
-    if rho < 0:
-        nx, ny, rho = -nx, -ny, -rho
-    rms = float(np.sqrt(np.mean(residual[keep] ** 2)))
-    if px[keep].min() > -COVER or px[keep].max() < COVER:  # the wall must run past the robot, not only ahead or behind it
-        return None
-    return rho, math.atan2(ny, nx), rms
+    flip = rho < 0
+    nx, ny, rho = np.where(flip, -nx, nx), np.where(flip, -ny, ny), np.abs(rho)
+    rms = np.sqrt(np.where(keep, residual ** 2, 0.0).sum(axis=1) / np.maximum(count, 1))
+    behind = np.where(keep, px, np.inf).min(axis=1)
+    ahead = np.where(keep, px, -np.inf).max(axis=1)
+    phi = np.arctan2(ny, nx)
+    good = ((count >= MIN_POINTS) & (rms <= MAX_RMS) & (behind <= -COVER) & (ahead >= COVER)
+            & (np.abs(np.sin(phi)) >= math.cos(ALONGSIDE)))  # a normal across the heading is no wall alongside
+    return np.where(good[:, None], np.stack([rho, phi, rms], axis=1), np.nan)
+
+
+def wall_lines_batch(scans) -> np.ndarray:
+    """The walls on the left and right of each scan, in the sensor frame: a batched scan reducer (``scan_batch``).
+
+    Parameters
+    ----------
+    scans : sequence of Scan
+        Laser scans (angles rad, ranges m).
+
+    Returns
+    -------
+    ndarray
+        (scans, 6): the numbers of `LINE_FIELDS` per scan (`wall_lines`).
+    """
+    out = np.full((len(scans), 6), np.nan)
+    groups = {}
+    for i, scan in enumerate(scans):  # the scans of one layout are reduced together
+        key = (scan.angle_min, scan.angle_increment, np.size(scan.ranges), scan.range_min, scan.range_max)
+        groups.setdefault(key, []).append(i)
+    for (a_min, a_inc, beams, r_min, r_max), rows in groups.items():
+        r = np.stack([np.asarray(scans[i].ranges, dtype=float) for i in rows])
+        a = a_min + a_inc * np.arange(beams)
+        ok = np.isfinite(r) & (r > r_min) & (r < r_max)
+        r = np.where(ok, r, 0.0)
+        for side, columns in ((0, np.sin(a) > 0), (3, np.sin(a) < 0)):  # the left half of the beams, the right half
+            rc, ac = r[:, columns], a[columns]
+            px, py = rc * np.cos(ac), rc * np.sin(ac)
+            out[rows, side:side + 3] = _fit_lines(px, py, ok[:, columns] & (np.abs(px) <= WINDOW))
+    return out
 
 
 def wall_lines(scan: Scan) -> np.ndarray:
@@ -109,24 +144,7 @@ def wall_lines(scan: Scan) -> np.ndarray:
         The six numbers of `LINE_FIELDS`: for each side the line's distance ρ (m), its normal's direction φ (rad,
         sensor frame) and the fit's rms (m); NaN for a side without a line (module docstring).
     """
-    r = np.asarray(scan.ranges, dtype=float)
-    a = scan.angle_min + scan.angle_increment * np.arange(r.size)
-    ok = np.isfinite(r) & (r > scan.range_min) & (r < scan.range_max)
-    px, py = r[ok] * np.cos(a[ok]), r[ok] * np.sin(a[ok])
-    near = np.abs(px) <= WINDOW
-    out = np.full(6, np.nan)
-    for i, side in enumerate((py > 0, py < 0)):
-        sel = near & side
-        if sel.sum() < MIN_POINTS:
-            continue
-        fit = _fit(px[sel], py[sel])
-        if fit is None:
-            continue
-        rho, phi, rms = fit
-        if rms > MAX_RMS or abs(math.sin(phi)) < math.cos(ALONGSIDE):  # a normal across the heading: a wall alongside
-            continue
-        out[3 * i: 3 * i + 3] = rho, phi, rms
-    return out
+    return wall_lines_batch([scan])[0]
 
 
 @dataclass(frozen=True)

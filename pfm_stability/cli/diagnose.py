@@ -26,6 +26,9 @@ from .identify import FORMATS, topic
 
 __all__ = ["add_parser", "run", "render_text", "render_markdown", "parameters_table"]
 
+SCAN_BATCH = 256
+"""Scans reduced at once (`analysis.stretches.wall_lines_batch`): at most this many are held."""
+
 _KEYS = {"k": "robot.k", "W": "robot.W", "f": "controller.f", "n": "controller.n", "tau": "robot.tau", "T": "controller.T"}
 """Parameter → its key in a configuration file (docs/config.md)."""
 
@@ -67,7 +70,7 @@ def run(args) -> int:
         The parsed command line.
     """
     from ..analysis.identification import identify
-    from ..analysis.stretches import wall_lines
+    from ..analysis.stretches import wall_lines_batch
     from ..extras import require
     from ..io.logs import LogTopics, log_format, read_log
     from ..io.serialize import SCHEMA_VERSION, dumps
@@ -87,7 +90,7 @@ def run(args) -> int:
     to_identify = [name for name in LOG_PARAMETERS if str(params.sources[name]).startswith(("preset ", "ASSUMED (preset "))]
     topics = LogTopics(command=args.cmd_topic, odometry=args.odom_topic, scan=args.scan_topic)
     need = ("command", "odometry", "pose", "scan") if to_identify else ("pose", "scan")
-    log = read_log(args.log, topics, need=need, scan_reducer=wall_lines)
+    log = read_log(args.log, topics, need=need, scan_reducer=wall_lines_batch, scan_batch=SCAN_BATCH)
     identification = identify(log, "odometry") if to_identify else None
     robot, controller, sources = complete_from_log(params.robot, params.controller, params.sources, identification)
     result = diagnose(log, robot, controller)

@@ -26,7 +26,7 @@ one-hour bag of 360-beam scans at 10 Hz is 13 million ranges: they are never hel
 
 The yaw rate is taken from the raw message bytes at its place in the layout (`_FIELDS`: the header's
 strings are the only variable-length part before it), which is 20× faster than deserializing every
-message; a scan is deserialized by `rosbags`.
+message; so are a scan's numbers and its ranges (a view of the bytes, no copy).
 
 Bad logs
 --------
@@ -364,7 +364,7 @@ def log_format(path: str) -> str:
 
 
 def read_log(path, topics: LogTopics = LogTopics(), *, need: Sequence[str] = ("command", "odometry"),
-             scan_reducer: Callable[[Scan], Any] | None = None) -> LogData:
+             scan_reducer: Callable[[Scan], Any] | None = None, scan_batch: int = 1) -> LogData:
     """Read the series `need` of the log at `path` in one pass, keeping only their numbers.
 
     Parameters
@@ -377,6 +377,9 @@ def read_log(path, topics: LogTopics = LogTopics(), *, need: Sequence[str] = ("c
         The series to read (of `SERIES`); each must be in the log, with messages.
     scan_reducer : callable, optional
         `Scan` → anything: applied to each scan as it is read, when ``"scan"`` is needed (required then).
+    scan_batch : int
+        With more than 1, the reducer takes a list of up to this many `Scan` (in order) and returns one result per
+        scan: a vectorized reducer, with at most `scan_batch` scans held at once.
 
     Returns
     -------
@@ -403,7 +406,7 @@ def read_log(path, topics: LogTopics = LogTopics(), *, need: Sequence[str] = ("c
     from ..extras import require
 
     require("logs", "reading a ROS bag")
-    return _read_bag(path, kind, topics, tuple(need), scan_reducer)
+    return _read_bag(path, kind, topics, tuple(need), scan_reducer, max(int(scan_batch), 1))
 
 
 class _ReducerFailed(Exception):
@@ -415,7 +418,7 @@ def _one_line(exc: BaseException) -> str:
     return text if len(text) <= 200 else text[:197] + "..."
 
 
-def _read_bag(path: str, kind: str, topics: LogTopics, need: tuple[str, ...], scan_reducer) -> LogData:
+def _read_bag(path: str, kind: str, topics: LogTopics, need: tuple[str, ...], scan_reducer, scan_batch: int) -> LogData:
     from pathlib import Path
 
     from rosbags.highlevel import AnyReader
@@ -429,7 +432,7 @@ def _read_bag(path: str, kind: str, topics: LogTopics, need: tuple[str, ...], sc
     except Exception as exc:  # noqa: BLE001 - rosbags and sqlite3/zstd raise many kinds on a corrupt file: one line each
         raise LogError(f"could not read {path} (corrupt or truncated?): {_one_line(exc)}") from None
     try:
-        return _stream(reader, path, kind, topics, need, scan_reducer)
+        return _stream(reader, path, kind, topics, need, scan_reducer, scan_batch)
     except LogError:
         raise
     except _ReducerFailed as failed:  # the caller's own error, not the file's
@@ -443,7 +446,7 @@ def _read_bag(path: str, kind: str, topics: LogTopics, need: tuple[str, ...], sc
             pass
 
 
-def _stream(reader, path: str, kind: str, topics: LogTopics, need: tuple[str, ...], scan_reducer) -> LogData:
+def _stream(reader, path: str, kind: str, topics: LogTopics, need: tuple[str, ...], scan_reducer, scan_batch: int) -> LogData:
     present = sorted({(c.topic, c.msgtype) for c in reader.connections})
     if not present or reader.message_count == 0:
         raise LogError(f"{path} is empty: no messages")
@@ -465,6 +468,8 @@ def _stream(reader, path: str, kind: str, topics: LogTopics, need: tuple[str, ..
     msgtypes = {}
     decode = _ros1_value if ros1 else _cdr_value
     decode_pose = _ros1_pose if ros1 else _cdr_pose
+    decode_scan = _ros1_scan if ros1 else _cdr_scan
+    pending = []  # scans read and not yet reduced: at most scan_batch
     for connection, received_ns, raw in reader.messages(connections=[c for c in reader.connections if c.id in role_of]):
         roles = role_of[connection.id]
         if "pose" in roles:
@@ -476,20 +481,17 @@ def _stream(reader, path: str, kind: str, topics: LogTopics, need: tuple[str, ..
         series = next(r for r in roles if r != "pose")
         msgtypes[series] = connection.msgtype
         if series == "scan":
-            msg = reader.deserialize(raw, connection.msgtype)
-            stamp = msg.header.stamp.sec * 1_000_000_000 + msg.header.stamp.nanosec
-            t = (stamp - start_ns) * 1e-9
+            stamp, numbers, ranges = decode_scan(raw)
             times[series].append(stamp)
-            scan = Scan(t, float(msg.angle_min), float(msg.angle_increment), float(msg.range_min), float(msg.range_max),
-                        np.asarray(msg.ranges))
-            try:
-                values[series].append(scan_reducer(scan))
-            except Exception as exc:
-                raise _ReducerFailed from exc
+            pending.append(Scan((stamp - start_ns) * 1e-9, *numbers, ranges))
+            if len(pending) >= scan_batch:
+                _reduce(pending, scan_reducer, scan_batch, values[series])
             continue
         stamp, value = decode(raw, _FIELDS[connection.msgtype])
         times[series].append(received_ns if stamp is None else stamp)
         values[series].append(value)
+    if pending:
+        _reduce(pending, scan_reducer, scan_batch, values["scan"])
     result = {}
     for series in need:
         topic = topics.of(series)
@@ -507,6 +509,37 @@ def _stream(reader, path: str, kind: str, topics: LogTopics, need: tuple[str, ..
             result[series] = TimeSeries(topic, msgtypes[series], t, np.frombuffer(values[series], dtype=float).copy(), stamps)
     duration = (reader.end_time - start_ns) * 1e-9
     return LogData(path, kind, start_ns * 1e-9, duration, tuple(present), **result)
+
+
+def _reduce(pending: list, reducer, batch: int, out: list) -> None:
+    """Reduce the scans `pending` (one call per scan, or one per batch when `batch` > 1) into `out`, and empty it."""
+    try:
+        if batch > 1:
+            out.extend(reducer(list(pending)))
+        else:
+            out.append(reducer(pending[0]))
+    except Exception as exc:
+        raise _ReducerFailed from exc
+    pending.clear()
+
+
+def _cdr_scan(raw) -> tuple[int, tuple, np.ndarray]:
+    """(header stamp ns, (angle_min, angle_increment, range_min, range_max), ranges) of a ROS 2 (CDR) LaserScan."""
+    endian = "<" if raw[1] & 1 else ">"
+    sec, nsec = struct.unpack_from(endian + "iI", raw, 4)
+    (n,) = struct.unpack_from(endian + "I", raw, 12)
+    pos = (8 + 4 + n + 3) & ~3  # after the frame id, aligned to 4
+    a_min, _, a_inc, _, _, r_min, r_max, count = struct.unpack_from(endian + "7fI", raw, 4 + pos)
+    ranges = np.frombuffer(raw, dtype=endian + "f4", count=count, offset=4 + pos + 32)
+    return sec * 1_000_000_000 + nsec, (a_min, a_inc, r_min, r_max), ranges
+
+
+def _ros1_scan(raw) -> tuple[int, tuple, np.ndarray]:
+    """(header stamp ns, (angle_min, angle_increment, range_min, range_max), ranges) of a ROS 1 LaserScan."""
+    _, sec, nsec, n = struct.unpack_from("<IIII", raw, 0)
+    pos = 16 + n
+    a_min, _, a_inc, _, _, r_min, r_max, count = struct.unpack_from("<7fI", raw, pos)
+    return sec * 1_000_000_000 + nsec, (a_min, a_inc, r_min, r_max), np.frombuffer(raw, dtype="<f4", count=count, offset=pos + 32)
 
 
 def _stack(values: list):

@@ -8,10 +8,12 @@ or identified from the same log, `complete_from_log`). On every stretch along a 
 1. **measures** the lateral oscillation with the project's one estimator (`sim.metrics.oscillation_metrics`
    on the binned lateral offset): ω (rad/s), σ (1/s) and the amplitude (the limit cycle's, else the largest
    half peak-to-peak swing, m);
-2. **predicts** it with every loop model (`report.stability.build_report`: the corridor of the measured
-   half-width L, or the wall whose equilibrium is the measured d0, α from the law's balance at d0,
-   `laws.force_law.wall_gain_at_distance`; V the robot's measured speed there): each model's verdict,
-   margin, V*, T*, k* and dominant root σ + jω;
+2. **predicts** it with every loop model, at the loop gain NV of the corridor of the measured half-width L
+   (`laws.force_law.corridor_gain`) or of the wall whose equilibrium is the measured d0 (α and N from the law's
+   balance at d0, `laws.force_law.wall_gain_at_distance`), V the robot's measured speed there: each model's
+   verdict, margin and V* (the one verdict rule, `models.verdicts.judge`) and its dominant root σ + jω; for the
+   stretch that answers for the whole log also T*, k* and the remedies (`report.stability.build_report`, whose
+   verdicts these are);
 3. **compares**: a model *matches* when its verdict is the measured one (the sign of σ; a stretch without an
    oscillation that settles is stable) and its root is within `MATCH` of the measured σ + jω (relative
    distance in the complex plane); the best match is the nearest. The remedies are the report's for that
@@ -26,20 +28,22 @@ answer is that of its worst judged stretch (the largest measured σ; a stretch w
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
 from ..analysis.stretches import MIN_DURATION, MIN_SPEED, LateralOffset, Stretch, find_stretches, lateral_offset
 from ..io.logs import LogData, PoseSeries
 from ..io.serialize import json_number
-from ..laws.force_law import ForceLaw, law_in_force, wall_gain_at_distance
+from ..laws.force_law import ForceLaw, corridor_gain, law_in_force, wall_gain_at_distance
+from ..models import Loop, models_for
+from ..models.verdicts import judge
 from ..parameters import MODEL_NAMES, RANGES, Controller, Robot, to_degrees
 from ..report.stability import build_report
 from ..sim.metrics import HYSTERESIS, OscillationMetrics, oscillation_metrics, turning_points
 
 __all__ = ["Measured", "Predicted", "StretchDiagnosis", "Diagnosis", "diagnose", "complete_from_log", "missing_parameters",
-           "USER_PARAMETERS", "LOG_PARAMETERS", "MATCH", "MAX_GAP", "VERDICTS"]
+           "USER_PARAMETERS", "LOG_PARAMETERS", "MATCH", "MAX_GAP", "MIN_AMPLITUDE", "VERDICTS"]
 
 USER_PARAMETERS = ("k", "W", "f", "n")
 """What no log shows: the steering gain, the robot's width and KB's law (f, n): the user's (``--config`` or options)."""
@@ -48,6 +52,9 @@ LOG_PARAMETERS = ("tau", "T", "dead_time", "plant_gain")
 gain, unless the user gives them."""
 MATCH = 0.15
 """A model matches when its root is within this relative distance of the measured σ + jω (and its verdict agrees)."""
+MIN_AMPLITUDE = 0.005
+"""Swings of the lateral offset smaller than this (m) are not an oscillation: wheel odometry and walls fitted to a
+scan's ranges do not resolve them (a settled robot's offset wanders by about a millimetre)."""
 MAX_GAP = 1.0
 """A stretch whose odometry misses more than this (s) at once is not judged (interpolating over it would invent a swing)."""
 VERDICTS = ("oscillating", "stable", "nothing to diagnose")
@@ -103,8 +110,11 @@ class Predicted:
         ``stable``, ``unstable`` or ``undecided``.
     margin : float
         NV*/NV − 1.
-    V_critical, T_critical, k_critical : float
-        The critical speed (m/s), period (s) and steering gain (1/s), the others fixed (``inf``: none).
+    V_critical : float
+        The critical speed V* = NV*/N (m/s), the others fixed (``inf``: none).
+    T_critical, k_critical : float or None
+        The critical period (s) and steering gain (1/s), the others fixed (``inf``: none); computed for the whole log's
+        stretch only (None elsewhere: their searches cost 0.1 s a stretch).
     omega, sigma : float or None
         The dominant root's imaginary (rad/s) and real part (1/s); None where the model has none.
     root_error : float or None
@@ -118,8 +128,8 @@ class Predicted:
     verdict: str
     margin: float
     V_critical: float
-    T_critical: float
-    k_critical: float
+    T_critical: float | None
+    k_critical: float | None
     omega: float | None
     sigma: float | None
     root_error: float | None
@@ -157,7 +167,8 @@ class StretchDiagnosis:
     matching : str or None
         The best-matching model (module docstring), None if none matches.
     remedies : dict
-        Parameter → {to, direction, change_percent} (`report.stability.remedies`) of the matching model, else ``sampled``'s.
+        Parameter → {to, direction, change_percent} (`report.stability.remedies`) of the matching model, else ``sampled``'s;
+        for the whole log's stretch only (empty elsewhere).
     envelope : tuple or None
         (t0 in s, a0 in m): the first swing's mid time and half amplitude, where the predicted envelope a0·e^(σ(t − t0)) starts.
     """
@@ -329,9 +340,10 @@ def _measure(offset: LateralOffset) -> tuple[OscillationMetrics, Measured, tuple
     return metrics, measured, envelope
 
 
-def _predicted(name: str, verdict, measured: Measured) -> Predicted:
-    stable = verdict.verdict == "stable"
-    root = verdict.rightmost_root
+def _predicted(name: str, verdict: str, margin: float, V_critical: float, root, measured: Measured, T_critical=None,
+               k_critical=None) -> Predicted:
+    """One model's `Predicted` from its verdict, margin, V* and dominant root, against the measurement."""
+    stable = verdict == "stable"
     sigma = omega = error = None
     if root is not None and np.isfinite(root):
         sigma, omega = float(root.real), abs(float(root.imag))
@@ -340,9 +352,35 @@ def _predicted(name: str, verdict, measured: Measured) -> Predicted:
             error = abs(complex(sigma, omega) - truth) / abs(truth)
     agrees = stable == measured.stable
     matches = agrees and (error is None and measured.sigma is None or error is not None and error <= MATCH)
-    c = verdict.critical
-    return Predicted(name, stable, verdict.verdict, float(verdict.margin), float(c["V_critical"]), float(c["T_critical"]),
-                     float(c["k_critical"]), omega, sigma, error, bool(matches))
+    return Predicted(name, stable, verdict, float(margin), float(V_critical),
+                     None if T_critical is None else float(T_critical), None if k_critical is None else float(k_critical),
+                     omega, sigma, error, bool(matches))
+
+
+def _quick(robot: Robot, controller: Controller, N: float, measured: Measured, models) -> dict:
+    """Model name → `Predicted` without T* and k* (their searches cost 0.1 s a stretch): the verdict rule
+    (`models.verdicts.judge`) on each model's boundary and its dominant root at NV = N·V, as the report's criteria."""
+    loop = Loop.of(robot, controller)
+    NV = N * robot.V
+    out = {}
+    for model in models_for(controller, models):
+        boundary = model.boundary(loop)
+        judgement = judge(NV, N, boundary, model.is_stable(NV, loop))
+        out[model.name] = _predicted(model.name, judgement.verdict, judgement.margin, judgement.V_critical,
+                                     model.rightmost_root(NV, loop), measured)
+    return out
+
+
+def _full(d: StretchDiagnosis, robot: Robot, controller: Controller, law: ForceLaw, models) -> StretchDiagnosis:
+    """`d` with every model's T* and k* and the remedies: the stability report (`report.stability.build_report`)."""
+    geometry = {"L": d.geometry} if d.stretch.kind == "corridor" else {"alpha_deg": d.alpha_deg}
+    report = build_report(robot.replace(V=d.V), controller, law=law, models=models, **geometry)
+    scene = report.corridor if d.stretch.kind == "corridor" else report.wall
+    predicted = {name: _predicted(name, v.verdict, v.margin, v.critical["V_critical"], v.rightmost_root, d.measured,
+                                  v.critical["T_critical"], v.critical["k_critical"])
+                 for name, v in scene.models.items()}
+    name = d.matching or "sampled"
+    return replace(d, predicted=predicted, remedies=report.remedies.get((d.stretch.kind, name), {}) if name in predicted else {})
 
 
 def _speed(stretch: Stretch, pose: PoseSeries) -> float:
@@ -371,6 +409,10 @@ def _judge(stretch: Stretch, pose: PoseSeries, robot: Robot, controller: Control
     if V > RANGES["V"].high:
         return StretchDiagnosis(stretch, False, f"a speed of {V:.3g} m/s is out of range {RANGES['V'].describe()}", **base)
     metrics, measured, envelope = _measure(offset)
+    if measured.amplitude is None or measured.amplitude < MIN_AMPLITUDE:  # the robot holds its line: noise, not a swing
+        measured = Measured(None, None, measured.amplitude, True, measured.method, measured.turning_points,
+                            f"no swing larger than {1000 * MIN_AMPLITUDE:g} mm (the offset holds its line)")
+        envelope = None
     if measured.sigma is None and not measured.stable:
         return StretchDiagnosis(stretch, False, f"no oscillation measured and the offset does not settle ({metrics.reason})",
                                 measured=measured, **base)
@@ -384,25 +426,22 @@ def _judge(stretch: Stretch, pose: PoseSeries, robot: Robot, controller: Control
                                     measured=measured, **base)
         geometry["L"] = offset.geometry
     else:
-        alpha, _ = wall_gain_at_distance(law, offset.geometry)
+        with np.errstate(divide="ignore", invalid="ignore"):  # d0 where the law balances no pull: α undefined, said below
+            alpha, N_wall = wall_gain_at_distance(law, offset.geometry)
         alpha = float(alpha)
         low, high = RANGES["alpha_deg"].low, RANGES["alpha_deg"].high
         if not np.isfinite(alpha) or not low < to_degrees(alpha) < high:
             return StretchDiagnosis(stretch, False, f"at d0 = {offset.geometry:.3g} m the law does not balance a target's pull "
                                     f"at any angle α in {RANGES['alpha_deg'].describe()}", measured=measured, **base)
         geometry["alpha"] = alpha
-    here = robot.replace(V=V)
-    report = build_report(here, controller, law=law, models=models, **geometry)
-    scene = report.corridor if stretch.kind == "corridor" else report.wall
-    predicted = {name: _predicted(name, v, measured) for name, v in scene.models.items()}
+    N = corridor_gain(law, offset.geometry) if stretch.kind == "corridor" else float(N_wall)
+    predicted = _quick(robot.replace(V=V), controller, N, measured, models)
     matching = [p for p in predicted.values() if p.matches]
     best = min(matching, key=lambda p: (p.root_error if p.root_error is not None else 0.0, -MODEL_NAMES.index(p.model))) \
         if matching else None
-    name = best.model if best else "sampled"
-    remedies = report.remedies.get((stretch.kind, name), {}) if name in predicted else {}
     return StretchDiagnosis(stretch, True, None, V, offset.geometry,
                             to_degrees(geometry["alpha"]) if "alpha" in geometry else None, offset, measured, predicted,
-                            best.model if best else None, remedies, envelope)
+                            best.model if best else None, {}, envelope)
 
 
 def diagnose(log: LogData, robot: Robot, controller: Controller, *, law: ForceLaw | None = None,
@@ -453,5 +492,7 @@ def diagnose(log: LogData, robot: Robot, controller: Controller, *, law: ForceLa
         else:
             verdict = "oscillating"
             reason = f"{where} oscillates: σ = {m.sigma:+.3g} 1/s at ω = {m.omega:.3g} rad/s"
+    if worst is not None:  # the whole log's stretch: every critical value and the remedies
+        judged = tuple(_full(d, robot, controller, law, tuple(models)) if d.stretch.index == worst else d for d in judged)
     V = judged[worst].V if worst is not None else robot.V
     return Diagnosis(verdict, reason, judged, worst, robot.replace(V=V), controller, log.pose, law)
