@@ -272,3 +272,25 @@ def test_batched_reduction_is_the_scan_by_scan_one(driven, read):
     np.testing.assert_allclose(batched.values, read.scan.values, rtol=0, atol=1e-12)
     first = read_log(driven[1], need=("scan",), scan_reducer=lambda s: s.ranges.copy()).scan.values[0]
     np.testing.assert_array_equal(first, driven[0].log.scan_ranges[0])
+
+
+def test_another_law_in_the_configuration_is_refused(driven, tmp_path):
+    """diagnose predicts with KB's power law: a configuration whose law is another is refused in one line, not ignored."""
+    config = tmp_path / "grid.yaml"
+    config.write_text(CONFIG + "law: grid\n")
+    code, out, err = run(["diagnose", str(driven[1]), "--config", str(config)])
+    assert code == 2 and out == "" and err.count("\n") == 1 and "law grid of --config" in err
+
+
+def test_a_bag_without_commands_is_diagnosed_when_tau_and_T_are_given(tmp_path):
+    """Given τ and T, the log is not identified: a bag without /cmd_vel is diagnosed (D and g keep 0 and 1); without them
+    the missing topic is named."""
+    log = drive((Leg("corridor", 12.0, L=0.9),), seed=6)
+    path = write_ros2(log.log, tmp_path / "bag", storage="mcap", topics={"command": "/other"})
+    base = ["diagnose", str(path), "--k", "2", "--W", "0.8", "--f", "0.8", "--n", "2", "--format", "json"]
+    code, out, err = run(base + ["--tau", "0.3", "--T", "0.065"])
+    assert code == 0, err
+    data = json.loads(out)
+    assert data["identification"] is None and data["parameters"]["dead_time"]["value"] == 0.0
+    code, _, err = run(base)
+    assert code == 2 and "has no command topic /cmd_vel" in err

@@ -8,7 +8,8 @@ odometry (docs/diagnose.md). The stretches where the robot drove along a wall or
 from the scans in the odometry's frame (`pfm_stability.analysis.stretches`); on each the lateral oscillation
 is measured and set against every loop model's prediction (`pfm_stability.validation.diagnose`). k, W, f and n
 cannot come from a log: ``--config`` (or the options) must give them; τ and T come from the same log
-(`pfm_stability.analysis.identification`) unless given. JSON keys (`pfm_stability/io/schema/output.schema.json`,
+(`pfm_stability.analysis.identification`) unless given, and with them D and g unless given. The law is KB's power
+law (a configuration naming another is refused). JSON keys (`pfm_stability/io/schema/output.schema.json`,
 ``$defs/diagnose``): ``verdict``, ``reason``, ``measured`` (``omega``, ``sigma``, ``amplitude``, ``stretch``),
 ``predicted.<model>`` (``stable``, ``V_critical``, ``margin``, ``omega``, ``sigma`` …), ``matching_model``,
 ``margin``, ``critical`` (V*, T*, k*), ``remedies``, ``stretches`` (each with its own), ``parameters``,
@@ -74,7 +75,7 @@ def run(args) -> int:
     from ..extras import require
     from ..io.logs import LogTopics, log_format, read_log
     from ..io.serialize import SCHEMA_VERSION, dumps
-    from ..validation.diagnose import LOG_PARAMETERS, complete_from_log, diagnose, missing_parameters
+    from ..validation.diagnose import complete_from_log, diagnose, missing_parameters, needs_identification
     from .options import resolve_parameters, typed
 
     started = time.perf_counter()
@@ -86,8 +87,12 @@ def run(args) -> int:
         raise ValueError(f"diagnose needs {', '.join(missing)}, which a log cannot show (the steering gain, the robot's width, "
                          f"the law): give {', '.join(_KEYS[m] for m in missing)} in --config ROBOT.yaml "
                          f"(or {' '.join('--' + m for m in missing)})")
+    law = params.config.law if params.config is not None else None
+    if law and law.get("name") != "power":
+        raise ValueError(f"diagnose predicts with KB's power law f(W/d)^n (controller.f, controller.n); "
+                         f"law {law.get('name')} of --config {params.config.path} is not one it takes")
     require("logs", "pfm-stability diagnose")
-    to_identify = [name for name in LOG_PARAMETERS if str(params.sources[name]).startswith(("preset ", "ASSUMED (preset "))]
+    to_identify = needs_identification(params.sources)
     topics = LogTopics(command=args.cmd_topic, odometry=args.odom_topic, scan=args.scan_topic)
     need = ("command", "odometry", "pose", "scan") if to_identify else ("pose", "scan")
     log = read_log(args.log, topics, need=need, scan_reducer=wall_lines_batch, scan_batch=SCAN_BATCH)

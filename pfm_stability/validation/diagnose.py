@@ -43,13 +43,14 @@ from ..report.stability import build_report
 from ..sim.metrics import HYSTERESIS, OscillationMetrics, oscillation_metrics, turning_points
 
 __all__ = ["Measured", "Predicted", "StretchDiagnosis", "Diagnosis", "diagnose", "complete_from_log", "missing_parameters",
-           "USER_PARAMETERS", "LOG_PARAMETERS", "MATCH", "MAX_GAP", "MIN_AMPLITUDE", "VERDICTS"]
+           "needs_identification", "USER_PARAMETERS", "LOG_PARAMETERS", "MATCH", "MAX_GAP", "MIN_AMPLITUDE", "VERDICTS"]
 
 USER_PARAMETERS = ("k", "W", "f", "n")
 """What no log shows: the steering gain, the robot's width and KB's law (f, n): the user's (``--config`` or options)."""
 LOG_PARAMETERS = ("tau", "T", "dead_time", "plant_gain")
 """What the log shows (`analysis.identification`): the steering lag, the controller's period, the plant's dead time and
-gain, unless the user gives them."""
+gain, unless the user gives them. The log is identified when τ or T is missing (`needs_identification`); D and g alone
+keep their defaults (0 s and 1) rather than ask a log without commands for them."""
 MATCH = 0.15
 """A model matches when its root is within this relative distance of the measured σ + jω (and its verdict agrees)."""
 MIN_AMPLITUDE = 0.005
@@ -283,7 +284,22 @@ def missing_parameters(sources: dict) -> tuple[str, ...]:
     sources : dict
         Parameter → provenance (``user``, ``config FILE``, ``preset carmel`` …; `cli.options.resolve_parameters`).
     """
-    return tuple(name for name in USER_PARAMETERS if str(sources.get(name, "")).startswith(("preset ", "ASSUMED (preset ")))
+    return tuple(name for name in USER_PARAMETERS if _from_preset(sources, name))
+
+
+def _from_preset(sources: dict, name: str) -> bool:
+    return str(sources.get(name, "")).startswith(("preset ", "ASSUMED (preset "))
+
+
+def needs_identification(sources: dict) -> bool:
+    """Whether τ or T must come from the log: the user gave it nowhere (its source is a preset).
+
+    Parameters
+    ----------
+    sources : dict
+        Parameter → provenance (`cli.options.resolve_parameters`).
+    """
+    return _from_preset(sources, "tau") or _from_preset(sources, "T")
 
 
 def complete_from_log(robot: Robot, controller: Controller, sources: dict, identification) -> tuple[Robot, Controller, dict]:
@@ -304,7 +320,7 @@ def complete_from_log(robot: Robot, controller: Controller, sources: dict, ident
         τ, D or g is needed and the plant was not identified (the line says why and which keys to give).
     """
     sources = dict(sources)
-    from_preset = {name for name in LOG_PARAMETERS if str(sources.get(name, "")).startswith(("preset ", "ASSUMED (preset "))}
+    from_preset = {name for name in LOG_PARAMETERS if _from_preset(sources, name)}
     if not from_preset or identification is None:
         return robot, controller, sources
     if "T" in from_preset:
