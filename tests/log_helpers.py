@@ -657,12 +657,14 @@ def drive(legs, robot=None, controller=None, *, odom_rate: float = 50.0, scan_ra
     return DrivenLog(log, walls, tuple(truth))
 
 
-def random_corridor(rng: np.random.Generator, *, away: float = 0.05):
-    """(robot, controller, L, sampled margin) of a random corridor whose ``sampled`` verdict is at least `away` from the boundary.
+def random_corridor(rng: np.random.Generator, *, away: float = 0.05, kind: str = "corridor"):
+    """(robot, controller, geometry, sampled margin) of a random corridor (or wall) whose ``sampled`` verdict is at least
+    `away` from the boundary.
 
     V 0.3–1.2 m/s, τ 0.1–0.5 s, k 1–4 1/s, W 0.5–0.8 m, f 0.5–1.5, n 2, T 0.02–0.1 s, compute delay 0 or 1 (the
-    command held), L from W/2 + 0.2 to W/2 + 0.7 m; drawn again until |margin| > `away` and the predicted growth keeps
-    the robot off the walls for 8 periods (σ·8·2π/ω < 2.5) and makes at least 6 swings before it decays by e³.
+    command held); a corridor's L from W/2 + 0.2 to W/2 + 0.7 m, a wall's α 20–70° (geometry: L in m, α in rad). Drawn
+    again until |margin| > `away` and the predicted growth keeps the robot off the walls for 8 periods
+    (σ·8·2π/ω < 2.5) and makes at least 6 swings before it decays by e³.
     """
     from pfm_stability.parameters import Controller, Robot
     from pfm_stability.report.stability import build_report
@@ -671,29 +673,38 @@ def random_corridor(rng: np.random.Generator, *, away: float = 0.05):
         robot = Robot(V=rng.uniform(0.3, 1.2), tau=rng.uniform(0.1, 0.5), k=rng.uniform(1.0, 4.0), W=rng.uniform(0.5, 0.8))
         controller = Controller(f=rng.uniform(0.5, 1.5), n=2.0, T=rng.uniform(0.02, 0.1), hold="command",
                                 compute_delay=int(rng.integers(0, 2)))
-        L = robot.W / 2 + rng.uniform(0.2, 0.7)
-        verdict = build_report(robot, controller, L=L, models=("sampled",)).corridor.models["sampled"]
+        if kind == "corridor":
+            geometry = robot.W / 2 + rng.uniform(0.2, 0.7)
+            report = build_report(robot, controller, L=geometry, models=("sampled",))
+            verdict = report.corridor.models["sampled"]
+        else:
+            geometry = math.radians(rng.uniform(20.0, 70.0))
+            report = build_report(robot, controller, alpha=geometry, models=("sampled",))
+            verdict = report.wall.models["sampled"]
+            if report.wall.d0 <= robot.W / 2 + 0.1:  # the robot would start touching the wall
+                continue
         root = verdict.rightmost_root
         if root is None or abs(verdict.margin) <= away or root.imag <= 0.2:
             continue
         period = 2 * math.pi / root.imag
         if root.real * 8 * period < 2.5 and -root.real * 6 * period < 3.0:
-            return robot, controller, L, float(verdict.margin)
+            return robot, controller, geometry, float(verdict.margin), root
 
 
-def corridor_run(seed: int, directory, *, duration: float | None = None):
-    """A random corridor (`random_corridor`, from `seed`) driven and written as an MCAP bag under `directory`.
+def corridor_run(seed: int, directory, *, duration: float | None = None, kind: str = "corridor"):
+    """A random corridor or wall (`random_corridor`, from `seed`) driven and written as an MCAP bag under `directory`.
 
-    Returns (path, robot, controller, L, margin, truth): the simulator's own metrics of the corridor leg in `truth`.
+    Returns (path, robot, controller, geometry, margin, truth): L (m) or α (rad), and the simulator's own metrics of the
+    leg in `truth`.
     """
     rng = np.random.default_rng(seed)
-    robot, controller, L, margin = random_corridor(rng)
-    from pfm_stability.report.stability import build_report
-
-    root = build_report(robot, controller, L=L, models=("sampled",)).corridor.models["sampled"].rightmost_root
+    robot, controller, geometry, margin, root = random_corridor(rng, kind=kind)
     period = 2 * math.pi / root.imag
     length = duration or float(np.clip(10 * period, 20.0, 60.0))
-    offset = min(0.08, 0.5 * (L - robot.W / 2))
-    log = drive([Leg("corridor", length, L=L, offset=offset)], robot, controller, seed=seed, drop=0.02)
-    path = write_ros2(log.log, Path(directory) / f"corridor_{seed}", storage="mcap")
-    return path, robot, controller, L, margin, log.truth[0]
+    if kind == "corridor":
+        leg = Leg("corridor", length, L=geometry, offset=min(0.08, 0.5 * (geometry - robot.W / 2)))
+    else:
+        leg = Leg("wall", length, alpha=geometry, offset=0.08)
+    log = drive([leg], robot, controller, seed=seed, drop=0.02)
+    path = write_ros2(log.log, Path(directory) / f"{kind}_{seed}", storage="mcap")
+    return path, robot, controller, geometry, margin, log.truth[0]

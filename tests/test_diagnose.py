@@ -3,10 +3,10 @@ on synthetic logs of the project's VFF simulator (`log_helpers.drive`: corridors
 ray-cast against the walls, odometry pose at 50 Hz, the held commands) against the simulator's own truth.
 
 Tolerances: the measured ω within 5 % of the simulator's (`oscillation_metrics` on the exact offset at every sample;
-measured 0.04–0.6 % over 40 random corridors, experiments/diagnose_agreement.py), σ within 0.01 1/s of it (the same
-estimator on the offset seen through noisy odometry and fitted walls: measured ≤ 0.002 1/s), L and d0 within 2 cm
-(the walls are fitted to 1 cm range noise; the binned offset's median), and the predicted verdict equal to the sign of
-the measured growth on every random corridor of the reduced set (|margin| > 5 %).
+measured ≤ 2.5 % over 40 random corridors and walls, experiments/diagnose_agreement.py), σ within 0.01 1/s of it (the
+same estimator on the offset seen through noisy odometry and fitted walls: 39 of those 40), L and d0 within 2 cm (the
+walls are fitted to 1 cm range noise), and the predicted verdict equal to the sign of the measured growth on every run
+of the reduced set (|margin| > 5 %; 39 of the 40).
 """
 
 from __future__ import annotations
@@ -139,17 +139,20 @@ def test_measured_oscillation_is_the_simulators(driven, read):
 
 
 @pytest.mark.slow
-def test_verdicts_agree_on_random_corridors(tmp_path):
-    """8 random corridors away from the boundary (|margin| > 5 %; the full set of 40 is experiments/diagnose_agreement.py):
-    the ``sampled`` verdict is the sign of the measured growth, and ω is the simulator's within 5 %."""
+def test_verdicts_agree_on_random_corridors_and_walls(tmp_path):
+    """4 random corridors and 4 walls away from the boundary (|margin| > 5 %; the full set of 40 is
+    experiments/diagnose_agreement.py): the ``sampled`` verdict is the sign of the measured growth, ω is the
+    simulator's within 5 %, L and d0 within 2 cm (the median of an oscillation about a wall's nonlinear force is not
+    quite its equilibrium: α inferred from d0 moved 2° for a 1 cm error at α = 36°)."""
     for seed in range(100, 108):
-        path, robot, controller, L, margin, truth = corridor_run(seed, tmp_path, duration=20.0)
+        kind = ("corridor", "wall")[seed % 2]
+        path, robot, controller, geometry, margin, truth = corridor_run(seed, tmp_path, duration=20.0, kind=kind)
         result = diagnose(read_log(path, need=("pose", "scan"), scan_reducer=wall_lines), robot, controller)
         s = result.judged
-        assert s is not None, result.reason
+        assert s is not None and s.stretch.kind == kind, result.reason
         assert s.predicted["sampled"].stable == s.measured.stable == (margin > 0), (seed, margin, s.measured)
         assert s.measured.omega == pytest.approx(truth.metrics.angular_frequency, rel=0.05)
-        assert s.geometry == pytest.approx(L, abs=0.02)
+        assert s.geometry == pytest.approx(truth.geometry, abs=0.02)  # L, or the wall's equilibrium d0
 
 
 # ------------------------------------------------------------------------------ nothing to diagnose

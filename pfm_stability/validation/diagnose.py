@@ -157,7 +157,7 @@ class StretchDiagnosis:
     V : float or None
         The robot's speed on the stretch, m/s: the odometry's forward speed (median), else its path length over time.
     geometry : float or None
-        L (corridor) or d0 (wall), m.
+        L (corridor) or d0 (wall), m: d0 is the swings' midpoint extrapolated to zero amplitude (`_equilibrium_shift`).
     alpha_deg : float or None
         The wall's α (deg) at which the law balances the pull at d0.
     offset : LateralOffset or None
@@ -399,6 +399,28 @@ def _full(d: StretchDiagnosis, robot: Robot, controller: Controller, law: ForceL
     return replace(d, predicted=predicted, remedies=report.remedies.get((d.stretch.kind, name), {}) if name in predicted else {})
 
 
+def _equilibrium_shift(offset: LateralOffset) -> float:
+    """Where the wall's equilibrium d0 lies from the offset's zero (m): the swings' midpoints extrapolated to zero amplitude.
+
+    A repulsion that grows faster than linearly as the robot nears the wall (f(W/d)^n) shifts the middle of a swing away
+    from the wall by about c·a² (a weakly nonlinear oscillator's mean moves with the square of its amplitude), so the
+    median distance of a growing oscillation overstates d0 (and α, and the margin): the midpoints m_i of the swings
+    against their squared half amplitudes a_i² are fitted with a line, whose intercept is d0's offset. With fewer than
+    three swings or amplitudes too alike to extrapolate, the midpoints' mean; without swings, 0.
+    """
+    x = offset.offset
+    span = float(np.ptp(x))
+    points = turning_points(x, HYSTERESIS * span) if span > 0 else np.array([], dtype=int)
+    if points.size < 2:
+        return 0.0
+    extremes = x[points]
+    middle = (extremes[1:] + extremes[:-1]) / 2
+    squared = ((extremes[1:] - extremes[:-1]) / 2) ** 2
+    if middle.size < 3 or np.ptp(squared) < 0.3 * squared.max():
+        return float(np.mean(middle))
+    return float(np.polyfit(squared, middle, 1)[1])
+
+
 def _speed(stretch: Stretch, pose: PoseSeries) -> float:
     """The robot's speed over the stretch, m/s: the odometry's forward speed (median), else its path length over time."""
     inside = (pose.t >= stretch.start) & (pose.t <= stretch.end)
@@ -442,6 +464,8 @@ def _judge(stretch: Stretch, pose: PoseSeries, robot: Robot, controller: Control
                                     measured=measured, **base)
         geometry["L"] = offset.geometry
     else:
+        offset = replace(offset, geometry=offset.geometry + _equilibrium_shift(offset))
+        base["geometry"] = offset.geometry
         with np.errstate(divide="ignore", invalid="ignore"):  # d0 where the law balances no pull: α undefined, said below
             alpha, N_wall = wall_gain_at_distance(law, offset.geometry)
         alpha = float(alpha)
