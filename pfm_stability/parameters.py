@@ -57,6 +57,8 @@ __all__ = [
     "to_radians",
     "TAU_RESOLUTION",
     "T_RESOLUTION",
+    "DEAD_TIME_RESOLUTION",
+    "dead_time_split",
     "check_corridor_fits",
 ]
 
@@ -64,6 +66,46 @@ TAU_RESOLUTION = 1e-9
 """τ with τ·k below this is taken as 0, an ideal steering motor, by the models and the simulator
 alike: the lag is 10⁹ times faster than the steering loop, below the resolution of either, and its
 pole at −1/τ would leave floating point."""
+
+DEAD_TIME_RESOLUTION = 1e-9
+"""A dead time within this fraction of a period of a whole number of periods is taken as that whole number
+(`dead_time_split`): D/T is rarely exact in floating point (0.1/0.05 is 2 to round-off, or just under), and a
+sub-interval of 1e-9·T moves the robot by 1e-9 of a step while it adds a mode at z = 0 that the
+simulator's linear-prediction fit and the sampled model would have to carry."""
+
+
+def dead_time_split(T: float, compute_delay: int, dead_time: float) -> tuple:
+    """(m, ε): a command computed at t_k reaches the motor at t_k + d·T + D = t_k + m·T + ε, 0 <= ε < T.
+
+    Over [t_k, t_k+1) the motor then sees u_(k−m−1) for the first ε seconds and
+    u_(k−m) for the rest: the one rule of the simulator (`sim.robot.delay_split`) and
+    of the `sampled` model (docs/models.md, "Plant gain and dead time"). ε within
+    `DEAD_TIME_RESOLUTION`·T of 0 or of T is snapped to a whole period.
+
+    Parameters
+    ----------
+    T : float
+        Sampling period, s (> 0).
+    compute_delay : int
+        d, samples (0 or 1).
+    dead_time : float
+        D, s (>= 0).
+
+    Returns
+    -------
+    m : int
+        Whole periods, d included.
+    eps : float
+        The fraction of a period, s, in [0, T).
+    """
+    whole = math.floor(dead_time / T)
+    eps = max(dead_time - whole * T, 0.0)
+    if eps > (1.0 - DEAD_TIME_RESOLUTION) * T:
+        whole, eps = whole + 1, 0.0
+    elif eps < DEAD_TIME_RESOLUTION * T:
+        eps = 0.0
+    return int(compute_delay) + int(whole), eps
+
 
 T_RESOLUTION = 1e-12
 """A loop delay / sampling period T (s) below this is taken as 0, a continuous controller, by the

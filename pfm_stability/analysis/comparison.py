@@ -401,7 +401,7 @@ def root_locus(loop: Loop, *, pade_order: int = 3, hold: str = "command", comput
     import control
 
     d, e = Pade(pade_order).polynomials(loop)
-    G = control.tf(loop.k * np.asarray(e), d)
+    G = control.tf(loop.steering_gain * np.asarray(e), d)  # g·k: the loop's steering gain (k for KB's robot)
     exact = ExactDelay().boundary(loop)
     if NV_max is None:
         NV_max = 2.5 * exact.NV_critical

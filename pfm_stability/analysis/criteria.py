@@ -447,6 +447,11 @@ def _negative_gain_root(model: LoopModel, NV: float, loop: Loop):
         return None
 
 
+def _plant_given(loop: Loop) -> bool:
+    """True for a robot with a dead time or a plant gain (not KB's g = 1, D = 0): its verdicts carry D*."""
+    return loop.dead_time > 0 or loop.plant_gain != 1.0
+
+
 def _verdict(model: LoopModel, loop: Loop, NV: float, boundary, critical_values, N: float, **geometry) -> ModelVerdict:
     """The verdict; `critical_values` (WallCritical or CorridorCritical) built from `geometry` plus V*, T*, k*.
 
@@ -456,7 +461,8 @@ def _verdict(model: LoopModel, loop: Loop, NV: float, boundary, critical_values,
     """
     if N < 0:
         judgement = judge(NV, N, boundary, False)
-        critical = critical_values(**geometry, V_critical=judgement.V_critical, T_critical=0.0, k_critical=0.0)
+        critical = critical_values(**geometry, V_critical=judgement.V_critical, T_critical=0.0, k_critical=0.0,
+                                   dead_time_critical=0.0 if _plant_given(loop) else None)
         return ModelVerdict(model.name, NV, boundary.NV_critical, boundary.omega_critical, judgement.margin, judgement.verdict, critical,
                             _negative_gain_root(model, NV, loop), judgement.reason)
     judgement = judge(NV, N, boundary, model.is_stable(NV, loop))
@@ -466,6 +472,7 @@ def _verdict(model: LoopModel, loop: Loop, NV: float, boundary, critical_values,
         T_critical=model.critical_delay(NV, loop),
         k_critical=model.critical_gain_k(NV, loop),
         tau_plus_T_critical=(1.0 / NV if NV > 0 else math.inf) if model.name == "kb_first_order" else None,
+        dead_time_critical=model.critical_dead_time(NV, loop) if _plant_given(loop) else None,
     )
     return ModelVerdict(
         model=model.name,

@@ -130,6 +130,10 @@ class WallCritical(CriticalValues):
     tau_plus_T_critical : float or None
         (τ + T)* = 1/NV, s: KB eq (20) solved for the loop's time constants
         (``kb_first_order`` only; None, and no key, otherwise).
+    dead_time_critical : float or None
+        D*, s: the largest dead time of the steering plant the operating point
+        tolerates (`LoopModel.critical_dead_time`); only for a robot with a
+        dead time or a plant gain (None, and no key, for KB's robot).
     eta_critical, rho0_critical, xi_critical : float or None
         Khatib's and the goal-aware law: the nearest η, ρ0 (m) and ξ at which
         the verdict of this equilibrium changes (docs/fields.md; ``inf``: no
@@ -141,7 +145,7 @@ class WallCritical(CriticalValues):
     """
 
     _SIDES = {"alpha_critical": "above", "alpha_critical_deg": "above", "f_critical": "above", "V_critical": "below", "T_critical": "below",
-              "k_critical": "below", "tau_plus_T_critical": "below"}
+              "k_critical": "below", "tau_plus_T_critical": "below", "dead_time_critical": "below"}
 
     alpha_critical: float
     alpha_critical_deg: float = field(init=False)
@@ -150,6 +154,7 @@ class WallCritical(CriticalValues):
     T_critical: float
     k_critical: float
     tau_plus_T_critical: float | None = None
+    dead_time_critical: float | None = None
     eta_critical: float | None = None
     rho0_critical: float | None = None
     xi_critical: float | None = None
@@ -180,6 +185,8 @@ class CorridorCritical(CriticalValues):
         k*, 1/s (see `WallCritical`).
     tau_plus_T_critical : float or None
         (τ + T)* = 1/NV, s (``kb_first_order`` only; None, and no key, otherwise).
+    dead_time_critical : float or None
+        D*, s (see `WallCritical`).
     eta_critical, rho0_critical, xi_critical : float or None
         As in `WallCritical`, for the middle of the corridor.
     sides : tuple of (str, str)
@@ -187,7 +194,7 @@ class CorridorCritical(CriticalValues):
     """
 
     _SIDES = {"L_critical": "above", "f_critical": "below", "V_critical": "below", "T_critical": "below", "k_critical": "below",
-              "tau_plus_T_critical": "below"}
+              "tau_plus_T_critical": "below", "dead_time_critical": "below"}
 
     L_critical: float
     V_critical: float
@@ -195,6 +202,7 @@ class CorridorCritical(CriticalValues):
     T_critical: float
     k_critical: float
     tau_plus_T_critical: float | None = None
+    dead_time_critical: float | None = None
     eta_critical: float | None = None
     rho0_critical: float | None = None
     xi_critical: float | None = None

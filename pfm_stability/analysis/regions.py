@@ -144,10 +144,16 @@ def region_model(controller: Controller, model: LoopModel | str | None = None) -
 
 
 # ------------------------------------------------------- dense region maps
+def _delay_loop(robot: Robot, controller: Controller) -> tuple:
+    """(τ, T + D, g·k): the exact delay loop's τ, delay and steering gain with the plant's dead time and gain
+    (docs/models.md, "Plant gain and dead time"; τ, T, k for KB's robot, the same floats)."""
+    return robot.tau, controller.T + robot.dead_time, robot.plant_gain * robot.k
+
+
 def _general_verdicts(robot: Robot, controller: Controller, NV):
     """`exact_delay` crossing-count verdicts for an array of NV (any force law)."""
     NV = np.asarray(NV, dtype=float)
-    tau, T, k = (np.full(NV.size, v) for v in (robot.tau, controller.T, robot.k))
+    tau, T, k = (np.full(NV.size, v) for v in _delay_loop(robot, controller))
     stable, _, _ = delay_verdicts_from_gain(tau, T, k, k * NV.ravel())
     return stable.reshape(NV.shape)
 
@@ -206,9 +212,9 @@ def wall_f_region(robot: Robot, controller: Controller, alpha: float, V, f, law:
     if law is None or isinstance(law, PowerLaw):
         n, W = _power_law_parameters(robot, controller, law)[1:]
         if isinstance(model, ExactDelay):
-            r = exact_delay_verdicts(V[None, :], robot.tau, controller.T, robot.k, f[:, None], n, W, alpha=alpha)
+            r = exact_delay_verdicts(V[None, :], *_delay_loop(robot, controller), f[:, None], n, W, alpha=alpha)
             return _region(robot, controller, model, axes, r.NV, r.stable)
-        NV = loop_gain_arrays(V[None, :], robot.tau, controller.T, robot.k, f[:, None], n, W, alpha=alpha)[3]
+        NV = loop_gain_arrays(V[None, :], *_delay_loop(robot, controller), f[:, None], n, W, alpha=alpha)[3]
         return _region(robot, controller, model, axes, NV)
     NV = wall_gain_arrays(law, alpha, f[:, None] / law.scale)[1] * V[None, :]
     return _region(robot, controller, model, axes, NV)
@@ -244,9 +250,9 @@ def wall_alpha_region(robot: Robot, controller: Controller, V, alpha, law: Force
     if law is None or isinstance(law, PowerLaw):
         f, n, W = _power_law_parameters(robot, controller, law)
         if isinstance(model, ExactDelay):
-            r = exact_delay_verdicts(V[None, :], robot.tau, controller.T, robot.k, f, n, W, alpha=alpha[:, None])
+            r = exact_delay_verdicts(V[None, :], *_delay_loop(robot, controller), f, n, W, alpha=alpha[:, None])
             return _region(robot, controller, model, axes, r.NV, r.stable)
-        NV = loop_gain_arrays(V[None, :], robot.tau, controller.T, robot.k, f, n, W, alpha=alpha[:, None])[3]
+        NV = loop_gain_arrays(V[None, :], *_delay_loop(robot, controller), f, n, W, alpha=alpha[:, None])[3]
         return _region(robot, controller, model, axes, NV)
     NV = wall_gain_arrays(law, alpha[:, None])[1] * V[None, :]
     return _region(robot, controller, model, axes, NV)
@@ -282,9 +288,9 @@ def corridor_region(robot: Robot, controller: Controller, L, V, law: ForceLaw | 
     if law is None or isinstance(law, PowerLaw):
         f, n, W = _power_law_parameters(robot, controller, law)
         if isinstance(model, ExactDelay):
-            r = exact_delay_verdicts(V[:, None], robot.tau, controller.T, robot.k, f, n, W, L=L[None, :])
+            r = exact_delay_verdicts(V[:, None], *_delay_loop(robot, controller), f, n, W, L=L[None, :])
             return _region(robot, controller, model, axes, r.NV, r.stable)
-        NV = loop_gain_arrays(V[:, None], robot.tau, controller.T, robot.k, f, n, W, L=L[None, :])[3]
+        NV = loop_gain_arrays(V[:, None], *_delay_loop(robot, controller), f, n, W, L=L[None, :])[3]
         return _region(robot, controller, model, axes, NV)
     if np.any(L <= robot.W / 2):
         raise ValueError(f"L must exceed W/2 = {robot.W / 2:g} m (the robot must fit)")

@@ -49,6 +49,8 @@ _LABELS = {
     "tau": "tau (steering time constant)",
     "T": "T (sampling period)",
     "k": "k (steering gain)",
+    "dead_time": "D (steering plant dead time)",
+    "plant_gain": "g (steering plant gain)",
     "f": "f (force ratio)",
     "n": "n (repulsion exponent)",
     "W": "W (robot width)",
@@ -80,9 +82,9 @@ _FIELD_COLUMNS = (["eta*", "rho0* m", "xi*"], ["eta_critical", "rho0_critical", 
 
 _SIDES = {
     "wall": {"NV_critical": "below", "alpha_critical_deg": "above", "f_critical": "above", "V_critical": "below", "T_critical": "below",
-             "k_critical": "below"},
+             "k_critical": "below", "dead_time_critical": "below"},
     "corridor": {"NV_critical": "below", "L_critical": "above", "f_critical": "below", "V_critical": "below", "T_critical": "below",
-                 "k_critical": "below"},
+                 "k_critical": "below", "dead_time_critical": "below"},
 }
 """The stable side of each starred column that the footnote names (docs/models.md, "Critical values"); a column whose
 JSON ``stable_side`` differs anywhere (the nearest change of a law that is not monotone; η*, ρ0*, ξ* always) shows
@@ -167,6 +169,8 @@ def _verdict_table(scenario: str, verdicts: dict, models: dict):
         own = _FIELD_COLUMNS if "eta_critical" in critical else ([], [])
         columns = columns[:at] + own[0] + columns[at + 1:]
         keys = keys[:at] + own[1] + keys[at + 1:]
+    if "dead_time_critical" in critical:  # a robot with a dead time or a plant gain: D* (docs/models.md)
+        columns, keys = columns + ["D* s"], keys + ["dead_time_critical"]
     header = ["model", "verdict", "margin", "NV* 1/s", "omega* rad/s"] + columns
     named = _SIDES[scenario]
     marked = {k for k in ["NV_critical", *keys] if any(v.get("stable_side", {}).get(k) not in (None, named.get(k)) for v in verdicts.values())}
@@ -248,7 +252,17 @@ def _footnote(report) -> list[str]:
         from .render_families import HOLONOMIC_FOOTNOTE
 
         return ["", HOLONOMIC_FOOTNOTE]
+    plant = {name: report.inputs[name]["value"] for name in ("dead_time", "plant_gain") if name in report.inputs}
+    if plant.get("dead_time", 0.0) > 0 or plant.get("plant_gain", 1.0) != 1.0:  # the verdicts carry D* (`criteria._plant_given`)
+        return ["", _FOOTNOTE + " " + _PLANT_FOOTNOTE]
     return ["", _FOOTNOTE]
+
+
+_PLANT_FOOTNOTE = (
+    "With the steering plant's dead time D and gain g (docs/models.md, \"Plant gain and dead time\"): the loop's steering gain is "
+    "g*k and its delay T + D; T* is the controller's period with D fixed, k* is in the controller's k, and D* is the largest "
+    "dead time this operating point tolerates with T fixed (stable below it)."
+)
 
 
 def _kb_error_line(report) -> list[str]:

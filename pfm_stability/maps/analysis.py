@@ -411,7 +411,7 @@ def analyze_map(occupancy: OccupancyMap, robot: Robot, controller: Controller, l
         samples = power_equilibria(grid, law, routes, clearance, robot.W, blocked, occupancy.resolution, occupancy.origin)
     stage("equilibria")
     c = 0.0  # the static VFF field and KB's law have no goal part
-    loop = Loop(robot.tau, controller.T, robot.k, c=c)
+    loop = Loop.of(robot, controller, c=c)
     boundary = loop_model.boundary(loop)
     growth = GrowthRate(lambda NV: loop_model.rightmost_root(NV, loop), boundary.NV_critical)
     heading_stable = loop_model.is_stable(0.0, loop)  # decides the samples with N = 0

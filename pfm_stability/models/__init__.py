@@ -10,6 +10,11 @@ exact_delay        τs³ + s² + ks + kNV e^(−sT) = 0 (KB 18)        crossing 
 sampled            det(zI − Φ_cl(kNV)) = 0, ZOH                   eigenvalues, Schur–Cohn
 =================  ============================================  ==========================
 
+The steering plant's gain g and dead time D (``Loop(…, plant_gain=g, dead_time=D)``,
+`Loop.of` takes them from the robot; defaults 1 and 0, KB's robot) make the loop's
+steering gain g·k and the continuous-time models' delay T + D; the sampled model
+carries the commands on their way (docs/models.md, "Plant gain and dead time").
+
 A heading gain c (``Loop(tau, T, k, c=…)``, default 0) turns the gain term kNV
 into k(cs + NV) in every model (docs/models.md, "The heading gain"); NV < 0 is
 unstable in every model (`divergent_reason`); at NV = 0 every model judges its

@@ -35,6 +35,7 @@ judges the other roots, the heading loop (`neutral_reason`, docs/models.md
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import math
 from dataclasses import dataclass, field
@@ -108,17 +109,34 @@ class Loop(Characteristic):
         δ = −N·(x − x0) − c·θ, so the gain term of every model becomes
         k(cs + NV) (delayed by e^(−sT) with the rest of the sensor data);
         docs/models.md, "The heading gain".
+    plant_gain : float, keyword only
+        Plant gain g of the steering motor τω̇ + ω = g·u(t − D), dimensionless,
+        in [10⁻³, 100] (`parameters.Robot.plant_gain`); default 1 (KB's
+        robot). The loop's steering gain is g·k (`steering_gain`) wherever k
+        multiplies the command; `k` stays the controller's gain, so k*
+        (`critical_gain_k`) is in the user's k.
+    dead_time : float, keyword only
+        Dead time D of the steering motor, s, in [0, 10]; default 0. The
+        continuous-time models see the delay T + D (`delay`); the sampled
+        model a command that reaches the motor d·T + D after its data
+        (docs/models.md, "Plant gain and dead time").
     """
 
     tau: float
     T: float
     k: float
     c: float = field(default=0.0, kw_only=True)
+    plant_gain: float = field(default=1.0, kw_only=True)
+    dead_time: float = field(default=0.0, kw_only=True)
 
     def __post_init__(self):
         for name in ("tau", "T", "k"):
             object.__setattr__(self, name, check_parameter(name, getattr(self, name)))
-        if self.tau * self.k < TAU_RESOLUTION:  # a lag 10⁹ times faster than the steering loop: an ideal motor
+        for name, default in (("plant_gain", 1.0), ("dead_time", 0.0)):
+            value = getattr(self, name)
+            if value.__class__ is not float or value != default:
+                object.__setattr__(self, name, check_parameter(name, value))
+        if self.tau * self.steering_gain < TAU_RESOLUTION:  # a lag 10⁹ times faster than the steering loop: an ideal motor
             object.__setattr__(self, "tau", 0.0)
         if self.T < T_RESOLUTION:  # faster than a picosecond: a continuous controller
             object.__setattr__(self, "T", 0.0)
@@ -129,6 +147,8 @@ class Loop(Characteristic):
     def of(cls, robot, controller, *, c: float = 0.0) -> "Loop":
         """The loop of a robot and its controller (τ, k; T), with heading gain `c`: the one constructor from them.
 
+        The robot's plant gain g and dead time D come along (`plant_gain`, `dead_time`).
+
         Parameters
         ----------
         robot : parameters.Robot
@@ -136,7 +156,16 @@ class Loop(Characteristic):
         c : float
             Heading gain of the equilibrium (0: a static law, KB's loop).
         """
-        return cls(robot.tau, controller.T, robot.k, c=c)
+        return cls(robot.tau, controller.T, robot.k, c=c, plant_gain=robot.plant_gain, dead_time=robot.dead_time)
+
+    @property
+    def steering_gain(self) -> float:
+        """g·k, 1/s: the loop's steering gain, the motor's rate per radian of heading error (k for KB's robot, g = 1)."""
+        return self.plant_gain * self.k
+
+    def replace(self, **changes) -> "Loop":
+        """A copy with `changes` (field name → value), checked as the constructor checks."""
+        return dataclasses.replace(self, **changes)
 
     @property
     def family(self) -> LoopFamily:
@@ -146,12 +175,13 @@ class Loop(Characteristic):
     @property
     def plant(self) -> np.ndarray:
         """a(s) = τs³ + s² + ks, descending (KB eq 17 without the gain term)."""
-        return np.array([self.tau, 1.0, self.k, 0.0]) if self.tau > 0 else np.array([1.0, self.k, 0.0])
+        k = self.steering_gain
+        return np.array([self.tau, 1.0, k, 0.0]) if self.tau > 0 else np.array([1.0, k, 0.0])
 
     @property
     def heading(self) -> float:
-        """kc, 1/s: the s-coefficient of the gain term k(cs + NV) (0 for KB's loop)."""
-        return self.k * self.c
+        """g·kc, 1/s: the s-coefficient of the gain term gk(cs + NV) (0 for KB's loop)."""
+        return self.steering_gain * self.c
 
     @property
     def damping(self) -> float:
@@ -166,27 +196,28 @@ class Loop(Characteristic):
         """
         if self.c == 0.0:
             return self.plant
-        return np.array([self.tau, 1.0, self.k * (1.0 + self.c), 0.0]) if self.tau > 0 else np.array([1.0, self.k * (1.0 + self.c), 0.0])
+        k = self.steering_gain
+        return np.array([self.tau, 1.0, k * (1.0 + self.c), 0.0]) if self.tau > 0 else np.array([1.0, k * (1.0 + self.c), 0.0])
 
     def loop_gain(self, NV: float) -> float:
-        """K = kNV, 1/s²."""
-        return self.k * NV
+        """K = gkNV, 1/s² (g = 1: KB's kNV)."""
+        return self.steering_gain * NV
 
     def gain_of(self, K: float) -> float:
-        """NV = K/k, 1/s."""
-        return K / self.k
+        """NV = K/(gk), 1/s."""
+        return K / self.steering_gain
 
     def check_gain(self, NV) -> float:
         """NV (1/s) as a float in [−`NV_MAX`, `NV_MAX`] (−0.0 becomes 0.0), or ValueError naming NV."""
         return check_number("NV", NV, -NV_MAX, NV_MAX, low_open=False, high_open=False, unit="1/s") + 0.0
 
     def boundary_from(self, model: str, interval: StabilityInterval) -> "Boundary":
-        """`Boundary` in NV (K/k)."""
-        return Boundary.from_interval(model, interval, self.k)
+        """`Boundary` in NV (K/(gk))."""
+        return Boundary.from_interval(model, interval, self.steering_gain)
 
     def with_delay(self, T: float) -> "Loop":
-        """τ, k and c with delay / period T, s."""
-        return Loop(self.tau, T, self.k, c=self.c)
+        """τ, k, c, g and D with delay / period T, s (the dead time stays: T* is the controller's)."""
+        return Loop(self.tau, T, self.k, c=self.c, plant_gain=self.plant_gain, dead_time=self.dead_time)
 
     def delay_search(self, NV: float) -> tuple:
         """T* searched from 1 % of the loop's fastest time scale to 1e-7 relative (a report shows 4 digits)."""
@@ -199,7 +230,7 @@ class Loop(Characteristic):
         The held input is v_k = −(F0 + K·F1)·state_k; the heading gain c adds kc to F0's θ entry.
         """
         check_choice("hold", hold, HOLDS)
-        tau, k = self.tau, self.k
+        tau, k = self.tau, self.steering_gain
         if tau > 0:
             if hold == "command":
                 A = np.array([[-1 / tau, 0, 0], [1, 0, 0], [0, 1, 0]], dtype=float)
@@ -228,10 +259,10 @@ class Loop(Characteristic):
         if self.c != 0.0:
             from .heading import kb_heading_interval  # only with a heading gain: KB's reports never compile it
 
-            return kb_heading_interval(self.tau, self.T, self.k, self.c)
+            return kb_heading_interval(self.tau, self.delay, self.steering_gain, self.c)
         from ..numerics.delay import kb_critical_gain
 
-        K, w = (float(x[0]) for x in kb_critical_gain(_one(self.tau), _one(self.T), _one(self.k)))
+        K, w = (float(x[0]) for x in kb_critical_gain(_one(self.tau), _one(self.delay), _one(self.steering_gain)))
         return StabilityInterval(K, w if math.isfinite(K) else None, (), ((0.0, K),))
 
     def _count(self, K: float):
@@ -239,7 +270,7 @@ class Loop(Characteristic):
         from ..numerics.delay import delay_verdicts_from_gain
 
         heading = () if self.c == 0.0 else (_one(self.c),)
-        stable, Z, margin = delay_verdicts_from_gain(_one(self.tau), _one(self.T), _one(self.k), _one(K), *heading)
+        stable, Z, margin = delay_verdicts_from_gain(_one(self.tau), _one(self.delay), _one(self.steering_gain), _one(K), *heading)
         return bool(stable[0]), int(Z[0]), float(margin[0])
 
     def delay_stable(self, K: float) -> bool:
@@ -247,8 +278,19 @@ class Loop(Characteristic):
         return self._count(K)[0]
 
     def delay_margin(self, K: float) -> float:
-        """T*, s, of the crossing count (`delay.delay_verdicts_from_gain`)."""
-        return self._count(K)[2]
+        """T*, s, of the crossing count (`delay.delay_verdicts_from_gain`): the margin of the delay T + D less D (`period_margin`)."""
+        return self.period_margin(self._count(K)[2])
+
+    def dead_time_margin(self, K: float) -> float:
+        """D*, s, of the crossing count: the margin of the delay T + D less T (0 if T alone exceeds it; ``inf`` stays).
+
+        Parameters
+        ----------
+        K : float
+            Loop gain g·k·NV, 1/s².
+        """
+        margin = self._count(K)[2]
+        return margin if math.isinf(margin) else max(margin - self.T, 0.0)
 
 
 def _one(x) -> np.ndarray:
@@ -434,11 +476,11 @@ class LoopModel:
         from ..numerics.solve import first_crossing
 
         gain = _check_NV(gain)
-        if gain < 0 or self.growth_rates(gain, [loop.with_delay(0.0)])[0] >= 0:
+        if gain < 0 or self._searched_growth_rates(gain, [loop.with_delay(0.0)])[0] >= 0:
             return 0.0
 
         def measure(Ts):
-            return self.growth_rates(gain, [loop.with_delay(float(T)) for T in Ts])
+            return self._searched_growth_rates(gain, [loop.with_delay(float(T)) for T in Ts])
 
         start, rtol, atol = loop.delay_search(gain)
         return first_crossing(measure, start, RANGES["T"].high, rtol=rtol, atol=atol)
@@ -456,13 +498,49 @@ class LoopModel:
         loop = _steering(loop, "critical_gain_k")
         NV = _check_NV(NV)
         lo, hi = gain_range(loop)
-        if NV < 0 or self.growth_rates(NV, [Loop(loop.tau, loop.T, lo, c=loop.c)])[0] >= 0:
+        if NV < 0 or self._searched_growth_rates(NV, [loop.replace(k=lo)])[0] >= 0:
             return 0.0
 
         def measure(ks):
-            return self.growth_rates(NV, [Loop(loop.tau, loop.T, float(k), c=loop.c) for k in ks])
+            return self._searched_growth_rates(NV, [loop.replace(k=float(k)) for k in ks])
 
         return first_crossing(measure, lo, hi, start=lo, rtol=_DELAY_RTOL, atol=1e-12 * lo)
+
+    def _searched_growth_rates(self, gain: float, loops) -> np.ndarray:
+        """The growth rates (1/s) the searches for T*, k* and D* measure: `growth_rates` (`sampled` stands in the
+        delay loop where it carries too many delayed commands)."""
+        return self.growth_rates(gain, loops)
+
+    @checked
+    def critical_dead_time(self, gain: float, loop: Loop) -> float:
+        """D*: the largest dead time of the steering plant that the gain tolerates, T and the rest fixed, s.
+
+        Stable for every D in [0, D*) (docs/models.md, "Plant gain and dead time"):
+        0 if the gain is unstable already without a dead time; ``inf`` if it stays
+        stable up to the largest allowed D (10 s). Found as T* is
+        (`critical_delay`: the dominant growth rate on a geometric grid of D,
+        refined to 1e-7 relative); `exact_delay` has the exact route (its delay
+        margin less T), `continuous` does not depend on D.
+
+        Parameters
+        ----------
+        gain : float
+            Loop gain NV, 1/s.
+        loop : Loop
+            τ, T, k, c and g (its own D is replaced).
+        """
+        from ..numerics.solve import first_crossing
+
+        loop = _steering(loop, "critical_dead_time")
+        gain = _check_NV(gain)
+        if gain < 0 or self._searched_growth_rates(gain, [loop.replace(dead_time=0.0)])[0] >= 0:
+            return 0.0
+
+        def measure(Ds):
+            return self._searched_growth_rates(gain, [loop.replace(dead_time=float(D)) for D in Ds])
+
+        start, rtol, atol = loop.delay_search(gain)
+        return first_crossing(measure, start, RANGES["dead_time"].high, rtol=rtol, atol=atol)
 
     @checked
     def damping_range(self, gain: float, loop: Characteristic) -> tuple:  # pragma: no cover - interface
@@ -481,7 +559,7 @@ class LoopModel:
 
 def _time_scale(loop: Loop, NV: float) -> float:
     """The loop's fastest time scale, s: min(τ, 1/k, 1/NV) (τ counts when > 0, 1/NV when NV != 0)."""
-    scales = [1.0 / loop.k] + ([1.0 / abs(NV)] if NV != 0 else []) + ([loop.tau] if loop.tau > 0 else [])
+    scales = [1.0 / loop.steering_gain] + ([1.0 / abs(NV)] if NV != 0 else []) + ([loop.tau] if loop.tau > 0 else [])
     return min(scales)
 
 

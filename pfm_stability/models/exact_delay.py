@@ -71,7 +71,7 @@ class ExactDelay(LoopModel):
     @staticmethod
     def heading_quasi_polynomial(loop: Characteristic) -> DelayLoop:
         """Gain 0 (N = 0): the quasi-polynomial divided by s, a(s)/s + δ·e^(−sT) (its gain is δ)."""
-        return DelayLoop(loop.plant[:-1], loop.T)
+        return DelayLoop(loop.plant[:-1], loop.delay)
 
     def _quasi(self, gain: float, loop: Characteristic):
         """(quasi-polynomial, K) of the roots the verdict judges: the loop's at its K, the heading loop's at gain 0."""
@@ -107,6 +107,20 @@ class ExactDelay(LoopModel):
     def critical_delay(self, gain: float, loop: Characteristic) -> float:
         """Delay margin: the smallest T at which the gain loses stability (the rest fixed), s."""
         return loop.delay_margin(loop.loop_gain(gain))
+
+    @checked
+    def critical_dead_time(self, gain: float, loop: Characteristic) -> float:
+        """D*: the delay margin of T + D less T (`Loop.dead_time_margin`), s; exact, as T*.
+
+        Parameters
+        ----------
+        gain : float
+            Loop gain NV, 1/s.
+        loop : Loop
+            τ, T, k, c and g.
+        """
+        loop = _steering(loop, "critical_dead_time")
+        return 0.0 if gain < 0 else loop.dead_time_margin(loop.loop_gain(gain))
 
     @checked
     def damping_range(self, gain: float, loop: Characteristic) -> tuple:
@@ -148,16 +162,17 @@ class ExactDelay(LoopModel):
             return 0.0
         if NV == 0 and loop.c == 0.0:
             return math.inf
-        if loop.T == 0:
+        if loop.delay == 0:
             return super().critical_gain_k(NV, loop)
-        if NV * (loop.tau + loop.T) >= 1.0 + loop.c:
+        if NV * (loop.tau + loop.delay) >= 1.0 + loop.c:
             return 0.0
         if loop.c != 0.0:
             return self._heading_gain_k(NV, loop)
+        g = loop.plant_gain
 
-        def measure(ks):
-            K_star = kb_critical_gain(loop.tau, loop.T, ks)[0]
-            return math.log(NV) + np.log(ks) - np.log(K_star)  # a sum of logs: NV·k underflows for subnormal NV
+        def measure(ks):  # the loop's steering gain is g·k (`Loop.steering_gain`); k* is the controller's k
+            K_star = kb_critical_gain(loop.tau, loop.delay, g * ks)[0]
+            return math.log(NV) + np.log(g * ks) - np.log(K_star)  # a sum of logs: NV·k underflows for subnormal NV
 
         lo, hi = gain_range(loop)
         return first_crossing(measure, lo, hi, start=lo)
@@ -167,8 +182,8 @@ class ExactDelay(LoopModel):
         from ..numerics.solve import first_crossing
 
         def measure(ks):
-            loops = [Loop(loop.tau, loop.T, float(k), c=loop.c) for k in ks]
-            arrays = (np.array([getattr(x, name) for x in loops]) for name in ("tau", "T", "k"))
+            loops = [loop.replace(k=float(k)) for k in ks]
+            arrays = (np.array([getattr(x, name) for x in loops]) for name in ("tau", "delay", "steering_gain"))
             tau, T, k = arrays
             stable = delay_verdicts_from_gain(tau, T, k, k * NV, np.full(k.shape, loop.c))[0]
             size = np.abs(Pade(6).growth_rates(NV, loops)) + 1e-300

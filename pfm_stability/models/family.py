@@ -11,6 +11,7 @@ what every family's results share (a stable set of the gain, a rightmost root).
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -61,6 +62,26 @@ class Characteristic:
 
     family: LoopFamily
     T: float
+    dead_time: float = 0.0
+    """D, s: the plant's dead time beyond T (`models.base.Loop.dead_time`; 0 for a family without one)."""
+
+    @property
+    def delay(self) -> float:
+        """T + D, s: the delay the continuous-time models (`kb_first_order`, `pade`, `exact_delay`) take
+        (docs/models.md, "Plant gain and dead time"); T itself when D = 0."""
+        return self.T + self.dead_time if self.dead_time else self.T
+
+    def period_margin(self, margin: float) -> float:
+        """T*, s, from the margin of the whole delay T + D: max(margin − D, 0) (the margin itself when D = 0).
+
+        Parameters
+        ----------
+        margin : float
+            The largest stable delay T + D (its first crossing), s; ``inf`` stays ``inf``.
+        """
+        if not self.dead_time or math.isinf(margin):
+            return margin
+        return max(margin - self.dead_time, 0.0)
 
     @property
     def plant(self) -> np.ndarray:  # pragma: no cover - interface
@@ -119,7 +140,7 @@ class Characteristic:
         from ..numerics.delay import DelayLoop
 
         delayed = self.delayed
-        return DelayLoop(self.plant, self.T) if delayed is None else DelayLoop(self.plant, self.T, delayed=delayed)
+        return DelayLoop(self.plant, self.delay) if delayed is None else DelayLoop(self.plant, self.delay, delayed=delayed)
 
     def delay_stable(self, K: float) -> bool:
         """The exact delay loop's verdict at K: the crossing count (`DelayLoop.is_stable`)."""

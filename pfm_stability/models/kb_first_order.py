@@ -48,15 +48,16 @@ class KBFirstOrder(AffineGainModel):
 
     def polynomials(self, loop: Characteristic):
         """D = a(s) + δs(1 − sT), E = 1 − sT (descending powers of s): τs³ + (1 − kcT)s² + k(1 + c)s (c = 0: KB eq 19)."""
+        T = loop.delay  # T + D (docs/models.md, "Plant gain and dead time")
         if loop.damping == 0.0:
-            return loop.plant, np.array([-loop.T, 1.0])
+            return loop.plant, np.array([-T, 1.0])
         D = loop.closed_plant.copy()
-        D[-3] -= loop.damping * loop.T  # the s² coefficient: 1 − δT
-        return D, np.array([-loop.T, 1.0])
+        D[-3] -= loop.damping * T  # the s² coefficient: 1 − δT
+        return D, np.array([-T, 1.0])
 
     def parts(self, loop: Characteristic):
         """(a(s), s(1 − sT), 1 − sT)."""
-        return _aligned(loop.plant, [-loop.T, 1.0, 0.0], [-loop.T, 1.0])
+        return _aligned(loop.plant, [-loop.delay, 1.0, 0.0], [-loop.delay, 1.0])
 
     @checked
     def critical_delay(self, NV: float, loop: Characteristic) -> float:
@@ -67,7 +68,9 @@ class KBFirstOrder(AffineGainModel):
         (0 when τNV >= 1 + c: unstable already at T = 0). NV < 0: 0. NV = 0
         (the heading loop τs² + (1 − kcT)s + k(1 + c), `neutral_reason`): the
         same root, 1/(kc) for c > 0, ``inf`` for c <= 0. Another family's loop: searched
-        (`LoopModel.critical_delay`).
+        (`LoopModel.critical_delay`). With a dead time D these are the margins of
+        the delay T + D, and T* is that less D (`Characteristic.period_margin`);
+        k is the loop's g·k (`Loop.steering_gain`).
         """
         if loop.family is not STEERING:
             return LoopModel.critical_delay(self, NV, loop)
@@ -75,14 +78,14 @@ class KBFirstOrder(AffineGainModel):
         if NV < 0:
             return 0.0
         if loop.c == 0.0:
-            return max(1.0 / NV - loop.tau, 0.0) if NV > 0 else math.inf
+            return loop.period_margin(max(1.0 / NV - loop.tau, 0.0) if NV > 0 else math.inf)
         A = loop.heading * NV
         B = loop.heading * (1.0 + loop.c) + NV
         C = 1.0 + loop.c - loop.tau * NV
         if C <= 0:
             return 0.0
         denominator = B + math.sqrt(B * B - 4.0 * A * C)
-        return 2.0 * C / denominator if denominator > 0 else math.inf  # 0 only at NV = 0 with c < 0
+        return loop.period_margin(2.0 * C / denominator if denominator > 0 else math.inf)  # 0 only at NV = 0 with c < 0
 
     @checked
     def critical_gain_k(self, NV: float, loop) -> float:
@@ -106,12 +109,13 @@ class KBFirstOrder(AffineGainModel):
         NV = _check_NV(NV)
         if NV < 0:
             return 0.0
+        T = loop.delay  # T + D
         if loop.c == 0.0:
-            return math.inf if NV * (loop.tau + loop.T) < 1.0 else 0.0
-        slack = 1.0 + loop.c - NV * (loop.tau + loop.T)
+            return math.inf if NV * (loop.tau + T) < 1.0 else 0.0
+        slack = 1.0 + loop.c - NV * (loop.tau + T)
         if slack <= 0:
             return 0.0
-        if loop.c < 0 or loop.T == 0:
+        if loop.c < 0 or T == 0:
             return math.inf
-        k_star = slack / (loop.c * loop.T * (1.0 + loop.c - NV * loop.T))
+        k_star = slack / (loop.c * T * (1.0 + loop.c - NV * T)) / loop.plant_gain  # the closed form gives g·k*
         return k_star if k_star <= RANGES["k"].high else math.inf

@@ -96,7 +96,7 @@ class Pade(AffineGainModel):
 
     def _rows(self, loops):
         """Rows of a(s)·Q_m, s·P_m and P_m for each loop, one width (the plants padded to the largest degree)."""
-        T = np.array([loop.T for loop in loops])
+        T = np.array([loop.delay for loop in loops])  # T + D (docs/models.md, "Plant gain and dead time")
         m = self.order
         c = np.array([_pade_term(m, j) for j in range(m + 1)])
         powers = T[:, None] ** np.arange(m + 1)

@@ -58,6 +58,26 @@ integrator with its acceleration held (`models.holonomic`) runs the same code �
 it is KB's loop with τ = 0 and the command held, its heading feedback k(1 + c)
 replaced by c_h and K by κ.
 
+Plant gain and dead time (docs/models.md, "Plant gain and dead time"). The
+motor is τω̇ + ω = g·u(t − D): g enters through the loop's steering gain g·k
+(`Loop.steering_gain`, in `Characteristic.state_space`). A command computed
+at t_k reaches the motor at t_k + d·T + D = t_k + m·T + ε, 0 <= ε < T
+(`parameters.dead_time_split`, the simulator's rule), so over [t_k, t_k+1)
+the motor holds v_(k−m−1) for the first ε and v_(k−m) after — the modified
+z-transform. The state is augmented with the commands still on their way,
+s_j = v_(k−j), j = 1 … m + (ε > 0), and
+
+    x_(k+1) = Φ(T)x_k + Γ(T − ε)·v_(k−m) + (Γ(T) − Γ(T − ε))·v_(k−m−1),
+
+Γ(h) = ∫₀ʰ e^(As) ds·B (Φ(T − ε)Γ(ε) = Γ(T) − Γ(T − ε)). In the δ form the
+closed-loop matrix is Ψ_a − G_a·(F0 + K·F1, 0 …), still rank one in K, so the
+polynomials, crossings and verdicts below run unchanged on the augmented
+blocks (`dead_time_plant`). D = 0 runs exactly the code it always ran; D a
+whole number of periods is a compute delay of m samples. A dead time inside
+the continuous servo (``hold="reference"``) is a delay differential equation,
+no sampled loop: refused with one line, as the simulator refuses it. At
+T = 0 the loop is the exact delay loop with delay D (`exact_delay`).
+
 NV = 0 (N = 0, `models.base.neutral_reason`): y feeds nothing back, so the
 closed-loop matrix's y column is zero and z = 1 (λ = 0) is a pole at every T,
 k and c. The verdict and the dominant pole are those of the matrix without
@@ -74,13 +94,14 @@ import numpy as np
 
 from ..checks import check_choice, check_integer
 from ..numerics.matrix_exponential import zoh_blocks
-from ..parameters import HOLDS
+from ..parameters import HOLDS, RANGES, dead_time_split
 from ..numerics.routh import schur_cohn_stable
 from .base import AffineGainModel, _check_NV, checked
 from .continuous import Continuous
 from .family import Characteristic
 
-__all__ = ["Sampled", "continuous_plant", "discretize", "closed_loop_matrix", "delta_plant", "bilinear_polynomial"]
+__all__ = ["Sampled", "continuous_plant", "discretize", "closed_loop_matrix", "delta_plant", "dead_time_plant", "bilinear_polynomial",
+           "MAX_DELAY_STATES"]
 
 
 def continuous_plant(loop: Characteristic, hold: str):
@@ -102,6 +123,10 @@ def continuous_plant(loop: Characteristic, hold: str):
     A, B, F0, F1 : ndarray
     """
     check_choice("hold", hold, HOLDS)
+    if loop.dead_time > 0 and hold == "reference":
+        raise ValueError(f"dead_time must be 0 with hold=reference (a dead time inside the continuous steering servo is a delay "
+                         f"differential equation, which the sampled model does not solve; docs/models.md); got dead_time = "
+                         f"{loop.dead_time:g} s with hold=reference")
     return loop.state_space(hold)
 
 
@@ -140,6 +165,63 @@ def delta_plant(loop: Characteristic, hold: str):
     return Psi, G, F0, F1
 
 
+MAX_DELAY_STATES = 64
+"""The most commands on their way (m + (ε > 0), `dead_time_plant`) the sampled model carries: a dead time of
+more than ~64 periods makes a characteristic polynomial of degree ~67, past what its coefficients resolve."""
+
+
+@lru_cache(maxsize=4096)
+def dead_time_plant(loop: Characteristic, hold: str, compute_delay: int):
+    """(Ψ_a, G_a, F0_a, F1_a): the δ-form blocks of the sampled loop whose commands reach the motor d·T + D late.
+
+    The state is (x, v_(k−1), …, v_(k−L)), L = m + (ε > 0) with d·T + D = m·T + ε
+    (`parameters.dead_time_split`), and (Φ_cl − I)/T = Ψ_a − G_a·(F0_a + K·F1_a)
+    (module docstring). Ψ_a's plant block is `delta_plant`'s Ψ; the commands'
+    columns are Γ(T − ε)/T (v_(k−m)) and (Γ(T) − Γ(T − ε))/T (v_(k−m−1)); the
+    line shifts by one each period. G_a feeds the new command v_k to the line
+    (1/T) and, when m = 0, to the plant after ε (Γ(T − ε)/T).
+
+    Parameters
+    ----------
+    loop : Loop
+        T > 0 and D = `dead_time`, s.
+    hold : {"command"}
+        ``"reference"`` with D > 0 is refused (`continuous_plant`).
+    compute_delay : {0, 1}
+        d, samples.
+    """
+    A, B, F0, F1 = continuous_plant(loop, hold)
+    Psi, G = delta_plant(loop, hold)[:2]
+    T = loop.T
+    m, eps = dead_time_split(T, compute_delay, loop.dead_time)
+    lines = m + (eps > 0)
+    if lines > MAX_DELAY_STATES:
+        raise ValueError(f"dead_time must be at most {MAX_DELAY_STATES} sampling periods for the sampled model "
+                         f"(d·T + D = {m} periods and {eps:g} s; a longer dead time is a delay loop: exact_delay); got dead_time = "
+                         f"{loop.dead_time:g} s with T = {T:g} s")
+    n = Psi.shape[0]
+    after = zoh_blocks(A, T - eps)[1] @ B / T if eps > 0 else G  # Γ(T − ε)/T
+    before = G - after  # (Γ(T) − Γ(T − ε))/T = Φ(T − ε)Γ(ε)/T
+    size = n + lines
+    Psi_a = np.zeros((size, size))
+    Psi_a[:n, :n] = Psi
+    if m >= 1:
+        Psi_a[:n, n + m - 1] = after[:, 0]
+    if eps > 0:
+        Psi_a[:n, n + m] = before[:, 0]
+    for j in range(1, lines):
+        Psi_a[n + j, n + j - 1] = 1.0 / T
+    Psi_a[n:, n:] -= np.eye(lines) / T
+    G_a = np.zeros((size, 1))
+    G_a[n, 0] = 1.0 / T
+    if m == 0:
+        G_a[:n, 0] = after[:, 0]
+    F0_a, F1_a = (np.concatenate([F, np.zeros(lines)]) for F in (F0, F1))
+    for array in (Psi_a, G_a, F0_a, F1_a):
+        array.setflags(write=False)
+    return Psi_a, G_a, F0_a, F1_a
+
+
 def closed_loop_matrix(loop: Characteristic, K: float, hold: str, compute_delay: int) -> np.ndarray:
     """Φ_cl of the sampled loop for the loop gain K (kNV, κ; 1/s²).
 
@@ -158,6 +240,8 @@ def closed_loop_matrix(loop: Characteristic, K: float, hold: str, compute_delay:
         State transition matrix over one period; with compute_delay = 1 the
         last state is the command waiting to be applied.
     """
+    if loop.dead_time > 0:
+        return np.eye(dead_time_plant(loop, hold, compute_delay)[0].shape[0]) + loop.T * _delta_matrix(loop, K, hold, compute_delay)
     Psi, G, F0, F1 = delta_plant(loop, hold)
     n = Psi.shape[0]
     Phi, Gamma = np.eye(n) + loop.T * Psi, loop.T * G
@@ -169,6 +253,9 @@ def closed_loop_matrix(loop: Characteristic, K: float, hold: str, compute_delay:
 
 def _delta_matrix(loop: Characteristic, K: float, hold: str, compute_delay: int) -> np.ndarray:
     """(Φ_cl − I)/T without cancellation: its eigenvalues λ give the poles z = 1 + Tλ."""
+    if loop.dead_time > 0 and loop.T > 0:
+        Psi_a, G_a, F0_a, F1_a = dead_time_plant(loop, hold, compute_delay)
+        return Psi_a - G_a @ (F0_a + K * F1_a)[None, :]
     Psi, G, F0, F1 = delta_plant(loop, hold)
     F = (F0 + K * F1)[None, :]
     if compute_delay == 0 or loop.T == 0:
@@ -249,8 +336,12 @@ class Sampled(AffineGainModel):
         loop : Loop
             τ (s), T (s), k (1/s) and the heading gain c.
         """
-        Psi, G, F0, F1 = delta_plant(loop, self.hold)
-        lead = self._lead(loop, Psi)
+        if loop.dead_time > 0:  # the commands on their way are states (`dead_time_plant`): det(wI − Ψ_a) leads
+            Psi, G, F0, F1 = dead_time_plant(loop, self.hold, self.compute_delay)
+            lead = np.poly(Psi)
+        else:
+            Psi, G, F0, F1 = delta_plant(loop, self.hold)
+            lead = self._lead(loop, Psi)
         e = _rank_one(Psi, G, F1)
         return np.polyadd(lead, _rank_one(Psi, G, F0)), np.trim_zeros(e, "f") if np.any(e) else np.zeros(1)
 
@@ -293,7 +384,7 @@ class Sampled(AffineGainModel):
         """Every stable loop gain K: the crossings of the bilinear polynomials, each stretch decided by the eigenvalues
         (T = 0: the continuous loop, KB eq 17 for the steering robot, exactly)."""
         if loop.T == 0:
-            return Continuous().stable_gains(loop)
+            return loop.delay_interval() if loop.dead_time > 0 else Continuous().stable_gains(loop)
         d, e = self.bilinear_polynomials(loop)
         return self._interval(d, e, lambda K: self._stable(loop.gain_of(K), loop), loop)
 
@@ -339,7 +430,7 @@ class Sampled(AffineGainModel):
 
     def _stable(self, gain: float, loop: Characteristic) -> bool:
         if loop.T == 0:
-            return Continuous()._stable(gain, loop)
+            return _limit(loop)._stable(gain, loop)
         lam = self._judged_eigenvalues(gain, loop)
         size = np.abs(lam)
         return bool(np.all(2.0 * lam.real + (loop.T * size) * size < 0.0))  # T|λ|·|λ|: no overflow of |λ|² at tiny T
@@ -355,7 +446,7 @@ class Sampled(AffineGainModel):
     def rightmost_root(self, gain: float, loop: Characteristic) -> complex:
         """Dominant pole as s = ln(z)/T: σ = ln|z|/T (1/s), ω = arg(z)/T in [0, π/T] (rad/s); NV = 0: the heading loop's."""
         if loop.T == 0:
-            return Continuous().rightmost_root(gain, loop)
+            return _limit(loop).rightmost_root(gain, loop)
         lam = self._judged_eigenvalues(gain, loop)
         T = loop.T
         sigma = _log_radius(lam, T) / T
@@ -368,10 +459,49 @@ class Sampled(AffineGainModel):
         """All closed-loop poles z (T > 0); the continuous roots s at T = 0."""
         return self._delta_eigenvalues(gain, loop) if loop.T == 0 else 1.0 + loop.T * self._delta_eigenvalues(gain, loop)
 
+    def _searched_growth_rates(self, gain: float, loops) -> np.ndarray:
+        """The growth rates the searches for T*, k* and D* measure (`LoopModel._searched_growth_rates`): `growth_rates`,
+        and for a loop with a dead time `_searched_growth` (the delay loop in place of one with too many delay states).
+
+        T* with a dead time D (docs/models.md, "Plant gain and dead time"): at T → 0 the loop is the exact delay
+        loop with delay D (T* = 0 if that is unstable); the sampled loop is searched wherever it carries the
+        commands on their way (at most `MAX_DELAY_STATES`, i.e. T >= ~D/63), the delay loop with the hold's mean
+        delay D + (d + 1/2)·T at shorter periods; D* beyond 64 periods likewise.
+        """
+        loops = list(loops)
+        if not any(loop.dead_time > 0 for loop in loops):
+            return self.growth_rates(gain, loops)
+        return np.array([self._searched_growth(gain, loop) for loop in loops])
+
+    def _searched_growth(self, gain: float, loop: Characteristic) -> float:
+        """The growth rate (1/s) a search over T or D measures: the sampled loop's where it carries the commands on their
+        way (`MAX_DELAY_STATES`), else the delay loop with delay D + (d + 1/2)·T (the hold's mean delay), a stand-in."""
+        if loop.T > 0:
+            m, eps = dead_time_split(loop.T, self.compute_delay, loop.dead_time)
+            if m + (eps > 0) <= MAX_DELAY_STATES:
+                return float(self.growth_rates(gain, [loop])[0])
+        from .exact_delay import ExactDelay
+
+        exact = ExactDelay()
+        near = loop.replace(T=min((self.compute_delay + 0.5) * loop.T, RANGES["T"].high))  # exact_delay's delay: this T + D
+        root = exact.rightmost_root(gain, near)
+        return root.real if root is not None else (-1.0 if exact._stable(gain, near) else 1.0)
+
     def growth_rates(self, NV: float, loops) -> np.ndarray:
-        """σ = max ln|z|/T (1/s) at the gain for each loop, all exponentials and eigenvalues in one batch."""
+        """σ = max ln|z|/T (1/s) at the gain for each loop, all exponentials and eigenvalues in one batch
+        (loops with a dead time one by one, `rightmost_root`)."""
         loops = list(loops)
         NV = _check_NV(NV)
+        late = [i for i, loop in enumerate(loops) if loop.dead_time > 0]
+        if late:
+            sigma = np.empty(len(loops))
+            for i in late:
+                root = self.rightmost_root(NV, loops[i])
+                sigma[i] = root.real if root is not None else math.nan
+            rest = [i for i in range(len(loops)) if i not in set(late)]
+            if rest:
+                sigma[rest] = self.growth_rates(NV, [loops[i] for i in rest])
+            return sigma
         K = np.array([loop.loop_gain(NV) for loop in loops])
         T = np.array([loop.T for loop in loops])
         plants = [continuous_plant(loop, self.hold) for loop in loops]
@@ -402,6 +532,15 @@ class Sampled(AffineGainModel):
         if (~sampled).any():
             sigma[~sampled] = np.linalg.eigvals(closed[~sampled][(slice(None),) + plant]).real.max(axis=1)
         return sigma
+
+
+def _limit(loop: Characteristic):
+    """The model a sampled loop tends to as T → 0: `continuous`, or `exact_delay` with the delay D when D > 0."""
+    if loop.dead_time > 0:
+        from .exact_delay import ExactDelay  # imports `pade`, which imports nothing of this module
+
+        return ExactDelay()
+    return Continuous()
 
 
 def _rank_one(Psi, G, F) -> np.ndarray:

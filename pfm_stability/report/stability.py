@@ -43,12 +43,17 @@ from ..models.family import root_json
 from ..laws.registry import FAMILY_CHOICE_DEFAULTS, FAMILY_DEFAULTS, HOLONOMIC_LAWS, LAW_PARAMETERS
 from ..parameters import MODEL_NAMES, RANGES, ROBOT_FAMILIES, Controller, Corridor, Robot, Wall, check_parameter
 
-__all__ = ["StabilityReport", "KBError", "LawDescription", "build_report", "remedies", "kb_error", "kb_errors", "KINEMATIC_TAU_SOURCE"]
+__all__ = ["StabilityReport", "KBError", "LawDescription", "build_report", "remedies", "kb_error", "kb_errors", "KINEMATIC_TAU_SOURCE",
+           "PLANT_INPUTS", "plant_inputs"]
 
 LAW_INPUTS = ("cell_ratio", "cell_size", "window_cells", "xi", "eta", "rho0", "attraction_exponent", "goal_exponent", "goal_distance", "delta")
 """The law's own parameters, listed after W when the law takes them (`parameters.LAW_PARAMETERS`)."""
 
-INPUTS = ("V", "tau", "T", "k", "f", "n", "W", *LAW_INPUTS, "hold", "compute_delay", "pade_order", "alpha_deg", "L")
+PLANT_INPUTS = ("dead_time", "plant_gain")
+"""The steering plant's dead time D and gain g (`parameters.Robot`), listed after k only when given: a value other than
+the default (D = 0, g = 1) or one the user or a file gave (`plant_inputs`), so reports without them are as before."""
+
+INPUTS = ("V", "tau", "T", "k", *PLANT_INPUTS, "f", "n", "W", *LAW_INPUTS, "hold", "compute_delay", "pade_order", "alpha_deg", "L")
 """The report's inputs for a static law, in the order it lists them (``alpha_deg`` and ``L`` when given; f and n for KB's laws only)."""
 
 UNITS = {name: RANGES[name].unit if name in RANGES else "" for name in INPUTS}
@@ -412,8 +417,8 @@ def _static_report(robot, controller, law, alpha, alpha_deg, L, models, pade_ord
         raise ValueError(f"sources must be a dict of parameter name to provenance; got {sources!r}")
     model_objs = tuple(models_for(controller, tuple(dict.fromkeys(models)), pade_order=pade_order))
     sources = sources or {}
-    values = {"V": robot.V, "tau": robot.tau, "T": controller.T, "k": robot.k, "f": controller.f, "n": controller.n, "W": robot.W,
-              "hold": controller.hold, "compute_delay": controller.compute_delay, "pade_order": pade_order}
+    values = {"V": robot.V, "tau": robot.tau, "T": controller.T, "k": robot.k, **plant_inputs(robot, sources), "f": controller.f,
+              "n": controller.n, "W": robot.W, "hold": controller.hold, "compute_delay": controller.compute_delay, "pade_order": pade_order}
     law = law_in_force(robot, controller, law)
     values = _law_inputs(values, law)
     if wall is not None:
@@ -502,10 +507,35 @@ def _family_law_report(robot, controller, family, law, alpha, alpha_deg, L, mode
                            LawDescription(**law.described()), None, kb_errors(robot, controller, wall_result, corridor_result), schedule)
 
 
+def plant_inputs(robot: Robot, sources: dict | None) -> dict:
+    """{name: value} of the steering plant's D and g that the report lists (`PLANT_INPUTS`).
+
+    Each is listed when it differs from KB's robot (D = 0, g = 1) or when its
+    source is neither a preset nor absent (``user``, ``config FILE``, ``ASSUMED …``:
+    `cli.options.resolve_parameters`), so every report that does not give them
+    keeps its inputs (and its JSON keys) as before.
+
+    Parameters
+    ----------
+    robot : parameters.Robot
+        The robot, with `dead_time` (s) and `plant_gain`.
+    sources : dict or None
+        Parameter name → provenance (`build_report`'s ``sources``).
+    """
+    sources = sources or {}
+    defaults = {"dead_time": 0.0, "plant_gain": 1.0}
+    shown = {}
+    for name in PLANT_INPUTS:
+        value, source = getattr(robot, name), sources.get(name)
+        if value != defaults[name] or (source is not None and not source.startswith("preset")):
+            shown[name] = value
+    return shown
+
+
 def _family_inputs(robot, controller, family, law, mass, pade_order, wall, corridor, sources) -> dict:
     """The report's inputs: the robot family, the robot and controller, the law's parameters and choices, the geometry."""
     holonomic = family == "holonomic"
-    values = {"robot": family, "V": robot.V, "tau": robot.tau, "T": controller.T, "k": robot.k}
+    values = {"robot": family, "V": robot.V, "tau": robot.tau, "T": controller.T, "k": robot.k, **plant_inputs(robot, sources)}
     if holonomic:
         values["mass"] = mass
     values.update(law.parameters)
@@ -518,7 +548,7 @@ def _family_inputs(robot, controller, family, law, mass, pade_order, wall, corri
     out = {}
     for name, value in values.items():
         source = sources.get(name, "default" if name in FAMILY_DEFAULTS or name in FAMILY_CHOICE_DEFAULTS else "user")
-        if holonomic and name in ("tau", "k", "hold"):
+        if holonomic and name in ("tau", "k", "hold", *PLANT_INPUTS):
             source = HOLONOMIC_UNUSED
         out[name] = {"value": value, "unit": UNITS.get(name, RANGES[name].unit if name in RANGES else ""), "source": source}
     return out
@@ -617,6 +647,9 @@ def remedies(scenario: str, verdict: ModelVerdict, robot: Robot, controller: Con
     c = verdict.critical
     current = {**law.parameters(), "V": robot.V, "f": law.lumped_f(), "T": controller.T, "k": robot.k}  # f: the user's (a grid's f_av)
     wanted = [("V", "V_critical", "lower"), ("T", "T_critical", "lower"), ("k", "k_critical", "lower")]  # (parameter, critical key, direction)
+    if "dead_time_critical" in c:  # a robot with a dead time or a plant gain (docs/models.md, "Plant gain and dead time")
+        current["dead_time"] = robot.dead_time
+        wanted.append(("dead_time", "dead_time_critical", "lower"))
     if scenario == "wall":
         wanted.append(("alpha_deg", "alpha_critical_deg", _towards(c.alpha_critical_deg, at, law)))
     else:

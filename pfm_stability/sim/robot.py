@@ -95,9 +95,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..numerics.solve import gauss_legendre as legendre_nodes
+from ..parameters import dead_time_split
 
 __all__ = [
-    "NODES", "RESOLUTION", "MAX_PANELS", "DEAD_TIME_RESOLUTION", "delay_split", "gauss_legendre", "slow_rate", "constant_input_modes", "servo_modes",
+    "NODES", "RESOLUTION", "MAX_PANELS", "delay_split", "gauss_legendre", "slow_rate", "constant_input_modes", "servo_modes",
     "panel_count", "graded_rule", "node_sum", "Rule", "Coefficients", "constant_input", "servo", "propagate",
     "advance_position",
 ]
@@ -113,19 +114,11 @@ MAX_PANELS = 64
 at most 2·NODES + 1 = 9 rad, so any T/τ and |θ̇|·T up to ~45 rad); beyond, the panels widen."""
 
 
-DEAD_TIME_RESOLUTION = 1e-9
-"""A dead time within this fraction of a period of a whole number of periods is taken as that whole number
-(`delay_split`): D/T is rarely exact in floating point (0.1/0.05 is 2 to round-off, or just under), and a
-sub-interval of 1e-9·T moves the robot by 1e-9 of a step while it adds a mode at z = 0 that the
-linear-prediction fit of the metrics (`sim.metrics`) would have to carry."""
-
-
 def delay_split(T, compute_delay, dead_time):
-    """(m, ε): a command computed at t_k reaches the motor at t_k + d·T + D = t_k + m·T + ε, 0 <= ε < T.
+    """(m, ε) per member: `parameters.dead_time_split` (the one rule, shared with the `sampled` model) on arrays.
 
-    Over [t_k, t_k+1) the motor then sees u_(k−m−1) for the first ε seconds
-    and u_(k−m) for the rest (module docstring). ε within
-    `DEAD_TIME_RESOLUTION`·T of 0 or of T is snapped to a whole period.
+    Over [t_k, t_k+1) the motor sees u_(k−m−1) for the first ε seconds and
+    u_(k−m) for the rest (module docstring).
 
     Parameters
     ----------
@@ -143,14 +136,9 @@ def delay_split(T, compute_delay, dead_time):
     eps : ndarray, shape (B,)
         The fraction of a period, s, in [0, T).
     """
-    T = np.asarray(T, dtype=float)
-    D = np.asarray(dead_time, dtype=float)
-    whole = np.floor(D / T)
-    eps = np.maximum(D - whole * T, 0.0)
-    up = eps > (1.0 - DEAD_TIME_RESOLUTION) * T
-    whole = np.where(up, whole + 1.0, whole)
-    eps = np.where(up | (eps < DEAD_TIME_RESOLUTION * T), 0.0, eps)
-    return np.asarray(compute_delay, dtype=np.int64) + whole.astype(np.int64), eps
+    pairs = [dead_time_split(float(t), int(d), float(D)) for t, d, D in
+             zip(np.ravel(T), np.ravel(compute_delay), np.ravel(dead_time))]
+    return np.array([m for m, _ in pairs], dtype=np.int64), np.array([e for _, e in pairs], dtype=float)
 
 
 def gauss_legendre(nodes: int = NODES):

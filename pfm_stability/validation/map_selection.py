@@ -84,7 +84,7 @@ def periods_omega(segment, robot: Robot, controller: Controller, model: Sampled)
     N = number(segment.N)
     c = number(getattr(segment, "c", 0.0)) or 0.0
     try:
-        loop = Loop(robot.tau, controller.T, robot.k, c=c)
+        loop = Loop.of(robot, controller, c=c)
     except ValueError:
         loop = loop_of(robot, controller)
     omega_star, sigma, omega = model.boundary(loop).omega_critical or 0.0, None, 0.0

@@ -393,7 +393,7 @@ def verdict_sweep(
                 dom = parameter_domain("alpha", "wall", env, r, c, scenario_law(env, r, c, **laws), None)
                 lo, hi = max(lo, dom[0]), min(hi, dom[1])
             geometry = lo + (hi - lo) * u
-        loop = Loop(r.tau, c.T, r.k)
+        loop = Loop.of(r, c)
         members.append((i, s["scenario"][i], r, c, geometry, simulation_duration(loop, c.hold, c.compute_delay, env)))
 
     models = {name: make_model(name, pade_order=pade_order) for name in COMPARED_MODELS if name != "sampled"}
@@ -450,7 +450,7 @@ def _assess(index, kind, robot, controller, run, models, exclude) -> SweepPoint:
     operating = s.analysis["L"] if kind == "corridor" else s.analysis["alpha"]
     geometry = float(operating) if kind == "corridor" else math.degrees(operating)
     NV = environment_gain(kind, s.effective_law(), operating) * robot.V
-    loop = Loop(robot.tau, controller.T, robot.k)
+    loop = Loop.of(robot, controller)
     sampled = make_model("sampled", hold=controller.hold, compute_delay=controller.compute_delay)
     answers = {
         name: model_answer(sampled if name == "sampled" else models[name], loop, NV, root=name == "sampled")
