@@ -661,8 +661,8 @@ def random_corridor(rng: np.random.Generator, *, away: float = 0.05, kind: str =
     """(robot, controller, geometry, sampled margin) of a random corridor (or wall) whose ``sampled`` verdict is at least
     `away` from the boundary.
 
-    V 0.3–1.2 m/s, τ 0.1–0.5 s, k 1–4 1/s, W 0.5–0.8 m, f 0.5–1.5, n 2, T 0.02–0.1 s, compute delay 0 or 1 (the
-    command held); a corridor's L from W/2 + 0.2 to W/2 + 0.7 m, a wall's α 20–70° (geometry: L in m, α in rad). Drawn
+    V 0.3–1.2 m/s, τ 0.1–0.5 s, k 1–4 1/s, W 0.5–0.8 m, dead time D 0–0.1 s, plant gain g 0.7–1.2, f 0.5–1.5, n 2,
+    T 0.02–0.1 s, compute delay 0 or 1 (the command held); a corridor's L from W/2 + 0.2 to W/2 + 0.7 m, a wall's α 20–70° (geometry: L in m, α in rad). Drawn
     again until |margin| > `away` and the predicted growth keeps the robot off the walls for 8 periods
     (σ·8·2π/ω < 2.5) and makes at least 6 swings before it decays by e³.
     """
@@ -670,7 +670,8 @@ def random_corridor(rng: np.random.Generator, *, away: float = 0.05, kind: str =
     from pfm_stability.report.stability import build_report
 
     while True:
-        robot = Robot(V=rng.uniform(0.3, 1.2), tau=rng.uniform(0.1, 0.5), k=rng.uniform(1.0, 4.0), W=rng.uniform(0.5, 0.8))
+        robot = Robot(V=rng.uniform(0.3, 1.2), tau=rng.uniform(0.1, 0.5), k=rng.uniform(1.0, 4.0), W=rng.uniform(0.5, 0.8),
+                      dead_time=rng.uniform(0.0, 0.1), plant_gain=rng.uniform(0.7, 1.2))
         controller = Controller(f=rng.uniform(0.5, 1.5), n=2.0, T=rng.uniform(0.02, 0.1), hold="command",
                                 compute_delay=int(rng.integers(0, 2)))
         if kind == "corridor":
