@@ -373,18 +373,29 @@ def _predicted(name: str, verdict: str, margin: float, V_critical: float, root, 
                      omega, sigma, error, bool(matches))
 
 
-def _quick(robot: Robot, controller: Controller, N: float, measured: Measured, models) -> dict:
-    """Model name → `Predicted` without T* and k* (their searches cost 0.1 s a stretch): the verdict rule
-    (`models.verdicts.judge`) on each model's boundary and its dominant root at NV = N·V, as the report's criteria."""
-    loop = Loop.of(robot, controller)
-    NV = N * robot.V
-    out = {}
-    for model in models_for(controller, models):
-        boundary = model.boundary(loop)
-        judgement = judge(NV, N, boundary, model.is_stable(NV, loop))
-        out[model.name] = _predicted(model.name, judgement.verdict, judgement.margin, judgement.V_critical,
-                                     model.rightmost_root(NV, loop), measured)
-    return out
+@dataclass(frozen=True)
+class _Models:
+    """The models built once for the log's loop, with their boundaries: the loop (τ, T, k, D, g) is the same on every
+    stretch; only NV = N·V changes."""
+
+    loop: Loop
+    pairs: tuple
+
+    @classmethod
+    def of(cls, robot: Robot, controller: Controller, names) -> "_Models":
+        loop = Loop.of(robot, controller)
+        return cls(loop, tuple((model, model.boundary(loop)) for model in models_for(controller, names)))
+
+    def predict(self, N: float, V: float, measured: Measured) -> dict:
+        """Model name → `Predicted` without T* and k* (their searches cost 0.1 s a stretch): the verdict rule
+        (`models.verdicts.judge`) on each model's boundary and its dominant root at NV = N·V, as the report's criteria."""
+        NV, loop = N * V, self.loop
+        out = {}
+        for model, boundary in self.pairs:
+            judgement = judge(NV, N, boundary, model.is_stable(NV, loop))
+            out[model.name] = _predicted(model.name, judgement.verdict, judgement.margin, judgement.V_critical,
+                                         model.rightmost_root(NV, loop), measured)
+        return out
 
 
 def _full(d: StretchDiagnosis, robot: Robot, controller: Controller, law: ForceLaw, models) -> StretchDiagnosis:
@@ -431,7 +442,7 @@ def _speed(stretch: Stretch, pose: PoseSeries) -> float:
     return float(np.sum(np.hypot(np.diff(xs), np.diff(ys))) / (ts[-1] - ts[0]))
 
 
-def _judge(stretch: Stretch, pose: PoseSeries, robot: Robot, controller: Controller, law: ForceLaw, models) -> StretchDiagnosis:
+def _judge(stretch: Stretch, pose: PoseSeries, robot: Robot, law: ForceLaw, models: _Models) -> StretchDiagnosis:
     if stretch.duration < MIN_DURATION:
         return StretchDiagnosis(stretch, False, f"shorter than {MIN_DURATION:g} s ({stretch.duration:.1f} s)")
     offset = lateral_offset(stretch, pose)
@@ -475,7 +486,7 @@ def _judge(stretch: Stretch, pose: PoseSeries, robot: Robot, controller: Control
                                     f"at any angle α in {RANGES['alpha_deg'].describe()}", measured=measured, **base)
         geometry["alpha"] = alpha
     N = corridor_gain(law, offset.geometry) if stretch.kind == "corridor" else float(N_wall)
-    predicted = _quick(robot.replace(V=V), controller, N, measured, models)
+    predicted = models.predict(N, V, measured)
     matching = [p for p in predicted.values() if p.matches]
     best = min(matching, key=lambda p: (p.root_error if p.root_error is not None else 0.0, -MODEL_NAMES.index(p.model))) \
         if matching else None
@@ -513,7 +524,8 @@ def diagnose(log: LogData, robot: Robot, controller: Controller, *, law: ForceLa
                          "scan_reducer=wall_lines))")
     law = law_in_force(robot, controller, law)
     stretches = find_stretches(log.scan.t, log.scan.values, log.pose)
-    judged = tuple(_judge(s, log.pose, robot, controller, law, tuple(models)) for s in stretches)
+    built = _Models.of(robot, controller, tuple(models))
+    judged = tuple(_judge(s, log.pose, robot, law, built) for s in stretches)
     rated = [d for d in judged if d.judged]
     if not stretches:
         verdict, reason, worst = "nothing to diagnose", "no wall in view while the robot moved (no stretch along a wall or through a corridor)", None
