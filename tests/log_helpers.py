@@ -19,7 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["Plant", "Recording", "SyntheticLog", "simulate", "write_ros2", "write_ros1", "write_csv", "write_log",
+__all__ = ["Plant", "Recording", "SyntheticLog", "simulate", "write_ros2", "write_ros1", "write_csv", "write_log", "corridor_log",
            "random_plant", "bad_log", "BAD_LOGS", "Leg", "LegTruth", "DrivenLog", "drive", "ray_cast", "random_corridor", "corridor_run"]
 
 
@@ -698,6 +698,19 @@ def corridor_run(seed: int, directory, *, duration: float | None = None, kind: s
     Returns (path, robot, controller, geometry, margin, truth): L (m) or α (rad), and the simulator's own metrics of the
     leg in `truth`.
     """
+    log, robot, controller, geometry, margin = corridor_log(seed, duration=duration, kind=kind)
+    path = write_ros2(log.log, Path(directory) / f"{kind}_{seed}", storage="mcap")
+    return path, robot, controller, geometry, margin, log.truth[0]
+
+
+def corridor_log(seed: int, *, duration: float | None = None, kind: str = "corridor", scans: bool = True):
+    """The `DrivenLog` of `corridor_run` (a random corridor or wall from `seed`, 10 periods, 20–60 s, 2 % dropped), not
+    written; without scans when `scans` is false (what `identify` reads, 20× faster to make).
+
+    Returns (log, robot, controller, geometry, margin). The commands are stamped when published, d·T after the sample
+    they were computed from (d the controller's compute delay), and the motor sees g·u(t − D) from that stamp on: the
+    dead time D the log shows is the robot's own (docs/diagnose.md, "Time").
+    """
     rng = np.random.default_rng(seed)
     robot, controller, geometry, margin, root = random_corridor(rng, kind=kind)
     period = 2 * math.pi / root.imag
@@ -706,6 +719,5 @@ def corridor_run(seed: int, directory, *, duration: float | None = None, kind: s
         leg = Leg("corridor", length, L=geometry, offset=min(0.08, 0.5 * (geometry - robot.W / 2)))
     else:
         leg = Leg("wall", length, alpha=geometry, offset=0.08)
-    log = drive([leg], robot, controller, seed=seed, drop=0.02)
-    path = write_ros2(log.log, Path(directory) / f"{kind}_{seed}", storage="mcap")
-    return path, robot, controller, geometry, margin, log.truth[0]
+    log = drive([leg], robot, controller, seed=seed, drop=0.02, scan_rate=10.0 if scans else 0.0)
+    return log, robot, controller, geometry, margin

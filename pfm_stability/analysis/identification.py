@@ -35,6 +35,19 @@ odometry) it widens by the right amount for each parameter, where an effective s
 widen every parameter alike. L is the larger of Newey and West's 4·(n/100)^(2/9) and three times the
 lag at which the residuals' autocorrelation falls below 0.1.
 
+Can the log separate g, τ and D?
+--------------------------------
+A robot oscillating in a corridor commands essentially one frequency ω. The log then fixes the plant's gain
+|G(jω)| = g/√(1 + ω²τ²) and phase −ωD − atan(ωτ) at ω — two numbers for three unknowns: every (g, τ, D) on that
+ridge explains the log as well, up to harmonics and the held commands' staircase, whose small ripple (one local
+minimum of the residual per controller period along D) picks a point on the ridge by luck, and the covariance of
+that point is then small and wrong. `command_spectrum` measures the excitation before any fit: the held command on
+a grid of T, its mean removed, its periodogram (Hann window); ω the peak (DC excluded) and `outside` the fraction
+of the power outside [ω/`BAND`, `BAND`·ω]. Below `NARROWBAND` the fit is kept (it explains the log, and its
+gain and phase at ω are what the log determines) but its intervals are null and the `narrowband` warning says why
+(docs/diagnose.md, "Identifiability"). The criterion reads the commands only, not the noise or the fit, so it does
+not depend on where the optimizer stopped on the ridge.
+
 Does the model explain the data?
 --------------------------------
 `FitQuality` gives the normalized error (NRMSE = rms(r)/std(y)), R² and the residuals' whiteness, and
@@ -60,8 +73,9 @@ import numpy as np
 from ..io.logs import LogData, TimeSeries
 from ..io.serialize import json_number
 
-__all__ = ["Estimate", "ControllerTiming", "FitWarning", "FitQuality", "PlantFit", "LogSummary", "Identification",
-           "controller_timing", "excitation_windows", "lag_response", "fit_plant", "identify",
+__all__ = ["Estimate", "ControllerTiming", "FitWarning", "FitQuality", "Excitation", "PlantFit", "LogSummary",
+           "Identification", "controller_timing", "excitation_windows", "command_spectrum", "lag_response", "fit_plant",
+           "identify", "NARROWBAND", "BAND",
            "MISSED_FACTOR", "SETTLE", "LEAD", "STALE", "DEAD_TIME_BOUNDS", "TAU_BOUNDS", "BETTER", "RATE_SOURCES"]
 
 MISSED_FACTOR = 1.5
@@ -78,6 +92,12 @@ BETTER = 0.1
 """A richer model (second lag, deadband) is named when it lowers the residual sum of squares by this fraction."""
 RATE_SOURCES = ("odometry", "imu")
 """Where the achieved yaw rate comes from: the odometry's twist, or the IMU's angular velocity."""
+NARROWBAND = 0.05
+"""The commands are narrowband (g, τ and D not separately identifiable) when less than this fraction of their power
+lies outside [ω/`BAND`, `BAND`·ω] around their dominant angular frequency ω. Measured: the VFF simulator's corridors
+and walls 0.000–0.014, step turns and chirps 0.14–0.93 (docs/diagnose.md, "Identifiability")."""
+BAND = 1.5
+"""The band around the dominant frequency that `NARROWBAND` counts as one frequency (a factor each way)."""
 Z95 = 1.959963984540054
 GRID_SAMPLES, CHECK_SAMPLES, FIRST_SAMPLES = 5_000, 8_000, 20_000
 """The grid search, the checks of richer models and a long log's first fit use a contiguous stretch of at most this
@@ -87,7 +107,8 @@ many samples (speed: the final fit uses every sample)."""
 # ------------------------------------------------------------------------------------------ results
 @dataclass(frozen=True)
 class Estimate:
-    """A parameter and its 95 % interval [low, high] (the parameter's unit)."""
+    """A parameter and its 95 % interval [low, high] (the parameter's unit); low and high are NaN (null in JSON) when
+    the log cannot determine the parameter (`Excitation.narrowband`)."""
 
     value: float
     low: float
@@ -125,7 +146,7 @@ class ControllerTiming:
 @dataclass(frozen=True)
 class FitWarning:
     """Something the model does not explain: `kind` (``rate_limit``, ``deadband``, ``second_order``, ``poor_fit``,
-    ``dead_time_at_bound``, ``negative_dead_time``) and a one-line `message`."""
+    ``dead_time_at_bound``, ``negative_dead_time``, ``narrowband``) and a one-line `message`."""
 
     kind: str
     message: str
@@ -167,15 +188,67 @@ class FitQuality:
 
 
 @dataclass(frozen=True)
+class Excitation:
+    """How the commands excite the plant (module docstring, "Can the log separate g, τ and D?").
+
+    Parameters
+    ----------
+    omega : float
+        The commands' dominant angular frequency (rad/s); NaN for a constant command.
+    outside : float
+        The fraction (−, 0–1) of their power outside [ω/`BAND`, `BAND`·ω].
+    narrowband : bool
+        outside < `NARROWBAND`: g, τ and D are not separately identifiable.
+    gain : float
+        The fitted plant's gain |g·e^(−jωD)/(jωτ + 1)| at omega (−), which a narrowband log does determine.
+    phase : float
+        Its phase −ωD − atan(ωτ) at omega (rad), which a narrowband log does determine.
+    """
+
+    omega: float
+    outside: float
+    narrowband: bool
+    gain: float
+    phase: float
+
+    def to_dict(self) -> dict:
+        """The ``fit.excitation`` of the JSON output."""
+        return {"omega": json_number(self.omega), "outside": json_number(self.outside), "narrowband": self.narrowband,
+                "gain": json_number(self.gain), "phase": json_number(self.phase)}
+
+
+@dataclass(frozen=True)
 class PlantFit:
-    """The fitted plant g·e^(−sD)/(τs + 1): g (−), tau (s), dead_time (s), each with its 95 % interval; the fit's
-    quality and what the model does not explain."""
+    """The fitted plant g·e^(−sD)/(τs + 1).
+
+    Parameters
+    ----------
+    g : Estimate
+        The plant gain (−) and its 95 % interval.
+    tau : Estimate
+        The lag (s) and its 95 % interval.
+    dead_time : Estimate
+        The dead time D (s) from the command's publication (docs/diagnose.md, "Time") and its 95 % interval.
+    quality : FitQuality
+        How well the model explains the samples.
+    warnings : tuple of FitWarning
+        What the model does not explain, and ``narrowband``.
+    excitation : Excitation or None
+        How the commands excite the plant; when narrowband the values are one point of the ridge the log cannot
+        resolve and the intervals are NaN.
+    """
 
     g: Estimate
     tau: Estimate
     dead_time: Estimate
     quality: FitQuality
     warnings: tuple[FitWarning, ...]
+    excitation: Excitation | None = None
+
+    @property
+    def identifiable(self) -> bool:
+        """Whether g, τ and D are separately determined by the log (not `Excitation.narrowband`)."""
+        return self.excitation is None or not self.excitation.narrowband
 
 
 @dataclass(frozen=True)
@@ -215,10 +288,12 @@ class Identification:
             "identified": self.identified,
             "reason": self.reason,
             "plant": None if plant is None else {"g": plant.g.to_dict(), "tau": plant.tau.to_dict(),
-                                                 "dead_time": plant.dead_time.to_dict()},
+                                                 "dead_time": plant.dead_time.to_dict(),
+                                                 "identifiable": plant.identifiable},
             "controller": self.controller.to_dict(),
             "fit": {"quality": None if plant is None else plant.quality.to_dict(),
-                    "warnings": [] if plant is None else [w.to_dict() for w in plant.warnings]},
+                    "warnings": [] if plant is None else [w.to_dict() for w in plant.warnings],
+                    "excitation": None if plant is None or plant.excitation is None else plant.excitation.to_dict()},
             "log": self.log.to_dict(),
         }
 
@@ -252,6 +327,46 @@ def controller_timing(t: np.ndarray) -> ControllerTiming:
     span = float(t[-1] - t[0])
     return ControllerTiming(T, p5, p95, int(np.count_nonzero(intervals > MISSED_FACTOR * T)), int(t.size),
                             (t.size - 1) / span, 1.0 / T)
+
+
+# ------------------------------------------------------------------------------------------ the excitation
+def command_spectrum(cmd_t: np.ndarray, u: np.ndarray, T: float) -> tuple[float, float]:
+    """The commands' dominant angular frequency and the fraction of their power outside [ω/`BAND`, `BAND`·ω].
+
+    Parameters
+    ----------
+    cmd_t : numpy.ndarray
+        The commands' times (s), non-decreasing.
+    u : numpy.ndarray
+        The commanded yaw rates (rad/s), each held until the next.
+    T : float
+        The controller's period (s), > 0: the held command is sampled every T.
+
+    Returns
+    -------
+    tuple of float
+        (ω in rad/s, the fraction outside in 0–1); (NaN, 1.0) when the command is constant.
+    """
+    cmd_t, u = np.asarray(cmd_t, dtype=float), np.asarray(u, dtype=float)
+    grid = np.arange(cmd_t[0], cmd_t[-1], T)
+    x = u[np.clip(np.searchsorted(cmd_t, grid, side="right") - 1, 0, u.size - 1)]
+    x = x - x.mean()
+    power = np.abs(np.fft.rfft(x * np.hanning(x.size))) ** 2 if x.size >= 4 else np.zeros(1)
+    omega = 2.0 * math.pi * np.fft.rfftfreq(x.size, T) if x.size >= 4 else np.zeros(1)
+    total = float(power[1:].sum())
+    if power.size < 3 or not total > 0 or not np.ptp(x) > 1e-12 * max(1.0, float(np.max(np.abs(u)))):
+        return math.nan, 1.0
+    peak = int(np.argmax(power[1:])) + 1
+    band = (omega >= omega[peak] / BAND) & (omega <= omega[peak] * BAND)
+    centre = float(np.sum(omega[band] * power[band]) / np.sum(power[band]))  # the peak refined: the band's centroid
+    return centre, float(max(0.0, 1.0 - power[band].sum() / total))
+
+
+def _excitation(cmd_t, u, T: float, g: float, tau: float, delay: float) -> Excitation:
+    omega, outside = command_spectrum(cmd_t, u, T)
+    w = omega if math.isfinite(omega) else 0.0
+    return Excitation(omega, outside, bool(outside < NARROWBAND), abs(g) / math.sqrt(1.0 + (w * tau) ** 2),
+                      -w * delay - math.atan(w * tau))
 
 
 # ------------------------------------------------------------------------------------------ the exact response
@@ -538,7 +653,15 @@ def fit_plant(cmd_t: np.ndarray, u: np.ndarray, rate: TimeSeries, T: float) -> t
         effective_samples=float(r.size / max(bartlett, 1.0)), windows=int(len(windows)),
         excited=float(np.sum(windows[:, 1] - windows[:, 0])), bias=float(b), hac_lags=L)
     warnings = _checks(s, (g, tau, delay, b), estimates, quality)
-    return PlantFit(estimates[0], estimates[1], estimates[2], quality, tuple(warnings)), None
+    excitation = _excitation(cmd_t, u, T, g, tau, delay)
+    if excitation.narrowband:  # one frequency: the fit is one point of a ridge, its intervals mean nothing
+        warnings.insert(0, FitWarning("narrowband", (
+            f"the commands excite one frequency (ω ≈ {excitation.omega:.3g} rad/s; {100 * (1 - excitation.outside):.1f} % "
+            f"of their power within a factor {BAND:g} of it): g, τ and D are not separately identifiable, only the plant's "
+            f"gain {excitation.gain:.3g} and phase {math.degrees(excitation.phase):.0f}° there; record step turns "
+            "(docs/diagnose.md)")))
+        estimates = [Estimate(e.value, math.nan, math.nan) for e in estimates]
+    return PlantFit(estimates[0], estimates[1], estimates[2], quality, tuple(warnings), excitation), None
 
 
 # ------------------------------------------------------------------------------------------ what the model misses

@@ -337,7 +337,13 @@ def complete_from_log(robot: Robot, controller: Controller, sources: dict, ident
         estimate, unit = estimates[name]
         value = max(estimate.value, 0.0) if name == "dead_time" else estimate.value  # a negative D: clocks differ (identify warns)
         robot = robot.replace(**{name: value})
-        sources[name] = f"identified from {identification.log.path} ({estimate.low:.4g} to {estimate.high:.4g}{' ' + unit if unit else ''})"
+        if fit.identifiable:
+            sources[name] = f"identified from {identification.log.path} ({estimate.low:.4g} to {estimate.high:.4g}{' ' + unit if unit else ''})"
+        else:  # a narrowband log: any plant of the ridge predicts the same loop near ω (docs/diagnose.md, "Identifiability")
+            x = fit.excitation
+            sources[name] = (f"identified from {identification.log.path}, not separately identifiable (narrowband at "
+                             f"ω ≈ {x.omega:.3g} rad/s): the prediction uses the plant's gain {x.gain:.3g} and phase "
+                             f"{math.degrees(x.phase):.0f}° there, which the log determines")
     return robot, controller, sources
 
 
