@@ -15,6 +15,7 @@ import contextlib
 import io
 import json
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -336,6 +337,39 @@ def test_a_corridor_log_alone_is_narrowband_yet_predicts_the_measured_root(tmp_p
     assert sampled["stable"] is data["measured"]["stable"] is (margin > 0)
     assert sampled["omega"] == pytest.approx(truth.metrics.angular_frequency, rel=0.05)
     assert sampled["sigma"] == pytest.approx(truth.metrics.growth_rate, abs=0.02)
+
+
+@pytest.mark.slow
+def test_a_narrowband_plant_stays_on_its_ridge_with_the_users_value(tmp_path):
+    """With a narrowband log and τ given by the user, D and g come from the ridge the log determines (`ridge_point`),
+    not from the fit's own point: the ridge passes through the truth, so with the true τ they are the truth's (D within
+    5 ms = the 0.011 rad phase error seen at ω ≈ 2.8 rad/s, doubled; g within 2 %), where the fit's point is far off.
+    Without any of them and a fit's negative D, D = 0 on the ridge, never the fit's point with D clamped."""
+    from log_helpers import corridor_log, write_log
+    from pfm_stability.analysis.identification import identify
+    from pfm_stability.validation.diagnose import complete_from_log
+
+    log, robot, controller, _, _ = corridor_log(11, scans=False, duration=20.0)
+    path = write_log(log.log, tmp_path, "csv")
+    identification = identify(read_log(path, need=("command", "odometry")))
+    assert not identification.plant.identifiable
+    sources = {"tau": "configuration", "T": "configuration", "dead_time": "preset CARMEL", "plant_gain": "preset CARMEL"}
+    start = CARMEL.robot.replace(tau=robot.tau)
+    completed, _, new = complete_from_log(start, controller, sources, identification)
+    assert completed.tau == robot.tau
+    assert completed.dead_time == pytest.approx(robot.dead_time, abs=0.005)
+    assert completed.plant_gain == pytest.approx(robot.plant_gain, rel=0.02)
+    assert "not separately identifiable" in new["dead_time"] and new["tau"] == "configuration"
+    x = identification.plant.excitation
+    negative = type(identification.plant)(identification.plant.g, identification.plant.tau,
+                                          type(identification.plant.dead_time)(-0.05, math.nan, math.nan),
+                                          identification.plant.quality, identification.plant.warnings, x)
+    sources = dict(sources, tau="preset CARMEL")
+    completed, _, _ = complete_from_log(CARMEL.robot, controller, sources, replace(identification, plant=negative))
+    assert completed.dead_time == 0.0
+    w = x.omega
+    assert completed.plant_gain / math.hypot(1, w * completed.tau) == pytest.approx(x.gain, rel=1e-9)
+    assert -math.atan(w * completed.tau) == pytest.approx(x.phase, abs=1e-9)
 
 
 def test_batched_reduction_is_the_scan_by_scan_one(driven, read):

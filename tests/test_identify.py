@@ -25,7 +25,8 @@ from jsonschema import Draft202012Validator
 from log_helpers import (BAD_LOGS, Leg, Plant, Recording, bad_log, corridor_log, drive, random_corridor, random_plant,
                          simulate, write_log, write_ros2)
 from pfm_stability.analysis.identification import (
-    BAND, NARROWBAND, _affine_scan, command_spectrum, controller_timing, excitation_windows, identify, lag_response)
+    BAND, NARROWBAND, Excitation, _affine_scan, command_spectrum, controller_timing, excitation_windows, identify, lag_response,
+    ridge_point)
 from pfm_stability.cli import main
 from pfm_stability.io.logs import read_log
 from pfm_stability.io.schema import load_schema
@@ -142,6 +143,27 @@ def test_command_spectrum_is_the_closed_form_of_tones():
     omega, outside = command_spectrum(t, np.sin(1.1 * t) + np.sin(3.3 * t), T)
     assert outside == pytest.approx(0.5, abs=0.02)
     assert math.isnan(command_spectrum(t, np.full(t.size, 0.3), T)[0])
+
+
+def test_ridge_point_keeps_the_gain_and_phase_at_omega():
+    """From each single value the two others follow the closed forms: the returned plant's g/√(1 + ω²τ²) and
+    −ωD − atan(ωτ) are the ridge's to round-off (1e-12), and the value given is kept; a value no plant of the ridge
+    has (a gain below the gain at ω, a dead time beyond the phase) gives None; not exactly one value is a ValueError."""
+    rng = np.random.default_rng(5)
+    for _ in range(20):
+        w, g, tau, D = rng.uniform(0.5, 6), rng.uniform(0.5, 1.5), rng.uniform(0.02, 0.8), rng.uniform(0, 0.2)
+        ridge = Excitation(w, 0.01, True, g / math.hypot(1, w * tau), -w * D - math.atan(w * tau))
+        for given in ({"tau": rng.uniform(0.01, 1.0)}, {"dead_time": D * rng.uniform(0, 1)},
+                      {"plant_gain": ridge.gain * rng.uniform(1, 3)}):
+            g2, tau2, D2 = ridge_point(ridge, **given)
+            assert g2 / math.hypot(1, w * tau2) == pytest.approx(ridge.gain, rel=1e-12)
+            assert -w * D2 - math.atan(w * tau2) == pytest.approx(ridge.phase, abs=1e-12)
+            assert dict(tau=tau2, dead_time=D2, plant_gain=g2)[next(iter(given))] == pytest.approx(next(iter(given.values())))
+        assert ridge_point(ridge, tau=tau) == pytest.approx((g, tau, D), rel=1e-9, abs=1e-12)
+        assert ridge_point(ridge, plant_gain=0.9 * ridge.gain) is None
+        assert ridge_point(ridge, dead_time=D + math.pi / w) is None
+    with pytest.raises(ValueError, match="exactly one"):
+        ridge_point(ridge, tau=0.1, dead_time=0.1)
 
 
 NARROW_SEEDS = (11, 12, 13, 15, 17, 18, 19, 20, 22, 23)

@@ -75,7 +75,7 @@ from ..io.serialize import json_number
 
 __all__ = ["Estimate", "ControllerTiming", "FitWarning", "FitQuality", "Excitation", "PlantFit", "LogSummary",
            "Identification", "controller_timing", "excitation_windows", "command_spectrum", "lag_response", "fit_plant",
-           "identify", "NARROWBAND", "BAND",
+           "identify", "ridge_point", "NARROWBAND", "BAND",
            "MISSED_FACTOR", "SETTLE", "LEAD", "STALE", "DEAD_TIME_BOUNDS", "TAU_BOUNDS", "BETTER", "RATE_SOURCES"]
 
 MISSED_FACTOR = 1.5
@@ -360,6 +360,53 @@ def command_spectrum(cmd_t: np.ndarray, u: np.ndarray, T: float) -> tuple[float,
     band = (omega >= omega[peak] / BAND) & (omega <= omega[peak] * BAND)
     centre = float(np.sum(omega[band] * power[band]) / np.sum(power[band]))  # the peak refined: the band's centroid
     return centre, float(max(0.0, 1.0 - power[band].sum() / total))
+
+
+def ridge_point(excitation: Excitation, *, tau: float | None = None, dead_time: float | None = None,
+                plant_gain: float | None = None) -> tuple[float, float, float] | None:
+    """The plant (g, τ, D) of a narrowband log's ridge — its gain and phase at ω — that has the one value given.
+
+    Parameters
+    ----------
+    excitation : Excitation
+        What the log determines: ω (rad/s), and the gain (−) and phase (rad) there.
+    tau : float, optional
+        The lag (s), > 0: g = gain·√(1 + ω²τ²), D = (−phase − atan(ωτ))/ω.
+    dead_time : float, optional
+        The dead time (s): atan(ωτ) = −phase − ωD, which must lie in [0, π/2).
+    plant_gain : float, optional
+        The plant gain (−), at least the gain at ω: ωτ = √((g/gain)² − 1).
+
+    Returns
+    -------
+    tuple of float or None
+        (g, τ, D) with the same gain and phase at ω; None when no plant of the ridge has the value given (or ω is
+        undefined).
+
+    Raises
+    ------
+    ValueError
+        Not exactly one of tau, dead_time, plant_gain given.
+    """
+    given = [name for name, v in (("tau", tau), ("dead_time", dead_time), ("plant_gain", plant_gain)) if v is not None]
+    if len(given) != 1:
+        raise ValueError(f"give exactly one of tau, dead_time, plant_gain; got {', '.join(given) or 'none'}")
+    w, gain, phase = excitation.omega, excitation.gain, excitation.phase
+    if not (math.isfinite(w) and w > 0 and gain > 0):
+        return None
+    if tau is None and dead_time is not None:
+        lag = -phase - w * dead_time
+        if not 0.0 <= lag < math.pi / 2:
+            return None
+        tau = math.tan(lag) / w
+    elif tau is None:
+        if not abs(plant_gain) >= gain:
+            return None
+        tau = math.sqrt((plant_gain / gain) ** 2 - 1.0) / w
+    if not tau >= 0:
+        return None
+    g = math.copysign(gain * math.sqrt(1.0 + (w * tau) ** 2), plant_gain if plant_gain is not None else 1.0)
+    return g, tau, (-phase - math.atan(w * tau)) / w
 
 
 def _excitation(cmd_t, u, T: float, g: float, tau: float, delay: float) -> Excitation:
@@ -652,8 +699,8 @@ def fit_plant(cmd_t: np.ndarray, u: np.ndarray, rate: TimeSeries, T: float) -> t
         lag1=float(rho20[0]), outside=outside, white=outside <= 0.2, samples=int(r.size),
         effective_samples=float(r.size / max(bartlett, 1.0)), windows=int(len(windows)),
         excited=float(np.sum(windows[:, 1] - windows[:, 0])), bias=float(b), hac_lags=L)
-    warnings = _checks(s, (g, tau, delay, b), estimates, quality)
     excitation = _excitation(cmd_t, u, T, g, tau, delay)
+    warnings = _checks(s, (g, tau, delay, b), estimates, quality, excitation.narrowband)
     if excitation.narrowband:  # one frequency: the fit is one point of a ridge, its intervals mean nothing
         warnings.insert(0, FitWarning("narrowband", (
             f"the commands excite one frequency (ω ≈ {excitation.omega:.3g} rad/s; {100 * (1 - excitation.outside):.1f} % "
@@ -665,7 +712,7 @@ def fit_plant(cmd_t: np.ndarray, u: np.ndarray, rate: TimeSeries, T: float) -> t
 
 
 # ------------------------------------------------------------------------------------------ what the model misses
-def _checks(s: _Samples, p, estimates, quality: FitQuality) -> list[FitWarning]:
+def _checks(s: _Samples, p, estimates, quality: FitQuality, narrowband: bool = False) -> list[FitWarning]:
     g, tau, delay, b = p
     warnings = []
     if quality.r2 < 0.8:
@@ -674,7 +721,7 @@ def _checks(s: _Samples, p, estimates, quality: FitQuality) -> list[FitWarning]:
     if delay >= DEAD_TIME_BOUNDS[1] - 1e-3:
         warnings.append(FitWarning("dead_time_at_bound", f"the dead time reached the largest searched, {DEAD_TIME_BOUNDS[1]:g} s: "
                                                          "the command and rate topics may not belong together"))
-    if estimates[2].high < 0:
+    if estimates[2].high < 0 and not narrowband:  # on a ridge a negative D is where the fit stopped, not the clocks
         warnings.append(FitWarning("negative_dead_time", f"the rate leads the command by {-1000 * delay:.0f} ms: "
                                                          "their stamps come from different clocks"))
     limit = _rate_limit(s, p)

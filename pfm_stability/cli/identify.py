@@ -9,8 +9,8 @@ odometry's, or the IMU's with ``--rate-source imu``) gives the plant g·e^(−sD
 intervals; the command's stamps give the controller's period T, its jitter and missed cycles
 (`pfm_stability.analysis.identification`). JSON keys (`pfm_stability/io/schema/output.schema.json`):
 ``schema_version``, ``command`` ("identify"), ``identified``, ``reason``, ``plant`` (``g``, ``tau``,
-``dead_time``, each ``{value, low, high}``), ``controller`` (``T``, ``jitter``, ``missed``, …), ``fit``
-(``quality``, ``warnings``), ``log`` (path, format, duration, topics), ``timing``.
+``dead_time``, each ``{value, low, high}``, and ``identifiable``), ``controller`` (``T``, ``jitter``, ``missed``,
+…), ``fit`` (``quality``, ``warnings``, ``excitation``), ``log`` (path, format, duration, topics), ``timing``.
 
 A log that shows nothing to identify (the command never changes, the robot does not move) is an
 answer, not an error: exit 0 with ``identified`` false and the reason (the controller's period is

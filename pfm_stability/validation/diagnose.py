@@ -32,6 +32,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from ..analysis.identification import ridge_point
 from ..analysis.stretches import MIN_DURATION, MIN_SPEED, LateralOffset, Stretch, find_stretches, lateral_offset
 from ..io.logs import LogData, PoseSeries
 from ..io.serialize import json_number
@@ -333,9 +334,17 @@ def complete_from_log(robot: Robot, controller: Controller, sources: dict, ident
                          f"(or {' '.join('--' + name.replace('_', '-') for name in plant)})")
     fit = identification.plant
     estimates = {"tau": (fit.tau, "s"), "dead_time": (fit.dead_time, "s"), "plant_gain": (fit.g, "")} if plant else {}
+    values = {name: estimates[name][0].value for name in plant}
+    if plant and not fit.identifiable:  # stay on the ridge the log determines (docs/diagnose.md, "Identifiability")
+        given = [name for name in ("tau", "dead_time", "plant_gain") if name not in plant]
+        anchor = {given[0]: getattr(robot, given[0])} if len(given) == 1 else \
+            {"dead_time": 0.0} if not given and fit.dead_time.value < 0 else {}
+        point = ridge_point(fit.excitation, **anchor) if anchor else None
+        if point is not None:
+            values.update((name, v) for name, v in zip(("plant_gain", "tau", "dead_time"), point) if name in plant)
     for name in plant:
         estimate, unit = estimates[name]
-        value = max(estimate.value, 0.0) if name == "dead_time" else estimate.value  # a negative D: clocks differ (identify warns)
+        value = max(values[name], 0.0) if name == "dead_time" else values[name]  # a negative D: clocks differ (identify warns)
         robot = robot.replace(**{name: value})
         if fit.identifiable:
             sources[name] = f"identified from {identification.log.path} ({estimate.low:.4g} to {estimate.high:.4g}{' ' + unit if unit else ''})"
