@@ -95,7 +95,7 @@ RATE_SOURCES = ("odometry", "imu")
 NARROWBAND = 0.05
 """The commands are narrowband (g, τ and D not separately identifiable) when less than this fraction of their power
 lies outside [ω/`BAND`, `BAND`·ω] around their dominant angular frequency ω. Measured: the VFF simulator's corridors
-and walls 0.000–0.014, step turns and chirps 0.14–0.93 (docs/diagnose.md, "Identifiability")."""
+and walls 0.0002–0.019 (20 seeds), step turns and chirps 0.14–0.93 (docs/diagnose.md, "Identifiability")."""
 BAND = 1.5
 """The band around the dominant frequency that `NARROWBAND` counts as one frequency (a factor each way)."""
 Z95 = 1.959963984540054
