@@ -19,8 +19,8 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["Plant", "Recording", "SyntheticLog", "simulate", "write_ros2", "write_ros1", "write_csv", "write_log",
-           "random_plant", "bad_log", "BAD_LOGS"]
+__all__ = ["Plant", "Recording", "SyntheticLog", "simulate", "write_ros2", "write_ros1", "write_csv", "write_log", "corridor_log",
+           "random_plant", "bad_log", "BAD_LOGS", "Leg", "LegTruth", "DrivenLog", "drive", "ray_cast", "random_corridor", "corridor_run"]
 
 
 @dataclass(frozen=True)
@@ -69,7 +69,11 @@ class Recording:
 
 @dataclass(frozen=True)
 class SyntheticLog:
-    """The simulated messages (times in s since `recording.start`) and the truth that made them."""
+    """The simulated messages (times in s since `recording.start`) and the truth that made them.
+
+    The odometry's pose (odom_x, odom_y, odom_yaw: m, m, rad) and forward speed odom_vx (m/s) and the scans' ranges
+    (scans × beams, m) when the log was driven (`drive`); else a pose at rest at the origin and random ranges.
+    """
 
     plant: Plant
     recording: Recording
@@ -81,6 +85,11 @@ class SyntheticLog:
     imu_t: np.ndarray = field(default_factory=lambda: np.zeros(0))
     imu_wz: np.ndarray = field(default_factory=lambda: np.zeros(0))
     scan_t: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    odom_x: np.ndarray | None = None
+    odom_y: np.ndarray | None = None
+    odom_yaw: np.ndarray | None = None
+    odom_vx: np.ndarray | None = None
+    scan_ranges: np.ndarray | None = None
 
     @property
     def true_T(self) -> float:
@@ -225,14 +234,14 @@ class _Messages:
     def twist_stamped(self, stamp_ns: int, vx: float, wz: float):
         return self.T["geometry_msgs/msg/TwistStamped"](header=self.header(stamp_ns, "base_link"), twist=self.twist(vx, wz))
 
-    def odometry(self, stamp_ns: int, wz: float):
+    def odometry(self, stamp_ns: int, wz: float, x: float = 0.0, y: float = 0.0, yaw: float = 0.0, vx: float = 0.3):
         T = self.T
-        pose = T["geometry_msgs/msg/Pose"](position=T["geometry_msgs/msg/Point"](x=0.0, y=0.0, z=0.0),
-                                           orientation=T["geometry_msgs/msg/Quaternion"](x=0.0, y=0.0, z=0.0, w=1.0))
+        q = T["geometry_msgs/msg/Quaternion"](x=0.0, y=0.0, z=math.sin(yaw / 2), w=math.cos(yaw / 2))
+        pose = T["geometry_msgs/msg/Pose"](position=T["geometry_msgs/msg/Point"](x=x, y=y, z=0.0), orientation=q)
         return T["nav_msgs/msg/Odometry"](
             header=self.header(stamp_ns, "odom"), child_frame_id="base_link",
             pose=T["geometry_msgs/msg/PoseWithCovariance"](pose=pose, covariance=self.cov36),
-            twist=T["geometry_msgs/msg/TwistWithCovariance"](twist=self.twist(0.3, wz), covariance=self.cov36))
+            twist=T["geometry_msgs/msg/TwistWithCovariance"](twist=self.twist(vx, wz), covariance=self.cov36))
 
     def imu(self, stamp_ns: int, wz: float):
         T = self.T
@@ -267,8 +276,14 @@ def _records(log: SyntheticLog, messages: _Messages, topics: dict, cmd_type: str
     if swap_odom is not None:  # two stamps exchanged: the header stamps go backwards once
         odom_stamps[swap_odom], odom_stamps[swap_odom + 1] = odom_stamps[swap_odom + 1], odom_stamps[swap_odom]
     odom_msgtype = "nav_msgs/msg/Odometry" if odom_type == "Odometry" else "geometry_msgs/msg/Twist"
+    pose = log.odom_x is not None
     for k, (stamp, wz) in enumerate(zip(odom_stamps, log.odom_wz.tolist())):
-        msg = messages.odometry(stamp, wz) if odom_type == "Odometry" else messages.twist(0.3, wz)
+        if odom_type != "Odometry":
+            msg = messages.twist(0.3, wz)
+        elif pose:
+            msg = messages.odometry(stamp, wz, float(log.odom_x[k]), float(log.odom_y[k]), float(log.odom_yaw[k]), float(log.odom_vx[k]))
+        else:
+            msg = messages.odometry(stamp, wz)
         out.append((_ns(log, float(log.odom_t[k])) + 3_000_000, topics["odometry"], odom_msgtype, messages.serialize(msg, odom_msgtype)))
     for t, wz in zip(log.imu_t.tolist(), log.imu_wz.tolist()):
         ns = _ns(log, t)
@@ -276,9 +291,10 @@ def _records(log: SyntheticLog, messages: _Messages, topics: dict, cmd_type: str
     if log.scan_t.size:
         rng = np.random.default_rng(log.recording.seed + 1)
         base = rng.uniform(0.5, 10.0, log.recording.beams)
-        for t in log.scan_t.tolist():
+        for i, t in enumerate(log.scan_t.tolist()):
             ns = _ns(log, t)
-            raw = messages.serialize(messages.scan(ns, base + 0.01 * math.sin(t)), "sensor_msgs/msg/LaserScan")
+            ranges = log.scan_ranges[i] if log.scan_ranges is not None else base + 0.01 * math.sin(t)
+            raw = messages.serialize(messages.scan(ns, ranges), "sensor_msgs/msg/LaserScan")
             out.append((ns + 2_000_000, topics["scan"], "sensor_msgs/msg/LaserScan", raw))
     out.sort(key=lambda r: r[0])
     return out
@@ -414,3 +430,294 @@ def bad_log(kind: str, directory) -> Path:
         return directory / "nowhere.mcap"
     raise ValueError(kind)
 
+
+
+# ------------------------------------------------------------------------------------------- the VFF robot driving
+@dataclass(frozen=True)
+class Leg:
+    """One part of a driven log: the project's VFF simulator in a corridor or beside a wall, or a manoeuvre.
+
+    kind "corridor" (half-width L, m), "wall" (target angle alpha, rad, from the wall normal), "still" (the robot
+    stands), "turn" (it turns in place at `rate` rad/s) or "steps" (step turns up to ±`rate` rad/s at 0.3 m/s in the
+    open, which show the plant to `identify`); a manoeuvre longer than 3 s is told to stop turning for its last 1.5 s
+    (a simulator's leg starts at rest) and starts from the yaw rate the last leg ended with; duration (s); offset (m, the simulator's start offset
+    from the equilibrium line); length (m of wall drawn beyond the leg's end; 0.3 m before its start).
+    """
+
+    kind: str
+    duration: float
+    L: float = 1.0
+    alpha: float = math.radians(45.0)
+    offset: float = 0.05
+    rate: float = 0.6
+    length: float = 3.0
+
+
+@dataclass(frozen=True)
+class DrivenLog:
+    """A VFF robot's log: the messages (`SyntheticLog`, with the odometry's pose and the scans' ranges) and the truth.
+
+    walls: segments ((x0, y0), (x1, y1)) in the odometry frame; truth: one `LegTruth` per leg.
+    """
+
+    log: SyntheticLog
+    walls: tuple
+    truth: tuple
+
+
+@dataclass(frozen=True)
+class LegTruth:
+    """What the simulator did on one leg: kind, its span t_start–t_end (s in the log), the simulator's own
+    `oscillation_metrics` of the lateral offset (None for a manoeuvre), L or d0 (m; None) and V (m/s)."""
+
+    kind: str
+    t_start: float
+    t_end: float
+    metrics: object
+    geometry: float | None
+    V: float
+
+
+def _sim_leg(leg: Leg, robot, controller):
+    """(trajectory, the command computed at every sample, the run, L or d0, the walls (simulator frame)) of one leg."""
+    from pfm_stability.laws.force_law import PowerLaw, wall_equilibrium
+    from pfm_stability.sim.api import simulate as sim_run
+    from pfm_stability.sim.vff import direction_of, steering_command
+
+    options = dict(L=leg.L) if leg.kind == "corridor" else dict(alpha=leg.alpha)
+    run = sim_run(leg.kind, env="analytic", robot=robot, controller=controller, offset=leg.offset, duration=leg.duration,
+                  **options)
+    tr = run.trajectory
+    f, n, W = controller.f, controller.n, robot.W
+    if leg.kind == "corridor":  # walls at X = ±L, target straight ahead (+Y)
+        fx = f * (W / (leg.L + tr.x)) ** n - f * (W / (leg.L - tr.x)) ** n
+        fy = 1.0
+    else:  # wall at X = 0, robot on its −X side, target at alpha from the wall's normal (+X)
+        fx = -f * (W / -tr.x) ** n + math.cos(leg.alpha)
+        fy = math.sin(leg.alpha)
+    value = steering_command(direction_of(fx, fy), tr.theta, robot.k, robot.max_steering_rate)
+    geometry = leg.L if leg.kind == "corridor" else wall_equilibrium(PowerLaw(f, n, W), leg.alpha)
+    walls = ([(-leg.L, -0.3), (-leg.L, tr.y[-1] + leg.length)], [(leg.L, -0.3), (leg.L, tr.y[-1] + leg.length)]) \
+        if leg.kind == "corridor" else ([(0.0, -0.3), (0.0, tr.y[-1] + leg.length)],)
+    return tr, value, run, geometry, walls
+
+
+def _fine(tr, value, robot, controller, dt: float):
+    """(t, x, y, θ, ω) on a grid of step dt: the command computed at t_k reaches the motor at t_k + d·T + D with gain g
+    (u_0 before, as the simulator starts); θ and ω exact between those instants, x and y by the trapezoid rule."""
+    T, tau, g = controller.T, robot.tau, robot.plant_gain
+    switch = np.concatenate([[0.0], tr.t[:-1] + controller.compute_delay * T + robot.dead_time])
+    v = g * np.concatenate([[value[0]], value[:-1]])
+    omega, theta = np.zeros(switch.size), np.full(switch.size, tr.theta[0])
+    for j in range(switch.size - 1):
+        span = switch[j + 1] - switch[j]
+        e = math.exp(-span / tau)
+        omega[j + 1] = v[j] + (omega[j] - v[j]) * e
+        theta[j + 1] = theta[j] + v[j] * span + (omega[j] - v[j]) * tau * (1 - e)
+    t = np.arange(0.0, tr.t[-1], dt)
+    j = np.searchsorted(switch, t, side="right") - 1
+    s = t - switch[j]
+    decay = np.exp(-s / tau)
+    w = v[j] + (omega[j] - v[j]) * decay
+    th = theta[j] + v[j] * s + (omega[j] - v[j]) * tau * (1 - decay)
+    vx, vy = robot.V * np.sin(th), robot.V * np.cos(th)
+    x = tr.x[0] + np.concatenate([[0.0], np.cumsum((vx[1:] + vx[:-1]) * dt / 2)])
+    y = tr.y[0] + np.concatenate([[0.0], np.cumsum((vy[1:] + vy[:-1]) * dt / 2)])
+    return t, x, y, th, w
+
+
+def ray_cast(x: float, y: float, yaw: float, angles: np.ndarray, walls) -> np.ndarray:
+    """Ranges (m, inf for no hit) of beams at `angles` (rad, robot frame) from (x, y, yaw) to the segments `walls`."""
+    c, s = np.cos(yaw + angles), np.sin(yaw + angles)
+    best = np.full(angles.size, np.inf)
+    for (x0, y0), (x1, y1) in walls:
+        ex, ey = x1 - x0, y1 - y0
+        den = c * ey - s * ex
+        with np.errstate(divide="ignore", invalid="ignore"):
+            r = ((x0 - x) * ey - (y0 - y) * ex) / den
+            q = ((x0 - x) * s - (y0 - y) * c) / den
+        hit = (np.abs(den) > 1e-12) & (r > 0) & (q >= 0) & (q <= 1)
+        best = np.where(hit & (r < best), r, best)
+    return best
+
+
+def drive(legs, robot=None, controller=None, *, odom_rate: float = 50.0, scan_rate: float = 10.0, beams: int = 360,
+          range_noise: float = 0.01, pose_noise: float = 0.0005, rate_noise: float = 0.005, drop: float = 0.0,
+          frame_angle: float | None = None, seed: int = 0, start: float = 1_700_000_000.0, dt: float = 0.002) -> DrivenLog:
+    """The log of the project's VFF simulator driving `legs` one after the other (placed end to end in the odometry frame).
+
+    Commands at every controller period T (the held command: what the base is told over the period), odometry at
+    `odom_rate` (pose and yaw rate, with noise), scans of `beams` ranges at `scan_rate` ray-cast against every wall with
+    noise `range_noise`; `drop` is the probability that any odometry, scan or command message is lost. The odometry
+    frame is the simulator's rotated by `frame_angle` (default: a random angle). The robot's plant gain g and dead time D
+    act as in the simulator (the motor sees g·u(t − D)); τ > 0, hold "command" only.
+    """
+    from pfm_stability.parameters import CARMEL
+
+    robot = robot or CARMEL.robot
+    controller = controller or CARMEL.controller
+    if controller.hold != "command" or not robot.tau > 0:
+        raise ValueError("drive() covers hold='command' with tau > 0")
+    rng = np.random.default_rng(seed)
+    phi = rng.uniform(-math.pi, math.pi) if frame_angle is None else frame_angle
+    parts, walls, truth = [], [], []
+    t0, px, py, pyaw = 0.0, 0.0, 0.0, 0.0  # where the next leg starts: time, pose in the odometry frame
+    T = controller.T
+    carried = (0.0, 0.0)
+    for leg in legs:
+        if leg.kind in ("corridor", "wall"):
+            tr, value, run, geometry, leg_walls = _sim_leg(leg, robot, controller)
+            t, x, y, theta, w = _fine(tr, value, robot, controller, dt)
+            # the simulator's frame (X lateral, Y forward, θ from +Y towards +X) → odometry: yaw = π/2 − θ, rotated to start at pyaw
+            rot = pyaw - (math.pi / 2 - tr.theta[0])
+            cr, sr = math.cos(rot), math.sin(rot)
+            ox, oy = px + cr * (x - x[0]) - sr * (y - y[0]), py + sr * (x - x[0]) + cr * (y - y[0])
+            yaw = math.pi / 2 - theta + rot
+            for (ax, ay), (bx, by) in leg_walls:
+                walls.append(tuple((px + cr * (wx - x[0]) - sr * (wy - y[0]), py + sr * (wx - x[0]) + cr * (wy - y[0]))
+                                   for wx, wy in ((ax, ay), (bx, by))))
+            cmd_t = tr.t[:-1] + controller.compute_delay * T  # published when computed: after the compute delay
+            cmd = (cmd_t, -value[:-1], np.full(cmd_t.size, robot.V))  # yaw rate = −dθ/dt
+            vx = np.full(t.size, robot.V)
+            truth.append(LegTruth(leg.kind, t0, t0 + t[-1], run.metrics, geometry, robot.V))
+            wz = -w
+        else:  # a manoeuvre in the open: held yaw-rate commands through the lag, exactly; the position by the trapezoid rule
+            t = np.arange(0.0, leg.duration, dt)
+            cmd_t = np.arange(0.0, leg.duration - T / 2, T)
+            speed = 0.3 if leg.kind == "steps" else 0.0
+            if leg.kind == "steps":  # a step turn of a random size every 1–2.5 s, both ways, with stops between
+                edges = np.cumsum(rng.uniform(1.0, 2.5, int(leg.duration) + 2))
+                levels = np.where(rng.random(edges.size) < 0.3, 0.0, rng.uniform(-leg.rate, leg.rate, edges.size))
+                u = levels[np.searchsorted(edges, cmd_t)]
+            else:
+                u = np.full(cmd_t.size, leg.rate if leg.kind == "turn" else 0.0)
+            if leg.duration > 3.0:  # the last 1.5 s told to stop turning: the next leg (a simulator's) starts at rest
+                u = np.where(cmd_t > leg.duration - 1.5, 0.0, u)
+            switch = np.concatenate([[0.0], cmd_t + robot.dead_time])  # the motor: g·u(t − D), the last leg's input before
+            v = np.concatenate([[carried[1]], robot.plant_gain * u])
+            w_k, yaw_k = np.zeros(switch.size), np.zeros(switch.size)
+            w_k[0] = carried[0]
+            for j in range(switch.size - 1):
+                span = switch[j + 1] - switch[j]
+                e = math.exp(-span / robot.tau)
+                w_k[j + 1] = v[j] + (w_k[j] - v[j]) * e
+                yaw_k[j + 1] = yaw_k[j] + v[j] * span + (w_k[j] - v[j]) * robot.tau * (1 - e)
+            j = np.searchsorted(switch, t, side="right") - 1
+            s_ = t - switch[j]
+            decay = np.exp(-s_ / robot.tau)
+            wz = v[j] + (w_k[j] - v[j]) * decay
+            yaw = pyaw + yaw_k[j] + v[j] * s_ + (w_k[j] - v[j]) * robot.tau * (1 - decay)
+            cmd = (cmd_t, u, np.full(cmd_t.size, speed))
+            cx, cy = speed * np.cos(yaw), speed * np.sin(yaw)
+            ox = px + np.concatenate([[0.0], np.cumsum((cx[1:] + cx[:-1]) * dt / 2)])
+            oy = py + np.concatenate([[0.0], np.cumsum((cy[1:] + cy[:-1]) * dt / 2)])
+            vx = np.full(t.size, speed)
+            truth.append(LegTruth(leg.kind, t0, t0 + t[-1], None, None, speed))
+        parts.append((t0 + t, ox, oy, yaw, wz, vx, t0 + cmd[0], cmd[1], cmd[2]))
+        carried = (float(wz[-1]), robot.plant_gain * float(cmd[1][-1]))  # yaw rate and motor input where the leg ends
+        t0, px, py, pyaw = t0 + t[-1] + dt, float(ox[-1]), float(oy[-1]), float(yaw[-1])
+    ft, fx, fy, fyaw, fwz, fvx = (np.concatenate([p[i] for p in parts]) for i in range(6))
+    cmd_t, cmd_wz, cmd_vx = (np.concatenate([p[i] for p in parts]) for i in (6, 7, 8))
+    # the odometry frame: the whole path rotated by phi about the origin
+    cp, sp = math.cos(phi), math.sin(phi)
+    fx, fy, fyaw = cp * fx - sp * fy, sp * fx + cp * fy, fyaw + phi
+    walls = tuple(tuple((cp * wx - sp * wy, sp * wx + cp * wy) for wx, wy in seg) for seg in walls)
+    duration = float(ft[-1])
+    odom_t = np.arange(rng.uniform(0, 1 / odom_rate), duration, 1 / odom_rate)
+    scan_t = np.arange(rng.uniform(0, 1 / scan_rate), duration, 1 / scan_rate) if scan_rate else np.zeros(0)
+
+    def at(times, values):
+        return np.interp(times, ft, values)
+
+    keep_o = rng.random(odom_t.size) >= drop
+    keep_s = rng.random(scan_t.size) >= drop
+    keep_c = rng.random(cmd_t.size) >= drop
+    keep_c[:2] = True
+    sx, sy, syaw = at(scan_t, fx), at(scan_t, fy), at(scan_t, fyaw)
+    angles = -math.pi + 2 * math.pi * np.arange(beams) / beams
+    ranges = np.empty((scan_t.size, beams), dtype=np.float32)
+    ends = np.array(walls, dtype=float).reshape(-1, 4)
+    for i in range(scan_t.size):
+        # only the walls within 30 m (the range) of the sensor
+        px, py = sx[i], sy[i]
+        ex, ey = ends[:, 2] - ends[:, 0], ends[:, 3] - ends[:, 1]
+        q = np.clip(((px - ends[:, 0]) * ex + (py - ends[:, 1]) * ey) / (ex * ex + ey * ey), 0.0, 1.0)
+        near = np.hypot(ends[:, 0] + q * ex - px, ends[:, 1] + q * ey - py) < 30.0
+        r = ray_cast(px, py, syaw[i], angles, [((a, b), (c, d)) for a, b, c, d in ends[near]])
+        ranges[i] = np.where(np.isfinite(r) & (r < 30.0), r + rng.normal(0.0, range_noise, beams), np.inf)
+    odom_t, scan_t, ranges = odom_t[keep_o], scan_t[keep_s], ranges[keep_s]
+    ox = at(odom_t, fx) + rng.normal(0, pose_noise, odom_t.size)
+    oy = at(odom_t, fy) + rng.normal(0, pose_noise, odom_t.size)
+    oyaw = np.angle(np.exp(1j * (at(odom_t, fyaw) + rng.normal(0, pose_noise, odom_t.size))))
+    owz = at(odom_t, fwz) + rng.normal(0, rate_noise, odom_t.size)
+    recording = Recording(T=T, jitter=0.0, drop=drop, profile="vff", duration=duration, odom_rate=odom_rate,
+                          odom_noise=rate_noise, scan_rate=scan_rate, beams=beams, start=start, seed=seed)
+    log = SyntheticLog(Plant(g=robot.plant_gain, tau=robot.tau, dead_time=robot.dead_time), recording, cmd_t[keep_c], cmd_wz[keep_c], cmd_vx[keep_c],
+                       odom_t, owz, scan_t=scan_t, odom_x=ox, odom_y=oy, odom_yaw=oyaw, odom_vx=at(odom_t, fvx), scan_ranges=ranges)
+    return DrivenLog(log, walls, tuple(truth))
+
+
+def random_corridor(rng: np.random.Generator, *, away: float = 0.05, kind: str = "corridor"):
+    """(robot, controller, geometry, sampled margin) of a random corridor (or wall) whose ``sampled`` verdict is at least
+    `away` from the boundary.
+
+    V 0.3–1.2 m/s, τ 0.1–0.5 s, k 1–4 1/s, W 0.5–0.8 m, dead time D 0–0.1 s, plant gain g 0.7–1.2, f 0.5–1.5, n 2,
+    T 0.02–0.1 s, compute delay 0 or 1 (the command held); a corridor's L from W/2 + 0.2 to W/2 + 0.7 m, a wall's α 20–70° (geometry: L in m, α in rad). Drawn
+    again until |margin| > `away` and the predicted growth keeps the robot off the walls for 8 periods
+    (σ·8·2π/ω < 2.5) and makes at least 6 swings before it decays by e³.
+    """
+    from pfm_stability.parameters import Controller, Robot
+    from pfm_stability.report.stability import build_report
+
+    while True:
+        robot = Robot(V=rng.uniform(0.3, 1.2), tau=rng.uniform(0.1, 0.5), k=rng.uniform(1.0, 4.0), W=rng.uniform(0.5, 0.8),
+                      dead_time=rng.uniform(0.0, 0.1), plant_gain=rng.uniform(0.7, 1.2))
+        controller = Controller(f=rng.uniform(0.5, 1.5), n=2.0, T=rng.uniform(0.02, 0.1), hold="command",
+                                compute_delay=int(rng.integers(0, 2)))
+        if kind == "corridor":
+            geometry = robot.W / 2 + rng.uniform(0.2, 0.7)
+            report = build_report(robot, controller, L=geometry, models=("sampled",))
+            verdict = report.corridor.models["sampled"]
+        else:
+            geometry = math.radians(rng.uniform(20.0, 70.0))
+            report = build_report(robot, controller, alpha=geometry, models=("sampled",))
+            verdict = report.wall.models["sampled"]
+            if report.wall.d0 <= robot.W / 2 + 0.1:  # the robot would start touching the wall
+                continue
+        root = verdict.rightmost_root
+        if root is None or abs(verdict.margin) <= away or root.imag <= 0.2:
+            continue
+        period = 2 * math.pi / root.imag
+        if root.real * 8 * period < 2.5 and -root.real * 6 * period < 3.0:
+            return robot, controller, geometry, float(verdict.margin), root
+
+
+def corridor_run(seed: int, directory, *, duration: float | None = None, kind: str = "corridor"):
+    """A random corridor or wall (`random_corridor`, from `seed`) driven and written as an MCAP bag under `directory`.
+
+    Returns (path, robot, controller, geometry, margin, truth): L (m) or α (rad), and the simulator's own metrics of the
+    leg in `truth`.
+    """
+    log, robot, controller, geometry, margin = corridor_log(seed, duration=duration, kind=kind)
+    path = write_ros2(log.log, Path(directory) / f"{kind}_{seed}", storage="mcap")
+    return path, robot, controller, geometry, margin, log.truth[0]
+
+
+def corridor_log(seed: int, *, duration: float | None = None, kind: str = "corridor", scans: bool = True):
+    """The `DrivenLog` of `corridor_run` (a random corridor or wall from `seed`, 10 periods, 20–60 s, 2 % dropped), not
+    written; without scans when `scans` is false (what `identify` reads, 20× faster to make).
+
+    Returns (log, robot, controller, geometry, margin). The commands are stamped when published, d·T after the sample
+    they were computed from (d the controller's compute delay), and the motor sees g·u(t − D) from that stamp on: the
+    dead time D the log shows is the robot's own (docs/diagnose.md, "Time").
+    """
+    rng = np.random.default_rng(seed)
+    robot, controller, geometry, margin, root = random_corridor(rng, kind=kind)
+    period = 2 * math.pi / root.imag
+    length = duration or float(np.clip(10 * period, 20.0, 60.0))
+    if kind == "corridor":
+        leg = Leg("corridor", length, L=geometry, offset=min(0.08, 0.5 * (geometry - robot.W / 2)))
+    else:
+        leg = Leg("wall", length, alpha=geometry, offset=0.08)
+    log = drive([leg], robot, controller, seed=seed, drop=0.02, scan_rate=10.0 if scans else 0.0)
+    return log, robot, controller, geometry, margin

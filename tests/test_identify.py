@@ -4,7 +4,9 @@ with a known truth (`log_helpers`: a simulated robot, its bags written by rosbag
 Tolerances are the brief's: over a seeded set of random plants (g 0.5–1.2, τ 0.05–0.8 s, D 0–0.2 s, T 0.02–0.2 s with
 jitter, dropped commands and sensor noise; step turns or chirps, 90 s) τ within 10 %, D within one odometry period
 (20 ms), g within 5 % and T within 1 %; the 95 % intervals hold the truth in most cases (measured: 69 of the 72
-intervals of `SEED`'s 24 plants, 96 %; asserted ≥ 85 %). The exactness of the response is checked against the helpers'
+intervals of `SEED`'s 24 plants, 96 %; asserted ≥ 90 %). On the VFF simulator's corridors and walls (one frequency
+excited) the fit is flagged ``narrowband`` with null intervals, and the plant's gain and phase at that frequency —
+what such a log does determine — are the truth's. The exactness of the response is checked against the helpers'
 independent event loop to 1e-9 rad/s (round-off of a few hundred exponential updates).
 """
 
@@ -20,9 +22,11 @@ import pytest
 import yaml
 from jsonschema import Draft202012Validator
 
-from log_helpers import BAD_LOGS, Plant, Recording, bad_log, random_plant, simulate, write_log, write_ros2
+from log_helpers import (BAD_LOGS, Leg, Plant, Recording, bad_log, corridor_log, drive, random_corridor, random_plant,
+                         simulate, write_log, write_ros2)
 from pfm_stability.analysis.identification import (
-    _affine_scan, controller_timing, excitation_windows, identify, lag_response)
+    BAND, NARROWBAND, Excitation, _affine_scan, command_spectrum, controller_timing, excitation_windows, identify, lag_response,
+    ridge_point)
 from pfm_stability.cli import main
 from pfm_stability.io.logs import read_log
 from pfm_stability.io.schema import load_schema
@@ -118,11 +122,107 @@ def test_random_plants_are_identified_within_the_tolerances(random_plants):
 
 
 def test_random_plants_intervals_hold_the_truth_in_most_cases(random_plants):
-    """95 % intervals: 69 of 72 hold the truth at SEED (96 %); ≥ 85 % asserted (binomial spread of 72 draws at 0.95)."""
+    """95 % intervals: 69 of 72 hold the truth at SEED (96 %); ≥ 90 % asserted (72 draws at 0.95: 3.6 misses expected,
+    standard deviation 1.8; 90 % allows 7). Steps and chirps are never narrowband (their spectra are broad)."""
+    assert all(r.plant.identifiable and r.plant.excitation.outside > 2 * NARROWBAND for _, _, r in random_plants)
     held = [p.g.low <= plant.g <= p.g.high for plant, _, r in random_plants for p in [r.plant]]
     held += [p.tau.low <= plant.tau <= p.tau.high for plant, _, r in random_plants for p in [r.plant]]
     held += [p.dead_time.low <= plant.dead_time <= p.dead_time.high for plant, _, r in random_plants for p in [r.plant]]
-    assert np.mean(held) >= 0.85, np.mean(held)
+    assert np.mean(held) >= 0.90, np.mean(held)
+
+
+# ------------------------------------------------------------------------------ identifiability
+def test_command_spectrum_is_the_closed_form_of_tones():
+    """A held sine has all its power at its frequency (outside ≈ 0, the Hann window's leakage stays within the band);
+    two equal tones a factor 3 apart (outside the band of either) split it in halves: outside = 1/2 to 2 % (leakage).
+    ω is the tone's to within one FFT bin (2π/span = 0.05 rad/s here)."""
+    T = 0.05
+    t = np.arange(0.0, 120.0, T)
+    omega, outside = command_spectrum(t, 0.4 * np.sin(2.3 * t) + 0.1, T)
+    assert omega == pytest.approx(2.3, abs=2 * math.pi / 120) and outside < 0.01
+    omega, outside = command_spectrum(t, np.sin(1.1 * t) + np.sin(3.3 * t), T)
+    assert outside == pytest.approx(0.5, abs=0.02)
+    assert math.isnan(command_spectrum(t, np.full(t.size, 0.3), T)[0])
+
+
+def test_ridge_point_keeps_the_gain_and_phase_at_omega():
+    """From each single value the two others follow the closed forms: the returned plant's g/√(1 + ω²τ²) and
+    −ωD − atan(ωτ) are the ridge's to round-off (1e-12), and the value given is kept; a value no plant of the ridge
+    has (a gain below the gain at ω, a dead time beyond the phase) gives None; not exactly one value is a ValueError."""
+    rng = np.random.default_rng(5)
+    for _ in range(20):
+        w, g, tau, D = rng.uniform(0.5, 6), rng.uniform(0.5, 1.5), rng.uniform(0.02, 0.8), rng.uniform(0, 0.2)
+        ridge = Excitation(w, 0.01, True, g / math.hypot(1, w * tau), -w * D - math.atan(w * tau))
+        for given in ({"tau": rng.uniform(0.01, 1.0)}, {"dead_time": D * rng.uniform(0, 1)},
+                      {"plant_gain": ridge.gain * rng.uniform(1, 3)}):
+            g2, tau2, D2 = ridge_point(ridge, **given)
+            assert g2 / math.hypot(1, w * tau2) == pytest.approx(ridge.gain, rel=1e-12)
+            assert -w * D2 - math.atan(w * tau2) == pytest.approx(ridge.phase, abs=1e-12)
+            assert dict(tau=tau2, dead_time=D2, plant_gain=g2)[next(iter(given))] == pytest.approx(next(iter(given.values())))
+        assert ridge_point(ridge, tau=tau) == pytest.approx((g, tau, D), rel=1e-9, abs=1e-12)
+        assert ridge_point(ridge, plant_gain=0.9 * ridge.gain) is None
+        assert ridge_point(ridge, dead_time=D + math.pi / w) is None
+    with pytest.raises(ValueError, match="exactly one"):
+        ridge_point(ridge, tau=0.1, dead_time=0.1)
+
+
+NARROW_SEEDS = (11, 12, 13, 15, 17, 18, 19, 20, 22, 23)
+"""Corridors (odd) and walls (even) whose random draw `random_corridor` accepts quickly (its rejection loop costs up to
+15 s on some seeds); every seed from 10 to 23 was checked the same way when this was written."""
+
+
+@pytest.mark.slow
+def test_corridor_and_wall_logs_are_narrowband_and_their_gain_and_phase_are_the_truths(tmp_path):
+    """The VFF simulator's own corridors and walls (10 seeds, 20 s, compute delay 0 or 1, D 0–0.1 s, g 0.7–1.2):
+    the commands excite one frequency (outside < 0.02 measured; `NARROWBAND` 0.05), so g, τ, D get null intervals and
+    the ``narrowband`` warning, and ``--out`` refuses to write them. What the log does determine, the plant's gain
+    g/√(1 + ω²τ²) and phase −ωD − atan(ωτ) at that ω, is the truth's (closed form of the true plant): gain within 3 %,
+    phase within 0.03 rad (3× the largest seen, 0.6 % and 0.011 rad: harmonics and the 2 % dropped commands, which
+    the simulated motor saw and the log does not hold). The dead time is the robot's own: the commands are stamped when
+    published, after the compute delay (docs/diagnose.md, "Time"), so the phase would miss by ω·d·T ≥ 0.06 rad if
+    the compute delay were counted in D."""
+    for seed in NARROW_SEEDS:
+        log, robot, controller, _, _ = corridor_log(seed, kind=("corridor", "wall")[seed % 2 == 0], scans=False,
+                                                   duration=20.0)
+        (tmp_path / str(seed)).mkdir()
+        path = write_log(log.log, tmp_path / str(seed), "csv")
+        result = identify(read_log(path, need=("command", "odometry")))
+        p = result.plant
+        assert result.identified and not p.identifiable, seed
+        assert p.warnings[0].kind == "narrowband" and "record step turns" in p.warnings[0].message
+        assert all(math.isnan(e.low) and math.isnan(e.high) for e in (p.g, p.tau, p.dead_time))
+        w = p.excitation.omega
+        assert p.excitation.gain == pytest.approx(robot.plant_gain / math.hypot(1, w * robot.tau), rel=0.03), seed
+        assert p.excitation.phase == pytest.approx(-w * robot.dead_time - math.atan(w * robot.tau), abs=0.03), seed
+    code, out, err = run(["identify", str(path), "--out", str(tmp_path / "robot.yaml"), "--format", "json"])
+    assert code == 2 and "not separately identifiable" in err and not (tmp_path / "robot.yaml").exists()
+    assert err.count("\n") == 1 and "Traceback" not in err
+
+
+def test_narrowband_json_validates_and_step_turns_make_it_identifiable(tmp_path):
+    """The JSON of a narrowband log validates (null intervals, ``plant.identifiable`` false, ``fit.excitation``), and
+    the same robot with 25 s of step turns after its corridor is identified with intervals holding the truth, D the
+    robot's own (within one odometry period, 20 ms; the compute delay, one period of 61 ms, is not in it): the
+    commands are stamped when published (docs/diagnose.md, "Time")."""
+    log, robot, controller, geometry, _ = corridor_log(11, scans=False, duration=20.0)
+    assert controller.compute_delay == 1
+    (tmp_path / "narrow").mkdir()
+    path = write_log(log.log, tmp_path / "narrow", "csv")
+    code, out, err = run(["identify", str(path), "--format", "json"])
+    data = json.loads(out)
+    assert code == 0
+    assert list(VALIDATOR.iter_errors(data)) == []
+    assert data["plant"]["identifiable"] is False and data["plant"]["tau"]["low"] is None
+    assert data["fit"]["excitation"]["narrowband"] is True
+    both = drive((Leg("corridor", 20.0, L=geometry), Leg("steps", 25.0, rate=0.8)), robot, controller, seed=11,
+                 scan_rate=0.0)
+    (tmp_path / "steps").mkdir()
+    path = write_log(both.log, tmp_path / "steps", "csv")
+    p = identify(read_log(path, need=("command", "odometry"))).plant
+    assert p.identifiable and p.warnings == ()
+    assert abs(p.dead_time.value - robot.dead_time) <= 0.02
+    for estimate, truth in ((p.g, robot.plant_gain), (p.tau, robot.tau), (p.dead_time, robot.dead_time)):
+        assert estimate.low <= truth <= estimate.high
 
 
 def test_profiles_turn_in_place_and_imu(tmp_path):

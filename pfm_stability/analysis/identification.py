@@ -35,6 +35,19 @@ odometry) it widens by the right amount for each parameter, where an effective s
 widen every parameter alike. L is the larger of Newey and West's 4·(n/100)^(2/9) and three times the
 lag at which the residuals' autocorrelation falls below 0.1.
 
+Can the log separate g, τ and D?
+--------------------------------
+A robot oscillating in a corridor commands essentially one frequency ω. The log then fixes the plant's gain
+|G(jω)| = g/√(1 + ω²τ²) and phase −ωD − atan(ωτ) at ω — two numbers for three unknowns: every (g, τ, D) on that
+ridge explains the log as well, up to harmonics and the held commands' staircase, whose small ripple (one local
+minimum of the residual per controller period along D) picks a point on the ridge by luck, and the covariance of
+that point is then small and wrong. `command_spectrum` measures the excitation before any fit: the held command on
+a grid of T, its mean removed, its periodogram (Hann window); ω the peak (DC excluded) and `outside` the fraction
+of the power outside [ω/`BAND`, `BAND`·ω]. Below `NARROWBAND` the fit is kept (it explains the log, and its
+gain and phase at ω are what the log determines) but its intervals are null and the `narrowband` warning says why
+(docs/diagnose.md, "Identifiability"). The criterion reads the commands only, not the noise or the fit, so it does
+not depend on where the optimizer stopped on the ridge.
+
 Does the model explain the data?
 --------------------------------
 `FitQuality` gives the normalized error (NRMSE = rms(r)/std(y)), R² and the residuals' whiteness, and
@@ -59,9 +72,11 @@ import numpy as np
 
 from ..io.logs import LogData, TimeSeries
 from ..io.serialize import json_number
+from .excitation import BAND, NARROWBAND, Excitation, command_spectrum, excitation_of, ridge_point
 
-__all__ = ["Estimate", "ControllerTiming", "FitWarning", "FitQuality", "PlantFit", "LogSummary", "Identification",
-           "controller_timing", "excitation_windows", "lag_response", "fit_plant", "identify",
+__all__ = ["Estimate", "ControllerTiming", "FitWarning", "FitQuality", "Excitation", "PlantFit", "LogSummary",
+           "Identification", "controller_timing", "excitation_windows", "command_spectrum", "lag_response", "fit_plant",
+           "identify", "ridge_point", "NARROWBAND", "BAND",
            "MISSED_FACTOR", "SETTLE", "LEAD", "STALE", "DEAD_TIME_BOUNDS", "TAU_BOUNDS", "BETTER", "RATE_SOURCES"]
 
 MISSED_FACTOR = 1.5
@@ -87,14 +102,15 @@ many samples (speed: the final fit uses every sample)."""
 # ------------------------------------------------------------------------------------------ results
 @dataclass(frozen=True)
 class Estimate:
-    """A parameter and its 95 % interval [low, high] (the parameter's unit).
+    """A parameter and its 95 % interval [low, high] (the parameter's unit); low and high are NaN (null in JSON) when
+    the log cannot determine the parameter (`Excitation.narrowband`).
 
     Attributes
     ----------
     value : float
-        The estimate (the parameter's unit).
+        The estimate, in the parameter's unit.
     low, high : float
-        Its 95 % interval (the parameter's unit).
+        The 95 % interval's ends, same unit; NaN when not identifiable.
     """
 
     value: float
@@ -143,12 +159,13 @@ class ControllerTiming:
 
 @dataclass(frozen=True)
 class FitWarning:
-    """Something the model does not explain: its `kind` and a one-line `message`.
+    """Something the model does not explain, or a log that cannot determine it.
 
     Attributes
     ----------
     kind : str
-        ``rate_limit``, ``deadband``, ``second_order``, ``poor_fit``, ``dead_time_at_bound`` or ``negative_dead_time``.
+        ``rate_limit``, ``deadband``, ``second_order``, ``poor_fit``, ``dead_time_at_bound``, ``negative_dead_time``
+        or ``narrowband``.
     message : str
         One line for the user.
     """
@@ -213,21 +230,23 @@ class FitQuality:
 
 @dataclass(frozen=True)
 class PlantFit:
-    """The fitted plant g·e^(−sD)/(τs + 1), each parameter with its 95 % interval; the fit's quality and what the
-    model does not explain.
+    """The fitted plant g·e^(−sD)/(τs + 1).
 
-    Attributes
+    Parameters
     ----------
     g : Estimate
-        Plant gain, dimensionless.
+        The plant gain (−) and its 95 % interval.
     tau : Estimate
-        Time constant, s.
+        The lag (s) and its 95 % interval.
     dead_time : Estimate
-        Dead time D, s.
+        The dead time D (s) from the command's publication (docs/diagnose.md, "Time") and its 95 % interval.
     quality : FitQuality
         How well the model explains the samples.
     warnings : tuple of FitWarning
-        What the model does not explain.
+        What the model does not explain, and ``narrowband``.
+    excitation : Excitation or None
+        How the commands excite the plant; when narrowband the values are one point of the ridge the log cannot
+        resolve and the intervals are NaN.
     """
 
     g: Estimate
@@ -235,6 +254,12 @@ class PlantFit:
     dead_time: Estimate
     quality: FitQuality
     warnings: tuple[FitWarning, ...]
+    excitation: Excitation | None = None
+
+    @property
+    def identifiable(self) -> bool:
+        """Whether g, τ and D are separately determined by the log (not `Excitation.narrowband`)."""
+        return self.excitation is None or not self.excitation.narrowband
 
 
 @dataclass(frozen=True)
@@ -303,10 +328,12 @@ class Identification:
             "identified": self.identified,
             "reason": self.reason,
             "plant": None if plant is None else {"g": plant.g.to_dict(), "tau": plant.tau.to_dict(),
-                                                 "dead_time": plant.dead_time.to_dict()},
+                                                 "dead_time": plant.dead_time.to_dict(),
+                                                 "identifiable": plant.identifiable},
             "controller": self.controller.to_dict(),
             "fit": {"quality": None if plant is None else plant.quality.to_dict(),
-                    "warnings": [] if plant is None else [w.to_dict() for w in plant.warnings]},
+                    "warnings": [] if plant is None else [w.to_dict() for w in plant.warnings],
+                    "excitation": None if plant is None or plant.excitation is None else plant.excitation.to_dict()},
             "log": self.log.to_dict(),
         }
 
@@ -342,6 +369,7 @@ def controller_timing(t: np.ndarray) -> ControllerTiming:
                             (t.size - 1) / span, 1.0 / T)
 
 
+# ------------------------------------------------------------------------------------------ the excitation
 # ------------------------------------------------------------------------------------------ the exact response
 def _affine_scan(a: np.ndarray, b: np.ndarray, x0: float) -> np.ndarray:
     """X with X_0 = x0 and X_(k+1) = a_k·X_k + b_k (length len(a) + 1), by doubling: log₂ n vector passes."""
@@ -625,12 +653,20 @@ def fit_plant(cmd_t: np.ndarray, u: np.ndarray, rate: TimeSeries, T: float) -> t
         lag1=float(rho20[0]), outside=outside, white=outside <= 0.2, samples=int(r.size),
         effective_samples=float(r.size / max(bartlett, 1.0)), windows=int(len(windows)),
         excited=float(np.sum(windows[:, 1] - windows[:, 0])), bias=float(b), hac_lags=L)
-    warnings = _checks(s, (g, tau, delay, b), estimates, quality)
-    return PlantFit(estimates[0], estimates[1], estimates[2], quality, tuple(warnings)), None
+    excitation = excitation_of(cmd_t, u, T, g, tau, delay)
+    warnings = _checks(s, (g, tau, delay, b), estimates, quality, excitation.narrowband)
+    if excitation.narrowband:  # one frequency: the fit is one point of a ridge, its intervals mean nothing
+        warnings.insert(0, FitWarning("narrowband", (
+            f"the commands excite one frequency (ω ≈ {excitation.omega:.3g} rad/s; {100 * (1 - excitation.outside):.1f} % "
+            f"of their power within a factor {BAND:g} of it): g, τ and D are not separately identifiable, only the plant's "
+            f"gain {excitation.gain:.3g} and phase {math.degrees(excitation.phase):.0f}° there; record step turns "
+            "(docs/diagnose.md)")))
+        estimates = [Estimate(e.value, math.nan, math.nan) for e in estimates]
+    return PlantFit(estimates[0], estimates[1], estimates[2], quality, tuple(warnings), excitation), None
 
 
 # ------------------------------------------------------------------------------------------ what the model misses
-def _checks(s: _Samples, p, estimates, quality: FitQuality) -> list[FitWarning]:
+def _checks(s: _Samples, p, estimates, quality: FitQuality, narrowband: bool = False) -> list[FitWarning]:
     g, tau, delay, b = p
     warnings = []
     if quality.r2 < 0.8:
@@ -639,7 +675,7 @@ def _checks(s: _Samples, p, estimates, quality: FitQuality) -> list[FitWarning]:
     if delay >= DEAD_TIME_BOUNDS[1] - 1e-3:
         warnings.append(FitWarning("dead_time_at_bound", f"the dead time reached the largest searched, {DEAD_TIME_BOUNDS[1]:g} s: "
                                                          "the command and rate topics may not belong together"))
-    if estimates[2].high < 0:
+    if estimates[2].high < 0 and not narrowband:  # on a ridge a negative D is where the fit stopped, not the clocks
         warnings.append(FitWarning("negative_dead_time", f"the rate leads the command by {-1000 * delay:.0f} ms: "
                                                          "their stamps come from different clocks"))
     limit = _rate_limit(s, p)

@@ -28,7 +28,7 @@ from ..extras import MissingExtra
 
 __all__ = ["main", "build_parser", "UsageError", "unknown_options"]
 
-SUBCOMMANDS = ("report", "derive", "simulate", "validate", "plot", "traps", "map", "sweep", "identify")
+SUBCOMMANDS = ("report", "derive", "simulate", "validate", "plot", "traps", "map", "sweep", "identify", "diagnose")
 
 
 class UsageError(Exception):

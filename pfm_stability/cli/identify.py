@@ -9,18 +9,22 @@ odometry's, or the IMU's with ``--rate-source imu``) gives the plant g·e^(−sD
 intervals; the command's stamps give the controller's period T, its jitter and missed cycles
 (`pfm_stability.analysis.identification`). JSON keys (`pfm_stability/io/schema/output.schema.json`):
 ``schema_version``, ``command`` ("identify"), ``identified``, ``reason``, ``plant`` (``g``, ``tau``,
-``dead_time``, each ``{value, low, high}``), ``controller`` (``T``, ``jitter``, ``missed``, …), ``fit``
-(``quality``, ``warnings``), ``log`` (path, format, duration, topics), ``timing``.
+``dead_time``, each ``{value, low, high}``, and ``identifiable``), ``controller`` (``T``, ``jitter``, ``missed``,
+…), ``fit`` (``quality``, ``warnings``, ``excitation``), ``log`` (path, format, duration, topics), ``timing``.
 
 A log that shows nothing to identify (the command never changes, the robot does not move) is an
 answer, not an error: exit 0 with ``identified`` false and the reason (the controller's period is
-still measured). ``--out`` then fails (exit 2, nothing written): there is no plant to write. A bad log
+still measured). ``--out`` then fails (exit 2, nothing written): there is no plant to write. So it does
+when the commands excite one frequency (the ``narrowband`` warning, ``plant.identifiable`` false, null
+intervals): the values are then one point of a ridge of equally good plants, and a configuration file would
+look certain where the log is not (docs/diagnose.md, "Identifiability"). A bad log
 is one line, exit 2. Reading a bag needs the extra ``logs`` (rosbags).
 """
 
 from __future__ import annotations
 
 import argparse
+import math
 import os
 import re
 import time
@@ -103,6 +107,10 @@ def run(args) -> int:
     if args.out:
         if not result.identified:
             raise ValueError(f"nothing identified from {args.log}: {result.reason}; {args.out} not written")
+        if not result.plant.identifiable:
+            x = result.plant.excitation
+            raise ValueError(f"g, tau and D are not separately identifiable from {args.log}: its commands excite one "
+                             f"frequency (omega ~ {x.omega:.3g} rad/s); record step turns; {args.out} not written")
         from ..io.files import write_text
 
         write_text(args.out, robot_yaml(result), what="configuration")
@@ -135,9 +143,21 @@ def _lines(result) -> dict:
 
 def _plant_rows(plant) -> list[tuple[str, str, str]]:
     g, tau, D = plant.g, plant.tau, plant.dead_time
+    if not plant.identifiable:  # one point of the ridge: no interval means anything
+        return [(name, value, "not identifiable") for name, value in
+                (("g (plant gain)", f"{g.value:.4g}"), ("τ (lag)", f"{tau.value:.4g} s"), ("D (dead time)", _ms(D.value)))]
     return [("g (plant gain)", f"{g.value:.4g}", f"{g.low:.4g} to {g.high:.4g}"),
             ("τ (lag)", f"{tau.value:.4g} s", f"{tau.low:.4g} to {tau.high:.4g} s"),
             ("D (dead time)", _ms(D.value), f"{_ms(D.low)} to {_ms(D.high)}")]
+
+
+def _ridge(plant) -> list[str]:
+    """What a narrowband log does determine: the plant's gain and phase at the commands' frequency."""
+    x = plant.excitation
+    if plant.identifiable:
+        return []
+    return [f"the log determines the plant at ω ≈ {x.omega:.3g} rad/s only: gain {x.gain:.3g}, phase "
+            f"{math.degrees(x.phase):.1f}° (any g, τ, D with these explains it as well)"]
 
 
 def _quality(q) -> str:
@@ -163,6 +183,7 @@ def render_text(result) -> str:
     plant = result.plant
     out.append("plant g·e^(−sD)/(τs + 1), 95 % intervals")
     out += [f"  {name:15s} {value:>10s}   [{interval}]" for name, value, interval in _plant_rows(plant)]
+    out += [f"  {line}" for line in _ridge(plant)]
     out += ["", f"fit: {_quality(plant.quality)}"]
     out += [f"warning ({w.kind}): {w.message}" for w in plant.warnings] or ["warnings: none"]
     return "\n".join(out + [""])
@@ -184,6 +205,7 @@ def render_markdown(result) -> str:
     plant = result.plant
     out += ["| plant g·e^(−sD)/(τs + 1) | value | 95 % interval |", "| --- | --- | --- |"]
     out += [f"| {name} | {value} | {interval} |" for name, value, interval in _plant_rows(plant)]
+    out += [f"\n{line[0].upper()}{line[1:]}." for line in _ridge(plant)]
     out += ["", f"Fit: {_quality(plant.quality)}.", ""]
     out += [f"- **{w.kind}**: {w.message}" for w in plant.warnings] or ["No warnings: the model explains the data."]
     return "\n".join(out + [""])

@@ -10,7 +10,13 @@ command       ``geometry_msgs/msg/Twist``                   ``angular.z`` (rad/s
 odometry      ``nav_msgs/msg/Odometry``                     ``twist.twist.angular.z`` the header stamp
 imu           ``sensor_msgs/msg/Imu``                       ``angular_velocity.z``  the header stamp
 scan          ``sensor_msgs/msg/LaserScan``                 a caller's reduction    the header stamp
+pose          ``nav_msgs/msg/Odometry`` (the odometry topic) x, y, yaw, linear.x    the header stamp
 ============= ============================================= ======================= ===================
+
+The pose (`PoseSeries`: position x, y in m, the yaw in rad from the orientation's quaternion, the forward speed
+``twist.twist.linear.x`` in m/s) is in the odometry's frame; `pose_at` interpolates it at other times (a scan's),
+which is how a scan's sensor-frame reduction is placed in the odometry frame (the laser is taken to sit at the base's
+origin, looking forward: a bag without ``/tf_static`` says nothing else).
 
 Times are seconds since the log's first message (`LogData.start`, epoch seconds, says when that was).
 A log is a ROS 2 bag (its directory, or one ``.db3``/``.mcap`` file of it), a ROS 1 ``.bag`` or a CSV
@@ -20,7 +26,7 @@ one-hour bag of 360-beam scans at 10 Hz is 13 million ranges: they are never hel
 
 The yaw rate is taken from the raw message bytes at its place in the layout (`_FIELDS`: the header's
 strings are the only variable-length part before it), which is 20× faster than deserializing every
-message; a scan is deserialized by `rosbags`.
+message; so are a scan's numbers and its ranges (a view of the bytes, no copy).
 
 Bad logs
 --------
@@ -46,10 +52,10 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["LogTopics", "TimeSeries", "Scan", "ScanSeries", "LogData", "LogError", "read_log", "log_format",
-           "SERIES", "MESSAGE_TYPES", "CSV_COLUMNS"]
+__all__ = ["LogTopics", "TimeSeries", "Scan", "ScanSeries", "PoseSeries", "LogData", "LogError", "read_log", "log_format",
+           "pose_at", "SERIES", "MESSAGE_TYPES", "CSV_COLUMNS"]
 
-SERIES = ("command", "odometry", "imu", "scan")
+SERIES = ("command", "odometry", "imu", "scan", "pose")
 """The series a log can give (`LogData`'s fields of the same names)."""
 
 MESSAGE_TYPES = {
@@ -57,6 +63,7 @@ MESSAGE_TYPES = {
     "odometry": ("nav_msgs/msg/Odometry",),
     "imu": ("sensor_msgs/msg/Imu",),
     "scan": ("sensor_msgs/msg/LaserScan",),
+    "pose": ("nav_msgs/msg/Odometry",),
 }
 """Series → the message types accepted on its topic."""
 
@@ -70,12 +77,12 @@ class LogError(ValueError):
 
 @dataclass(frozen=True)
 class LogTopics:
-    """The topic of each series (defaults: ``/cmd_vel``, ``/odom``, ``/imu``, ``/scan``).
+    """The topic of each series.
 
     Attributes
     ----------
     command, odometry, imu, scan : str
-        The topic of each series.
+        The topics (defaults: ``/cmd_vel``, ``/odom``, ``/imu``, ``/scan``); the pose is the odometry's.
     """
 
     command: str = "/cmd_vel"
@@ -84,35 +91,31 @@ class LogTopics:
     scan: str = "/scan"
 
     def of(self, series: str) -> str:
-        """The topic of `series` (one of `SERIES`).
+        """The topic of `series` (the pose is the odometry topic's).
 
         Parameters
         ----------
         series : str
             One of `SERIES`.
         """
-        return getattr(self, series)
+        return self.odometry if series == "pose" else getattr(self, series)
 
 
 @dataclass(frozen=True)
 class TimeSeries:
-    """One topic's values: `t` (s since the log's start, non-decreasing) and `value` (rad/s), one per message.
-
-    `stamps` says where the times come from: ``"header"`` (the message's header stamp), ``"receive"`` (the bag's
-    receive time: a ``Twist`` has no stamp) or ``"csv"``.
+    """One topic's values, one per message.
 
     Attributes
     ----------
-    topic : str
-        The topic.
-    msgtype : str
-        Its message type.
-    t : ndarray
-        Times since the log's start, s, non-decreasing.
-    value : ndarray
-        One value per message, rad/s.
+    topic, msgtype : str
+        The topic and its message type.
+    t : numpy.ndarray
+        s since the log's start, non-decreasing.
+    value : numpy.ndarray
+        The yaw rate, rad/s.
     stamps : str
-        Where the times come from: ``"header"``, ``"receive"`` or ``"csv"``.
+        Where the times come from: ``"header"`` (the message's header stamp), ``"receive"`` (the bag's receive
+        time: a ``Twist`` has no stamp) or ``"csv"``.
     """
 
     topic: str
@@ -129,19 +132,17 @@ class TimeSeries:
 
 @dataclass(frozen=True)
 class Scan:
-    """One laser scan as handed to a reducer: `t` (s since the log's start), the beam angles (rad) and `ranges` (m).
+    """One laser scan as handed to a reducer.
 
     Attributes
     ----------
     t : float
-        Time since the log's start, s.
-    angle_min : float
-        Angle of the first beam, rad.
-    angle_increment : float
-        Angle between beams, rad.
+        s since the log's start.
+    angle_min, angle_increment : float
+        The first beam's angle and the step between beams, rad (sensor frame).
     range_min, range_max : float
-        The scanner's valid range, m.
-    ranges : ndarray
+        The valid ranges, m.
+    ranges : numpy.ndarray
         One range per beam, m.
     """
 
@@ -155,15 +156,14 @@ class Scan:
 
 @dataclass(frozen=True)
 class ScanSeries:
-    """The scans of one topic, reduced: `t` (s) and `values`, the reducer's result per scan (an array if they are numbers).
+    """The scans of one topic, reduced.
 
     Attributes
     ----------
     topic : str
-        The scan topic.
-    t : ndarray
-        Times since the log's start, s.
-    values : ndarray or list
+    t : numpy.ndarray
+        s since the log's start.
+    values : numpy.ndarray or tuple
         The reducer's result per scan (an array if they are numbers).
     """
 
@@ -173,25 +173,70 @@ class ScanSeries:
 
 
 @dataclass(frozen=True)
+class PoseSeries:
+    """The odometry's pose, one per message.
+
+    Attributes
+    ----------
+    topic : str
+        The odometry's topic.
+    t : numpy.ndarray
+        s since the log's start.
+    x, y : numpy.ndarray
+        The position in the odometry frame, m.
+    yaw : numpy.ndarray
+        The heading from the orientation's quaternion, rad in (−π, π].
+    vx : numpy.ndarray
+        The forward speed ``twist.twist.linear.x``, m/s.
+    """
+
+    topic: str
+    t: np.ndarray
+    x: np.ndarray
+    y: np.ndarray
+    yaw: np.ndarray
+    vx: np.ndarray
+
+    @property
+    def count(self) -> int:
+        """The number of messages."""
+        return int(self.t.size)
+
+
+def pose_at(pose: PoseSeries, t) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(x, y, yaw) of `pose` linearly interpolated at the times `t` (s; the yaw unwrapped first, then wrapped).
+
+    Parameters
+    ----------
+    pose : PoseSeries
+        The odometry's pose.
+    t : array_like
+        Times, s since the log's start (clamped to the pose's span).
+    """
+    yaw = np.unwrap(pose.yaw)
+    angle = np.interp(t, pose.t, yaw)
+    return np.interp(t, pose.t, pose.x), np.interp(t, pose.t, pose.y), np.angle(np.exp(1j * angle))
+
+
+@dataclass(frozen=True)
 class LogData:
     """What `read_log` read: the series asked for (None when not asked for) and what the log holds.
 
     Attributes
     ----------
     path : str
-        The log as given.
+        As given.
     format : str
         ``"ros2-sqlite3"``, ``"ros2-mcap"``, ``"ros1"`` or ``"csv"``.
     start : float
-        Epoch time of the first message, s.
+        Epoch s of the first message.
     duration : float
-        First to last message of the whole log, s.
-    topics : tuple of (str, str)
+        s, first to last message of the whole log.
+    topics : tuple
         (topic, message type) of every topic in the log, sorted.
     command, odometry, imu : TimeSeries or None
-        The series asked for (None when not asked for).
     scan : ScanSeries or None
-        The reduced scans, when asked for.
+    pose : PoseSeries or None
     """
 
     path: str
@@ -203,6 +248,7 @@ class LogData:
     odometry: TimeSeries | None = None
     imu: TimeSeries | None = None
     scan: ScanSeries | None = field(default=None)
+    pose: PoseSeries | None = None
 
 
 # ----------------------------------------------------------------------------------------- the yaw rate in the bytes
@@ -237,6 +283,41 @@ def _cdr_value(raw, spec: _Field) -> tuple[int | None, float]:
             pos += 4 + n
     pos = ((pos + 7) & ~7) + 8 * spec.index
     return stamp, struct.unpack_from(endian + "d", raw, 4 + pos)[0]
+
+
+_POSE = _Field(True, 1, 0)
+"""Where an Odometry's pose starts: position x, y, z (0–2), orientation x, y, z, w (3–6); twist.linear.x is number 43."""
+
+
+def _pose_numbers(x: float, y: float, qx: float, qy: float, qz: float, qw: float, vx: float) -> tuple:
+    return x, y, math.atan2(2.0 * (qw * qz + qx * qy), 1.0 - 2.0 * (qy * qy + qz * qz)), vx
+
+
+def _cdr_pose(raw) -> tuple[int, tuple]:
+    """(header stamp ns, (x, y, yaw, vx)) of a ROS 2 (CDR) Odometry."""
+    endian = "<" if raw[1] & 1 else ">"
+    sec, nsec = struct.unpack_from(endian + "iI", raw, 4)
+    pos = 8
+    for _ in range(2):
+        pos = (pos + 3) & ~3
+        (n,) = struct.unpack_from(endian + "I", raw, 4 + pos)
+        pos += 4 + n
+    pos = (pos + 7) & ~7
+    x, y, _, qx, qy, qz, qw = struct.unpack_from(endian + "7d", raw, 4 + pos)
+    (vx,) = struct.unpack_from(endian + "d", raw, 4 + pos + 8 * 43)
+    return sec * 1_000_000_000 + nsec, _pose_numbers(x, y, qx, qy, qz, qw, vx)
+
+
+def _ros1_pose(raw) -> tuple[int, tuple]:
+    """(header stamp ns, (x, y, yaw, vx)) of a ROS 1 Odometry."""
+    _, sec, nsec = struct.unpack_from("<III", raw, 0)
+    pos = 12
+    for _ in range(2):
+        (n,) = struct.unpack_from("<I", raw, pos)
+        pos += 4 + n
+    x, y, _, qx, qy, qz, qw = struct.unpack_from("<7d", raw, pos)
+    (vx,) = struct.unpack_from("<d", raw, pos + 8 * 43)
+    return sec * 1_000_000_000 + nsec, _pose_numbers(x, y, qx, qy, qz, qw, vx)
 
 
 def _ros1_value(raw, spec: _Field) -> tuple[int | None, float]:
@@ -283,7 +364,7 @@ def log_format(path: str) -> str:
 
 
 def read_log(path, topics: LogTopics = LogTopics(), *, need: Sequence[str] = ("command", "odometry"),
-             scan_reducer: Callable[[Scan], Any] | None = None) -> LogData:
+             scan_reducer: Callable[[Scan], Any] | None = None, scan_batch: int = 1) -> LogData:
     """Read the series `need` of the log at `path` in one pass, keeping only their numbers.
 
     Parameters
@@ -296,6 +377,9 @@ def read_log(path, topics: LogTopics = LogTopics(), *, need: Sequence[str] = ("c
         The series to read (of `SERIES`); each must be in the log, with messages.
     scan_reducer : callable, optional
         `Scan` → anything: applied to each scan as it is read, when ``"scan"`` is needed (required then).
+    scan_batch : int
+        With more than 1, the reducer takes a list of up to this many `Scan` (in order) and returns one result per
+        scan: a vectorized reducer, with at most `scan_batch` scans held at once.
 
     Returns
     -------
@@ -315,13 +399,14 @@ def read_log(path, topics: LogTopics = LogTopics(), *, need: Sequence[str] = ("c
         raise LogError("reading scans needs a scan_reducer (scans are reduced as they are read, never held)")
     kind = log_format(path)
     if kind == "csv":
-        if "scan" in need:
-            raise LogError(f"{path}: a CSV log has no scans (its columns: t, {', '.join(CSV_COLUMNS.values())})")
+        for series in ("scan", "pose"):
+            if series in need:
+                raise LogError(f"{path}: a CSV log has no {series}s (its columns: t, {', '.join(CSV_COLUMNS.values())})")
         return _read_csv(path, need)
     from ..extras import require
 
     require("logs", "reading a ROS bag")
-    return _read_bag(path, kind, topics, tuple(need), scan_reducer)
+    return _read_bag(path, kind, topics, tuple(need), scan_reducer, max(int(scan_batch), 1))
 
 
 class _ReducerFailed(Exception):
@@ -333,7 +418,7 @@ def _one_line(exc: BaseException) -> str:
     return text if len(text) <= 200 else text[:197] + "..."
 
 
-def _read_bag(path: str, kind: str, topics: LogTopics, need: tuple[str, ...], scan_reducer) -> LogData:
+def _read_bag(path: str, kind: str, topics: LogTopics, need: tuple[str, ...], scan_reducer, scan_batch: int) -> LogData:
     from pathlib import Path
 
     from rosbags.highlevel import AnyReader
@@ -347,7 +432,7 @@ def _read_bag(path: str, kind: str, topics: LogTopics, need: tuple[str, ...], sc
     except Exception as exc:  # noqa: BLE001 - rosbags and sqlite3/zstd raise many kinds on a corrupt file: one line each
         raise LogError(f"could not read {path} (corrupt or truncated?): {_one_line(exc)}") from None
     try:
-        return _stream(reader, path, kind, topics, need, scan_reducer)
+        return _stream(reader, path, kind, topics, need, scan_reducer, scan_batch)
     except LogError:
         raise
     except _ReducerFailed as failed:  # the caller's own error, not the file's
@@ -361,7 +446,7 @@ def _read_bag(path: str, kind: str, topics: LogTopics, need: tuple[str, ...], sc
             pass
 
 
-def _stream(reader, path: str, kind: str, topics: LogTopics, need: tuple[str, ...], scan_reducer) -> LogData:
+def _stream(reader, path: str, kind: str, topics: LogTopics, need: tuple[str, ...], scan_reducer, scan_batch: int) -> LogData:
     present = sorted({(c.topic, c.msgtype) for c in reader.connections})
     if not present or reader.message_count == 0:
         raise LogError(f"{path} is empty: no messages")
@@ -376,30 +461,37 @@ def _stream(reader, path: str, kind: str, topics: LogTopics, need: tuple[str, ..
             if c.msgtype not in MESSAGE_TYPES[series]:
                 raise LogError(f"topic {topic} of {path} carries {c.msgtype}; the {series} must be "
                                f"{' or '.join(MESSAGE_TYPES[series])}")
-            role_of[c.id] = series
+            role_of.setdefault(c.id, []).append(series)
     start_ns = reader.start_time
     times = {s: array("q") for s in need}  # packed 8-byte numbers, not Python objects: 16 bytes a message
     values = {s: [] if s == "scan" else array("d") for s in need}
     msgtypes = {}
     decode = _ros1_value if ros1 else _cdr_value
+    decode_pose = _ros1_pose if ros1 else _cdr_pose
+    decode_scan = _ros1_scan if ros1 else _cdr_scan
+    pending = []  # scans read and not yet reduced: at most scan_batch
     for connection, received_ns, raw in reader.messages(connections=[c for c in reader.connections if c.id in role_of]):
-        series = role_of[connection.id]
+        roles = role_of[connection.id]
+        if "pose" in roles:
+            stamp, numbers = decode_pose(raw)
+            times["pose"].append(stamp)
+            values["pose"].extend(numbers)
+            if len(roles) == 1:
+                continue
+        series = next(r for r in roles if r != "pose")
         msgtypes[series] = connection.msgtype
         if series == "scan":
-            msg = reader.deserialize(raw, connection.msgtype)
-            stamp = msg.header.stamp.sec * 1_000_000_000 + msg.header.stamp.nanosec
-            t = (stamp - start_ns) * 1e-9
+            stamp, numbers, ranges = decode_scan(raw)
             times[series].append(stamp)
-            scan = Scan(t, float(msg.angle_min), float(msg.angle_increment), float(msg.range_min), float(msg.range_max),
-                        np.asarray(msg.ranges))
-            try:
-                values[series].append(scan_reducer(scan))
-            except Exception as exc:
-                raise _ReducerFailed from exc
+            pending.append(Scan((stamp - start_ns) * 1e-9, *numbers, ranges))
+            if len(pending) >= scan_batch:
+                _reduce(pending, scan_reducer, scan_batch, values[series])
             continue
         stamp, value = decode(raw, _FIELDS[connection.msgtype])
         times[series].append(received_ns if stamp is None else stamp)
         values[series].append(value)
+    if pending:
+        _reduce(pending, scan_reducer, scan_batch, values["scan"])
     result = {}
     for series in need:
         topic = topics.of(series)
@@ -409,11 +501,45 @@ def _stream(reader, path: str, kind: str, topics: LogTopics, need: tuple[str, ..
         _check_order(t, topic, path)
         if series == "scan":
             result[series] = ScanSeries(topic, t, _stack(values[series]))
+        elif series == "pose":
+            x, y, yaw, vx = np.frombuffer(values[series], dtype=float).reshape(-1, 4).T.copy()
+            result[series] = PoseSeries(topic, t, x, y, yaw, vx)
         else:
             stamps = "header" if _FIELDS[msgtypes[series]].header else "receive"
             result[series] = TimeSeries(topic, msgtypes[series], t, np.frombuffer(values[series], dtype=float).copy(), stamps)
     duration = (reader.end_time - start_ns) * 1e-9
     return LogData(path, kind, start_ns * 1e-9, duration, tuple(present), **result)
+
+
+def _reduce(pending: list, reducer, batch: int, out: list) -> None:
+    """Reduce the scans `pending` (one call per scan, or one per batch when `batch` > 1) into `out`, and empty it."""
+    try:
+        if batch > 1:
+            out.extend(reducer(list(pending)))
+        else:
+            out.append(reducer(pending[0]))
+    except Exception as exc:
+        raise _ReducerFailed from exc
+    pending.clear()
+
+
+def _cdr_scan(raw) -> tuple[int, tuple, np.ndarray]:
+    """(header stamp ns, (angle_min, angle_increment, range_min, range_max), ranges) of a ROS 2 (CDR) LaserScan."""
+    endian = "<" if raw[1] & 1 else ">"
+    sec, nsec = struct.unpack_from(endian + "iI", raw, 4)
+    (n,) = struct.unpack_from(endian + "I", raw, 12)
+    pos = (8 + 4 + n + 3) & ~3  # after the frame id, aligned to 4
+    a_min, _, a_inc, _, _, r_min, r_max, count = struct.unpack_from(endian + "7fI", raw, 4 + pos)
+    ranges = np.frombuffer(raw, dtype=endian + "f4", count=count, offset=4 + pos + 32)
+    return sec * 1_000_000_000 + nsec, (a_min, a_inc, r_min, r_max), ranges
+
+
+def _ros1_scan(raw) -> tuple[int, tuple, np.ndarray]:
+    """(header stamp ns, (angle_min, angle_increment, range_min, range_max), ranges) of a ROS 1 LaserScan."""
+    _, sec, nsec, n = struct.unpack_from("<IIII", raw, 0)
+    pos = 16 + n
+    a_min, _, a_inc, _, _, r_min, r_max, count = struct.unpack_from("<7fI", raw, pos)
+    return sec * 1_000_000_000 + nsec, (a_min, a_inc, r_min, r_max), np.frombuffer(raw, dtype="<f4", count=count, offset=pos + 32)
 
 
 def _stack(values: list):
