@@ -253,6 +253,7 @@ RANGES = {
     "velocity_exponent": Range(0.0, 10.0, unit=""),  # n of GC2002's α_v‖ė‖ⁿ (docs/velocity_and_fuzzy.md)
     "step": Range(0.0, 1e6, unit="m"),
     "min_length": Range(0.0, 1e4, unit="m"),  # map: shortest segment analysed
+    "dilate_upstream": Range(0.0, 1e6, unit="m/s^2"),  # map: braking deceleration of the mask's upstream dilation
     # integers (closed bounds, checked with `checks.check_integer`)
     "compute_delay": Range(0, 1, low_open=False, unit="samples"),
     "pade_order": Range(1, 12, low_open=False),

@@ -48,7 +48,8 @@ ROBOTS = {"depot": ["--W", "0.4", "--tau", "0.2", "--k", "10", "--T", "0.05", "-
 def test_shipped_map_outputs(tmp_path, name):
     """Every output is written and readable: the PNG; the CSV (one row per segment, as in the JSON); the mask PGM with
     the map's size, its YAML with the map's resolution and origin; and the mask's values decode to 100 % off the
-    unstable segments and to floor(100 V*/V) (>= 1) within W/2 of each unstable segment."""
+    unstable segments and route stretches and to floor(100 V*/V) (>= 1) within W/2 of each of them (a route
+    stretch's piece of its route cut at its arc positions, here with numpy's interpolation)."""
     out = tmp_path / "out"
     code, stdout, err = run(["map", name, *ROBOTS[name], "--out-dir", str(out), "--format", "json", "--quiet"])
     assert code == 0, err
@@ -77,6 +78,18 @@ def test_shipped_map_outputs(tmp_path, name):
         t = np.clip(((px - s["x0"]) * dx + (py - s["y0"]) * dy) / (dx * dx + dy * dy), 0, 1)
         near = np.hypot(px - s["x0"] - t * dx, py - s["y0"] - t * dy) <= W / 2
         expected[near] = np.minimum(expected[near], max(1, math.floor(100 * s["V_critical"] / V)))
+    for s in data["paths"]["stretches"]:  # and within W/2 of each route stretch with V* < V (its piece of the route)
+        if s["V_critical"] is None or isinstance(s["V_critical"], str) or not s["V_critical"] < V:
+            continue
+        route = np.array(data["paths"]["routes"][s["route"]]["points"])
+        edges = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(route, axis=0).T))])
+        arcs = np.concatenate([[s["start"]], edges[(edges > s["start"]) & (edges < s["stop"])], [s["stop"]]])
+        piece = np.column_stack([np.interp(arcs, edges, route[:, 0]), np.interp(arcs, edges, route[:, 1])])
+        for (x0, y0), (x1, y1) in zip(piece[:-1], piece[1:]):
+            dx, dy = x1 - x0, y1 - y0
+            t = np.clip(((px - x0) * dx + (py - y0) * dy) / max(dx * dx + dy * dy, 1e-300), 0, 1)
+            near = np.hypot(px - x0 - t * dx, py - y0 - t * dy) <= W / 2
+            expected[near] = np.minimum(expected[near], max(1, math.floor(100 * s["V_critical"] / V)))
     assert np.array_equal(percent, expected)
     assert limited and (percent < 100).any()
     assert VALIDATOR.is_valid(data), [e.message for e in VALIDATOR.iter_errors(data)][:3]
@@ -250,6 +263,37 @@ def test_a_resolution_typo_is_warned_about(tmp_path):
     assert VALIDATOR.is_valid(data)
     code, out, err = run(["map", str(_open_corridor(tmp_path, 0.05, 20, 200)), "--W", "0.4", "--format", "json", "--quiet"])
     assert code == 0 and err == "" and json.loads(out)["warnings"] == []
+
+
+class _Stop(Exception):
+    pass
+
+
+def test_a_resolution_typo_making_a_500_m_map_is_warned_before_the_work(tmp_path):
+    """The issue's case: resolution 5.0 typed for 0.05 turns a 100-pixel map into a 500 m one. `analyze_map` calls
+    ``warn`` with one line naming the resolution before any work: a ``warn`` that raises stops it before the histogram
+    grid (5000 x 5000 cells at 0.1 m) is built, so the call returns at once. The CLI's text and JSON say which reading of
+    unknown cells was used (checked on a plausible map)."""
+    from pfm_stability.laws.fields import make_law
+    from pfm_stability.maps.analysis import analyze_map
+    from pfm_stability.maps.occupancy import load_map
+    from pfm_stability.parameters import CARMEL
+
+    lines = []
+
+    def warn(line):
+        lines.append(line)
+        raise _Stop
+
+    occupancy = load_map(_open_corridor(tmp_path, 5.0, 8, 100))
+    with pytest.raises(_Stop):
+        analyze_map(occupancy, CARMEL.robot, CARMEL.controller, make_law("grid", CARMEL.robot, CARMEL.controller), warn=warn)
+    assert len(lines) == 1 and "\n" not in lines[0] and "resolution 5 m/pixel is implausible" in lines[0] and "5.0 for 0.05" in lines[0]
+    path = _open_corridor(tmp_path, 0.05, 20, 200)
+    code, out, err = run(["map", str(path), "--W", "0.4", "--format", "json", "--quiet", "--unknown", "free"])
+    assert code == 0 and json.loads(out)["inputs"]["unknown"] == "free"
+    code, out, err = run(["map", str(path), "--W", "0.4", "--quiet"])
+    assert code == 0 and "(unknown = occupied)" in out
 
 
 def test_corridors_many_robot_widths_wide_are_warned_about(tmp_path):

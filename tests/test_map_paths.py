@@ -304,3 +304,71 @@ def test_thin_slam_walls_with_unknown_behind_the_simulation_sides_with_unknown_f
     thin = analyze_map(occupancy, robot, CONTROLLER, make_law("grid", robot, CONTROLLER), unknown="free")
     judged = drive_map(thin, 4, seed=2)
     assert judged.counts["episodes"] == 0, judged.counts
+
+
+def _rack_grid(law, rack_column: int, width: int = 60, length: int = 200):
+    """A histogram grid `width` × `length` cells (c = law.cell_size) with one solid rack: every cell from column
+    `rack_column` to the grid's right edge occupied (certainty law.cv)."""
+    from pfm_stability.maps.field import HistogramMap
+
+    cv = np.zeros((width, length), dtype=np.int16)
+    cv[rack_column:, :] = law.cv
+    return HistogramMap(0.0, 0.0, law.cell_size, cv)
+
+
+def test_window_edge_relay_where_a_rack_enters_the_window():
+    """`maps.relay.window_relay` on a route along y with a solid rack on its +x side (CARMEL's grid law, window 33
+    cells, c = 0.1 m). With the path 16 cells (h) from the rack's first column the window gains that column when the
+    robot moves one cell towards it: F_n falls by the column's force (restoring: a relay). Expected size, by hand:
+    the force of one column of 33 cells at 16.5 cells' lateral distance, Σ ρ·W^n·cv·dx/(dx² + dy²)^((n+1)/2) over the
+    window's rows (dy = b·c, b = −16 … 16), within 10 % (the robot's position within its cell shifts dx and dy by up
+    to half a cell, averaged over the cell along t). F_n is 0 on the far side of that boundary and pushes the robot
+    back on the rack's side: the net force changes sign across the jump. A path 5 cells from the rack (F_n pushes
+    it away on both sides: no sign change) and a path with no rack within reach have no relay."""
+    from pfm_stability.laws.fields import make_law
+    from pfm_stability.maps.relay import window_relay
+
+    law = make_law("grid", CARMEL.robot, CARMEL.controller)
+    h, c = law.window_cells // 2, law.cell_size
+    grid = _rack_grid(law, 40)
+    y = np.full(3, 10.05)
+    t = (np.zeros(3), np.ones(3))
+    x = np.array([(40 - h - 0.5 + 0.125) * c, (40 - 5 + 0.5) * c, (40 - h - 8 + 0.5) * c])  # the 1st 3/8 cell from the edge
+    relay, jump = window_relay(grid, law, x, y, *t, np.zeros(3))
+    assert relay.tolist() == [True, False, False]
+    assert jump[0] == pytest.approx(_column_force(law, h), rel=0.1)
+    assert jump[1:].tolist() == [0.0, 0.0]
+    # the mirror image (rack on the −x side, entering when the robot moves along −x): the same relay
+    mirror = _rack_grid(law, 40)
+    from pfm_stability.maps.field import HistogramMap
+
+    mirror = HistogramMap(0.0, 0.0, c, np.ascontiguousarray(mirror.cv[::-1]))
+    relay, jump_m = window_relay(mirror, law, 60 * c - x[:1], y[:1], *(v[:1] for v in t), np.zeros(1))
+    assert relay.tolist() == [True] and jump_m[0] == pytest.approx(jump[0], rel=1e-6)
+
+
+def _column_force(law, h):
+    """F_r/F_ct of one column of cells (certainty law.cv) at (h + 0.5) cells across, rows −h … h (the law's scale
+    ρ·W^n, `maps.field.window_kernels`' weights), by hand."""
+    c = law.cell_size
+    dx, dy = (h + 0.5) * c, np.arange(-h, h + 1) * c
+    return float(law.ratio * law.W**law.n * law.cv * np.sum(dx / (dx * dx + dy * dy) ** ((law.n + 1) / 2)))
+
+
+def test_a_path_taken_is_linearized_at_itself_away_from_the_equilibrium(root):
+    """`judge_routes(..., taken=True)` (a path the robot drove, held there by its goal): along the 1.2 m corridor
+    (axis x = 0.65 m, equilibrium on it by symmetry), a path 0.3 m off the axis — farther than W/2 = 0.2 m (ROBOT) —
+    is linearized at its own points (the linearization point is the path point, to 1e-12 m), while the same path judged as a route keeps the axis' equilibrium (its linearization point within a cell of
+    x = 0.65 m); a path 0.1 m off (within W/2) keeps it too."""
+    from pfm_stability.maps.analysis import judge_routes
+    from pfm_stability.maps.routes import path_of
+
+    analysis = corridor_analysis(0.6, 0.5, root)
+    assert ROBOT.W / 2 == pytest.approx(0.2)
+    far, near = path_of([[0.95, 6.0], [0.95, 14.0]], 0, "drive"), path_of([[0.75, 6.0], [0.75, 14.0]], 1, "drive")
+    taken = judge_routes(analysis, [far, near], taken=True)
+    as_route = judge_routes(analysis, [far], taken=False)
+    mine = taken.samples.segment == 0
+    assert np.allclose(taken.px[mine], 0.95, atol=1e-12)
+    assert np.allclose(as_route.px, 0.65, atol=0.1)
+    assert np.allclose(taken.px[~mine], 0.65, atol=0.1)

@@ -71,6 +71,10 @@ def add_parser(sub) -> None:
                    help="also judge your own route: a Nav2 path (nav_msgs/Path as YAML), waypoints in YAML, or a CSV of x,y (m); repeatable")
     p.add_argument("--goals", type=input_file("goals"), metavar="FILE",
                    help="drive the simulated robot between these goals (YAML or CSV of x,y, m) and judge the paths it takes")
+    p.add_argument("--dilate-upstream", type=number("dilate_upstream"), metavar="A_MAX",
+                   help="with --out-dir: extend each unstable route stretch's slow zone of the speed mask by the braking distance "
+                   f"(V^2 - V*^2)/(2 A_MAX) along its route, both ways (Nav2's speed filter slows the robot only inside a zone), "
+                   f"A_MAX {describe('dilate_upstream')}")
     p.add_argument("--format", choices=FORMATS, default="text")
     p.add_argument("--quiet", action="store_true", help="no progress on stderr")
     p.set_defaults(run=run)
@@ -119,7 +123,7 @@ def _drive(analysis, count: int, seed: int, progress):
     return drive_map(analysis, count, seed=seed, progress=progress)
 
 
-def _write_outputs(analysis, out_dir: str, drives=None) -> dict:
+def _write_outputs(analysis, out_dir: str, drives=None, a_max=None) -> dict:
     """The files of ``--out-dir``, all or none (`files.atomic_directory`): the four of the segments, and with the routes'
     verdicts their picture (with the drives' episodes) and CSV."""
     import os
@@ -148,7 +152,7 @@ def _write_outputs(analysis, out_dir: str, drives=None) -> dict:
                     fig.savefig(fh, format="png", dpi=110)
             finally:
                 plt.close(fig)
-        for name, content in (("segments.csv", segments_csv(analysis).encode("utf-8")), ("speed_mask.pgm", speed_mask_pgm(analysis)),
+        for name, content in (("segments.csv", segments_csv(analysis).encode("utf-8")), ("speed_mask.pgm", speed_mask_pgm(analysis, a_max)),
                               ("speed_mask.yaml", speed_mask_yaml(analysis.occupancy).encode("utf-8"))):
             with open_new(paths[name], "wb") as fh:
                 fh.write(content)
@@ -183,7 +187,7 @@ def run(args) -> int:
             analysis = _with_goals(analysis, args.goals, progress)
         validation = _validate(analysis, args.validate, args.seed, progress) if args.validate and analysis.segments else None
         drives = _drive(analysis, args.validate, args.seed, progress) if args.validate and analysis.paths is not None else None
-        outputs = _write_outputs(analysis, args.out_dir, drives) if args.out_dir else None
+        outputs = _write_outputs(analysis, args.out_dir, drives, args.dilate_upstream) if args.out_dir else None
     data = {
         **analysis.to_dict(),
         "validation": validation.to_dict() if validation is not None else None,

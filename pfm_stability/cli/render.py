@@ -591,13 +591,16 @@ def render_map_text(data: dict) -> str:
     if p:  # the verdict along every route (docs/maps.md, "Verdicts along every route")
         unjudged = ", ".join(f"{length:.1f} m {reason}" for reason, length in p["unjudged_length_m"].items() if length > 0)
         lines.append(f"routes: {p['routes']} routes, {p['route_length_m']:.1f} m: {percent(p['decided_fraction'])[1:]} decided; "
-                     f"unstable {p['unstable_length_m']:.1f} m, stable {p['stable_length_m']:.1f} m" + (f"; no verdict: {unjudged}" if unjudged else ""))
+                     f"unstable {p['unstable_length_m']:.1f} m" + (f" (window-edge relay {p['relay_length_m']:.1f} m)" if p.get("relay_length_m") else "")
+                     + f", stable {p['stable_length_m']:.1f} m" + (f"; no verdict: {unjudged}" if unjudged else ""))
     d = data.get("drives")
     if d is not None:
         share = {k: (percent(d[k])[1:] if d[k] is not None else "n/a (nothing to measure)") for k in ("recall", "precision")}
         lines.append(f"validation by driving: {d['counts']['drives']} drives, {d['counts']['episodes']} oscillation episodes; "
                      f"recall {share['recall']}, precision {share['precision']} by route length ({d['lengths']['driven']:.1f} of "
-                     f"{d['lengths']['route']:.1f} m driven); {len(d['disagreements'])} disagreements")
+                     f"{d['lengths']['route']:.1f} m driven"
+                     + (f"; drives between points judged along their own paths, {d['lengths']['drive_paths']:.1f} m" if d["lengths"].get("drive_paths") else "")
+                     + f"); {len(d['disagreements'])} disagreements")
     v = data.get("validation")
     if v is not None:
         share = f"{percent(v['agreement'])[1:]} of the {v['measured']} measured" if v.get("agreement") is not None else "- (none measured)"

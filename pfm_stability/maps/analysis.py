@@ -58,7 +58,7 @@ from .routes import Route, default_min_length, find_paths, find_routes
 from .verdicts import END_FRACTION, TAPER_SLOPE, GrowthRate, drift_slope, critical_speed, is_weak, judged_run, segment_gain, wavelength
 
 __all__ = ["DIRECTIONS", "MAP_LAWS", "MAX_CORRIDOR_WIDTHS", "MAX_MAP_SIDE", "MAX_RESOLUTION", "NO_VERDICT", "MapAnalysis", "MapSegment",
-           "add_routes", "analyze_map", "corridor_warnings", "sample_verdict", "scale_warnings"]
+           "add_routes", "analyze_map", "corridor_warnings", "judge_routes", "sample_verdict", "scale_warnings"]
 
 DIRECTIONS = ("forward", "reverse")
 """Travel directions of a segment: from (x0, y0) to (x1, y1), and back."""
@@ -461,16 +461,33 @@ def add_routes(analysis: MapAnalysis, routes) -> MapAnalysis:
     """
     if analysis.paths is None:
         raise ValueError("routes need --law grid: a route is judged with the histogram grid's field")
+    paths = list(analysis.paths.paths)
+    paths += [replace(r, branch=len(paths) + k) for k, r in enumerate(routes)]
+    return replace(analysis, paths=judge_routes(analysis, paths))
+
+
+def judge_routes(analysis: MapAnalysis, routes, taken: bool = False) -> PathVerdicts:
+    """The verdicts along `routes` alone (`paths.analyze_paths` with the analysis' grid, law, robot and loop model;
+    grid law only): e.g. the paths the simulated robot took (`validation.map_drives`).
+
+    Parameters
+    ----------
+    analysis : MapAnalysis
+        A grid-law analysis.
+    routes : sequence of RoutePath
+        The routes, in map coordinates (m).
+    taken : bool
+        The routes are paths the simulated robot took (`paths.analyze_paths`' ``taken``).
+    """
+    if analysis.paths is None:
+        raise ValueError("routes need --law grid: a route is judged with the histogram grid's field")
     (loop_model,) = models_for(analysis.controller, [analysis.model])
     loop = Loop(analysis.robot.tau, analysis.controller.T, analysis.robot.k, c=0.0)
     boundary = loop_model.boundary(loop)
     growth = GrowthRate(lambda NV: loop_model.rightmost_root(NV, loop), boundary.NV_critical)
     transition = SampledTransition.of(loop_model, loop) if loop_model.name == "sampled" else None
-    paths = list(analysis.paths.paths)
-    paths += [replace(r, branch=len(paths) + k) for k, r in enumerate(routes)]
-    along = analyze_paths(analysis.grid, analysis.law, paths, analysis.clearance, analysis.robot.W, analysis.robot.V, boundary, growth,
-                          loop_model.is_stable(0.0, loop), transition)
-    return replace(analysis, paths=along)
+    return analyze_paths(analysis.grid, analysis.law, list(routes), analysis.clearance, analysis.robot.W, analysis.robot.V, boundary, growth,
+                         loop_model.is_stable(0.0, loop), transition, taken=taken)
 
 
 def sample_verdict(N: float, V: float, boundary, heading_stable: bool) -> Judgement:

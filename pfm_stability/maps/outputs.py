@@ -4,8 +4,11 @@ The speed mask (docs/maps.md, "The speed mask") has the input map's size, resolu
 and origin. Each cell holds a speed limit as a percentage of the robot's V, for the
 Nav2 speed filter with ``type: 1`` (percentage), ``base: 0``, ``multiplier: 1``:
 
-* cells within W/2 of a segment whose V* is below V: 100·V*/V rounded down (never
-  above what is stable), at least 1 (the filter reads 0 as "no limit");
+* cells within W/2 of a segment, or of a route stretch (`maps.paths`), whose V* is below V:
+  100·V*/V rounded down (never above what is stable), at least 1 (the filter reads 0 as
+  "no limit"); with a braking deceleration a_max (``--dilate-upstream``) each route
+  stretch's zone reaches (V² − V*²)/(2·a_max) further along its route at both ends
+  (`upstream_distance`: Nav2's filter slows the robot only once it is inside a zone);
 * every other cell — free, occupied or unknown — 100: the robot may drive at V.
   Occupied cells are never driven through, and 100 % is the filter's "no
   reduction"; no cell is written as unknown (−1), which the filter ignores
@@ -30,11 +33,13 @@ __all__ = [
     "ROUTE_FILES",
     "routes_csv",
     "percent_to_pixel",
+    "route_piece",
     "pixel_to_percent",
     "segments_csv",
     "speed_limits",
     "speed_mask_yaml",
     "speed_mask_pgm",
+    "upstream_distance",
 ]
 
 OUTPUT_FILES = ("stability.png", "segments.csv", "speed_mask.pgm", "speed_mask.yaml")
@@ -113,41 +118,105 @@ def pixel_to_percent(value) -> np.ndarray:
     return np.rint(100.0 * (255.0 - np.asarray(value, dtype=float)) / 255.0).astype(np.int64)
 
 
-def speed_limits(analysis) -> np.ndarray:
-    """Speed limit per map cell, % of V (int, shape (height, width), row 0 at y = origin).
+def speed_limits(analysis, a_max: float | None = None) -> np.ndarray:
+    """Speed limit per map cell, % of V (int, shape (height, width), row 0 at y = origin): within W/2 of each segment
+    and of each route stretch whose V* is below V (module docstring), each route stretch optionally dilated upstream
+    by the braking distance (V² − V*²)/(2·a_max) along its route, both travel directions (`upstream_distance`).
 
     Parameters
     ----------
     analysis : MapAnalysis
-        The analysis (map, segments and their verdicts).
+        The analysis (map, segments and their verdicts; the routes' stretches when it has them).
+    a_max : float, optional
+        The robot's braking deceleration, m/s² (> 0): dilate each route stretch's slow zone upstream so the robot,
+        slowed by Nav2's speed filter only once it is inside the zone, has braked to V* where the stretch begins.
+        None: no dilation.
     """
     occupancy = analysis.occupancy
     V, half = analysis.robot.V, analysis.robot.W / 2
     limits = np.full(occupancy.values.shape, 100, dtype=np.int64)
-    r = occupancy.resolution
-    ox, oy = occupancy.origin[0], occupancy.origin[1]
     for s in analysis.segments:
         if s.V_critical is None or not s.V_critical < V:
             continue
-        percent = max(MIN_PERCENT, min(100, math.floor(100.0 * s.V_critical / V)))
-        i0, j0 = occupancy.cell_of(min(s.x0, s.x1) - half, min(s.y0, s.y1) - half)
-        i1, j1 = occupancy.cell_of(max(s.x0, s.x1) + half, max(s.y0, s.y1) + half)
-        i0, j0 = max(int(i0), 0), max(int(j0), 0)
-        i1, j1 = min(int(i1), occupancy.width - 1), min(int(j1), occupancy.height - 1)
-        if i1 < i0 or j1 < j0:
+        _stamp(limits, occupancy, s.x0, s.y0, s.x1, s.y1, half, _percent(s.V_critical, V))
+    pv = getattr(analysis, "paths", None)
+    for s in (pv.stretches if pv is not None else ()):
+        if s.V_critical is None or not s.V_critical < V:
             continue
-        jj, ii = np.mgrid[j0:j1 + 1, i0:i1 + 1]
-        px, py = ox + (ii + 0.5) * r, oy + (jj + 0.5) * r
-        near = _distance_to_segment(px, py, s) <= half
-        block = limits[j0:j1 + 1, i0:i1 + 1]
-        block[near] = np.minimum(block[near], percent)
+        reach = upstream_distance(V, s.V_critical, a_max) if a_max is not None else 0.0
+        points = route_piece(pv.paths[s.route].points, s.start - reach, s.stop + reach)
+        for (x0, y0), (x1, y1) in zip(points[:-1], points[1:]):
+            _stamp(limits, occupancy, x0, y0, x1, y1, half, _percent(s.V_critical, V))
     return limits
 
 
-def _distance_to_segment(px, py, s):
-    dx, dy = s.x1 - s.x0, s.y1 - s.y0
-    t = np.clip(((px - s.x0) * dx + (py - s.y0) * dy) / (dx * dx + dy * dy), 0.0, 1.0)
-    return np.hypot(px - s.x0 - t * dx, py - s.y0 - t * dy)
+def upstream_distance(V: float, V_limit: float, a_max: float) -> float:
+    """How far before a slow zone the robot must start braking, m: (V² − V_limit²)/(2·a_max) (0 if V_limit >= V).
+
+    Nav2's speed filter lowers the speed limit only once the robot's position is inside a mask zone (without a
+    look-ahead), so a zone drawn exactly over the unstable stretch is entered at full speed; dilating it upstream by
+    the braking distance at `a_max` makes the robot arrive at the stretch at V_limit.
+
+    Parameters
+    ----------
+    V : float
+        The robot's speed, m/s.
+    V_limit : float
+        The zone's speed limit, m/s.
+    a_max : float
+        Braking deceleration, m/s² (> 0).
+    """
+    if not a_max > 0:
+        raise ValueError(f"a_max must be > 0 m/s^2; got {a_max!r}")
+    return max(V * V - V_limit * V_limit, 0.0) / (2.0 * a_max)
+
+
+def route_piece(points, start: float, stop: float) -> np.ndarray:
+    """The polyline of a route between arc positions `start` and `stop` (m, clipped to the route), shape (k, 2).
+
+    Parameters
+    ----------
+    points : array_like, shape (n, 2)
+        The route's points, m.
+    start, stop : float
+        Arc positions along the route, m (start <= stop).
+    """
+    p = np.asarray(points, dtype=float).reshape(-1, 2)
+    edges = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(p, axis=0).T))])
+    a, b = max(float(start), 0.0), min(float(stop), float(edges[-1]))
+    if b < a:
+        return np.zeros((0, 2))
+    inner = (edges > a) & (edges < b)
+    arcs = np.concatenate([[a], edges[inner], [b]])
+    return np.column_stack([np.interp(arcs, edges, p[:, 0]), np.interp(arcs, edges, p[:, 1])])
+
+
+def _percent(V_limit: float, V: float) -> int:
+    return max(MIN_PERCENT, min(100, math.floor(100.0 * V_limit / V)))
+
+
+def _stamp(limits: np.ndarray, occupancy, x0: float, y0: float, x1: float, y1: float, half: float, percent: int) -> None:
+    """Lower `limits` to `percent` in the cells whose centres lie within `half` m of the segment (x0, y0)–(x1, y1)."""
+    r = occupancy.resolution
+    ox, oy = occupancy.origin[0], occupancy.origin[1]
+    i0, j0 = occupancy.cell_of(min(x0, x1) - half, min(y0, y1) - half)
+    i1, j1 = occupancy.cell_of(max(x0, x1) + half, max(y0, y1) + half)
+    i0, j0 = max(int(i0), 0), max(int(j0), 0)
+    i1, j1 = min(int(i1), occupancy.width - 1), min(int(j1), occupancy.height - 1)
+    if i1 < i0 or j1 < j0:
+        return
+    jj, ii = np.mgrid[j0:j1 + 1, i0:i1 + 1]
+    px, py = ox + (ii + 0.5) * r, oy + (jj + 0.5) * r
+    near = _distance_to_segment(px, py, x0, y0, x1, y1) <= half
+    block = limits[j0:j1 + 1, i0:i1 + 1]
+    block[near] = np.minimum(block[near], percent)
+
+
+def _distance_to_segment(px, py, x0, y0, x1, y1):
+    dx, dy = x1 - x0, y1 - y0
+    length2 = dx * dx + dy * dy
+    t = np.clip(((px - x0) * dx + (py - y0) * dy) / length2, 0.0, 1.0) if length2 > 0 else 0.0
+    return np.hypot(px - x0 - t * dx, py - y0 - t * dy)
 
 
 def speed_mask_yaml(occupancy, image: str = "speed_mask.pgm") -> str:
@@ -165,14 +234,16 @@ def speed_mask_yaml(occupancy, image: str = "speed_mask.pgm") -> str:
             "occupied_thresh: 1.0\nfree_thresh: 0.0\n")
 
 
-def speed_mask_pgm(analysis) -> bytes:
+def speed_mask_pgm(analysis, a_max: float | None = None) -> bytes:
     """The mask image as a binary PGM (P5, 8 bits, row 0 at the top, as map_server reads it).
 
     Parameters
     ----------
     analysis : MapAnalysis
         The analysis (`speed_limits`).
+    a_max : float, optional
+        Braking deceleration, m/s², of the upstream dilation (`speed_limits`); None: none.
     """
-    pixels = percent_to_pixel(speed_limits(analysis))[::-1]
+    pixels = percent_to_pixel(speed_limits(analysis, a_max))[::-1]
     height, width = pixels.shape
     return f"P5\n{width} {height}\n255\n".encode("ascii") + np.ascontiguousarray(pixels).tobytes()

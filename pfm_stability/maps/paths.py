@@ -35,6 +35,15 @@ about a line. That travel direction is not judged at those samples (left out of 
 analysis' end rule, `verdicts.judged_run`), the other direction still is. What cannot be judged is named
 (`UNJUDGED`): a wall ahead both ways (a narrow dead end), or a sample inside an obstacle.
 
+**The window-edge relay** (`relay.window_relay`): where F_n jumps within a cell of the path (the window gaining or
+losing a wall's column as the robot moves a cell sideways) by more than its smooth change over a cell, and the jump
+restores (pushes the robot back across it), the robot holds a sustained oscillation of about a cell's amplitude
+there, which the smooth linearization cannot see: such a sample is unstable, its stretch labelled "relay".
+
+**Paths taken** (``taken``: the paths the simulated robot drove between goals, `validation.map_drives`). Its goal,
+not only the field, holds the robot there: a lateral equilibrium farther than W/2 from the path is not the one it
+follows, so the loop is linearized at the path itself, and the line it is pulled to is the path.
+
 **Stretches**: runs of consecutive samples with one verdict (`PathStretch`), each with the
 numbers of its worst window: σ̄_w, e-folds σ̄_w·Λ/V, N_eff (`verdicts.effective_gain`:
 the uniform gain with that growth), margin NV*/(N_eff·V) − 1, and V* (the speed at which that
@@ -52,6 +61,8 @@ from ..io.serialize import json_number
 from ..models import gain_margin, verdict_label
 from ..models.verdicts import inside as in_set, judge_arrays
 from .equilibria import Samples, equilibria_at, lateral_force
+from .episodes import AMPLITUDE_THRESHOLD
+from .relay import relay_amplitude, window_relay
 from .routes import RoutePath
 from .verdicts import EFOLDS, END_FRACTION, GrowthRate, critical_speed, effective_gain, wavelength
 
@@ -177,6 +188,8 @@ class PathVerdicts:
         The linear loop driven along the route weaves here (`maps.episodes`: a forced or growing oscillation).
     amplitude : ndarray
         The largest predicted lateral amplitude of the run through each sample, m.
+    relay : ndarray of bool
+        The window-edge relay holds the robot in a sustained oscillation here (`maps.relay`): unstable ("relay").
     """
 
     paths: tuple
@@ -197,6 +210,7 @@ class PathVerdicts:
     stretches: tuple
     oscillates: np.ndarray = None
     amplitude: np.ndarray = None
+    relay: np.ndarray = None
 
     @property
     def route_length(self) -> float:
@@ -228,6 +242,7 @@ class PathVerdicts:
             "unstable_length_m": self.length_of("unstable"),
             "stable_length_m": self.length_of("stable"),
             "linearized_at_route_length_m": float(self.spacing[~np.isfinite(self.samples.offset)].sum()),
+            "relay_length_m": float(self.spacing[self.relay].sum()) if self.relay is not None else 0.0,
             "unjudged_length_m": {r: self.length_of(r) for r in UNJUDGED},
             "window_m": json_number(self.window),
             "V_critical_min": json_number(min(values)) if values else None,
@@ -292,7 +307,7 @@ def _window_mean(values: np.ndarray, route: np.ndarray, arc: np.ndarray, ds: np.
 
 
 def analyze_paths(grid, law, paths, clearance: np.ndarray, W: float, V: float, boundary, growth: GrowthRate,
-                  heading_stable: bool, transition=None, end_fraction: float = END_FRACTION) -> PathVerdicts:
+                  heading_stable: bool, transition=None, end_fraction: float = END_FRACTION, taken: bool = False) -> PathVerdicts:
     """The verdict at every point of every route (module docstring).
 
     Parameters
@@ -322,21 +337,29 @@ def analyze_paths(grid, law, paths, clearance: np.ndarray, W: float, V: float, b
     end_fraction : float
         A travel direction is not judged where the repulsion ahead cancels more than this fraction of the attraction
         (1 ± F_r·t < 1 − end_fraction: `verdicts.END_FRACTION`): the robot turns there (module docstring).
+    taken : bool
+        The routes are paths the simulated robot took (its goal holds it there, not only the field): a lateral
+        equilibrium farther than W/2 from the path is not the robot's, and the path itself is the line it follows
+        (linearized there, no pull towards the equilibrium; module docstring, "Paths taken").
     """
     paths = tuple(paths)
     x, y, tx, ty, route, arc, ds = path_samples(paths, grid.cell_size)
     samples = equilibria_at(grid, law, x, y, tx, ty, route, clearance, W, newton_steps=PATH_NEWTON_STEPS)
     has = np.isfinite(samples.offset)
+    along, slope = np.array(samples.along, dtype=float), samples.N * samples.forward  # −dF_n/ds at the equilibrium
+    if taken:  # an equilibrium the robot's own path keeps away from is not the one it follows
+        far = has & (np.abs(np.nan_to_num(samples.offset)) > W / 2)
+        has = has & ~far
+        slope = np.where(far, np.nan, slope)
     offset = np.where(has, samples.offset, 0.0)
     px, py = x - ty * offset, y + tx * offset
-    along, slope = np.array(samples.along, dtype=float), samples.N * samples.forward  # −dF_n/ds at the equilibrium
     # the gradient at the route's own point where there is no equilibrium (and at an equilibrium the repulsion stops
     # the robot at in one direction, where the corridor search keeps no N)
     redo = np.flatnonzero(~np.isfinite(slope))
     pull = np.zeros(x.size)  # F_n at the linearization point (0 at an equilibrium)
     if redo.size:
         fn0, ft0, df0 = lateral_force(grid, law, x[redo], y[redo], tx[redo], ty[redo], offset[redo], jacobian=True)
-        along[redo], slope[redo], pull[redo] = ft0, -df0, np.where(has[redo], 0.0, fn0)
+        along[redo], slope[redo], pull[redo] = ft0, -df0, np.where(has[redo] | taken, 0.0, fn0)
     inside = ~(np.isfinite(along) & np.isfinite(slope))
     with np.errstate(divide="ignore", invalid="ignore"):
         N_forward = np.where(1 + along >= 1 - end_fraction, slope / (1 + along), np.nan)
@@ -375,14 +398,23 @@ def analyze_paths(grid, law, paths, clearance: np.ndarray, W: float, V: float, b
     if transition is not None and boundary.omega_critical and boundary.omega_critical > 0:
         oscillates, amplitude = _forced(route, arc, (N_forward, N_reverse), line, V, transition, 2 * math.pi / boundary.omega_critical)
         code = np.where((code == 0) & oscillates, 1, code)
+    # the window-edge relay (`relay`): a restoring jump of F_n within a cell of the path, larger than its smooth change
+    relay = np.zeros(x.size, dtype=bool)
+    check = np.flatnonzero((code == 0) & (has | taken))  # where the robot's path is known: its equilibrium, or driven
+    if check.size and boundary.NV_critical and math.isfinite(boundary.NV_critical) and boundary.NV_critical > 0:
+        found, jump = window_relay(grid, law, x[check], y[check], tx[check], ty[check], offset[check], reference=~has[check])
+        cycle = relay_amplitude(jump, boundary.NV_critical / V)
+        relay[check] = found & (cycle >= AMPLITUDE_THRESHOLD)  # a limit cycle the episodes' judge would see
+        amplitude[check] = np.where(relay[check], np.maximum(amplitude[check], cycle), amplitude[check])
+    code = np.where(relay, 1, code)
     N_worse = np.stack([N_forward, N_reverse])[worse, rows]
     NV = np.nan_to_num(N_worse) * V
     local_stable = np.array([bool(heading_stable) if v == 0 else in_set(boundary, float(v)) for v in NV]) if NV.size else np.zeros(0, bool)
     local_verdict, local_margin = judge_arrays(NV, np.full(NV.shape, boundary.NV_critical), local_stable)
     stretches = _stretches(paths, route, arc, ds, x, y, code, window_growth, worse, np.stack(mean_N), np.stack([N_forward, N_reverse]),
-                           has, boundary, growth, heading_stable, V, window, efolds, oscillates, amplitude)
+                           has, boundary, growth, heading_stable, V, window, efolds, oscillates, amplitude, relay)
     return PathVerdicts(paths, samples, arc, ds, px, py, N_forward, N_reverse, sig[0], sig[1], window_growth, code, local_verdict,
-                        local_margin, window, stretches, oscillates, amplitude)
+                        local_margin, window, stretches, oscillates, amplitude, relay)
 
 
 @dataclass(frozen=True)
@@ -534,14 +566,14 @@ def _forced(route, arc, gains, line, V: float, transition: SampledTransition, pe
 
 
 def _stretches(paths, route, arc, ds, x, y, code, window_growth, worse, mean_N, N, has, boundary, growth, heading_stable, V, window,
-               efolds, oscillates, amplitude):
+               efolds, oscillates, amplitude, relay):
     """The runs of one verdict along each route, with their worst window's numbers (module docstring)."""
     out = []
     for r in range(len(paths)):
         idx = np.flatnonzero(route == r)
         if idx.size == 0:
             continue
-        breaks = np.flatnonzero(np.diff(code[idx]) != 0) + 1
+        breaks = np.flatnonzero(np.diff(code[idx] + 10 * relay[idx]) != 0) + 1
         for run in np.split(idx, breaks):
             first, last = run[0], run[-1]
             start, stop = float(arc[first] - ds[first] / 2), float(arc[last] + ds[last] / 2)
@@ -561,7 +593,9 @@ def _stretches(paths, route, arc, ds, x, y, code, window_growth, worse, mean_N, 
             Nw = Nw[np.isfinite(Nw)]
             numbers = _window_numbers(sigma, float(mean_N[d, k]), Nw, V, float(efolds[k]), code[first] == 0, boundary, growth, heading_stable)
             numbers["efolds"] = float(efolds[k])
-            if code[first] == 1 and not numbers["efolds"] >= EFOLDS:
+            if relay[first]:
+                numbers["label"] = "relay"  # the window-edge relay (`maps.relay`): a sustained oscillation of ~ a cell
+            elif code[first] == 1 and not numbers["efolds"] >= EFOLDS:
                 numbers["label"] = "oscillates"  # a forced weave (`_forced`), the loop itself damped
             out.append(PathStretch(**base, **numbers, direction=("forward", "reverse")[d], oscillates=bool(oscillates[run].any()),
                                    amplitude=float(amplitude[run].max())))

@@ -14,6 +14,7 @@ ROUTE_STYLES = {
     "stable": dict(color="#1a9641", lw=2.6, label="stable (a disturbance decays)"),
     "oscillates": dict(color="#fdae61", lw=3.2, label="unstable: the loop weaves (an episode over 3 periods)"),
     "unstable": dict(color="#d7191c", lw=3.6, label="unstable: a disturbance grows (>= 1 e-fold)"),
+    "relay": dict(color="#7b3294", lw=3.6, label="unstable: window-edge relay (a jump of the window's force)"),
     "wall ahead both ways": dict(color="0.45", lw=1.4, label="no verdict: wall ahead both ways", ls=(0, (1.5, 2.0))),
     "inside an obstacle": dict(color="0.3", lw=1.4, label="no verdict: inside an obstacle", ls=(0, (4.0, 2.0))),
 }
@@ -24,7 +25,7 @@ def _kind(stretch) -> str:
     if stretch.verdict == "stable":
         return "nothing grows" if stretch.label == "nothing grows" else "stable"
     if stretch.verdict == "unstable":
-        return "oscillates" if stretch.label == "oscillates" else "unstable"
+        return stretch.label if stretch.label in ("oscillates", "relay") else "unstable"
     return stretch.verdict if stretch.verdict in ROUTE_STYLES else "inside an obstacle"
 
 
@@ -74,6 +75,19 @@ def plot_route_verdicts(analysis, drives=None, ax=None, *, title: str | None = N
                       label=ROUTE_STYLES[k]["label"]) for k in kinds]
     validation = ""
     if drives is not None:
+        dp = getattr(drives, "drive_paths", None)
+        if dp is not None:  # the paths the drives between points took, and their unstable stretches (what they are scored on)
+            ax.add_collection(LineCollection([p.points for p in dp.paths], colors="0.55", linewidths=0.7, linestyles=[(0, (2.0, 2.0))], zorder=2.5))
+            handles.append(Line2D([], [], color="0.55", lw=0.7, ls=(0, (2.0, 2.0)), label="drives between points: the paths taken"))
+            for s in dp.stretches:
+                kind = _kind(s)
+                if s.verdict == "unstable":
+                    style = ROUTE_STYLES[kind]
+                    ax.add_collection(LineCollection([_stretch_lines(dp.paths, s)], colors=style["color"], linewidths=1.6, zorder=3.5,
+                                                     capstyle="butt"))
+                    if kind not in kinds:
+                        kinds.append(kind)
+                        handles.append(Line2D([], [], color=style["color"], lw=style["lw"], label=style["label"]))
         if drives.episode_points.size:
             ax.scatter(drives.episode_points[:, 0], drives.episode_points[:, 1], s=3, color="#c51b7d", alpha=0.5, zorder=6, lw=0)
             handles.append(Line2D([], [], marker="o", ls="", color="#c51b7d", markersize=5, label="simulated oscillation episodes"))

@@ -143,6 +143,9 @@ class DriveValidation:
         Robot positions during the episodes, m (for the picture).
     by_kind : dict
         ``route`` and ``waypoints``: the same recall, precision and lengths over that kind of drive only.
+    drive_paths : PathVerdicts or None
+        The verdicts along the paths the waypoint drives took (`maps.analysis.judge_routes`): those drives are scored
+        against them (a disagreement's ``route`` >= the map's route count is drive path ``route`` − that count).
     """
 
     recall: float | None
@@ -155,10 +158,12 @@ class DriveValidation:
     seconds: float = 0.0
     episode_points: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))
     by_kind: dict = field(default_factory=dict)
+    drive_paths: object = None
 
     def to_dict(self) -> dict:
         """JSON form."""
         return {
+            "drive_paths": self.drive_paths.to_dict() if self.drive_paths is not None else None,
             "recall": json_number(self.recall) if self.recall is not None else None,
             "precision": json_number(self.precision) if self.precision is not None else None,
             "by_kind": json_ready(self.by_kind),
@@ -227,6 +232,7 @@ def drive_map(analysis, count: int, *, seed: int = 0, progress=None) -> DriveVal
     """
     from scipy.spatial import cKDTree
 
+    from ..maps.analysis import judge_routes
     from ..maps.paths import PATH_VERDICTS
 
     started = time.perf_counter()
@@ -276,6 +282,20 @@ def drive_map(analysis, count: int, *, seed: int = 0, progress=None) -> DriveVal
         if progress:
             progress(f"map drives: batch {b}/{len(batches)}: {len(batch)} drives")
 
+    # the waypoint drives' own paths (period-averaged), judged like any route: prediction and episode on one path
+    taken, own = [], {}
+    for d, (t, x, y) in zip(drives, traces):
+        if d.kind == "waypoints":
+            try:
+                route = _taken_path(x, y, period, controller.T, analysis.grid.cell_size, len(taken), "drive")
+            except ValueError:  # fewer than two distinct points: the drive did not move
+                continue
+            own[d.index] = len(taken)
+            taken.append(route)
+    dp = judge_routes(analysis, taken, taken=True) if taken else None
+    sc = _Scored.of(pv, dp)
+    base = pv.code.size
+
     # route samples driven, and during episodes, per drive
     tree = cKDTree(np.column_stack([pv.samples.x, pv.samples.y]))
     limit = max(MATCH_DISTANCE, robot.W)
@@ -284,7 +304,12 @@ def drive_map(analysis, count: int, *, seed: int = 0, progress=None) -> DriveVal
         if t.size == 0:
             marks.append((np.zeros(0, dtype=int), np.zeros(0, dtype=int), 0.0))
             continue
-        dist, nearest = tree.query(np.column_stack([x, y]), distance_upper_bound=limit)
+        if d.index in own:  # its own path's samples only
+            mine = base + np.flatnonzero(dp.samples.segment == own[d.index])
+            dist, nearest = cKDTree(np.column_stack([sc.x[mine], sc.y[mine]])).query(np.column_stack([x, y]), distance_upper_bound=limit)
+            nearest = mine[np.minimum(nearest, mine.size - 1)]
+        else:
+            dist, nearest = tree.query(np.column_stack([x, y]), distance_upper_bound=limit)
         hit = np.isfinite(dist) & (t - t[0] >= min(period, 0.25 * d.duration))  # the start's transient is not measured
         during = np.zeros(t.size, dtype=bool)
         for lo, hi in d.episodes:
@@ -293,22 +318,22 @@ def drive_map(analysis, count: int, *, seed: int = 0, progress=None) -> DriveVal
         off = float(step[during & ~np.isfinite(dist)].sum())  # an episode where no route runs: measured, not scored
         marks.append((np.unique(nearest[hit]), np.unique(nearest[hit & during]), off))
         points.append(np.column_stack([x[during], y[during]]))
-    unstable = pv.code == PATH_VERDICTS.index("unstable")
+    unstable = sc.code == PATH_VERDICTS.index("unstable")
     half = pv.window / 2 if math.isfinite(pv.window) else 0.0
-    near_unstable = _within(unstable, pv.samples.segment, pv.arc, half)
-    lengths, recall, precision, driven, episode, near_episode = _score(pv, marks, range(len(drives)), unstable, near_unstable, half)
+    near_unstable = _within(unstable, sc.route, sc.arc, half)
+    lengths, recall, precision, driven, episode, near_episode = _score(sc, marks, range(len(drives)), unstable, near_unstable, half, base)
     by_kind = {}
     for kind in ("route", "waypoints"):
         chosen = [k for k, d in enumerate(drives) if d.kind == kind]
-        kind_lengths, kind_recall, kind_precision = _score(pv, marks, chosen, unstable, near_unstable, half)[:3]
+        kind_lengths, kind_recall, kind_precision = _score(sc, marks, chosen, unstable, near_unstable, half, base)[:3]
         by_kind[kind] = {"recall": json_number(kind_recall) if kind_recall is not None else None,
                          "precision": json_number(kind_precision) if kind_precision is not None else None, "lengths": kind_lengths}
-    passed_by = [set() for _ in range(pv.code.size)]
+    passed_by = [set() for _ in range(sc.code.size)]
     for d, (hit, _, _) in zip(drives, marks):
         for k in hit:
             passed_by[k].add(d.index)
-    disagreements = (_runs("missed", episode & ~near_unstable, pv, passed_by)
-                     + _runs("false alarm", unstable & driven & ~near_episode, pv, passed_by))
+    disagreements = (_runs("missed", episode & ~near_unstable, sc, passed_by)
+                     + _runs("false alarm", unstable & driven & ~near_episode, sc, passed_by))
     events = [d.event or "time" for d in drives]
     counts = {"drives": len(drives), "not_started": skipped, "route_drives": sum(d.kind == "route" for d in drives),
               "waypoint_drives": sum(d.kind == "waypoints" for d in drives), "episodes": sum(len(d.episodes) for d in drives),
@@ -318,28 +343,51 @@ def drive_map(analysis, count: int, *, seed: int = 0, progress=None) -> DriveVal
               "noise_floor": NOISE_FLOOR, "match_distance": limit, "start_offset": START_OFFSET}
     pts = np.vstack(points) if points else np.zeros((0, 2))
     return DriveValidation(recall, precision, tuple(drives), disagreements, lengths, counts, inputs, time.perf_counter() - started, pts,
-                           by_kind)
+                           by_kind, dp)
 
 
-def _score(pv, marks, chosen, unstable, near_unstable, half):
-    """(lengths, recall, precision, driven, episode, near_episode) of the drives `chosen` (module docstring)."""
-    driven = np.zeros(pv.code.size, dtype=bool)
-    episode = np.zeros(pv.code.size, dtype=bool)
+@dataclass(frozen=True)
+class _Scored:
+    """The samples scored: the map's routes' (`PathVerdicts`), then the waypoint drives' own paths' (route index
+    offset by the map's routes)."""
+
+    code: np.ndarray
+    route: np.ndarray
+    arc: np.ndarray
+    spacing: np.ndarray
+    x: np.ndarray
+    y: np.ndarray
+
+    @classmethod
+    def of(cls, pv, dp=None) -> "_Scored":
+        parts = [(pv.code, pv.samples.segment, pv.arc, pv.spacing, pv.samples.x, pv.samples.y)]
+        if dp is not None:
+            parts.append((dp.code, dp.samples.segment + len(pv.paths), dp.arc, dp.spacing, dp.samples.x, dp.samples.y))
+        return cls(*(np.concatenate(a) for a in zip(*parts)))
+
+
+def _score(sc, marks, chosen, unstable, near_unstable, half, base):
+    """(lengths, recall, precision, driven, episode, near_episode) of the drives `chosen` (module docstring); the
+    first `base` samples are the map's routes', the rest the drives' own paths'."""
+    driven = np.zeros(sc.code.size, dtype=bool)
+    episode = np.zeros(sc.code.size, dtype=bool)
     off_route = 0.0
     for k in chosen:
         hit, during, off = marks[k]
         driven[hit] = True
         episode[during] = True
         off_route += off
-    near_episode = _within(episode, pv.samples.segment, pv.arc, half)
-    ds = pv.spacing
+    near_episode = _within(episode, sc.route, sc.arc, half)
+    ds = sc.spacing
+    on_map = np.arange(ds.size) < base
     lengths = {
-        "route": float(ds.sum()), "driven": float(ds[driven].sum()), "not_driven": float(ds[~driven].sum()),
+        "route": float(ds[on_map].sum()), "driven": float(ds[driven & on_map].sum()), "not_driven": float(ds[~driven & on_map].sum()),
+        "drive_paths": float(ds[~on_map].sum()), "drive_paths_driven": float(ds[driven & ~on_map].sum()),
         "episode": float(ds[episode].sum()), "episode_recalled": float(ds[episode & near_unstable].sum()),
         "episode_off_route": off_route,
         "predicted_unstable_driven": float(ds[unstable & driven].sum()),
         "predicted_unstable_matched": float(ds[unstable & driven & near_episode].sum()),
-        "predicted_unstable_not_driven": float(ds[unstable & ~driven].sum()),
+        "predicted_unstable_not_driven": float(ds[unstable & ~driven & on_map].sum()),
     }
     recall = lengths["episode_recalled"] / lengths["episode"] if lengths["episode"] > 0 else None
     precision = (lengths["predicted_unstable_matched"] / lengths["predicted_unstable_driven"]
@@ -378,21 +426,36 @@ def _within(mask: np.ndarray, route: np.ndarray, arc: np.ndarray, half: float) -
     return out
 
 
-def _runs(kind: str, mask: np.ndarray, pv, passed_by) -> tuple:
+def _runs(kind: str, mask: np.ndarray, sc, passed_by) -> tuple:
     """The stretches of consecutive `mask` samples of each route, as `Disagreement`s."""
     out = []
-    route = pv.samples.segment
+    route = sc.route
     for r in np.unique(route[mask]):
         idx = np.flatnonzero(route == r)
         m = mask[idx]
         edges = np.flatnonzero(np.diff(np.concatenate([[0], m.astype(int), [0]])))
         for a, b in zip(edges[::2], edges[1::2]):
             run = idx[a:b]
-            start, stop = float(pv.arc[run[0]] - pv.spacing[run[0]] / 2), float(pv.arc[run[-1]] + pv.spacing[run[-1]] / 2)
+            start, stop = float(sc.arc[run[0]] - sc.spacing[run[0]] / 2), float(sc.arc[run[-1]] + sc.spacing[run[-1]] / 2)
             drives = sorted(set().union(*(passed_by[k] for k in run)))
-            out.append(Disagreement(kind, int(r), start, stop, float(pv.spacing[run].sum()), float(pv.samples.x[run[0]]),
-                                    float(pv.samples.y[run[0]]), float(pv.samples.x[run[-1]]), float(pv.samples.y[run[-1]]), tuple(drives)))
+            out.append(Disagreement(kind, int(r), start, stop, float(sc.spacing[run].sum()), float(sc.x[run[0]]),
+                                    float(sc.y[run[0]]), float(sc.x[run[-1]]), float(sc.y[run[-1]]), tuple(drives)))
     return tuple(out)
+
+
+def _taken_path(x, y, period: float, T: float, cell: float, index: int, source: str):
+    """The path a drive took: its positions (m) averaged over one period (s; the controller's step T, s), a point
+    every `cell` m of arc (`routes.path_of`, route `index`, `source`)."""
+    from scipy.ndimage import uniform_filter1d
+
+    from ..maps.routes import path_of
+
+    n = max(1, int(round(period / T)))
+    x, y = uniform_filter1d(x, n, mode="nearest"), uniform_filter1d(y, n, mode="nearest")
+    arc = np.concatenate([[0.0], np.cumsum(np.hypot(np.diff(x), np.diff(y)))])
+    step = np.flatnonzero(np.diff(np.concatenate([[-1.0], arc // cell])) > 0)  # a point every cell
+    points = np.column_stack([x[step], y[step]]) if step.size >= 2 else np.column_stack([x[[0, -1]], y[[0, -1]]])
+    return path_of(points, index, source)
 
 
 def goal_routes(analysis, goals, progress=None) -> list:
@@ -410,10 +473,6 @@ def goal_routes(analysis, goals, progress=None) -> list:
     progress : callable, optional
         ``progress(line)`` once the drives are done.
     """
-    from scipy.ndimage import uniform_filter1d
-
-    from ..maps.routes import path_of
-
     goals = np.asarray(goals, dtype=float).reshape(-1, 2)
     if len(goals) < 2:
         raise ValueError(f"goals must hold at least two points (m); got {len(goals)}")
@@ -433,15 +492,8 @@ def goal_routes(analysis, goals, progress=None) -> list:
         except ValueError as exc:
             raise ValueError(f"goal {k + 1} -> {k + 2}: {exc}") from None
     outcome = run_batch(scenarios, record="trajectory", metrics=False)
-    routes = []
-    for k, run in enumerate(outcome.runs):
-        tr = run.trajectory
-        n = max(1, int(round(period / controller.T)))
-        x, y = uniform_filter1d(tr.x, n, mode="nearest"), uniform_filter1d(tr.y, n, mode="nearest")
-        arc = np.concatenate([[0.0], np.cumsum(np.hypot(np.diff(x), np.diff(y)))])
-        step = np.flatnonzero(np.diff(np.concatenate([[-1.0], arc // analysis.grid.cell_size])) > 0)  # a point every cell
-        points = np.column_stack([x[step], y[step]]) if step.size >= 2 else np.column_stack([x[[0, -1]], y[[0, -1]]])
-        routes.append(path_of(points, k, "goals"))
+    routes = [_taken_path(run.trajectory.x, run.trajectory.y, period, controller.T, analysis.grid.cell_size, k, "goals")
+              for k, run in enumerate(outcome.runs)]
     if progress:
         progress(f"goals: {len(routes)} drives between {len(goals)} goals")
     return routes
