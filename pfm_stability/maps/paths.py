@@ -63,7 +63,7 @@ from ..models.verdicts import inside as in_set, judge_arrays
 from .equilibria import Samples, equilibria_at, lateral_force
 from .episodes import AMPLITUDE_THRESHOLD
 from .relay import relay_amplitude, window_relay
-from .routes import RoutePath
+from .routes import RoutePath  # noqa: F401 (named in the docstrings and annotations)
 from .verdicts import EFOLDS, END_FRACTION, GrowthRate, critical_speed, effective_gain, wavelength
 
 __all__ = ["PATH_VERDICTS", "RENORMALIZE", "ROUND_OFF_EFOLDS", "UNJUDGED", "WINDOW_PERIODS", "PathStretch", "PathVerdicts", "SampledTransition",

@@ -202,7 +202,6 @@ class FieldArrays:
         self.tvx, self.tvy = np.array([t.velocity[0] for t in targets]), np.array([t.velocity[1] for t in targets])
 
     def _compile_repulsion(self, fields):
-        B = self.size
         rep = [f.repulsion for f in fields]
         self.repels = np.array([r is not None for r in rep], dtype=bool)
         self.nearest_only = np.array([f.nearest_only for f in fields], dtype=bool)[:, None]

@@ -9,7 +9,6 @@ on that part), whether it is steady, and whether the robot touched a wall.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
