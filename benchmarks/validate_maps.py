@@ -65,7 +65,7 @@ def analysed(name: str, p: dict):
     robot = CARMEL.robot.replace(W=p["W"], tau=p["tau"], k=p["k"], V=p["V"])
     controller = CARMEL.controller.replace(T=p["T"], f=p["f"])
     law = make_law("grid", robot, controller, cell_size=p["cell_size"], window_cells=p.get("window", 33))
-    analysis = analyze_map(load_map(MAPS / f"{name}.yaml"), robot, controller, law, min_length=p["min_length"],
+    analysis = analyze_map(load_map(MAPS / f"{name}.yaml"), robot, controller, law, min_length=p["min_length"], along_routes=False,
                            end_fraction=p.get("end_fraction", END_FRACTION), taper_slope=p.get("taper_slope", TAPER_SLOPE))
     return analysis, robot, controller, law
 

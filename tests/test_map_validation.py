@@ -346,7 +346,7 @@ def _shipped(name: str, V: float):
     robot = CARMEL.robot.replace(W=0.4, tau=0.1, k=20.0, V=V)
     controller = CARMEL.controller.replace(T=0.025, f=2.0)
     law = make_law("grid", robot, controller, cell_size=0.1, window_cells=33)
-    return analyze_map(load_map(maps / f"{name}.yaml"), robot, controller, law), robot, controller, law
+    return analyze_map(load_map(maps / f"{name}.yaml"), robot, controller, law, along_routes=False), robot, controller, law
 
 
 @pytest.mark.slow  # seconds: scheduled first (tests/conftest.py)

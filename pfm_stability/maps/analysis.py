@@ -344,7 +344,7 @@ def corridor_warnings(occupancy: OccupancyMap, grid: HistogramMap, routes, clear
 def analyze_map(occupancy: OccupancyMap, robot: Robot, controller: Controller, law: ForceLaw, *, model: str = "sampled",
                 unknown: str = "occupied", cell_size: float | None = None, min_length: float | None = None,
                 progress=None, end_fraction: float = END_FRACTION, taper_slope: float = TAPER_SLOPE, warn=None,
-                routes=()) -> MapAnalysis:
+                routes=(), along_routes: bool = True) -> MapAnalysis:
     """Every corridor segment of a map, decided (module docstring).
 
     Parameters
@@ -375,6 +375,9 @@ def analyze_map(occupancy: OccupancyMap, robot: Robot, controller: Controller, l
         `corridor_warnings` once the routes are found); the warnings are also in `MapAnalysis.warnings`.
     routes : sequence of RoutePath
         The user's own routes (`user_routes.read_routes`), judged after the skeleton's (`MapAnalysis.paths`; grid law).
+    along_routes : bool
+        Judge every route (`MapAnalysis.paths`, the grid law's); False: the straight segments alone (``paths`` None,
+        the user's routes refused), for work that reads only the segments (their validation by simulation).
 
     Raises
     ------
@@ -415,8 +418,8 @@ def analyze_map(occupancy: OccupancyMap, robot: Robot, controller: Controller, l
         raise ValueError(f"map {occupancy.name!r} has no free space (every cell is occupied{'' if unknown == 'free' else ' or unknown'})")
     stage("grid")
     routes, skeleton, clearance = find_routes(grid, robot.W, min_length)
-    paths = find_paths(grid, skeleton, clearance) if is_grid else []
-    if own_routes and not is_grid:
+    paths = find_paths(grid, skeleton, clearance) if is_grid and along_routes else []
+    if own_routes and not (is_grid and along_routes):
         raise ValueError("routes need --law grid: a route is judged with the histogram grid's field")
     paths = paths + [replace(r, branch=len(paths) + k) for k, r in enumerate(own_routes)]
     shortest = min_length if min_length is not None else default_min_length(robot.W)
@@ -443,7 +446,7 @@ def analyze_map(occupancy: OccupancyMap, robot: Robot, controller: Controller, l
     transition = SampledTransition.of(loop_model, loop) if loop_model.name == "sampled" else None
     along = analyze_paths(grid, law, paths, clearance, robot.W, robot.V, boundary, growth, heading_stable, transition,
                           end_fraction) if paths else None
-    if is_grid:
+    if is_grid and along_routes:
         stage("paths")
     return MapAnalysis(occupancy, grid, law, robot, controller, loop_model.name, boundary.NV_critical, segments, samples,
                        skeleton, clearance, unknown, timing, tuple(warnings), along)
