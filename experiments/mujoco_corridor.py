@@ -34,6 +34,7 @@ import math
 import os
 import sys
 import time
+from pathlib import Path
 from concurrent.futures import ProcessPoolExecutor
 
 ROBOTS = {"diffdrive": 0.5, "diffdrive-heavy": 0.6}
@@ -216,7 +217,7 @@ def _call(job):
 
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--out-dir", default="mujoco_corridor_out")
+    parser.add_argument("--out-dir", default=str(Path(__file__).resolve().parent / "results"), help="output folder (default: experiments/results)")
     parser.add_argument("--quick", action="store_true", help="one robot, one corridor, one T, no ablation")
     parser.add_argument("--workers", type=int, default=2, help="processes (default 2)")
     args = parser.parse_args(argv)
