@@ -385,11 +385,38 @@ def test_batched_reduction_is_the_scan_by_scan_one(driven, read):
 
 
 def test_another_law_in_the_configuration_is_refused(driven, tmp_path):
-    """diagnose predicts with KB's power law: a configuration whose law is another is refused in one line, not ignored."""
-    config = tmp_path / "grid.yaml"
-    config.write_text(CONFIG + "law: grid\n")
+    """diagnose predicts with KB's power law or the grid's law: a configuration whose law is another is refused in one
+    line, not ignored."""
+    config = tmp_path / "khatib.yaml"
+    config.write_text(CONFIG + "law: {name: khatib, goal_distance: 1.0}\n")
     code, out, err = run(["diagnose", str(driven[1]), "--config", str(config)])
-    assert code == 2 and out == "" and err.count("\n") == 1 and "law grid of --config" in err
+    assert code == 2 and out == "" and err.count("\n") == 1 and "law khatib of --config" in err
+
+
+def test_the_grid_law_of_the_configuration_is_the_one_predicted_with(driven, tmp_path):
+    """``law: grid`` in the configuration: the predictions use the grid's law. The loop (the identified plant, k, T) is
+    the same as with KB's power law, so each model's NV* is too, and V* = NV*/N: the ratio of the sampled V* under the
+    two laws is the inverse ratio of their corridor gains at the measured L (`corridor_gain` of each law built by
+    `make_law`, an independent evaluation; 1e-9 relative)."""
+    from pfm_stability.laws.fields import make_law
+    from pfm_stability.laws.force_law import corridor_gain
+    from pfm_stability.parameters import Controller, Robot
+
+    grid_config = tmp_path / "grid.yaml"
+    grid_config.write_text(CONFIG + "law: {name: grid, cell_ratio: 0.3}\n")
+    answers = []
+    for config in (driven[2], grid_config):
+        code, out, err = run(["diagnose", str(driven[1]), "--config", str(config), "--format", "json"])
+        assert code == 0, err
+        data = json.loads(out)
+        stretch = next(s for s in data["stretches"] if s["judged"] and s["kind"] == "corridor")
+        answers.append((stretch["L"], stretch["predicted"]["sampled"]["V_critical"]))
+    (L, V_power), (L_grid, V_grid) = answers
+    assert L == L_grid
+    robot, controller = Robot(V=0.8, tau=0.3, k=2.0, W=0.8), Controller(f=0.8, n=2.0, T=0.065)
+    N_power = corridor_gain(make_law("power", robot, controller), L)
+    N_grid = corridor_gain(make_law("grid", robot, controller, cell_ratio=0.3), L)
+    assert V_grid / V_power == pytest.approx(N_power / N_grid, rel=1e-9)
 
 
 def test_a_bag_without_commands_is_diagnosed_when_tau_and_T_are_given(tmp_path):

@@ -9,7 +9,7 @@ from the scans in the odometry's frame (`pfm_stability.analysis.stretches`); on 
 is measured and set against every loop model's prediction (`pfm_stability.validation.diagnose`). k, W, f and n
 cannot come from a log: ``--config`` (or the options) must give them; τ and T come from the same log
 (`pfm_stability.analysis.identification`) unless given, and with them D and g unless given. The law is KB's power
-law (a configuration naming another is refused). JSON keys (`pfm_stability/io/schema/output.schema.json`,
+law, or the grid's law when the configuration says ``law: grid`` (another is refused). JSON keys (`pfm_stability/io/schema/output.schema.json`,
 ``$defs/diagnose``): ``verdict``, ``reason``, ``measured`` (``omega``, ``sigma``, ``amplitude``, ``stretch``),
 ``predicted.<model>`` (``stable``, ``V_critical``, ``margin``, ``omega``, ``sigma`` …), ``matching_model``,
 ``margin``, ``critical`` (V*, T*, k*), ``remedies``, ``stretches`` (each with its own), ``parameters``,
@@ -32,6 +32,28 @@ SCAN_BATCH = 256
 
 _KEYS = {"k": "robot.k", "W": "robot.W", "f": "controller.f", "n": "controller.n", "tau": "robot.tau", "T": "controller.T"}
 """Parameter → its key in a configuration file (docs/config.md)."""
+
+
+DIAGNOSE_LAWS = ("power", "grid")
+"""The lateral laws diagnose predicts with: KB's power law, or the law a histogram grid's cells exert (a VFF controller
+on a real grid, docs/simulator.md), from the configuration's ``law`` (its ``cell_ratio``, ``cell_size``, ``window_cells``)."""
+
+
+def _law(law: dict, robot, controller):
+    """The configuration's law built for the robot (None: KB's power law, `diagnose`'s default).
+
+    Parameters
+    ----------
+    law : dict
+        The configuration's ``law`` mapping (``name`` and the law's parameters), or empty.
+    robot, controller : Robot, Controller
+        The robot (W) and controller (f, n) the law is built for.
+    """
+    if not law or law.get("name") == "power":
+        return None
+    from ..laws.fields import make_law
+
+    return make_law(law["name"], robot, controller, **{k: v for k, v in law.items() if k != "name"})
 
 
 def add_parser(sub) -> None:
@@ -87,9 +109,9 @@ def run(args) -> int:
         raise ValueError(f"diagnose needs {', '.join(missing)}, which a log cannot show (the steering gain, the robot's width, "
                          f"the law): give {', '.join(_KEYS[m] for m in missing)} in --config ROBOT.yaml "
                          f"(or {' '.join('--' + m for m in missing)})")
-    law = params.config.law if params.config is not None else None
-    if law and law.get("name") != "power":
-        raise ValueError(f"diagnose predicts with KB's power law f(W/d)^n (controller.f, controller.n); "
+    law = (params.config.law if params.config is not None else None) or {}
+    if law and law.get("name") not in DIAGNOSE_LAWS:
+        raise ValueError(f"diagnose predicts with KB's power law f(W/d)^n or the histogram grid's law (law: power or grid); "
                          f"law {law.get('name')} of --config {params.config.path} is not one it takes")
     require("logs", "pfm-stability diagnose")
     to_identify = needs_identification(params.sources)
@@ -98,7 +120,7 @@ def run(args) -> int:
     log = read_log(args.log, topics, need=need, scan_reducer=wall_lines_batch, scan_batch=SCAN_BATCH)
     identification = identify(log, "odometry") if to_identify else None
     robot, controller, sources = complete_from_log(params.robot, params.controller, params.sources, identification)
-    result = diagnose(log, robot, controller)
+    result = diagnose(log, robot, controller, law=_law(law, robot, controller))
     if result.judged is not None:
         sources["V"] = f"measured on stretch {result.worst} (the odometry's forward speed)"
     if args.plot:
