@@ -276,3 +276,49 @@ def test_engine_refusals():
     with pytest.raises(ValueError, match="corridor"):
         run_scenario(make_scenario("wall", env="grid", robot=ROBOT, controller=CONTROLLER, duration=1))
     assert check_drives(load_robot_model("diffdrive").path).tilt < 1.0
+
+
+@pytest.mark.slow
+def test_diagnose_reads_a_mujoco_corridor_run_on_both_sides_of_its_boundary(tmp_path):
+    """MuJoCo's ``diffdrive`` in a 0.9 m corridor (k = 2 1/s, f = 3, n = 2, T = 0.1 s, command hold, compute delay 1:
+    experiments/mujoco_corridor.py), recorded by `corridor_log` (commands, 50 Hz odometry pose, 10 Hz scans of 360 rays
+    cast by MuJoCo) and written as ROS 2 bags (tests/log_helpers' writer); its plant identified from a step/chirp drive
+    at the boundary's speed as the experiment does. `diagnose` given k, W, f, n, T, τ, D, g and the law the engine's
+    controller applies (the grid's, `scenario_law`, as the experiment predicts) judges the run at 0.85·V* stable and
+    the one at 1.15·V* oscillating, measured and predicted, and its ``sampled`` V* lies within 5 % of V* = 1.2245 m/s,
+    the boundary bisected in MuJoCo to 0.2 % (experiments/results/mujoco_corridor.json; the experiment's sampled
+    prediction is +1.6 % from it; the plant identified here from a 24-s drive is the experiment's 60-s one within 1 %).
+    The measured V (the odometry's speed, the casters' drag) and L (fitted to the scans) enter the prediction, so the
+    bound is the experiment's gap plus what the log's measurement adds."""
+    from log_helpers import Plant, Recording, SyntheticLog, write_ros2
+    from pfm_stability.analysis.identification import identify
+    from pfm_stability.analysis.stretches import wall_lines
+    from pfm_stability.engines.mujoco import corridor_log
+    from pfm_stability.io.logs import read_log
+    from pfm_stability.sim.scenario import scenario_law
+    from pfm_stability.validation.diagnose import diagnose
+
+    V_mujoco = 1.2245062543053884
+    log = drive_log("both", V=1.23, T=0.05, amplitude=0.1, duration=24.0)
+    write_csv_log(log, tmp_path / "identify.csv")
+    plant = identify(read_log(tmp_path / "identify.csv", need=("command", "imu")), "imu").plant
+    g, tau, D = plant.g.value, plant.tau.value, max(plant.dead_time.value, 0.0)
+    assert g == pytest.approx(0.7535, rel=0.01) and tau == pytest.approx(0.1294, rel=0.02)  # the experiment's 60-s log
+    controller = Controller(f=3.0, n=2.0, T=0.1, hold="command", compute_delay=1)
+    results = []
+    for factor, stable in ((0.85, True), (1.15, False)):
+        robot = Robot(V=factor * V_mujoco, tau=tau, k=2.0, W=0.5, plant_gain=g, dead_time=D)
+        run = corridor_log(make_scenario("corridor", env="grid", robot=robot, controller=controller, L=0.9, offset=0.05, duration=20.0))
+        synthetic = SyntheticLog(Plant(g=g, tau=tau, dead_time=D), Recording(T=0.1, scan_rate=10.0), run.cmd_t, run.cmd_wz, run.cmd_vx,
+                                 run.odom_t, run.odom_wz, scan_t=run.scan_t, odom_x=run.odom_x, odom_y=run.odom_y,
+                                 odom_yaw=run.odom_yaw, odom_vx=run.odom_vx, scan_ranges=run.scan_ranges)
+        bag = write_ros2(synthetic, tmp_path / f"run{factor}", storage="mcap")
+        result = diagnose(read_log(bag, need=("pose", "scan"), scan_reducer=wall_lines), robot, controller,
+                          law=scenario_law("grid", robot, controller))
+        s = result.judged
+        assert s is not None and s.stretch.kind == "corridor", result.reason
+        assert s.geometry == pytest.approx(0.9, abs=0.01)
+        assert s.measured.stable is stable and s.predicted["sampled"].stable is stable, (factor, s.measured, s.predicted["sampled"])
+        results.append((factor, s.V, s.predicted["sampled"].V_critical, s.measured.sigma, s.measured.omega))
+    for factor, V, V_critical, sigma, omega in results:
+        assert V_critical == pytest.approx(V_mujoco, rel=0.05), results

@@ -48,7 +48,8 @@ from ..sim.vff import cell_repulsion, direction_of, steering_command, wrap_angle
 from .robots import WALL_GROUP, check_drives, corridor_world, heading, load_robot_model, place
 
 __all__ = ["EngineOptions", "run_scenario", "run_scenarios", "MujocoRuns", "DriveLog", "drive_log", "write_csv_log",
-           "SENSING", "PROFILES", "engine_timestep"]
+           "SENSING", "PROFILES", "engine_timestep",
+           "CorridorLog", "corridor_log"]
 
 SENSING = ("rays", "drawn")
 """Where the controller's grid comes from: MuJoCo's ray casts (default) or the scenario's drawn grid (an ablation:
@@ -170,6 +171,11 @@ def run_scenario(scenario, options: EngineOptions = EngineOptions(), *, record: 
     ValueError
         A scenario the engine does not run (module docstring), a robot file that cannot be read or cannot drive.
     """
+    return _run(scenario, options, record, metrics, None)
+
+
+def _run(scenario, options: EngineOptions, record: str, metrics: bool, recorder) -> RunResult:
+    """`run_scenario`'s loop; `recorder` (a `_Recorder` or None) logs the run as a robot would."""
     import mujoco
 
     _check_scenario(scenario)
@@ -206,6 +212,8 @@ def run_scenario(scenario, options: EngineOptions = EngineOptions(), *, record: 
     dist = np.zeros(options.rays)
 
     place(model, data, robot, scenario.start.x, scenario.start.y, scenario.start.theta, r.V)
+    if recorder is not None:
+        recorder.start(model, data, dt, base, lidar, group)
     steps = int(math.ceil(scenario.duration / c.T - 1e-9))
     lat, along = scenario.measure.lateral_unit, scenario.measure.along_unit
     ox_, oy_ = scenario.measure.origin
@@ -248,6 +256,8 @@ def run_scenario(scenario, options: EngineOptions = EngineOptions(), *, record: 
         applied = pending if c.compute_delay == 1 else u
         pending = u
         queue.append((now + delay_steps, *robot.wheel_speeds(r.V, applied)))
+        if recorder is not None:
+            recorder.command(now * dt, -applied, r.V)  # published when applied to the command path; ROS yaw rate = −θ̇
         # advance one period, switching the wheels' targets when a command arrives
         end = now + per_period
         while now < end:
@@ -255,6 +265,10 @@ def run_scenario(scenario, options: EngineOptions = EngineOptions(), *, record: 
                 _, data.ctrl[left], data.ctrl[right] = queue.pop(0)
                 continue
             nxt = min(end, queue[0][0]) if queue else end
+            if recorder is not None:
+                if recorder.due(now):
+                    recorder.sample(now)
+                nxt = min(nxt, recorder.next_step(now))
             mujoco.mj_step(model, data, nstep=nxt - now)
             now = nxt
             if data.ncon and any(int(g) in walls for pair in data.contact.geom[: data.ncon] for g in pair):
@@ -277,6 +291,122 @@ def run_scenario(scenario, options: EngineOptions = EngineOptions(), *, record: 
     trajectory = Trajectory(t, pose[:n, 0].copy(), pose[:n, 1].copy(), pose[:n, 2].copy()) if pose is not None else None
     clearance = float(L - np.max(np.abs(off[:n] + scenario.measure.origin[0] * lat[0]))) - r.W / 2 if n else None
     return RunResult(scenario, (event,) if event else (), m, done * c.T, done, offset_t, offset.copy(), clearance, trajectory)
+
+
+# ----------------------------------------------------------------------------------- closed-loop logs
+@dataclass(frozen=True)
+class CorridorLog:
+    """A corridor run recorded as a robot's log (times in s from the start; world frame = odometry frame).
+
+    Attributes
+    ----------
+    run : RunResult
+        The run itself (`run_scenario`'s result).
+    cmd_t, cmd_wz, cmd_vx : ndarray
+        Every period's command, stamped when it is published (when it enters the command path), its yaw rate
+        (rad/s, ROS sign: counter-clockwise positive) and forward speed (m/s).
+    odom_t, odom_x, odom_y, odom_yaw, odom_vx, odom_wz : ndarray
+        The base's pose (m, m, rad: yaw from +x towards +y) and its forward speed (m/s) and yaw rate (rad/s), MuJoCo's
+        state, at the odometry's rate.
+    scan_t, scan_ranges : ndarray
+        The scans' times and ranges (scans × beams, m; inf: no wall within the range), beam i at angle −π + 2πi/beams
+        from the base's heading (counter-clockwise), cast from the ``lidar`` site by `mujoco.mj_multiRay`.
+    """
+
+    run: RunResult
+    cmd_t: np.ndarray
+    cmd_wz: np.ndarray
+    cmd_vx: np.ndarray
+    odom_t: np.ndarray
+    odom_x: np.ndarray
+    odom_y: np.ndarray
+    odom_yaw: np.ndarray
+    odom_vx: np.ndarray
+    odom_wz: np.ndarray
+    scan_t: np.ndarray
+    scan_ranges: np.ndarray
+
+
+class _Recorder:
+    """Samples the odometry and the scans of a run at whole engine steps (`_run` stops the engine at each)."""
+
+    def __init__(self, odom_rate: float, scan_rate: float, beams: int, scan_range: float):
+        self.odom_rate, self.scan_rate, self.beams, self.scan_range = odom_rate, scan_rate, beams, scan_range
+        self.cmd, self.odom, self.scans, self.scan_t = [], [], [], []
+        self.done = -1
+
+    def start(self, model, data, dt, base, lidar, group):
+        self.model, self.data, self.dt, self.base, self.lidar, self.group = model, data, dt, base, lidar, group
+        self.dof = model.jnt_dofadr[model.body_jntadr[base]]
+        self.odom_every = max(1, int(round(1.0 / (self.odom_rate * dt))))
+        self.scan_every = max(1, int(round(1.0 / (self.scan_rate * dt))))
+        self.angles = -math.pi + 2 * math.pi * np.arange(self.beams) / self.beams
+        self.geomid = np.zeros(self.beams, dtype=np.int32)
+        self.dist = np.zeros(self.beams)
+
+    def command(self, t: float, wz: float, vx: float):
+        self.cmd.append((t, wz, vx))
+
+    def due(self, step: int) -> bool:
+        return step > self.done and (step % self.odom_every == 0 or step % self.scan_every == 0)
+
+    def next_step(self, step: int) -> int:
+        return min((step // e + 1) * e for e in (self.odom_every, self.scan_every))
+
+    def sample(self, step: int):
+        import mujoco
+
+        self.done = step
+        data, t = self.data, step * self.dt
+        R = data.xmat[self.base]
+        yaw = math.atan2(R[3], R[0])
+        if step % self.odom_every == 0:
+            v = data.qvel[self.dof:self.dof + 2]
+            self.odom.append((t, float(data.xpos[self.base][0]), float(data.xpos[self.base][1]), yaw,
+                              float(v[0] * math.cos(yaw) + v[1] * math.sin(yaw)), float(data.qvel[self.dof + 5])))
+        if step % self.scan_every == 0:
+            a = yaw + self.angles
+            vec = np.column_stack([np.cos(a), np.sin(a), np.zeros(self.beams)])
+            mujoco.mj_multiRay(self.model, data, data.site_xpos[self.lidar].copy(), vec.ravel(), self.group, 1, self.base,
+                               self.geomid, self.dist, None, self.beams, self.scan_range)
+            self.scan_t.append(t)
+            self.scans.append(np.where(self.geomid >= 0, self.dist, np.inf))
+
+
+def corridor_log(scenario, options: EngineOptions = EngineOptions(), *, odom_rate: float = 50.0, scan_rate: float = 10.0,
+                 beams: int = 360, scan_range: float = 30.0) -> CorridorLog:
+    """One corridor run (`run_scenario`) recorded as a robot's log: what ``pfm-stability diagnose`` reads
+    (docs/mujoco.md, "Logs of corridor runs").
+
+    Parameters
+    ----------
+    scenario : Scenario
+        A ``corridor`` scenario in the grid (`run_scenario`).
+    options : EngineOptions
+        The robot file and the engine's settings.
+    odom_rate : float
+        The odometry's rate, Hz, in (0, 1000] (rounded to whole engine steps).
+    scan_rate : float
+        The scans' rate, Hz, in (0, 1000] (rounded to whole engine steps).
+    beams : int
+        Beams per scan, in [8, 10000].
+    scan_range : float
+        The scans' reach, m, in (0, 100].
+
+    Returns
+    -------
+    CorridorLog
+    """
+    odom_rate = check_number("odom_rate", odom_rate, 0.0, 1000.0, unit="Hz")
+    scan_rate = check_number("scan_rate", scan_rate, 0.0, 1000.0, unit="Hz")
+    beams = check_integer("beams", beams, 8, 10_000)
+    scan_range = check_number("scan_range", scan_range, 0.0, 100.0, unit="m")
+    rec = _Recorder(odom_rate, scan_rate, beams, scan_range)
+    run = _run(scenario, options, "offset", True, rec)
+    cmd = np.asarray(rec.cmd, dtype=float).reshape(-1, 3)
+    odom = np.asarray(rec.odom, dtype=float).reshape(-1, 6)
+    return CorridorLog(run, cmd[:, 0], cmd[:, 1], cmd[:, 2], *odom.T, np.asarray(rec.scan_t, dtype=float),
+                       np.asarray(rec.scans, dtype=float).reshape(-1, beams))
 
 
 def run_scenarios(scenarios, options: EngineOptions = EngineOptions(), *, record: str = "offset", metrics: bool = True) -> BatchResult:
