@@ -75,6 +75,9 @@ def add_parser(sub) -> None:
                    help="with --out-dir: extend each unstable route stretch's slow zone of the speed mask by the braking distance "
                    f"(V^2 - V*^2)/(2 A_MAX) along its route, both ways (Nav2's speed filter slows the robot only inside a zone), "
                    f"A_MAX {describe('dilate_upstream')}")
+    p.add_argument("--wobble", type=number("wobble"), metavar="TOL",
+                   help="the speed mask's segment zones at V_tolerance, the fastest speed whose wobble stays under TOL "
+                   f"(docs/wobble.md), instead of V* where the describing function is trusted; route stretches keep V*; TOL {describe('wobble')}")
     p.add_argument("--format", choices=FORMATS, default="text")
     p.add_argument("--quiet", action="store_true", help="no progress on stderr")
     p.set_defaults(run=run)
@@ -185,6 +188,12 @@ def run(args) -> int:
                                warn=lambda line: print(f"pfm-stability: warning: {line}", file=sys.stderr, flush=True), routes=routes)
         if args.goals:
             analysis = _with_goals(analysis, args.goals, progress)
+        if args.wobble is not None:
+            from ..maps.wobble import with_wobble
+
+            analysis = with_wobble(analysis, args.wobble)
+            if progress is not None:
+                progress("wobble done")
         validation = _validate(analysis, args.validate, args.seed, progress) if args.validate and analysis.segments else None
         drives = _drive(analysis, args.validate, args.seed, progress) if args.validate and analysis.paths is not None else None
         outputs = _write_outputs(analysis, args.out_dir, drives, args.dilate_upstream) if args.out_dir else None

@@ -55,6 +55,7 @@ from .field import UNKNOWN_AS, HistogramMap, histogram_of
 from .occupancy import OccupancyMap
 from .paths import PathVerdicts, SampledTransition, analyze_paths
 from .routes import Route, default_min_length, find_paths, find_routes
+from .wobble import SegmentWobble
 from .verdicts import END_FRACTION, TAPER_SLOPE, GrowthRate, drift_slope, critical_speed, is_weak, judged_run, segment_gain, wavelength
 
 __all__ = ["DIRECTIONS", "MAP_LAWS", "MAX_CORRIDOR_WIDTHS", "MAX_MAP_SIDE", "MAX_RESOLUTION", "NO_VERDICT", "MapAnalysis", "MapSegment",
@@ -131,6 +132,8 @@ class MapSegment:
         |F_r·t| <= `verdicts.END_FRACTION`); None without an equilibrium.
     growth_rate : float or None
         σ̄, the mean growth rate over the judged part at the robot's V, 1/s (`verdicts.mean_growth`).
+    wobble : SegmentWobble or None
+        The speed limit by wobble tolerance (`maps.wobble.with_wobble`, ``map --wobble``); None: not asked.
     """
 
     x0: float
@@ -158,10 +161,11 @@ class MapSegment:
     judged_from: float | None = None
     judged_to: float | None = None
     growth_rate: float | None = None
+    wobble: SegmentWobble | None = None
 
     def to_dict(self) -> dict:
-        """JSON-ready (infinities as "inf", undefined as null)."""
-        return {
+        """JSON-ready (infinities as "inf", undefined as null; ``wobble`` only when asked)."""
+        out = {
             "x0": self.x0, "y0": self.y0, "x1": self.x1, "y1": self.y1, "length": self.length,
             "N": self.N, "c": self.c, "V_critical": json_number(self.V_critical) if self.V_critical is not None else None,
             "margin": json_number(self.margin) if self.margin is not None else None, "stable": self.stable,
@@ -172,6 +176,9 @@ class MapSegment:
             "direction": self.direction, "judged_from": self.judged_from, "judged_to": self.judged_to,
             "growth_rate": self.growth_rate,
         }
+        if self.wobble is not None:
+            out["wobble"] = self.wobble.to_dict()
+        return out
 
 
 @dataclass(frozen=True)

@@ -9,6 +9,9 @@ Nav2 speed filter with ``type: 1`` (percentage), ``base: 0``, ``multiplier: 1``:
   "no limit"); with a braking deceleration a_max (``--dilate-upstream``) each route
   stretch's zone reaches (V² − V*²)/(2·a_max) further along its route at both ends
   (`upstream_distance`: Nav2's filter slows the robot only once it is inside a zone);
+* with a wobble tolerance (``map --wobble TOL``, `maps.wobble`) a segment's zone holds 100·V_limit/V instead:
+  V_tolerance, the fastest speed whose wobble stays under TOL, where the describing function is trusted, else
+  V* (`SegmentWobble.V_limit`); no zone where V_limit >= V. Route stretches keep V*;
 * every other cell — free, occupied or unknown — 100: the robot may drive at V.
   Occupied cells are never driven through, and 100 % is the filter's "no
   reduction"; no cell is written as unknown (−1), which the filter ignores
@@ -136,9 +139,10 @@ def speed_limits(analysis, a_max: float | None = None) -> np.ndarray:
     V, half = analysis.robot.V, analysis.robot.W / 2
     limits = np.full(occupancy.values.shape, 100, dtype=np.int64)
     for s in analysis.segments:
-        if s.V_critical is None or not s.V_critical < V:
+        limit = s.wobble.V_limit if getattr(s, "wobble", None) is not None else s.V_critical
+        if s.V_critical is None or not s.V_critical < V or not limit < V:
             continue
-        _stamp(limits, occupancy, s.x0, s.y0, s.x1, s.y1, half, _percent(s.V_critical, V))
+        _stamp(limits, occupancy, s.x0, s.y0, s.x1, s.y1, half, _percent(limit, V))
     pv = getattr(analysis, "paths", None)
     for s in (pv.stretches if pv is not None else ()):
         if s.V_critical is None or not s.V_critical < V:
