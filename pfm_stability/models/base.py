@@ -593,16 +593,11 @@ class LoopModel:
         loop : Characteristic
             The loop judged; its own T, s, is replaced by the searched ones.
         """
-        from ..numerics.solve import first_crossing
+        def search():  # probes of the checked loop: T in [start, RANGES["T"].high]
+            start, rtol, atol = loop.delay_search(gain)
+            return start, RANGES["T"].high, {"rtol": rtol, "atol": atol}
 
-        if gain < 0 or self._searched_growth_rates(gain, [loop._with_delay(0.0)])[0] >= 0:
-            return 0.0
-
-        def measure(Ts):  # probes of the checked loop: T in [start, RANGES["T"].high]
-            return self._searched_growth_rates(gain, [loop._with_delay(T) for T in Ts])
-
-        start, rtol, atol = loop.delay_search(gain)
-        return first_crossing(measure, start, RANGES["T"].high, rtol=rtol, atol=atol)
+        return self._first_loss(gain, loop._with_delay, 0.0, search)
 
     @checked
     def critical_gain_k(self, NV: float, loop: Loop) -> float:
@@ -619,17 +614,20 @@ class LoopModel:
         loop : Loop
             The steering loop judged; its own k is replaced by the searched ones.
         """
+        loop = _steering(loop, "critical_gain_k")
+        lo, hi = gain_range(loop)  # probes of the checked loop: k in gain_range
+        return self._first_loss(NV, loop._with_steering_gain, lo, lambda: (lo, hi, {"start": lo, "rtol": _DELAY_RTOL, "atol": 1e-12 * lo}))
+
+    def _first_loss(self, gain: float, probe, origin: float, search) -> float:
+        """The first value x > `origin` at which the gain loses stability, the loop `probe(x)` (T*, k*, D*): 0 when
+        unstable already at `origin` (or gain < 0), else `solve.first_crossing` of the growth rate on the interval
+        ``search()`` gives, ``(low, high, first_crossing's keywords)`` (asked only then; ``inf``: stable up to high)."""
         from ..numerics.solve import first_crossing
 
-        loop = _steering(loop, "critical_gain_k")
-        lo, hi = gain_range(loop)
-        if NV < 0 or self._searched_growth_rates(NV, [loop._with_steering_gain(lo)])[0] >= 0:
+        if gain < 0 or self._searched_growth_rates(gain, [probe(origin)])[0] >= 0:
             return 0.0
-
-        def measure(ks):  # probes of the checked loop: k in gain_range
-            return self._searched_growth_rates(NV, [loop._with_steering_gain(k) for k in ks])
-
-        return first_crossing(measure, lo, hi, start=lo, rtol=_DELAY_RTOL, atol=1e-12 * lo)
+        low, high, options = search()
+        return first_crossing(lambda xs: self._searched_growth_rates(gain, [probe(x) for x in xs]), low, high, **options)
 
     def _searched_growth_rates(self, gain: float, loops) -> np.ndarray:
         """The growth rates (1/s) the searches for T*, k* and D* measure: `_growth_rates` (`sampled`'s has a stand-in)."""

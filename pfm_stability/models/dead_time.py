@@ -4,7 +4,7 @@ The robot's plant g·e^(−sD)/(τs + 1) (`Loop.plant_gain`, `Loop.dead_time`): 
 T and the rest fixed, the loop is stable for every D in [0, D*). `search_dead_time`
 finds D* as `LoopModel.critical_delay` finds T*: the dominant growth rate on a
 geometric grid of D, every local maximum before the first sign change refined, the
-first sign change narrowed to 1e-7 relative (`numerics.solve.first_crossing`). 0 if
+first sign change narrowed to 1e-7 relative (`numerics.solve.first_crossing` through `LoopModel._first_loss`). 0 if
 the gain is unstable already without a dead time; ``inf`` if it stays stable up to the
 largest allowed D (10 s). `exact_delay` has the exact route instead (the crossing
 count's margin of the whole delay T + D, less T) and `continuous` does not depend on D.
@@ -12,7 +12,6 @@ count's margin of the whole delay T + D, less T) and `continuous` does not depen
 
 from __future__ import annotations
 
-from ..numerics.solve import first_crossing
 from ..parameters import RANGES
 
 __all__ = ["search_dead_time"]
@@ -30,11 +29,8 @@ def search_dead_time(model, gain: float, loop) -> float:
     loop : Loop
         τ, T, k, c and g.
     """
-    if gain < 0 or model._searched_growth_rates(gain, [loop.replace(dead_time=0.0)])[0] >= 0:
-        return 0.0
+    def search():
+        start, rtol, atol = loop.delay_search(gain)
+        return start, RANGES["dead_time"].high, {"rtol": rtol, "atol": atol}
 
-    def measure(Ds):
-        return model._searched_growth_rates(gain, [loop.replace(dead_time=float(D)) for D in Ds])
-
-    start, rtol, atol = loop.delay_search(gain)
-    return first_crossing(measure, start, RANGES["dead_time"].high, rtol=rtol, atol=atol)
+    return model._first_loss(gain, lambda D: loop.replace(dead_time=float(D)), 0.0, search)
