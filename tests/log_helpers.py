@@ -657,6 +657,29 @@ def drive(legs, robot=None, controller=None, *, odom_rate: float = 50.0, scan_ra
     return DrivenLog(log, walls, tuple(truth))
 
 
+def _verdict_only(controller):
+    """[the controller's ``sampled`` model without its critical values]: T*, k* and D* are NaN, not searched.
+
+    `random_corridor` reads only the verdict's margin and rightmost root (and a wall's d0), which do not depend on the
+    critical values; their searches and the report's remedies cost most of a draw (and a draw is rejected several
+    times before one is kept). The same class's verdict, margin and root (`analysis.criteria`, which the report's
+    sections are), so the draws are the ones `build_report(..., models=("sampled",))` accepts.
+    """
+    from pfm_stability.models import Sampled
+
+    class VerdictOnly(Sampled):
+        def critical_delay(self, gain, loop):
+            return math.nan
+
+        def critical_gain_k(self, NV, loop):
+            return math.nan
+
+        def critical_dead_time(self, gain, loop):
+            return math.nan
+
+    return [VerdictOnly(controller.hold, controller.compute_delay)]
+
+
 def random_corridor(rng: np.random.Generator, *, away: float = 0.05, kind: str = "corridor"):
     """(robot, controller, geometry, sampled margin) of a random corridor (or wall) whose ``sampled`` verdict is at least
     `away` from the boundary.
@@ -666,8 +689,8 @@ def random_corridor(rng: np.random.Generator, *, away: float = 0.05, kind: str =
     again until |margin| > `away` and the predicted growth keeps the robot off the walls for 8 periods
     (σ·8·2π/ω < 2.5) and makes at least 6 swings before it decays by e³.
     """
-    from pfm_stability.parameters import Controller, Robot
-    from pfm_stability.report.stability import build_report
+    from pfm_stability.analysis.criteria import analyze_corridor, analyze_wall
+    from pfm_stability.parameters import Controller, Corridor, Robot, Wall
 
     while True:
         robot = Robot(V=rng.uniform(0.3, 1.2), tau=rng.uniform(0.1, 0.5), k=rng.uniform(1.0, 4.0), W=rng.uniform(0.5, 0.8),
@@ -676,13 +699,12 @@ def random_corridor(rng: np.random.Generator, *, away: float = 0.05, kind: str =
                                 compute_delay=int(rng.integers(0, 2)))
         if kind == "corridor":
             geometry = robot.W / 2 + rng.uniform(0.2, 0.7)
-            report = build_report(robot, controller, L=geometry, models=("sampled",))
-            verdict = report.corridor.models["sampled"]
+            verdict = analyze_corridor(robot, controller, Corridor(geometry), _verdict_only(controller)).models["sampled"]
         else:
             geometry = math.radians(rng.uniform(20.0, 70.0))
-            report = build_report(robot, controller, alpha=geometry, models=("sampled",))
-            verdict = report.wall.models["sampled"]
-            if report.wall.d0 <= robot.W / 2 + 0.1:  # the robot would start touching the wall
+            wall = analyze_wall(robot, controller, Wall(geometry), _verdict_only(controller))
+            verdict = wall.models["sampled"]
+            if wall.d0 <= robot.W / 2 + 0.1:  # the robot would start touching the wall
                 continue
         root = verdict.rightmost_root
         if root is None or abs(verdict.margin) <= away or root.imag <= 0.2:
