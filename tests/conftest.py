@@ -23,6 +23,12 @@ imported (they reach the notebooks' kernels and the fresh processes of the CLI t
 `threadpoolctl` pins the thread pools in case a plugin loaded numpy first. Numbers do not depend
 on it (the recorded answers of tests/test_answers_unchanged.py replay to 1e-12 either way).
 
+The notebooks of ``analyses/`` run with ``PFM_STABILITY_QUICK=1`` (set here, unless set already; their kernels
+inherit it): each then takes the same steps on coarser grids and fewer simulated boundary points (its first code
+cell says which), so the suite checks that every cell still runs in a fraction of the time. Run normally (the
+variable unset) a notebook draws its published figures as before; ``PFM_STABILITY_QUICK= pytest analyses`` runs
+them in full here.
+
 Scheduling under ``pytest -n N`` (``--dist loadgroup`` in pyproject.toml):
 
 * tests that share an expensive module fixture carry ``pytest.mark.xdist_group(name)``: a group runs
@@ -38,6 +44,7 @@ import os
 
 for _variable in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_variable, "1")
+os.environ.setdefault("PFM_STABILITY_QUICK", "1")  # the notebooks' quick run (module docstring)
 
 import numpy as np  # noqa: E402  (after the thread variables)
 import pytest  # noqa: E402
@@ -77,10 +84,34 @@ def random_loops(count, seed, *, tau=(0.02, 1.0), T=(0.005, 0.5), k=(0.3, 10.0))
     return out
 
 
+@pytest.hookimpl(trylast=True)  # after xdist's own group suffix, and after any plugin that reorders
 def pytest_collection_modifyitems(config, items):
-    """The notebooks are slow; the slow tests go first (a stable sort: otherwise collection order)."""
+    """The notebooks are slow; the slow tests go first (a stable sort: otherwise collection order); each test of an
+    ``xdist_group`` carries its group in its node id (`_join_group`)."""
     for item in items:
         if item.path.suffix == ".ipynb":
             item.add_marker(pytest.mark.slow)
+        if config.getvalue("loadgroup"):
+            _join_group(item)
     items.sort(key=lambda item: item.get_closest_marker("slow") is None)
+
+
+def _join_group(item) -> None:
+    """The ``@name`` suffix by which ``--dist loadgroup`` sends the tests of ``xdist_group(name)`` to one worker.
+
+    pytest-xdist (3.8) adds it by setting ``item._nodeid``, which pytest 9.2 no longer reads (a node id is
+    ``str(item._id)`` there): the suffix was lost without a word, every group's tests were spread over the workers
+    and each worker that got one computed the group's module fixture again. Added here where it is missing, as
+    xdist writes it (the names sorted, joined by ``_``).
+    """
+    names = sorted({str(m.args[0] if m.args else m.kwargs.get("name", "default")) for m in item.iter_markers("xdist_group")})
+    if not names:
+        return
+    suffix = "@" + "_".join(names)
+    if item.nodeid.endswith(suffix):
+        return  # xdist's own suffix took
+    if isinstance(getattr(item, "_id", None), str) or not hasattr(item, "_id"):
+        item._nodeid = item.nodeid + suffix
+    else:
+        item._id = type(item._id).parse(item.nodeid + suffix)
 
