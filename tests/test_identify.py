@@ -109,6 +109,7 @@ def random_plants(tmp_path_factory):
     return out
 
 
+@pytest.mark.xdist_group("identify_random_plants")  # its module fixture once per suite (tests/conftest.py)
 def test_random_plants_are_identified_within_the_tolerances(random_plants):
     for plant, recording, result in random_plants:
         assert result.identified, result.reason
@@ -121,6 +122,7 @@ def test_random_plants_are_identified_within_the_tolerances(random_plants):
         assert p.warnings == (), where  # an exact first-order plant: nothing unexplained
 
 
+@pytest.mark.xdist_group("identify_random_plants")  # its module fixture once per suite (tests/conftest.py)
 def test_random_plants_intervals_hold_the_truth_in_most_cases(random_plants):
     """95 % intervals: 69 of 72 hold the truth at SEED (96 %); ≥ 90 % asserted (72 draws at 0.95: 3.6 misses expected,
     standard deviation 1.8; 90 % allows 7). Steps and chirps are never narrowband (their spectra are broad)."""

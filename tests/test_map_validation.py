@@ -10,6 +10,7 @@ summed cell by cell (`sim.vff.measured_wall_force`: a static window sum, not
 a simulated run) fed to the same `sampled` model.
 """
 
+import functools
 import json
 import math
 from dataclasses import dataclass
@@ -335,8 +336,10 @@ def test_bad_arguments_raise_naming_the_argument(change, name):
         )
 
 
+@functools.lru_cache(maxsize=None)
 def _shipped(name: str, V: float):
-    """(analysis, robot, controller, law) of a shipped map with the validation robot of benchmarks/validate_maps.py at V."""
+    """(analysis, robot, controller, law) of a shipped map with the validation robot of benchmarks/validate_maps.py at V;
+    computed once per worker (depot at 0.3 m/s is read by two tests, grouped on one worker: tests/conftest.py)."""
     from pathlib import Path
 
     from pfm_stability.maps.analysis import analyze_map
@@ -350,6 +353,7 @@ def _shipped(name: str, V: float):
 
 
 @pytest.mark.slow  # seconds: scheduled first (tests/conftest.py)
+@pytest.mark.xdist_group("map_validation_shipped")
 def test_shipped_maps_clear_segments_agree_at_least_85_percent():
     """>= 85 % of >= 18 clear (|margin| > 10 %) measured segments of the shipped maps agree with the simulator.
 
@@ -377,6 +381,7 @@ def test_shipped_maps_clear_segments_agree_at_least_85_percent():
     assert agreed >= 0.85 * len(clear), f"{agreed}/{len(clear)} agree"
 
 
+@pytest.mark.xdist_group("map_validation_shipped")
 def test_end_effect_and_judged_part_follow_the_along_track_force():
     """The judged part is the longest run with |F_r·t| <= the end fraction, and no judged sample exceeds it.
 

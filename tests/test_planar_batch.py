@@ -117,6 +117,7 @@ def random_batch():
     return members, simulate_planar_batch(members), [_oracle(m) for m in members]
 
 
+@pytest.mark.xdist_group("planar_random_batch")  # its module fixture once per suite (tests/conftest.py)
 def test_batch_matches_scalar_oracle_on_random_members(random_batch):
     """Every member of a mixed batch of 42 members agrees with the former scalar stepper run alone.
 
@@ -146,6 +147,7 @@ def test_batch_matches_scalar_oracle_on_random_members(random_batch):
     assert len(kinds) >= 8  # the draw covers the robots × repulsions
 
 
+@pytest.mark.xdist_group("planar_random_batch")  # its module fixture once per suite (tests/conftest.py)
 def test_batch_forces_match_scalar_oracle(random_batch):
     """The recorded forces agree with the oracle's to 1e-9 of the run's largest force.
 
@@ -161,6 +163,7 @@ def test_batch_forces_match_scalar_oracle(random_batch):
             assert np.allclose(run.wheel_speeds, want.wheel_speeds, rtol=0, atol=1e-12), f"member {i}"
 
 
+@pytest.mark.xdist_group("planar_random_batch")  # its module fixture once per suite (tests/conftest.py)
 def test_batch_events_identical_to_scalar_oracle(random_batch):
     """Events: the same kinds on the same obstacles in the same order; times equal to 1e-9 s.
 
@@ -181,6 +184,7 @@ def test_batch_events_identical_to_scalar_oracle(random_batch):
     assert seen == {"gate_open", "gate_close", "influence_enter", "influence_exit", "contact", "collision_unavoidable"}
 
 
+@pytest.mark.xdist_group("planar_random_batch")  # its module fixture once per suite (tests/conftest.py)
 def test_member_alone_equals_member_in_batch(random_batch):
     """A member run alone (`simulate_planar`, a batch of one) agrees with its run inside the mixed batch.
 

@@ -435,6 +435,7 @@ def cluster():
     c.close()
 
 
+@pytest.mark.xdist_group("sweeps_cluster")  # one LocalCluster per suite (tests/conftest.py)
 def test_cluster_table_equals_local_table(tmp_path, cluster):
     """The same spec on local threads and on a cluster of worker processes gives identical tables (pyarrow equality)."""
     s = spec(grid=None, models=["sampled", "exact_delay", "pade"], sample={"method": "sobol", "n": 64, "seed": 2,
@@ -445,6 +446,7 @@ def test_cluster_table_equals_local_table(tmp_path, cluster):
     assert same(read(tmp_path / "cluster.parquet"), read(tmp_path / "local.parquet"))
 
 
+@pytest.mark.xdist_group("sweeps_cluster")  # one LocalCluster per suite (tests/conftest.py)
 def test_simulation_on_cluster_with_retry_agrees_with_sampled(tmp_path, cluster):
     """simulate: true on the cluster, a chunk failing once (retried by Dask): the table equals the in-process
     evaluation, and away from the boundary (|margin| > 5 %) the simulated sign of σ agrees with `sampled`."""
@@ -461,6 +463,7 @@ def test_simulation_on_cluster_with_retry_agrees_with_sampled(tmp_path, cluster)
 
 
 @pytest.mark.slow  # seconds: scheduled first (tests/conftest.py)
+@pytest.mark.xdist_group("sweeps_cluster")  # one LocalCluster per suite (tests/conftest.py)
 def test_simulation_on_local_processes_equals_cluster_and_in_process(tmp_path, cluster):
     """simulate: true without a scheduler runs on Dask's local worker processes (no cluster): the table equals the
     cluster's and the in-process evaluation (pyarrow equality), a chunk failing once in a worker process is retried

@@ -53,6 +53,7 @@ def runs():
     return predictions, cases, simulate_wobbles(cases), unstable
 
 
+@pytest.mark.xdist_group("wobble_sim_runs")  # its module fixture once per suite (tests/conftest.py)
 def test_amplitude_and_frequency_against_simulation(runs):
     """CARMEL (command hold at 1.2·V*, reference hold at 1.1·V*), a random robot with the grid's law at 1.2·V* and CARMEL
     with a plant gain and a fractional dead time (`PLANT_ROBOT`) at 1.1·V*: the
@@ -66,6 +67,7 @@ def test_amplitude_and_frequency_against_simulation(runs):
         assert cycle.omega == pytest.approx(m.omega, rel=0.05)
 
 
+@pytest.mark.xdist_group("wobble_sim_runs")  # its module fixture once per suite (tests/conftest.py)
 def test_subcritical_starts(runs):
     """Subcritical (a weak, steep law in a narrow corridor): below V* (halfway to the fold) a run started at 0.7 of the
     unstable cycle's amplitude decays (to under half its start), one started at 1.3 of it grows into the wall."""
