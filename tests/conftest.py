@@ -91,7 +91,7 @@ def pytest_collection_modifyitems(config, items):
     for item in items:
         if item.path.suffix == ".ipynb":
             item.add_marker(pytest.mark.slow)
-        if config.getvalue("loadgroup"):
+        if config.getoption("loadgroup", default=False):  # set on xdist workers under --dist loadgroup
             _join_group(item)
     items.sort(key=lambda item: item.get_closest_marker("slow") is None)
 
