@@ -45,7 +45,7 @@ __all__ = ["KEPT", "V_CRITICAL_AGREEMENT", "SegmentWobble", "WobbleStretch", "Wo
 V_CRITICAL_AGREEMENT = 0.02
 """Largest |V*_wobble/V*_segment − 1| for which a segment counts as the straight corridor the wobble models (the
 map's straight corridors agree with the grid law's to 0.7 %, tests/test_map_corridors.py)."""
-KEPT = ("no verdict", "unstable at any speed", "stable at any speed", "no half-width", "no wobble branch", "not a straight corridor",
+KEPT = ("no verdict", "V* = 0", "stable at any speed", "no half-width", "no wobble branch", "not a straight corridor",
         "subcritical", "not trusted", "relay", "oscillates", "no zone")
 """Short names of the reasons a zone keeps V* (`ZoneWobble.kept`; the text output counts them)."""
 _RAY_STEP = 0.125
@@ -277,7 +277,7 @@ def _zone_wobble(analysis, V_star, half_width, tolerance: float) -> ZoneWobble:
     if V_star is None:
         return keep("no verdict", "no verdict: no speed limit")
     if not (0.0 < V_star < math.inf):
-        return (keep("unstable at any speed", "unstable at any speed: no limit cycle to tolerate") if V_star == 0
+        return (keep("V* = 0", "V* = 0 (the loop grows at any speed): no limit cycle to tolerate") if V_star == 0
                 else keep("stable at any speed", "stable at any speed: no wobble"))
     model = analysis.model if analysis.model in WOBBLE_MODELS else "sampled"
     L = half_width()
