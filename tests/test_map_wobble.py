@@ -149,10 +149,11 @@ def routed(tmp_path_factory):
     return path, csv, analyze_map(load_map(path), ROBOT, CONTROLLER, make_law("grid", ROBOT, CONTROLLER), routes=[route])
 
 
-def _pgm_percent(analysis, x: float, y: float) -> int:
-    """The speed limit (% of V) Nav2 reads from the mask's PGM at (x, y): the image read back by PIL, row 0 at the top,
-    and map_server's scale mode rint(100·(255 − v)/255) (written out here, not the library's `pixel_to_percent`)."""
-    image = np.asarray(Image.open(io.BytesIO(speed_mask_pgm(analysis))))
+def _pgm_percent(analysis, x: float, y: float, a_max: float | None = None) -> int:
+    """The speed limit (% of V) Nav2 reads from the mask's PGM (upstream dilation `a_max`) at (x, y): the image read back
+    by PIL, row 0 at the top, and map_server's scale mode rint(100·(255 − v)/255) (written out here, not the library's
+    `pixel_to_percent`)."""
+    image = np.asarray(Image.open(io.BytesIO(speed_mask_pgm(analysis, a_max))))
     occupancy = analysis.occupancy
     i = int(math.floor((x - occupancy.origin[0]) / occupancy.resolution))
     j = int(math.floor((y - occupancy.origin[1]) / occupancy.resolution))
@@ -295,3 +296,27 @@ def test_random_robots_route_stretch_follows_corridor_wobble(tmp_path, draw):
         assert w.V_limit == pytest.approx(expected.V_tolerance, abs=1e-6) and w.kept is None
     else:
         assert w.V_limit == own.V_critical and w.kept == ("subcritical" if expected.criticality == "subcritical" else "not trusted")
+
+
+def test_upstream_dilation_brakes_to_v_limit(routed):
+    """``--dilate-upstream A_MAX`` with the wobble: a stretch's zone reaches the braking distance (V² − V_limit²)/(2·A_MAX)
+    beyond its ends (the closed form, `outputs.upstream_distance`), plus W/2 around the route. The unstable stretch of
+    the user's route is cut to 0.5 m in the route's middle (the mask reads only its place, V* and wobble), A_MAX =
+    0.1 m/s²: braking to V_tolerance takes ~0.1 m less than to V*, so a cell centre between the two zone ends is
+    outside the zone with the wobble (100 %) and inside without it."""
+    _, _, analysis = routed
+    route = analysis.paths.paths[1]
+    pv = judge_routes(analysis, [route])
+    (unstable,) = [s for s in pv.stretches if s.verdict == "unstable"]
+    cut = replace(unstable, start=2.0, stop=2.5)
+    alone = replace(analysis, segments=(), paths=replace(pv, stretches=(cut,)))
+    relaxed = with_wobble(alone, TOL)
+    V_limit = relaxed.paths.stretches[0].wobble.V_limit
+    assert V_limit > cut.V_critical
+    a_max, V, half = 0.1, ROBOT.V, ROBOT.W / 2
+    ends = [cut.stop + (V * V - v * v) / (2 * a_max) + half for v in (V_limit, cut.V_critical)]
+    y0 = route.points[0][1]
+    centres = [float(c) for c in SHORT_ORIGIN[1] + (np.arange(SHORT_CELLS) + 0.5) * 0.1 if ends[0] + 0.01 < c - y0 < ends[1] - 0.01]
+    assert centres
+    for analysed, inside in ((relaxed, False), (alone, True)):
+        assert (_pgm_percent(analysed, route.points[0][0], centres[0], a_max) < 100) == inside
