@@ -1,27 +1,33 @@
-"""``map --wobble TOL``: each straight segment's speed limit by wobble tolerance (docs/maps.md, "Speed limits by wobble
-tolerance").
+"""``map --wobble TOL``: each straight segment's and route stretch's speed limit by wobble tolerance (docs/maps.md,
+"Speed limits by wobble tolerance").
 
 A straight synthetic corridor (`test_map_corridors.corridor_map`: one-cell walls on histogram cell centres at ±L) is
 the straight corridor of half-width L that `analysis.wobble.corridor_wobble` models, so the segment's half-width must be
 the built L and its V_tolerance ``corridor_wobble``'s for the same robot, law and L; the mask's segment zone follows it.
+The same holds for a route stretch along the corridor's middle (a user's route there: its windows see no wall ahead),
+and the mask's value over the stretch, read back from the PGM, follows it.
 """
 
 from __future__ import annotations
 
+import io
 import json
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
+from PIL import Image
 
 from cli_helpers import VALIDATOR, run
 from test_map_corridors import ROBOT as FAST_STEERING, CONTROLLER as FAST_CONTROLLER, corridor_map
 from pfm_stability.analysis.wobble import corridor_wobble
 from pfm_stability.laws.fields import make_law
-from pfm_stability.maps.analysis import analyze_map
+from pfm_stability.maps.analysis import analyze_map, judge_routes
 from pfm_stability.maps.occupancy import load_map
-from pfm_stability.maps.outputs import speed_limits
-from pfm_stability.maps.wobble import with_wobble
+from pfm_stability.maps.outputs import speed_limits, speed_mask_pgm
+from pfm_stability.maps.routes import path_of
+from pfm_stability.maps.wobble import V_CRITICAL_AGREEMENT, wobble_summary, with_wobble
 from pfm_stability.parameters import CARMEL
 
 ROBOT, CONTROLLER = CARMEL.robot, CARMEL.controller
@@ -103,6 +109,214 @@ def test_cli_json_gives_each_segments_wobble_and_without_it_nothing_changes(corr
     assert "wobble" not in plain["segments"][0]
     strip = lambda d: {k: v for k, v in d.items() if k != "timing"}
     data["segments"][0].pop("wobble")
+    for stretch in data["paths"]["stretches"]:
+        assert stretch.pop("wobble")["tolerance"] == TOL
+    assert data.pop("wobble")["tolerance"] == TOL
+    assert "wobble" not in plain
     assert strip(data) == strip(plain)
     code, out, err = run([*args, "--wobble", "-1"])
     assert code == 2 and out == "" and len(err.strip().splitlines()) == 1 and "wobble" in err
+
+
+SHORT_CELLS = 120
+"""12 m corridors for the route stretches (their analysis with the routes ~0.3 s)."""
+SHORT_ORIGIN = (-7.3, 2.1)
+ROUTE_SPAN = (3.0, 9.0)
+"""The user's route along the corridor's axis, y from origin + 3 m to origin + 9 m: 3 m from the corridor's ends, so
+its windows (clipped at the route's ends) see the straight corridor alone, no wall ahead."""
+
+
+def short_corridor(directory, half_width: float):
+    """(YAML path, the user's route along the axis) of a corridor along y, one-cell walls on cell centres at ±half_width."""
+    gap = round(2 * half_width / 0.1)
+    img = np.full((SHORT_CELLS, gap + 1), 254, dtype=np.uint8)
+    img[:, 0] = img[:, gap] = 0
+    Image.fromarray(img).save(directory / "short.pgm")
+    path = directory / "short.yaml"
+    path.write_text(f"image: short.pgm\nresolution: 0.1\norigin: [{SHORT_ORIGIN[0]}, {SHORT_ORIGIN[1]}, 0.0]\nnegate: 0\n"
+                    "occupied_thresh: 0.65\nfree_thresh: 0.196\n")
+    axis = SHORT_ORIGIN[0] + (gap / 2 + 0.5) * 0.1
+    return path, path_of([(axis, SHORT_ORIGIN[1] + ROUTE_SPAN[0]), (axis, SHORT_ORIGIN[1] + ROUTE_SPAN[1])])
+
+
+@pytest.fixture(scope="module")
+def routed(tmp_path_factory):
+    """(map path, route file, analysis with the skeleton's route and the user's) of the short corridor; shared."""
+    directory = tmp_path_factory.mktemp("routed")
+    path, route = short_corridor(directory, L)
+    csv = directory / "route.csv"
+    csv.write_text("".join(f"{float(x)!r},{float(y)!r}\n" for x, y in route.points))
+    return path, csv, analyze_map(load_map(path), ROBOT, CONTROLLER, make_law("grid", ROBOT, CONTROLLER), routes=[route])
+
+
+def _pgm_percent(analysis, x: float, y: float, a_max: float | None = None) -> int:
+    """The speed limit (% of V) Nav2 reads from the mask's PGM (upstream dilation `a_max`) at (x, y): the image read back
+    by PIL, row 0 at the top, and map_server's scale mode rint(100·(255 − v)/255) (written out here, not the library's
+    `pixel_to_percent`)."""
+    image = np.asarray(Image.open(io.BytesIO(speed_mask_pgm(analysis, a_max))))
+    occupancy = analysis.occupancy
+    i = int(math.floor((x - occupancy.origin[0]) / occupancy.resolution))
+    j = int(math.floor((y - occupancy.origin[1]) / occupancy.resolution))
+    return int(np.rint(100 * (255 - int(image[image.shape[0] - 1 - j, i])) / 255))
+
+
+def test_route_stretch_v_tolerance_is_corridor_wobbles_and_the_mask_follows_it(routed):
+    """The user's route along the corridor's middle: its unstable stretch's L is the built half-width (1e-9 m, straight
+    rows of cell centres) and its V_tolerance ``corridor_wobble``'s for the same robot, grid law and L (1e-6 m/s: the
+    same branch), trusted (reason None); its V* is the straight corridor's to `V_CRITICAL_AGREEMENT`. The mask,
+    written as the PGM and read back, holds floor(100·V_tolerance/V) over the stretch (with only that route's zones:
+    the segment and the skeleton's route would cover the same cells), and floor(100·V*/V) without the wobble — two
+    different percentages. The skeleton's route runs the corridor's whole length: its worst window sees the map's end
+    (a wall ahead raises N), its V* is off the straight corridor's by more than the agreement, so it keeps V* with
+    that reason."""
+    _, _, analysis = routed
+    expected = corridor_wobble(ROBOT, CONTROLLER, make_law("grid", ROBOT, CONTROLLER), L, TOL)
+    relaxed = with_wobble(analysis, TOL)
+    skeleton, own = [[s for s in relaxed.paths.stretches if s.route == r] for r in (0, 1)]
+    (unstable,) = [s for s in own if s.verdict == "unstable"]
+    w = unstable.wobble
+    assert w.L == pytest.approx(L, abs=1e-9)
+    assert w.V_tolerance == pytest.approx(expected.V_tolerance, abs=1e-6)
+    assert w.V_limit == w.V_tolerance and w.reason is None and w.kept is None
+    assert unstable.V_critical == pytest.approx(expected.V_critical, rel=V_CRITICAL_AGREEMENT)
+    (whole,) = skeleton
+    assert whole.verdict == "unstable" and abs(whole.V_critical / expected.V_critical - 1) > V_CRITICAL_AGREEMENT
+    assert whole.wobble.kept == "not a straight corridor" and whole.wobble.V_limit == whole.V_critical
+    route = analysis.paths.paths[1]
+    alone = replace(analysis, segments=(), paths=judge_routes(analysis, [route]))
+    middle = ((unstable.x0 + unstable.x1) / 2, (unstable.y0 + unstable.y1) / 2)
+    assert _pgm_percent(with_wobble(alone, TOL), *middle) == math.floor(100 * expected.V_tolerance / ROBOT.V)
+    assert _pgm_percent(alone, *middle) == math.floor(100 * unstable.V_critical / ROBOT.V) < math.floor(100 * expected.V_tolerance / ROBOT.V)
+    assert "wobble" not in analysis.paths.stretches[0].to_dict() and "wobble" in relaxed.paths.stretches[0].to_dict()
+
+
+@pytest.mark.parametrize("label", ["relay", "oscillates"])
+def test_relay_and_weave_stretches_keep_v_star(routed, label):
+    """A stretch labelled "relay" (the window-edge relay) or "oscillates" (a forced weave) is not a Hopf cycle of the
+    straight corridor: the same stretch as above, relabelled, keeps its V* (exactly: nothing is computed) and says
+    why, and the mask over it holds floor(100·V*/V)."""
+    _, _, analysis = routed
+    route = analysis.paths.paths[1]
+    pv = judge_routes(analysis, [route])
+    stretches = tuple(replace(s, label=label) if s.verdict == "unstable" else s for s in pv.stretches)
+    alone = replace(analysis, segments=(), paths=replace(pv, stretches=stretches))
+    relaxed = with_wobble(alone, TOL)
+    (unstable,) = [s for s in relaxed.paths.stretches if s.verdict == "unstable"]
+    assert unstable.wobble.V_limit == unstable.V_critical and unstable.wobble.kept == label
+    assert "not a Hopf cycle" in unstable.wobble.reason and unstable.wobble.V_tolerance is None
+    middle = ((unstable.x0 + unstable.x1) / 2, (unstable.y0 + unstable.y1) / 2)
+    assert _pgm_percent(relaxed, *middle) == math.floor(100 * unstable.V_critical / ROBOT.V)
+
+
+def test_summary_counts_the_zones(routed):
+    """`wobble_summary`: the zones (V* < V) at V_tolerance and those that kept V*, by reason, counted and measured
+    here from the stretches themselves; the unstable fraction is the user's unstable stretch over every unstable
+    stretch's length; the mask's range runs from the skeleton's kept V* to V_tolerance."""
+    _, _, analysis = routed
+    relaxed = with_wobble(analysis, TOL)
+    summary = wobble_summary(relaxed, TOL)
+    stretches = relaxed.paths.stretches
+    zoned = [s for s in stretches if s.V_critical < ROBOT.V]
+    relaxed_zones = [s for s in zoned if s.wobble.V_limit == s.wobble.V_tolerance]
+    assert summary.segments == {"V_tolerance": 1, "kept": {}}
+    assert summary.stretches == {"V_tolerance": len(relaxed_zones), "kept": {"not a straight corridor": len(zoned) - len(relaxed_zones)}}
+    unstable = [s for s in stretches if s.verdict == "unstable"]
+    assert summary.unstable_length_m == pytest.approx(sum(s.length for s in unstable), rel=1e-12)
+    assert summary.unstable_fraction == pytest.approx(sum(s.length for s in unstable if s.route == 1) / summary.unstable_length_m, rel=1e-12)
+    assert summary.V_limit_min == min(s.V_critical for s in stretches) and summary.V_limit_max == max(s.wobble.V_limit for s in zoned)
+
+
+def test_text_output_shows_the_wobble_block(routed):
+    """``map --route FILE --wobble TOL`` (text): a short block with the tolerance, the segments and the route stretches at
+    V_tolerance (counts and length, from the library's own analysis of the same map, `test_summary_counts_the_zones`)
+    and the mask's range; without --wobble no such block."""
+    path, csv, analysis = routed
+    summary = wobble_summary(with_wobble(analysis, TOL), TOL)
+    args = ["map", str(path), "--preset", "carmel", "--route", str(csv), "--quiet"]
+    code, out, err = run([*args, "--wobble", str(TOL)])
+    assert code == 0, err
+    block = out[out.index("wobble tolerance"):].splitlines()
+    assert block[0].startswith(f"wobble tolerance {TOL:g} m")
+    assert block[1] == "  segments: 1 of 1 with a zone at V_tolerance"
+    total = summary.stretches["V_tolerance"] + sum(summary.stretches["kept"].values())
+    assert block[2].startswith(f"  route stretches: {summary.stretches['V_tolerance']} of {total} with a zone at V_tolerance "
+                               f"({summary.route_length_m['V_tolerance']:.1f} m; {100 * summary.unstable_fraction:.1f}% of the "
+                               f"{summary.unstable_length_m:.1f} m unstable)")
+    assert "not a straight corridor" in block[2]
+    assert block[3].startswith("  mask limits: ") and len(block) == 4
+    code, plain, err = run(args)
+    assert code == 0, err
+    assert "wobble" not in plain
+
+
+def test_a_weave_stretch_of_the_skeleton_keeps_v_star_and_a_stable_zone_gets_v_tolerance(tmp_path):
+    """CARMEL at V = 1 m/s in a corridor of half-width 0.7 m (V* ≈ 0.82 m/s < V): the skeleton's route, run to the
+    map's ends, is labelled "oscillates" (a forced weave, found by the analysis itself, not relabelled) over its
+    middle and keeps its V* with that reason; the user's route along the middle is "stable" (less than one e-fold over
+    its clipped windows) with V* < V, so the mask uses its V* and it gets ``corridor_wobble``'s V_tolerance (1e-6 m/s)."""
+    robot = ROBOT.replace(V=1.0)
+    path, route = short_corridor(tmp_path, 0.7)
+    law = make_law("grid", robot, CONTROLLER)
+    analysis = with_wobble(analyze_map(load_map(path), robot, CONTROLLER, law, routes=[route]), TOL)
+    expected = corridor_wobble(robot, CONTROLLER, law, 0.7, TOL)
+    weaves = [s for s in analysis.paths.stretches if s.route == 0 and s.label == "oscillates"]
+    assert weaves and all(s.wobble.kept == "oscillates" and s.wobble.V_limit == s.V_critical for s in weaves)
+    (own,) = [s for s in analysis.paths.stretches if s.route == 1]
+    assert own.verdict == "stable" and own.V_critical < robot.V
+    assert own.wobble.V_limit == pytest.approx(expected.V_tolerance, abs=1e-6) and own.wobble.kept is None
+
+
+@pytest.mark.parametrize("draw", range(3))
+def test_random_robots_route_stretch_follows_corridor_wobble(tmp_path, draw):
+    """Random robots (seeded: tau 0.15–0.5 s, k 1.5–3 1/s, W 0.5–0.8 m, V 1.2 m/s, CARMEL's controller) in a corridor of
+    random half-width: the user's route along the middle gets ``corridor_wobble``'s V_tolerance (1e-6 m/s, the same
+    branch) where the mask draws its zone, trusted exactly when ``corridor_wobble`` says supercritical with small
+    harmonics at V = V_tolerance; a subcritical branch keeps V* ("subcritical"); a stretch with V* >= V has no zone ("no zone")."""
+    from pfm_stability.analysis.wobble import RATE_HARMONIC_LIMIT, THIRD_HARMONIC_LIMIT
+
+    rng = np.random.default_rng(7)
+    for _ in range(draw + 1):
+        tau, k, W = rng.uniform(0.15, 0.5), rng.uniform(1.5, 3.0), rng.uniform(0.5, 0.8)
+        half_width = round(rng.uniform(W / 2 + 0.2, 0.9), 1)
+    robot = ROBOT.replace(tau=tau, k=k, W=W, V=1.2)
+    path, route = short_corridor(tmp_path, half_width)
+    law = make_law("grid", robot, CONTROLLER)
+    analysis = with_wobble(analyze_map(load_map(path), robot, CONTROLLER, law, routes=[route]), 0.05)
+    expected = corridor_wobble(robot, CONTROLLER, law, half_width, 0.05)
+    (own,) = [s for s in analysis.paths.stretches if s.route == 1]
+    w = own.wobble
+    if not own.V_critical < robot.V:
+        assert w.kept == "no zone" and w.V_limit == own.V_critical
+        return
+    assert w.V_tolerance == pytest.approx(expected.V_tolerance, abs=1e-6) and w.criticality == expected.criticality
+    at = corridor_wobble(robot.replace(V=expected.V_tolerance), CONTROLLER, law, half_width, 0.05)  # the cycle at V_tolerance
+    trusted = (expected.criticality == "supercritical" and at.third_harmonic is not None and at.third_harmonic <= THIRD_HARMONIC_LIMIT
+               and at.rate_harmonic <= RATE_HARMONIC_LIMIT)
+    if trusted:
+        assert w.V_limit == pytest.approx(expected.V_tolerance, abs=1e-6) and w.kept is None
+    else:
+        assert w.V_limit == own.V_critical and w.kept == ("subcritical" if expected.criticality == "subcritical" else "not trusted")
+
+
+def test_upstream_dilation_brakes_to_v_limit(routed):
+    """``--dilate-upstream A_MAX`` with the wobble: a stretch's zone reaches the braking distance (V² − V_limit²)/(2·A_MAX)
+    beyond its ends (the closed form, `outputs.upstream_distance`), plus W/2 around the route. The unstable stretch of
+    the user's route is cut to 0.5 m in the route's middle (the mask reads only its place, V* and wobble), A_MAX =
+    0.1 m/s²: braking to V_tolerance takes ~0.1 m less than to V*, so a cell centre between the two zone ends is
+    outside the zone with the wobble (100 %) and inside without it."""
+    _, _, analysis = routed
+    route = analysis.paths.paths[1]
+    pv = judge_routes(analysis, [route])
+    (unstable,) = [s for s in pv.stretches if s.verdict == "unstable"]
+    cut = replace(unstable, start=2.0, stop=2.5)
+    alone = replace(analysis, segments=(), paths=replace(pv, stretches=(cut,)))
+    relaxed = with_wobble(alone, TOL)
+    V_limit = relaxed.paths.stretches[0].wobble.V_limit
+    assert V_limit > cut.V_critical
+    a_max, V, half = 0.1, ROBOT.V, ROBOT.W / 2
+    ends = [cut.stop + (V * V - v * v) / (2 * a_max) + half for v in (V_limit, cut.V_critical)]
+    y0 = route.points[0][1]
+    centres = [float(c) for c in SHORT_ORIGIN[1] + (np.arange(SHORT_CELLS) + 0.5) * 0.1 if ends[0] + 0.01 < c - y0 < ends[1] - 0.01]
+    assert centres
+    for analysed, inside in ((relaxed, False), (alone, True)):
+        assert (_pgm_percent(analysed, route.points[0][0], centres[0], a_max) < 100) == inside

@@ -76,8 +76,8 @@ def add_parser(sub) -> None:
                    f"(V^2 - V*^2)/(2 A_MAX) along its route, both ways (Nav2's speed filter slows the robot only inside a zone), "
                    f"A_MAX {describe('dilate_upstream')}")
     p.add_argument("--wobble", type=number("wobble"), metavar="TOL",
-                   help="the speed mask's segment zones at V_tolerance, the fastest speed whose wobble stays under TOL "
-                   f"(docs/wobble.md), instead of V* where the describing function is trusted; route stretches keep V*; TOL {describe('wobble')}")
+                   help="the speed mask's zones (segments and route stretches) at V_tolerance, the fastest speed whose wobble stays "
+                   f"under TOL (docs/wobble.md), instead of V* where the describing function is trusted; TOL {describe('wobble')}")
     p.add_argument("--format", choices=FORMATS, default="text")
     p.add_argument("--quiet", action="store_true", help="no progress on stderr")
     p.set_defaults(run=run)
@@ -204,6 +204,10 @@ def run(args) -> int:
         "outputs": outputs,
         "timing": {"seconds": time.perf_counter() - started, **{f"{k}_seconds": v for k, v in analysis.timing.items()}},
     }
+    if args.wobble is not None:
+        from ..maps.wobble import wobble_summary
+
+        data["wobble"] = wobble_summary(analysis, args.wobble).to_dict()
     if args.format == "json":
         print(dumps({"schema_version": _schema_version(), "command": "map", **data}))
     else:

@@ -606,7 +606,29 @@ def render_map_text(data: dict) -> str:
         share = f"{percent(v['agreement'])[1:]} of the {v['measured']} measured" if v.get("agreement") is not None else "- (none measured)"
         lines.append(f"validation: {len(v['cases'])} simulated segments: {v['agreed']} agree, {v['disagreed']} disagree, "
                      f"{v['not_measurable']} not measurable; agreement {share}")
+    lines += _map_wobble_lines(data.get("wobble"), i["V"])
     for name, path in (data.get("outputs") or {}).items():
         lines.append(f"{name}: {path}")
     return "\n".join(lines) + "\n"
+
+
+def _map_wobble_lines(w: dict | None, V: float) -> list[str]:
+    """``map --wobble TOL``: how many zones (segments, route stretches) the mask drives at V_tolerance instead of V*, why
+    the others keep V*, and the range of the mask's limits (`maps.wobble.WobbleSummary`; docs/maps.md)."""
+    if w is None:
+        return []
+    kept = lambda counts, unit="": ", ".join(f"{n:.1f} m {why}" if unit else f"{n} {why}" for why, n in counts["kept"].items())
+    seg, st, length = w["segments"], w["stretches"], w["route_length_m"]
+    lines = [f"wobble tolerance {number(w['tolerance'])} m (docs/maps.md): zones with V* < V at V_tolerance where trusted, else V*:",
+             f"  segments: {seg['V_tolerance']} of {seg['V_tolerance'] + sum(seg['kept'].values())} with a zone at V_tolerance"
+             + (f"; V* kept: {kept(seg)}" if seg["kept"] else "")]
+    total = st["V_tolerance"] + sum(st["kept"].values())
+    if total:
+        share = f"; {percent(w['unstable_fraction'])[1:]} of the {w['unstable_length_m']:.1f} m unstable" if w["unstable_fraction"] is not None else ""
+        lines.append(f"  route stretches: {st['V_tolerance']} of {total} with a zone at V_tolerance ({length['V_tolerance']:.1f} m{share})"
+                     + (f"; V* kept: {kept(length, 'm')}" if length["kept"] else ""))
+    span = lambda lo, hi: (f"{number(lo)} .. {number(hi)} m/s ({math.floor(100 * lo / V)} .. {math.floor(100 * hi / V)} % of V)"
+                           if lo is not None else "none")
+    lines.append(f"  mask limits: {span(w['V_limit_min'], w['V_limit_max'])}; at V* alone {span(w['V_critical_min'], w['V_critical_max'])}")
+    return lines
 

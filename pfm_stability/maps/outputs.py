@@ -9,9 +9,10 @@ Nav2 speed filter with ``type: 1`` (percentage), ``base: 0``, ``multiplier: 1``:
   "no limit"); with a braking deceleration a_max (``--dilate-upstream``) each route
   stretch's zone reaches (V² − V*²)/(2·a_max) further along its route at both ends
   (`upstream_distance`: Nav2's filter slows the robot only once it is inside a zone);
-* with a wobble tolerance (``map --wobble TOL``, `maps.wobble`) a segment's zone holds 100·V_limit/V instead:
-  V_tolerance, the fastest speed whose wobble stays under TOL, where the describing function is trusted, else
-  V* (`SegmentWobble.V_limit`); no zone where V_limit >= V. Route stretches keep V*;
+* with a wobble tolerance (``map --wobble TOL``, `maps.wobble`) a segment's or route stretch's zone holds
+  100·V_limit/V instead: V_tolerance, the fastest speed whose wobble stays under TOL, where the describing function
+  is trusted, else V* (`ZoneWobble.V_limit`); no zone where V_limit >= V; a stretch's upstream dilation brakes to
+  V_limit;
 * every other cell — free, occupied or unknown — 100: the robot may drive at V.
   Occupied cells are never driven through, and 100 % is the filter's "no
   reduction"; no cell is written as unknown (−1), which the filter ignores
@@ -132,26 +133,37 @@ def speed_limits(analysis, a_max: float | None = None) -> np.ndarray:
         The analysis (map, segments and their verdicts; the routes' stretches when it has them).
     a_max : float, optional
         The robot's braking deceleration, m/s² (> 0): dilate each route stretch's slow zone upstream so the robot,
-        slowed by Nav2's speed filter only once it is inside the zone, has braked to V* where the stretch begins.
+        slowed by Nav2's speed filter only once it is inside the zone, has braked to its limit (V*, or V_limit with
+        ``map --wobble``) where the stretch begins.
         None: no dilation.
     """
     occupancy = analysis.occupancy
     V, half = analysis.robot.V, analysis.robot.W / 2
     limits = np.full(occupancy.values.shape, 100, dtype=np.int64)
     for s in analysis.segments:
-        limit = s.wobble.V_limit if getattr(s, "wobble", None) is not None else s.V_critical
-        if s.V_critical is None or not s.V_critical < V or not limit < V:
+        limit = _limit(s, V)
+        if limit is None:
             continue
         _stamp(limits, occupancy, s.x0, s.y0, s.x1, s.y1, half, _percent(limit, V))
     pv = getattr(analysis, "paths", None)
     for s in (pv.stretches if pv is not None else ()):
-        if s.V_critical is None or not s.V_critical < V:
+        limit = _limit(s, V)
+        if limit is None:
             continue
-        reach = upstream_distance(V, s.V_critical, a_max) if a_max is not None else 0.0
+        reach = upstream_distance(V, limit, a_max) if a_max is not None else 0.0
         points = route_piece(pv.paths[s.route].points, s.start - reach, s.stop + reach)
         for (x0, y0), (x1, y1) in zip(points[:-1], points[1:]):
-            _stamp(limits, occupancy, x0, y0, x1, y1, half, _percent(s.V_critical, V))
+            _stamp(limits, occupancy, x0, y0, x1, y1, half, _percent(limit, V))
     return limits
+
+
+def _limit(zone, V: float) -> float | None:
+    """The speed limit of a segment's or route stretch's zone, m/s: its wobble's V_limit when it has one (``map --wobble``),
+    else V*; None: no zone (no verdict, V* >= V, or V_limit >= V)."""
+    if zone.V_critical is None or not zone.V_critical < V:
+        return None
+    limit = zone.wobble.V_limit if getattr(zone, "wobble", None) is not None else zone.V_critical
+    return limit if limit < V else None
 
 
 def upstream_distance(V: float, V_limit: float, a_max: float) -> float:
