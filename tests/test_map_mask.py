@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 from types import SimpleNamespace
 
 import numpy as np
@@ -79,3 +80,15 @@ def test_route_piece_follows_the_polyline():
     piece = route_piece([(0, 0), (3, 0), (3, 4)], 2.0, 5.0)
     assert piece == pytest.approx(np.array([[2, 0], [3, 0], [3, 2]]), abs=1e-12)
     assert math.fsum(np.hypot(*np.diff(piece, axis=0).T)) == pytest.approx(3.0, rel=1e-12)
+
+
+def test_a_stable_stretch_whose_V_star_lies_below_V_gets_no_zone():
+    """A stable stretch with V* < V (a window where the field pushes the robot off its line on average: σ̄(V) > 0 only
+    at low speeds, so V* = 0 there) is stable at V: the mask leaves it at 100 % (it slowed the robot to the 1 % floor on
+    50 m of the warehouse's stable routes). The same stretch called unstable gets its zone (exact integers)."""
+    a = _analysis([(0.0, 1.0), (20.0, 1.0)], (5.0, 10.0), V_star=0.0)
+    stable = PathStretch(0, 5.0, 10.0, 0, 0, 0, 0, 5.0, "stable", V_critical=0.0)
+    a.paths = SimpleNamespace(paths=a.paths.paths, stretches=(stable,))
+    assert np.all(speed_limits(a) == 100)
+    a.paths = SimpleNamespace(paths=a.paths.paths, stretches=(replace(stable, verdict="unstable"),))
+    assert speed_limits(a).min() == 1

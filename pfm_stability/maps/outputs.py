@@ -11,7 +11,7 @@ Nav2 speed filter with ``type: 1`` (percentage), ``base: 0``, ``multiplier: 1``:
   (`upstream_distance`: Nav2's filter slows the robot only once it is inside a zone);
 * with a wobble tolerance (``map --wobble TOL``, `maps.wobble`) a segment's or route stretch's zone holds
   100·V_limit/V instead: V_tolerance, the fastest speed whose wobble stays under TOL, where the describing function
-  is trusted, else V* (`ZoneWobble.V_limit`); no zone where V_limit >= V; a stretch's upstream dilation brakes to
+  is trusted, else V* (`ZoneWobble.V_limit`); a zone only where the verdict is unstable, none where V_limit >= V; a stretch's upstream dilation brakes to
   V_limit;
 * every other cell — free, occupied or unknown — 100: the robot may drive at V.
   Occupied cells are never driven through, and 100 % is the filter's "no
@@ -159,8 +159,10 @@ def speed_limits(analysis, a_max: float | None = None) -> np.ndarray:
 
 def _limit(zone, V: float) -> float | None:
     """The speed limit of a segment's or route stretch's zone, m/s: its wobble's V_limit when it has one (``map --wobble``),
-    else V*; None: no zone (no verdict, V* >= V, or V_limit >= V)."""
-    if zone.V_critical is None or not zone.V_critical < V:
+    else V*; None: no zone (not unstable at V, V* >= V, or V_limit >= V). A stable stretch whose V* lies below V (a
+    window where the field pushes the robot off its line on average, σ̄ > 0 only at low speeds) gets no zone: it is
+    stable at V, and slowing down would not help it."""
+    if zone.verdict != "unstable" or zone.V_critical is None or not zone.V_critical < V:
         return None
     limit = zone.wobble.V_limit if getattr(zone, "wobble", None) is not None else zone.V_critical
     return limit if limit < V else None
