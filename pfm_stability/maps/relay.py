@@ -144,9 +144,11 @@ def relay_amplitude(jump, N_critical: float, N_smooth=0.0):
 def profile_cycle(offsets, force, N_critical: float, centred=False):
     """(amplitude, centre) of the limit cycle of the loop with the lateral force profile `force` (module docstring,
     "the window's staircase"): the first amplitude A at which the profile's describing function
-    N_1(A) = −(2/A)·⟨F(B + A·sin θ)·sin θ⟩ falls through `N_critical`, the cycle's centre B making ⟨F(B + A·sin θ)⟩ = 0
-    (or B = 0 where `centred`). Amplitude 0 where N_1 is below N* already at the smallest amplitude (no cycle), inf where
-    it stays above N* up to half the profile's reach (the cycle leaves it); centre nan then.
+    N_1(A) = −(2/A)·⟨F(B + A·sin θ)·sin θ⟩ falls through `N_critical` from above, the cycle's centre B making
+    ⟨F(B + A·sin θ)⟩ = 0 (or B = 0 where `centred`). Amplitude 0 where N_1 never exceeds N* (no cycle), inf where
+    it stays above N* up to half the profile's reach (the cycle leaves it); centre nan then. Where N_1 starts below
+    N* (a smooth equilibrium beside the jump) and rises above it, the cycle is the stable one past that rise; the
+    rise is an unstable cycle a disturbance must exceed (at a relay point, of the order of the distance to the jump).
 
     Parameters
     ----------
@@ -191,7 +193,7 @@ def profile_cycle(offsets, force, N_critical: float, centred=False):
     amplitude, where = np.full(m, np.inf), np.full(m, np.nan)
     for r in range(m):
         falls = np.flatnonzero(above[r, :-1] & (N1[r, 1:] <= N_critical))
-        if not above[r, 0] and np.isfinite(N1[r, 0]):
+        if not above[r].any():
             amplitude[r] = 0.0
         elif falls.size:
             k = falls[0]
