@@ -162,7 +162,7 @@ def map_level(gaps, length: int = 500):
             found, jump = window_relay(analysis.grid, law, x[mid], y[mid], tx[mid], ty[mid], off)
             N_s = np.nan_to_num(np.fmax(pv.N_forward[mid], pv.N_reverse[mid]))
             one = relay_amplitude(jump, N0, N_s)
-            profile = window_cycle(analysis.grid, law, x[mid], y[mid], tx[mid], ty[mid], off, N0)
+            profile = np.where(found, window_cycle(analysis.grid, law, x[mid], y[mid], tx[mid], ty[mid], off, N0), 0.0)  # as paths.py would
             x0 = float(np.median(pv.px[mid]))
             scenario = Scenario(name=f"aisle {gap}", robot=robot, controller=controller, environment=simulator_grid(analysis.grid),
                                 start=Pose(x0 + 0.03, 2.0, 0.0), target=Target.direction(0.0), duration=55.0, cell_ratio=law.ratio,
@@ -218,15 +218,17 @@ def _figure(loop_rows, map_rows, traces, out: Path) -> Path:
     t, x, x0 = traces[gap]
     r = next(r for r in map_rows if r["gap_cells"] == gap)
     b.plot(t, x, lw=0.8, label="VFF simulator")
-    for key, style, label in (("predicted_paths", ":", "paths.py (one jump, split)"), ("predicted_one_jump", "--", "one jump, merged, slope"),
+    for key, style, label in (("predicted_paths", ":", "paths.py: 2|J|/(πN*)"), ("predicted_one_jump", "--", "2|J|/(π(N* − N_s))"),
                               ("predicted_profile", "-", "window_cycle (whole profile)")):
         for sign in (1, -1):
             b.axhline(r["mean_x"] + sign * r[key], ls=style, color="C3" if key == "predicted_profile" else "0.4", lw=1.0,
                       label=label if sign == 1 else None)
     b.set_xlabel("t, s")
-    b.set_ylabel("x across the aisle, m")
-    b.set_title(f"map level: CARMEL, aisle of {gap} cells (wall | rack)")
-    b.legend(fontsize=7, loc="lower right")
+    b.set_ylabel("x across the aisle, m (lines: mean ± predicted)")
+    b.set_title(f"map level: CARMEL, {gap}-cell aisle (wall | rack)")
+    lo, hi = b.get_ylim()
+    b.set_ylim(lo - 0.45 * (hi - lo), hi)  # room for the legend under the trace
+    b.legend(fontsize=7, loc="lower right", ncol=2)
     fig.tight_layout()
     return save_figure(fig, out / "relay_amplitude.png")
 
