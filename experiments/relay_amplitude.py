@@ -13,7 +13,8 @@ Two levels:
    relay's one-jump prediction as `maps.paths` calls it), the one-jump formula with the jump merged and the slope,
    `window_cycle` (the describing function of the window's whole profile), and the VFF simulator (`sim.engine`, the
    grid law, target straight along the aisle, started 3 cm off the equilibrium): first harmonic, peak and the
-   episodes' amplitude (`maps.episodes.episodes`), and the frequency.
+   episodes' amplitude (`maps.episodes.episodes`), and the frequency; and the settled first harmonic started 1, 3, 8
+   and 15 cm off (the equilibrium beside a rack is stable only for small disturbances: the staircase's gain).
 
     python experiments/relay_amplitude.py --out experiments/results [--quick]
 """
@@ -36,6 +37,8 @@ from pfm_stability.parameters import CARMEL, HOLDS  # noqa: E402
 
 GAPS = (24, 28, 30, 32, 34)
 """Aisle widths, cells (the free columns between the wall at column 0 and the rack)."""
+STARTS = (0.01, 0.03, 0.08, 0.15)
+"""Start offsets from the equilibrium, m (towards the wall): the equilibrium beside a rack is stable only for small ones."""
 
 
 def sampled_loop(tau, k, T, V, hold, delay):
@@ -164,10 +167,15 @@ def map_level(gaps, length: int = 500):
             one = relay_amplitude(jump, N0, N_s)
             profile = np.where(found, window_cycle(analysis.grid, law, x[mid], y[mid], tx[mid], ty[mid], off, N0), 0.0)  # as paths.py would
             x0 = float(np.median(pv.px[mid]))
-            scenario = Scenario(name=f"aisle {gap}", robot=robot, controller=controller, environment=simulator_grid(analysis.grid),
-                                start=Pose(x0 + 0.03, 2.0, 0.0), target=Target.direction(0.0), duration=55.0, cell_ratio=law.ratio,
-                                window_cells=law.window_cells)
-            tr = run_batch([scenario], record="trajectory", metrics=False).runs[0].trajectory
+            scenarios = [Scenario(name=f"aisle {gap}, start {start:+.2f} m", robot=robot, controller=controller,
+                                  environment=simulator_grid(analysis.grid), start=Pose(x0 + start, 2.0, 0.0), target=Target.direction(0.0),
+                                  duration=55.0, cell_ratio=law.ratio, window_cells=law.window_cells) for start in STARTS]
+            runs = run_batch(scenarios, record="trajectory", metrics=False).runs
+            by_start = {}
+            for start, result in zip(STARTS, runs):
+                keep = result.trajectory.t > 15.0
+                by_start[start] = settled_cycle(result.trajectory.x[keep], float(np.median(np.diff(result.trajectory.t))))[0]
+            tr = runs[STARTS.index(0.03)].trajectory
             keep = tr.t > 15.0
             dt = float(np.median(np.diff(tr.t)))
             a1, peak, w = settled_cycle(tr.x[keep], dt)
@@ -177,7 +185,8 @@ def map_level(gaps, length: int = 500):
                          "jump": float(np.median(jump[found])) if found.any() else 0.0, "N_smooth": float(np.median(N_s)),
                          "predicted_paths": float(np.median(pv.amplitude[mid])), "predicted_one_jump": float(np.median(one)),
                          "predicted_profile": float(np.median(profile)), "first_harmonic": a1, "peak": peak,
-                         "episodes_amplitude": judged, "omega": w, "omega_critical": w0, "mean_x": float(tr.x[keep].mean())})
+                         "episodes_amplitude": judged, "omega": w, "omega_critical": w0, "mean_x": float(tr.x[keep].mean()),
+                         "first_harmonic_by_start": {f"{k:+.2f}": (v if v > 1e-4 else 0.0) for k, v in by_start.items()}})
     return rows, traces
 
 
@@ -196,6 +205,9 @@ def _print(loop_rows, map_rows) -> None:
         print(f"{r['gap_cells']:4d} {r['equilibrium_x']:6.3f} {r['jump']:6.3f} {r['N_smooth']:6.3f} {r['predicted_paths']:9.4f} "
               f"{r['predicted_one_jump']:9.4f} {r['predicted_profile']:8.4f} {r['first_harmonic']:7.4f} {r['peak']:7.4f} "
               f"{r['episodes_amplitude']:9.4f} {r['omega'] / r['omega_critical']:6.3f}")
+    print("\nmap level: the simulator's settled first harmonic (m) against the start offset from the equilibrium (m)")
+    for r in map_rows:
+        print(f"{r['gap_cells']:4d} " + "  ".join(f"{k}: {v:.3f}" for k, v in r["first_harmonic_by_start"].items()))
 
 
 def _figure(loop_rows, map_rows, traces, out: Path) -> Path:
