@@ -58,7 +58,7 @@ from .routes import Route, default_min_length, find_paths, find_routes
 from .wobble import SegmentWobble
 from .verdicts import END_FRACTION, TAPER_SLOPE, GrowthRate, drift_slope, critical_speed, is_weak, judged_run, segment_gain, wavelength
 
-__all__ = ["DIRECTIONS", "MAP_LAWS", "MAX_CORRIDOR_WIDTHS", "MAX_MAP_SIDE", "MAX_RESOLUTION", "NO_VERDICT", "MapAnalysis", "MapSegment",
+__all__ = ["DIRECTIONS", "MAP_LAWS", "MAX_CORRIDOR_WIDTHS", "MAX_MAP_SIDE", "MAX_RESOLUTION", "NO_VERDICT", "TAKEN_SOURCES", "MapAnalysis", "MapSegment",
            "add_routes", "analyze_map", "corridor_warnings", "judge_routes", "sample_verdict", "scale_warnings"]
 
 DIRECTIONS = ("forward", "reverse")
@@ -450,7 +450,7 @@ def analyze_map(occupancy: OccupancyMap, robot: Robot, controller: Controller, l
     segments = tuple(_segment(r, samples, k, boundary, robot, c, growth, heading_stable, end_fraction, taper_slope)
                      for k, r in enumerate(routes))
     stage("verdicts")
-    transition = SampledTransition.of(loop_model, loop) if loop_model.name == "sampled" else None
+    transition = SampledTransition.of(loop_model, loop, robot.max_steering_rate) if loop_model.name == "sampled" else None
     along = analyze_paths(grid, law, paths, clearance, robot.W, robot.V, boundary, growth, heading_stable, transition,
                           end_fraction) if paths else None
     if is_grid and along_routes:
@@ -473,10 +473,14 @@ def add_routes(analysis: MapAnalysis, routes) -> MapAnalysis:
         raise ValueError("routes need --law grid: a route is judged with the histogram grid's field")
     paths = list(analysis.paths.paths)
     paths += [replace(r, branch=len(paths) + k) for k, r in enumerate(routes)]
-    return replace(analysis, paths=judge_routes(analysis, paths))
+    return replace(analysis, paths=judge_routes(analysis, paths, taken=[r.source in TAKEN_SOURCES for r in paths]))
 
 
-def judge_routes(analysis: MapAnalysis, routes, taken: bool = False) -> PathVerdicts:
+TAKEN_SOURCES = ("goals", "drive")
+"""Route sources that are paths the simulated robot took (`validation.map_drives`): judged as taken."""
+
+
+def judge_routes(analysis: MapAnalysis, routes, taken=False) -> PathVerdicts:
     """The verdicts along `routes` alone (`paths.analyze_paths` with the analysis' grid, law, robot and loop model;
     grid law only): e.g. the paths the simulated robot took (`validation.map_drives`).
 
@@ -486,16 +490,16 @@ def judge_routes(analysis: MapAnalysis, routes, taken: bool = False) -> PathVerd
         A grid-law analysis.
     routes : sequence of RoutePath
         The routes, in map coordinates (m).
-    taken : bool
-        The routes are paths the simulated robot took (`paths.analyze_paths`' ``taken``).
+    taken : bool or sequence of bool
+        The routes (all, or each) are paths the simulated robot took (`paths.analyze_paths`' ``taken``).
     """
     if analysis.paths is None:
         raise ValueError("routes need --law grid: a route is judged with the histogram grid's field")
     (loop_model,) = models_for(analysis.controller, [analysis.model])
-    loop = Loop(analysis.robot.tau, analysis.controller.T, analysis.robot.k, c=0.0)
+    loop = Loop.of(analysis.robot, analysis.controller, c=0.0)  # the plant's gain and dead time too
     boundary = loop_model.boundary(loop)
     growth = GrowthRate(lambda NV: loop_model.rightmost_root(NV, loop), boundary.NV_critical)
-    transition = SampledTransition.of(loop_model, loop) if loop_model.name == "sampled" else None
+    transition = SampledTransition.of(loop_model, loop, analysis.robot.max_steering_rate) if loop_model.name == "sampled" else None
     return analyze_paths(analysis.grid, analysis.law, list(routes), analysis.clearance, analysis.robot.W, analysis.robot.V, boundary, growth,
                          loop_model.is_stable(0.0, loop), transition, taken=taken)
 

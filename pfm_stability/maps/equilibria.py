@@ -190,7 +190,7 @@ def _band(grid: HistogramMap, clearance: np.ndarray, x, y, tx, ty, W: float, rea
     return np.where(any_fit, low, 1.0), np.where(any_fit, high, -1.0)
 
 
-def lateral_force(grid, law, x, y, tx, ty, s, jacobian=False):
+def lateral_force(grid, law, x, y, tx, ty, s, jacobian=False, phase_nodes: int = PHASE_NODES):
     """F_n, F_r·t (and dF_n/ds) at p + s·nrm, nrm = (−ty, tx), averaged over the robot's position along t within one cell.
 
     The average is over u in [−c/2, c/2) (Gauss–Legendre, `PHASE_NODES` nodes), the
@@ -211,10 +211,12 @@ def lateral_force(grid, law, x, y, tx, ty, s, jacobian=False):
         Lateral offsets along nrm = (−ty, tx), m.
     jacobian : bool
         Also return dF_n/ds (1/m).
+    phase_nodes : int
+        Gauss–Legendre nodes of the average along t (`PHASE_NODES`).
     """
     from ..numerics.solve import gauss_legendre
 
-    nodes, weights = gauss_legendre(PHASE_NODES)
+    nodes, weights = gauss_legendre(phase_nodes)
     u = nodes * grid.cell_size / 2
     nx_, ny_ = -ty, tx
     qx = (x + s * nx_)[:, None] + u[None, :] * tx[:, None]

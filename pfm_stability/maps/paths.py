@@ -40,9 +40,17 @@ losing a wall's column as the robot moves a cell sideways) by more than its smoo
 restores (pushes the robot back across it), the robot holds a sustained oscillation of about a cell's amplitude
 there, which the smooth linearization cannot see: such a sample is unstable, its stretch labelled "relay".
 
-**Paths taken** (``taken``: the paths the simulated robot drove between goals, `validation.map_drives`). Its goal,
-not only the field, holds the robot there: a lateral equilibrium farther than W/2 from the path is not the one it
-follows, so the loop is linearized at the path itself, and the line it is pulled to is the path.
+**The loop driven along the route** (`_driven`): the sampled loop is also run along each route through the force
+across it (`lateral_profile`, every quarter cell: the window sum's jumps, a rack's staircase, a one-sided field), with
+the steering-rate limit on its command (`SampledTransition`, `models.sampled.command_form`); its episodes (the
+drives' own definition, `maps.episodes`) mark the route unstable ("oscillates"): a forced weave, or a cycle the
+nonlinearity holds, that the window growth cannot see.
+
+**Paths taken** (``taken``: the paths the simulated robot drove, between goals or in the validation,
+`validation.map_drives`). Its goal, not only the field, holds the robot there: a lateral equilibrium farther than W/2
+from the path is not the one it follows, so the loop is linearized at the path itself, and the line it is pulled to
+is the path (the goal balances the field's mean over a wavelength there). Such a path is judged the way it was
+driven; where a wall is ahead that way it is unjudged ("wall ahead").
 
 **Stretches**: runs of consecutive samples with one verdict (`PathStretch`), each with the
 numbers of its worst window: σ̄_w, e-folds σ̄_w·Λ/V, N_eff (`verdicts.effective_gain`:
@@ -61,7 +69,7 @@ from ..io.serialize import json_number
 from ..models import gain_margin, verdict_label
 from ..models.verdicts import inside as in_set, judge_arrays
 from .equilibria import Samples, equilibria_at, lateral_force
-from .episodes import AMPLITUDE_THRESHOLD
+from .episodes import AMPLITUDE_THRESHOLD, NOISE_FLOOR
 from .relay import relay_amplitude, window_relay
 from .routes import RoutePath  # noqa: F401 (named in the docstrings and annotations)
 from .verdicts import EFOLDS, END_FRACTION, GrowthRate, critical_speed, effective_gain, wavelength
@@ -77,7 +85,7 @@ PATH_NEWTON_STEPS = 12
 """Newton steps per equilibrium along the routes (`equilibria.equilibria_at`): the corridor analysis' `NEWTON_STEPS`.
 With 6 (a jump located to < 1 mm) the depot's north-wall weave at CARMEL's preset, predicted near the episode
 threshold, was lost (recall 97 % -> 54 %): the forced weave is that sensitive to where the line is."""
-UNJUDGED = ("wall ahead both ways", "inside an obstacle")
+UNJUDGED = ("wall ahead both ways", "inside an obstacle", "wall ahead")
 """Reasons a sample gets no verdict: a wall ahead in both travel directions (the repulsion along the route cancels more
 than `verdicts.END_FRACTION` of the attraction either way: the robot turns there, a narrow dead end), or the sample
 lies in an occupied cell (the field is not finite)."""
@@ -307,7 +315,7 @@ def _window_mean(values: np.ndarray, route: np.ndarray, arc: np.ndarray, ds: np.
 
 
 def analyze_paths(grid, law, paths, clearance: np.ndarray, W: float, V: float, boundary, growth: GrowthRate,
-                  heading_stable: bool, transition=None, end_fraction: float = END_FRACTION, taken: bool = False) -> PathVerdicts:
+                  heading_stable: bool, transition=None, end_fraction: float = END_FRACTION, taken=False) -> PathVerdicts:
     """The verdict at every point of every route (module docstring).
 
     Parameters
@@ -337,18 +345,21 @@ def analyze_paths(grid, law, paths, clearance: np.ndarray, W: float, V: float, b
     end_fraction : float
         A travel direction is not judged where the repulsion ahead cancels more than this fraction of the attraction
         (1 ± F_r·t < 1 − end_fraction: `verdicts.END_FRACTION`): the robot turns there (module docstring).
-    taken : bool
-        The routes are paths the simulated robot took (its goal holds it there, not only the field): a lateral
-        equilibrium farther than W/2 from the path is not the robot's, and the path itself is the line it follows
-        (linearized there, no pull towards the equilibrium; module docstring, "Paths taken").
+    taken : bool or sequence of bool
+        The routes (all, or each) are paths the simulated robot took (its goal holds it there, not only the field): a
+        lateral equilibrium farther than W/2 from the path is not the robot's, the path itself is the line it follows
+        (linearized there, no pull towards the equilibrium), judged the way it was driven (module docstring, "Paths
+        taken").
     """
     paths = tuple(paths)
     x, y, tx, ty, route, arc, ds = path_samples(paths, grid.cell_size)
+    driven = np.broadcast_to(np.asarray(taken, dtype=bool), (len(paths),))  # per route
+    taken = driven[route] if route.size else np.zeros(0, dtype=bool)  # per sample
     samples = equilibria_at(grid, law, x, y, tx, ty, route, clearance, W, newton_steps=PATH_NEWTON_STEPS)
     has = np.isfinite(samples.offset)
     along, slope = np.array(samples.along, dtype=float), samples.N * samples.forward  # −dF_n/ds at the equilibrium
-    if taken:  # an equilibrium the robot's own path keeps away from is not the one it follows
-        far = has & (np.abs(np.nan_to_num(samples.offset)) > W / 2)
+    if taken.any():  # an equilibrium the robot's own path keeps away from is not the one it follows
+        far = has & taken & (np.abs(np.nan_to_num(samples.offset)) > W / 2)
         has = has & ~far
         slope = np.where(far, np.nan, slope)
     offset = np.where(has, samples.offset, 0.0)
@@ -356,15 +367,15 @@ def analyze_paths(grid, law, paths, clearance: np.ndarray, W: float, V: float, b
     # the gradient at the route's own point where there is no equilibrium (and at an equilibrium the repulsion stops
     # the robot at in one direction, where the corridor search keeps no N)
     redo = np.flatnonzero(~np.isfinite(slope))
-    pull = np.zeros(x.size)  # F_n at the linearization point (0 at an equilibrium)
     if redo.size:
-        fn0, ft0, df0 = lateral_force(grid, law, x[redo], y[redo], tx[redo], ty[redo], offset[redo], jacobian=True)
-        along[redo], slope[redo], pull[redo] = ft0, -df0, np.where(has[redo] | taken, 0.0, fn0)
+        _, ft0, df0 = lateral_force(grid, law, x[redo], y[redo], tx[redo], ty[redo], offset[redo], jacobian=True)
+        along[redo], slope[redo] = ft0, -df0
     inside = ~(np.isfinite(along) & np.isfinite(slope))
     with np.errstate(divide="ignore", invalid="ignore"):
         N_forward = np.where(1 + along >= 1 - end_fraction, slope / (1 + along), np.nan)
         N_reverse = np.where(1 - along >= 1 - end_fraction, slope / (1 - along), np.nan)
     N_forward[inside], N_reverse[inside] = np.nan, np.nan
+    N_reverse[taken] = np.nan  # the robot drove a path taken one way, from its start: the reverse is not its path
     sig = [np.where(np.isfinite(n), growth(np.nan_to_num(n) * V), np.nan) for n in (N_forward, N_reverse)]
     lam = wavelength(V, boundary.omega_critical)
     window = WINDOW_PERIODS * lam if math.isfinite(lam) else math.inf
@@ -383,27 +394,33 @@ def analyze_paths(grid, law, paths, clearance: np.ndarray, W: float, V: float, b
     efolds = window_growth * np.stack(seconds)[worse, rows]
     code = np.where(efolds >= EFOLDS, 1, 0)  # a disturbance grows by at least one e-fold over the window
     stopped = ~np.isfinite(N_forward) & ~np.isfinite(N_reverse)
-    code = np.where(stopped, 2, code)
-    code = np.where(inside, 3, code)
-    code = np.where(~np.isfinite(window_growth) & (code < 2), 2, code)
-    # the equilibrium line the loop is pulled to: s0, or without one the linear extrapolation F_n/(−dF_n/ds) from the
-    # route point (a virtual equilibrium), within the room the robot has there
-    i, j = grid.cell_index(x, y)
-    room = np.maximum(clearance[np.clip(i, 0, clearance.shape[0] - 1), np.clip(j, 0, clearance.shape[1] - 1)] - W / 2, 0.0)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        virtual = np.where(slope > 0, pull / slope, 0.0)
-    line = np.where(has, offset, np.clip(np.nan_to_num(virtual), -room, room))
+    wall = np.where(taken, PATH_VERDICTS.index("wall ahead"), PATH_VERDICTS.index("wall ahead both ways"))
+    code = np.where(stopped, wall, code)
+    code = np.where(inside, PATH_VERDICTS.index("inside an obstacle"), code)
+    code = np.where(~np.isfinite(window_growth) & (code < 2), wall, code)
     oscillates = np.zeros(x.size, dtype=bool)
     amplitude = np.zeros(x.size)
     if transition is not None and boundary.omega_critical and boundary.omega_critical > 0:
-        oscillates, amplitude = _forced(route, arc, (N_forward, N_reverse), line, V, transition, 2 * math.pi / boundary.omega_critical)
+        profile = lateral_profile(grid, law, x, y, tx, ty, LEAVES)
+        # on a path taken, the goal balances the field's mean over a period of travel; its ripple along the path forces
+        reference = np.where(taken, _window_mean(profile[1][:, profile[0].size // 2], route, arc, ds, lam / 2), 0.0)
+        stopped = np.stack([~np.isfinite(N_forward), ~np.isfinite(N_reverse)])
+        oscillates, amplitude = _driven(route, arc, stopped, profile, np.nan_to_num(reference), V, transition,
+                                        2 * math.pi / boundary.omega_critical, driven)
         code = np.where((code == 0) & oscillates, 1, code)
     # the window-edge relay (`relay`): a restoring jump of F_n within a cell of the path, larger than its smooth change
     relay = np.zeros(x.size, dtype=bool)
     check = np.flatnonzero((code == 0) & (has | taken))  # where the robot's path is known: its equilibrium, or driven
     if check.size and boundary.NV_critical and math.isfinite(boundary.NV_critical) and boundary.NV_critical > 0:
         found, jump = window_relay(grid, law, x[check], y[check], tx[check], ty[check], offset[check], reference=~has[check])
-        cycle = relay_amplitude(jump, boundary.NV_critical / V)
+        # the describing function of one jump beside the smooth slope, per unit forward force, in the worse direction
+        # (`relay.relay_amplitude`; the whole profile's, `relay.window_cycle`, is what the driven loop above runs through)
+        d = worse[check]
+        ahead = np.where(d == 0, 1 + along[check], 1 - along[check])
+        N_smooth = np.nan_to_num(np.where(d == 0, N_forward[check], N_reverse[check]))
+        with np.errstate(invalid="ignore", divide="ignore"):
+            cycle = np.minimum(relay_amplitude(jump / np.where(ahead > 0, ahead, np.nan), boundary.NV_critical / V, N_smooth), LEAVES)
+        cycle = np.nan_to_num(cycle)
         relay[check] = found & (cycle >= AMPLITUDE_THRESHOLD)  # a limit cycle the episodes' judge would see
         amplitude[check] = np.where(relay[check], np.maximum(amplitude[check], cycle), amplitude[check])
     code = np.where(relay, 1, code)
@@ -420,7 +437,9 @@ def analyze_paths(grid, law, paths, clearance: np.ndarray, W: float, V: float, b
 @dataclass(frozen=True)
 class SampledTransition:
     """The sampled loop's one-period transition matrix Φ(NV) = Φ0 + NV·Φ1 (`models.sampled.closed_loop_matrix` is
-    affine in the loop gain: only the feedback row depends on it).
+    affine in the loop gain: only the feedback row depends on it), and the same loop with its command apart
+    (`models.sampled.command_form`): x_(k+1) = M·x_k + n·sat(v_k), v_k = −F0·x_k − gk·δ_k with δ_k the heading the
+    lateral force asks for (−N·x to first order), sat the steering-rate limit.
 
     Attributes
     ----------
@@ -428,14 +447,33 @@ class SampledTransition:
         Φ at NV = 0 and its derivative in NV (s).
     T : float
         The period, s.
+    M : ndarray, shape (n, n)
+        The loop without the command.
+    command : ndarray, shape (n,)
+        Where the command v enters.
+    F0 : ndarray, shape (n,)
+        The command's feedback from the state at NV = 0 (the heading's).
+    steering_gain : float
+        g·k, 1/s: the command per radian of heading error, in motor units.
+    rate_limit : float
+        The largest |v|, rad/s: g·max_steering_rate with the command held (the simulator clips the held command);
+        inf with the reference held (the servo's limit acts inside the period, which the one-period map does not see).
+    lateral_index : int
+        The state that holds the lateral position, as x/V (s).
     """
 
     Phi0: np.ndarray
     Phi1: np.ndarray
     T: float
+    M: np.ndarray = None
+    command: np.ndarray = None
+    F0: np.ndarray = None
+    steering_gain: float = 1.0
+    rate_limit: float = math.inf
+    lateral_index: int = 0
 
     @classmethod
-    def of(cls, model, loop) -> "SampledTransition":
+    def of(cls, model, loop, max_steering_rate: float = math.inf) -> "SampledTransition":
         """From a `models.Sampled` model and its loop (c = 0).
 
         Parameters
@@ -443,15 +481,19 @@ class SampledTransition:
         model : Sampled
             The loop model.
         loop : Loop
-            KB's loop (τ, T, k, c).
+            KB's loop (τ, T, k, g, D, c).
+        max_steering_rate : float
+            The robot's limit on its steering command, rad/s (`Robot.max_steering_rate`; inf: none).
         """
-        from ..models.sampled import closed_loop_matrix
+        from ..models.sampled import closed_loop_matrix, command_form
 
         def at(NV):  # Φ_cl at the loop gain NV (1/s)
             return np.asarray(closed_loop_matrix(loop, loop.loop_gain(NV), model.hold, model.compute_delay), dtype=float)
 
         Phi0 = at(0.0)
-        return cls(Phi0, at(1.0) - Phi0, float(loop.T))
+        M, command, F0, F1 = command_form(loop, model.hold, model.compute_delay)
+        limit = loop.plant_gain * max_steering_rate if model.hold == "command" else math.inf
+        return cls(Phi0, at(1.0) - Phi0, float(loop.T), M, command, F0, float(loop.steering_gain), float(limit), int(np.flatnonzero(F1)[0]))
 
 
 RENORMALIZE = 8
@@ -507,26 +549,88 @@ def _window_product(N: np.ndarray, route: np.ndarray, arc: np.ndarray, half: flo
 
 
 PREDICTION_OFFSET = 0.03
-"""Lateral offset (m) of the linear loop's start from the equilibrium line in `_forced` (the drives' start offset,
+"""Lateral offset (m) of the loop's start from the route in `_driven` (the drives' start offset,
 `validation.maps.START_OFFSET`): the disturbance whose growth shows where the loop is unstable."""
 
 
 LEAVES = 1.0
-"""Lateral distance (m) from the route at which the linear loop's run stops: it has left any corridor (its amplitude
+"""Lateral distance (m) from the route at which the loop's run stops: it has left any corridor (its amplitude
 is then "at least this")."""
+PROFILE_STEP = 0.25
+"""Spacing of the lateral force profile across the route, histogram cells: a quarter cell, so that each jump of the
+window sum (at the cell boundaries) lies between two nodes a quarter cell apart, as in `relay.window_relay`."""
+PROFILE_PHASE_NODES = 1
+"""Positions along the route within a cell over which the profile's force is averaged (`equilibria.lateral_force`'s
+phase average; one: the cell's middle — the robot's run crosses every along-track position of the cell anyway)."""
 
 
-def _forced(route, arc, gains, line, V: float, transition: SampledTransition, period: float):
-    """(oscillates, amplitude) per sample: the sampled loop driven along each route in both directions at V, pulled
-    to the equilibrium line (x_{k+1} = Φ(N_k V)·x_k − N_k V·Φ1·s0_k e_y), started `PREDICTION_OFFSET` off it; its
-    lateral position's episodes (`episodes.lateral_episodes`) mark the samples the robot passes meanwhile."""
+def lateral_profile(grid, law, x, y, tx, ty, reach: float):
+    """(offsets, F_n, F_r·t): the VFF force across each route point p, at p + s·nrm for the offsets s (m, every
+    `PROFILE_STEP` cells within ±`reach`), in F_ct units, shape (points, offsets); nan inside an obstacle.
+
+    Parameters
+    ----------
+    grid : HistogramMap
+        The map's histogram grid.
+    law : GridWallLaw
+        KB's grid law.
+    x, y : ndarray
+        Route points, m.
+    tx, ty : ndarray
+        Unit travel directions.
+    reach : float
+        Largest |s|, m.
+    """
+    step = PROFILE_STEP * grid.cell_size
+    half = int(math.ceil(reach / step))
+    offsets = np.arange(-half, half + 1) * step
+    S = offsets.size
+    rep = lambda v: np.repeat(np.asarray(v, dtype=float), S)  # noqa: E731
+    fn, ft = lateral_force(grid, law, rep(x), rep(y), rep(tx), rep(ty), np.tile(offsets, np.size(x)), phase_nodes=PROFILE_PHASE_NODES)
+    return offsets, fn.reshape(-1, S), ft.reshape(-1, S)
+
+
+def _driven(route, arc, stopped, profile, reference, V: float, transition: SampledTransition, period: float, taken):
+    """(oscillates, amplitude) per sample: the sampled loop driven along each route at V through the real lateral force
+    across it (module docstring, "The loop driven along the route"), in both directions (a path taken: the way it was
+    driven), started `PREDICTION_OFFSET` off a route (`NOISE_FLOOR` off a path taken); its lateral position's episodes
+    (`episodes.lateral_episodes`, the drives' judge) mark the samples the robot passes meanwhile.
+
+    ``x_{k+1} = M·x_k + n·sat(v_k)``, ``v_k = −F0·x_k − gk·g_k(y_k)`` (`SampledTransition`), g(y) = −(F_n(y) − F_ref)/
+    (1 ± F_r·t): the linear loop's N·y with the lateral force itself (interpolated in `profile` between its quarter
+    cells), sat the steering-rate limit. `stopped` (per direction and sample): the direction is not judged there (a
+    wall ahead, `END_FRACTION`): no lateral force. The run stops where it leaves the profile or `LEAVES`.
+
+    Parameters
+    ----------
+    route, arc : ndarray
+        Route index and arc position (m) of each sample.
+    stopped : ndarray of bool, shape (2, samples)
+        Forward and reverse.
+    profile : tuple
+        `lateral_profile`'s (offsets, F_n, F_r·t).
+    reference : ndarray
+        F_ref per sample, F_ct units.
+    V : float
+        Speed, m/s.
+    transition : SampledTransition
+        The loop.
+    period : float
+        The episodes' period P = 2π/ω*, s.
+    taken : bool or ndarray of bool
+        Per route (or all): a path the robot took.
+    """
     from .episodes import lateral_episodes
 
-    y_index = int(np.flatnonzero(np.abs(transition.Phi1).sum(axis=0))[0])
-    forcing = transition.Phi1[:, y_index]
+    offsets, fn, ft = profile
+    taken = np.broadcast_to(np.asarray(taken, dtype=bool), (int(route.max()) + 1 if route.size else 0,))  # per route
+    y_index = transition.lateral_index
+    M, command, F0, gk, limit = transition.M, transition.command, transition.F0, transition.steering_gain, transition.rate_limit
     step = V * transition.T
+    h = offsets[1] - offsets[0]
     oscillates, amplitude = np.zeros(arc.size, dtype=bool), np.zeros(arc.size)
-    runs = []  # (samples passed at each step, K, s0) of each route and direction
+    centre = offsets.size // 2
+    runs = []  # (samples passed at each step, sign of travel) of each route and direction
     for r in np.unique(route):
         idx = np.flatnonzero(route == r)
         a = arc[idx]
@@ -535,30 +639,45 @@ def _forced(route, arc, gains, line, V: float, transition: SampledTransition, pe
         positions = (np.arange(int((a[-1] + (a[1] - a[0]) / 2) / step)) + 0.5) * step
         if positions.size < 8:
             continue
-        for d, N in enumerate(gains):
+        for d in ((0,) if taken[r] else (0, 1)):  # a path taken was driven one way, from its start
             pos = positions if d == 0 else positions[::-1]
-            nearest = idx[np.clip(np.searchsorted((a[:-1] + a[1:]) / 2, pos), 0, a.size - 1)]
-            runs.append((nearest, np.nan_to_num(N[nearest]) * V, line[nearest] if d == 0 else -line[nearest]))  # the normal flips
+            runs.append((idx[np.clip(np.searchsorted((a[:-1] + a[1:]) / 2, pos), 0, a.size - 1)], d, bool(taken[r])))
     if not runs:
         return oscillates, amplitude
     steps = max(r[0].size for r in runs)
-    K, s0 = np.zeros((len(runs), steps)), np.zeros((len(runs), steps))
-    for i, (nearest, k, line_k) in enumerate(runs):
-        K[i, :k.size], s0[i, :k.size] = k, line_k
-    state = np.zeros((len(runs), transition.Phi0.shape[0]))
-    state[:, y_index] = s0[:, 0] + PREDICTION_OFFSET
+    rows = np.zeros((len(runs), steps), dtype=int)
+    sign = np.array([1.0 if d == 0 else -1.0 for _, d, _ in runs])
+    length = np.array([n.size for n, _, _ in runs])
+    start = np.array([NOISE_FLOOR if on_path else PREDICTION_OFFSET for _, _, on_path in runs])
+    for i, (nearest, _, _) in enumerate(runs):
+        rows[i, :nearest.size] = nearest
+    state = np.zeros((len(runs), M.shape[0]))
+    state[:, y_index] = sign * start / V  # to the left of the travel direction (the state is x/V, s)
     lateral = np.full((len(runs), steps), np.nan)
     alive = np.ones(len(runs), dtype=bool)
-    for k in range(steps):
-        lateral[alive, k] = state[alive, y_index]
-        state = state @ transition.Phi0.T + K[:, k, None] * (state @ transition.Phi1.T - forcing[None, :] * s0[:, k, None])
-        alive &= np.isfinite(state).all(axis=1) & (np.abs(state[:, y_index]) <= LEAVES)
-        state[~alive] = 0.0
+    with np.errstate(invalid="ignore"):
+        for k in range(steps):
+            alive &= k < length
+            row = rows[:, k]
+            yk = V * state[:, y_index]  # m
+            u = (yk - offsets[0]) / h
+            i0 = np.clip(np.floor(u).astype(int), 0, offsets.size - 2)
+            frac = u - i0
+            f = fn[row, i0] * (1 - frac) + fn[row, i0 + 1] * frac
+            ahead = 1 + sign * ft[row, centre]
+            g = -(f - reference[row]) / ahead
+            g = np.where(stopped[(sign < 0).astype(int), row], 0.0, g)
+            inside = (u >= 0) & (u <= offsets.size - 1) & (np.abs(yk) <= LEAVES) & np.isfinite(g)
+            alive &= inside & np.isfinite(state).all(axis=1)
+            lateral[alive, k] = yk[alive]
+            v = np.clip(-(state @ F0) - gk * np.where(alive, g, 0.0), -limit, limit)  # the command, rate-limited
+            state = state @ M.T + v[:, None] * command[None, :]
+            state[~alive] = 0.0
     t = np.arange(steps) * transition.T
-    for i, (nearest, _, _) in enumerate(runs):
+    for i, (nearest, d, _) in enumerate(runs):
         m = nearest.size
         ok = np.isfinite(lateral[i, :m])
-        found, peak = lateral_episodes(t[:m][ok], lateral[i, :m][ok], period)
+        found, peak = lateral_episodes(t[:m][ok], sign[i] * lateral[i, :m][ok], period)
         for lo, hi in found:
             oscillates[nearest[(t[:m] >= lo) & (t[:m] <= hi)]] = True
         amplitude[nearest] = np.maximum(amplitude[nearest], peak if ok.all() else max(peak, LEAVES))

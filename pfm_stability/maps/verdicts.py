@@ -17,7 +17,8 @@ over the samples with an equilibrium: a gap is not a gain):
 * N_eff is the uniform gain with the same growth, σ(N_eff·V) = σ̄ (`effective_gain`),
   so the margin NV*/(N_eff·V) − 1 keeps its meaning. σ is not one-to-one on (0, NV*)
   (a small gain's real root decays slowly, the most damped gain lies in between), so
-  for σ̄ < 0 N_eff is taken on the branch holding the samples' mean N·V; for σ̄ >= 0 it
+  for σ̄ < 0 N_eff is taken on the branch holding the samples' mean N·V (a window whose gain varies can
+  decay faster than any uniform gain does: N_eff is then the most damped gain); for σ̄ >= 0 it
   is the gain above NV* — or, when the samples' mean N is negative (the field pushes
   the robot off the line on average), the negative gain with that divergence: unstable
   at any speed, V* = 0, margin −1 (docs/models.md, "N < 0").
@@ -255,6 +256,8 @@ def effective_gain(sigma: float, mean_N: float, V: float, growth: GrowthRate, NV
         return _rising(f, NV_critical, NV_critical) / V
     least = growth.NV_least
     top = NV_critical if finite else growth.hi
+    if f(least) > 0:  # a window whose gain varies can decay faster than any uniform gain: the fastest one's
+        return least / V
     if mean_N * V > least and f(top) >= 0:  # the oscillating branch: σ rises from its least value to 0 at NV*
         return bisect_root(f, least, top) / V
     return bisect_root(f, 0.0, least) / V  # the slow real root's branch: σ falls from 0 (f(0) = −σ̄ > 0)

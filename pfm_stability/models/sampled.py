@@ -100,7 +100,7 @@ from .base import AffineGainModel, checked
 from .continuous import Continuous
 from .family import Characteristic
 
-__all__ = ["Sampled", "continuous_plant", "discretize", "closed_loop_matrix", "delta_plant", "dead_time_plant", "bilinear_polynomial",
+__all__ = ["command_form", "Sampled", "continuous_plant", "discretize", "closed_loop_matrix", "delta_plant", "dead_time_plant", "bilinear_polynomial",
            "MAX_DELAY_STATES"]
 
 
@@ -220,6 +220,38 @@ def dead_time_plant(loop: Characteristic, hold: str, compute_delay: int):
     for array in (Psi_a, G_a, F0_a, F1_a):
         array.setflags(write=False)
     return Psi_a, G_a, F0_a, F1_a
+
+
+def command_form(loop: Characteristic, hold: str, compute_delay: int) -> tuple:
+    """(M, n, F0, F1): the sampled loop with its command apart, x_(k+1) = M·x_k + n·v_k, v_k = −(F0 + K·F1)·x_k, so that
+    Φ_cl(K) = M − n·(F0 + K·F1) (`closed_loop_matrix`): a nonlinearity acting on the command (a rate limit) or on the
+    lateral feedback (the force itself instead of its gradient) enters there.
+
+    The state is `closed_loop_matrix`'s: the plant's, then with compute_delay = 1 the command waiting to be applied
+    (v_k enters it and reaches the plant a period later), or with a dead time the commands on their way
+    (`dead_time_plant`).
+
+    Parameters
+    ----------
+    loop : Loop or HolonomicLoop
+        T must be > 0.
+    hold : {"command", "reference"}
+    compute_delay : {0, 1}
+    """
+    T = loop.T
+    if loop.dead_time > 0:
+        Psi_a, G_a, F0_a, F1_a = dead_time_plant(loop, hold, compute_delay)
+        return np.eye(Psi_a.shape[0]) + T * Psi_a, T * G_a[:, 0], np.array(F0_a), np.array(F1_a)
+    Psi, G, F0, F1 = delta_plant(loop, hold)
+    n = Psi.shape[0]
+    Phi, Gamma = np.eye(n) + T * Psi, T * G[:, 0]
+    if compute_delay == 0:
+        return Phi, Gamma, np.array(F0), np.array(F1)
+    M = np.zeros((n + 1, n + 1))
+    M[:n, :n], M[:n, n] = Phi, Gamma
+    waiting = np.zeros(n + 1)
+    waiting[n] = 1.0
+    return M, waiting, np.concatenate([F0, [0.0]]), np.concatenate([F1, [0.0]])
 
 
 def closed_loop_matrix(loop: Characteristic, K: float, hold: str, compute_delay: int) -> np.ndarray:

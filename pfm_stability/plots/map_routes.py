@@ -16,6 +16,7 @@ ROUTE_STYLES = {
     "unstable": dict(color="#d7191c", lw=3.6, label="unstable: a disturbance grows (>= 1 e-fold)"),
     "relay": dict(color="#7b3294", lw=3.6, label="unstable: window-edge relay (a jump of the window's force)"),
     "wall ahead both ways": dict(color="0.45", lw=1.4, label="no verdict: wall ahead both ways", ls=(0, (1.5, 2.0))),
+    "wall ahead": dict(color="0.45", lw=1.4, label="no verdict: wall ahead (a path driven one way)", ls=(0, (1.5, 2.0))),
     "inside an obstacle": dict(color="0.3", lw=1.4, label="no verdict: inside an obstacle", ls=(0, (4.0, 2.0))),
 }
 """Style of a stretch by its kind: the label of a stable or unstable stretch, else its verdict (a reason)."""
@@ -106,8 +107,9 @@ def plot_route_verdicts(analysis, drives=None, ax=None, *, title: str | None = N
         L = drives.lengths
         kinds = "; ".join(f"{kind} drives {pct(v['recall'])} / {pct(v['precision'])}" for kind, v in drives.by_kind.items())
         validation = (f"\n{drives.counts['drives']} drives, {drives.counts['episodes']} episodes: recall {pct(drives.recall)}, "
-                      f"precision {pct(drives.precision)} by route length ({kinds})\n{L['driven']:.0f} of {L['route']:.0f} m "
-                      f"driven; {L['episode']:.1f} m of episodes on the routes, {L['episode_off_route']:.0f} m off them (not scored)")
+                      f"precision {pct(drives.precision)} along the paths driven ({kinds})\n{L['drive_paths_driven']:.0f} m measured "
+                      f"({L.get('drive_paths_unmeasured', 0.0):.0f} m not: a drive's last 3 periods); {L['episode']:.1f} m of episodes; "
+                      f"{L['driven']:.0f} of {L['route']:.0f} m of route covered")
     handles.append(Line2D([], [], marker="s", ls="", color=str(OCCUPIED_GREY), markersize=8, label="occupied"))
     if occupancy.unknown.any():
         handles.append(Line2D([], [], marker="s", ls="", color=str(UNKNOWN_GREY), markeredgecolor="0.6", markersize=8, label="unknown"))

@@ -10,12 +10,21 @@ it collides or stalls, or `DRIVE_TIME_FACTOR` times its straight-line time.
 
 **Episodes** (`maps.episodes.episodes`, the one definition the map's prediction uses too): the robot's
 lateral oscillation about its own path averaged over one period P = 2π/ω*; an episode is three periods of it
-that grow by an e-fold or stay above 5 cm.
+that grow by an e-fold or stay above `AMPLITUDE_THRESHOLD`.
 
-**Route length** (`score`). Each trajectory point marks its nearest route sample (within `MATCH_DISTANCE` or
-the robot's width): those samples are driven; the points during an episode mark episode samples; samples passed
-in the drive's first period are the start's transient and not measured. A driven sample predicted unstable
-(`maps.paths`: the window's mean growth rate > 0) matches an episode when an episode sample of the same route lies
+**Each drive is judged along the path it took** (its positions averaged over one period, `maps.analysis.judge_routes`
+with ``taken``: the prediction the map makes along any route — the loop driven through the force across the path,
+`maps.paths` — made along that path, in the direction it was driven). The VFF robot aims at a point, not along a
+route: it leaves the skeleton wherever the field bends it away (beside a rack it rides the window's edge, metres from
+the route), so comparing the skeleton's verdicts with a robot that drove elsewhere would compare two different paths.
+The map's route samples within `MATCH_DISTANCE` of a drive are counted as covered (``lengths["driven"]``), not scored.
+
+**Route length** (`_score`). Each trajectory point marks its nearest sample of its own path (within `MATCH_DISTANCE`
+or the robot's width): those samples are driven; the points during an episode mark episode samples. Two kinds of
+sample cannot show an episode and are not measured: those passed in the drive's first period (the start's
+transient), and those passed only in its last `EPISODE_PERIODS` periods (an episode needs three periods after
+them: the drive reached its goal, collided or stalled first; counted as ``drive_paths_unmeasured``, never as
+agreement). A driven sample predicted unstable matches an episode when an episode sample of the same path lies
 within half the verdict's window Λ (the point's verdict is the growth over the window centred there), and an
 episode sample is recalled when a predicted-unstable sample lies within Λ/2. Recall = recalled episode length /
 episode length; precision = matched predicted-unstable length / predicted-unstable length driven (None when a
@@ -132,9 +141,12 @@ class DriveValidation:
     drives : tuple of Drive
     disagreements : tuple of Disagreement
     lengths : dict
-        Route length (m): ``route``, ``driven``, ``not_driven``, ``episode``, ``episode_recalled``, ``episode_off_route``
-        (the drives' path length in episodes farther than the match distance from any route: measured, not scored),
-        ``predicted_unstable_driven``, ``predicted_unstable_matched``, ``predicted_unstable_not_driven``.
+        Length (m): of the map's routes ``route``, ``driven`` (covered by a drive), ``not_driven``; of the drives' own
+        paths ``drive_paths``, ``drive_paths_driven`` (measured), ``drive_paths_unmeasured`` (passed only in a drive's
+        last three periods); ``episode``, ``episode_recalled``, ``episode_off_route`` (the drives' path length in
+        episodes farther than the match distance from their own path: measured, not scored),
+        ``predicted_unstable_driven``, ``predicted_unstable_matched``, ``predicted_unstable_unmeasured``,
+        ``predicted_unstable_not_driven`` (on the map's routes, no drive near).
     counts : dict
         Drives by how they ended, episodes found.
     inputs : dict
@@ -144,7 +156,7 @@ class DriveValidation:
     by_kind : dict
         ``route`` and ``waypoints``: the same recall, precision and lengths over that kind of drive only.
     drive_paths : PathVerdicts or None
-        The verdicts along the paths the waypoint drives took (`maps.analysis.judge_routes`): those drives are scored
+        The verdicts along the paths the drives took (`maps.analysis.judge_routes`): the drives are scored
         against them (a disagreement's ``route`` >= the map's route count is drive path ``route`` − that count).
     """
 
@@ -282,41 +294,43 @@ def drive_map(analysis, count: int, *, seed: int = 0, progress=None) -> DriveVal
         if progress:
             progress(f"map drives: batch {b}/{len(batches)}: {len(batch)} drives")
 
-    # the waypoint drives' own paths (period-averaged), judged like any route: prediction and episode on one path
+    # every drive's own path (period-averaged), judged like any route: prediction and episode on one path
     taken, own = [], {}
     for d, (t, x, y) in zip(drives, traces):
-        if d.kind == "waypoints":
-            try:
-                route = _taken_path(x, y, period, controller.T, analysis.grid.cell_size, len(taken), "drive")
-            except ValueError:  # fewer than two distinct points: the drive did not move
-                continue
-            own[d.index] = len(taken)
-            taken.append(route)
+        try:
+            route = _taken_path(x, y, period, controller.T, analysis.grid.cell_size, len(taken), "drive")
+        except ValueError:  # fewer than two distinct points: the drive did not move
+            continue
+        own[d.index] = len(taken)
+        taken.append(route)
     dp = judge_routes(analysis, taken, taken=True) if taken else None
     sc = _Scored.of(pv, dp)
     base = pv.code.size
 
-    # route samples driven, and during episodes, per drive
+    # per drive: its own path's samples passed (scored), those during its episodes, and the map's route samples it passed
     tree = cKDTree(np.column_stack([pv.samples.x, pv.samples.y]))
     limit = max(MATCH_DISTANCE, robot.W)
     marks, points = [], []
     for d, (t, x, y) in zip(drives, traces):
-        if t.size == 0:
-            marks.append((np.zeros(0, dtype=int), np.zeros(0, dtype=int), 0.0))
+        if t.size == 0 or d.index not in own:
+            marks.append(_Marks.none())
             continue
-        if d.index in own:  # its own path's samples only
-            mine = base + np.flatnonzero(dp.samples.segment == own[d.index])
-            dist, nearest = cKDTree(np.column_stack([sc.x[mine], sc.y[mine]])).query(np.column_stack([x, y]), distance_upper_bound=limit)
-            nearest = mine[np.minimum(nearest, mine.size - 1)]
-        else:
-            dist, nearest = tree.query(np.column_stack([x, y]), distance_upper_bound=limit)
-        hit = np.isfinite(dist) & (t - t[0] >= min(period, 0.25 * d.duration))  # the start's transient is not measured
+        dist, near = tree.query(np.column_stack([x, y]), distance_upper_bound=limit)
+        on_routes = np.unique(near[np.isfinite(dist)])
+        mine = base + np.flatnonzero(dp.samples.segment == own[d.index])
+        dist, nearest = cKDTree(np.column_stack([sc.x[mine], sc.y[mine]])).query(np.column_stack([x, y]), distance_upper_bound=limit)
+        nearest = mine[np.minimum(nearest, mine.size - 1)]
         during = np.zeros(t.size, dtype=bool)
         for lo, hi in d.episodes:
             during |= (t >= lo) & (t <= hi)
+        near_path = np.isfinite(dist)
+        start = t - t[0] >= min(period, 0.25 * d.duration)  # the start's transient is not measured
+        end = t[-1] - t >= EPISODE_PERIODS * period  # an episode needs three periods after a sample to be found
+        hit = near_path & start & (end | during)
         step = np.concatenate([[0.0], np.hypot(np.diff(x), np.diff(y))])
-        off = float(step[during & ~np.isfinite(dist)].sum())  # an episode where no route runs: measured, not scored
-        marks.append((np.unique(nearest[hit]), np.unique(nearest[hit & during]), off))
+        off = float(step[during & ~near_path].sum())  # an episode away from its own path (a spin): measured, not scored
+        unmeasured = np.setdiff1d(np.unique(nearest[near_path & start & ~end & ~during]), nearest[hit])
+        marks.append(_Marks(np.unique(nearest[hit]), np.unique(nearest[hit & during]), off, unmeasured, on_routes))
         points.append(np.column_stack([x[during], y[during]]))
     unstable = sc.code == PATH_VERDICTS.index("unstable")
     half = pv.window / 2 if math.isfinite(pv.window) else 0.0
@@ -329,8 +343,8 @@ def drive_map(analysis, count: int, *, seed: int = 0, progress=None) -> DriveVal
         by_kind[kind] = {"recall": json_number(kind_recall) if kind_recall is not None else None,
                          "precision": json_number(kind_precision) if kind_precision is not None else None, "lengths": kind_lengths}
     passed_by = [set() for _ in range(sc.code.size)]
-    for d, (hit, _, _) in zip(drives, marks):
-        for k in hit:
+    for d, mark in zip(drives, marks):
+        for k in mark.scored:
             passed_by[k].add(d.index)
     disagreements = (_runs("missed", episode & ~near_unstable, sc, passed_by)
                      + _runs("false alarm", unstable & driven & ~near_episode, sc, passed_by))
@@ -348,8 +362,8 @@ def drive_map(analysis, count: int, *, seed: int = 0, progress=None) -> DriveVal
 
 @dataclass(frozen=True)
 class _Scored:
-    """The samples scored: the map's routes' (`PathVerdicts`), then the waypoint drives' own paths' (route index
-    offset by the map's routes)."""
+    """The samples: the map's routes' (`PathVerdicts`; passed, not scored), then the drives' own paths' (scored; route
+    index offset by the map's routes)."""
 
     code: np.ndarray
     route: np.ndarray
@@ -366,33 +380,59 @@ class _Scored:
         return cls(*(np.concatenate(a) for a in zip(*parts)))
 
 
+@dataclass(frozen=True)
+class _Marks:
+    """What one drive marks: the samples of its own path it passed and that are measured (`scored`: after the start's
+    first period, and three periods or more before it ended unless during an episode), those during its episodes,
+    its episodes' path length away from its own path (m), the samples it passed only in its last three periods
+    (`unmeasured`: no episode could have been found after them), and the map's route samples it passed."""
+
+    scored: np.ndarray
+    episode: np.ndarray
+    off_path: float
+    unmeasured: np.ndarray
+    on_routes: np.ndarray
+
+    @classmethod
+    def none(cls) -> "_Marks":
+        empty = np.zeros(0, dtype=int)
+        return cls(empty, empty, 0.0, empty, empty)
+
+
 def _score(sc, marks, chosen, unstable, near_unstable, half, base):
     """(lengths, recall, precision, driven, episode, near_episode) of the drives `chosen` (module docstring); the
-    first `base` samples are the map's routes', the rest the drives' own paths'."""
+    first `base` samples are the map's routes' (passed: coverage only), the rest the drives' own paths' (scored)."""
     driven = np.zeros(sc.code.size, dtype=bool)
     episode = np.zeros(sc.code.size, dtype=bool)
-    off_route = 0.0
+    unmeasured = np.zeros(sc.code.size, dtype=bool)
+    off_path = 0.0
     for k in chosen:
-        hit, during, off = marks[k]
-        driven[hit] = True
-        episode[during] = True
-        off_route += off
+        mark = marks[k]
+        driven[mark.scored] = True
+        driven[mark.on_routes] = True
+        episode[mark.episode] = True
+        unmeasured[mark.unmeasured] = True
+        off_path += mark.off_path
+    unmeasured &= ~driven
     near_episode = _within(episode, sc.route, sc.arc, half)
     ds = sc.spacing
     on_map = np.arange(ds.size) < base
+    scored = driven & ~on_map
     lengths = {
         "route": float(ds[on_map].sum()), "driven": float(ds[driven & on_map].sum()), "not_driven": float(ds[~driven & on_map].sum()),
-        "drive_paths": float(ds[~on_map].sum()), "drive_paths_driven": float(ds[driven & ~on_map].sum()),
+        "drive_paths": float(ds[~on_map].sum()), "drive_paths_driven": float(ds[scored].sum()),
+        "drive_paths_unmeasured": float(ds[unmeasured].sum()),
         "episode": float(ds[episode].sum()), "episode_recalled": float(ds[episode & near_unstable].sum()),
-        "episode_off_route": off_route,
-        "predicted_unstable_driven": float(ds[unstable & driven].sum()),
-        "predicted_unstable_matched": float(ds[unstable & driven & near_episode].sum()),
+        "episode_off_route": off_path,
+        "predicted_unstable_driven": float(ds[unstable & scored].sum()),
+        "predicted_unstable_matched": float(ds[unstable & scored & near_episode].sum()),
+        "predicted_unstable_unmeasured": float(ds[unstable & unmeasured].sum()),
         "predicted_unstable_not_driven": float(ds[unstable & ~driven & on_map].sum()),
     }
     recall = lengths["episode_recalled"] / lengths["episode"] if lengths["episode"] > 0 else None
     precision = (lengths["predicted_unstable_matched"] / lengths["predicted_unstable_driven"]
                  if lengths["predicted_unstable_driven"] > 0 else None)
-    return lengths, recall, precision, driven, episode, near_episode
+    return lengths, recall, precision, scored, episode, near_episode
 
 
 @dataclass(frozen=True)

@@ -1,0 +1,189 @@
+"""The loop driven along a route through the force across it (`maps.paths._driven`, docs/maps.md, "The loop driven
+along the route"), its command form (`models.sampled.command_form`), and the drives' unmeasurable ends
+(`validation.map_drives`)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from pfm_stability.maps.paths import SampledTransition, _driven
+from pfm_stability.maps.verdicts import GrowthRate, effective_gain
+from pfm_stability.models import Loop, models_for
+from pfm_stability.models.sampled import closed_loop_matrix, command_form
+from pfm_stability.parameters import CARMEL
+
+
+def _loops(seed: int, count: int):
+    """Random KB loops (τ, T, k, plant gain g, dead time D) with each hold and compute delay."""
+    rng = np.random.default_rng(seed)
+    for _ in range(count):
+        T = float(rng.uniform(0.01, 0.2))
+        loop = Loop(float(rng.uniform(0.0, 0.5)), T, float(rng.uniform(0.5, 20.0)), plant_gain=float(rng.uniform(0.5, 1.5)),
+                    dead_time=float(rng.choice([0.0, rng.uniform(0.0, 3 * T)])))
+        hold = "reference" if loop.dead_time == 0 and loop.tau > 0 and rng.random() < 0.3 else "command"
+        yield loop, hold, int(rng.integers(0, 2))
+
+
+def test_command_form_rebuilds_the_closed_loop_matrix():
+    """Φ_cl(K) = M − n·(F0 + K·F1) (`command_form`) against `closed_loop_matrix` at random loops (τ, T, k, g, D), both
+    holds, both compute delays and random gains K, to round-off: 1e-12 relative to |Φ| (the same blocks, summed in
+    another order)."""
+    rng = np.random.default_rng(7)
+    for loop, hold, delay in _loops(3, 40):
+        M, n, F0, F1 = command_form(loop, hold, delay)
+        for K in rng.uniform(-5.0, 200.0, 3):
+            expected = closed_loop_matrix(loop, K, hold, delay)
+            got = M - np.outer(n, F0 + K * F1)
+            assert np.abs(got - expected).max() <= 1e-12 * max(1.0, np.abs(expected).max()), (loop, hold, delay, K)
+
+
+def _transition(robot, controller, max_rate=math.inf):
+    model = models_for(controller, ["sampled"])[0]
+    loop = Loop.of(robot, controller, c=0.0)
+    return model, loop, SampledTransition.of(model, loop, max_rate)
+
+
+def _straight(N: float, steps: int, spacing: float, reach: float = 1.0):
+    """One straight route of `steps` samples `spacing` m apart whose force across it is linear, F_n = −N·s (F_ct units,
+    F_r·t = 0): the loop driven through it is the linear loop at gain N."""
+    offsets = np.arange(-reach, reach + 1e-9, spacing / 4)
+    fn = np.tile(-N * offsets, (steps, 1))
+    return offsets, fn, np.zeros_like(fn)
+
+
+@pytest.mark.parametrize("ratio", [0.5, 0.9, 1.3])
+def test_a_linear_force_drives_the_linear_loop(ratio):
+    """Through a force linear across the route (gain N, no rate limit) the driven loop is the linear sampled loop:
+    its lateral position step by step equals x_(k+1) = Φ(NV)·x_k (`closed_loop_matrix`, an independent product)
+    started at the same offset, to round-off (1e-9 m over the run, far below the profile's interpolation, exact for
+    a linear force), below, near and above NV*."""
+    robot, controller = CARMEL.robot, CARMEL.controller
+    model, loop, tr = _transition(robot, controller)
+    N = ratio * model.boundary(loop).NV_critical / robot.V
+    spacing = robot.V * controller.T
+    steps = 400
+    profile = _straight(N, steps, spacing, reach=5.0)
+    arc = (np.arange(steps) + 0.5) * spacing
+    route = np.zeros(steps, dtype=int)
+    stopped = np.zeros((2, steps), dtype=bool)
+    captured = {}
+    import pfm_stability.maps.episodes as episodes
+
+    original = episodes.lateral_episodes
+
+    def spy(t, lateral, period, *args):
+        captured.setdefault("lateral", lateral.copy())
+        return original(t, lateral, period, *args)
+
+    episodes.lateral_episodes = spy
+    try:
+        _driven(route, arc, stopped, profile, np.zeros(steps), robot.V, tr, 1.0, taken=True)
+    finally:
+        episodes.lateral_episodes = original
+    lateral = captured["lateral"]
+    Phi = closed_loop_matrix(loop, loop.loop_gain(N * robot.V), model.hold, model.compute_delay)
+    x = np.zeros(Phi.shape[0])
+    x[tr.lateral_index] = 0.005 / robot.V  # the driven loop's start on a path taken (NOISE_FLOOR), the state x/V
+    expected = []
+    for _ in range(lateral.size):
+        expected.append(robot.V * x[tr.lateral_index])
+        x = Phi @ x
+    expected = np.array(expected)
+    alive = np.abs(expected) <= 1.0
+    n = int(np.argmin(alive)) if not alive.all() else alive.size
+    assert np.abs(lateral[:n] - expected[:n]).max() <= 1e-9
+
+
+def test_the_steering_rate_limit_holds_an_unstable_loop_in_a_cycle():
+    """At 1.5·NV* the linear loop grows without bound (it leaves the profile, 1 m); with the robot's steering-rate limit
+    (120°/s) the driven loop settles on a cycle that stays inside it (1.2 cm; the VFF simulator's is about 2 cm in the
+    grid corridor at 1.4 V*, docs/maps.md: the driven loop's saturated cycles run smaller than the simulator's). The robot
+    of the map tests' straight corridor (k = 20 1/s, τ = 0.1 s, T = 25 ms), whose command reaches the limit at a
+    heading error of 0.1 rad (CARMEL's k = 2 1/s only past 1 rad, after the run has left)."""
+    robot = CARMEL.robot.replace(W=0.4, tau=0.1, k=20.0, V=1.0)
+    controller = CARMEL.controller.replace(T=0.025, f=2.0)
+    model, loop, tr = _transition(robot, controller, robot.max_steering_rate)
+    assert tr.rate_limit == pytest.approx(robot.plant_gain * robot.max_steering_rate)
+    N = 1.5 * model.boundary(loop).NV_critical / robot.V
+    spacing = robot.V * controller.T
+    steps = 3000
+    profile = _straight(N, steps, spacing, reach=5.0)
+    arc = (np.arange(steps) + 0.5) * spacing
+    _, amplitude = _driven(np.zeros(steps, dtype=int), arc, np.zeros((2, steps), dtype=bool), profile, np.zeros(steps), robot.V,
+                                    tr, 2 * math.pi / model.boundary(loop).omega_critical, taken=False)
+    assert 0.005 < amplitude.max() < 0.1  # the cycle, inside the profile: it never left
+    unlimited = SampledTransition.of(model, loop)
+    _, free = _driven(np.zeros(steps, dtype=int), arc, np.zeros((2, steps), dtype=bool), profile, np.zeros(steps), robot.V, unlimited,
+                      2 * math.pi / model.boundary(loop).omega_critical, taken=False)
+    assert free.max() >= 1.0  # without the limit it leaves (the run stops at LEAVES)
+
+
+def test_effective_gain_of_a_window_that_decays_faster_than_any_uniform_gain():
+    """A window whose gain varies can decay faster than the most damped uniform gain (found on the TurtleBot sandbox
+    at W 0.3 m, V 0.5 m/s, seed 1: a bisection with no sign change, a traceback): N_eff is then that most damped gain,
+    and a growth rate inside the uniform range still bisects to σ(N_eff·V) = σ̄ (1e-9 1/s)."""
+    robot, controller = CARMEL.robot, CARMEL.controller
+    model, loop, _ = _transition(robot, controller)
+    boundary = model.boundary(loop)
+    growth = GrowthRate(lambda NV: model.rightmost_root(NV, loop), boundary.NV_critical)
+    least = growth.NV_least
+    fastest = float(growth(least))
+    assert effective_gain(fastest - 0.1, least / robot.V, robot.V, growth, boundary.NV_critical) == pytest.approx(least / robot.V)
+    sigma = 0.5 * fastest
+    N = effective_gain(sigma, 0.5 * least / robot.V, robot.V, growth, boundary.NV_critical)
+    assert abs(float(growth(N * robot.V)) - sigma) <= 1e-9
+
+
+def test_a_drives_last_three_periods_are_not_measured(tmp_path):
+    """A drive that reaches its goal (or collides) in less than three periods after passing a sample could not have
+    shown an episode there: those samples are counted as unmeasured, never scored. On the stable corridor (0.7 V*,
+    no episode) every drive's last 3·P·V metres of own path (less its first period) are unmeasured, to within a few
+    samples of its path (the match is to the nearest sample, 0.1 m apart) per drive."""
+    import sys
+    from pathlib import Path
+
+    sys.path.insert(0, str(Path(__file__).parent))
+    from test_map_paths import _report, corridor_analysis
+
+    from pfm_stability.validation.map_drives import drive_map
+
+    V_star = _report(0.6).models["sampled"].critical["V_critical"]
+    analysis = corridor_analysis(0.6, 0.7 * V_star, str(tmp_path))
+    result = drive_map(analysis, 4, seed=3)
+    assert result.counts["episodes"] == 0
+    period, V = result.inputs["period"], analysis.robot.V
+    expected = 0.0
+    for d in result.drives:
+        length = d.duration * V
+        expected += max(0.0, min(3 * period * V, length - max(0.0, min(period, 0.25 * d.duration) * V)))
+    assert result.lengths["drive_paths_unmeasured"] == pytest.approx(expected, abs=0.3 * len(result.drives))
+    assert result.lengths["predicted_unstable_unmeasured"] == 0.0
+
+
+def test_goal_paths_are_judged_as_the_robot_drove_them(tmp_path):
+    """`--goals`: the paths the simulated robot took between goals are judged as taken (`maps.analysis.TAKEN_SOURCES`),
+    the way they were driven only (their reverse direction is not judged: N nan), while the skeleton's routes keep both
+    directions; the same path added as the user's own route (source "path") is judged both ways."""
+    import sys
+    from pathlib import Path
+
+    sys.path.insert(0, str(Path(__file__).parent))
+    from test_map_paths import _report, corridor_analysis
+
+    from pfm_stability.maps.analysis import add_routes
+    from pfm_stability.maps.routes import path_of
+    from pfm_stability.validation.map_drives import goal_routes
+
+    V_star = _report(0.6).models["sampled"].critical["V_critical"]
+    analysis = corridor_analysis(0.6, 0.7 * V_star, str(tmp_path))
+    (driven,) = goal_routes(analysis, [(0.65, 3.0), (0.65, 15.0)])
+    assert driven.source == "goals"
+    both = add_routes(analysis, [driven, path_of(driven.points, 0, "path")])
+    pv = both.paths
+    skeleton, goal, user = 0, len(pv.paths) - 2, len(pv.paths) - 1
+    on = lambda r: pv.samples.segment == r  # noqa: E731
+    assert np.isnan(pv.N_reverse[on(goal)]).all() and np.isfinite(pv.N_forward[on(goal)]).any()
+    assert np.isfinite(pv.N_reverse[on(user)]).any() and np.isfinite(pv.N_reverse[on(skeleton)]).any()
