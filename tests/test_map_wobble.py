@@ -223,7 +223,9 @@ def test_summary_counts_the_zones(routed):
     unstable = [s for s in stretches if s.verdict == "unstable"]
     assert summary.unstable_length_m == pytest.approx(sum(s.length for s in unstable), rel=1e-12)
     assert summary.unstable_fraction == pytest.approx(sum(s.length for s in unstable if s.route == 1) / summary.unstable_length_m, rel=1e-12)
-    assert summary.V_limit_min == min(s.V_critical for s in stretches) and summary.V_limit_max == max(s.wobble.V_limit for s in zoned)
+    # the segment's and the stretch's V_tolerance solve one branch at an L measured along two code paths: equal to round-off
+    assert summary.V_limit_min == pytest.approx(min(s.V_critical for s in stretches), rel=1e-9)
+    assert summary.V_limit_max == pytest.approx(max(s.wobble.V_limit for s in zoned), rel=1e-9)
 
 
 def test_text_output_shows_the_wobble_block(routed):
