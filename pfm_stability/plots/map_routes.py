@@ -63,7 +63,7 @@ def plot_route_verdicts(analysis, drives=None, ax=None, *, title: str | None = N
 
     occupancy = analysis.occupancy
     pv = analysis.paths
-    fig, ax, (x0, x1, y0, y1), _ = map_frame(occupancy, ax, size, (0.6, 2.4))
+    fig, ax, (x0, x1, y0, y1), _ = map_frame(occupancy, ax, size, (0.6, 3.0))
     kinds = []
     for kind, style in ROUTE_STYLES.items():
         lines = [_stretch_lines(pv.paths, s) for s in pv.stretches if _kind(s) == kind]
@@ -79,7 +79,7 @@ def plot_route_verdicts(analysis, drives=None, ax=None, *, title: str | None = N
         dp = getattr(drives, "drive_paths", None)
         if dp is not None:  # the paths the drives between points took, and their unstable stretches (what they are scored on)
             ax.add_collection(LineCollection([p.points for p in dp.paths], colors="0.55", linewidths=0.7, linestyles=[(0, (2.0, 2.0))], zorder=2.5))
-            handles.append(Line2D([], [], color="0.55", lw=0.7, ls=(0, (2.0, 2.0)), label="drives between points: the paths taken"))
+            handles.append(Line2D([], [], color="0.55", lw=0.7, ls=(0, (2.0, 2.0)), label="drives: the paths taken"))
             for s in dp.stretches:
                 kind = _kind(s)
                 if s.verdict == "unstable":
@@ -107,13 +107,12 @@ def plot_route_verdicts(analysis, drives=None, ax=None, *, title: str | None = N
         L = drives.lengths
         kinds = "; ".join(f"{kind} drives {pct(v['recall'])} / {pct(v['precision'])}" for kind, v in drives.by_kind.items())
         validation = (f"\n{drives.counts['drives']} drives, {drives.counts['episodes']} episodes: recall {pct(drives.recall)}, "
-                      f"precision {pct(drives.precision)} along the paths driven ({kinds})\n{L['drive_paths_driven']:.0f} m measured "
-                      f"({L.get('drive_paths_unmeasured', 0.0):.0f} m not: a drive's last 3 periods); {L['episode']:.1f} m of episodes; "
-                      f"{L['driven']:.0f} of {L['route']:.0f} m of route covered")
+                      f"precision {pct(drives.precision)} along the paths driven\n{kinds}\n{L['drive_paths_driven']:.0f} m measured, "
+                      f"{L.get('drive_paths_unmeasured', 0.0):.0f} m not (a drive's last 3 periods)")
     handles.append(Line2D([], [], marker="s", ls="", color=str(OCCUPIED_GREY), markersize=8, label="occupied"))
     if occupancy.unknown.any():
         handles.append(Line2D([], [], marker="s", ls="", color=str(UNKNOWN_GREY), markeredgecolor="0.6", markersize=8, label="unknown"))
-    fig.legend(handles=handles, loc="outside lower center", ncol=2, fontsize=8.5, frameon=False)
+    fig.legend(handles=handles, loc="outside lower center", ncol=2, fontsize=7.5, frameon=False)
     ax.set_xlim(x0, x1)
     ax.set_ylim(y0, y1)
     ax.set_xlabel("x (m)")
@@ -121,8 +120,8 @@ def plot_route_verdicts(analysis, drives=None, ax=None, *, title: str | None = N
     ax.set_aspect("equal")
     if title is None:
         s = pv.summary()
-        title = (f"{occupancy.name}: will the robot oscillate at V = {analysis.robot.V:g} m/s? ({analysis.model} model, "
-                 f"unknown cells {analysis.unknown})\n{100 * (s['decided_fraction'] or 0):.0f}% of {s['route_length_m']:.0f} m of route "
+        title = (f"{occupancy.name}: will the robot oscillate at V = {analysis.robot.V:g} m/s?\n{analysis.model} model, "
+                 f"unknown cells {analysis.unknown}\n{100 * (s['decided_fraction'] or 0):.0f}% of {s['route_length_m']:.0f} m of route "
                  f"decided; unstable {s['unstable_length_m']:.1f} m" + validation)
-    ax.set_title(title, fontsize=10.5)
+    ax.set_title(title, fontsize=9.5)
     return fig
