@@ -50,7 +50,7 @@ def test_shipped_map_outputs(tmp_path, name):
     the map's size, its YAML with the map's resolution and origin; and the mask's values decode to 100 % off the
     unstable segments and route stretches and to floor(100 V*/V) (>= 1) within W/2 of each of them with V* < V (a
     route stretch's piece of its route cut at its arc positions, here with numpy's interpolation; a stable stretch
-    gets no zone, whatever its V*)."""
+    gets no zone, whatever its V*, nor an unstable one with V* = 0)."""
     out = tmp_path / "out"
     code, stdout, err = run(["map", name, *ROBOTS[name], "--out-dir", str(out), "--format", "json", "--quiet"])
     assert code == 0, err
@@ -71,7 +71,7 @@ def test_shipped_map_outputs(tmp_path, name):
     V, W = data["inputs"]["V"], data["inputs"]["W"]
     r, (ox, oy) = data["map"]["resolution"], data["map"]["origin"][:2]
     limited = [s for s in data["segments"] if s["verdict"] == "unstable" and s["V_critical"] is not None
-               and not isinstance(s["V_critical"], str) and s["V_critical"] < V]
+               and not isinstance(s["V_critical"], str) and 0 < s["V_critical"] < V]
     expected = np.full(percent.shape, 100)
     jj, ii = np.mgrid[0:percent.shape[0], 0:percent.shape[1]]
     px, py = ox + (ii + 0.5) * r, oy + (jj + 0.5) * r
@@ -81,7 +81,7 @@ def test_shipped_map_outputs(tmp_path, name):
         near = np.hypot(px - s["x0"] - t * dx, py - s["y0"] - t * dy) <= W / 2
         expected[near] = np.minimum(expected[near], max(1, math.floor(100 * s["V_critical"] / V)))
     for s in data["paths"]["stretches"]:  # and within W/2 of each unstable route stretch with V* < V (its piece of the route)
-        if s["verdict"] != "unstable" or s["V_critical"] is None or isinstance(s["V_critical"], str) or not s["V_critical"] < V:
+        if s["verdict"] != "unstable" or s["V_critical"] is None or isinstance(s["V_critical"], str) or not 0 < s["V_critical"] < V:
             continue
         route = np.array(data["paths"]["routes"][s["route"]]["points"])
         edges = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(route, axis=0).T))])

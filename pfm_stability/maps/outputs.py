@@ -11,7 +11,7 @@ Nav2 speed filter with ``type: 1`` (percentage), ``base: 0``, ``multiplier: 1``:
   (`upstream_distance`: Nav2's filter slows the robot only once it is inside a zone);
 * with a wobble tolerance (``map --wobble TOL``, `maps.wobble`) a segment's or route stretch's zone holds
   100·V_limit/V instead: V_tolerance, the fastest speed whose wobble stays under TOL, where the describing function
-  is trusted, else V* (`ZoneWobble.V_limit`); a zone only where the verdict is unstable, none where V_limit >= V; a stretch's upstream dilation brakes to
+  is trusted, else V* (`ZoneWobble.V_limit`); a zone only where the verdict is unstable and 0 < V* < V, none where V_limit >= V; a stretch's upstream dilation brakes to
   V_limit;
 * every other cell — free, occupied or unknown — 100: the robot may drive at V.
   Occupied cells are never driven through, and 100 % is the filter's "no
@@ -32,6 +32,7 @@ import math
 import numpy as np
 
 __all__ = [
+    "has_zone",
     "OUTPUT_FILES",
     "ROUTE_COLUMNS",
     "ROUTE_FILES",
@@ -157,12 +158,28 @@ def speed_limits(analysis, a_max: float | None = None) -> np.ndarray:
     return limits
 
 
+def has_zone(zone, V: float) -> bool:
+    """Whether the speed mask draws a zone for a segment or route stretch at speed V (m/s), at V* (or at V_limit with
+    ``--wobble``): where a speed limit helps — the verdict is unstable and 0 < V* < V. No zone for a stable stretch
+    whose V* lies below V (a window where the field pushes the robot off its line on average, σ̄ > 0 only at low
+    speeds: stable at V), nor where V* = 0 (unstable at any speed, or a weave whose window does not grow at any speed:
+    a zone at the 1 % floor would stop the robot there — 47.5 m of the warehouse's routes — and not make it stable).
+
+    Parameters
+    ----------
+    zone : MapSegment or PathStretch
+        With ``verdict`` and ``V_critical`` (m/s).
+    V : float
+        The robot's speed, m/s.
+    """
+    V_star = zone.V_critical
+    return zone.verdict == "unstable" and V_star is not None and not isinstance(V_star, str) and 0 < V_star < V
+
+
 def _limit(zone, V: float) -> float | None:
-    """The speed limit of a segment's or route stretch's zone, m/s: its wobble's V_limit when it has one (``map --wobble``),
-    else V*; None: no zone (not unstable at V, V* >= V, or V_limit >= V). A stable stretch whose V* lies below V (a
-    window where the field pushes the robot off its line on average, σ̄ > 0 only at low speeds) gets no zone: it is
-    stable at V, and slowing down would not help it."""
-    if zone.verdict != "unstable" or zone.V_critical is None or not zone.V_critical < V:
+    """The speed limit of a zone, m/s (`has_zone`): its wobble's V_limit when it has one (``map --wobble``), else V*;
+    None: no zone, or V_limit >= V."""
+    if not has_zone(zone, V):
         return None
     limit = zone.wobble.V_limit if getattr(zone, "wobble", None) is not None else zone.V_critical
     return limit if limit < V else None

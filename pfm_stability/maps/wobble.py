@@ -37,6 +37,7 @@ from ..io.serialize import json_number
 from ..laws.effective_force import GridWallLaw
 from ..checks import check_number
 from .equilibria import RAY_LENGTH
+from .outputs import has_zone
 from .paths import PathStretch, path_samples
 
 __all__ = ["KEPT", "V_CRITICAL_AGREEMENT", "SegmentWobble", "WobbleStretch", "WobbleSummary", "ZoneWobble", "corridor_half_width",
@@ -382,7 +383,7 @@ def wobble_summary(analysis, tolerance: float) -> WobbleSummary:
         For an analysis without the wobble.
     """
     V = analysis.robot.V
-    zoned = lambda s: s.V_critical is not None and s.V_critical < V  # the mask draws its zone (`outputs.speed_limits`)
+    zoned = lambda s: has_zone(s, V)  # noqa: E731  (the mask draws its zone, `outputs.speed_limits`)
     segments = [s for s in analysis.segments if zoned(s)]
     stretches = [s for s in (analysis.paths.stretches if analysis.paths is not None else ()) if zoned(s)]
     if any(getattr(s, "wobble", None) is None for s in segments + stretches):
