@@ -598,7 +598,7 @@ def render_map_text(data: dict) -> str:
         share = {k: (percent(d[k])[1:] if d[k] is not None else "n/a (nothing to measure)") for k in ("recall", "precision")}
         lines.append(f"validation by driving: {d['counts']['drives']} drives, {d['counts']['episodes']} oscillation episodes; "
                      f"recall {share['recall']}, precision {share['precision']} by length along the paths driven "
-                     f"({d['lengths']['drive_paths_driven']:.1f} m measured, {d['lengths'].get('drive_paths_unmeasured', 0.0):.1f} m passed "
+                     f"({d['lengths']['drive_paths_driven']:.1f} m measured, {d['lengths']['drive_paths_unmeasured']:.1f} m passed "
                      f"only in a drive's last three periods, not measurable; {d['lengths']['driven']:.1f} of {d['lengths']['route']:.1f} m "
                      f"of route covered); {len(d['disagreements'])} disagreements")
     v = data.get("validation")

@@ -173,7 +173,7 @@ def has_zone(zone, V: float) -> bool:
         The robot's speed, m/s.
     """
     V_star = zone.V_critical
-    return zone.verdict == "unstable" and V_star is not None and not isinstance(V_star, str) and 0 < V_star < V
+    return zone.verdict == "unstable" and V_star is not None and 0 < V_star < V
 
 
 def _limit(zone, V: float) -> float | None:

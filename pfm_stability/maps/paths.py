@@ -465,12 +465,12 @@ class SampledTransition:
     Phi0: np.ndarray
     Phi1: np.ndarray
     T: float
-    M: np.ndarray = None
-    command: np.ndarray = None
-    F0: np.ndarray = None
-    steering_gain: float = 1.0
-    rate_limit: float = math.inf
-    lateral_index: int = 0
+    M: np.ndarray
+    command: np.ndarray
+    F0: np.ndarray
+    steering_gain: float
+    rate_limit: float
+    lateral_index: int
 
     @classmethod
     def of(cls, model, loop, max_steering_rate: float = math.inf) -> "SampledTransition":

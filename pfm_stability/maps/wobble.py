@@ -383,9 +383,8 @@ def wobble_summary(analysis, tolerance: float) -> WobbleSummary:
         For an analysis without the wobble.
     """
     V = analysis.robot.V
-    zoned = lambda s: has_zone(s, V)  # noqa: E731  (the mask draws its zone, `outputs.speed_limits`)
-    segments = [s for s in analysis.segments if zoned(s)]
-    stretches = [s for s in (analysis.paths.stretches if analysis.paths is not None else ()) if zoned(s)]
+    segments = [s for s in analysis.segments if has_zone(s, V)]  # the zones the mask draws (`outputs.speed_limits`)
+    stretches = [s for s in (analysis.paths.stretches if analysis.paths is not None else ()) if has_zone(s, V)]
     if any(getattr(s, "wobble", None) is None for s in segments + stretches):
         raise ValueError("the analysis has no wobble: call with_wobble first")
 
@@ -401,7 +400,7 @@ def wobble_summary(analysis, tolerance: float) -> WobbleSummary:
 
     unstable = [s for s in (analysis.paths.stretches if analysis.paths is not None else ()) if s.verdict == "unstable"]
     unstable_length = float(sum(s.length for s in unstable))
-    relaxed = float(sum(s.length for s in unstable if zoned(s) and s.wobble.kept is None))
+    relaxed = float(sum(s.length for s in unstable if has_zone(s, V) and s.wobble.kept is None))
     limits = [s.wobble.V_limit for s in segments + stretches if s.wobble.V_limit < V]
     stars = [s.V_critical for s in segments + stretches]
     return WobbleSummary(tolerance, counts(segments, None), counts(stretches, None), counts(stretches, lambda s: float(s.length)),

@@ -108,7 +108,7 @@ def plot_route_verdicts(analysis, drives=None, ax=None, *, title: str | None = N
         kinds = "; ".join(f"{kind} drives {pct(v['recall'])} / {pct(v['precision'])}" for kind, v in drives.by_kind.items())
         validation = (f"\n{drives.counts['drives']} drives, {drives.counts['episodes']} episodes: recall {pct(drives.recall)}, "
                       f"precision {pct(drives.precision)} along the paths driven\n{kinds}\n{L['drive_paths_driven']:.0f} m measured, "
-                      f"{L.get('drive_paths_unmeasured', 0.0):.0f} m not (a drive's last 3 periods)")
+                      f"{L['drive_paths_unmeasured']:.0f} m not (a drive's last 3 periods)")
     handles.append(Line2D([], [], marker="s", ls="", color=str(OCCUPIED_GREY), markersize=8, label="occupied"))
     if occupancy.unknown.any():
         handles.append(Line2D([], [], marker="s", ls="", color=str(UNKNOWN_GREY), markeredgecolor="0.6", markersize=8, label="unknown"))
