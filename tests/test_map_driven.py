@@ -55,11 +55,15 @@ def _straight(N: float, steps: int, spacing: float, reach: float = 1.0):
 
 
 @pytest.mark.parametrize("ratio", [0.5, 0.9, 1.3])
-def test_a_linear_force_drives_the_linear_loop(ratio):
+def test_a_linear_force_drives_the_linear_loop(ratio, monkeypatch):
     """Through a force linear across the route (gain N, no rate limit) the driven loop is the linear sampled loop:
     its lateral position step by step equals x_(k+1) = Φ(NV)·x_k (`closed_loop_matrix`, an independent product)
-    started at the same offset, to round-off (1e-9 m over the run, far below the profile's interpolation, exact for
-    a linear force), below, near and above NV*."""
+    started at the same offset, below, near and above NV*. The robot steers to the resultant's direction,
+    atan(N·y) ≈ N·y − (N·y)³/3: started 1 µm off and compared while |y| <= 0.1 mm, the cubic term is below 1e-7 of
+    the command (N·y <= 5e-4 here), so the two agree to 1e-12 m + 1e-6·|y| (round-off and that term, with margin)."""
+    import pfm_stability.maps.paths as paths
+
+    monkeypatch.setattr(paths, "PREDICTION_OFFSET", 1e-6)
     robot, controller = CARMEL.robot, CARMEL.controller
     model, loop, tr = _transition(robot, controller)
     N = ratio * model.boundary(loop).NV_critical / robot.V
@@ -78,27 +82,25 @@ def test_a_linear_force_drives_the_linear_loop(ratio):
         captured.setdefault("lateral", lateral.copy())
         return original(t, lateral, period, *args)
 
-    episodes.lateral_episodes = spy
-    try:
-        _driven(route, arc, stopped, profile, np.zeros(steps), robot.V, tr, 1.0, taken=True)
-    finally:
-        episodes.lateral_episodes = original
+    monkeypatch.setattr(episodes, "lateral_episodes", spy)
+    _driven(route, arc, stopped, profile, np.zeros(steps), np.ones(steps), robot.V, tr, 1.0, taken=True)
     lateral = captured["lateral"]
     Phi = closed_loop_matrix(loop, loop.loop_gain(N * robot.V), model.hold, model.compute_delay)
     x = np.zeros(Phi.shape[0])
-    x[tr.lateral_index] = 0.005 / robot.V  # the driven loop's start on a path taken (NOISE_FLOOR), the state x/V
+    x[tr.lateral_index] = 1e-6 / robot.V  # the driven loop's start, the state x/V
     expected = []
     for _ in range(lateral.size):
         expected.append(robot.V * x[tr.lateral_index])
         x = Phi @ x
     expected = np.array(expected)
-    alive = np.abs(expected) <= 1.0
-    n = int(np.argmin(alive)) if not alive.all() else alive.size
-    assert np.abs(lateral[:n] - expected[:n]).max() <= 1e-9
+    small = np.abs(expected) <= 1e-4
+    n = int(np.argmin(small)) if not small.all() else small.size
+    assert n >= 50 and N * 1e-4 <= 5e-4
+    assert np.all(np.abs(lateral[:n] - expected[:n]) <= 1e-12 + 1e-6 * np.abs(expected[:n]))
 
 
 def test_the_steering_rate_limit_holds_an_unstable_loop_in_a_cycle():
-    """At 1.5·NV* the linear loop grows without bound (it leaves the profile, 1 m); with the robot's steering-rate limit
+    """At 1.5·NV* the linear loop grows until the heading reference saturates (decimetres); with the robot's steering-rate limit
     (120°/s) the driven loop settles on a cycle that stays inside it (1.2 cm; the VFF simulator's is about 2 cm in the
     grid corridor at 1.4 V*, docs/maps.md: the driven loop's saturated cycles run smaller than the simulator's). The robot
     of the map tests' straight corridor (k = 20 1/s, τ = 0.1 s, T = 25 ms), whose command reaches the limit at a
@@ -112,13 +114,15 @@ def test_the_steering_rate_limit_holds_an_unstable_loop_in_a_cycle():
     steps = 3000
     profile = _straight(N, steps, spacing, reach=5.0)
     arc = (np.arange(steps) + 0.5) * spacing
-    _, amplitude = _driven(np.zeros(steps, dtype=int), arc, np.zeros((2, steps), dtype=bool), profile, np.zeros(steps), robot.V,
-                                    tr, 2 * math.pi / model.boundary(loop).omega_critical, taken=False)
+    _, amplitude = _driven(np.zeros(steps, dtype=int), arc, np.zeros((2, steps), dtype=bool), profile, np.zeros(steps), np.ones(steps),
+                           robot.V, tr, 2 * math.pi / model.boundary(loop).omega_critical, taken=False)
     assert 0.005 < amplitude.max() < 0.1  # the cycle, inside the profile: it never left
     unlimited = SampledTransition.of(model, loop)
-    _, free = _driven(np.zeros(steps, dtype=int), arc, np.zeros((2, steps), dtype=bool), profile, np.zeros(steps), robot.V, unlimited,
+    _, free = _driven(np.zeros(steps, dtype=int), arc, np.zeros((2, steps), dtype=bool), profile, np.zeros(steps), np.ones(steps), robot.V, unlimited,
                       2 * math.pi / model.boundary(loop).omega_critical, taken=False)
-    assert free.max() >= 1.0  # without the limit it leaves (the run stops at LEAVES)
+    # without the limit only the heading reference's own bound holds it (the resultant's direction, |atan| < π/2):
+    # a cycle of decimetres (0.45 m here), not centimetres
+    assert free.max() >= 10 * amplitude.max()
 
 
 def test_effective_gain_of_a_window_that_decays_faster_than_any_uniform_gain():

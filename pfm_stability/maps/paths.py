@@ -49,8 +49,11 @@ nonlinearity holds, that the window growth cannot see.
 **Paths taken** (``taken``: the paths the simulated robot drove, between goals or in the validation,
 `validation.map_drives`). Its goal, not only the field, holds the robot there: a lateral equilibrium farther than W/2
 from the path is not the one it follows, so the loop is linearized at the path itself, and the line it is pulled to
-is the path (the goal balances the field's mean over a wavelength there). Such a path is judged the way it was
-driven; where a wall is ahead that way it is unjudged ("wall ahead").
+is the path. The goal's pull balances the field's mean P there (over a wavelength along the path and a cell across
+it, `_goal_pull`); the attraction has unit size, so its part along the path is A = √(1 − P²), and the lateral gain
+is N = −(dF_n/ds)/(A ± F_r·t): a robot sliding along a wall towards a goal off to its side steers against a small
+forward force, and its loop is that much stiffer. Such a path is judged the way it was driven; where a wall is
+ahead that way it is unjudged ("wall ahead").
 
 **Stretches**: runs of consecutive samples with one verdict (`PathStretch`), each with the
 numbers of its worst window: σ̄_w, e-folds σ̄_w·Λ/V, N_eff (`verdicts.effective_gain`:
@@ -69,7 +72,7 @@ from ..io.serialize import json_number
 from ..models import gain_margin, verdict_label
 from ..models.verdicts import inside as in_set, judge_arrays
 from .equilibria import Samples, equilibria_at, lateral_force
-from .episodes import AMPLITUDE_THRESHOLD, NOISE_FLOOR
+from .episodes import AMPLITUDE_THRESHOLD
 from .relay import relay_amplitude, window_relay
 from .routes import RoutePath  # noqa: F401 (named in the docstrings and annotations)
 from .verdicts import EFOLDS, END_FRACTION, GrowthRate, critical_speed, effective_gain, wavelength
@@ -314,6 +317,54 @@ def _window_mean(values: np.ndarray, route: np.ndarray, arc: np.ndarray, ds: np.
     return out
 
 
+def _goal_pull(grid, law, x, y, tx, ty, route, arc, ds, taken, wavelength_m: float):
+    """(P, A) per sample, F_ct units: the lateral force F_n that the goal's pull balances where the robot holds its
+    path, and the goal's attraction along the path (module docstring, "Paths taken"; P = 0, A = 1 on a route,
+    whose goal lies along it).
+
+    On a path the robot took, P is the field's mean over one wavelength λ of travel (the path is the robot's position
+    averaged over a period: the goal and the path's curvature balance that mean, its ripple forces the loop) and
+    across one cell (`_cell_mean`: where the path runs along a jump of the window sum, the robot holds the jump's
+    middle, not the value on one side of it). The attraction has unit size, so its part along the path is
+    A = √(1 − P²): the forward force the robot steers against is A ± F_r·t, not 1 ± F_r·t, when the goal lies off to
+    the side (a robot sliding along a wall towards a goal behind it).
+
+    Parameters
+    ----------
+    grid : HistogramMap
+        The map's histogram grid.
+    law : GridWallLaw
+        KB's grid law.
+    x, y, tx, ty : ndarray
+        Samples (m) and unit tangents.
+    route, arc, ds : ndarray
+        Route index, arc position (m) and length (m) of each sample.
+    taken : ndarray of bool
+        Per sample: on a path the robot took.
+    wavelength_m : float
+        λ = 2πV/ω*, m.
+    """
+    pull = np.zeros(np.size(x))
+    on = np.flatnonzero(taken)
+    if on.size and math.isfinite(wavelength_m):
+        fn = np.full(np.size(x), np.nan)
+        fn[on] = _cell_mean(grid, law, x[on], y[on], tx[on], ty[on])
+        pull = np.where(taken, np.nan_to_num(_window_mean(fn, route, arc, ds, wavelength_m / 2)), 0.0)
+    return pull, np.sqrt(np.clip(1.0 - pull ** 2, 0.0, None))
+
+
+def _cell_mean(grid, law, x, y, tx, ty) -> np.ndarray:
+    """F_n at the points averaged across the path over one cell, s in [−c/2, c/2] (F_ct units; the trapezoid rule on
+    `PROFILE_STEP` nodes, those of `lateral_profile`)."""
+    offsets = np.linspace(-0.5, 0.5, int(round(1 / PROFILE_STEP)) + 1) * grid.cell_size
+    weights = np.full(offsets.size, 1.0)
+    weights[[0, -1]] = 0.5
+    S = offsets.size
+    rep = lambda v: np.repeat(np.asarray(v, dtype=float), S)  # noqa: E731
+    fn, _ = lateral_force(grid, law, rep(x), rep(y), rep(tx), rep(ty), np.tile(offsets, np.size(x)), phase_nodes=PROFILE_PHASE_NODES)
+    return fn.reshape(-1, S) @ (weights / weights.sum())
+
+
 def analyze_paths(grid, law, paths, clearance: np.ndarray, W: float, V: float, boundary, growth: GrowthRate,
                   heading_stable: bool, transition=None, end_fraction: float = END_FRACTION, taken=False) -> PathVerdicts:
     """The verdict at every point of every route (module docstring).
@@ -371,13 +422,14 @@ def analyze_paths(grid, law, paths, clearance: np.ndarray, W: float, V: float, b
         _, ft0, df0 = lateral_force(grid, law, x[redo], y[redo], tx[redo], ty[redo], offset[redo], jacobian=True)
         along[redo], slope[redo] = ft0, -df0
     inside = ~(np.isfinite(along) & np.isfinite(slope))
-    with np.errstate(divide="ignore", invalid="ignore"):
-        N_forward = np.where(1 + along >= 1 - end_fraction, slope / (1 + along), np.nan)
-        N_reverse = np.where(1 - along >= 1 - end_fraction, slope / (1 - along), np.nan)
+    lam = wavelength(V, boundary.omega_critical)
+    pull, attraction = _goal_pull(grid, law, x, y, tx, ty, route, arc, ds, taken, lam)
+    with np.errstate(divide="ignore", invalid="ignore"):  # a wall ahead (the repulsion along the path) stops the robot
+        N_forward = np.where((1 + along >= 1 - end_fraction) & (attraction + along > 0), slope / (attraction + along), np.nan)
+        N_reverse = np.where((1 - along >= 1 - end_fraction) & (attraction - along > 0), slope / (attraction - along), np.nan)
     N_forward[inside], N_reverse[inside] = np.nan, np.nan
     N_reverse[taken] = np.nan  # the robot drove a path taken one way, from its start: the reverse is not its path
     sig = [np.where(np.isfinite(n), growth(np.nan_to_num(n) * V), np.nan) for n in (N_forward, N_reverse)]
-    lam = wavelength(V, boundary.omega_critical)
     window = WINDOW_PERIODS * lam if math.isfinite(lam) else math.inf
     half = window / 2
     if transition is not None and math.isfinite(window):
@@ -402,10 +454,8 @@ def analyze_paths(grid, law, paths, clearance: np.ndarray, W: float, V: float, b
     amplitude = np.zeros(x.size)
     if transition is not None and boundary.omega_critical and boundary.omega_critical > 0:
         profile = lateral_profile(grid, law, x, y, tx, ty, LEAVES)
-        # on a path taken, the goal balances the field's mean over a period of travel; its ripple along the path forces
-        reference = np.where(taken, _window_mean(profile[1][:, profile[0].size // 2], route, arc, ds, lam / 2), 0.0)
         stopped = np.stack([~np.isfinite(N_forward), ~np.isfinite(N_reverse)])
-        oscillates, amplitude = _driven(route, arc, stopped, profile, np.nan_to_num(reference), V, transition,
+        oscillates, amplitude = _driven(route, arc, stopped, profile, pull, attraction, V, transition,
                                         2 * math.pi / boundary.omega_critical, driven)
         code = np.where((code == 0) & oscillates, 1, code)
     # the window-edge relay (`relay`): a restoring jump of F_n within a cell of the path, larger than its smooth change
@@ -416,7 +466,7 @@ def analyze_paths(grid, law, paths, clearance: np.ndarray, W: float, V: float, b
         # the describing function of one jump beside the smooth slope, per unit forward force, in the worse direction
         # (`relay.relay_amplitude`; the whole profile's, `relay.window_cycle`, is what the driven loop above runs through)
         d = worse[check]
-        ahead = np.where(d == 0, 1 + along[check], 1 - along[check])
+        ahead = np.where(d == 0, attraction[check] + along[check], attraction[check] - along[check])
         N_smooth = np.nan_to_num(np.where(d == 0, N_forward[check], N_reverse[check]))
         with np.errstate(invalid="ignore", divide="ignore"):
             cycle = np.minimum(relay_amplitude(jump / np.where(ahead > 0, ahead, np.nan), boundary.NV_critical / V, N_smooth), LEAVES)
@@ -549,8 +599,10 @@ def _window_product(N: np.ndarray, route: np.ndarray, arc: np.ndarray, half: flo
 
 
 PREDICTION_OFFSET = 0.03
-"""Lateral offset (m) of the loop's start from the route in `_driven` (the drives' start offset,
-`validation.maps.START_OFFSET`): the disturbance whose growth shows where the loop is unstable."""
+"""Lateral offset (m) of the loop's start from the route or path in `_driven` (the drives' start offset,
+`validation.maps.START_OFFSET`): the disturbance whose growth shows where the loop is unstable. On a path taken too:
+the loop's cycle is reached from above as from below (a rate-limited cycle at 1.7 cm, approached from 5 mm,
+overshoots and dips under the episodes' threshold for periods on its way)."""
 
 
 LEAVES = 1.0
@@ -590,15 +642,17 @@ def lateral_profile(grid, law, x, y, tx, ty, reach: float):
     return offsets, fn.reshape(-1, S), ft.reshape(-1, S)
 
 
-def _driven(route, arc, stopped, profile, reference, V: float, transition: SampledTransition, period: float, taken):
+def _driven(route, arc, stopped, profile, pull, attraction, V: float, transition: SampledTransition, period: float, taken):
     """(oscillates, amplitude) per sample: the sampled loop driven along each route at V through the real lateral force
     across it (module docstring, "The loop driven along the route"), in both directions (a path taken: the way it was
-    driven), started `PREDICTION_OFFSET` off a route (`NOISE_FLOOR` off a path taken); its lateral position's episodes
+    driven), started `PREDICTION_OFFSET` off it; its lateral position's episodes
     (`episodes.lateral_episodes`, the drives' judge) mark the samples the robot passes meanwhile.
 
-    ``x_{k+1} = M·x_k + n·sat(v_k)``, ``v_k = −F0·x_k − gk·g_k(y_k)`` (`SampledTransition`), g(y) = −(F_n(y) − F_ref)/
-    (1 ± F_r·t): the linear loop's N·y with the lateral force itself (interpolated in `profile` between its quarter
-    cells), sat the steering-rate limit. `stopped` (per direction and sample): the direction is not judged there (a
+    ``x_{k+1} = M·x_k + n·sat(v_k)``, ``v_k = −F0·x_k − gk·g_k(y_k)`` (`SampledTransition`),
+    g(y) = −atan2(F_n(y) − P, A ± F_r·t): the direction of the resultant the robot steers to (KB eq 4; the linear
+    loop's N·y for small y) with the lateral force itself (interpolated in `profile` between its quarter cells), P
+    and A what the goal balances across the path and its attraction along it (`_goal_pull`), sat the steering-rate
+    limit. `stopped` (per direction and sample): the direction is not judged there (a
     wall ahead, `END_FRACTION`): no lateral force. The run stops where it leaves the profile or `LEAVES`.
 
     Parameters
@@ -609,8 +663,8 @@ def _driven(route, arc, stopped, profile, reference, V: float, transition: Sampl
         Forward and reverse.
     profile : tuple
         `lateral_profile`'s (offsets, F_n, F_r·t).
-    reference : ndarray
-        F_ref per sample, F_ct units.
+    pull, attraction : ndarray
+        The goal's pull across the path (P) and along it (A) per sample, F_ct units (0 and 1 on a route).
     V : float
         Speed, m/s.
     transition : SampledTransition
@@ -648,11 +702,10 @@ def _driven(route, arc, stopped, profile, reference, V: float, transition: Sampl
     rows = np.zeros((len(runs), steps), dtype=int)
     sign = np.array([1.0 if d == 0 else -1.0 for _, d, _ in runs])
     length = np.array([n.size for n, _, _ in runs])
-    start = np.array([NOISE_FLOOR if on_path else PREDICTION_OFFSET for _, _, on_path in runs])
     for i, (nearest, _, _) in enumerate(runs):
         rows[i, :nearest.size] = nearest
     state = np.zeros((len(runs), M.shape[0]))
-    state[:, y_index] = sign * start / V  # to the left of the travel direction (the state is x/V, s)
+    state[:, y_index] = sign * PREDICTION_OFFSET / V  # to the left of the travel direction (the state is x/V, s)
     lateral = np.full((len(runs), steps), np.nan)
     alive = np.ones(len(runs), dtype=bool)
     with np.errstate(invalid="ignore"):
@@ -664,8 +717,8 @@ def _driven(route, arc, stopped, profile, reference, V: float, transition: Sampl
             i0 = np.clip(np.floor(u).astype(int), 0, offsets.size - 2)
             frac = u - i0
             f = fn[row, i0] * (1 - frac) + fn[row, i0 + 1] * frac
-            ahead = 1 + sign * ft[row, centre]
-            g = -(f - reference[row]) / ahead
+            ahead = attraction[row] + sign * ft[row, centre]
+            g = -np.arctan2(f - pull[row], ahead)  # the resultant's direction (KB eq 4), ~ N·y for small y
             g = np.where(stopped[(sign < 0).astype(int), row], 0.0, g)
             inside = (u >= 0) & (u <= offsets.size - 1) & (np.abs(yk) <= LEAVES) & np.isfinite(g)
             alive &= inside & np.isfinite(state).all(axis=1)
