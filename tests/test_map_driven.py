@@ -191,3 +191,50 @@ def test_goal_paths_are_judged_as_the_robot_drove_them(tmp_path):
     on = lambda r: pv.samples.segment == r  # noqa: E731
     assert np.isnan(pv.N_reverse[on(goal)]).all() and np.isfinite(pv.N_forward[on(goal)]).any()
     assert np.isfinite(pv.N_reverse[on(user)]).any() and np.isfinite(pv.N_reverse[on(skeleton)]).any()
+
+
+@pytest.mark.slow
+def test_a_path_taken_beside_a_wall_steers_against_the_goals_pull_along_it(tmp_path):
+    """On a path the robot took beside a wall (its goal off to the side holds it there against the wall's push), the
+    goal's attraction along the path is √(1 − P²), P the wall's mean push across one cell that it balances, so the
+    lateral gain is N = −(dF_n/ds)/(√(1 − P²) + F_r·t) (docs/maps.md, "Paths taken"); the same line as a route (its
+    goal along it) keeps N = −(dF_n/ds)/(1 + F_r·t). A small robot (W 0.3 m, V 0.5 m/s, CARMEL's loop) 0.7, 0.9 and
+    1.2 m from a straight wall, mid-way along it (its ends 5 m away, outside the window). Expected values from the force itself: P by scipy's adaptive quadrature over the cell
+    (the code: the trapezoid rule on quarter cells), dF_n/ds by a central difference (h = 0.1 mm; the code: the window
+    sum's Jacobian). Tolerance 1e-3 relative: the 5-node trapezoid's error on this smooth push (~1e-4 here) and the
+    difference's O(h²)."""
+    import sys
+    from pathlib import Path
+
+    from scipy.integrate import quad
+
+    sys.path.insert(0, str(Path(__file__).parent))
+    from test_map_paths import write_map
+
+    from pfm_stability.laws.fields import make_law
+    from pfm_stability.maps.analysis import analyze_map, judge_routes
+    from pfm_stability.maps.equilibria import lateral_force
+    from pfm_stability.maps.occupancy import load_map
+    from pfm_stability.maps.routes import path_of
+
+    img = np.full((100, 30), 254, dtype=np.uint8)
+    img[:, :3] = 0  # a wall 3 cells thick along y, x in [0, 0.3) m, 10 m long
+    robot, controller = CARMEL.robot.replace(W=0.3, V=0.5), CARMEL.controller
+    analysis = analyze_map(load_map(write_map(tmp_path, img)), robot, controller, make_law("grid", robot, controller))
+    grid, law, c = analysis.grid, analysis.law, analysis.grid.cell_size
+    distances = (0.7, 0.9, 1.2)
+    lines = [path_of([[d, 2.5], [d, 7.5]], k, "goals") for k, d in enumerate(distances)]
+    pv = judge_routes(analysis, lines + lines, taken=[True] * 3 + [False] * 3)
+    one = lambda v: np.array([v], dtype=float)  # noqa: E731
+    for k, d in enumerate(distances):
+
+        def push(s):
+            return float(lateral_force(grid, law, one(d), one(5.0), one(0.0), one(1.0), one(s))[0][0])
+
+        P = quad(push, -c / 2, c / 2, limit=200)[0] / c
+        along = float(lateral_force(grid, law, one(d), one(5.0), one(0.0), one(1.0), one(0.0))[1][0])
+        slope = -(push(1e-4) - push(-1e-4)) / 2e-4
+        assert 0.2 < abs(P) < 0.6  # the goal's pull is well off the path's direction: √(1 − P²) from 0.98 to 0.8
+        taken, route = (int(np.argmin(np.abs(pv.arc + 1e9 * (pv.samples.segment != r) - 2.5))) for r in (k, k + 3))
+        assert pv.N_forward[taken] == pytest.approx(slope / (math.sqrt(1 - P * P) + along), rel=1e-3), d
+        assert pv.N_forward[route] == pytest.approx(slope / (1 + along), rel=1e-3), d
