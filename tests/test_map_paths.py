@@ -164,6 +164,25 @@ def test_episode_detector_on_closed_form_signals():
     assert found and amplitude == pytest.approx(0.08, rel=0.1) and AMPLITUDE_THRESHOLD < 0.08
 
 
+def test_swing_is_the_weaves_amplitude_the_judge_sees():
+    """`swing` (a disagreement's simulated amplitude) of a 5 cm weave about a diagonal line: the weave smoothed over
+    P/8 as the episodes' judge smooths it, 5 cm · sin(π/8)/(π/8) = 4.87 cm (a moving average of a sinusoid over
+    1/8 of its period), to 1 % (the step T = P/126: the discrete average and the sampled peak); 0 over the first
+    and last half period; zeros for a run shorter than two periods."""
+    from pfm_stability.maps.episodes import swing
+
+    T, omega = 0.025, 2.0
+    period = 2 * math.pi / omega
+    t = np.arange(0, 30, T)
+    s, w = 1.0 * t, 0.05 * np.sin(omega * t)
+    x, y = (s - w) / math.sqrt(2), (s + w) / math.sqrt(2)
+    got = swing(t, x, y, period)
+    n = int(round(period / T))
+    assert np.all(got[: n // 2] == 0) and np.all(got[-(n // 2):] == 0)
+    assert got.max() == pytest.approx(0.05 * math.sin(math.pi / 8) / (math.pi / 8), rel=0.01)
+    assert not swing(t[:n], x[:n], y[:n], period).any()
+
+
 @pytest.mark.slow
 def test_driving_finds_the_unstable_corridor_and_nothing_in_the_stable_one(root):
     """Validation by driving on two corridors: at 1.4 V* the simulator's drives oscillate and the unstable stretches
@@ -177,6 +196,9 @@ def test_driving_finds_the_unstable_corridor_and_nothing_in_the_stable_one(root)
     unstable = drive_map(corridor_analysis(0.6, 1.4 * V_star, root), 6, seed=1)
     assert unstable.counts["episodes"] > 0
     assert unstable.recall >= 0.8 and unstable.precision >= 0.8, (unstable.lengths, unstable.disagreements)
+    false_alarms = [d for d in unstable.disagreements if d.kind == "false alarm"]
+    assert unstable.lengths["false_alarm_swinging"] <= sum(d.length for d in false_alarms) + 1e-9
+    assert all(d.simulated_amplitude >= 0 and d.predicted_amplitude >= 0 for d in unstable.disagreements)
     stable = drive_map(corridor_analysis(0.6, 0.7 * V_star, root), 6, seed=1)
     assert stable.counts["episodes"] == 0 and stable.lengths["predicted_unstable_driven"] == 0
     assert stable.recall is None and stable.precision is None

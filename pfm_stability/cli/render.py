@@ -600,7 +600,10 @@ def render_map_text(data: dict) -> str:
                      f"recall {share['recall']}, precision {share['precision']} by length along the paths driven "
                      f"({d['lengths']['drive_paths_driven']:.1f} m measured, {d['lengths']['drive_paths_unmeasured']:.1f} m passed "
                      f"only in a drive's last three periods, not measurable; {d['lengths']['driven']:.1f} of {d['lengths']['route']:.1f} m "
-                     f"of route covered); {len(d['disagreements'])} disagreements")
+                     f"of route covered); {len(d['disagreements'])} disagreements"
+                     + (f" (false alarms where a drive swung past {100 * d['inputs']['amplitude_threshold']:.1f} cm for fewer than "
+                        f"{d['inputs']['episode_periods']} periods: {d['lengths']['false_alarm_swinging']:.1f} m)"
+                        if d['lengths'].get('false_alarm_swinging') else ""))
     v = data.get("validation")
     if v is not None:
         share = f"{percent(v['agreement'])[1:]} of the {v['measured']} measured" if v.get("agreement") is not None else "- (none measured)"

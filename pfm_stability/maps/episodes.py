@@ -16,7 +16,8 @@ import math
 
 import numpy as np
 
-__all__ = ["AMPLITUDE_THRESHOLD", "EPISODE_PERIODS", "GROWTH_EFOLDS", "NOISE_FLOOR", "episodes", "lateral_episodes"]
+__all__ = ["AMPLITUDE_THRESHOLD", "EPISODE_PERIODS", "GROWTH_EFOLDS", "NOISE_FLOOR", "episodes", "lateral_episodes", "lateral_swing",
+           "oscillation", "swing"]
 
 EPISODE_PERIODS = 3
 """Periods of an episode ("a lateral deviation that grows over at least three periods, or stays above a threshold")."""
@@ -45,15 +46,39 @@ def lateral_episodes(t, lateral, period: float) -> tuple:
     period : float
         The oscillation period P, s.
     """
+    t = np.asarray(t, dtype=float)
+    r, n = _about_average(t, lateral, period)
+    return ((), 0.0) if r is None else _episodes(t, r, period, n)
+
+
+def lateral_swing(t, lateral, period: float) -> np.ndarray:
+    """|r| per sample (m): a lateral signal's oscillation about its one-period average, smoothed as the episodes' judge
+    smooths it (`swing`'s, for a lateral position); zeros for a signal shorter than two periods.
+
+    Parameters
+    ----------
+    t : ndarray
+        Times, s (uniform step).
+    lateral : ndarray
+        Lateral position, m.
+    period : float
+        The oscillation period P, s.
+    """
+    r, n = _about_average(t, lateral, period)
+    return np.zeros(np.size(t)) if r is None else np.abs(_smoothed(r, n))
+
+
+def _about_average(t, lateral, period: float) -> tuple:
+    """(r, n): `lateral` minus its average over one period of n samples; (None, 0) for fewer than two periods."""
     from scipy.ndimage import uniform_filter1d
 
     t, lateral = np.asarray(t, dtype=float), np.asarray(lateral, dtype=float)
     if t.size < 8 or not period > 0 or not math.isfinite(period):
-        return (), 0.0
+        return None, 0
     n = max(3, int(round(period / float(np.median(np.diff(t))))))
     if t.size < 2 * n:
-        return (), 0.0
-    return _episodes(t, lateral - uniform_filter1d(lateral, n, mode="nearest"), period, n)
+        return None, 0
+    return lateral - uniform_filter1d(lateral, n, mode="nearest"), n
 
 
 def episodes(t, x, y, period: float) -> tuple:
@@ -69,27 +94,71 @@ def episodes(t, x, y, period: float) -> tuple:
     period : float
         The oscillation period P, s.
     """
+    t = np.asarray(t, dtype=float)
+    r, n = oscillation(t, x, y, period)
+    if r is None:
+        return (), 0.0
+    return _episodes(t, r, period, n)
+
+
+def oscillation(t, x, y, period: float) -> tuple:
+    """(r, n): a trajectory's lateral oscillation r (m, per point: its distance across its own path averaged over one
+    period, left positive) and the samples per period n; (None, 0) for a run shorter than two periods.
+
+    Parameters
+    ----------
+    t : ndarray
+        Times, s (uniform step).
+    x, y : ndarray
+        Positions, m.
+    period : float
+        The oscillation period P, s.
+    """
     from scipy.ndimage import uniform_filter1d
 
     t, x, y = (np.asarray(v, dtype=float) for v in (t, x, y))
     if t.size < 8 or not period > 0 or not math.isfinite(period):
-        return (), 0.0
+        return None, 0
     n = max(3, int(round(period / float(np.median(np.diff(t))))))
     if t.size < 2 * n:
-        return (), 0.0
+        return None, 0
     sx, sy = uniform_filter1d(x, n, mode="nearest"), uniform_filter1d(y, n, mode="nearest")
     hx, hy = np.gradient(sx), np.gradient(sy)
     norm = np.hypot(hx, hy)
     norm[norm == 0] = 1.0
-    return _episodes(t, ((x - sx) * -hy + (y - sy) * hx) / norm, period, n)
+    return ((x - sx) * -hy + (y - sy) * hx) / norm, n
+
+
+def swing(t, x, y, period: float) -> np.ndarray:
+    """|r| per point (m): the lateral oscillation (`oscillation`) smoothed over P/8 as the episodes' judge smooths it,
+    its ends (half a period, where the average path is not centred) 0; zeros for a run shorter than two periods.
+
+    Parameters
+    ----------
+    t : ndarray
+        Times, s (uniform step).
+    x, y : ndarray
+        Positions, m.
+    period : float
+        The oscillation period P, s.
+    """
+    r, n = oscillation(t, x, y, period)
+    return np.zeros(np.size(t)) if r is None else np.abs(_smoothed(r, n))
+
+
+def _smoothed(r, n: int) -> np.ndarray:
+    """The oscillation `r` (m) smoothed over an eighth of its `n` samples a period (the cell ripple is faster), its
+    first and last half period 0 (the averaged path is not centred at the ends)."""
+    from scipy.ndimage import uniform_filter1d
+
+    r = uniform_filter1d(r, max(1, n // 8), mode="nearest")
+    r[: n // 2], r[-(n // 2):] = 0.0, 0.0
+    return r
 
 
 def _episodes(t, r, period, n) -> tuple:
     """The episodes of the oscillation `r` (m) about the average path (`n` samples a period)."""
-    from scipy.ndimage import uniform_filter1d
-
-    r = uniform_filter1d(r, max(1, n // 8), mode="nearest")
-    r[: n // 2], r[-(n // 2):] = 0.0, 0.0  # the averaged path is not centred at the ends
+    r = _smoothed(r, n)
     dr = np.diff(r)
     turn = np.flatnonzero((dr[:-1] > 0) & (dr[1:] <= 0) | (dr[:-1] < 0) & (dr[1:] >= 0)) + 1
     turn = turn[np.abs(r[turn]) > NOISE_FLOOR]

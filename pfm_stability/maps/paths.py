@@ -131,7 +131,8 @@ class PathStretch:
     oscillates : bool
         The linear loop driven along the route weaves over part of it (`maps.episodes`).
     amplitude : float
-        The largest lateral amplitude the linear loop predicts for the runs through it, m.
+        The largest lateral oscillation the loop driven along the route predicts on it, m (`maps.episodes.lateral_swing`;
+        `LEAVES` where it left the corridor: at least that; a relay's cycle where that is larger).
     """
 
     route: int
@@ -198,7 +199,7 @@ class PathVerdicts:
     oscillates : ndarray of bool
         The linear loop driven along the route weaves here (`maps.episodes`: a forced or growing oscillation).
     amplitude : ndarray
-        The largest predicted lateral amplitude of the run through each sample, m.
+        The predicted lateral oscillation at each sample, m (the largest of the runs passing it; as on `PathStretch`).
     relay : ndarray of bool
         The window-edge relay holds the robot in a sustained oscillation here (`maps.relay`): unstable ("relay").
     """
@@ -674,7 +675,7 @@ def _driven(route, arc, stopped, profile, pull, attraction, V: float, transition
     taken : bool or ndarray of bool
         Per route (or all): a path the robot took.
     """
-    from .episodes import lateral_episodes
+    from .episodes import lateral_episodes, lateral_swing
 
     offsets, fn, ft = profile
     taken = np.broadcast_to(np.asarray(taken, dtype=bool), (int(route.max()) + 1 if route.size else 0,))  # per route
@@ -730,10 +731,11 @@ def _driven(route, arc, stopped, profile, pull, attraction, V: float, transition
     for i, (nearest, d, _) in enumerate(runs):
         m = nearest.size
         ok = np.isfinite(lateral[i, :m])
-        found, peak = lateral_episodes(t[:m][ok], sign[i] * lateral[i, :m][ok], period)
+        found, _ = lateral_episodes(t[:m][ok], sign[i] * lateral[i, :m][ok], period)
         for lo, hi in found:
             oscillates[nearest[(t[:m] >= lo) & (t[:m] <= hi)]] = True
-        amplitude[nearest] = np.maximum(amplitude[nearest], peak if ok.all() else max(peak, LEAVES))
+        np.maximum.at(amplitude, nearest[ok], lateral_swing(t[:m][ok], lateral[i, :m][ok], period))
+        amplitude[nearest[~ok]] = np.maximum(amplitude[nearest[~ok]], LEAVES)  # it left the corridor: at least that
     return oscillates, amplitude
 
 

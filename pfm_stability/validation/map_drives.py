@@ -45,7 +45,7 @@ from ..checks import check_integer
 from ..io.serialize import json_number, json_ready
 from ..sim.engine import run_batch
 from ..sim.scenario import Pose, Scenario, Target
-from ..maps.episodes import AMPLITUDE_THRESHOLD, EPISODE_PERIODS, GROWTH_EFOLDS, NOISE_FLOOR, episodes
+from ..maps.episodes import AMPLITUDE_THRESHOLD, EPISODE_PERIODS, GROWTH_EFOLDS, NOISE_FLOOR, episodes, swing
 from .maps import START_OFFSET, _batches, _table_size, crop_grid, simulator_grid
 
 __all__ = ["DRIVE_TIME_FACTOR", "MATCH_DISTANCE", "Disagreement", "Drive", "DriveValidation", "drive_map", "goal_routes"]
@@ -112,6 +112,13 @@ class Disagreement:
         Its ends, m.
     drives : tuple of int
         The drives that passed it.
+    predicted_amplitude : float
+        The largest lateral oscillation of the loop driven along it (`maps.paths`), m.
+    simulated_amplitude : float
+        The largest lateral oscillation of the drives there (`maps.episodes.swing`: about their paths averaged over
+        a period, as the episodes' judge measures it), m. Above `AMPLITUDE_THRESHOLD` on a false alarm: the robot
+        swung that far but for fewer than `EPISODE_PERIODS` periods; on a missed episode, the predicted one above it
+        is the loop's swing that did not last.
     """
 
     kind: str
@@ -124,6 +131,8 @@ class Disagreement:
     x1: float
     y1: float
     drives: tuple = ()
+    predicted_amplitude: float = 0.0
+    simulated_amplitude: float = 0.0
 
     def to_dict(self) -> dict:
         """JSON form."""
@@ -146,7 +155,9 @@ class DriveValidation:
         last three periods); ``episode``, ``episode_recalled``, ``episode_off_route`` (the drives' path length in
         episodes farther than the match distance from their own path: measured, not scored),
         ``predicted_unstable_driven``, ``predicted_unstable_matched``, ``predicted_unstable_unmeasured``,
-        ``predicted_unstable_not_driven`` (on the map's routes, no drive near).
+        ``predicted_unstable_not_driven`` (on the map's routes, no drive near); of the disagreements,
+        ``false_alarm_swinging`` (false alarms where a drive swung past `AMPLITUDE_THRESHOLD` for fewer than three
+        periods) and ``missed_predicted_swinging`` (missed episodes where the loop's swing passed it but did not last).
     counts : dict
         Drives by how they ended, episodes found.
     inputs : dict
@@ -311,6 +322,7 @@ def drive_map(analysis, count: int, *, seed: int = 0, progress=None) -> DriveVal
     tree = cKDTree(np.column_stack([pv.samples.x, pv.samples.y]))
     limit = max(MATCH_DISTANCE, robot.W)
     marks, points = [], []
+    swung = np.zeros(sc.code.size)  # the drives' largest lateral oscillation at each sample of their own paths, m
     for d, (t, x, y) in zip(drives, traces):
         if t.size == 0 or d.index not in own:
             marks.append(_Marks.none())
@@ -330,6 +342,7 @@ def drive_map(analysis, count: int, *, seed: int = 0, progress=None) -> DriveVal
         step = np.concatenate([[0.0], np.hypot(np.diff(x), np.diff(y))])
         off = float(step[during & ~near_path].sum())  # an episode away from its own path (a spin): measured, not scored
         unmeasured = np.setdiff1d(np.unique(nearest[near_path & start & ~end & ~during]), nearest[hit])
+        np.maximum.at(swung, nearest[hit], swing(t, x, y, period)[hit])
         marks.append(_Marks(np.unique(nearest[hit]), np.unique(nearest[hit & during]), off, unmeasured, on_routes))
         points.append(np.column_stack([x[during], y[during]]))
     unstable = sc.code == PATH_VERDICTS.index("unstable")
@@ -346,8 +359,11 @@ def drive_map(analysis, count: int, *, seed: int = 0, progress=None) -> DriveVal
     for d, mark in zip(drives, marks):
         for k in mark.scored:
             passed_by[k].add(d.index)
-    disagreements = (_runs("missed", episode & ~near_unstable, sc, passed_by)
-                     + _runs("false alarm", unstable & driven & ~near_episode, sc, passed_by))
+    disagreements = (_runs("missed", episode & ~near_unstable, sc, passed_by, swung)
+                     + _runs("false alarm", unstable & driven & ~near_episode, sc, passed_by, swung))
+    for kind, key in (("false alarm", "false_alarm_swinging"), ("missed", "missed_predicted_swinging")):
+        amplitude = "simulated_amplitude" if kind == "false alarm" else "predicted_amplitude"
+        lengths[key] = float(sum(d.length for d in disagreements if d.kind == kind and getattr(d, amplitude) >= AMPLITUDE_THRESHOLD))
     events = [d.event or "time" for d in drives]
     counts = {"drives": len(drives), "not_started": skipped, "route_drives": sum(d.kind == "route" for d in drives),
               "waypoint_drives": sum(d.kind == "waypoints" for d in drives), "episodes": sum(len(d.episodes) for d in drives),
@@ -371,12 +387,13 @@ class _Scored:
     spacing: np.ndarray
     x: np.ndarray
     y: np.ndarray
+    amplitude: np.ndarray
 
     @classmethod
     def of(cls, pv, dp=None) -> "_Scored":
-        parts = [(pv.code, pv.samples.segment, pv.arc, pv.spacing, pv.samples.x, pv.samples.y)]
+        parts = [(pv.code, pv.samples.segment, pv.arc, pv.spacing, pv.samples.x, pv.samples.y, pv.amplitude)]
         if dp is not None:
-            parts.append((dp.code, dp.samples.segment + len(pv.paths), dp.arc, dp.spacing, dp.samples.x, dp.samples.y))
+            parts.append((dp.code, dp.samples.segment + len(pv.paths), dp.arc, dp.spacing, dp.samples.x, dp.samples.y, dp.amplitude))
         return cls(*(np.concatenate(a) for a in zip(*parts)))
 
 
@@ -466,8 +483,9 @@ def _within(mask: np.ndarray, route: np.ndarray, arc: np.ndarray, half: float) -
     return out
 
 
-def _runs(kind: str, mask: np.ndarray, sc, passed_by) -> tuple:
-    """The stretches of consecutive `mask` samples of each route, as `Disagreement`s."""
+def _runs(kind: str, mask: np.ndarray, sc, passed_by, swung) -> tuple:
+    """The stretches of consecutive `mask` samples of each route, as `Disagreement`s (`swung`: the drives' largest
+    lateral oscillation per sample, m)."""
     out = []
     route = sc.route
     for r in np.unique(route[mask]):
@@ -479,7 +497,8 @@ def _runs(kind: str, mask: np.ndarray, sc, passed_by) -> tuple:
             start, stop = float(sc.arc[run[0]] - sc.spacing[run[0]] / 2), float(sc.arc[run[-1]] + sc.spacing[run[-1]] / 2)
             drives = sorted(set().union(*(passed_by[k] for k in run)))
             out.append(Disagreement(kind, int(r), start, stop, float(sc.spacing[run].sum()), float(sc.x[run[0]]),
-                                    float(sc.y[run[0]]), float(sc.x[run[-1]]), float(sc.y[run[-1]]), tuple(drives)))
+                                    float(sc.y[run[0]]), float(sc.x[run[-1]]), float(sc.y[run[-1]]), tuple(drives),
+                                    float(np.nan_to_num(sc.amplitude[run]).max()), float(swung[run].max())))
     return tuple(out)
 
 
