@@ -32,6 +32,8 @@ from pfm_stability.maps.occupancy import load_map
 from pfm_stability.models import Loop, models_for
 from pfm_stability.parameters import CARMEL
 
+pytestmark = pytest.mark.xdist_group("map_corridors")  # `oracle` and `corridor_analysis` once per suite (tests/conftest.py)
+
 ROBOT_OPTIONS = ["--W", "0.4", "--tau", "0.1", "--k", "20", "--T", "0.025", "--f", "2", "--V", "1"]
 """The robot of the corridors (a 25 ms loop at 1 m/s: V* of the narrow corridors lies below V, of the wide ones above)."""
 ROBOT = CARMEL.robot.replace(W=0.4, tau=0.1, k=20.0, V=1.0)
