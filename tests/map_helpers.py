@@ -6,9 +6,10 @@ same one through different outputs: ``map depot`` as JSON, as text, with ``--out
 thresholds), robot, controller, law and options as an earlier call in this process returns that call's analysis (a
 frozen dataclass; nothing downstream changes it), with its warnings given to ``warn`` again as the first call gave
 them. What each test checks is unchanged: every output is still rendered, written and read from the analysis; the
-analysis itself is computed once by the same code. A call with a ``progress`` callback (its lines carry the
-stages' timings) or with the user's own routes is computed afresh. That the analysis does not depend on anything else — the process's history, the time —
-is itself checked, by two fresh runs: tests/test_map_cli.py::test_json_is_deterministic.
+analysis itself is computed once by the same code. A call with a ``progress`` callback (its lines carry the stages'
+timings) or with the user's own routes is computed afresh. That an analysis depends on nothing else (the process's
+history, the time) is itself checked: tests/test_map_cli.py::test_json_is_deterministic compares a fresh analysis
+with an earlier one.
 
 Tests that share an analysis carry the same ``pytest.mark.xdist_group`` (tests/conftest.py), so that they run on one
 worker under ``pytest -n``: the cache lives in the worker's process.

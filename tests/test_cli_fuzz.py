@@ -480,7 +480,7 @@ def _writer_argv(name, target, tmp_path):
 
 
 @pytest.mark.parametrize("room", [0, 3000])
-@pytest.mark.parametrize("name", [pytest.param(name, marks=[pytest.mark.xdist_group("map_depot_carmel")] if name == "map" else [])
+@pytest.mark.parametrize("name", [pytest.param(name, marks=[pytest.mark.xdist_group("map_depot_carmel")] * (name == "map"))
                                   for name in sorted(WRITERS)])
 def test_every_writing_command_on_a_full_disk_and_an_uncreatable_path(tmp_path, name, room):
     """A full disk (0 or 3000 bytes left): exit 2, one line "could not write … No space left on device", no output, no
