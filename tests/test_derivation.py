@@ -44,8 +44,6 @@ from pfm_stability.analysis.derivation import (
     theta,
 )
 
-pytestmark = pytest.mark.xdist_group("sympy_derivation")  # sympy's cache of the derivation filled once (tests/conftest.py)
-
 
 def same(a, b) -> bool:
     """Exact symbolic identity a ≡ b."""
