@@ -46,6 +46,7 @@ from pathlib import Path
 
 import pytest
 
+from map_helpers import shared_map_analyses
 from pfm_stability.cli import main
 
 DATA = Path(__file__).parent / "data" / "answers.json.gz"
@@ -241,11 +242,24 @@ def test_report_answers_are_unchanged(recorded, argvs):
         assert not found, f"{' '.join(argv)}:\n" + "\n".join(found)
 
 
-@pytest.mark.parametrize("argv", other_cases(), ids=lambda argv: "-".join(argv[:2] + argv[2:4]))
+DEPOT_AT_CARMEL = ["map", "depot", "--quiet", "--format", "json"]
+"""The map line whose analysis other tests read too (tests/map_helpers.py): their tests share an xdist group."""
+
+
+def _other_case(argv):
+    marks = [pytest.mark.xdist_group("map_depot_carmel")] if argv == DEPOT_AT_CARMEL else []
+    return pytest.param(argv, marks=marks, id="-".join(argv[:2] + argv[2:4]))
+
+
+@pytest.mark.parametrize("argv", [_other_case(argv) for argv in other_cases()])
 def test_traps_and_map_answers_are_unchanged(recorded, argv):
-    """Each recorded `traps` and `map` command line, a map to its method's accuracy (module docstring)."""
+    """Each recorded `traps` and `map` command line, a map to its method's accuracy (module docstring). A map's
+    analysis is computed once per process for this test and others that read the same map with the same options
+    (tests/map_helpers.py)."""
     tolerances = {"rtol": MAP_RTOL, "absolute": MAP_ABSOLUTE} if argv[0] == "map" else {}
-    now, then = run(argv), recorded[" ".join(argv)]
+    with shared_map_analyses():
+        now = run(argv)
+    then = recorded[" ".join(argv)]
     if argv[0] == "map" and then["code"] == 2 and "has no route long enough" in (then["error"] or "") and now["code"] == 0:
         # a map refused for want of a straight corridor now has routes of any shape (docs/maps.md, "Verdicts along
         # every route"): a new answer where there was none; no segment verdict can have flipped, there are none

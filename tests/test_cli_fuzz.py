@@ -50,6 +50,7 @@ from pfm_stability.cli.traps import SHIPPED_SCENES
 from pfm_stability.parameters import RANGES, SHOWN_AS
 from pfm_stability.io.schema import load_schema
 from cli_helpers import disk_full
+from map_helpers import shared_map_analyses
 
 pytestmark = pytest.mark.filterwarnings("error::RuntimeWarning")  # a numpy warning is a silent NaN or overflow
 
@@ -479,17 +480,20 @@ def _writer_argv(name, target, tmp_path):
 
 
 @pytest.mark.parametrize("room", [0, 3000])
-@pytest.mark.parametrize("name", sorted(WRITERS))
+@pytest.mark.parametrize("name", [pytest.param(name, marks=[pytest.mark.xdist_group("map_depot_carmel")] * (name == "map"))
+                                  for name in sorted(WRITERS)])
 def test_every_writing_command_on_a_full_disk_and_an_uncreatable_path(tmp_path, name, room):
     """A full disk (0 or 3000 bytes left): exit 2, one line "could not write … No space left on device", no output, no
     temporary file, and a file already at the output path untouched (the write is atomic: a rename once complete).
-    An output where nothing can be created (/proc, /sys: root passes os.access there) is refused before any work."""
+    An output where nothing can be created (/proc, /sys: root passes os.access there) is refused before any work.
+    The depot's analysis, which comes before the writing, is computed once per process for the two rooms and the other
+    tests that read it (tests/map_helpers.py)."""
     argv, written = _writer_argv(name, tmp_path / "out", tmp_path)
     if name != "map":
         with open(written, "wb") as fh:
             fh.write(b"the user's old file")
     before = sorted(p.name for p in tmp_path.rglob("*"))
-    with disk_full(room):
+    with disk_full(room), shared_map_analyses():
         code, out, err = run_cli(argv)
     assert code == 2 and out == "", err
     assert err.splitlines()[-1].startswith("pfm-stability: error: could not write ") and err.endswith("No space left on device\n") or \

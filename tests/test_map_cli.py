@@ -29,6 +29,7 @@ from pfm_stability.cli import main
 from pfm_stability.maps.outputs import pixel_to_percent
 from pfm_stability.io.schema import load_schema
 from cli_helpers import file_error
+from map_helpers import shared_map_analyses
 
 MAPS = Path(str(resources.files("pfm_stability").joinpath("data", "maps")))
 VALIDATOR = Draft202012Validator(load_schema())
@@ -44,7 +45,11 @@ def run(argv):
 ROBOTS = {"depot": ["--W", "0.4", "--tau", "0.2", "--k", "10", "--T", "0.05", "--f", "2", "--V", "0.3"], "tb3_sandbox": ["--W", "0.2", "--tau", "0.1", "--k", "20", "--T", "0.025", "--f", "2", "--V", "0.6", "--min-length", "0.5"]}
 
 
-@pytest.mark.parametrize("name", list(ROBOTS))
+SHARED = {name: pytest.mark.xdist_group(f"map_cli_{name}") for name in ROBOTS}
+"""The tests that read a shipped map with its robot run on one worker: its analysis once (tests/map_helpers.py)."""
+
+
+@pytest.mark.parametrize("name", [pytest.param(name, marks=SHARED[name]) for name in ROBOTS])
 def test_shipped_map_outputs(tmp_path, name):
     """Every output is written and readable: the PNG; the CSV (one row per segment, as in the JSON); the mask PGM with
     the map's size, its YAML with the map's resolution and origin; and the mask's values decode to 100 % off the
@@ -52,7 +57,8 @@ def test_shipped_map_outputs(tmp_path, name):
     route stretch's piece of its route cut at its arc positions, here with numpy's interpolation; a stable stretch
     gets no zone, whatever its V*, nor an unstable one with V* = 0)."""
     out = tmp_path / "out"
-    code, stdout, err = run(["map", name, *ROBOTS[name], "--out-dir", str(out), "--format", "json", "--quiet"])
+    with shared_map_analyses():
+        code, stdout, err = run(["map", name, *ROBOTS[name], "--out-dir", str(out), "--format", "json", "--quiet"])
     assert code == 0, err
     data = json.loads(stdout)
     assert sorted(p.name for p in out.iterdir()) == ["routes.csv", "routes.png", "segments.csv", "speed_mask.pgm", "speed_mask.yaml",
@@ -97,20 +103,27 @@ def test_shipped_map_outputs(tmp_path, name):
     assert VALIDATOR.is_valid(data), [e.message for e in VALIDATOR.iter_errors(data)][:3]
 
 
+@SHARED["depot"]
 def test_text_output_lists_the_worst_segments():
-    """The text output names the map, the robot, the worst segments (lowest margin first) and the summary."""
-    code, stdout, err = run(["map", "depot", *ROBOTS["depot"], "--quiet"])
+    """The text output names the map, the robot, the worst segments (lowest margin first) and the summary (the analysis
+    of test_shipped_map_outputs[depot], tests/map_helpers.py)."""
+    with shared_map_analyses():
+        code, stdout, err = run(["map", "depot", *ROBOTS["depot"], "--quiet"])
     assert code == 0, err
     assert stdout.startswith("map depot: 604 x 307 cells of 0.05 m") and "worst" in stdout and "unstable:" in stdout
     margins = [float(line.split()[-2].rstrip("%")) for line in stdout.splitlines() if line.strip().startswith("(") and "%" in line]
     assert margins == sorted(margins) and len(margins) >= 3
 
 
+@SHARED["tb3_sandbox"]
 def test_json_is_deterministic():
-    """Two runs print the same JSON once the wall-clock timing is dropped (seeded thinning and selection)."""
+    """Two runs print the same JSON once the wall-clock timing is dropped (seeded thinning and selection): the second
+    analyses the map afresh; the first is the analysis test_shipped_map_outputs[tb3_sandbox] made earlier in this
+    process when it ran first (tests/map_helpers.py), a fresh one otherwise."""
     outs = []
-    for _ in range(2):
-        code, stdout, _ = run(["map", "tb3_sandbox", *ROBOTS["tb3_sandbox"], "--format", "json", "--quiet"])
+    for shared in (shared_map_analyses(), contextlib.nullcontext()):
+        with shared:
+            code, stdout, _ = run(["map", "tb3_sandbox", *ROBOTS["tb3_sandbox"], "--format", "json", "--quiet"])
         assert code == 0
         data = json.loads(stdout)
         data.pop("timing")

@@ -27,8 +27,12 @@ from PIL import Image
 from cli_helpers import report_json, run
 from pfm_stability.laws.fields import make_law
 from pfm_stability.laws.force_law import corridor_gain
+from pfm_stability.maps.analysis import analyze_map
+from pfm_stability.maps.occupancy import load_map
 from pfm_stability.models import Loop, models_for
 from pfm_stability.parameters import CARMEL
+
+pytestmark = pytest.mark.xdist_group("map_corridors")  # `oracle` and `corridor_analysis` once per suite (tests/conftest.py)
 
 ROBOT_OPTIONS = ["--W", "0.4", "--tau", "0.1", "--k", "20", "--T", "0.025", "--f", "2", "--V", "1"]
 """The robot of the corridors (a 25 ms loop at 1 m/s: V* of the narrow corridors lies below V, of the wide ones above)."""
@@ -42,6 +46,9 @@ THICK = (0.3, 0.35, 0.4, 0.45, 0.5, 0.55, 0.6, 0.7, 0.8, 0.9, 1.0, 1.1, 1.2, 1.3
 ORIGIN = {"y": (-7.3, 2.1), "x": (3.4, -12.6)}
 """Map origins (m): multiples of the cell, away from 0, so that coordinates carry round-off as real maps do."""
 V_TOLERANCE = 0.01
+CLI_L = 0.7
+"""The width at which the segment is also read from ``pfm-stability map --format json`` (one-cell and three-cell walls,
+along x and y): the CLI prints the library's segment (`MapSegment.to_dict`), checked equal there."""
 
 
 def corridor_map(directory: Path, L: float, thickness: int, along: str) -> tuple[Path, float]:
@@ -79,21 +86,44 @@ def oracle(L: float, thickness: int) -> tuple[float, str]:
     return model.boundary(loop).NV_critical / N, "stable" if model.is_stable(N * ROBOT.V, loop) else "unstable"
 
 
+@pytest.fixture(scope="module")
+def root(tmp_path_factory):
+    return str(tmp_path_factory.mktemp("corridors"))
+
+
+@lru_cache(maxsize=None)
+def corridor_analysis(root: str, L: float, thickness: int, along: str):
+    """(map YAML path, axis coordinate across the corridor (m), `analyze_map` of it with the straight segments alone):
+    once per corridor, for both tests below (the routes' verdicts, ``along_routes``, are read by neither; the
+    segments do not depend on them)."""
+    directory = Path(root) / f"{L}_{thickness}_{along}"
+    directory.mkdir()
+    path, axis = corridor_map(directory, L, thickness, along)
+    law = make_law("grid", ROBOT, CONTROLLER)
+    return path, axis, analyze_map(load_map(path), ROBOT, CONTROLLER, law, along_routes=False)
+
+
 @pytest.mark.parametrize("along", ["x", "y"])
 @pytest.mark.parametrize("thickness, L", [(1, L) for L in THIN] + [(3, L) for L in THICK])
-def test_straight_corridor_segment_matches_the_grid_law(tmp_path, along, thickness, L):
+def test_straight_corridor_segment_matches_the_grid_law(root, along, thickness, L):
     """One segment, with the oracle's verdict and its V* to 1 % (measured: up to 0.7 %, at the narrowest widths), and
     an equilibrium at every sample.
 
     What the 1 % allows for: the segment is judged whole, ends included. The walls stop at the map's edge, so over
     the last metre the window sees a truncated wall (less lateral force, and an along-track force that changes the
     forward force 1 ± F_r·t); the segment's mean growth rate counts those samples too (docs/maps.md, "Checked"). Away
-    from the ends the samples' N equals the oracle's to 5e-4 (the next test)."""
+    from the ends the samples' N equals the oracle's to 5e-4 (the next test).
+
+    The segment is the library's (`analyze_map` with the straight segments alone: the routes' verdicts are not read
+    here, and the CLI spends most of its time on them); at L = `CLI_L` the JSON of ``pfm-stability map`` is read too
+    and must hold the same segments, value for value (the CLI prints `MapSegment.to_dict`)."""
     V_star, verdict = oracle(L, thickness)
-    path, axis = corridor_map(tmp_path, L, thickness, along)
-    code, out, err = run(["map", str(path), *ROBOT_OPTIONS, "--format", "json", "--quiet"])
-    assert code == 0, err
-    segments = json.loads(out)["segments"]
+    path, axis, analysis = corridor_analysis(root, L, thickness, along)
+    segments = [s.to_dict() for s in analysis.segments]
+    if L == CLI_L:
+        code, out, err = run(["map", str(path), *ROBOT_OPTIONS, "--format", "json", "--quiet"])
+        assert code == 0, err
+        assert json.loads(out)["segments"] == segments
     assert len(segments) == 1, [(s["verdict"], s["length"]) for s in segments]
     (segment,) = segments
     assert segment["length"] > 25.0
@@ -106,7 +136,7 @@ def test_straight_corridor_segment_matches_the_grid_law(tmp_path, along, thickne
 
 @pytest.mark.parametrize("along", ["x", "y"])
 @pytest.mark.parametrize("L", [0.3, 0.35, 0.4, 0.45, 1.05])
-def test_middle_of_the_corridor_is_on_the_axis_with_the_grid_laws_N(tmp_path, along, L):
+def test_middle_of_the_corridor_is_on_the_axis_with_the_grid_laws_N(root, along, L):
     """Away from the ends (> 2 m, beyond the window's 1.65 m reach) every sample finds the equilibrium, on the
     corridor's axis, with the N of ``report --law grid --L`` to 5e-4 (measured: 2e-4, `python benchmarks/map_corridors.py`).
 
@@ -115,13 +145,10 @@ def test_middle_of_the_corridor_is_on_the_axis_with_the_grid_laws_N(tmp_path, al
     window, 16 cells ahead or behind) falls inside that interval the 4-node rule is off by up to 2e-4. Axis: to 1e-5 m;
     the segment is tilted by up to ~3e-3 rad (the skeleton beside an axis on a cell boundary), which moves the root
     along its tilted normal by ~1e-6 m; a root missed or found in the wrong cell is off by centimetres.
-    """
-    from pfm_stability.maps.analysis import analyze_map
-    from pfm_stability.maps.occupancy import load_map
 
-    path, axis = corridor_map(tmp_path, L, 1, along)
-    law = make_law("grid", ROBOT, CONTROLLER)
-    analysis = analyze_map(load_map(path), ROBOT, CONTROLLER, law)
+    The analysis is the previous test's where the widths coincide (`corridor_analysis`).
+    """
+    path, axis, analysis = corridor_analysis(root, L, 1, along)
     s = analysis.samples
     (segment,) = analysis.segments
     t = np.array([segment.x1 - segment.x0, segment.y1 - segment.y0]) / segment.length

@@ -14,6 +14,13 @@ from pfm_stability.maps.verdicts import GrowthRate, effective_gain
 from pfm_stability.models import Loop, models_for
 from pfm_stability.models.sampled import closed_loop_matrix, command_form
 from pfm_stability.parameters import CARMEL
+from test_map_paths import SHARED_CORRIDORS, corridors_root
+
+
+@pytest.fixture(scope="module")
+def root(tmp_path_factory):
+    """`test_map_paths.corridor_analysis`' folder: its analyses of the 1.2 m corridor are shared with that module's tests."""
+    return corridors_root(tmp_path_factory)
 
 
 def _loops(seed: int, count: int):
@@ -141,21 +148,18 @@ def test_effective_gain_of_a_window_that_decays_faster_than_any_uniform_gain():
     assert abs(float(growth(N * robot.V)) - sigma) <= 1e-9
 
 
-def test_a_drives_last_three_periods_are_not_measured(tmp_path):
+@SHARED_CORRIDORS
+def test_a_drives_last_three_periods_are_not_measured(root):
     """A drive that reaches its goal (or collides) in less than three periods after passing a sample could not have
     shown an episode there: those samples are counted as unmeasured, never scored. On the stable corridor (0.7 V*,
     no episode) every drive's last 3·P·V metres of own path (less its first period) are unmeasured, to within a few
     samples of its path (the match is to the nearest sample, 0.1 m apart) per drive."""
-    import sys
-    from pathlib import Path
-
-    sys.path.insert(0, str(Path(__file__).parent))
     from test_map_paths import _report, corridor_analysis
 
     from pfm_stability.validation.map_drives import drive_map
 
     V_star = _report(0.6).models["sampled"].critical["V_critical"]
-    analysis = corridor_analysis(0.6, 0.7 * V_star, str(tmp_path))
+    analysis = corridor_analysis(0.6, 0.7 * V_star, root)
     result = drive_map(analysis, 4, seed=3)
     assert result.counts["episodes"] == 0
     period, V = result.inputs["period"], analysis.robot.V
@@ -167,14 +171,11 @@ def test_a_drives_last_three_periods_are_not_measured(tmp_path):
     assert result.lengths["predicted_unstable_unmeasured"] == 0.0
 
 
-def test_goal_paths_are_judged_as_the_robot_drove_them(tmp_path):
+@SHARED_CORRIDORS
+def test_goal_paths_are_judged_as_the_robot_drove_them(root):
     """`--goals`: the paths the simulated robot took between goals are judged as taken (`maps.analysis.TAKEN_SOURCES`),
     the way they were driven only (their reverse direction is not judged: N nan), while the skeleton's routes keep both
     directions; the same path added as the user's own route (source "path") is judged both ways."""
-    import sys
-    from pathlib import Path
-
-    sys.path.insert(0, str(Path(__file__).parent))
     from test_map_paths import _report, corridor_analysis
 
     from pfm_stability.maps.analysis import add_routes
@@ -182,7 +183,7 @@ def test_goal_paths_are_judged_as_the_robot_drove_them(tmp_path):
     from pfm_stability.validation.map_drives import goal_routes
 
     V_star = _report(0.6).models["sampled"].critical["V_critical"]
-    analysis = corridor_analysis(0.6, 0.7 * V_star, str(tmp_path))
+    analysis = corridor_analysis(0.6, 0.7 * V_star, root)
     (driven,) = goal_routes(analysis, [(0.65, 3.0), (0.65, 15.0)])
     assert driven.source == "goals"
     both = add_routes(analysis, [driven, path_of(driven.points, 0, "path")])

@@ -56,9 +56,22 @@ def corridor_analysis(L: float, V: float, root: str):
     return analyze_map(load_map(corridor(directory, L)), robot, CONTROLLER, make_law("grid", robot, CONTROLLER))
 
 
+SHARED_CORRIDORS = pytest.mark.xdist_group("map_corridor_0.6")
+"""The tests here and in tests/test_map_driven.py that read `corridor_analysis` of the 1.2 m corridor: on one worker,
+each analysis is made once (tests/conftest.py)."""
+
+
+def corridors_root(tmp_path_factory) -> str:
+    """The folder of `corridor_analysis`' maps: one per test session (per worker), the same for every module (the
+    analyses are cached by it)."""
+    folder = tmp_path_factory.getbasetemp() / "map_corridors"
+    folder.mkdir(exist_ok=True)
+    return str(folder)
+
+
 @pytest.fixture(scope="module")
 def root(tmp_path_factory):
-    return str(tmp_path_factory.mktemp("paths"))
+    return corridors_root(tmp_path_factory)
 
 
 def _report(L: float):
@@ -83,6 +96,7 @@ def test_transition_matrix_is_affine_in_the_loop_gain():
         assert math.log(radius) / loop.T == pytest.approx(model.rightmost_root(float(NV), loop).real, abs=1e-9)
 
 
+@SHARED_CORRIDORS
 @pytest.mark.parametrize("L, factor", [(0.6, 0.7), (0.6, 1.4)])
 def test_straight_corridor_growth_and_verdict_are_the_reports(root, L, factor):
     """In the middle of a straight corridor (more than half a window plus the active window's reach from its ends,
@@ -104,6 +118,7 @@ def test_straight_corridor_growth_and_verdict_are_the_reports(root, L, factor):
     assert pv.summary()["decided_fraction"] == 1.0
 
 
+@SHARED_CORRIDORS
 def test_unstable_corridor_stretch_has_the_reports_critical_speed(root):
     """The unstable stretch of a corridor driven at 1.4 V*: margin < 0, and its V* (the speed at which its worst window's
     growth turns positive) at most the report's (2 % for the map's N against the law's) and above 0.7 of it: the worst
@@ -184,6 +199,7 @@ def test_swing_is_the_weaves_amplitude_the_judge_sees():
 
 
 @pytest.mark.slow
+@SHARED_CORRIDORS
 def test_driving_finds_the_unstable_corridor_and_nothing_in_the_stable_one(root):
     """Validation by driving on two corridors: at 1.4 V* the simulator's drives oscillate and the unstable stretches
     along their paths recall >= 80 % of the episodes' length with >= 80 % precision; at 0.7 V* no drive oscillates,
@@ -223,6 +239,7 @@ def test_user_routes_read_nav2_paths_waypoints_and_csv(tmp_path):
         read_routes(tmp_path / "bad.yaml")
 
 
+@SHARED_CORRIDORS
 def test_a_users_route_along_an_unstable_corridor_is_judged_unstable(root):
     """A waypoint route drawn by the user along the unstable corridor's axis (x = 0.65 m) is judged like the skeleton's
     route there: unstable at 1.4 V*, over most of its length (its ends within the window of the corridor's ends aside)."""

@@ -30,6 +30,8 @@ from pfm_stability.maps.routes import path_of
 from pfm_stability.maps.wobble import V_CRITICAL_AGREEMENT, wobble_summary, with_wobble
 from pfm_stability.parameters import CARMEL
 
+pytestmark = pytest.mark.xdist_group("map_wobble")  # the `corridor` and `routed` analyses once per suite (tests/conftest.py)
+
 ROBOT, CONTROLLER = CARMEL.robot, CARMEL.controller
 L = 0.6
 """CARMEL (W = 0.8 m, V = 0.8 m/s) in a corridor of half-width 0.6 m: V* ≈ 0.61 m/s < V, supercritical."""

@@ -135,20 +135,24 @@ def test_plot_method_draws_what_the_plot_function_draws(case):
         _same_picture(result.plot(), function(result))
 
 
+@pytest.mark.xdist_group("map_depot_carmel")  # the depot's analysis once per suite (tests/map_helpers.py)
 def test_plot_method_draws_into_a_given_axes():
     """``result.plot(ax=ax)`` draws into that axes and returns its figure, as the plot functions do (a map of the shipped depot
-    and a region panel: one of each family of pictures that take ``ax``)."""
+    and a region panel: one of each family of pictures that take ``ax``). The depot's analysis at CARMEL's preset is the
+    one ``map depot`` makes in other tests, computed once per process (tests/map_helpers.py)."""
     from pfm_stability.analysis.region_panels import corridor_V_panel
     from pfm_stability.cli.map import map_path
     from pfm_stability.laws.fields import make_law
-    from pfm_stability.maps.analysis import analyze_map
+    import pfm_stability.maps.analysis as map_analysis
+    from map_helpers import shared_map_analyses
     from pfm_stability.maps.occupancy import load_map
     from pfm_stability.plots.map import plot_map_stability
 
     panel = corridor_V_panel(ROBOT, CONTROLLER, resolution=RES)
     fig, ax = plt.subplots()
     assert panel.plot(ax=ax, legend=False) is fig and ax.get_lines()
-    analysis = analyze_map(load_map(map_path("depot")), ROBOT, CONTROLLER, make_law("grid", ROBOT, CONTROLLER))
+    with shared_map_analyses():
+        analysis = map_analysis.analyze_map(load_map(map_path("depot")), ROBOT, CONTROLLER, make_law("grid", ROBOT, CONTROLLER))
     fig, ax = plt.subplots()
     assert analysis.plot(ax=ax) is fig
     _same_picture(analysis.plot(), plot_map_stability(analysis))
