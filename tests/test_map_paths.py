@@ -180,22 +180,31 @@ def test_episode_detector_on_closed_form_signals():
 
 
 def test_swing_is_the_weaves_amplitude_the_judge_sees():
-    """`swing` (a disagreement's simulated amplitude) of a 5 cm weave about a diagonal line: the weave smoothed over
-    P/8 as the episodes' judge smooths it, 5 cm · sin(π/8)/(π/8) = 4.87 cm (a moving average of a sinusoid over
-    1/8 of its period), to 1 % (the step T = P/126: the discrete average and the sampled peak); 0 over the first
-    and last half period; zeros for a run shorter than two periods."""
-    from pfm_stability.maps.episodes import swing
+    """`swing` (a disagreement's simulated amplitude): a 5 cm weave about a diagonal line is held at its amplitude
+    smoothed over P/8 as the episodes' judge smooths it, 5 cm · sin(π/8)/(π/8) = 4.87 cm (a moving average of a
+    sinusoid over 1/8 of its period), to 1 % (the step T = P/126: the discrete average and the sampled peak); a bend
+    of the path (a 90° arc of 2 m radius), whose distance from its own one-period average reaches centimetres, is
+    no swing (0); zeros for a run shorter than two periods. `lateral_swing` of the same weave as a lateral signal
+    agrees."""
+    from pfm_stability.maps.episodes import lateral_swing, swing
 
     T, omega = 0.025, 2.0
     period = 2 * math.pi / omega
     t = np.arange(0, 30, T)
     s, w = 1.0 * t, 0.05 * np.sin(omega * t)
     x, y = (s - w) / math.sqrt(2), (s + w) / math.sqrt(2)
-    got = swing(t, x, y, period)
+    expected = 0.05 * math.sin(math.pi / 8) / (math.pi / 8)
+    assert swing(t, x, y, period).max() == pytest.approx(expected, rel=0.01)
+    assert lateral_swing(t, w, period).max() == pytest.approx(expected, rel=0.01)
     n = int(round(period / T))
-    assert np.all(got[: n // 2] == 0) and np.all(got[-(n // 2):] == 0)
-    assert got.max() == pytest.approx(0.05 * math.sin(math.pi / 8) / (math.pi / 8), rel=0.01)
     assert not swing(t[:n], x[:n], y[:n], period).any()
+    # a straight run, a quarter circle of radius 2 m, a straight run (1 m/s)
+    heading = np.clip((t - 10.0) / (math.pi / 2 * 2.0), 0.0, 1.0) * math.pi / 2
+    bx, by = np.cumsum(np.cos(heading)) * T, np.cumsum(np.sin(heading)) * T
+    from pfm_stability.maps.episodes import oscillation
+
+    assert np.abs(oscillation(t, bx, by, period)[0]).max() > 0.015  # the bend is off its average by more than the threshold
+    assert not swing(t, bx, by, period).any()
 
 
 @pytest.mark.slow

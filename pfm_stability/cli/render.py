@@ -601,8 +601,8 @@ def render_map_text(data: dict) -> str:
                      f"({d['lengths']['drive_paths_driven']:.1f} m measured, {d['lengths']['drive_paths_unmeasured']:.1f} m passed "
                      f"only in a drive's last three periods, not measurable; {d['lengths']['driven']:.1f} of {d['lengths']['route']:.1f} m "
                      f"of route covered); {len(d['disagreements'])} disagreements"
-                     + (f" (false alarms where a drive swung past {100 * d['inputs']['amplitude_threshold']:.1f} cm for fewer than "
-                        f"{d['inputs']['episode_periods']} periods: {d['lengths']['false_alarm_swinging']:.1f} m)"
+                     + (f" (false alarms where a drive wove past {100 * d['inputs']['amplitude_threshold']:.1f} cm for a period, "
+                        f"not {d['inputs']['episode_periods']}: {d['lengths']['false_alarm_swinging']:.1f} m)"
                         if d['lengths'].get('false_alarm_swinging') else ""))
     v = data.get("validation")
     if v is not None:

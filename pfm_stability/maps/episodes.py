@@ -52,8 +52,8 @@ def lateral_episodes(t, lateral, period: float) -> tuple:
 
 
 def lateral_swing(t, lateral, period: float) -> np.ndarray:
-    """|r| per sample (m): a lateral signal's oscillation about its one-period average, smoothed as the episodes' judge
-    smooths it (`swing`'s, for a lateral position); zeros for a signal shorter than two periods.
+    """Per sample, the amplitude (m) of the oscillation about its one-period average it is part of, held for at least
+    one period (`swing`, for a lateral position); zeros for a signal shorter than two periods.
 
     Parameters
     ----------
@@ -64,8 +64,9 @@ def lateral_swing(t, lateral, period: float) -> np.ndarray:
     period : float
         The oscillation period P, s.
     """
+    t = np.asarray(t, dtype=float)
     r, n = _about_average(t, lateral, period)
-    return np.zeros(np.size(t)) if r is None else np.abs(_smoothed(r, n))
+    return np.zeros(t.size) if r is None else _held(t, _smoothed(r, n), period)
 
 
 def _about_average(t, lateral, period: float) -> tuple:
@@ -130,8 +131,9 @@ def oscillation(t, x, y, period: float) -> tuple:
 
 
 def swing(t, x, y, period: float) -> np.ndarray:
-    """|r| per point (m): the lateral oscillation (`oscillation`) smoothed over P/8 as the episodes' judge smooths it,
-    its ends (half a period, where the average path is not centred) 0; zeros for a run shorter than two periods.
+    """Per point, the amplitude (m) of the lateral oscillation it is part of, held for at least one period — three
+    turning points alternating in side, P/4 to P apart, as the episodes' judge finds them (a bend of the path is no
+    swing) — the smallest of those three (the largest such window's); 0 where there is none.
 
     Parameters
     ----------
@@ -142,8 +144,20 @@ def swing(t, x, y, period: float) -> np.ndarray:
     period : float
         The oscillation period P, s.
     """
+    t = np.asarray(t, dtype=float)
     r, n = oscillation(t, x, y, period)
-    return np.zeros(np.size(t)) if r is None else np.abs(_smoothed(r, n))
+    return np.zeros(t.size) if r is None else _held(t, _smoothed(r, n), period)
+
+
+def _held(t, r, period) -> np.ndarray:
+    """Per sample, the smallest amplitude (m) of the three turning points of the smoothed oscillation `r` that hold it
+    for a period around it, the largest such (0: none)."""
+    out = np.zeros(t.size)
+    kept, amplitude = _turning_points(t, r, period)
+    for sel, a in _oscillating(t, r, kept, amplitude, period, 3):
+        inside = (t >= t[sel[0]] - period / 4) & (t <= t[sel[-1]])
+        out[inside] = np.maximum(out[inside], a.min())
+    return out
 
 
 def _smoothed(r, n: int) -> np.ndarray:
@@ -159,25 +173,9 @@ def _smoothed(r, n: int) -> np.ndarray:
 def _episodes(t, r, period, n) -> tuple:
     """The episodes of the oscillation `r` (m) about the average path (`n` samples a period)."""
     r = _smoothed(r, n)
-    dr = np.diff(r)
-    turn = np.flatnonzero((dr[:-1] > 0) & (dr[1:] <= 0) | (dr[:-1] < 0) & (dr[1:] >= 0)) + 1
-    turn = turn[np.abs(r[turn]) > NOISE_FLOOR]
-    kept = []  # turning points closer than a quarter period are ripple: keep the larger of each close pair
-    for k in turn:
-        if kept and t[k] - t[kept[-1]] < period / 4:
-            if abs(r[k]) > abs(r[kept[-1]]):
-                kept[-1] = k
-            continue
-        kept.append(k)
-    kept = np.array(kept, dtype=int)
-    amplitude = np.abs(r[kept]) if kept.size else np.zeros(0)
+    kept, amplitude = _turning_points(t, r, period)
     found = []
-    m = 2 * EPISODE_PERIODS
-    for i in range(0, max(0, kept.size - m + 1)):
-        sel, a = kept[i:i + m], amplitude[i:i + m]
-        gaps = np.diff(t[sel])
-        if np.any(np.sign(r[sel][1:]) == np.sign(r[sel][:-1])) or gaps.min() < period / 4 or gaps.max() > period:
-            continue  # not an oscillation: turning points on one side, or half-periods far from P/2 (a bend of the path)
+    for sel, a in _oscillating(t, r, kept, amplitude, period, 2 * EPISODE_PERIODS):
         span = t[sel[-1]] - t[sel[0]]
         slope = np.polyfit(t[sel], np.log(a), 1)[0]
         if slope * span >= GROWTH_EFOLDS or a.min() >= AMPLITUDE_THRESHOLD:
@@ -187,3 +185,31 @@ def _episodes(t, r, period, n) -> tuple:
             else:
                 found.append((float(lo), float(hi)))
     return tuple(found), float(amplitude.max()) if amplitude.size else 0.0
+
+
+def _turning_points(t, r, period) -> tuple:
+    """(indices, amplitudes (m)) of the turning points of the smoothed oscillation `r` above `NOISE_FLOOR`; of two closer
+    than a quarter period (ripple), the larger."""
+    dr = np.diff(r)
+    turn = np.flatnonzero((dr[:-1] > 0) & (dr[1:] <= 0) | (dr[:-1] < 0) & (dr[1:] >= 0)) + 1
+    turn = turn[np.abs(r[turn]) > NOISE_FLOOR]
+    kept = []
+    for k in turn:
+        if kept and t[k] - t[kept[-1]] < period / 4:
+            if abs(r[k]) > abs(r[kept[-1]]):
+                kept[-1] = k
+            continue
+        kept.append(k)
+    kept = np.array(kept, dtype=int)
+    return kept, (np.abs(r[kept]) if kept.size else np.zeros(0))
+
+
+def _oscillating(t, r, kept, amplitude, period, count: int):
+    """The runs of `count` consecutive turning points that oscillate — alternating in side, consecutive ones P/4 to P
+    apart (not a bend of the path) — as (indices, amplitudes)."""
+    for i in range(0, max(0, kept.size - count + 1)):
+        sel = kept[i:i + count]
+        gaps = np.diff(t[sel])
+        if np.any(np.sign(r[sel][1:]) == np.sign(r[sel][:-1])) or gaps.min() < period / 4 or gaps.max() > period:
+            continue
+        yield sel, amplitude[i:i + count]

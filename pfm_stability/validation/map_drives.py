@@ -113,12 +113,13 @@ class Disagreement:
     drives : tuple of int
         The drives that passed it.
     predicted_amplitude : float
-        The largest lateral oscillation of the loop driven along it (`maps.paths`), m.
+        The largest lateral oscillation of the loop driven along it held for at least one period (`maps.paths`,
+        `maps.episodes.lateral_swing`), m.
     simulated_amplitude : float
-        The largest lateral oscillation of the drives there (`maps.episodes.swing`: about their paths averaged over
-        a period, as the episodes' judge measures it), m. Above `AMPLITUDE_THRESHOLD` on a false alarm: the robot
-        swung that far but for fewer than `EPISODE_PERIODS` periods; on a missed episode, the predicted one above it
-        is the loop's swing that did not last.
+        The same of the drives there (`maps.episodes.swing`: three alternating turning points about their paths
+        averaged over a period, as the episodes' judge finds them; a bend is none), m. Above `AMPLITUDE_THRESHOLD`
+        on a false alarm: the robot did weave past it, for one period or more but fewer than `EPISODE_PERIODS`; on a
+        missed episode, the predicted amplitude above it is the loop's weave that did not last.
     """
 
     kind: str
@@ -156,8 +157,8 @@ class DriveValidation:
         episodes farther than the match distance from their own path: measured, not scored),
         ``predicted_unstable_driven``, ``predicted_unstable_matched``, ``predicted_unstable_unmeasured``,
         ``predicted_unstable_not_driven`` (on the map's routes, no drive near); of the disagreements,
-        ``false_alarm_swinging`` (false alarms where a drive swung past `AMPLITUDE_THRESHOLD` for fewer than three
-        periods) and ``missed_predicted_swinging`` (missed episodes where the loop's swing passed it but did not last).
+        ``false_alarm_swinging`` (false alarms where a drive wove past `AMPLITUDE_THRESHOLD` for at least one period,
+        not three) and ``missed_predicted_swinging`` (missed episodes where the loop wove past it, not for three).
     counts : dict
         Drives by how they ended, episodes found.
     inputs : dict
