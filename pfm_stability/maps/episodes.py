@@ -74,12 +74,17 @@ def _about_average(t, lateral, period: float) -> tuple:
     from scipy.ndimage import uniform_filter1d
 
     t, lateral = np.asarray(t, dtype=float), np.asarray(lateral, dtype=float)
+    n = _period_samples(t, period)
+    return (None, 0) if n is None else (lateral - uniform_filter1d(lateral, n, mode="nearest"), n)
+
+
+def _period_samples(t: np.ndarray, period: float):
+    """Samples per period of the uniform times `t` (s; at least 3), or None when the run is shorter than two periods
+    (or eight samples) or the period is not a positive number."""
     if t.size < 8 or not period > 0 or not math.isfinite(period):
-        return None, 0
+        return None
     n = max(3, int(round(period / float(np.median(np.diff(t))))))
-    if t.size < 2 * n:
-        return None, 0
-    return lateral - uniform_filter1d(lateral, n, mode="nearest"), n
+    return None if t.size < 2 * n else n
 
 
 def episodes(t, x, y, period: float) -> tuple:
@@ -118,10 +123,8 @@ def oscillation(t, x, y, period: float) -> tuple:
     from scipy.ndimage import uniform_filter1d
 
     t, x, y = (np.asarray(v, dtype=float) for v in (t, x, y))
-    if t.size < 8 or not period > 0 or not math.isfinite(period):
-        return None, 0
-    n = max(3, int(round(period / float(np.median(np.diff(t))))))
-    if t.size < 2 * n:
+    n = _period_samples(t, period)
+    if n is None:
         return None, 0
     sx, sy = uniform_filter1d(x, n, mode="nearest"), uniform_filter1d(y, n, mode="nearest")
     hx, hy = np.gradient(sx), np.gradient(sy)

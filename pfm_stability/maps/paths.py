@@ -356,14 +356,11 @@ def _goal_pull(grid, law, x, y, tx, ty, route, arc, ds, taken, wavelength_m: flo
 
 def _cell_mean(grid, law, x, y, tx, ty) -> np.ndarray:
     """F_n at the points averaged across the path over one cell, s in [−c/2, c/2] (F_ct units; the trapezoid rule on
-    `PROFILE_STEP` nodes, those of `lateral_profile`)."""
-    offsets = np.linspace(-0.5, 0.5, int(round(1 / PROFILE_STEP)) + 1) * grid.cell_size
-    weights = np.full(offsets.size, 1.0)
+    `lateral_profile`'s nodes within half a cell)."""
+    _, fn, _ = lateral_profile(grid, law, x, y, tx, ty, grid.cell_size / 2)
+    weights = np.full(fn.shape[1], 1.0)
     weights[[0, -1]] = 0.5
-    S = offsets.size
-    rep = lambda v: np.repeat(np.asarray(v, dtype=float), S)  # noqa: E731
-    fn, _ = lateral_force(grid, law, rep(x), rep(y), rep(tx), rep(ty), np.tile(offsets, np.size(x)), phase_nodes=PROFILE_PHASE_NODES)
-    return fn.reshape(-1, S) @ (weights / weights.sum())
+    return fn @ (weights / weights.sum())
 
 
 def analyze_paths(grid, law, paths, clearance: np.ndarray, W: float, V: float, boundary, growth: GrowthRate,
@@ -425,9 +422,10 @@ def analyze_paths(grid, law, paths, clearance: np.ndarray, W: float, V: float, b
     inside = ~(np.isfinite(along) & np.isfinite(slope))
     lam = wavelength(V, boundary.omega_critical)
     pull, attraction = _goal_pull(grid, law, x, y, tx, ty, route, arc, ds, taken, lam)
+    forward = np.stack([attraction + along, attraction - along])  # the forward force of each travel direction
     with np.errstate(divide="ignore", invalid="ignore"):  # a wall ahead (the repulsion along the path) stops the robot
-        N_forward = np.where((1 + along >= 1 - end_fraction) & (attraction + along > 0), slope / (attraction + along), np.nan)
-        N_reverse = np.where((1 - along >= 1 - end_fraction) & (attraction - along > 0), slope / (attraction - along), np.nan)
+        N_forward = np.where((1 + along >= 1 - end_fraction) & (forward[0] > 0), slope / forward[0], np.nan)
+        N_reverse = np.where((1 - along >= 1 - end_fraction) & (forward[1] > 0), slope / forward[1], np.nan)
     N_forward[inside], N_reverse[inside] = np.nan, np.nan
     N_reverse[taken] = np.nan  # the robot drove a path taken one way, from its start: the reverse is not its path
     sig = [np.where(np.isfinite(n), growth(np.nan_to_num(n) * V), np.nan) for n in (N_forward, N_reverse)]
@@ -467,7 +465,7 @@ def analyze_paths(grid, law, paths, clearance: np.ndarray, W: float, V: float, b
         # the describing function of one jump beside the smooth slope, per unit forward force, in the worse direction
         # (`relay.relay_amplitude`; the whole profile's, `relay.window_cycle`, is what the driven loop above runs through)
         d = worse[check]
-        ahead = np.where(d == 0, attraction[check] + along[check], attraction[check] - along[check])
+        ahead = forward[d, check]
         N_smooth = np.nan_to_num(np.where(d == 0, N_forward[check], N_reverse[check]))
         with np.errstate(invalid="ignore", divide="ignore"):
             cycle = np.minimum(relay_amplitude(jump / np.where(ahead > 0, ahead, np.nan), boundary.NV_critical / V, N_smooth), LEAVES)

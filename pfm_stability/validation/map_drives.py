@@ -362,8 +362,8 @@ def drive_map(analysis, count: int, *, seed: int = 0, progress=None) -> DriveVal
             passed_by[k].add(d.index)
     disagreements = (_runs("missed", episode & ~near_unstable, sc, passed_by, swung)
                      + _runs("false alarm", unstable & driven & ~near_episode, sc, passed_by, swung))
-    for kind, key in (("false alarm", "false_alarm_swinging"), ("missed", "missed_predicted_swinging")):
-        amplitude = "simulated_amplitude" if kind == "false alarm" else "predicted_amplitude"
+    for key, kind, amplitude in (("false_alarm_swinging", "false alarm", "simulated_amplitude"),
+                                 ("missed_predicted_swinging", "missed", "predicted_amplitude")):  # the side that wove
         lengths[key] = float(sum(d.length for d in disagreements if d.kind == kind and getattr(d, amplitude) >= AMPLITUDE_THRESHOLD))
     events = [d.event or "time" for d in drives]
     counts = {"drives": len(drives), "not_started": skipped, "route_drives": sum(d.kind == "route" for d in drives),
