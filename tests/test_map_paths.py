@@ -209,24 +209,55 @@ def test_swing_is_the_weaves_amplitude_the_judge_sees():
 
 @pytest.mark.slow
 @SHARED_CORRIDORS
-def test_driving_finds_the_unstable_corridor_and_nothing_in_the_stable_one(root):
+def test_driving_finds_the_unstable_corridor_and_nothing_in_the_stable_one(root, monkeypatch):
     """Validation by driving on two corridors: at 1.4 V* the simulator's drives oscillate and the unstable stretches
     along their paths recall >= 80 % of the episodes' length with >= 80 % precision; at 0.7 V* no drive oscillates,
     nothing is predicted unstable, and recall and precision are undefined (None: nothing to measure), not counted as
-    agreement. (Recall is 88 % here: the corridor's rate-limited cycle, ~2 cm in the simulator, is 1.5 cm in the
+    agreement; each figure lies in its 95 % interval over the drives, whose per-drive lengths add up to it.
+    (Recall is 88 % here: the corridor's rate-limited cycle, ~2 cm in the simulator, is 1.5 cm in the
     driven loop, at the episodes' threshold, so the first metre or two of each short drive is missed — docs/maps.md.)"""
+    from pfm_stability.validation import map_drives
     from pfm_stability.validation.map_drives import drive_map
 
+    sums, interval = [], map_drives._interval
+    monkeypatch.setattr(map_drives, "_interval", lambda part, whole, rng: sums.append((part.sum(), whole.sum())) or interval(part, whole, rng))
     V_star = _report(0.6).models["sampled"].critical["V_critical"]
     unstable = drive_map(corridor_analysis(0.6, 1.4 * V_star, root), 6, seed=1)
+    # the interval resamples the drives' own lengths: they add up to the figures' (sums of the same lengths in another order)
+    L = unstable.lengths
+    figures = (L["episode_recalled"], L["episode"], L["predicted_unstable_matched"], L["predicted_unstable_driven"])
+    assert [v for pair in sums for v in pair] == pytest.approx(figures, rel=1e-12)
     assert unstable.counts["episodes"] > 0
     assert unstable.recall >= 0.8 and unstable.precision >= 0.8, (unstable.lengths, unstable.disagreements)
     false_alarms = [d for d in unstable.disagreements if d.kind == "false alarm"]
     assert unstable.lengths["false_alarm_swinging"] <= sum(d.length for d in false_alarms) + 1e-9
     assert all(d.simulated_amplitude >= 0 and d.predicted_amplitude >= 0 for d in unstable.disagreements)
+    for figure, (lo, hi) in ((unstable.recall, unstable.recall_interval), (unstable.precision, unstable.precision_interval)):
+        assert 0.0 <= lo <= figure <= hi <= 1.0
     stable = drive_map(corridor_analysis(0.6, 0.7 * V_star, root), 6, seed=1)
     assert stable.counts["episodes"] == 0 and stable.lengths["predicted_unstable_driven"] == 0
     assert stable.recall is None and stable.precision is None
+    assert stable.recall_interval is None and stable.precision_interval is None
+
+
+def test_the_interval_over_the_drives_is_the_ratios_resampling_spread():
+    """`map_drives._interval`, the 95 % interval of a figure Σpart/Σwhole over the drives resampled: for 400 drives
+    (lengths 1-3 m, 70 % of each one's length agreeing, or none) it is the delta method's R ± 1.96·SE,
+    SE = √Σ(part − R·whole)² / Σwhole, to 10 % of its half-width (2000 resamples: the percentiles' own scatter is a
+    few %, and the bootstrap's skew at n = 400 about as much); drives that all agree give a point; a drive with
+    nothing to measure changes nothing."""
+    from pfm_stability.validation.map_drives import _interval
+
+    rng = np.random.default_rng(3)
+    whole = rng.uniform(1.0, 3.0, 400)
+    part = whole * (rng.random(400) < 0.7)
+    R = part.sum() / whole.sum()
+    half = 1.96 * math.sqrt(((part - R * whole) ** 2).sum()) / whole.sum()
+    lo, hi = _interval(part, whole, np.random.default_rng(0))
+    assert (hi - lo) / 2 == pytest.approx(half, rel=0.1) and (lo + hi) / 2 == pytest.approx(R, abs=0.1 * half)
+    assert _interval(whole, whole, np.random.default_rng(0)) == pytest.approx((1.0, 1.0), abs=1e-12)
+    padded = _interval(np.append(part, 0.0), np.append(whole, 0.0), np.random.default_rng(0))
+    assert padded == pytest.approx((lo, hi), abs=0.2 * half)
 
 
 def test_user_routes_read_nav2_paths_waypoints_and_csv(tmp_path):
@@ -422,3 +453,18 @@ def test_a_path_taken_is_linearized_at_itself_away_from_the_equilibrium(root):
     assert np.allclose(taken.px[mine], 0.95, atol=1e-12)
     assert np.allclose(as_route.px, 0.65, atol=0.1)
     assert np.allclose(taken.px[~mine], 0.65, atol=0.1)
+
+
+def test_a_predicted_stretch_the_drive_ended_in_is_not_measured():
+    """`map_drives._cut_short`: of the predicted-unstable stretches along a drive's own path, exactly those that
+    reach a sample passed only in the drive's last three periods are taken out whole (matched or not); a stretch
+    ending one sample before them stays; no unstable sample, nothing."""
+    from pfm_stability.validation.map_drives import _cut_short
+
+    path = np.arange(100, 120)  # the drive's own path: samples 100..119 of the scored set, in order
+    unstable = np.zeros(130, dtype=bool)
+    unstable[[103, 104, 105, 106, 110, 111, 112, 113, 114, 117, 118, 119]] = True
+    assert _cut_short(path, unstable, np.array([112, 113])).tolist() == [110, 111, 112, 113, 114]
+    assert _cut_short(path, unstable, np.array([107, 108, 109])).tolist() == []
+    assert _cut_short(path, unstable, np.array([106, 119])).tolist() == [103, 104, 105, 106, 117, 118, 119]
+    assert _cut_short(path, np.zeros(130, dtype=bool), np.array([112])).size == 0

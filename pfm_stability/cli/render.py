@@ -595,7 +595,8 @@ def render_map_text(data: dict) -> str:
                      + f", stable {p['stable_length_m']:.1f} m" + (f"; no verdict: {unjudged}" if unjudged else ""))
     d = data.get("drives")
     if d is not None:
-        share = {k: (percent(d[k])[1:] if d[k] is not None else "n/a (nothing to measure)") for k in ("recall", "precision")}
+        share = {k: (percent(d[k])[1:] + _interval_text(d.get(f"{k}_interval")) if d[k] is not None else "n/a (nothing to measure)")
+                 for k in ("recall", "precision")}
         lines.append(f"validation by driving: {d['counts']['drives']} drives, {d['counts']['episodes']} oscillation episodes; "
                      f"recall {share['recall']}, precision {share['precision']} by length along the paths driven "
                      f"({d['lengths']['drive_paths_driven']:.1f} m measured, {d['lengths']['drive_paths_unmeasured']:.1f} m passed "
@@ -613,6 +614,11 @@ def render_map_text(data: dict) -> str:
     for name, path in (data.get("outputs") or {}).items():
         lines.append(f"{name}: {path}")
     return "\n".join(lines) + "\n"
+
+
+def _interval_text(interval) -> str:
+    """`` (95 %: lo–hi %)`` of a validation figure's interval over the choice of drives, or nothing."""
+    return f" (95 %: {100 * interval[0]:.0f}–{100 * interval[1]:.0f} % over the drives)" if interval else ""
 
 
 def _map_wobble_lines(w: dict | None, V: float) -> list[str]:

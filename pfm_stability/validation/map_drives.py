@@ -24,13 +24,15 @@ or the robot's width): those samples are driven; the points during an episode ma
 sample cannot show an episode and are not measured: those passed in the drive's first period (the start's
 transient), and those passed only in its last `EPISODE_PERIODS` periods (an episode needs three periods after
 them: the drive reached its goal, collided or stalled first; counted as ``drive_paths_unmeasured``, never as
-agreement). A driven sample predicted unstable matches an episode when an episode sample of the same path lies
-within half the verdict's window Λ (the point's verdict is the growth over the window centred there), and an
-episode sample is recalled when a predicted-unstable sample lies within Λ/2. Recall = recalled episode length /
+agreement), and with them the whole of a predicted-unstable stretch that reaches them (`_cut_short`: the drive ended
+before the weave predicted there could be seen in full; matched or not, so that cut drives count neither way). A
+driven sample predicted unstable matches an episode when an episode sample of the same path lies within half the
+verdict's window Λ (the point's verdict is the growth over the window centred there), and an episode sample is
+recalled when a predicted-unstable sample lies within Λ/2. Recall = recalled episode length /
 episode length; precision = matched predicted-unstable length / predicted-unstable length driven (None when a
-denominator is 0: nothing to measure, never counted as agreement). Every disagreement is listed as a stretch
-(`Disagreement`: "missed" — an episode where stable was predicted; "false alarm" — predicted unstable, driven, no
-episode). Route length never driven, and drives that stalled or collided, are counted as such.
+denominator is 0: nothing to measure, never counted as agreement), each with its 95 % interval over the choice of
+drives (`_interval`). Every disagreement is listed as a stretch (`Disagreement`: "missed" — an episode where stable
+was predicted; "false alarm" — predicted unstable, driven, no episode). Route length never driven, and drives that stalled or collided, are counted as such.
 """
 
 from __future__ import annotations
@@ -56,6 +58,8 @@ DRIVE_TIME_FACTOR = 2.5
 """A drive lasts at most this many times its straight-line time, plus 5 s."""
 START_ROOM = 1e-3
 """Least room (m) beside the robot at a drive's start offset by δ; with less the drive starts on the route itself."""
+INTERVAL_RESAMPLES = 2000
+"""Resamples of the drives behind the 95 % intervals of recall and precision (`_interval`)."""
 CROP_SLACK = 3.0
 """How far (m) around a drive's straight line its cropped grid reaches beyond the window."""
 
@@ -167,6 +171,9 @@ class DriveValidation:
         Robot positions during the episodes, m (for the picture).
     by_kind : dict
         ``route`` and ``waypoints``: the same recall, precision and lengths over that kind of drive only.
+    recall_interval, precision_interval : tuple of float or None
+        95 % intervals of recall and precision over the choice of drives (`_interval`: the drives resampled with
+        replacement, `INTERVAL_RESAMPLES` times, seeded); None where the figure is None.
     drive_paths : PathVerdicts or None
         The verdicts along the paths the drives took (`maps.analysis.judge_routes`): the drives are scored
         against them (a disagreement's ``route`` >= the map's route count is drive path ``route`` − that count).
@@ -183,6 +190,8 @@ class DriveValidation:
     episode_points: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))
     by_kind: dict = field(default_factory=dict)
     drive_paths: object = None
+    recall_interval: tuple | None = None
+    precision_interval: tuple | None = None
 
     def to_dict(self) -> dict:
         """JSON form."""
@@ -190,6 +199,8 @@ class DriveValidation:
             "drive_paths": self.drive_paths.to_dict() if self.drive_paths is not None else None,
             "recall": json_number(self.recall) if self.recall is not None else None,
             "precision": json_number(self.precision) if self.precision is not None else None,
+            "recall_interval": json_ready(self.recall_interval),
+            "precision_interval": json_ready(self.precision_interval),
             "by_kind": json_ready(self.by_kind),
             "lengths": json_ready(self.lengths),
             "counts": json_ready(self.counts),
@@ -323,6 +334,7 @@ def drive_map(analysis, count: int, *, seed: int = 0, progress=None) -> DriveVal
     tree = cKDTree(np.column_stack([pv.samples.x, pv.samples.y]))
     limit = max(MATCH_DISTANCE, robot.W)
     marks, points = [], []
+    unstable = sc.code == PATH_VERDICTS.index("unstable")
     swung = np.zeros(sc.code.size)  # the drives' largest lateral oscillation at each sample of their own paths, m
     for d, (t, x, y) in zip(drives, traces):
         if t.size == 0 or d.index not in own:
@@ -344,9 +356,11 @@ def drive_map(analysis, count: int, *, seed: int = 0, progress=None) -> DriveVal
         off = float(step[during & ~near_path].sum())  # an episode away from its own path (a spin): measured, not scored
         unmeasured = np.setdiff1d(np.unique(nearest[near_path & start & ~end & ~during]), nearest[hit])
         np.maximum.at(swung, nearest[hit], swing(t, x, y, period)[hit])
-        marks.append(_Marks(np.unique(nearest[hit]), np.unique(nearest[hit & during]), off, unmeasured, on_routes))
+        scored = np.unique(nearest[hit])
+        cut = _cut_short(mine, unstable, unmeasured)
+        marks.append(_Marks(np.setdiff1d(scored, cut), np.unique(nearest[hit & during]), off,
+                            np.union1d(unmeasured, np.intersect1d(scored, cut)), on_routes))
         points.append(np.column_stack([x[during], y[during]]))
-    unstable = sc.code == PATH_VERDICTS.index("unstable")
     half = pv.window / 2 if math.isfinite(pv.window) else 0.0
     near_unstable = _within(unstable, sc.route, sc.arc, half)
     lengths, recall, precision, driven, episode, near_episode = _score(sc, marks, range(len(drives)), unstable, near_unstable, half, base)
@@ -371,10 +385,18 @@ def drive_map(analysis, count: int, *, seed: int = 0, progress=None) -> DriveVal
               **{f"ended_{e}": events.count(e) for e in sorted(set(events))}}
     inputs = {"count": count, "seed": seed, "V": robot.V, "period": json_number(period), "window": json_number(pv.window),
               "episode_periods": EPISODE_PERIODS, "growth_efolds": GROWTH_EFOLDS, "amplitude_threshold": AMPLITUDE_THRESHOLD,
-              "noise_floor": NOISE_FLOOR, "match_distance": limit, "start_offset": START_OFFSET}
+              "noise_floor": NOISE_FLOOR, "match_distance": limit, "start_offset": START_OFFSET,
+              "interval_resamples": INTERVAL_RESAMPLES}
+    per_drive = [_score(sc, marks, [k], unstable, near_unstable, half, base)[0] for k in range(len(drives))]
+    shares = {key: np.array([L[key] for L in per_drive], dtype=float) for key in
+              ("episode", "episode_recalled", "predicted_unstable_driven", "predicted_unstable_matched")}
+    resampled = np.random.default_rng([seed, 1])
+    recall_interval = _interval(shares["episode_recalled"], shares["episode"], resampled) if recall is not None else None
+    precision_interval = (_interval(shares["predicted_unstable_matched"], shares["predicted_unstable_driven"], resampled)
+                          if precision is not None else None)
     pts = np.vstack(points) if points else np.zeros((0, 2))
     return DriveValidation(recall, precision, tuple(drives), disagreements, lengths, counts, inputs, time.perf_counter() - started, pts,
-                           by_kind, dp)
+                           by_kind, dp, recall_interval, precision_interval)
 
 
 @dataclass(frozen=True)
@@ -469,6 +491,34 @@ def _omega(analysis) -> float | None:
     if not math.isfinite(w) or w <= 0:
         return None
     return WINDOW_PERIODS * 2 * math.pi * analysis.robot.V / w
+
+
+def _cut_short(path: np.ndarray, unstable: np.ndarray, unmeasured: np.ndarray) -> np.ndarray:
+    """The samples of the predicted-unstable stretches along a drive's own `path` (its sample indices in order) that
+    reach a sample it passed only in its last three periods (`unmeasured`): the drive ended before the predicted
+    weave could be seen in full, so none of the stretch is measured, whether or not an episode lies on it (keeping
+    those with one would count the drives cut short only when they agree)."""
+    u = unstable[path]
+    if not u.any():
+        return np.zeros(0, dtype=int)
+    run = np.cumsum(np.concatenate([[True], u[1:] != u[:-1]]))  # a label per run of equal verdicts
+    reached = np.unique(run[u & np.isin(path, unmeasured)])
+    return path[u & np.isin(run, reached)]
+
+
+def _interval(part: np.ndarray, whole: np.ndarray, rng) -> tuple | None:
+    """The 95 % percentile interval of Σpart/Σwhole over the drives resampled with replacement (`part`, `whole`: each
+    drive's lengths, m; a drive's own path is its own, so the figure over any choice of drives is their sums' ratio);
+    resamples whose Σwhole is 0 (no drive with anything to measure) are left out. When every drive agrees the interval
+    is a point: the resampling shows how the figure moves with the choice of drives, not how it would with others
+    that meet a weave the chosen ones never met (the episodes' count says how many there were)."""
+    n = part.size
+    counts = rng.multinomial(n, np.full(n, 1.0 / n), size=INTERVAL_RESAMPLES)
+    num, den = counts @ part, counts @ whole
+    ratio = num[den > 0] / den[den > 0]
+    if ratio.size == 0:
+        return None
+    return tuple(float(v) for v in np.percentile(ratio, [2.5, 97.5]))
 
 
 def _within(mask: np.ndarray, route: np.ndarray, arc: np.ndarray, half: float) -> np.ndarray:
