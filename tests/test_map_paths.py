@@ -163,7 +163,8 @@ def test_routes_run_straight_through_a_side_gap(tmp_path):
 
 def test_episode_detector_on_closed_form_signals():
     """Growing oscillation e^{0.3 t}·sin(ω t) (from 1 cm): an episode; a decaying one: none; a constant 8 cm weave:
-    an episode (above the 1.5 cm threshold); a 1 cm one: none; a single bend of the path (a step of 0.5 m): none."""
+    an episode (above the 1.5 cm threshold); a 1 cm one: none; a single bend of the path (a step of 0.5 m): none; a
+    swerve after a quiet stretch: none."""
     T, omega = 0.025, 2.0
     period = 2 * math.pi / omega
     t = np.arange(0, 30, T)
@@ -172,6 +173,12 @@ def test_episode_detector_on_closed_form_signals():
     assert lateral_episodes(t, 0.08 * np.sin(omega * t), period)[0]
     assert not lateral_episodes(t, 0.01 * np.sin(omega * t), period)[0]
     assert not lateral_episodes(t, 0.5 * (t > 15), period)[0]
+    # a weave of 3-4 cm dying under 1 cm, then one swerve of 12 cm (turning-point amplitudes interpolated): the fitted
+    # amplitude rises 1.4-1.6 e-folds over six turning points, but each side's falls before it rises: a swerve after
+    # a quiet stretch, not growth
+    turns = np.r_[0.0, 0.0, 0.04, 0.03, 0.006, 0.006, 0.12, 0.12, 0.01, np.zeros(31)]
+    swerve = np.interp(t, period / 4 + np.arange(40) * period / 2, turns) * np.sin(omega * t)
+    assert not lateral_episodes(t, swerve, period)[0]
     # in the plane: a weave about a diagonal line
     s = 1.0 * t
     x, y = s / math.sqrt(2) - 0.08 * np.sin(omega * t) / math.sqrt(2), s / math.sqrt(2) + 0.08 * np.sin(omega * t) / math.sqrt(2)
@@ -456,15 +463,25 @@ def test_a_path_taken_is_linearized_at_itself_away_from_the_equilibrium(root):
 
 
 def test_a_predicted_stretch_the_drive_ended_in_is_not_measured():
-    """`map_drives._cut_short`: of the predicted-unstable stretches along a drive's own path, exactly those that
-    reach a sample passed only in the drive's last three periods are taken out whole (matched or not); a stretch
-    ending one sample before them stays; no unstable sample, nothing."""
+    """`map_drives._cut_short`: of the predicted-unstable stretches along a drive's own path (samples 1 m apart), those
+    that reach a sample passed only in the drive's last three periods lose the samples within `reach` before the first
+    such sample (matched or not); a stretch ending one sample before them keeps all; samples without a verdict (a wall
+    ahead) between two stretches join them; no unstable sample, nothing."""
     from pfm_stability.validation.map_drives import _cut_short
 
     path = np.arange(100, 120)  # the drive's own path: samples 100..119 of the scored set, in order
+    arc = np.zeros(130)
+    arc[path] = np.arange(20.0)  # m
     unstable = np.zeros(130, dtype=bool)
     unstable[[103, 104, 105, 106, 110, 111, 112, 113, 114, 117, 118, 119]] = True
-    assert _cut_short(path, unstable, np.array([112, 113])).tolist() == [110, 111, 112, 113, 114]
-    assert _cut_short(path, unstable, np.array([107, 108, 109])).tolist() == []
-    assert _cut_short(path, unstable, np.array([106, 119])).tolist() == [103, 104, 105, 106, 117, 118, 119]
-    assert _cut_short(path, np.zeros(130, dtype=bool), np.array([112])).size == 0
+    none = np.zeros(130, dtype=bool)
+    everything = math.inf
+    assert _cut_short(path, arc, unstable, none, np.array([112, 113]), everything).tolist() == [110, 111, 112, 113, 114]
+    assert _cut_short(path, arc, unstable, none, np.array([112, 113]), 1.0).tolist() == [111, 112, 113, 114]
+    assert _cut_short(path, arc, unstable, none, np.array([107, 108, 109]), everything).tolist() == []
+    assert _cut_short(path, arc, unstable, none, np.array([106, 119]), everything).tolist() == [103, 104, 105, 106, 117, 118, 119]
+    assert _cut_short(path, arc, none, none, np.array([112]), everything).size == 0
+    wall_ahead = none.copy()
+    wall_ahead[[107, 108, 109]] = True  # joins 103-106 to 110-114
+    assert _cut_short(path, arc, unstable, wall_ahead, np.array([113]), everything).tolist() == [103, 104, 105, 106, 110, 111, 112, 113, 114]
+    assert _cut_short(path, arc, unstable, wall_ahead, np.array([113]), 4.0).tolist() == [110, 111, 112, 113, 114]

@@ -6,7 +6,8 @@ over one period P = 2π/ω* (the loop's oscillation at the boundary; `scipy.ndim
 over P/8 (the cell ripple, at c/V, is faster). Its turning points give amplitudes; an **episode** is
 `EPISODE_PERIODS` periods — 2·`EPISODE_PERIODS` turning points alternating in side, consecutive ones P/4 to P
 apart (an oscillation, not a bend of the path) — whose amplitudes grow (a least-squares fit of log amplitude
-against time rises by at least `GROWTH_EFOLDS` e-fold over them) or all stay above `AMPLITUDE_THRESHOLD`.
+against time rises by at least `GROWTH_EFOLDS` e-fold over them, and each side's amplitude rises period after period:
+a swerve after a quiet stretch is no growth) or all stay above `AMPLITUDE_THRESHOLD`.
 Amplitudes below `NOISE_FLOOR` are no oscillation.
 """
 
@@ -181,7 +182,8 @@ def _episodes(t, r, period, n) -> tuple:
     for sel, a in _oscillating(t, r, kept, amplitude, period, 2 * EPISODE_PERIODS):
         span = t[sel[-1]] - t[sel[0]]
         slope = np.polyfit(t[sel], np.log(a), 1)[0]
-        if slope * span >= GROWTH_EFOLDS or a.min() >= AMPLITUDE_THRESHOLD:
+        grows = slope * span >= GROWTH_EFOLDS and np.all(a[2:] >= a[:-2])  # and on each side, period after period
+        if grows or a.min() >= AMPLITUDE_THRESHOLD:
             lo, hi = t[sel[0]] - period / 4, t[sel[-1]]
             if found and lo <= found[-1][1]:
                 found[-1] = (found[-1][0], float(hi))

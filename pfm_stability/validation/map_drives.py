@@ -22,17 +22,18 @@ The map's route samples within `MATCH_DISTANCE` of a drive are counted as covere
 **Route length** (`_score`). Each trajectory point marks its nearest sample of its own path (within `MATCH_DISTANCE`
 or the robot's width): those samples are driven; the points during an episode mark episode samples. Two kinds of
 sample cannot show an episode and are not measured: those passed in the drive's first period (the start's
-transient), and those passed only in its last `EPISODE_PERIODS` periods (an episode needs three periods after
-them: the drive reached its goal, collided or stalled first; counted as ``drive_paths_unmeasured``, never as
-agreement), and with them the whole of a predicted-unstable stretch that reaches them (`_cut_short`: the drive ended
-before the weave predicted there could be seen in full; matched or not, so that cut drives count neither way). A
-driven sample predicted unstable matches an episode when an episode sample of the same path lies within half the
-verdict's window Λ (the point's verdict is the growth over the window centred there), and an episode sample is
-recalled when a predicted-unstable sample lies within Λ/2. Recall = recalled episode length /
-episode length; precision = matched predicted-unstable length / predicted-unstable length driven (None when a
-denominator is 0: nothing to measure, never counted as agreement), each with its 95 % interval over the choice of
-drives (`_interval`). Every disagreement is listed as a stretch (`Disagreement`: "missed" — an episode where stable
-was predicted; "false alarm" — predicted unstable, driven, no episode). Route length never driven, and drives that stalled or collided, are counted as such.
+transient), and those passed only in its last `EPISODE_PERIODS` periods (an episode needs three periods after them:
+the drive reached its goal, collided or stalled first; counted as ``drive_paths_unmeasured``, never as agreement),
+and with them the end of a predicted-unstable stretch that reaches them, over three periods' travel less half a
+window Λ before them (`_cut_short`: a weave arriving there, at most Λ/2 early, would have run into the drive's end
+before three periods; matched or not, so that drives cut short count neither way). A driven sample predicted
+unstable matches an episode when an episode sample of the same path lies within half the verdict's window Λ (the
+point's verdict is the growth over the window centred there), and an episode sample is recalled when a
+predicted-unstable sample lies within Λ/2. Recall = recalled episode length / episode length; precision = matched
+predicted-unstable length / predicted-unstable length driven (None when a denominator is 0: nothing to measure,
+never counted as agreement), each with its 95 % interval over the choice of drives (`_interval`). Every disagreement
+is listed as a stretch (`Disagreement`: "missed" — an episode where stable was predicted; "false alarm" — predicted
+unstable, driven, no episode). Route length never driven, and drives that stalled or collided, are counted as such.
 """
 
 from __future__ import annotations
@@ -268,7 +269,7 @@ def drive_map(analysis, count: int, *, seed: int = 0, progress=None) -> DriveVal
     from scipy.spatial import cKDTree
 
     from ..maps.analysis import judge_routes
-    from ..maps.paths import PATH_VERDICTS
+    from ..maps.paths import PATH_VERDICTS, UNJUDGED
 
     started = time.perf_counter()
     count = check_integer("count", count, 1, 100_000)
@@ -334,7 +335,8 @@ def drive_map(analysis, count: int, *, seed: int = 0, progress=None) -> DriveVal
     tree = cKDTree(np.column_stack([pv.samples.x, pv.samples.y]))
     limit = max(MATCH_DISTANCE, robot.W)
     marks, points = [], []
-    unstable = sc.code == PATH_VERDICTS.index("unstable")
+    unstable, unjudged = sc.code == PATH_VERDICTS.index("unstable"), sc.code >= len(PATH_VERDICTS) - len(UNJUDGED)
+    reach_back = max(0.0, EPISODE_PERIODS * robot.V * period - (pv.window / 2 if math.isfinite(pv.window) else 0.0))  # m
     swung = np.zeros(sc.code.size)  # the drives' largest lateral oscillation at each sample of their own paths, m
     for d, (t, x, y) in zip(drives, traces):
         if t.size == 0 or d.index not in own:
@@ -357,7 +359,7 @@ def drive_map(analysis, count: int, *, seed: int = 0, progress=None) -> DriveVal
         unmeasured = np.setdiff1d(np.unique(nearest[near_path & start & ~end & ~during]), nearest[hit])
         np.maximum.at(swung, nearest[hit], swing(t, x, y, period)[hit])
         scored = np.unique(nearest[hit])
-        cut = _cut_short(mine, unstable, unmeasured)
+        cut = _cut_short(mine, sc.arc, unstable, unjudged, unmeasured, reach_back)
         marks.append(_Marks(np.setdiff1d(scored, cut), np.unique(nearest[hit & during]), off,
                             np.union1d(unmeasured, np.intersect1d(scored, cut)), on_routes))
         points.append(np.column_stack([x[during], y[during]]))
@@ -493,17 +495,25 @@ def _omega(analysis) -> float | None:
     return WINDOW_PERIODS * 2 * math.pi * analysis.robot.V / w
 
 
-def _cut_short(path: np.ndarray, unstable: np.ndarray, unmeasured: np.ndarray) -> np.ndarray:
-    """The samples of the predicted-unstable stretches along a drive's own `path` (its sample indices in order) that
-    reach a sample it passed only in its last three periods (`unmeasured`): the drive ended before the predicted
-    weave could be seen in full, so none of the stretch is measured, whether or not an episode lies on it (keeping
-    those with one would count the drives cut short only when they agree)."""
+def _cut_short(path: np.ndarray, arc: np.ndarray, unstable: np.ndarray, unjudged: np.ndarray, unmeasured: np.ndarray,
+               reach: float) -> np.ndarray:
+    """The samples of a drive's own `path` (its sample indices in order; `arc`, m, along it) predicted unstable that the
+    drive ended too soon to check: on a predicted-unstable stretch that reaches a sample passed only in the drive's
+    last three periods (`unmeasured`), those within `reach` m before the first such sample — three periods' travel
+    less half the match's window: an episode beginning no earlier than half a window before such a sample (a weave
+    arriving where it was predicted) would have run into the drive's end. They are not measured, whether or not an
+    episode lies on them (keeping those with one would count the drives cut short only when they agree). Samples
+    without a verdict (`unjudged`: a wall ahead) do not end a stretch."""
     u = unstable[path]
     if not u.any():
         return np.zeros(0, dtype=int)
-    run = np.cumsum(np.concatenate([[True], u[1:] != u[:-1]]))  # a label per run of equal verdicts
-    reached = np.unique(run[u & np.isin(path, unmeasured)])
-    return path[u & np.isin(run, reached)]
+    inside = u | unjudged[path]
+    run = np.cumsum(np.concatenate([[True], inside[1:] != inside[:-1]]))  # a label per run
+    ends = inside & np.isin(path, unmeasured)
+    first = np.full(run.max() + 1, np.inf)
+    np.minimum.at(first, run[ends], arc[path][ends])  # per run, where the drive's last three periods begin, m
+    reached = np.isfinite(first[run])
+    return path[u & reached & (arc[path] >= np.where(reached, first[run], 0.0) - reach)]
 
 
 def _interval(part: np.ndarray, whole: np.ndarray, rng) -> tuple | None:
