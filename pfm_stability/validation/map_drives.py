@@ -172,12 +172,12 @@ class DriveValidation:
         Robot positions during the episodes, m (for the picture).
     by_kind : dict
         ``route`` and ``waypoints``: the same recall, precision and lengths over that kind of drive only.
-    recall_interval, precision_interval : tuple of float or None
-        95 % intervals of recall and precision over the choice of drives (`_interval`: the drives resampled with
-        replacement, `INTERVAL_RESAMPLES` times, seeded); None where the figure is None.
     drive_paths : PathVerdicts or None
         The verdicts along the paths the drives took (`maps.analysis.judge_routes`): the drives are scored
         against them (a disagreement's ``route`` >= the map's route count is drive path ``route`` − that count).
+    recall_interval, precision_interval : tuple of float or None
+        95 % intervals of recall and precision over the choice of drives (`_interval`: the drives resampled with
+        replacement, `INTERVAL_RESAMPLES` times, seeded); None where the figure is None.
     """
 
     recall: float | None
