@@ -335,8 +335,10 @@ def drive_map(analysis, count: int, *, seed: int = 0, progress=None) -> DriveVal
     tree = cKDTree(np.column_stack([pv.samples.x, pv.samples.y]))
     limit = max(MATCH_DISTANCE, robot.W)
     marks, points = [], []
-    unstable, unjudged = sc.code == PATH_VERDICTS.index("unstable"), sc.code >= len(PATH_VERDICTS) - len(UNJUDGED)
-    reach_back = max(0.0, EPISODE_PERIODS * robot.V * period - (pv.window / 2 if math.isfinite(pv.window) else 0.0))  # m
+    unstable = sc.code == PATH_VERDICTS.index("unstable")
+    unjudged = np.isin(sc.code, [PATH_VERDICTS.index(reason) for reason in UNJUDGED])
+    half = pv.window / 2 if math.isfinite(pv.window) else 0.0
+    reach_back = max(0.0, EPISODE_PERIODS * robot.V * period - half)  # m (`_cut_short`)
     swung = np.zeros(sc.code.size)  # the drives' largest lateral oscillation at each sample of their own paths, m
     for d, (t, x, y) in zip(drives, traces):
         if t.size == 0 or d.index not in own:
@@ -363,7 +365,6 @@ def drive_map(analysis, count: int, *, seed: int = 0, progress=None) -> DriveVal
         marks.append(_Marks(np.setdiff1d(scored, cut), np.unique(nearest[hit & during]), off,
                             np.union1d(unmeasured, np.intersect1d(scored, cut)), on_routes))
         points.append(np.column_stack([x[during], y[during]]))
-    half = pv.window / 2 if math.isfinite(pv.window) else 0.0
     near_unstable = _within(unstable, sc.route, sc.arc, half)
     lengths, recall, precision, driven, episode, near_episode = _score(sc, marks, range(len(drives)), unstable, near_unstable, half, base)
     by_kind = {}
