@@ -505,16 +505,14 @@ def _cut_short(path: np.ndarray, arc: np.ndarray, unstable: np.ndarray, unjudged
     arriving where it was predicted) would have run into the drive's end. They are not measured, whether or not an
     episode lies on them (keeping those with one would count the drives cut short only when they agree). Samples
     without a verdict (`unjudged`: a wall ahead) do not end a stretch."""
-    u = unstable[path]
-    if not u.any():
-        return np.zeros(0, dtype=int)
-    inside = u | unjudged[path]
-    run = np.cumsum(np.concatenate([[True], inside[1:] != inside[:-1]]))  # a label per run
-    ends = inside & np.isin(path, unmeasured)
-    first = np.full(run.max() + 1, np.inf)
-    np.minimum.at(first, run[ends], arc[path][ends])  # per run, where the drive's last three periods begin, m
-    reached = np.isfinite(first[run])
-    return path[u & reached & (arc[path] >= np.where(reached, first[run], 0.0) - reach)]
+    from scipy.ndimage import label
+
+    u, s = unstable[path], arc[path]
+    stretch, count = label(u | unjudged[path])  # 1.. per stretch, its unjudged samples joining it; 0 elsewhere
+    ends = (stretch > 0) & np.isin(path, unmeasured)
+    first = np.full(count + 1, np.inf)
+    np.minimum.at(first, stretch[ends], s[ends])  # per stretch, where the drive's last three periods begin, m
+    return path[u & np.isfinite(first[stretch]) & (s + reach >= first[stretch])]
 
 
 def _interval(part: np.ndarray, whole: np.ndarray, rng) -> tuple | None:
