@@ -90,7 +90,7 @@ def test_a_linear_force_drives_the_linear_loop(ratio, monkeypatch):
         return original(t, lateral, period, *args)
 
     monkeypatch.setattr(episodes, "lateral_episodes", spy)
-    _driven(route, arc, stopped, profile, np.zeros(steps), np.ones(steps), robot.V, tr, 1.0, taken=True)
+    _driven(route, arc, stopped, profile, np.zeros(steps), np.ones(steps), np.zeros(steps), robot.V, tr, 1.0, taken=True)
     lateral = captured["lateral"]
     Phi = closed_loop_matrix(loop, loop.loop_gain(N * robot.V), model.hold, model.compute_delay)
     x = np.zeros(Phi.shape[0])
@@ -121,11 +121,11 @@ def test_the_steering_rate_limit_holds_an_unstable_loop_in_a_cycle():
     steps = 3000
     profile = _straight(N, steps, spacing, reach=5.0)
     arc = (np.arange(steps) + 0.5) * spacing
-    _, amplitude = _driven(np.zeros(steps, dtype=int), arc, np.zeros((2, steps), dtype=bool), profile, np.zeros(steps), np.ones(steps),
+    _, amplitude = _driven(np.zeros(steps, dtype=int), arc, np.zeros((2, steps), dtype=bool), profile, np.zeros(steps), np.ones(steps), np.zeros(steps),
                            robot.V, tr, 2 * math.pi / model.boundary(loop).omega_critical, taken=False)
     assert 0.005 < amplitude.max() < 0.1  # the cycle, inside the profile: it never left
     unlimited = SampledTransition.of(model, loop)
-    _, free = _driven(np.zeros(steps, dtype=int), arc, np.zeros((2, steps), dtype=bool), profile, np.zeros(steps), np.ones(steps), robot.V, unlimited,
+    _, free = _driven(np.zeros(steps, dtype=int), arc, np.zeros((2, steps), dtype=bool), profile, np.zeros(steps), np.ones(steps), np.zeros(steps), robot.V, unlimited,
                       2 * math.pi / model.boundary(loop).omega_critical, taken=False)
     # without the limit only the heading reference's own bound holds it (the resultant's direction, |atan| < π/2):
     # a cycle of decimetres (0.45 m here), not centimetres

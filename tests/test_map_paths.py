@@ -148,6 +148,50 @@ def test_open_hall_is_a_verdict_nothing_grows(tmp_path):
     assert all(s.label == "nothing grows" and s.margin == math.inf for s in open_stretches)
 
 
+@pytest.mark.parametrize("factor", [0.6, 2.0])
+def test_a_carrot_too_near_makes_the_robot_weave_in_an_open_hall(tmp_path, factor):
+    """Pure pursuit in the 10 × 24 m hall, no wall in the window: the robot follows a straight plan, pulled towards
+    its point D = L ahead, so its only lateral gain is the goal's, N = K = 1/L (`paths._aim_stiffness`, A = 1 with
+    no field): the loop is unstable once V/L passes NV* (ROBOT: NV* = 2.52 1/s, L* = V/NV* = 0.40 m). With
+    V/L = 1.5 NV* the path taken is predicted unstable along its middle and the simulator's drive along it (3 cm
+    off at the start, `Target.follow`) weaves in an episode there; with V/L = 0.6 NV* neither. (The factors keep
+    clear of NV*: at 1.5 NV* the window's growth is 0.97 e-fold, at the verdict's one-e-fold threshold.) A path taken
+    towards a point target instead has N = 1/max(D, W), D the goal's distance. N to 1e-9: a closed form, evaluated
+    along another route than the loop's."""
+    from pfm_stability.maps.analysis import judge_routes
+    from pfm_stability.maps.routes import path_of
+    from pfm_stability.sim.engine import run_batch
+    from pfm_stability.sim.scenario import Pose, Scenario, Target
+    from pfm_stability.validation.maps import simulator_grid
+
+    img = np.full((240, 100), 254, dtype=np.uint8)
+    img[0, :] = img[-1, :] = img[:, 0] = img[:, -1] = 0
+    analysis = analyze_map(load_map(write_map(tmp_path, img)), ROBOT, CONTROLLER, make_law("grid", ROBOT, CONTROLLER))
+    (model,), loop = models_for(CONTROLLER, ["sampled"]), Loop.of(ROBOT, CONTROLLER, c=0.0)
+    L = ROBOT.V / (factor * model.boundary(loop).NV_critical)
+    plan = [(5.0, 4.0), (5.0, 20.0)]
+    judged = judge_routes(analysis, [path_of(plan, 0, "drive", goal=plan[-1], lookahead=L)], taken=True)
+    middle = (judged.samples.y > 8.0) & (judged.samples.y < 16.0)
+    assert np.allclose(judged.N_forward[middle], 1.0 / L, rtol=1e-9)  # the field adds nothing: no wall in the window
+    # a point target instead (no plan): D is the goal's distance, at least W
+    point = judge_routes(analysis, [path_of(plan, 0, "goals", goal=plan[-1])], taken=True)
+    inside = (point.samples.y > 8.0) & (point.samples.y < 19.5)
+    expected = 1.0 / np.maximum(20.0 - point.samples.y[inside], ROBOT.W)
+    assert np.allclose(point.N_forward[inside], expected, rtol=1e-9)
+    unstable = judged.code[middle] == PATH_VERDICTS.index("unstable")
+    law = make_law("grid", ROBOT, CONTROLLER)
+    scenario = Scenario(name="pursuit", robot=ROBOT, controller=CONTROLLER, environment=simulator_grid(analysis.grid),
+                        start=Pose(5.03, 4.0, 0.0), target=Target.follow(plan, L, radius=0.3), duration=20.0,
+                        cell_ratio=law.ratio, window_cells=law.window_cells)
+    tr = run_batch([scenario], record="trajectory", metrics=False).runs[0].trajectory
+    found, _ = episodes(tr.t, tr.x, tr.y, 2 * math.pi / model.boundary(loop).omega_critical)
+    weaving = any(tr.y[np.searchsorted(tr.t, lo)] < 16.0 and tr.y[np.searchsorted(tr.t, min(hi, tr.t[-1]))] > 8.0 for lo, hi in found)
+    if factor > 1:
+        assert unstable.all() and weaving
+    else:
+        assert not unstable.any() and not found
+
+
 def test_routes_run_straight_through_a_side_gap(tmp_path):
     """A 20 m corridor with a side opening at its middle (a T): the route along the corridor is one route through the
     junction (length 20 m within the cut at the map's ends, 0.5 m), the side branch its own."""
@@ -220,9 +264,10 @@ def test_driving_finds_the_unstable_corridor_and_nothing_in_the_stable_one(root,
     """Validation by driving on two corridors: at 1.4 V* the simulator's drives oscillate and the unstable stretches
     along their paths recall >= 80 % of the episodes' length with >= 80 % precision; at 0.7 V* no drive oscillates,
     nothing is predicted unstable, and recall and precision are undefined (None: nothing to measure), not counted as
-    agreement; each figure lies in its 95 % interval over the drives, whose per-drive lengths add up to it.
-    (Recall is 88 % here: the corridor's rate-limited cycle, ~2 cm in the simulator, is 1.5 cm in the
-    driven loop, at the episodes' threshold, so the first metre or two of each short drive is missed — docs/maps.md.)"""
+    agreement, and all the length driven is predicted stable (specificity 100 %); each figure lies in its 95 %
+    interval over the drives, whose per-drive lengths add up to it. (Recall is 97 % here: the corridor's rate-limited
+    cycle, ~2 cm in the simulator, is 1.5 cm in the driven loop, at the episodes' threshold, so the first metre of a
+    short drive can be missed — docs/maps.md.)"""
     from pfm_stability.validation import map_drives
     from pfm_stability.validation.map_drives import drive_map
 
@@ -244,6 +289,7 @@ def test_driving_finds_the_unstable_corridor_and_nothing_in_the_stable_one(root,
     stable = drive_map(corridor_analysis(0.6, 0.7 * V_star, root), 6, seed=1)
     assert stable.counts["episodes"] == 0 and stable.lengths["predicted_unstable_driven"] == 0
     assert stable.recall is None and stable.precision is None
+    assert stable.specificity == pytest.approx(1.0, rel=1e-12) and stable.specificity_interval == pytest.approx((1.0, 1.0))
     assert stable.recall_interval is None and stable.precision_interval is None
 
 

@@ -281,7 +281,7 @@ def _straight_run():
     trajectory = SimpleNamespace(x=np.zeros_like(t), y=0.8 * t, t=t, at_times=lambda ts: (np.zeros(len(ts)), 0.8 * np.asarray(ts)))
     walls = [SimpleNamespace(p0=(x, -1.0), p1=(x, 5.0)) for x in (-0.9, 0.9)]
     scenario = SimpleNamespace(env="analytic", environment=SimpleNamespace(walls=walls), robot=ROBOT, name="straight",
-                               start=SimpleNamespace(x=0.0, y=0.0), target=SimpleNamespace(is_point=False, angle=0.0))
+                               start=SimpleNamespace(x=0.0, y=0.0), target=SimpleNamespace(is_point=False, is_path=False, angle=0.0))
     return SimpleNamespace(trajectory=trajectory, scenario=scenario, events=[])
 
 

@@ -595,10 +595,11 @@ def render_map_text(data: dict) -> str:
                      + f", stable {p['stable_length_m']:.1f} m" + (f"; no verdict: {unjudged}" if unjudged else ""))
     d = data.get("drives")
     if d is not None:
-        share = {k: (percent(d[k])[1:] + _interval_text(d.get(f"{k}_interval")) if d[k] is not None else "n/a (nothing to measure)")
-                 for k in ("recall", "precision")}
+        share = {k: (percent(d[k])[1:] + _interval_text(d.get(f"{k}_interval")) if d.get(k) is not None else "n/a (nothing to measure)")
+                 for k in ("recall", "precision", "specificity")}
         lines.append(f"validation by driving: {d['counts']['drives']} drives, {d['counts']['episodes']} oscillation episodes; "
-                     f"recall {share['recall']}, precision {share['precision']} by length along the paths driven "
+                     f"recall {share['recall']}, precision {share['precision']}, specificity {share['specificity']} "
+                     f"(of {d['lengths']['quiet_driven']:.1f} m driven without an episode, the share predicted stable) by length along the paths driven "
                      f"({d['lengths']['drive_paths_driven']:.1f} m measured, {d['lengths']['drive_paths_unmeasured']:.1f} m passed "
                      f"only in a drive's last three periods, not measurable; {d['lengths']['driven']:.1f} of {d['lengths']['route']:.1f} m "
                      f"of route covered); {len(d['disagreements'])} disagreements"

@@ -51,8 +51,11 @@ nonlinearity holds, that the window growth cannot see.
 from the path is not the one it follows, so the loop is linearized at the path itself, and the line it is pulled to
 is the path. The goal's pull balances the field's mean P there (over a wavelength along the path and a cell across
 it, `_goal_pull`); the attraction has unit size, so its part along the path is A = √(1 − P²), and the lateral gain
-is N = −(dF_n/ds)/(A ± F_r·t): a robot sliding along a wall towards a goal off to its side steers against a small
-forward force, and its loop is that much stiffer. Such a path is judged the way it was driven; where a wall is
+is N = −(dF_n/ds − K)/(A ± F_r·t): a robot sliding along a wall towards a goal off to its side steers against a small
+forward force, and its loop is that much stiffer. K = A²/D (`_aim_stiffness`) is the goal's own pull back to the
+path: the point the robot steers at lies D ahead (a plan's carrot at its lookahead, or a point target), so a
+lateral offset y turns the attraction by y/D — the whole lateral gain of a pure-pursuit robot in an open hall,
+which oscillates once V/D passes NV*. Such a path is judged the way it was driven; where a wall is
 ahead that way it is unjudged ("wall ahead").
 
 **Stretches**: runs of consecutive samples with one verdict (`PathStretch`), each with the
@@ -354,6 +357,22 @@ def _goal_pull(grid, law, x, y, tx, ty, route, arc, ds, taken, wavelength_m: flo
     return pull, np.sqrt(np.clip(1.0 - pull ** 2, 0.0, None))
 
 
+def _aim_stiffness(paths, route, x, y, attraction, W: float) -> np.ndarray:
+    """K per sample, F_ct/m: how much the goal's pull across the path grows per metre of lateral offset on a path
+    taken towards a point at distance D, K = A²/D, the derivative of the unit attraction's lateral part at the path
+    (A its part along the path, `_goal_pull`). D is the plan's lookahead (`RoutePath.lookahead`: its carrot) or the
+    point target's distance (`RoutePath.goal`), whichever is nearer, the target's at least W (within W of its goal
+    the robot arrives); 0 on a route, whose goal lies along it at infinity (module docstring, "Paths taken")."""
+    stiffness = np.zeros(np.size(x))
+    for r, path in enumerate(paths):
+        on = route == r
+        D = np.full(int(on.sum()), path.lookahead)
+        if path.goal is not None:
+            D = np.minimum(D, np.maximum(np.hypot(path.goal[0] - x[on], path.goal[1] - y[on]), W))
+        stiffness[on] = attraction[on] ** 2 / D
+    return stiffness
+
+
 def _cell_mean(grid, law, x, y, tx, ty) -> np.ndarray:
     """F_n at the points averaged across the path over one cell, s in [−c/2, c/2] (F_ct units; the trapezoid rule on
     `lateral_profile`'s nodes within half a cell)."""
@@ -422,6 +441,8 @@ def analyze_paths(grid, law, paths, clearance: np.ndarray, W: float, V: float, b
     inside = ~(np.isfinite(along) & np.isfinite(slope))
     lam = wavelength(V, boundary.omega_critical)
     pull, attraction = _goal_pull(grid, law, x, y, tx, ty, route, arc, ds, taken, lam)
+    aim = _aim_stiffness(paths, route, x, y, attraction, W)
+    slope = slope + aim
     forward = np.stack([attraction + along, attraction - along])  # the forward force of each travel direction
     with np.errstate(divide="ignore", invalid="ignore"):  # a wall ahead (the repulsion along the path) stops the robot
         N_forward = np.where((1 + along >= 1 - end_fraction) & (forward[0] > 0), slope / forward[0], np.nan)
@@ -454,7 +475,7 @@ def analyze_paths(grid, law, paths, clearance: np.ndarray, W: float, V: float, b
     if transition is not None and boundary.omega_critical and boundary.omega_critical > 0:
         profile = lateral_profile(grid, law, x, y, tx, ty, LEAVES)
         stopped = np.stack([~np.isfinite(N_forward), ~np.isfinite(N_reverse)])
-        oscillates, amplitude = _driven(route, arc, stopped, profile, pull, attraction, V, transition,
+        oscillates, amplitude = _driven(route, arc, stopped, profile, pull, attraction, aim, V, transition,
                                         2 * math.pi / boundary.omega_critical, driven)
         code = np.where((code == 0) & oscillates, 1, code)
     # the window-edge relay (`relay`): a restoring jump of F_n within a cell of the path, larger than its smooth change
@@ -641,17 +662,17 @@ def lateral_profile(grid, law, x, y, tx, ty, reach: float):
     return offsets, fn.reshape(-1, S), ft.reshape(-1, S)
 
 
-def _driven(route, arc, stopped, profile, pull, attraction, V: float, transition: SampledTransition, period: float, taken):
+def _driven(route, arc, stopped, profile, pull, attraction, aim, V: float, transition: SampledTransition, period: float, taken):
     """(oscillates, amplitude) per sample: the sampled loop driven along each route at V through the real lateral force
     across it (module docstring, "The loop driven along the route"), in both directions (a path taken: the way it was
     driven), started `PREDICTION_OFFSET` off it; its lateral position's episodes
     (`episodes.lateral_episodes`, the drives' judge) mark the samples the robot passes meanwhile.
 
     ``x_{k+1} = M·x_k + n·sat(v_k)``, ``v_k = −F0·x_k − gk·g_k(y_k)`` (`SampledTransition`),
-    g(y) = −atan2(F_n(y) − P, A ± F_r·t): the direction of the resultant the robot steers to (KB eq 4; the linear
-    loop's N·y for small y) with the lateral force itself (interpolated in `profile` between its quarter cells), P
-    and A what the goal balances across the path and its attraction along it (`_goal_pull`), sat the steering-rate
-    limit. `stopped` (per direction and sample): the direction is not judged there (a
+    g(y) = −atan2(F_n(y) − P − K·y, A ± F_r·t): the direction of the resultant the robot steers to (KB eq 4; the
+    linear loop's N·y for small y) with the lateral force itself (interpolated in `profile` between its quarter
+    cells), P and A what the goal balances across the path and its attraction along it (`_goal_pull`), K the goal's
+    pull back to the path (`_aim_stiffness`), sat the steering-rate limit. `stopped` (per direction and sample): the direction is not judged there (a
     wall ahead, `END_FRACTION`): no lateral force. The run stops where it leaves the profile or `LEAVES`.
 
     Parameters
@@ -664,6 +685,8 @@ def _driven(route, arc, stopped, profile, pull, attraction, V: float, transition
         `lateral_profile`'s (offsets, F_n, F_r·t).
     pull, attraction : ndarray
         The goal's pull across the path (P) and along it (A) per sample, F_ct units (0 and 1 on a route).
+    aim : ndarray
+        K per sample, F_ct/m (`_aim_stiffness`; 0 on a route).
     V : float
         Speed, m/s.
     transition : SampledTransition
@@ -717,7 +740,7 @@ def _driven(route, arc, stopped, profile, pull, attraction, V: float, transition
             frac = u - i0
             f = fn[row, i0] * (1 - frac) + fn[row, i0 + 1] * frac
             ahead = attraction[row] + sign * ft[row, centre]
-            g = -np.arctan2(f - pull[row], ahead)  # the resultant's direction (KB eq 4), ~ N·y for small y
+            g = -np.arctan2(f - pull[row] - aim[row] * yk, ahead)  # the resultant's direction (KB eq 4), ~ N·y for small y
             g = np.where(stopped[(sign < 0).astype(int), row], 0.0, g)
             inside = (u >= 0) & (u <= offsets.size - 1) & (np.abs(yk) <= LEAVES) & np.isfinite(g)
             alive &= inside & np.isfinite(state).all(axis=1)

@@ -83,11 +83,17 @@ class RoutePath:
         Index of the route (a skeleton branch, or the user's route).
     source : str
         Where it comes from: "skeleton", "path" (a Nav2 path or CSV), "waypoints" or "goals".
+    goal : tuple of float or None
+        A path a robot took towards a point target: that target (x, y), m (None: a goal along the route, at infinity).
+    lookahead : float
+        A path a robot took following a plan: how far ahead along it the point it steered at lay, m (inf: none).
     """
 
     points: np.ndarray
     branch: int
     source: str = "skeleton"
+    goal: tuple | None = None
+    lookahead: float = math.inf
 
     @property
     def length(self) -> float:
@@ -95,7 +101,7 @@ class RoutePath:
         return float(np.hypot(*np.diff(self.points, axis=0).T).sum())
 
 
-def path_of(points, branch: int = 0, source: str = "path") -> RoutePath:
+def path_of(points, branch: int = 0, source: str = "path", goal=None, lookahead: float = math.inf) -> RoutePath:
     """A `RoutePath` through `points` (m; repeated points dropped); ValueError if fewer than two distinct points.
 
     Parameters
@@ -106,6 +112,10 @@ def path_of(points, branch: int = 0, source: str = "path") -> RoutePath:
         Index of the route.
     source : str
         Where it comes from (`RoutePath.source`).
+    goal : (float, float), optional
+        The point target of the robot that took it, m (`RoutePath.goal`).
+    lookahead : float
+        The lookahead of the plan it followed, m (`RoutePath.lookahead`).
     """
     p = np.asarray(points, dtype=float).reshape(-1, 2)
     if not np.isfinite(p).all():
@@ -114,7 +124,7 @@ def path_of(points, branch: int = 0, source: str = "path") -> RoutePath:
     p = p[keep]
     if len(p) < 2:
         raise ValueError(f"a {source} route needs at least two distinct points; got {len(p)}")
-    return RoutePath(p, int(branch), source)
+    return RoutePath(p, int(branch), source, None if goal is None else (float(goal[0]), float(goal[1])), float(lookahead))
 
 
 def find_paths(grid: HistogramMap, skeleton: np.ndarray, clearance: np.ndarray) -> list:

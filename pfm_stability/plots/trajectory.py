@@ -116,6 +116,9 @@ def plot_trajectory(result, ax=None, *, every: float = 1.0, title: str | None = 
 
 def _draw_target(ax, s, tr):
     t = s.target
+    if t.is_path:  # the path it follows
+        px, py = zip(*t.path)
+        ax.plot(px, py, "--", color="C3", lw=1, label="path followed")
     if t.is_point:
         ax.plot([t.x], [t.y], "D", color="C3", ms=6)
         ax.annotate("Target", (t.x, t.y), xytext=(6, 4), textcoords="offset points", color="C3")

@@ -58,6 +58,7 @@ from ..parameters import TAU_RESOLUTION
 from .contact import StepPath, chord_cell_gap, chord_wall_gap, first_contact, path_slack, point_cell_gap, point_wall_gap
 from .environment import segment_clearance, wall_coordinates
 from .events import Event
+from .follow import PathFollower
 from .metrics import oscillation_metrics
 from .results import BatchResult, RunResult, Trajectory
 from .robot import advance_position, constant_input, constant_input_modes, delay_split, graded_rule, propagate, servo, servo_modes, slow_rate
@@ -147,6 +148,8 @@ class _Batch:
         self.radius = _array(s, lambda m: m.target.radius)
         self.finish = _array(s, lambda m: math.inf if m.target.is_point or m.target.finish is None else m.target.finish)
         self.any_point = bool(self.point.any())
+        self.follow_idx = np.flatnonzero([m.target.is_path for m in s])
+        self.follower = PathFollower([s[m].target for m in self.follow_idx]) if self.follow_idx.size else None
         self.trap_time = _array(s, lambda m: m.trap_time)
         self.trap_distance = _array(s, lambda m: m.trap_distance)
 
@@ -285,13 +288,22 @@ class _Batch:
         return gap
 
     def attraction(self, x, y):
-        """Unit vector towards the target (KB eq 3)."""
+        """Unit vector towards the target (KB eq 3): a path target's carrot (`follow`)."""
         if not self.any_point:
             return self.dx, self.dy
-        rx, ry = self.tx - x, self.ty - y
+        tx, ty = self.tx, self.ty
+        if self.follower is not None:
+            tx, ty = tx.copy(), ty.copy()
+            tx[self.follow_idx], ty[self.follow_idx] = self.follower.carrot()
+        rx, ry = tx - x, ty - y
         dist = np.hypot(rx, ry)
         safe = np.where(dist > 0, dist, 1.0)
         return np.where(self.point, rx / safe, self.dx), np.where(self.point, ry / safe, self.dy)
+
+    def follow(self, x, y):
+        """Move the path targets' progress to the robots' positions at t_k, m (`follow.PathFollower.advance`)."""
+        if self.follower is not None:
+            self.follower.advance(x[self.follow_idx], y[self.follow_idx])
 
     def target_distance(self, x, y):
         """Distance to point targets, m (0 for direction targets)."""
@@ -300,8 +312,11 @@ class _Batch:
         return np.where(self.point, np.hypot(self.tx - x, self.ty - y), 0.0)
 
     def progress(self, x, y, x0, y0, distance):
-        """Progress towards the target, m: −distance (point) or advance along the direction."""
-        return np.where(self.point, -distance, (x - x0) * self.dx + (y - y0) * self.dy)
+        """Progress towards the target, m: −distance (point), advance along the direction, or along the path."""
+        out = np.where(self.point, -distance, (x - x0) * self.dx + (y - y0) * self.dy)
+        if self.follower is not None:
+            out[self.follow_idx] = self.follower.s
+        return out
 
 
 def _law_key(law):
@@ -480,6 +495,7 @@ def run_batch(scenarios, *, record: str = "trajectory", metrics: bool = True, pr
                 alive[m] = False
                 min_gap[m] = min(min_gap[m], contact.gap)
             due &= alive
+        b.follow(x, y)
         _check_events(b, k, x, y, x0, y0, gap, due, alive, events, best, best_t, last_gap)
         np.minimum(min_gap, last_gap, out=min_gap)
         running = due & alive & (k < b.steps)

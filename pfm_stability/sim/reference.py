@@ -244,6 +244,32 @@ def _path_contact(s, sense, tau, start, applied, V, substepped, gap_start, switc
     return None
 
 
+def _path_progress(path, lookahead, along, x, y):
+    """A path target's progress (m): the arc of the nearest point of the path within arc [along, along + lookahead]
+    from (x, y), m, never less than `along` (the rule of `sim.follow`, walked segment by segment)."""
+    best, best_arc, start = math.inf, along, 0.0
+    for (ax, ay), (bx, by) in zip(path[:-1], path[1:]):
+        length = math.hypot(bx - ax, by - ay)
+        if length > 0 and start + length >= along and start <= along + lookahead:
+            u = ((x - ax) * (bx - ax) + (y - ay) * (by - ay)) / (length * length)
+            u = min(max(u, (along - start) / length, 0.0), (along + lookahead - start) / length, 1.0)
+            d = math.hypot(ax + u * (bx - ax) - x, ay + u * (by - ay) - y)
+            if d < best:
+                best, best_arc = d, start + u * length
+        start += length
+    return max(along, best_arc)
+
+
+def _path_point(path, arc):
+    """The point of the polyline `path` at `arc` m from its start (its end beyond)."""
+    for (ax, ay), (bx, by) in zip(path[:-1], path[1:]):
+        length = math.hypot(bx - ax, by - ay)
+        if arc <= length:
+            return ax + arc / length * (bx - ax), ay + arc / length * (by - ay)
+        arc -= length
+    return path[-1]
+
+
 def simulate_reference(s: Scenario):
     """Run one scenario in a per-robot Python loop.
 
@@ -280,11 +306,16 @@ def simulate_reference(s: Scenario):
     pending_V = None
     best, best_t, last_gap = None, 0.0, math.inf
     event = None
+    along = 0.0  # a path target's progress, m
     for step in range(steps + 1):
         t = step * T
         fx, fy, gap, goal = sense(s, x, y)
         distance = math.hypot(tgt.x - x, tgt.y - y) if tgt.is_point else 0.0
-        progress = -distance if tgt.is_point else (x - x0) * math.sin(tgt.angle) + (y - y0) * math.cos(tgt.angle)
+        if tgt.is_path:
+            along = _path_progress(tgt.path, tgt.lookahead, along, x, y)
+            progress = along
+        else:
+            progress = -distance if tgt.is_point else (x - x0) * math.sin(tgt.angle) + (y - y0) * math.cos(tgt.angle)
         if best is None:
             best = progress
         if progress >= best + s.trap_distance:
@@ -299,7 +330,11 @@ def simulate_reference(s: Scenario):
         last_gap = gap
         if event is not None or step == steps:
             break
-        if tgt.is_point:
+        if tgt.is_path:
+            cx, cy = _path_point(tgt.path, along + tgt.lookahead)
+            reach = math.hypot(cx - x, cy - y)
+            ax, ay = ((cx - x) / reach, (cy - y) / reach) if reach > 0 else (0.0, 0.0)
+        elif tgt.is_point:
             ax, ay = (tgt.x - x) / distance, (tgt.y - y) / distance
         else:
             ax, ay = math.sin(tgt.angle), math.cos(tgt.angle)

@@ -122,10 +122,12 @@ class Pose:
 
 @dataclass(frozen=True)
 class Target:
-    """A point target, or a direction "at infinity" (KB eq 3; docs/simulator.md).
+    """A point target, a direction "at infinity" (KB eq 3; docs/simulator.md), or a path to follow.
 
-    Use `Target.point` or `Target.direction`. A direction keeps α constant
-    along a wall, as KB's analysis assumes (α̇ ≈ 0).
+    Use `Target.point`, `Target.direction` or `Target.follow`. A direction keeps
+    α constant along a wall, as KB's analysis assumes (α̇ ≈ 0). A path pulls the
+    robot towards a point `lookahead` m ahead of it along the path (a pure-pursuit
+    carrot, `sim.follow`); it is reached at its last point, (x, y).
 
     Attributes
     ----------
@@ -138,6 +140,10 @@ class Target:
     finish : float or None
         Direction target: reached when the robot has advanced this far along
         the direction from its start, m (None: never).
+    path : tuple of (float, float) or None
+        Path target: its vertices, m (the last one is (x, y)).
+    lookahead : float
+        Path target: how far ahead along the path the robot is pulled, m.
     """
 
     x: float | None = None
@@ -145,6 +151,8 @@ class Target:
     angle: float | None = None
     radius: float = 0.2
     finish: float | None = None
+    path: tuple | None = None
+    lookahead: float = 0.0
 
     @classmethod
     def point(cls, x: float, y: float, radius: float = 0.2) -> "Target":
@@ -177,12 +185,43 @@ class Target:
         finish = None if finish is None else check_number("finish", finish, 0.0, unit="m")
         return cls(angle=check_number("target angle", angle, unit="rad"), finish=finish)
 
+    @classmethod
+    def follow(cls, points, lookahead: float, radius: float = 0.2) -> "Target":
+        """A path to follow: the robot is pulled towards the point `lookahead` m ahead of it along the polyline
+        `points` (`sim.follow`), and reaches the target within `radius` m of its last point.
+
+        Parameters
+        ----------
+        points : array_like, shape (n, 2)
+            Vertices, m (n >= 2; repeated points are dropped).
+        lookahead : float
+            How far ahead along the path the robot is pulled, m (> 0).
+        radius : float
+            Reached within this distance of the last point, m.
+        """
+        pts = np.asarray(points, dtype=float)
+        if pts.ndim != 2 or pts.shape[1] != 2 or not np.all(np.isfinite(pts)):
+            raise ValueError(f"path must be finite (x, y) points in m; got an array of shape {pts.shape}")
+        keep = np.concatenate([[True], np.hypot(*np.diff(pts, axis=0).T) > 0]) if len(pts) else np.zeros(0, bool)
+        pts = pts[keep]
+        if len(pts) < 2:
+            raise ValueError(f"path must hold at least two distinct points; got {len(pts)}")
+        lookahead = check_number("lookahead", lookahead, 0.0, unit="m")
+        return cls(x=float(pts[-1, 0]), y=float(pts[-1, 1]), radius=check_number("target radius", radius, 0.0, unit="m"),
+                   path=tuple(map(tuple, pts.tolist())), lookahead=lookahead)
+
     @property
     def is_point(self) -> bool:
         return self.angle is None
 
+    @property
+    def is_path(self) -> bool:
+        return self.path is not None
+
     def to_dict(self) -> dict:
         """The fields as a JSON-ready dict (SI units)."""
+        if self.is_path:
+            return {"kind": "path", "points": [list(p) for p in self.path], "lookahead": self.lookahead, "radius": self.radius}
         if self.is_point:
             return {"kind": "point", "x": self.x, "y": self.y, "radius": self.radius}
         return {"kind": "direction", "angle_deg": math.degrees(self.angle), "finish": self.finish}

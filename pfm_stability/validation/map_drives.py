@@ -5,8 +5,10 @@
 around each drive). Half of them follow the routes: a route (`routes.RoutePath`) drawn at random (seeded), driven
 in a random direction from its first point plus a lateral offset δ = `START_OFFSET` (the disturbance) towards its
 last (`Target.point`: the VFF robot finds its own path); the other half go between two random reachable points of
-the routes (the same free component), the robot starting towards the goal. Every drive runs until its target is reached,
-it collides or stalls, or `DRIVE_TIME_FACTOR` times its straight-line time.
+the routes (the same free component), following the global plan between them (`maps.planner.SkeletonPlanner`: the
+shortest path along the skeleton) as a navigation stack would hand it to the VFF controller: the robot is pulled
+towards the plan's point `LOOKAHEAD` ahead of it (`Target.follow`, a pure-pursuit carrot), starting towards it. Every
+drive runs until its target is reached, it collides or stalls, or `DRIVE_TIME_FACTOR` times its length's time.
 
 **Episodes** (`maps.episodes.episodes`, the one definition the map's prediction uses too): the robot's
 lateral oscillation about its own path averaged over one period P = 2π/ω*; an episode is three periods of it
@@ -14,7 +16,8 @@ that grow by an e-fold or stay above `AMPLITUDE_THRESHOLD`.
 
 **Each drive is judged along the path it took** (its positions averaged over one period, `maps.analysis.judge_routes`
 with ``taken``: the prediction the map makes along any route — the loop driven through the force across the path,
-`maps.paths` — made along that path, in the direction it was driven). The VFF robot aims at a point, not along a
+`maps.paths` — made along that path, in the direction it was driven, with the pull back to it of the point the robot
+steered at: its plan's carrot or its goal, `RoutePath.lookahead` and `RoutePath.goal`). The VFF robot aims at a point, not along a
 route: it leaves the skeleton wherever the field bends it away (beside a rack it rides the window's edge, metres from
 the route), so comparing the skeleton's verdicts with a robot that drove elsewhere would compare two different paths.
 The map's route samples within `MATCH_DISTANCE` of a drive are counted as covered (``lengths["driven"]``), not scored.
@@ -49,6 +52,7 @@ from ..io.serialize import json_number, json_ready
 from ..sim.engine import run_batch
 from ..sim.scenario import Pose, Scenario, Target
 from ..maps.episodes import AMPLITUDE_THRESHOLD, EPISODE_PERIODS, GROWTH_EFOLDS, NOISE_FLOOR, episodes, swing
+from ..maps.planner import SkeletonPlanner
 from .maps import START_OFFSET, _batches, _table_size, crop_grid, simulator_grid
 
 __all__ = ["DRIVE_TIME_FACTOR", "MATCH_DISTANCE", "Disagreement", "Drive", "DriveValidation", "drive_map", "goal_routes"]
@@ -56,11 +60,14 @@ __all__ = ["DRIVE_TIME_FACTOR", "MATCH_DISTANCE", "Disagreement", "Drive", "Driv
 MATCH_DISTANCE = 0.5
 """Largest distance (m) from a trajectory point to the route sample it marks (at least the robot's width W)."""
 DRIVE_TIME_FACTOR = 2.5
-"""A drive lasts at most this many times its straight-line time, plus 5 s."""
+"""A drive lasts at most this many times its length's time (the plan's, or the straight line's), plus 5 s."""
 START_ROOM = 1e-3
 """Least room (m) beside the robot at a drive's start offset by δ; with less the drive starts on the route itself."""
 INTERVAL_RESAMPLES = 2000
 """Resamples of the drives behind the 95 % intervals of recall and precision (`_interval`)."""
+LOOKAHEAD = 2.0
+"""How far ahead along its plan a waypoint drive's robot is pulled, m (`sim.follow`; docs/maps.md, "Validation by
+driving": at 1 m and 3 m the figures were worse)."""
 CROP_SLACK = 3.0
 """How far (m) around a drive's straight line its cropped grid reaches beyond the window."""
 
@@ -178,6 +185,13 @@ class DriveValidation:
     recall_interval, precision_interval : tuple of float or None
         95 % intervals of recall and precision over the choice of drives (`_interval`: the drives resampled with
         replacement, `INTERVAL_RESAMPLES` times, seeded); None where the figure is None.
+    specificity : float or None
+        Of the length driven with no episode within half a window (``lengths["quiet_driven"]``), the share predicted
+        stable (``quiet_predicted_stable``); None when every measured metre was near an episode. Where no drive
+        oscillates, recall is undefined and precision rests on the few metres predicted unstable; this says how much
+        of the calm driving the map also called calm.
+    specificity_interval : tuple of float or None
+        Its 95 % interval over the drives.
     """
 
     recall: float | None
@@ -193,6 +207,8 @@ class DriveValidation:
     drive_paths: object = None
     recall_interval: tuple | None = None
     precision_interval: tuple | None = None
+    specificity: float | None = None
+    specificity_interval: tuple | None = None
 
     def to_dict(self) -> dict:
         """JSON form."""
@@ -202,6 +218,8 @@ class DriveValidation:
             "precision": json_number(self.precision) if self.precision is not None else None,
             "recall_interval": json_ready(self.recall_interval),
             "precision_interval": json_ready(self.precision_interval),
+            "specificity": json_number(self.specificity) if self.specificity is not None else None,
+            "specificity_interval": json_ready(self.specificity_interval),
             "by_kind": json_ready(self.by_kind),
             "lengths": json_ready(self.lengths),
             "counts": json_ready(self.counts),
@@ -225,7 +243,8 @@ def _components(analysis):
 
 
 def _plan(analysis, count: int, rng) -> list:
-    """The drives: (kind, start (x, y, heading), target, straight length) for `count` drives (module docstring)."""
+    """The drives: (kind, path (its first point the start, its last the goal; m), start heading (rad), length (m)) for
+    `count` drives (module docstring)."""
     pv = analysis.paths
     c = analysis.grid.cell_size
     pieces = [(path.points[0], path.points[-1]) for path in pv.paths if math.hypot(*(path.points[-1] - path.points[0])) >= 4 * c]
@@ -239,16 +258,21 @@ def _plan(analysis, count: int, rng) -> list:
         if rng.random() < 0.5:
             p, q = q, p
         heading = math.atan2(q[0] - p[0], q[1] - p[1])
-        plans.append(("route", p, q, heading, float(math.hypot(*(q - p)))))
+        plans.append(("route", np.array([p, q]), heading, float(math.hypot(*(q - p)))))
     candidates = np.flatnonzero(ok)
+    planner = SkeletonPlanner(analysis.grid, analysis.skeleton)
     tries = 0
     while len(plans) < count and candidates.size >= 2 and tries < 50 * count:
         tries += 1
         a, b = rng.choice(candidates, 2, replace=False)
         if component[a] != component[b] or math.hypot(*(samples[b] - samples[a])) < 2.0:
             continue
-        p, q = samples[a], samples[b]
-        plans.append(("waypoints", p, q, math.atan2(q[0] - p[0], q[1] - p[1]), float(math.hypot(*(q - p)))))
+        path = planner.plan(samples[a], samples[b])
+        if path is None:
+            continue
+        arc = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(path, axis=0).T))])
+        ahead = np.array([np.interp(min(LOOKAHEAD, arc[-1]), arc, path[:, k]) for k in (0, 1)])
+        plans.append(("waypoints", path, math.atan2(ahead[0] - path[0, 0], ahead[1] - path[0, 1]), float(arc[-1])))
     return plans
 
 
@@ -285,12 +309,14 @@ def drive_map(analysis, count: int, *, seed: int = 0, progress=None) -> DriveVal
     h = law.window_cells // 2
     reach = (h + 1) * grid.cell_size + CROP_SLACK
     runs, skipped = [], 0
-    for kind, p, q, heading, length in _plan(analysis, count, rng):
+    for kind, path, heading, length in _plan(analysis, count, rng):
+        p, q = path[0], path[-1]
         ux, uy = math.sin(heading), math.cos(heading)
         delta = START_OFFSET if kind == "route" else 0.0
         sx, sy = p[0] + delta * uy, p[1] - delta * ux  # δ to the right of the travel direction
-        local = crop_grid(grid, min(p[0], q[0]) - reach, max(p[0], q[0]) + reach, min(p[1], q[1]) - reach, max(p[1], q[1]) + reach)
-        target = Target.point(float(q[0]), float(q[1]), radius=0.3)
+        (x_lo, y_lo), (x_hi, y_hi) = path.min(axis=0), path.max(axis=0)
+        local = crop_grid(grid, x_lo - reach, x_hi + reach, y_lo - reach, y_hi + reach)
+        target = Target.point(float(q[0]), float(q[1]), radius=0.3) if kind == "route" else Target.follow(path, LOOKAHEAD, radius=0.3)
         duration = DRIVE_TIME_FACTOR * length / robot.V + 5.0
         room = float(local.clearance([sx], [sy])[0]) - robot.W / 2
         if not room > START_ROOM:
@@ -304,7 +330,7 @@ def drive_map(analysis, count: int, *, seed: int = 0, progress=None) -> DriveVal
             continue
         runs.append(_Prepared(kind, (float(p[0]), float(p[1]), float(q[0]), float(q[1])), scenario,
                               _table_size(local, h)))
-    drives, traces = [], []
+    drives, traces, targets = [], [], []
     batches = _batches(runs)
     for b, batch in enumerate(batches, 1):
         outcome = run_batch([r.scenario for r in batch], record="trajectory", metrics=False)
@@ -315,14 +341,15 @@ def drive_map(analysis, count: int, *, seed: int = 0, progress=None) -> DriveVal
             drives.append(Drive(len(drives), r.kind, *r.ends, event=event, duration=float(tr.t[-1] - tr.t[0]) if tr.t.size else 0.0,
                                 episodes=found, max_amplitude=amplitude))
             traces.append((tr.t, tr.x, tr.y))
+            targets.append(r.scenario.target)
         if progress:
             progress(f"map drives: batch {b}/{len(batches)}: {len(batch)} drives")
 
     # every drive's own path (period-averaged), judged like any route: prediction and episode on one path
     taken, own = [], {}
-    for d, (t, x, y) in zip(drives, traces):
+    for d, (t, x, y), target in zip(drives, traces, targets):
         try:
-            route = _taken_path(x, y, period, controller.T, analysis.grid.cell_size, len(taken), "drive")
+            route = _taken_path(x, y, period, controller.T, analysis.grid.cell_size, len(taken), "drive", target)
         except ValueError:  # fewer than two distinct points: the drive did not move
             continue
         own[d.index] = len(taken)
@@ -336,6 +363,7 @@ def drive_map(analysis, count: int, *, seed: int = 0, progress=None) -> DriveVal
     limit = max(MATCH_DISTANCE, robot.W)
     marks, points = [], []
     unstable = sc.code == PATH_VERDICTS.index("unstable")
+    stable = sc.code == PATH_VERDICTS.index("stable")
     unjudged = np.isin(sc.code, [PATH_VERDICTS.index(reason) for reason in UNJUDGED])
     half = pv.window / 2 if math.isfinite(pv.window) else 0.0
     reach_back = max(0.0, EPISODE_PERIODS * robot.V * period - half)  # m (`_cut_short`)
@@ -366,11 +394,12 @@ def drive_map(analysis, count: int, *, seed: int = 0, progress=None) -> DriveVal
                             np.union1d(unmeasured, np.intersect1d(scored, cut)), on_routes))
         points.append(np.column_stack([x[during], y[during]]))
     near_unstable = _within(unstable, sc.route, sc.arc, half)
-    lengths, recall, precision, driven, episode, near_episode = _score(sc, marks, range(len(drives)), unstable, near_unstable, half, base)
+    lengths, recall, precision, driven, episode, near_episode = _score(sc, marks, range(len(drives)), unstable, stable, near_unstable, half, base)
+    specificity = _ratio(lengths, "quiet_predicted_stable", "quiet_driven")
     by_kind = {}
     for kind in ("route", "waypoints"):
         chosen = [k for k, d in enumerate(drives) if d.kind == kind]
-        kind_lengths, kind_recall, kind_precision = _score(sc, marks, chosen, unstable, near_unstable, half, base)[:3]
+        kind_lengths, kind_recall, kind_precision = _score(sc, marks, chosen, unstable, stable, near_unstable, half, base)[:3]
         by_kind[kind] = {"recall": json_number(kind_recall) if kind_recall is not None else None,
                          "precision": json_number(kind_precision) if kind_precision is not None else None, "lengths": kind_lengths}
     passed_by = [set() for _ in range(sc.code.size)]
@@ -390,16 +419,19 @@ def drive_map(analysis, count: int, *, seed: int = 0, progress=None) -> DriveVal
               "episode_periods": EPISODE_PERIODS, "growth_efolds": GROWTH_EFOLDS, "amplitude_threshold": AMPLITUDE_THRESHOLD,
               "noise_floor": NOISE_FLOOR, "match_distance": limit, "start_offset": START_OFFSET,
               "interval_resamples": INTERVAL_RESAMPLES}
-    per_drive = [_score(sc, marks, [k], unstable, near_unstable, half, base)[0] for k in range(len(drives))]
+    per_drive = [_score(sc, marks, [k], unstable, stable, near_unstable, half, base)[0] for k in range(len(drives))]
     shares = {key: np.array([L[key] for L in per_drive], dtype=float) for key in
-              ("episode", "episode_recalled", "predicted_unstable_driven", "predicted_unstable_matched")}
+              ("episode", "episode_recalled", "predicted_unstable_driven", "predicted_unstable_matched", "quiet_driven",
+               "quiet_predicted_stable")}
     resampled = np.random.default_rng([seed, 1])
     recall_interval = _interval(shares["episode_recalled"], shares["episode"], resampled) if recall is not None else None
     precision_interval = (_interval(shares["predicted_unstable_matched"], shares["predicted_unstable_driven"], resampled)
                           if precision is not None else None)
+    specificity_interval = (_interval(shares["quiet_predicted_stable"], shares["quiet_driven"], resampled)
+                            if specificity is not None else None)
     pts = np.vstack(points) if points else np.zeros((0, 2))
     return DriveValidation(recall, precision, tuple(drives), disagreements, lengths, counts, inputs, time.perf_counter() - started, pts,
-                           by_kind, dp, recall_interval, precision_interval)
+                           by_kind, dp, recall_interval, precision_interval, specificity, specificity_interval)
 
 
 @dataclass(frozen=True)
@@ -442,7 +474,7 @@ class _Marks:
         return cls(empty, empty, 0.0, empty, empty)
 
 
-def _score(sc, marks, chosen, unstable, near_unstable, half, base):
+def _score(sc, marks, chosen, unstable, stable, near_unstable, half, base):
     """(lengths, recall, precision, driven, episode, near_episode) of the drives `chosen` (module docstring); the
     first `base` samples are the map's routes' (passed: coverage only), the rest the drives' own paths' (scored)."""
     driven = np.zeros(sc.code.size, dtype=bool)
@@ -471,10 +503,11 @@ def _score(sc, marks, chosen, unstable, near_unstable, half, base):
         "predicted_unstable_matched": float(ds[unstable & scored & near_episode].sum()),
         "predicted_unstable_unmeasured": float(ds[unstable & unmeasured].sum()),
         "predicted_unstable_not_driven": float(ds[unstable & ~driven & on_map].sum()),
+        "quiet_driven": float(ds[scored & ~near_episode].sum()),
+        "quiet_predicted_stable": float(ds[scored & ~near_episode & stable].sum()),
     }
-    recall = lengths["episode_recalled"] / lengths["episode"] if lengths["episode"] > 0 else None
-    precision = (lengths["predicted_unstable_matched"] / lengths["predicted_unstable_driven"]
-                 if lengths["predicted_unstable_driven"] > 0 else None)
+    recall = _ratio(lengths, "episode_recalled", "episode")
+    precision = _ratio(lengths, "predicted_unstable_matched", "predicted_unstable_driven")
     return lengths, recall, precision, scored, episode, near_episode
 
 
@@ -513,6 +546,11 @@ def _cut_short(path: np.ndarray, arc: np.ndarray, unstable: np.ndarray, unjudged
     first = np.full(count + 1, np.inf)
     np.minimum.at(first, stretch[ends], s[ends])  # per stretch, where the drive's last three periods begin, m
     return path[u & np.isfinite(first[stretch]) & (s + reach >= first[stretch])]
+
+
+def _ratio(lengths: dict, part: str, whole: str) -> float | None:
+    """lengths[part] / lengths[whole] (None when the whole is 0: nothing to measure)."""
+    return lengths[part] / lengths[whole] if lengths[whole] > 0 else None
 
 
 def _interval(part: np.ndarray, whole: np.ndarray, rng) -> tuple | None:
@@ -562,9 +600,10 @@ def _runs(kind: str, mask: np.ndarray, sc, passed_by, swung) -> tuple:
     return tuple(out)
 
 
-def _taken_path(x, y, period: float, T: float, cell: float, index: int, source: str):
+def _taken_path(x, y, period: float, T: float, cell: float, index: int, source: str, target):
     """The path a drive took: its positions (m) averaged over one period (s; the controller's step T, s), a point
-    every `cell` m of arc (`routes.path_of`, route `index`, `source`)."""
+    every `cell` m of arc (`routes.path_of`, route `index`, `source`), with the point `target` (a `Target`) the robot
+    steered at (`RoutePath.goal`, `RoutePath.lookahead`)."""
     from scipy.ndimage import uniform_filter1d
 
     from ..maps.routes import path_of
@@ -574,7 +613,8 @@ def _taken_path(x, y, period: float, T: float, cell: float, index: int, source: 
     arc = np.concatenate([[0.0], np.cumsum(np.hypot(np.diff(x), np.diff(y)))])
     step = np.flatnonzero(np.diff(np.concatenate([[-1.0], arc // cell])) > 0)  # a point every cell
     points = np.column_stack([x[step], y[step]]) if step.size >= 2 else np.column_stack([x[[0, -1]], y[[0, -1]]])
-    return path_of(points, index, source)
+    return path_of(points, index, source, goal=(target.x, target.y) if target.is_point else None,
+                   lookahead=target.lookahead if target.is_path else math.inf)
 
 
 def goal_routes(analysis, goals, progress=None) -> list:
@@ -611,8 +651,8 @@ def goal_routes(analysis, goals, progress=None) -> list:
         except ValueError as exc:
             raise ValueError(f"goal {k + 1} -> {k + 2}: {exc}") from None
     outcome = run_batch(scenarios, record="trajectory", metrics=False)
-    routes = [_taken_path(run.trajectory.x, run.trajectory.y, period, controller.T, analysis.grid.cell_size, k, "goals")
-              for k, run in enumerate(outcome.runs)]
+    routes = [_taken_path(run.trajectory.x, run.trajectory.y, period, controller.T, analysis.grid.cell_size, k, "goals", s.target)
+              for k, (s, run) in enumerate(zip(scenarios, outcome.runs))]
     if progress:
         progress(f"goals: {len(routes)} drives between {len(goals)} goals")
     return routes
