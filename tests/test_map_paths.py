@@ -411,6 +411,29 @@ def test_cli_judges_a_route_file_and_goals_and_refuses_a_bad_one(tmp_path):
     assert code == 2 and out == "" and err.strip().count("\n") == 0 and "one.yaml" in err
 
 
+def test_goals_round_a_corner_are_reached_along_the_plan(tmp_path):
+    """Two goals in the two arms of an L-shaped corridor 1.2 m wide between one-cell walls (ROBOT at 0.5 m/s, stable
+    there): the robot follows the skeleton's plan between them (`goal_routes`), so the path it took turns the corner
+    and ends within the target's 0.3 m of the second goal (plus a cell, the path's spacing, and the period's
+    averaging, V·P/4); the goal's
+    distance and lookahead ride with the path, for its verdicts. The straight line between the goals crosses the
+    corner's wall."""
+    from pfm_stability.validation.map_drives import goal_routes
+
+    img = np.full((120, 120), 254, dtype=np.uint8)  # row 0 at the top: cell centres at y = 12 − (row + 0.5)·0.1
+    img[107, 10:82] = img[119, 10:95] = 0  # the arm along x: walls at y = 1.25 and 0.05 m
+    img[10:108, 82] = img[10:120, 94] = 0  # the arm along y: walls at x = 8.25 and 9.45 m
+    img[107:120, 10] = img[10, 82:95] = 0  # its ends
+    robot = ROBOT.replace(V=0.5)
+    analysis = analyze_map(load_map(write_map(tmp_path, img)), robot, CONTROLLER, make_law("grid", robot, CONTROLLER))
+    start, goal = np.array([3.0, 0.65]), np.array([8.85, 9.0])
+    (route,) = goal_routes(analysis, [start, goal])
+    assert route.source == "goals" and route.goal == (8.85, 9.0) and route.lookahead == 2.0
+    period = 2 * math.pi / models_for(CONTROLLER, ["sampled"])[0].boundary(Loop.of(robot, CONTROLLER, c=0.0)).omega_critical
+    assert np.hypot(*(route.points[-1] - goal)) < 0.3 + analysis.grid.cell_size + robot.V * period / 4
+    assert route.points[:, 1].max() > 8.0 and route.points[:, 0].min() < 3.1  # from the first arm up the second
+
+
 @pytest.mark.slow
 def test_thin_slam_walls_with_unknown_behind_the_simulation_sides_with_unknown_free(tmp_path):
     """The --unknown evidence (docs/maps.md, "Map files"): a 0.8 m corridor whose walls are one pixel thin (0.05 m) with

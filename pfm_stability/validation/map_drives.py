@@ -267,13 +267,21 @@ def _plan(analysis, count: int, rng) -> list:
         a, b = rng.choice(candidates, 2, replace=False)
         if component[a] != component[b] or math.hypot(*(samples[b] - samples[a])) < 2.0:
             continue
-        path = planner.plan(samples[a], samples[b])
-        if path is None:
-            continue
-        arc = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(path, axis=0).T))])
-        ahead = np.array([np.interp(min(LOOKAHEAD, arc[-1]), arc, path[:, k]) for k in (0, 1)])
-        plans.append(("waypoints", path, math.atan2(ahead[0] - path[0, 0], ahead[1] - path[0, 1]), float(arc[-1])))
+        planned = _planned(planner, samples[a], samples[b])
+        if planned is not None:
+            plans.append(("waypoints", *planned))
     return plans
+
+
+def _planned(planner, p, q) -> tuple | None:
+    """(path, start heading (rad), length (m)) of the plan from `p` to `q` (m; `SkeletonPlanner.plan`), the robot
+    starting towards its carrot; None when the skeleton does not join them."""
+    path = planner.plan(p, q)
+    if path is None:
+        return None
+    arc = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(path, axis=0).T))])
+    ahead = [np.interp(min(LOOKAHEAD, arc[-1]), arc, path[:, k]) for k in (0, 1)]
+    return path, math.atan2(ahead[0] - path[0, 0], ahead[1] - path[0, 1]), float(arc[-1])
 
 
 def drive_map(analysis, count: int, *, seed: int = 0, progress=None) -> DriveValidation:
@@ -619,9 +627,10 @@ def _taken_path(x, y, period: float, T: float, cell: float, index: int, source: 
 
 def goal_routes(analysis, goals, progress=None) -> list:
     """The paths the simulated VFF robot takes between consecutive goals, as routes to judge (`maps.analysis.add_routes`):
-    each drive (point target, the robot starting towards it; the simulator's grid law on the map's grid) averaged over
-    one oscillation period P = 2π/ω* — the path it follows, about which `maps.paths` linearizes — from its start to
-    where it stopped (the goal, a collision or a stall).
+    each drive (the simulator's grid law on the map's grid) follows the plan between the two goals as the validation's
+    do (`SkeletonPlanner`, `Target.follow` with `LOOKAHEAD`; a point target straight at the goal where the skeleton
+    does not join them), averaged over one oscillation period P = 2π/ω* — the path it follows, about which
+    `maps.paths` linearizes — from its start to where it stopped (the goal, a collision or a stall).
 
     Parameters
     ----------
@@ -639,13 +648,18 @@ def goal_routes(analysis, goals, progress=None) -> list:
     grid = simulator_grid(analysis.grid)
     omega = _omega(analysis)
     period = 2 * math.pi / omega if omega else 1.0
+    planner = SkeletonPlanner(analysis.grid, analysis.skeleton)
     scenarios = []
     for k, (p, q) in enumerate(zip(goals[:-1], goals[1:])):
-        length = float(math.hypot(*(q - p)))
-        heading = math.atan2(q[0] - p[0], q[1] - p[1])
+        planned = _planned(planner, p, q)
+        if planned is None:  # no plan: straight at the goal
+            target, heading, length = Target.point(float(q[0]), float(q[1]), radius=0.3), math.atan2(q[0] - p[0], q[1] - p[1]), float(math.hypot(*(q - p)))
+        else:
+            path, heading, length = planned
+            target = Target.follow(path, LOOKAHEAD, radius=0.3)
         try:
             scenarios.append(Scenario(name=f"goal {k + 1}", robot=robot, controller=controller, environment=grid,
-                                      start=Pose(float(p[0]), float(p[1]), heading), target=Target.point(float(q[0]), float(q[1]), radius=0.3),
+                                      start=Pose(float(p[0]), float(p[1]), heading), target=target,
                                       duration=DRIVE_TIME_FACTOR * length / robot.V + 5.0, cell_ratio=law.ratio,
                                       window_cells=law.window_cells, trap_time=max(10.0, 1.5 / robot.V)))
         except ValueError as exc:
