@@ -599,7 +599,7 @@ def render_map_text(data: dict) -> str:
                  for k in ("recall", "precision", "specificity")}
         lines.append(f"validation by driving: {d['counts']['drives']} drives, {d['counts']['episodes']} oscillation episodes; "
                      f"recall {share['recall']}, precision {share['precision']}, specificity {share['specificity']} "
-                     f"(of {d['lengths']['quiet_driven']:.1f} m driven without an episode, the share predicted stable) by length along the paths driven "
+                     f"(of {d['lengths']['quiet_driven']:.1f} m driven with a verdict and without an episode, the share predicted stable) by length along the paths driven "
                      f"({d['lengths']['drive_paths_driven']:.1f} m measured, {d['lengths']['drive_paths_unmeasured']:.1f} m passed "
                      f"only in a drive's last three periods, not measurable; {d['lengths']['driven']:.1f} of {d['lengths']['route']:.1f} m "
                      f"of route covered); {len(d['disagreements'])} disagreements"

@@ -186,8 +186,8 @@ class DriveValidation:
         95 % intervals of recall and precision over the choice of drives (`_interval`: the drives resampled with
         replacement, `INTERVAL_RESAMPLES` times, seeded); None where the figure is None.
     specificity : float or None
-        Of the length driven with no episode within half a window (``lengths["quiet_driven"]``), the share predicted
-        stable (``quiet_predicted_stable``); None when every measured metre was near an episode. Where no drive
+        Of the length driven with a verdict and no episode within half a window (``lengths["quiet_driven"]``), the
+        share predicted stable (``quiet_predicted_stable``); None when every such metre was near an episode. Where no drive
         oscillates, recall is undefined and precision rests on the few metres predicted unstable; this says how much
         of the calm driving the map also called calm.
     specificity_interval : tuple of float or None
@@ -511,7 +511,7 @@ def _score(sc, marks, chosen, unstable, stable, near_unstable, half, base):
         "predicted_unstable_matched": float(ds[unstable & scored & near_episode].sum()),
         "predicted_unstable_unmeasured": float(ds[unstable & unmeasured].sum()),
         "predicted_unstable_not_driven": float(ds[unstable & ~driven & on_map].sum()),
-        "quiet_driven": float(ds[scored & ~near_episode].sum()),
+        "quiet_driven": float(ds[scored & ~near_episode & (stable | unstable)].sum()),
         "quiet_predicted_stable": float(ds[scored & ~near_episode & stable].sum()),
     }
     recall = _ratio(lengths, "episode_recalled", "episode")
