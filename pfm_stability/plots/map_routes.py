@@ -110,7 +110,7 @@ def plot_route_verdicts(analysis, drives=None, ax=None, *, title: str | None = N
             return f" ({100 * interval[0]:.0f}–{100 * interval[1]:.0f}%)" if interval else ""
 
         validation = (f"\n{drives.counts['drives']} drives, {drives.counts['episodes']} episodes: recall {pct(drives.recall)}"
-                      f"{span(drives.recall_interval)}, precision {pct(drives.precision)}{span(drives.precision_interval)}, "
+                      f"{span(drives.recall_interval)}, precision {pct(drives.precision)}{span(drives.precision_interval)}\n"
                       f"specificity {pct(drives.specificity)}{span(drives.specificity_interval)} along "
                       f"the paths driven (95% over the drives)\n{kinds}\n{L['drive_paths_driven']:.0f} m measured, "
                       f"{L['drive_paths_unmeasured']:.0f} m not (a drive's last 3 periods)")
