@@ -672,8 +672,9 @@ def _driven(route, arc, stopped, profile, pull, attraction, aim, V: float, trans
     g(y) = −atan2(F_n(y) − P − K·y, A ± F_r·t): the direction of the resultant the robot steers to (KB eq 4; the
     linear loop's N·y for small y) with the lateral force itself (interpolated in `profile` between its quarter
     cells), P and A what the goal balances across the path and its attraction along it (`_goal_pull`), K the goal's
-    pull back to the path (`_aim_stiffness`), sat the steering-rate limit. `stopped` (per direction and sample): the direction is not judged there (a
-    wall ahead, `END_FRACTION`): no lateral force. The run stops where it leaves the profile or `LEAVES`.
+    pull back to the path (`_aim_stiffness`), sat the steering-rate limit. `stopped` (per direction and sample): the
+    direction is not judged there (a wall ahead, `END_FRACTION`): no lateral force. The run stops where it leaves the
+    profile or `LEAVES`.
 
     Parameters
     ----------

@@ -124,6 +124,8 @@ def path_of(points, branch: int = 0, source: str = "path", goal=None, lookahead:
     p = p[keep]
     if len(p) < 2:
         raise ValueError(f"a {source} route needs at least two distinct points; got {len(p)}")
+    if not lookahead > 0:
+        raise ValueError(f"a {source} route's lookahead must be > 0 m; got {lookahead!r}")
     return RoutePath(p, int(branch), source, None if goal is None else (float(goal[0]), float(goal[1])), float(lookahead))
 
 
