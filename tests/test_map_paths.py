@@ -417,7 +417,7 @@ def test_goals_round_a_corner_are_reached_along_the_plan(tmp_path):
     and ends within the target's 0.3 m of the second goal (plus a cell, the path's spacing, and the period's
     averaging, V·P/4); the goal's
     distance and lookahead ride with the path, for its verdicts. The straight line between the goals crosses the
-    corner's wall."""
+    corner's wall. A goal the skeleton does not reach (beyond the L's wall) is driven at straight."""
     from pfm_stability.validation.map_drives import goal_routes
 
     img = np.full((120, 120), 254, dtype=np.uint8)  # row 0 at the top: cell centres at y = 12 − (row + 0.5)·0.1
@@ -432,6 +432,11 @@ def test_goals_round_a_corner_are_reached_along_the_plan(tmp_path):
     period = 2 * math.pi / models_for(CONTROLLER, ["sampled"])[0].boundary(Loop.of(robot, CONTROLLER, c=0.0)).omega_critical
     assert np.hypot(*(route.points[-1] - goal)) < 0.3 + analysis.grid.cell_size + robot.V * period / 4
     assert route.points[:, 1].max() > 8.0 and route.points[:, 0].min() < 3.1  # from the first arm up the second
+    # a goal outside the L (the free space beyond its one-cell wall): the skeleton does not join them, the robot
+    # goes straight at it (a point target: no lookahead) and stops at the wall
+    (straight,) = goal_routes(analysis, [start, np.array([3.0, 3.0])])
+    assert straight.goal == (3.0, 3.0) and straight.lookahead == math.inf
+    assert straight.points[:, 1].max() < 1.25
 
 
 @pytest.mark.slow
