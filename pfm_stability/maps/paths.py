@@ -365,6 +365,8 @@ def _aim_stiffness(paths, route, x, y, attraction, W: float) -> np.ndarray:
     the robot arrives); 0 on a route, whose goal lies along it at infinity (module docstring, "Paths taken")."""
     stiffness = np.zeros(np.size(x))
     for r, path in enumerate(paths):
+        if path.goal is None and not math.isfinite(path.lookahead):
+            continue  # a goal at infinity: K = 0 (every skeleton route)
         on = route == r
         D = np.full(int(on.sum()), path.lookahead)
         if path.goal is not None:

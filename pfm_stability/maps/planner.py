@@ -39,7 +39,6 @@ class SkeletonPlanner:
 
         self.grid = grid
         i, j = np.nonzero(skeleton)
-        self.i, self.j = i, j
         node = np.full(skeleton.shape, -1, dtype=np.int64)
         node[i, j] = np.arange(i.size)
         rows, cols, weights = [], [], []

@@ -4,8 +4,8 @@ A robot given a path (a polyline, m) keeps its progress s along it: the arc posi
 path ahead of it within one lookahead L, that is of the arc range [s, s + L] (the part behind is pruned, so s never
 decreases, and a later part of the path that passes nearby is not taken for the robot's place). Its attraction
 (KB eq 3) points at the carrot, the path's point at arc min(s + L, length) — the local planner's goal a global plan
-hands it, as Nav2's pure-pursuit controllers take a lookahead point (docs/simulator.md, "What is simulated", sensing). Progress towards
-the target, for the trap check, is s.
+hands it, as Nav2's pure-pursuit controllers take a lookahead point (docs/simulator.md, "What is simulated",
+sensing). Progress towards the target, for the trap check, is s.
 
 `pfm_stability.sim.reference` follows a path by its own per-robot loop over the segments; the tests compare the two.
 """
@@ -30,9 +30,9 @@ class PathFollower:
         count = max(len(t.path) for t in targets)
         n = len(targets)
         self.vx, self.vy = np.zeros((n, count)), np.zeros((n, count))
-        for m, t in enumerate(targets):  # a shorter path repeats its last vertex: zero-length segments, never nearest alone
-            pts = np.asarray(t.path, dtype=float)
-            self.vx[m], self.vy[m] = np.pad(pts[:, 0], (0, count - len(pts)), mode="edge"), np.pad(pts[:, 1], (0, count - len(pts)), mode="edge")
+        for m, t in enumerate(targets):  # a shorter path repeats its last vertex: zero-length segments, never chosen
+            pts = np.pad(np.asarray(t.path, dtype=float), ((0, count - len(t.path)), (0, 0)), mode="edge")
+            self.vx[m], self.vy[m] = pts[:, 0], pts[:, 1]
         self.dx, self.dy = np.diff(self.vx, axis=1), np.diff(self.vy, axis=1)
         self.seg = np.hypot(self.dx, self.dy)  # (n, count − 1) segment lengths, m
         self.arc = np.concatenate([np.zeros((n, 1)), np.cumsum(self.seg, axis=1)], axis=1)  # arc at each vertex, m

@@ -17,9 +17,10 @@ that grow by an e-fold or stay above `AMPLITUDE_THRESHOLD`.
 **Each drive is judged along the path it took** (its positions averaged over one period, `maps.analysis.judge_routes`
 with ``taken``: the prediction the map makes along any route — the loop driven through the force across the path,
 `maps.paths` — made along that path, in the direction it was driven, with the pull back to it of the point the robot
-steered at: its plan's carrot or its goal, `RoutePath.lookahead` and `RoutePath.goal`). The VFF robot aims at a point, not along a
-route: it leaves the skeleton wherever the field bends it away (beside a rack it rides the window's edge, metres from
-the route), so comparing the skeleton's verdicts with a robot that drove elsewhere would compare two different paths.
+steered at: its plan's carrot or its goal, `RoutePath.lookahead` and `RoutePath.goal`). The VFF robot aims at a
+point, not along a route: it leaves the skeleton wherever the field bends it away (beside a rack it rides the
+window's edge, metres from the route), so comparing the skeleton's verdicts with a robot that drove elsewhere would
+compare two different paths.
 The map's route samples within `MATCH_DISTANCE` of a drive are counted as covered (``lengths["driven"]``), not scored.
 
 **Route length** (`_score`). Each trajectory point marks its nearest sample of its own path (within `MATCH_DISTANCE`
@@ -187,9 +188,9 @@ class DriveValidation:
         replacement, `INTERVAL_RESAMPLES` times, seeded); None where the figure is None.
     specificity : float or None
         Of the length driven with a verdict and no episode within half a window (``lengths["quiet_driven"]``), the
-        share predicted stable (``quiet_predicted_stable``); None when every such metre was near an episode. Where no drive
-        oscillates, recall is undefined and precision rests on the few metres predicted unstable; this says how much
-        of the calm driving the map also called calm.
+        share predicted stable (``quiet_predicted_stable``); None when every such metre was near an episode. Where no
+        drive oscillates, recall is undefined and precision rests on the few metres predicted unstable; this says how
+        much of the calm driving the map also called calm.
     specificity_interval : tuple of float or None
         Its 95 % interval over the drives.
     """
@@ -324,7 +325,8 @@ def drive_map(analysis, count: int, *, seed: int = 0, progress=None) -> DriveVal
         sx, sy = p[0] + delta * uy, p[1] - delta * ux  # δ to the right of the travel direction
         (x_lo, y_lo), (x_hi, y_hi) = path.min(axis=0), path.max(axis=0)
         local = crop_grid(grid, x_lo - reach, x_hi + reach, y_lo - reach, y_hi + reach)
-        target = Target.point(float(q[0]), float(q[1]), radius=0.3) if kind == "route" else Target.follow(path, LOOKAHEAD, radius=0.3)
+        target = (Target.point(float(q[0]), float(q[1]), radius=0.3) if kind == "route"
+                  else Target.follow(path, LOOKAHEAD, radius=0.3))
         duration = DRIVE_TIME_FACTOR * length / robot.V + 5.0
         room = float(local.clearance([sx], [sy])[0]) - robot.W / 2
         if not room > START_ROOM:
@@ -653,7 +655,8 @@ def goal_routes(analysis, goals, progress=None) -> list:
     for k, (p, q) in enumerate(zip(goals[:-1], goals[1:])):
         planned = _planned(planner, p, q)
         if planned is None:  # no plan: straight at the goal
-            target, heading, length = Target.point(float(q[0]), float(q[1]), radius=0.3), math.atan2(q[0] - p[0], q[1] - p[1]), float(math.hypot(*(q - p)))
+            target = Target.point(float(q[0]), float(q[1]), radius=0.3)
+            heading, length = math.atan2(q[0] - p[0], q[1] - p[1]), float(math.hypot(*(q - p)))
         else:
             path, heading, length = planned
             target = Target.follow(path, LOOKAHEAD, radius=0.3)
