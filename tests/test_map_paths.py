@@ -264,7 +264,7 @@ def test_driving_finds_the_unstable_corridor_and_nothing_in_the_stable_one(root,
     """Validation by driving on two corridors: at 1.4 V* the simulator's drives oscillate and the unstable stretches
     along their paths recall >= 80 % of the episodes' length with >= 80 % precision; at 0.7 V* no drive oscillates,
     nothing is predicted unstable, and recall and precision are undefined (None: nothing to measure), not counted as
-    agreement, and all the length driven is predicted stable (specificity 100 %); each figure lies in its 95 %
+    agreement, and all the length driven is predicted stable (specificity 100 %, of each kind of drive too); each figure lies in its 95 %
     interval over the drives, whose per-drive lengths add up to it. (Recall is 97 % here: the corridor's rate-limited
     cycle, ~2 cm in the simulator, is 1.5 cm in the driven loop, at the episodes' threshold, so the first metre of a
     short drive can be missed — docs/maps.md.)"""
@@ -291,6 +291,15 @@ def test_driving_finds_the_unstable_corridor_and_nothing_in_the_stable_one(root,
     assert stable.recall is None and stable.precision is None
     assert stable.specificity == pytest.approx(1.0, rel=1e-12) and stable.specificity_interval == pytest.approx((1.0, 1.0))
     assert stable.recall_interval is None and stable.precision_interval is None
+    # the same figures per kind of drive: each kind's specificity is its own lengths' ratio; in the stable corridor 1
+    for drives, expected in ((unstable, None), (stable, 1.0)):
+        for kind in drives.by_kind.values():
+            L = kind["lengths"]
+            if L["quiet_driven"] == 0:  # every metre of this kind's driving near an episode: no figure
+                assert kind["specificity"] is None and expected is None
+                continue
+            assert kind["specificity"] == pytest.approx(L["quiet_predicted_stable"] / L["quiet_driven"], rel=1e-12)
+            assert 0.0 <= kind["specificity"] <= 1.0 and (expected is None or kind["specificity"] == pytest.approx(expected))
 
 
 def test_the_interval_over_the_drives_is_the_ratios_resampling_spread():

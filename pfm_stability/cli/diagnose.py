@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import time
 
-from .identify import FORMATS, topic
+from .identify import FORMATS, add_topic_options
 
 __all__ = ["add_parser", "run", "render_text", "render_markdown", "parameters_table"]
 
@@ -77,9 +77,7 @@ def add_parser(sub) -> None:
     p.add_argument("--format", choices=FORMATS, default="text")
     p.add_argument("--plot", type=output_path("plot", ".png"), metavar="PNG",
                    help="draw the lateral offsets with the predicted envelopes, the walls seen and the stretches judged")
-    p.add_argument("--cmd-topic", type=topic("cmd-topic"), default="/cmd_vel", metavar="TOPIC", help="the command (Twist or TwistStamped; default /cmd_vel)")
-    p.add_argument("--odom-topic", type=topic("odom-topic"), default="/odom", metavar="TOPIC", help="the odometry (Odometry; default /odom)")
-    p.add_argument("--scan-topic", type=topic("scan-topic"), default="/scan", metavar="TOPIC", help="the laser scans (LaserScan; default /scan)")
+    add_topic_options(p, ("cmd", "odom", "scan"))
     add_parameter_options(p)
     p.set_defaults(run=run)
 

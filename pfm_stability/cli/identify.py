@@ -29,7 +29,7 @@ import os
 import re
 import time
 
-__all__ = ["add_parser", "run", "render_text", "render_markdown", "robot_yaml", "topic", "FORMATS"]
+__all__ = ["add_parser", "add_topic_options", "run", "render_text", "render_markdown", "robot_yaml", "topic", "FORMATS", "TOPICS"]
 
 FORMATS = ("text", "json", "markdown")
 _TOPIC = re.compile(r"^(~/|/)?[A-Za-z_][A-Za-z0-9_]*(/[A-Za-z0-9_]+)*$")
@@ -56,6 +56,28 @@ def topic(name: str):
     return parse
 
 
+TOPICS = {"cmd": ("/cmd_vel", "the command (Twist or TwistStamped; default /cmd_vel)"),
+          "odom": ("/odom", "the odometry (Odometry; default /odom)"),
+          "imu": ("/imu", "the IMU (Imu; default /imu), read with --rate-source imu"),
+          "scan": ("/scan", "the laser scans (LaserScan; default /scan)")}
+"""The log's topics a command reads: option ``--KEY-topic``, its default and help."""
+
+
+def add_topic_options(parser: argparse.ArgumentParser, keys) -> None:
+    """Add a ``--KEY-topic`` option (`TOPICS`) to `parser` for each of `keys`.
+
+    Parameters
+    ----------
+    parser : argparse.ArgumentParser
+        The command's parser.
+    keys : iterable of str
+        Keys of `TOPICS`.
+    """
+    for key in keys:
+        default, help_text = TOPICS[key]
+        parser.add_argument(f"--{key}-topic", type=topic(f"{key}-topic"), default=default, metavar="TOPIC", help=help_text)
+
+
 def add_parser(sub) -> None:
     """Add the ``identify`` subcommand to `sub` (argparse subparsers).
 
@@ -77,9 +99,7 @@ def add_parser(sub) -> None:
     p.add_argument("--out", type=output_path("out", ".yaml"), metavar="ROBOT.yaml",
                    help="write the identified tau, dead_time, plant_gain and T as a configuration file (docs/config.md)")
     p.add_argument("--format", choices=FORMATS, default="text")
-    p.add_argument("--cmd-topic", type=topic("cmd-topic"), default="/cmd_vel", metavar="TOPIC", help="the command (Twist or TwistStamped; default /cmd_vel)")
-    p.add_argument("--odom-topic", type=topic("odom-topic"), default="/odom", metavar="TOPIC", help="the odometry (Odometry; default /odom)")
-    p.add_argument("--imu-topic", type=topic("imu-topic"), default="/imu", metavar="TOPIC", help="the IMU (Imu; default /imu), read with --rate-source imu")
+    add_topic_options(p, ("cmd", "odom", "imu"))
     p.add_argument("--rate-source", choices=("odometry", "imu"), default="odometry",
                    help="where the achieved yaw rate comes from (default: odometry)")
     p.set_defaults(run=run)

@@ -179,7 +179,7 @@ class DriveValidation:
     episode_points : ndarray, shape (n, 2)
         Robot positions during the episodes, m (for the picture).
     by_kind : dict
-        ``route`` and ``waypoints``: the same recall, precision and lengths over that kind of drive only.
+        ``route`` and ``waypoints``: the same recall, precision, specificity and lengths over that kind of drive only.
     drive_paths : PathVerdicts or None
         The verdicts along the paths the drives took (`maps.analysis.judge_routes`): the drives are scored
         against them (a disagreement's ``route`` >= the map's route count is drive path ``route`` − that count).
@@ -410,8 +410,11 @@ def drive_map(analysis, count: int, *, seed: int = 0, progress=None) -> DriveVal
     for kind in ("route", "waypoints"):
         chosen = [k for k, d in enumerate(drives) if d.kind == kind]
         kind_lengths, kind_recall, kind_precision = _score(sc, marks, chosen, unstable, stable, near_unstable, half, base)[:3]
+        kind_specificity = _ratio(kind_lengths, "quiet_predicted_stable", "quiet_driven")
         by_kind[kind] = {"recall": json_number(kind_recall) if kind_recall is not None else None,
-                         "precision": json_number(kind_precision) if kind_precision is not None else None, "lengths": kind_lengths}
+                         "precision": json_number(kind_precision) if kind_precision is not None else None,
+                         "specificity": json_number(kind_specificity) if kind_specificity is not None else None,
+                         "lengths": kind_lengths}
     passed_by = [set() for _ in range(sc.code.size)]
     for d, mark in zip(drives, marks):
         for k in mark.scored:
