@@ -13,6 +13,7 @@ from __future__ import annotations
 import json
 import math
 import os
+import re
 from itertools import pairwise
 
 import numpy as np
@@ -281,6 +282,24 @@ def test_config_file_gives_the_fixed_values(tmp_path):
     (tmp_path / "bad.yaml").write_text("config: missing.yaml\ngrid: {tau: {from: 0.1, to: 0.6, num: 3}}\n")
     with pytest.raises(ValueError, match=r"bad.yaml, line \d+: config: .*missing.yaml"):
         load_spec(tmp_path / "bad.yaml")
+
+
+@pytest.mark.parametrize("robot, message", [("{dead_time: 0.05}", r"robot.dead_time 0.05 s is not modelled by sweeps"),
+                                            ("{plant_gain: 0.85}", r"robot.plant_gain 0.85 is not modelled by sweeps")])
+def test_a_config_with_a_plant_sweeps_do_not_model_is_refused(tmp_path, capsys, robot, message):
+    """A robot with a dead time or a plant gain (as `identify --out` writes it): the sweep models KB's plant only, so
+    it refuses the file (library: ValueError; command line: exit 2, the value named) rather than answer for another
+    robot; the same file with dead_time 0 and plant_gain 1 sweeps."""
+    from pfm_stability.sweeps import load_spec
+
+    (tmp_path / "robot.yaml").write_text(f"robot: {robot}\n")
+    (tmp_path / "plain.yaml").write_text("robot: {dead_time: 0, plant_gain: 1}\n")
+    (tmp_path / "s.yaml").write_text("config: robot.yaml\nscenario: {wall: {alpha: 40}}\nmodels: [sampled]\ngrid: {V: {from: 0.2, to: 1.2, num: 3}}\n")
+    with pytest.raises(ValueError, match=message):
+        load_spec(tmp_path / "s.yaml")
+    assert load_spec(tmp_path / "s.yaml", config=tmp_path / "plain.yaml").robot.dead_time == 0.0
+    assert main(["sweep", str(tmp_path / "s.yaml"), "--config", str(tmp_path / "robot.yaml"), "--out", str(tmp_path / "t.parquet")]) == 2
+    assert re.search(message, capsys.readouterr().err) and not (tmp_path / "t.parquet").exists()
 
 
 # ------------------------------------------------------------------ engine

@@ -19,7 +19,8 @@ __all__ = ["SkeletonPlanner", "TOLERANCE_CELLS"]
 TOLERANCE_CELLS = 1.0
 """Largest distance of a plan's cells from its polyline, cells (3 cells, which straightens the skeleton's bends
 towards a room's openings, raised the bookstore's recall with the small robot to 77–79 % but lowered the small
-house's precision at CARMEL to 72 % over 50 drives: kept at one)."""
+house's precision at CARMEL to 72 % over 50 drives: kept at one; docs/maps.md also gives the figures of a plan
+straightened by shortcuts that keep the skeleton's room, not kept either)."""
 
 
 class SkeletonPlanner:
