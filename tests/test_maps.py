@@ -157,6 +157,26 @@ def test_field_equals_the_simulators_window_sum_on_a_random_map():
     assert np.abs(dfx[same_cell] - ex[2][same_cell]).max() < 1e-5 * np.abs(ex[2][same_cell]).max()
 
 
+def test_the_field_does_not_depend_on_how_its_sum_is_chunked(monkeypatch):
+    """`window_force` sums a chunk of points at a time (`field.CHUNK_ENTRIES` window cells): chunks of 37 cells —
+    hundreds of chunks, and points with more cells than a chunk, alone in theirs — give the one-chunk answer to 4 ULP
+    (each point's cells are summed in the same order either way, by one `np.bincount`), points off the grid included."""
+    from pfm_stability.maps import field
+
+    rng = np.random.default_rng(11)
+    law = make_law("grid", ROBOT, CONTROLLER, cell_size=0.1, window_cells=15)
+    cv = np.where(rng.random((40, 30)) < 0.2, 15, 0).astype(np.int16)
+    hmap = HistogramMap(0.0, 0.0, 0.1, cv)
+    px, py = rng.uniform(-1.0, 5.0, 2000), rng.uniform(-1.0, 4.0, 2000)
+    whole = window_force(hmap, law, px, py, jacobian=True)
+    monkeypatch.setattr(field, "CHUNK_ENTRIES", 37)
+    chunked = window_force(hmap, law, px, py, jacobian=True)
+    for a, b in zip(whole, chunked):
+        ok = np.isfinite(a)
+        np.testing.assert_array_equal(np.isfinite(b), ok)
+        assert np.all(np.abs(a[ok] - b[ok]) <= 4 * np.spacing(np.abs(a[ok]))) and np.abs(a[ok]).max() > 0
+
+
 # ------------------------------------------------------------------ corridors against report --law grid
 @pytest.mark.parametrize("L, n, f", [(0.9, 2.0, 0.8), (1.2, 2.0, 0.8), (0.7, 1.5, 2.5)])
 def test_straight_corridor_matches_the_report(tmp_path, L, n, f):
