@@ -294,11 +294,13 @@ def test_a_config_with_a_plant_sweeps_do_not_model_is_refused(tmp_path, capsys, 
 
     (tmp_path / "robot.yaml").write_text(f"robot: {robot}\n")
     (tmp_path / "plain.yaml").write_text("robot: {dead_time: 0, plant_gain: 1}\n")
-    (tmp_path / "s.yaml").write_text("config: robot.yaml\nscenario: {wall: {alpha: 40}}\nmodels: [sampled]\ngrid: {V: {from: 0.2, to: 1.2, num: 3}}\n")
+    (tmp_path / "s.yaml").write_text("config: robot.yaml\nscenario: {wall: {alpha: 40}}\nmodels: [sampled]\n"
+                                     "grid: {V: {from: 0.2, to: 1.2, num: 3}}\n")
     with pytest.raises(ValueError, match=message):
         load_spec(tmp_path / "s.yaml")
     assert load_spec(tmp_path / "s.yaml", config=tmp_path / "plain.yaml").robot.dead_time == 0.0
-    assert main(["sweep", str(tmp_path / "s.yaml"), "--config", str(tmp_path / "robot.yaml"), "--out", str(tmp_path / "t.parquet")]) == 2
+    command = ["sweep", str(tmp_path / "s.yaml"), "--config", str(tmp_path / "robot.yaml"), "--out", str(tmp_path / "t.parquet")]
+    assert main(command) == 2
     assert re.search(message, capsys.readouterr().err) and not (tmp_path / "t.parquet").exists()
 
 

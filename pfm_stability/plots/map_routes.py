@@ -105,7 +105,8 @@ def plot_route_verdicts(analysis, drives=None, ax=None, *, title: str | None = N
             return "n/a" if v is None else f"{100 * v:.0f}%"
 
         L = drives.lengths
-        kinds = "; ".join(f"{kind} drives {pct(v['recall'])} / {pct(v['precision'])} / {pct(v['specificity'])}" for kind, v in drives.by_kind.items())
+        kinds = "; ".join(f"{kind} drives {pct(v['recall'])} / {pct(v['precision'])} / {pct(v['specificity'])}"
+                          for kind, v in drives.by_kind.items())
         def span(interval):
             return f" ({100 * interval[0]:.0f}–{100 * interval[1]:.0f}%)" if interval else ""
 

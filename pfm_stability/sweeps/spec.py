@@ -369,14 +369,14 @@ def _base(where: _Where, data: dict, base_dir):
             config = where.wrap("config", load_config, path)
         else:
             where.fail(f"config must be a file name or a mapping; got {given!r}", "config")
-        _steering_only(where, config, "law" in data)
+        _sweepable_robot(where, config, "law" in data)
         return config.robot, config.controller, config.law, dict(config.scenario or {}), dict(config.sources)
     preset = where.wrap("preset", get_preset, data.get("preset", "carmel"))
     sources = {name: f"preset {preset.name}" for name in ("V", "tau", "k", "W", "f", "n", "T", "hold", "compute_delay")}
     return preset.robot, preset.controller, None, {}, sources
 
 
-def _steering_only(where: _Where, config, own_law: bool) -> None:
+def _sweepable_robot(where: _Where, config, own_law: bool) -> None:
     """Refuse a config's robot family other than steering, its law that sweeps do not take (`SWEEP_LAWS`) unless
     the spec's own ``law`` replaces it, and its plant's dead time or gain: sweeps analyse KB's steering robot with the
     static laws (docs/config.md), its plant 1/(τs + 1) (docs/sweeps.md)."""
