@@ -13,7 +13,6 @@ from __future__ import annotations
 import json
 import math
 import os
-import re
 from itertools import pairwise
 
 import numpy as np
@@ -284,24 +283,66 @@ def test_config_file_gives_the_fixed_values(tmp_path):
         load_spec(tmp_path / "bad.yaml")
 
 
-@pytest.mark.parametrize("robot, message", [("{dead_time: 0.05}", r"robot.dead_time 0.05 s is not modelled by sweeps"),
-                                            ("{plant_gain: 0.85}", r"robot.plant_gain 0.85 is not modelled by sweeps")])
-def test_a_config_with_a_plant_sweeps_do_not_model_is_refused(tmp_path, capsys, robot, message):
-    """A robot with a dead time or a plant gain (as `identify --out` writes it): the sweep models KB's plant only, so
-    it refuses the file (library: ValueError; command line: exit 2, the value named) rather than answer for another
-    robot; the same file with dead_time 0 and plant_gain 1 sweeps."""
-    from pfm_stability.sweeps import load_spec
+def _plant_columns(robot, models, grid, controller=None, simulate=False):
+    """The sweep's columns for CARMEL's preset with `robot` and `controller` changed (an embedded config), 0.9 m corridor."""
+    config = {"preset": "carmel", "robot": robot, **({"controller": controller} if controller else {})}
+    return _columns(spec_from_mapping({"config": config, "scenario": {"corridor": {"L": 0.9}}, "models": models, "grid": grid,
+                                       "simulate": simulate}, origin="s.yaml"))
 
-    (tmp_path / "robot.yaml").write_text(f"robot: {robot}\n")
-    (tmp_path / "plain.yaml").write_text("robot: {dead_time: 0, plant_gain: 1}\n")
-    (tmp_path / "s.yaml").write_text("config: robot.yaml\nscenario: {wall: {alpha: 40}}\nmodels: [sampled]\n"
-                                     "grid: {V: {from: 0.2, to: 1.2, num: 3}}\n")
-    with pytest.raises(ValueError, match=message):
-        load_spec(tmp_path / "s.yaml")
-    assert load_spec(tmp_path / "s.yaml", config=tmp_path / "plain.yaml").robot.dead_time == 0.0
-    command = ["sweep", str(tmp_path / "s.yaml"), "--config", str(tmp_path / "robot.yaml"), "--out", str(tmp_path / "t.parquet")]
-    assert main(command) == 2
-    assert re.search(message, capsys.readouterr().err) and not (tmp_path / "t.parquet").exists()
+
+def test_a_plant_gain_enters_every_model_as_the_steering_gain_g_times_k():
+    """A config's plant gain g (as `identify --out` writes it; docs/models.md, "Plant gain and dead time") makes the
+    loop's steering gain g·k: the sweep at k = 3 1/s, g = 0.4 (every point the scalar model, no array route) gives every
+    model's NV*, verdict and margin of KB's plant at k = 1.2 1/s (the array routes: another code path), NV* to 1e-12
+    relative (closed forms and the same polynomials: measured 5e-15), over V and T."""
+    grid = {"V": {"from": 0.2, "to": 1.6, "num": 5}, "T": {"from": 0.02, "to": 0.2, "num": 3}}
+    plant = _plant_columns({"k": 3.0, "plant_gain": 0.4}, list(MODEL_NAMES), grid)
+    kb = _plant_columns({"k": 1.2}, list(MODEL_NAMES), grid)
+    for m in MODEL_NAMES:
+        np.testing.assert_allclose(plant[f"{m}_NV_critical"], kb[f"{m}_NV_critical"], rtol=1e-12)
+        np.testing.assert_allclose(plant[f"{m}_margin"], kb[f"{m}_margin"], rtol=1e-10, atol=1e-12)
+        assert list(plant[f"{m}_verdict"]) == list(kb[f"{m}_verdict"])
+    assert 0 < sum(v == "stable" for v in plant["sampled_verdict"]) < len(plant["sampled_verdict"])  # both verdicts met
+
+
+def test_a_dead_time_delays_the_continuous_models_and_the_sampled_model_agrees_with_the_simulator():
+    """A dead time D adds to the continuous-time models' delay (KB eq 18 with T + D; `continuous` has none): at T = 0.05 s
+    and D = 0.07 s they give KB's plant's answers at T = 0.12 s (NV* to 1e-12). The sampled model carries the commands
+    on their way instead (its period stays T): with D = 0.12 s and g = 0.8 its verdict is the simulator's (the sweep's
+    own sim column: the growth of the lateral motion, `validation.sweep`) at every point, among them V = 0.64 m/s,
+    unstable with that plant and stable with KB's (NV = 1.80 1/s, NV* 1.57 against 2.33 1/s)."""
+    plant = _plant_columns({"dead_time": 0.07}, list(MODEL_NAMES), {"V": {"from": 0.2, "to": 1.6, "num": 5}}, {"T": 0.05})
+    kb = _plant_columns({}, list(MODEL_NAMES), {"V": {"from": 0.2, "to": 1.6, "num": 5}}, {"T": 0.12})
+    for m in ("continuous", "kb_first_order", "pade", "exact_delay"):
+        np.testing.assert_allclose(plant[f"{m}_NV_critical"], kb[f"{m}_NV_critical"], rtol=1e-12)
+        assert list(plant[f"{m}_verdict"]) == list(kb[f"{m}_verdict"])
+    grid = {"V": {"from": 0.3, "to": 2.0, "num": 6}}
+    plant = _plant_columns({"dead_time": 0.12, "plant_gain": 0.8}, ["sampled"], grid, {"T": 0.05}, simulate=True)
+    kb = _plant_columns({}, ["sampled"], grid, {"T": 0.05})
+    assert list(plant["sampled_verdict"]) == list(plant["sim_verdict"])
+    assert plant["sampled_verdict"][1] == "unstable" and kb["sampled_verdict"][1] == "stable"
+    assert plant["sampled_NV_critical"][0] == pytest.approx(1.5732, rel=1e-4) and kb["sampled_NV_critical"][0] == pytest.approx(2.3345, rel=1e-4)
+
+
+def test_a_plant_is_part_of_the_sweeps_digest_and_kb_s_plant_leaves_it_as_it_was(tmp_path):
+    """`--resume` reuses parts only of the same sweep: a plant gain or dead time changes the digest; KB's plant (g = 1,
+    D = 0, given or not) adds nothing to the normalized spec, so the digests of sweeps without one are unchanged."""
+    base = {"scenario": {"wall": {"alpha": 40}}, "models": ["sampled"], "grid": {"V": {"from": 0.2, "to": 1.2, "num": 3}}}
+    plain = spec_from_mapping({**base, "config": {"preset": "carmel", "robot": {"dead_time": 0, "plant_gain": 1}}})
+    assert plain.digest == spec_from_mapping({**base, "preset": "carmel"}).digest
+    assert "dead_time" not in plain.to_dict()["robot"] and "plant_gain" not in plain.to_dict()["robot"]
+    digests = {spec_from_mapping({**base, "config": {"preset": "carmel", "robot": robot}}).digest
+               for robot in ({"dead_time": 0.05}, {"plant_gain": 0.85}, {"dead_time": 0.05, "plant_gain": 0.85})}
+    assert len(digests) == 3 and plain.digest not in digests
+    # the command line: a robot file as `identify --out` writes it, given with --config, sweeps (exit 0)
+    (tmp_path / "robot.yaml").write_text("robot: {tau: 0.15, dead_time: 0.05, plant_gain: 0.9}\ncontroller: {T: 0.1}\n")
+    (tmp_path / "s.yaml").write_text("scenario: {wall: {alpha: 40}}\nmodels: [sampled]\ngrid: {V: {from: 0.2, to: 1.2, num: 3}}\n")
+    out = tmp_path / "t.parquet"
+    assert main(["sweep", str(tmp_path / "s.yaml"), "--config", str(tmp_path / "robot.yaml"), "--out", str(out), "--quiet"]) == 0
+    import pyarrow.parquet as pq
+
+    robot = json.loads(pq.read_table(out).schema.metadata[b"pfm_stability.spec"])["robot"]
+    assert (robot["dead_time"], robot["plant_gain"]) == (0.05, 0.9)
 
 
 # ------------------------------------------------------------------ engine

@@ -364,3 +364,12 @@ def test_closed_form_cubic_root_equals_the_newton_iteration():
     assert np.all(expected > 0) and np.all(np.isfinite(y))
     np.testing.assert_allclose(y, expected, rtol=1e-12, atol=0.0)
     assert sum(fallback) < tau.size / 100
+
+
+@pytest.mark.parametrize("plant, message", [({"plant_gain": 0.0}, r"plant_gain must be .*\[0.001, 100\].*got 0.0"),
+                                            ({"dead_time": -0.1}, r"dead_time must be .*\[0, 10\] s.*got -0.1")])
+def test_a_plant_out_of_its_range_is_refused_by_name(plant, message):
+    """`loop_verdicts` takes the steering plant's gain and dead time (the sweep's config) with the scalar models' ranges
+    and words (`parameters.RANGES`)."""
+    with pytest.raises(ValueError, match=message):
+        loop_verdicts("sampled", 0.3, 0.065, 2.0, 1.0, **plant)

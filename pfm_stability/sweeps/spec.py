@@ -204,7 +204,9 @@ class SweepSpec:
     def to_dict(self) -> dict:
         """The normalized spec (what the digest covers; JSON-ready)."""
         return {
-            "robot": {n: getattr(self.robot, n) for n in ("V", "tau", "k", "W", "max_steering_rate")},
+            "robot": {**{n: getattr(self.robot, n) for n in ("V", "tau", "k", "W", "max_steering_rate")},
+                      **({"plant_gain": self.robot.plant_gain} if self.robot.plant_gain != 1.0 else {}),
+                      **({"dead_time": self.robot.dead_time} if self.robot.dead_time != 0.0 else {})},  # KB's plant: none
             "controller": {n: getattr(self.controller, n) for n in ("f", "n", "T", "hold", "compute_delay")},
             "geometry": self.geometry,
             "geometry_value": self.geometry_value,
@@ -377,9 +379,8 @@ def _base(where: _Where, data: dict, base_dir):
 
 
 def _sweepable_robot(where: _Where, config, own_law: bool) -> None:
-    """Refuse a config's robot family other than steering, its law that sweeps do not take (`SWEEP_LAWS`) unless
-    the spec's own ``law`` replaces it, and its plant's dead time or gain: sweeps analyse KB's steering robot with the
-    static laws (docs/config.md), its plant 1/(τs + 1) (docs/sweeps.md)."""
+    """Refuse a config's robot family other than steering, and its law that sweeps do not take (`SWEEP_LAWS`) unless
+    the spec's own ``law`` replaces it: sweeps analyse KB's steering robot with the static laws (docs/config.md)."""
     others = [name for name in LAW_NAMES if name not in SWEEP_LAWS]
     why = f"sweeps analyse KB's steering robot with the laws {', '.join(SWEEP_LAWS)}; robot families and the laws " \
           f"{', '.join(others)} are report's (docs/velocity_and_fuzzy.md)"
@@ -387,12 +388,6 @@ def _sweepable_robot(where: _Where, config, own_law: bool) -> None:
         where.fail(f"config: robot.family {config.family} is not supported: {why}", "config")
     if config.law is not None and config.law["name"] not in SWEEP_LAWS and not own_law:
         where.fail(f"config: law.name {config.law['name']} is not supported: {why}", "config")
-    robot = config.robot
-    for name, value, plain, unit in (("dead_time", robot.dead_time, 0.0, " s"), ("plant_gain", robot.plant_gain, 1.0, "")):
-        if value != plain:
-            where.fail(f"config: robot.{name} {value:g}{unit} is not modelled by sweeps, which analyse KB's plant (dead time "
-                       f"0, plant gain 1); report, validate, plot, simulate and map take it, or set {name}: {plain:g} in the "
-                       "config to sweep KB's plant (docs/sweeps.md)", "config")
 
 
 def _models(where: _Where, models) -> tuple:

@@ -36,7 +36,7 @@ from ..checks import check_choice, check_integer, check_number
 from ..models import Loop, make_model
 from ..models.base import _check_NV
 from ..models.verdicts import NV_MAX, gain_margin, judge_arrays, verdict_label
-from ..parameters import HOLDS, MODEL_NAMES
+from ..parameters import HOLDS, MODEL_NAMES, check_parameter
 from . import routes
 from .exact_delay import _check, heading_gain_array, resolved_lag_and_delay
 from .routes import Answers as _Answers
@@ -101,13 +101,19 @@ def _NV_array(NV) -> np.ndarray:
     return NV + 0.0
 
 
-def _options(model, hold, compute_delay, pade_order):
+def _options(model, hold, compute_delay, pade_order, plant_gain=1.0, dead_time=0.0):
     """The checked model name and its options (the scalar models' messages)."""
     check_choice("model", model, MODEL_NAMES)
     hold = check_choice("hold", hold, HOLDS)
     compute_delay = check_integer("compute_delay", compute_delay, 0, 1)
     pade_order = check_integer("pade_order", pade_order, 1, 12)
-    return model, {"hold": hold, "compute_delay": compute_delay, "pade_order": pade_order}
+    plant = {"plant_gain": check_parameter("plant_gain", plant_gain), "dead_time": check_parameter("dead_time", dead_time)}
+    return model, {"hold": hold, "compute_delay": compute_delay, "pade_order": pade_order, "plant": plant}
+
+
+def _kb_plant(options) -> bool:
+    """KB's plant 1/(τs + 1) (plant gain 1, no dead time): the loops the array routes solve."""
+    return options["plant"] == {"plant_gain": 1.0, "dead_time": 0.0}
 
 
 def loop_arrays(tau, T, k, NV, c=None):
@@ -131,13 +137,13 @@ def loop_arrays(tau, T, k, NV, c=None):
     return (tau, T, k, c, NV), shape
 
 
-def _scalar_route(model, points, index, answers: _Answers, verdicts: bool) -> list:
-    """The scalar model's boundary at the points `index` (and its `is_stable` if `verdicts`):
-    fills `answers` there and returns the (point, Boundary) pairs."""
+def _scalar_route(model, points, index, answers: _Answers, verdicts: bool, plant: dict) -> list:
+    """The scalar model's boundary at the points `index` (and its `is_stable` if `verdicts`), for the steering plant
+    `plant` (``plant_gain``, ``dead_time``): fills `answers` there and returns the (point, Boundary) pairs."""
     tau, T, k, c, NV = points
     out = []
     for i in index:
-        loop = Loop(float(tau[i]), float(T[i]), float(k[i]), c=float(c[i]))
+        loop = Loop(float(tau[i]), float(T[i]), float(k[i]), c=float(c[i]), **plant)
         boundary = model.boundary(loop)
         if verdicts:
             answers.stable[i] = model.is_stable(float(NV[i]), loop)
@@ -160,7 +166,8 @@ def _fallback(points, options):
     return _Answers(np.zeros(n, bool), np.zeros(n), np.zeros(n), np.ones(n, bool)), np.arange(n), True
 
 
-def loop_verdicts(model, tau, T, k, NV, *, c=None, hold="command", compute_delay=0, pade_order=3, columns="all") -> LoopVerdicts:
+def loop_verdicts(model, tau, T, k, NV, *, c=None, hold="command", compute_delay=0, pade_order=3, plant_gain=1.0, dead_time=0.0,
+                  columns="all") -> LoopVerdicts:
     """One loop model's verdicts, NV* and margins for arrays of points.
 
     All arrays broadcast together (scalars allowed).
@@ -185,6 +192,11 @@ def loop_verdicts(model, tau, T, k, NV, *, c=None, hold="command", compute_delay
         ``sampled`` only: samples from measurement to actuation.
     pade_order : int
         ``pade`` only: Padé order m, 1 … 12.
+    plant_gain, dead_time : float
+        The steering plant's gain g ([0.001, 100]) and dead time D (s, [0, 10]), the same at every point
+        (`models.Loop`; default 1 and 0, KB's plant). Another plant than KB's has no array route: every point is
+        the scalar model's (`models.make_model`), some thirty times slower (6.5 against 0.25 ms a point for the five
+        models, 200 random loops).
     columns : {"all", "verdict"}
         ``"all"`` (default): every field. ``"verdict"``: only `stable` and
         `verdict` (the same values as with ``"all"``), several times faster
@@ -203,21 +215,22 @@ def loop_verdicts(model, tau, T, k, NV, *, c=None, hold="command", compute_delay
         An unknown model or option, or the first out-of-range value
         (parameter, range, point index) — the scalar models' messages.
     """
-    name, options = _options(model, hold, compute_delay, pade_order)
+    name, options = _options(model, hold, compute_delay, pade_order, plant_gain, dead_time)
     check_choice("columns", columns, COLUMNS)
     points, shape = loop_arrays(tau, T, k, NV, c)
-    if columns == "verdict" and name in _STABILITY:
+    if columns == "verdict" and name in _STABILITY and _kb_plant(options):
         return _verdicts_only(name, points, shape, options)
     return _all_columns(name, points, shape, options)
 
 
 def _all_columns(name, points, shape, options) -> LoopVerdicts:
     """Every field of `LoopVerdicts` for flat checked points."""
-    answers, scalar, verdicts = _ROUTES.get(name, _fallback)(points, options)
+    route = _ROUTES.get(name, _fallback) if _kb_plant(options) else _fallback  # another plant: the scalar model
+    answers, scalar, verdicts = route(points, options)
     irregular = []
     if len(scalar):
         scalar_model = make_model(name, pade_order=options["pade_order"], hold=options["hold"], compute_delay=options["compute_delay"])
-        irregular = _scalar_route(scalar_model, points, scalar, answers, verdicts)
+        irregular = _scalar_route(scalar_model, points, scalar, answers, verdicts, options["plant"])
     NV = points[4]
     verdict, margin = judge_arrays(NV, answers.NV_critical, answers.stable)
     if irregular:
