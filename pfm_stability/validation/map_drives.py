@@ -69,6 +69,9 @@ INTERVAL_RESAMPLES = 2000
 LOOKAHEAD = 2.0
 """How far ahead along its plan a waypoint drive's robot is pulled, m (`sim.follow`; docs/maps.md, "Validation by
 driving": at 1 m and 3 m the figures were worse)."""
+FIGURES = {"recall": ("episode_recalled", "episode"), "precision": ("predicted_unstable_matched", "predicted_unstable_driven"),
+           "specificity": ("quiet_predicted_stable", "quiet_driven")}
+"""Each figure of the validation: the (part, whole) of `_score`'s lengths whose ratio it is (module docstring)."""
 CROP_SLACK = 3.0
 """How far (m) around a drive's straight line its cropped grid reaches beyond the window."""
 
@@ -404,16 +407,13 @@ def drive_map(analysis, count: int, *, seed: int = 0, progress=None) -> DriveVal
                             np.union1d(unmeasured, np.intersect1d(scored, cut)), on_routes))
         points.append(np.column_stack([x[during], y[during]]))
     near_unstable = _within(unstable, sc.route, sc.arc, half)
-    lengths, recall, precision, driven, episode, near_episode = _score(sc, marks, range(len(drives)), unstable, stable, near_unstable, half, base)
-    specificity = _ratio(lengths, "quiet_predicted_stable", "quiet_driven")
+    lengths, driven, episode, near_episode = _score(sc, marks, range(len(drives)), unstable, stable, near_unstable, half, base)
+    figures = _figures(lengths)
     by_kind = {}
     for kind in ("route", "waypoints"):
         chosen = [k for k, d in enumerate(drives) if d.kind == kind]
-        kind_lengths, kind_recall, kind_precision = _score(sc, marks, chosen, unstable, stable, near_unstable, half, base)[:3]
-        kind_specificity = _ratio(kind_lengths, "quiet_predicted_stable", "quiet_driven")
-        by_kind[kind] = {"recall": json_number(kind_recall) if kind_recall is not None else None,
-                         "precision": json_number(kind_precision) if kind_precision is not None else None,
-                         "specificity": json_number(kind_specificity) if kind_specificity is not None else None,
+        kind_lengths = _score(sc, marks, chosen, unstable, stable, near_unstable, half, base)[0]
+        by_kind[kind] = {**{name: json_number(v) if v is not None else None for name, v in _figures(kind_lengths).items()},
                          "lengths": kind_lengths}
     passed_by = [set() for _ in range(sc.code.size)]
     for d, mark in zip(drives, marks):
@@ -433,18 +433,15 @@ def drive_map(analysis, count: int, *, seed: int = 0, progress=None) -> DriveVal
               "noise_floor": NOISE_FLOOR, "match_distance": limit, "start_offset": START_OFFSET,
               "interval_resamples": INTERVAL_RESAMPLES}
     per_drive = [_score(sc, marks, [k], unstable, stable, near_unstable, half, base)[0] for k in range(len(drives))]
-    shares = {key: np.array([L[key] for L in per_drive], dtype=float) for key in
-              ("episode", "episode_recalled", "predicted_unstable_driven", "predicted_unstable_matched", "quiet_driven",
-               "quiet_predicted_stable")}
     resampled = np.random.default_rng([seed, 1])
-    recall_interval = _interval(shares["episode_recalled"], shares["episode"], resampled) if recall is not None else None
-    precision_interval = (_interval(shares["predicted_unstable_matched"], shares["predicted_unstable_driven"], resampled)
-                          if precision is not None else None)
-    specificity_interval = (_interval(shares["quiet_predicted_stable"], shares["quiet_driven"], resampled)
-                            if specificity is not None else None)
+    intervals = {}
+    for name, (part, whole) in FIGURES.items():  # in this order: they draw on one generator
+        shares = [np.array([L[key] for L in per_drive], dtype=float) for key in (part, whole)]
+        intervals[name] = _interval(*shares, resampled) if figures[name] is not None else None
     pts = np.vstack(points) if points else np.zeros((0, 2))
-    return DriveValidation(recall, precision, tuple(drives), disagreements, lengths, counts, inputs, time.perf_counter() - started, pts,
-                           by_kind, dp, recall_interval, precision_interval, specificity, specificity_interval)
+    return DriveValidation(figures["recall"], figures["precision"], tuple(drives), disagreements, lengths, counts, inputs,
+                           time.perf_counter() - started, pts, by_kind, dp, intervals["recall"], intervals["precision"],
+                           figures["specificity"], intervals["specificity"])
 
 
 @dataclass(frozen=True)
@@ -488,7 +485,7 @@ class _Marks:
 
 
 def _score(sc, marks, chosen, unstable, stable, near_unstable, half, base):
-    """(lengths, recall, precision, driven, episode, near_episode) of the drives `chosen` (module docstring); the
+    """(lengths, driven, episode, near_episode) of the drives `chosen` (module docstring); the
     first `base` samples are the map's routes' (passed: coverage only), the rest the drives' own paths' (scored)."""
     driven = np.zeros(sc.code.size, dtype=bool)
     episode = np.zeros(sc.code.size, dtype=bool)
@@ -519,9 +516,7 @@ def _score(sc, marks, chosen, unstable, stable, near_unstable, half, base):
         "quiet_driven": float(ds[scored & ~near_episode & (stable | unstable)].sum()),
         "quiet_predicted_stable": float(ds[scored & ~near_episode & stable].sum()),
     }
-    recall = _ratio(lengths, "episode_recalled", "episode")
-    precision = _ratio(lengths, "predicted_unstable_matched", "predicted_unstable_driven")
-    return lengths, recall, precision, scored, episode, near_episode
+    return lengths, scored, episode, near_episode
 
 
 @dataclass(frozen=True)
@@ -561,9 +556,9 @@ def _cut_short(path: np.ndarray, arc: np.ndarray, unstable: np.ndarray, unjudged
     return path[u & np.isfinite(first[stretch]) & (s + reach >= first[stretch])]
 
 
-def _ratio(lengths: dict, part: str, whole: str) -> float | None:
-    """lengths[part] / lengths[whole] (None when the whole is 0: nothing to measure)."""
-    return lengths[part] / lengths[whole] if lengths[whole] > 0 else None
+def _figures(lengths: dict) -> dict:
+    """Each of `FIGURES`: lengths[part] / lengths[whole] (None when the whole is 0: nothing to measure)."""
+    return {name: lengths[part] / lengths[whole] if lengths[whole] > 0 else None for name, (part, whole) in FIGURES.items()}
 
 
 def _interval(part: np.ndarray, whole: np.ndarray, rng) -> tuple | None:
