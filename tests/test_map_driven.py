@@ -149,24 +149,43 @@ def test_effective_gain_of_a_window_that_decays_faster_than_any_uniform_gain():
 
 
 @SHARED_CORRIDORS
-def test_a_drives_last_three_periods_are_not_measured(root):
+@pytest.mark.parametrize("stall", [None, 1.5])
+def test_a_drives_last_three_periods_are_not_measured(root, stall, monkeypatch):
     """A drive that reaches its goal (or collides) in less than three periods after passing a sample could not have
     shown an episode there: those samples are counted as unmeasured, never scored. On the stable corridor (0.7 V*,
     no episode) every drive's last 3·P·V metres of own path (less its first period) are unmeasured, to within a few
-    samples of its path (the match is to the nearest sample, 0.1 m apart) per drive."""
+    samples of its path (the match is to the nearest sample, 0.1 m apart) per drive.
+
+    A drive that stalls ended when its progress stopped, `stall_time` before the simulator calls it trapped: the same
+    drives relabelled as stalled, with a stall time of 1.5 s (0.8 m at this V, more than the 0.3 m tolerance), have
+    their last (3·P + 1.5 s)·V metres unmeasured."""
+    from dataclasses import replace
+
     from test_map_paths import _report, corridor_analysis
 
-    from pfm_stability.validation.map_drives import drive_map
+    import pfm_stability.validation.map_drives as map_drives
+    from pfm_stability.sim.events import Event
 
+    if stall is not None:
+        real = map_drives.run_batch
+
+        def stalled(scenarios, **options):
+            outcome = real(scenarios, **options)
+            runs = [replace(r, events=(Event("trapped", r.t_end, 0.0, 0.0),)) for r in outcome.runs]
+            return replace(outcome, runs=tuple(runs))
+
+        monkeypatch.setattr(map_drives, "run_batch", stalled)
+        monkeypatch.setattr(map_drives, "stall_time", lambda V: stall)
     V_star = _report(0.6).models["sampled"].critical["V_critical"]
     analysis = corridor_analysis(0.6, 0.7 * V_star, root)
-    result = drive_map(analysis, 4, seed=3)
+    result = map_drives.drive_map(analysis, 4, seed=3)
     assert result.counts["episodes"] == 0
+    assert result.counts.get("ended_trapped", 0) == (len(result.drives) if stall else 0)
     period, V = result.inputs["period"], analysis.robot.V
     expected = 0.0
     for d in result.drives:
         length = d.duration * V
-        expected += max(0.0, min(3 * period * V, length - max(0.0, min(period, 0.25 * d.duration) * V)))
+        expected += max(0.0, min((3 * period + (stall or 0.0)) * V, length - max(0.0, min(period, 0.25 * d.duration) * V)))
     assert result.lengths["drive_paths_unmeasured"] == pytest.approx(expected, abs=0.3 * len(result.drives))
     assert result.lengths["predicted_unstable_unmeasured"] == 0.0
 

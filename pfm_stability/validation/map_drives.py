@@ -54,7 +54,7 @@ from ..sim.engine import run_batch
 from ..sim.scenario import Pose, Scenario, Target
 from ..maps.episodes import AMPLITUDE_THRESHOLD, EPISODE_PERIODS, GROWTH_EFOLDS, NOISE_FLOOR, episodes, swing
 from ..maps.planner import SkeletonPlanner
-from .maps import START_OFFSET, _batches, _table_size, crop_grid, simulator_grid
+from .maps import START_OFFSET, _batches, _table_size, crop_grid, simulator_grid, stall_time
 
 __all__ = ["DRIVE_TIME_FACTOR", "MATCH_DISTANCE", "Disagreement", "Drive", "DriveValidation", "drive_map", "goal_routes"]
 
@@ -337,7 +337,7 @@ def drive_map(analysis, count: int, *, seed: int = 0, progress=None) -> DriveVal
         try:
             scenario = Scenario(name=f"drive {len(runs)} ({kind})", robot=robot, controller=controller, environment=local,
                                 start=Pose(float(sx), float(sy), heading), target=target, duration=duration,
-                                cell_ratio=law.ratio, window_cells=law.window_cells, trap_time=max(10.0, 1.5 / robot.V))
+                                cell_ratio=law.ratio, window_cells=law.window_cells, trap_time=stall_time(robot.V))
         except ValueError:  # the start or the goal touches an obstacle: a drive that cannot start
             skipped += 1
             continue
@@ -395,7 +395,10 @@ def drive_map(analysis, count: int, *, seed: int = 0, progress=None) -> DriveVal
             during |= (t >= lo) & (t <= hi)
         near_path = np.isfinite(dist)
         start = t - t[0] >= min(period, 0.25 * d.duration)  # the start's transient is not measured
-        end = t[-1] - t >= EPISODE_PERIODS * period  # an episode needs three periods after a sample to be found
+        # an episode needs three periods after a sample to be found, before the drive ended: a stall ended it when its
+        # progress stopped, `stall_time` before the stall was called
+        stop = t[-1] - (stall_time(robot.V) if d.event == "trapped" else 0.0)
+        end = stop - t >= EPISODE_PERIODS * period
         hit = near_path & start & (end | during)
         step = np.concatenate([[0.0], np.hypot(np.diff(x), np.diff(y))])
         off = float(step[during & ~near_path].sum())  # an episode away from its own path (a spin): measured, not scored
@@ -662,7 +665,7 @@ def goal_routes(analysis, goals, progress=None) -> list:
             scenarios.append(Scenario(name=f"goal {k + 1}", robot=robot, controller=controller, environment=grid,
                                       start=Pose(float(p[0]), float(p[1]), heading), target=target,
                                       duration=DRIVE_TIME_FACTOR * length / robot.V + 5.0, cell_ratio=law.ratio,
-                                      window_cells=law.window_cells, trap_time=max(10.0, 1.5 / robot.V)))
+                                      window_cells=law.window_cells, trap_time=stall_time(robot.V)))
         except ValueError as exc:
             raise ValueError(f"goal {k + 1} -> {k + 2}: {exc}") from None
     outcome = run_batch(scenarios, record="trajectory", metrics=False)

@@ -324,6 +324,12 @@ def linear_offset(robot: Robot, N: float) -> float:
     return LINEAR_FRACTION * robot.max_steering_rate / (robot.k * abs(N))
 
 
+def stall_time(V: float) -> float:
+    """Seconds without progress after which a map drive stalls (`Scenario.trap_time`): 10 s, or the time to cover
+    1.5 m at V (m/s) when that is longer."""
+    return max(10.0, 1.5 / V)
+
+
 def simulator_grid(hmap) -> HistogramGrid:
     """The simulator's frozen `HistogramGrid` of a map's histogram grid (`maps.field.HistogramMap`: same cells, same origin).
 
@@ -406,7 +412,7 @@ def _prepare(case: MapCase, grid, robot, controller, cell_ratio, window_cells, e
             cell_ratio=cell_ratio,
             window_cells=window_cells,
             measure=MeasureAxis((ex, ey), heading, along_from=0.0),
-            trap_time=max(10.0, 1.5 / robot.V),
+            trap_time=stall_time(robot.V),
         )
         for sign in (1, -1)
     )
