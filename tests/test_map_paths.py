@@ -258,6 +258,35 @@ def test_swing_is_the_weaves_amplitude_the_judge_sees():
     assert not swing(t, bx, by, period).any()
 
 
+def test_excursion_is_how_far_the_loop_strays_however_irregular():
+    """`lateral_excursion` (the driven loop's confirmation of a relay cycle): a steady 5 cm sinusoid about a line strays
+    5 cm from its one-period average at every sample (the moving average of a whole period of a sinusoid is 0; within
+    half a period either side lies a peak) to 1 % (the sampled peak at T = P/126). A weave too slow for
+    `lateral_swing` (half periods of 1.2 P: no held swing) of 20 cm still strays, by what its one-period average does
+    not follow: (1 − sin(π/2.4)/(π/2.4))·20 cm = 5.2 cm, past the threshold (down to 97 % of it between the residual's
+    peaks, which a one-period window can miss by 0.1 P; 1 % for the discrete average). Zeros for a run shorter than two
+    periods."""
+    from pfm_stability.maps.episodes import lateral_excursion, lateral_swing
+
+    T, omega = 0.025, 2.0
+    period = 2 * math.pi / omega
+    t = np.arange(0, 30, T)
+    n = int(round(period / T))
+    inner = slice(n, t.size - n)
+    steady = lateral_excursion(t, 0.05 * np.sin(omega * t), period)
+    assert steady[inner] == pytest.approx(np.full(steady[inner].size, 0.05), rel=0.01)
+    slow = 0.2 * np.sin(omega / 2.4 * t)
+    assert not lateral_swing(t, slow, period).any()
+    expected = (1 - math.sin(math.pi / 2.4) / (math.pi / 2.4)) * 0.2
+    far = slice(2 * n, t.size - 2 * n)  # a period from either end: the average and the maximum each reach half a period
+    strays = lateral_excursion(t, slow, period)[far]
+    # the residual's peaks are 1.2 P apart: a window of one period misses the nearest by up to 0.1 P, cos(2π·0.1/2.4)
+    low = math.cos(2 * math.pi * 0.1 / 2.4)
+    assert (strays >= 0.99 * low * expected).all() and (strays <= 1.01 * expected).all()
+    assert expected > AMPLITUDE_THRESHOLD
+    assert not lateral_excursion(t[:n], slow[:n], period).any()
+
+
 @pytest.mark.slow
 @SHARED_CORRIDORS
 def test_driving_finds_the_unstable_corridor_and_nothing_in_the_stable_one(root, monkeypatch):
@@ -516,6 +545,45 @@ def test_window_edge_relay_where_a_rack_enters_the_window():
     mirror = HistogramMap(0.0, 0.0, c, np.ascontiguousarray(mirror.cv[::-1]))
     relay, jump_m = window_relay(mirror, law, 60 * c - x[:1], y[:1], *(v[:1] for v in t), np.zeros(1))
     assert relay.tolist() == [True] and jump_m[0] == pytest.approx(jump[0], rel=1e-6)
+
+
+def test_a_relay_stands_only_where_the_loop_driven_through_the_profile_strays_as_far(tmp_path, monkeypatch):
+    """The window-edge relay with the sampled model (`maps.paths`, docs/maps.md): the describing function of one jump
+    is an estimate of the cycle; the loop driven through the whole profile (`paths._driven`) is run there too, and the
+    relay stands only where that loop strays as far from its one-period average (its excursion) as well. In a 3 m
+    aisle between a one-cell wall and a solid rack (the test robot; the equilibrium at the window's edge, a restoring
+    jump on every sample of the skeleton's route), the describing function alone predicts a relay cycle past the
+    threshold on every sample: with the driven loop's excursion replaced by 1 m those are the relay samples, with 0
+    none remain. The real driven loop strays less than the threshold there, so the route is stable — and the VFF
+    simulator agrees: four drives along the aisle find no episode (their largest weave held a period is under 2 cm)."""
+    import pfm_stability.maps.paths as paths
+    from pfm_stability.maps.analysis import judge_routes
+    from pfm_stability.validation.map_drives import drive_map
+
+    gap = 30  # free cells between the wall (column 0) and the rack
+    pixels = np.full((200, 1 + gap + 20), 254, dtype=np.uint8)
+    pixels[:, 0] = 0
+    pixels[:, 1 + gap:] = 0
+    analysis = analyze_map(load_map(write_map(tmp_path, pixels)), ROBOT, CONTROLLER, make_law("grid", ROBOT, CONTROLLER))
+    routes = analysis.paths.paths
+    real = paths._driven
+
+    def swinging(value):
+        def driven(*args):
+            oscillates, amplitude, excursion = real(*args)
+            return oscillates, amplitude, np.full_like(excursion, value)
+        return driven
+
+    monkeypatch.setattr(paths, "_driven", swinging(1.0))
+    alone = judge_routes(analysis, routes)
+    assert alone.relay.all() and alone.relay.size > 100
+    monkeypatch.setattr(paths, "_driven", swinging(0.0))
+    assert not judge_routes(analysis, routes).relay.any()
+    monkeypatch.setattr(paths, "_driven", real)
+    pv = analysis.paths
+    assert not pv.relay.any() and (pv.code == PATH_VERDICTS.index("stable")).all()
+    drives = drive_map(analysis, 4, seed=0)
+    assert drives.counts["episodes"] == 0 and max(d.max_amplitude for d in drives.drives) < 0.02
 
 
 def _column_force(law, h):

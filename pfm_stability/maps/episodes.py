@@ -70,6 +70,27 @@ def lateral_swing(t, lateral, period: float) -> np.ndarray:
     return np.zeros(t.size) if r is None else _held(t, _smoothed(r, n), period)
 
 
+def lateral_excursion(t, lateral, period: float) -> np.ndarray:
+    """Per sample, the largest distance (m) of a lateral signal from its one-period average within half a period
+    either side: how far it strays however irregular its turning points (`lateral_swing` needs three alternating
+    ones, P/4 to P apart); zeros for a signal shorter than two periods.
+
+    Parameters
+    ----------
+    t : ndarray
+        Times, s (uniform step).
+    lateral : ndarray
+        Lateral position, m.
+    period : float
+        The oscillation period P, s.
+    """
+    from scipy.ndimage import maximum_filter1d
+
+    t = np.asarray(t, dtype=float)
+    r, n = _about_average(t, lateral, period)
+    return np.zeros(t.size) if r is None else maximum_filter1d(np.abs(r), n, mode="nearest")
+
+
 def _about_average(t, lateral, period: float) -> tuple:
     """(r, n): `lateral` minus its average over one period of n samples; (None, 0) for fewer than two periods."""
     from scipy.ndimage import uniform_filter1d

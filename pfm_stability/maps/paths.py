@@ -38,7 +38,11 @@ analysis' end rule, `verdicts.judged_run`), the other direction still is. What c
 **The window-edge relay** (`relay.window_relay`): where F_n jumps within a cell of the path (the window gaining or
 losing a wall's column as the robot moves a cell sideways) by more than its smooth change over a cell, and the jump
 restores (pushes the robot back across it), the robot holds a sustained oscillation of about a cell's amplitude
-there, which the smooth linearization cannot see: such a sample is unstable, its stretch labelled "relay".
+there, which the smooth linearization cannot see: such a sample is unstable, its stretch labelled "relay", where
+the cycle reaches the episodes' threshold — by the describing function of the jump (`relay.relay_amplitude`) and,
+with the sampled model, by the loop driven along the route there too (below: it runs the whole profile, the
+sampling and the rate limit; the one jump's first harmonic runs high near the threshold): its lateral excursion
+about its one-period average within half a period of the sample must reach the threshold as well.
 
 **The loop driven along the route** (`_driven`): the sampled loop is also run along each route through the force
 across it (`lateral_profile`, every quarter cell: the window sum's jumps, a rack's staircase, a one-sided field), with
@@ -474,11 +478,12 @@ def analyze_paths(grid, law, paths, clearance: np.ndarray, W: float, V: float, b
     code = np.where(~np.isfinite(window_growth) & (code < 2), wall, code)
     oscillates = np.zeros(x.size, dtype=bool)
     amplitude = np.zeros(x.size)
+    excursion = None  # the driven loop's, where it ran
     if transition is not None and boundary.omega_critical and boundary.omega_critical > 0:
         profile = lateral_profile(grid, law, x, y, tx, ty, LEAVES)
         stopped = np.stack([~np.isfinite(N_forward), ~np.isfinite(N_reverse)])
-        oscillates, amplitude = _driven(route, arc, stopped, profile, pull, attraction, aim, V, transition,
-                                        2 * math.pi / boundary.omega_critical, driven)
+        oscillates, amplitude, excursion = _driven(route, arc, stopped, profile, pull, attraction, aim, V, transition,
+                                                   2 * math.pi / boundary.omega_critical, driven)
         code = np.where((code == 0) & oscillates, 1, code)
     # the window-edge relay (`relay`): a restoring jump of F_n within a cell of the path, larger than its smooth change
     relay = np.zeros(x.size, dtype=bool)
@@ -493,6 +498,8 @@ def analyze_paths(grid, law, paths, clearance: np.ndarray, W: float, V: float, b
         with np.errstate(invalid="ignore", divide="ignore"):
             cycle = np.minimum(relay_amplitude(jump / np.where(ahead > 0, ahead, np.nan), boundary.NV_critical / V, N_smooth), LEAVES)
         cycle = np.nan_to_num(cycle)
+        if excursion is not None:  # the loop driven through the whole profile must stray as far there (docstring)
+            cycle = np.minimum(cycle, excursion[check])
         relay[check] = found & (cycle >= AMPLITUDE_THRESHOLD)  # a limit cycle the episodes' judge would see
         amplitude[check] = np.where(relay[check], np.maximum(amplitude[check], cycle), amplitude[check])
     code = np.where(relay, 1, code)
@@ -665,10 +672,12 @@ def lateral_profile(grid, law, x, y, tx, ty, reach: float):
 
 
 def _driven(route, arc, stopped, profile, pull, attraction, aim, V: float, transition: SampledTransition, period: float, taken):
-    """(oscillates, amplitude) per sample: the sampled loop driven along each route at V through the real lateral force
-    across it (module docstring, "The loop driven along the route"), in both directions (a path taken: the way it was
-    driven), started `PREDICTION_OFFSET` off it; its lateral position's episodes
-    (`episodes.lateral_episodes`, the drives' judge) mark the samples the robot passes meanwhile.
+    """(oscillates, amplitude, excursion) per sample: the sampled loop driven along each route at V through the real
+    lateral force across it (module docstring, "The loop driven along the route"), in both directions (a path taken:
+    the way it was driven), started `PREDICTION_OFFSET` off it; its lateral position's episodes
+    (`episodes.lateral_episodes`, the drives' judge) mark the samples the robot passes meanwhile; amplitude is the
+    largest weave held there (`episodes.lateral_swing`, m), excursion the farthest it strays from its one-period
+    average within half a period (`episodes.lateral_excursion`, m); both `LEAVES` where the run left the corridor.
 
     ``x_{k+1} = M·x_k + n·sat(v_k)``, ``v_k = −F0·x_k − gk·g_k(y_k)`` (`SampledTransition`),
     g(y) = −atan2(F_n(y) − P − K·y, A ± F_r·t): the direction of the resultant the robot steers to (KB eq 4; the
@@ -699,7 +708,7 @@ def _driven(route, arc, stopped, profile, pull, attraction, aim, V: float, trans
     taken : bool or ndarray of bool
         Per route (or all): a path the robot took.
     """
-    from .episodes import lateral_episodes, lateral_swing
+    from .episodes import lateral_episodes, lateral_excursion, lateral_swing
 
     offsets, fn, ft = profile
     taken = np.broadcast_to(np.asarray(taken, dtype=bool), (int(route.max()) + 1 if route.size else 0,))  # per route
@@ -707,7 +716,7 @@ def _driven(route, arc, stopped, profile, pull, attraction, aim, V: float, trans
     M, command, F0, gk, limit = transition.M, transition.command, transition.F0, transition.steering_gain, transition.rate_limit
     step = V * transition.T
     h = offsets[1] - offsets[0]
-    oscillates, amplitude = np.zeros(arc.size, dtype=bool), np.zeros(arc.size)
+    oscillates, amplitude, excursion = np.zeros(arc.size, dtype=bool), np.zeros(arc.size), np.zeros(arc.size)
     centre = offsets.size // 2
     runs = []  # (samples passed at each step, sign of travel) of each route and direction
     for r in np.unique(route):
@@ -722,7 +731,7 @@ def _driven(route, arc, stopped, profile, pull, attraction, aim, V: float, trans
             pos = positions if d == 0 else positions[::-1]
             runs.append((idx[np.clip(np.searchsorted((a[:-1] + a[1:]) / 2, pos), 0, a.size - 1)], d, bool(taken[r])))
     if not runs:
-        return oscillates, amplitude
+        return oscillates, amplitude, excursion
     steps = max(r[0].size for r in runs)
     rows = np.zeros((len(runs), steps), dtype=int)
     sign = np.array([1.0 if d == 0 else -1.0 for _, d, _ in runs])
@@ -759,8 +768,10 @@ def _driven(route, arc, stopped, profile, pull, attraction, aim, V: float, trans
         for lo, hi in found:
             oscillates[nearest[(t[:m] >= lo) & (t[:m] <= hi)]] = True
         np.maximum.at(amplitude, nearest[ok], lateral_swing(t[:m][ok], lateral[i, :m][ok], period))
+        np.maximum.at(excursion, nearest[ok], lateral_excursion(t[:m][ok], lateral[i, :m][ok], period))
         amplitude[nearest[~ok]] = np.maximum(amplitude[nearest[~ok]], LEAVES)  # it left the corridor: at least that
-    return oscillates, amplitude
+        excursion[nearest[~ok]] = LEAVES
+    return oscillates, amplitude, excursion
 
 
 def _stretches(paths, route, arc, ds, x, y, code, window_growth, worse, mean_N, N, has, boundary, growth, heading_stable, V, window,
