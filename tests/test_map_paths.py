@@ -235,9 +235,9 @@ def test_swing_is_the_weaves_amplitude_the_judge_sees():
     smoothed over P/8 as the episodes' judge smooths it, 5 cm · sin(π/8)/(π/8) = 4.87 cm (a moving average of a
     sinusoid over 1/8 of its period), to 1 % (the step T = P/126: the discrete average and the sampled peak); a bend
     of the path (a 90° arc of 2 m radius), whose distance from its own one-period average reaches centimetres, is
-    no swing (0); zeros for a run shorter than two periods. `lateral_swing` of the same weave as a lateral signal
+    no swing (0); zeros for a run shorter than two periods. `lateral_extent`'s swing of the same weave as a lateral signal
     agrees."""
-    from pfm_stability.maps.episodes import lateral_swing, swing
+    from pfm_stability.maps.episodes import lateral_extent, swing
 
     T, omega = 0.025, 2.0
     period = 2 * math.pi / omega
@@ -246,7 +246,7 @@ def test_swing_is_the_weaves_amplitude_the_judge_sees():
     x, y = (s - w) / math.sqrt(2), (s + w) / math.sqrt(2)
     expected = 0.05 * math.sin(math.pi / 8) / (math.pi / 8)
     assert swing(t, x, y, period).max() == pytest.approx(expected, rel=0.01)
-    assert lateral_swing(t, w, period).max() == pytest.approx(expected, rel=0.01)
+    assert lateral_extent(t, w, period)[0].max() == pytest.approx(expected, rel=0.01)
     n = int(round(period / T))
     assert not swing(t[:n], x[:n], y[:n], period).any()
     # a straight run, a quarter circle of radius 2 m, a straight run (1 m/s)
@@ -259,32 +259,33 @@ def test_swing_is_the_weaves_amplitude_the_judge_sees():
 
 
 def test_excursion_is_how_far_the_loop_strays_however_irregular():
-    """`lateral_excursion` (the driven loop's confirmation of a relay cycle): a steady 5 cm sinusoid about a line strays
+    """`lateral_extent`'s excursion (the driven loop's confirmation of a relay cycle): a steady 5 cm sinusoid about a line strays
     5 cm from its one-period average at every sample (the moving average of a whole period of a sinusoid is 0; within
     half a period either side lies a peak) to 1 % (the sampled peak at T = P/126). A weave too slow for
-    `lateral_swing` (half periods of 1.2 P: no held swing) of 20 cm still strays, by what its one-period average does
+    a swing (half periods of 1.2 P: none held) of 20 cm still strays, by what its one-period average does
     not follow: (1 − sin(π/2.4)/(π/2.4))·20 cm = 5.2 cm, past the threshold (down to 97 % of it between the residual's
     peaks, which a one-period window can miss by 0.1 P; 1 % for the discrete average). Zeros for a run shorter than two
     periods."""
-    from pfm_stability.maps.episodes import lateral_excursion, lateral_swing
+    from pfm_stability.maps.episodes import lateral_extent
 
     T, omega = 0.025, 2.0
     period = 2 * math.pi / omega
     t = np.arange(0, 30, T)
     n = int(round(period / T))
     inner = slice(n, t.size - n)
-    steady = lateral_excursion(t, 0.05 * np.sin(omega * t), period)
+    steady = lateral_extent(t, 0.05 * np.sin(omega * t), period)[1]
     assert steady[inner] == pytest.approx(np.full(steady[inner].size, 0.05), rel=0.01)
     slow = 0.2 * np.sin(omega / 2.4 * t)
-    assert not lateral_swing(t, slow, period).any()
+    swing, strays = lateral_extent(t, slow, period)
+    assert not swing.any()
     expected = (1 - math.sin(math.pi / 2.4) / (math.pi / 2.4)) * 0.2
     far = slice(2 * n, t.size - 2 * n)  # a period from either end: the average and the maximum each reach half a period
-    strays = lateral_excursion(t, slow, period)[far]
+    strays = strays[far]
     # the residual's peaks are 1.2 P apart: a window of one period misses the nearest by up to 0.1 P, cos(2π·0.1/2.4)
     low = math.cos(2 * math.pi * 0.1 / 2.4)
     assert (strays >= 0.99 * low * expected).all() and (strays <= 1.01 * expected).all()
     assert expected > AMPLITUDE_THRESHOLD
-    assert not lateral_excursion(t[:n], slow[:n], period).any()
+    assert not np.any(lateral_extent(t[:n], slow[:n], period))
 
 
 @pytest.mark.slow

@@ -52,28 +52,11 @@ def lateral_episodes(t, lateral, period: float) -> tuple:
     return ((), 0.0) if r is None else _episodes(t, r, period, n)
 
 
-def lateral_swing(t, lateral, period: float) -> np.ndarray:
-    """Per sample, the amplitude (m) of the oscillation about its one-period average it is part of, held for at least
-    one period (`swing`, for a lateral position); zeros for a signal shorter than two periods.
-
-    Parameters
-    ----------
-    t : ndarray
-        Times, s (uniform step).
-    lateral : ndarray
-        Lateral position, m.
-    period : float
-        The oscillation period P, s.
-    """
-    t = np.asarray(t, dtype=float)
-    r, n = _about_average(t, lateral, period)
-    return np.zeros(t.size) if r is None else _held(t, _smoothed(r, n), period)
-
-
-def lateral_excursion(t, lateral, period: float) -> np.ndarray:
-    """Per sample, the largest distance (m) of a lateral signal from its one-period average within half a period
-    either side: how far it strays however irregular its turning points (`lateral_swing` needs three alternating
-    ones, P/4 to P apart); zeros for a signal shorter than two periods.
+def lateral_extent(t, lateral, period: float) -> tuple:
+    """(swing, excursion) per sample of a lateral signal, m: the amplitude of the oscillation about its one-period
+    average it is part of, held for at least one period (`swing`, for a lateral position), and the farthest it strays
+    from that average within half a period either side — however irregular its turning points (a swing needs three
+    alternating ones, P/4 to P apart); zeros for a signal shorter than two periods.
 
     Parameters
     ----------
@@ -88,7 +71,9 @@ def lateral_excursion(t, lateral, period: float) -> np.ndarray:
 
     t = np.asarray(t, dtype=float)
     r, n = _about_average(t, lateral, period)
-    return np.zeros(t.size) if r is None else maximum_filter1d(np.abs(r), n, mode="nearest")
+    if r is None:
+        return np.zeros(t.size), np.zeros(t.size)
+    return _held(t, _smoothed(r, n), period), maximum_filter1d(np.abs(r), n, mode="nearest")
 
 
 def _about_average(t, lateral, period: float) -> tuple:

@@ -138,7 +138,7 @@ class PathStretch:
     oscillates : bool
         The linear loop driven along the route weaves over part of it (`maps.episodes`).
     amplitude : float
-        The largest lateral oscillation the loop driven along the route predicts on it, m (`maps.episodes.lateral_swing`;
+        The largest lateral oscillation the loop driven along the route predicts on it, m (`maps.episodes.lateral_extent`;
         `LEAVES` where it left the corridor: at least that; a relay's cycle where that is larger).
     """
 
@@ -676,8 +676,8 @@ def _driven(route, arc, stopped, profile, pull, attraction, aim, V: float, trans
     lateral force across it (module docstring, "The loop driven along the route"), in both directions (a path taken:
     the way it was driven), started `PREDICTION_OFFSET` off it; its lateral position's episodes
     (`episodes.lateral_episodes`, the drives' judge) mark the samples the robot passes meanwhile; amplitude is the
-    largest weave held there (`episodes.lateral_swing`, m), excursion the farthest it strays from its one-period
-    average within half a period (`episodes.lateral_excursion`, m); both `LEAVES` where the run left the corridor.
+    largest weave held there and excursion the farthest it strays from its one-period average within half a period
+    (`episodes.lateral_extent`, m); both `LEAVES` where the run left the corridor.
 
     ``x_{k+1} = M·x_k + n·sat(v_k)``, ``v_k = −F0·x_k − gk·g_k(y_k)`` (`SampledTransition`),
     g(y) = −atan2(F_n(y) − P − K·y, A ± F_r·t): the direction of the resultant the robot steers to (KB eq 4; the
@@ -708,7 +708,7 @@ def _driven(route, arc, stopped, profile, pull, attraction, aim, V: float, trans
     taken : bool or ndarray of bool
         Per route (or all): a path the robot took.
     """
-    from .episodes import lateral_episodes, lateral_excursion, lateral_swing
+    from .episodes import lateral_episodes, lateral_extent
 
     offsets, fn, ft = profile
     taken = np.broadcast_to(np.asarray(taken, dtype=bool), (int(route.max()) + 1 if route.size else 0,))  # per route
@@ -767,8 +767,9 @@ def _driven(route, arc, stopped, profile, pull, attraction, aim, V: float, trans
         found, _ = lateral_episodes(t[:m][ok], sign[i] * lateral[i, :m][ok], period)
         for lo, hi in found:
             oscillates[nearest[(t[:m] >= lo) & (t[:m] <= hi)]] = True
-        np.maximum.at(amplitude, nearest[ok], lateral_swing(t[:m][ok], lateral[i, :m][ok], period))
-        np.maximum.at(excursion, nearest[ok], lateral_excursion(t[:m][ok], lateral[i, :m][ok], period))
+        swing, strays = lateral_extent(t[:m][ok], lateral[i, :m][ok], period)
+        np.maximum.at(amplitude, nearest[ok], swing)
+        np.maximum.at(excursion, nearest[ok], strays)
         amplitude[nearest[~ok]] = np.maximum(amplitude[nearest[~ok]], LEAVES)  # it left the corridor: at least that
         excursion[nearest[~ok]] = LEAVES
     return oscillates, amplitude, excursion

@@ -131,7 +131,7 @@ class Disagreement:
         The drives that passed it.
     predicted_amplitude : float
         The largest lateral oscillation of the loop driven along it held for at least one period (`maps.paths`,
-        `maps.episodes.lateral_swing`), m.
+        `maps.episodes.lateral_extent`), m.
     simulated_amplitude : float
         The same of the drives there (`maps.episodes.swing`: three alternating turning points about their paths
         averaged over a period, as the episodes' judge finds them; a bend is none), m. Above `AMPLITUDE_THRESHOLD`
