@@ -17,7 +17,7 @@ import math
 
 import numpy as np
 
-__all__ = ["AMPLITUDE_THRESHOLD", "EPISODE_PERIODS", "GROWTH_EFOLDS", "NOISE_FLOOR", "episodes", "lateral_episodes", "lateral_swing",
+__all__ = ["AMPLITUDE_THRESHOLD", "EPISODE_PERIODS", "GROWTH_EFOLDS", "NOISE_FLOOR", "episodes", "lateral_episodes", "lateral_extent",
            "oscillation", "swing"]
 
 EPISODE_PERIODS = 3
