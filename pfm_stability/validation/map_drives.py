@@ -27,9 +27,9 @@ The map's route samples within `MATCH_DISTANCE` of a drive are counted as covere
 or the robot's width): those samples are driven; the points during an episode mark episode samples. Two kinds of
 sample cannot show an episode and are not measured: those passed in the drive's first period (the start's
 transient), and those passed only in its last `EPISODE_PERIODS` periods (an episode needs three periods after them:
-the drive reached its goal, collided or stalled first — a stall when its progress stopped, `validation.maps.stall_time` before
-the simulator calls it trapped; counted as ``drive_paths_unmeasured``, never as agreement),
-and with them the end of a predicted-unstable stretch that reaches them, over three periods' travel less half a
+the drive reached its goal, collided or stalled first — a stall when its progress stopped,
+`validation.maps.stall_time` before the simulator calls it trapped; counted as ``drive_paths_unmeasured``, never as
+agreement), and with them the end of a predicted-unstable stretch that reaches them, over three periods' travel less half a
 window Λ before them (`_cut_short`: a weave arriving there, at most Λ/2 early, would have run into the drive's end
 before three periods; matched or not, so that drives cut short count neither way). A driven sample predicted
 unstable matches an episode when an episode sample of the same path lies within half the verdict's window Λ (the
