@@ -59,6 +59,8 @@ __all__ = [
     "T_RESOLUTION",
     "DEAD_TIME_RESOLUTION",
     "dead_time_split",
+    "KB_PLANT",
+    "plant_not_kb",
     "check_corridor_fits",
 ]
 
@@ -72,6 +74,21 @@ DEAD_TIME_RESOLUTION = 1e-9
 (`dead_time_split`): D/T is rarely exact in floating point (0.1/0.05 is 2 to round-off, or just under), and a
 sub-interval of 1e-9·T moves the robot by 1e-9 of a step while it adds a mode at z = 0 that the
 simulator's linear-prediction fit and the sampled model would have to carry."""
+
+
+KB_PLANT = {"plant_gain": 1.0, "dead_time": 0.0}
+"""KB's steering plant τω̇ + ω = u: plant gain 1, no dead time (`Robot`'s and `models.Loop`'s defaults)."""
+
+
+def plant_not_kb(source) -> dict:
+    """The fields of a steering plant that differ from KB's (`KB_PLANT`), in that order; {} for KB's plant.
+
+    Parameters
+    ----------
+    source : Robot or models.Loop
+        Anything with ``plant_gain`` and ``dead_time`` (s).
+    """
+    return {name: getattr(source, name) for name, kb in KB_PLANT.items() if getattr(source, name) != kb}
 
 
 def dead_time_split(T: float, compute_delay: int, dead_time: float) -> tuple:

@@ -37,7 +37,7 @@ from .critical import CorridorBranches, CorridorCritical, CriticalValues, WallBr
 from ..laws.fields import finite_goal_gain
 from ..laws.force_law import Equilibrium, ForceLaw, PowerLaw, corridor_equilibria, corridor_gain, law_in_force, wall_equilibria, wall_gain, _wall_gain
 from ..models import Loop, LoopModel, check_loop_gain, judge, models_for
-from ..parameters import RANGES, Controller, Corridor, Robot, Wall, check_corridor_fits, check_parameter, to_degrees
+from ..parameters import RANGES, Controller, Corridor, Robot, Wall, check_corridor_fits, check_parameter, plant_not_kb, to_degrees
 from ..numerics.solve import bisect_root, expand_bracket
 
 __all__ = [
@@ -457,7 +457,7 @@ def _negative_gain_root(model: LoopModel, NV: float, loop: Loop):
 
 def _plant_given(loop: Loop) -> bool:
     """True for a robot with a dead time or a plant gain (not KB's g = 1, D = 0): its verdicts carry D*."""
-    return loop.dead_time > 0 or loop.plant_gain != 1.0
+    return bool(plant_not_kb(loop))
 
 
 def _verdict(model: LoopModel, loop: Loop, NV: float, boundary, critical_values, N: float, **geometry) -> ModelVerdict:

@@ -36,7 +36,7 @@ from dataclasses import dataclass, field
 from ..checks import check_choice, check_integer
 from ..io.yaml_files import YamlFile, mapping_source, read_yaml
 from ..laws.registry import DEFAULT_LAW, LAW_NAMES, check_parameters, get_law, laws_for, parameter_keys, refusal
-from ..parameters import HOLDS, MODEL_NAMES, RANGES, Controller, Robot, check_parameter, get_preset
+from ..parameters import HOLDS, MODEL_NAMES, RANGES, Controller, Robot, check_parameter, get_preset, plant_not_kb
 from ..version import __version__
 
 __all__ = [
@@ -205,8 +205,7 @@ class SweepSpec:
         """The normalized spec (what the digest covers; JSON-ready)."""
         return {
             "robot": {**{n: getattr(self.robot, n) for n in ("V", "tau", "k", "W", "max_steering_rate")},
-                      **({"plant_gain": self.robot.plant_gain} if self.robot.plant_gain != 1.0 else {}),
-                      **({"dead_time": self.robot.dead_time} if self.robot.dead_time != 0.0 else {})},  # KB's plant: none
+                      **plant_not_kb(self.robot)},  # KB's plant: none (existing digests unchanged)
             "controller": {n: getattr(self.controller, n) for n in ("f", "n", "T", "hold", "compute_delay")},
             "geometry": self.geometry,
             "geometry_value": self.geometry_value,

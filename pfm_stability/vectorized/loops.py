@@ -36,7 +36,7 @@ from ..checks import check_choice, check_integer, check_number
 from ..models import Loop, make_model
 from ..models.base import _check_NV
 from ..models.verdicts import NV_MAX, gain_margin, judge_arrays, verdict_label
-from ..parameters import HOLDS, MODEL_NAMES, check_parameter
+from ..parameters import HOLDS, KB_PLANT, MODEL_NAMES, check_parameter
 from . import routes
 from .exact_delay import _check, heading_gain_array, resolved_lag_and_delay
 from .routes import Answers as _Answers
@@ -113,7 +113,7 @@ def _options(model, hold, compute_delay, pade_order, plant_gain=1.0, dead_time=0
 
 def _kb_plant(options) -> bool:
     """KB's plant 1/(τs + 1) (plant gain 1, no dead time): the loops the array routes solve."""
-    return options["plant"] == {"plant_gain": 1.0, "dead_time": 0.0}
+    return options["plant"] == KB_PLANT
 
 
 def loop_arrays(tau, T, k, NV, c=None):
