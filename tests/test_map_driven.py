@@ -262,3 +262,21 @@ def test_a_path_taken_beside_a_wall_steers_against_the_goals_pull_along_it(tmp_p
         taken, route = (int(np.argmin(np.abs(pv.arc + 1e9 * (pv.samples.segment != r) - 2.5))) for r in (k, k + 3))
         assert pv.N_forward[taken] == pytest.approx(slope / (math.sqrt(1 - P * P) + along), rel=1e-3), d
         assert pv.N_forward[route] == pytest.approx(slope / (1 + along), rel=1e-3), d
+
+
+def test_wobble_agreement_compares_the_weaves_where_either_passed_the_threshold():
+    """`wobble_agreement` by hand: of six samples (lengths 1, 1, 2, 1, 1, 5 m), one agrees in size (2 against 2 cm:
+    ratio 1), one is a third of the simulated (1 against 3 cm), one held no predicted weave (ratio 0), one no simulated
+    weave (ratio inf), one is where the loop left the corridor (counted apart) and one where neither passed 1.5 cm
+    (left out): 5 m compared, 1 m within a factor 2 (20 %); the ratios sorted by length weight (0: 2 m, 1/3, 1, inf:
+    1 m each) reach 25, 50 and 75 % of the 5 m at 0, 1/3 and 1 (exactly: samples' values, not interpolated). Nothing
+    past the threshold gives no figure (None), not agreement."""
+    from pfm_stability.validation.map_drives import wobble_agreement
+
+    got = wobble_agreement([0.02, 0.01, 0.0, 0.03, 2.0, 0.004], [0.02, 0.03, 0.02, 0.0, 0.01, 0.004], [1, 1, 2, 1, 1, 5], 1.0)
+    assert got.length == 5.0 and got.left == 1.0
+    assert got.within == pytest.approx(0.2, rel=1e-12)
+    assert got.ratio_quartiles == pytest.approx((0.0, 1 / 3, 1.0), rel=1e-12)
+    quiet = wobble_agreement([0.01, 0.004], [0.014, 0.0], [1.0, 1.0], 1.0)
+    assert quiet.length == 0.0 and quiet.within is None and quiet.ratio_quartiles is None
+    assert quiet.to_dict()["within"] is None and got.to_dict()["ratio_quartiles"][2] == pytest.approx(1.0)

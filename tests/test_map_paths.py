@@ -292,7 +292,8 @@ def test_excursion_is_how_far_the_loop_strays_however_irregular():
 @SHARED_CORRIDORS
 def test_driving_finds_the_unstable_corridor_and_nothing_in_the_stable_one(root, monkeypatch):
     """Validation by driving on two corridors: at 1.4 V* the simulator's drives oscillate and the unstable stretches
-    along their paths recall >= 80 % of the episodes' length with >= 80 % precision; at 0.7 V* no drive oscillates,
+    along their paths recall >= 80 % of the episodes' length with >= 80 % precision, and the predicted weave has the
+    simulated one's size; at 0.7 V* no drive oscillates,
     nothing is predicted unstable, and recall and precision are undefined (None: nothing to measure), not counted as
     agreement, and all the length driven is predicted stable (specificity 100 %, of each kind of drive too); each figure lies in its 95 %
     interval over the drives, whose per-drive lengths add up to it. (Recall is 97 % here: the corridor's rate-limited
@@ -316,8 +317,14 @@ def test_driving_finds_the_unstable_corridor_and_nothing_in_the_stable_one(root,
     assert all(d.simulated_amplitude >= 0 and d.predicted_amplitude >= 0 for d in unstable.disagreements)
     for figure, (lo, hi) in ((unstable.recall, unstable.recall_interval), (unstable.precision, unstable.precision_interval)):
         assert 0.0 <= lo <= figure <= hi <= 1.0
+    # the weaves' size where either passes the threshold: the loop and the simulator hold the same rate-limited cycle,
+    # so their ratio's quartiles lie within 25 % of 1 (measured 0.98, 1.01, 1.06: the grid's ripple and the drives'
+    # ends move single samples) and nearly all the length within a factor 2 (measured 92 %)
+    assert unstable.wobble.length > 0 and unstable.wobble.within >= 0.85, unstable.wobble
+    assert all(0.8 <= q <= 1.25 for q in unstable.wobble.ratio_quartiles), unstable.wobble
     stable = drive_map(corridor_analysis(0.6, 0.7 * V_star, root), 6, seed=1)
     assert stable.counts["episodes"] == 0 and stable.lengths["predicted_unstable_driven"] == 0
+    assert stable.wobble.length == 0.0 and stable.wobble.within is None  # neither weaves past the threshold: no figure
     assert stable.recall is None and stable.precision is None
     assert stable.specificity == pytest.approx(1.0, rel=1e-12) and stable.specificity_interval == pytest.approx((1.0, 1.0))
     assert stable.recall_interval is None and stable.precision_interval is None

@@ -606,6 +606,12 @@ def render_map_text(data: dict) -> str:
                      + (f" (false alarms where a drive wove past {100 * d['inputs']['amplitude_threshold']:.1f} cm for a period, "
                         f"not {d['inputs']['episode_periods']}: {d['lengths']['false_alarm_swinging']:.1f} m)"
                         if d['lengths'].get('false_alarm_swinging') else ""))
+        w = d.get("wobble")
+        if w and w.get("within") is not None:  # how big the predicted weave is against the simulated one
+            q = ", ".join(f"{v:.2f}" if isinstance(v, (int, float)) else str(v) for v in w["ratio_quartiles"])
+            lines.append(f"  wobble: where either wove past {100 * d['inputs']['amplitude_threshold']:.1f} cm for a period "
+                         f"({w['length']:.1f} m), the predicted weave is within a factor {w['factor']:g} of the simulated on "
+                         f"{percent(w['within'])[1:]} of it (predicted/simulated quartiles {q})")
     v = data.get("validation")
     if v is not None:
         share = f"{percent(v['agreement'])[1:]} of the {v['measured']} measured" if v.get("agreement") is not None else "- (none measured)"

@@ -57,7 +57,8 @@ from ..maps.episodes import AMPLITUDE_THRESHOLD, EPISODE_PERIODS, GROWTH_EFOLDS,
 from ..maps.planner import SkeletonPlanner
 from .maps import START_OFFSET, _batches, _table_size, crop_grid, simulator_grid, stall_time
 
-__all__ = ["DRIVE_TIME_FACTOR", "MATCH_DISTANCE", "Disagreement", "Drive", "DriveValidation", "drive_map", "goal_routes"]
+__all__ = ["DRIVE_TIME_FACTOR", "MATCH_DISTANCE", "WOBBLE_FACTOR", "Disagreement", "Drive", "DriveValidation", "WobbleAgreement",
+           "drive_map", "goal_routes"]
 
 MATCH_DISTANCE = 0.5
 """Largest distance (m) from a trajectory point to the route sample it marks (at least the robot's width W)."""
@@ -75,6 +76,9 @@ FIGURES = {"recall": ("episode_recalled", "episode"), "precision": ("predicted_u
 """Each figure of the validation: the (part, whole) of `_score`'s lengths whose ratio it is (module docstring)."""
 CROP_SLACK = 3.0
 """How far (m) around a drive's straight line its cropped grid reaches beyond the window."""
+WOBBLE_FACTOR = 2.0
+"""A predicted weave agrees in size with the simulated one when their ratio lies within 1/this .. this
+(`WobbleAgreement`)."""
 
 
 @dataclass(frozen=True)
@@ -158,6 +162,70 @@ class Disagreement:
 
 
 @dataclass(frozen=True)
+class WobbleAgreement:
+    """How big the predicted weave is against the simulated one, along the measured part of the drives' own paths
+    (`wobble_agreement`): where either the prediction's loop or the drive wove past `AMPLITUDE_THRESHOLD` for at
+    least one period, the ratio of the two weaves held there (`DriveValidation`'s per-sample amplitudes:
+    `maps.episodes.lateral_extent`'s swing of the loop, `maps.episodes.swing` of the drive; 0 where one held none).
+    Recall and precision judge each side against the threshold; this says how far apart the two are in size, which
+    is what decides them near it.
+
+    Attributes
+    ----------
+    length : float
+        Measured length where either side wove past the threshold, m (the loop still in the corridor: where it left,
+        its size is only "at least `maps.paths.LEAVES`", and the length is counted as ``left`` instead).
+    within : float or None
+        Share of `length` where predicted / simulated lies within 1/`WOBBLE_FACTOR` .. `WOBBLE_FACTOR` (None: no
+        length).
+    ratio_quartiles : tuple of float or None
+        The 25th, 50th and 75th percentiles of predicted / simulated by length (a value of the samples, not
+        interpolated; 0 where the loop held no weave, inf where the drive held none).
+    left : float
+        Measured length where the prediction's loop left the corridor, m.
+    """
+
+    length: float
+    within: float | None
+    ratio_quartiles: tuple | None
+    left: float
+
+    def to_dict(self) -> dict:
+        """JSON form."""
+        return {"length": json_number(self.length), "within": json_number(self.within), "factor": WOBBLE_FACTOR,
+                "ratio_quartiles": None if self.ratio_quartiles is None else [json_number(v) for v in self.ratio_quartiles],
+                "left": json_number(self.left)}
+
+
+def wobble_agreement(predicted, simulated, spacing, leaves: float) -> WobbleAgreement:
+    """`WobbleAgreement` of measured samples.
+
+    Parameters
+    ----------
+    predicted, simulated : ndarray
+        The weave held at each sample by the prediction's loop and by the drive, m (>= 0).
+    spacing : ndarray
+        The samples' lengths, m.
+    leaves : float
+        A predicted weave this large or larger means the loop left the corridor, m.
+    """
+    predicted, simulated, spacing = (np.asarray(v, dtype=float) for v in (predicted, simulated, spacing))
+    left = predicted >= leaves
+    either = ~left & (np.maximum(predicted, simulated) >= AMPLITUDE_THRESHOLD)
+    length = float(spacing[either].sum())
+    if not length > 0:
+        return WobbleAgreement(0.0, None, None, float(spacing[left].sum()))
+    with np.errstate(divide="ignore"):
+        ratio = np.where(simulated[either] > 0, predicted[either] / np.where(simulated[either] > 0, simulated[either], 1.0), np.inf)
+    weight = spacing[either]
+    within = float(weight[(ratio >= 1 / WOBBLE_FACTOR) & (ratio <= WOBBLE_FACTOR)].sum()) / length
+    order = np.argsort(ratio, kind="stable")
+    cumulative = np.cumsum(weight[order]) / length
+    quartiles = tuple(float(ratio[order][min(np.searchsorted(cumulative, q - 1e-12), ratio.size - 1)]) for q in (0.25, 0.5, 0.75))
+    return WobbleAgreement(length, within, quartiles, float(spacing[left].sum()))
+
+
+@dataclass(frozen=True)
 class DriveValidation:
     """Recall and precision of the map's unstable stretches against the drives' episodes, by route length.
 
@@ -197,6 +265,8 @@ class DriveValidation:
         much of the calm driving the map also called calm.
     specificity_interval : tuple of float or None
         Its 95 % interval over the drives.
+    wobble : WobbleAgreement or None
+        How big the predicted weave is against the simulated one where either passed the threshold.
     """
 
     recall: float | None
@@ -214,10 +284,12 @@ class DriveValidation:
     precision_interval: tuple | None = None
     specificity: float | None = None
     specificity_interval: tuple | None = None
+    wobble: WobbleAgreement | None = None
 
     def to_dict(self) -> dict:
         """JSON form."""
         return {
+            "wobble": self.wobble.to_dict() if self.wobble is not None else None,
             "drive_paths": self.drive_paths.to_dict() if self.drive_paths is not None else None,
             "recall": json_number(self.recall) if self.recall is not None else None,
             "precision": json_number(self.precision) if self.precision is not None else None,
@@ -306,7 +378,7 @@ def drive_map(analysis, count: int, *, seed: int = 0, progress=None) -> DriveVal
     from scipy.spatial import cKDTree
 
     from ..maps.analysis import judge_routes
-    from ..maps.paths import PATH_VERDICTS, UNJUDGED
+    from ..maps.paths import LEAVES, PATH_VERDICTS, UNJUDGED
 
     started = time.perf_counter()
     count = check_integer("count", count, 1, 100_000)
@@ -443,9 +515,12 @@ def drive_map(analysis, count: int, *, seed: int = 0, progress=None) -> DriveVal
         shares = [np.array([L[key] for L in per_drive], dtype=float) for key in (part, whole)]
         intervals[name] = _interval(*shares, resampled) if figures[name] is not None else None
     pts = np.vstack(points) if points else np.zeros((0, 2))
+    measured = np.unique(np.concatenate([m.scored for m in marks] + [np.zeros(0, dtype=int)])).astype(int)
+    measured = measured[measured >= base]  # the drives' own paths' samples scored
+    wobble = wobble_agreement(np.nan_to_num(sc.amplitude[measured]), swung[measured], sc.spacing[measured], LEAVES)
     return DriveValidation(figures["recall"], figures["precision"], tuple(drives), disagreements, lengths, counts, inputs,
                            time.perf_counter() - started, pts, by_kind, dp, intervals["recall"], intervals["precision"],
-                           figures["specificity"], intervals["specificity"])
+                           figures["specificity"], intervals["specificity"], wobble)
 
 
 @dataclass(frozen=True)
