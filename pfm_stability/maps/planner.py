@@ -6,6 +6,17 @@ the one nearest its goal by Dijkstra's shortest path (``scipy.sparse.csgraph.dij
 as the corridor allows — where a planner with a wide inflation layer (Nav2's) would put it. Its cell centres are
 simplified into a polyline (``skimage.measure.approximate_polygon``, `TOLERANCE_CELLS` cells) and joined to the
 start and the goal themselves.
+
+**Smoothed as a navigation stack hands it over** (`smooth_plan`). The medial axis carries jags a navigation stack's
+plan does not: a speck in a room, a shelf's end or an opening bends it by decimetres over a metre, and a robot
+following such a plan by a carrot (`sim.follow`) feels each jag as a jump of its carrot — a kick the robot would not
+get from Nav2, whose planners descend a smooth potential and whose smoother server (``nav2_smoother``'s Simple
+Smoother) smooths the plan further. The plan is resampled every cell and smoothed as Nav2's Simple Smoother does at
+its default weights (`W_DATA`, `W_SMOOTH`, `REFINEMENTS`): each point p_i of the smoothed path balances its pull to
+the given point q_i against the pull to its neighbours' middle, W_DATA·(q_i − p_i) + W_SMOOTH·(p_(i−1) + p_(i+1) −
+2·p_i) = 0, the ends fixed — the point Nav2's iterations converge to (its tolerance 1e-10), here by one banded solve
+(``scipy.linalg.solve_banded``) — and the result smoothed so again, `REFINEMENTS` times. As in Nav2, a smoothed plan
+with a point in an occupied cell (or off the map) is not used: the plan stays as it was.
 """
 
 from __future__ import annotations
@@ -14,13 +25,20 @@ import math
 
 import numpy as np
 
-__all__ = ["SkeletonPlanner", "TOLERANCE_CELLS"]
+__all__ = ["REFINEMENTS", "SkeletonPlanner", "TOLERANCE_CELLS", "W_DATA", "W_SMOOTH", "smooth_plan"]
 
 TOLERANCE_CELLS = 1.0
 """Largest distance of a plan's cells from its polyline, cells (3 cells, which straightens the skeleton's bends
 towards a room's openings, raised the bookstore's recall with the small robot to 77–79 % but lowered the small
 house's precision at CARMEL to 72 % over 50 drives: kept at one; docs/maps.md also gives the figures of a plan
 straightened by shortcuts that keep the skeleton's room, not kept either)."""
+W_DATA = 0.2
+"""Nav2 Simple Smoother's ``w_data`` (its default): the pull of a smoothed point to the plan's."""
+W_SMOOTH = 0.3
+"""Nav2 Simple Smoother's ``w_smooth`` (its default): the pull of a smoothed point to its neighbours' middle."""
+REFINEMENTS = 2
+"""Nav2 Simple Smoother's ``refinement_num`` (its default, with ``do_refinement`` true): the smoothed path smoothed again
+this many times."""
 
 
 class SkeletonPlanner:
@@ -81,4 +99,40 @@ class SkeletonPlanner:
         cells = np.column_stack([self.x[chain[::-1]], self.y[chain[::-1]]])
         cells = approximate_polygon(cells, TOLERANCE_CELLS * self.grid.cell_size) if len(cells) > 2 else cells
         points = np.vstack([np.asarray(start, dtype=float), cells, np.asarray(goal, dtype=float)])
-        return points[np.concatenate([[True], np.hypot(*np.diff(points, axis=0).T) > 0])]
+        points = points[np.concatenate([[True], np.hypot(*np.diff(points, axis=0).T) > 0])]
+        smoothed = smooth_plan(points, self.grid.cell_size)
+        i, j = self.grid.cell_index(smoothed[:, 0], smoothed[:, 1])
+        inside = (i >= 0) & (i < self.grid.shape[0]) & (j >= 0) & (j < self.grid.shape[1])
+        if not inside.all() or self.grid.occupied[i, j].any():  # as Nav2: a smoothed plan in collision is not used
+            return points
+        return smoothed
+
+
+def smooth_plan(points, spacing: float) -> np.ndarray:
+    """The polyline `points` (m, shape (n, 2)) resampled every `spacing` m of arc (at least its two ends) and smoothed
+    as Nav2's Simple Smoother converges to (module docstring): shape (m, 2), m, its ends the given ones.
+
+    Parameters
+    ----------
+    points : array_like, shape (n, 2)
+        Vertices, m (n >= 2, consecutive ones distinct).
+    spacing : float
+        Resampling step, m (> 0).
+    """
+    from scipy.linalg import solve_banded
+
+    p = np.asarray(points, dtype=float)
+    arc = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(p, axis=0).T))])
+    at = np.linspace(0.0, arc[-1], max(2, int(math.ceil(arc[-1] / spacing)) + 1))
+    path = np.column_stack([np.interp(at, arc, p[:, 0]), np.interp(at, arc, p[:, 1])])
+    inner = path.shape[0] - 2
+    if inner < 1:
+        return path
+    bands = np.zeros((3, inner))  # rows i = 1 .. n − 2: (W_DATA + 2·W_SMOOTH)·p_i − W_SMOOTH·(p_(i−1) + p_(i+1)) = W_DATA·q_i
+    bands[0, 1:], bands[1], bands[2, :-1] = -W_SMOOTH, W_DATA + 2 * W_SMOOTH, -W_SMOOTH
+    for _ in range(REFINEMENTS + 1):
+        rhs = W_DATA * path[1:-1]
+        rhs[0] += W_SMOOTH * path[0]
+        rhs[-1] += W_SMOOTH * path[-1]
+        path = np.vstack([path[:1], solve_banded((1, 1), bands, rhs), path[-1:]])
+    return path
