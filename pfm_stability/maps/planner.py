@@ -103,7 +103,7 @@ class SkeletonPlanner:
         smoothed = smooth_plan(points, self.grid.cell_size)
         i, j = self.grid.cell_index(smoothed[:, 0], smoothed[:, 1])
         inside = (i >= 0) & (i < self.grid.shape[0]) & (j >= 0) & (j < self.grid.shape[1])
-        if not inside.all() or self.grid.occupied[i, j].any():  # as Nav2: a smoothed plan in collision is not used
+        if not inside.all() or np.any(self.grid.cv[i, j] > 0):  # as Nav2: a smoothed plan in collision is not used
             return points
         return smoothed
 

@@ -215,8 +215,7 @@ def wobble_agreement(predicted, simulated, spacing, leaves: float) -> WobbleAgre
     length = float(spacing[either].sum())
     if not length > 0:
         return WobbleAgreement(0.0, None, None, float(spacing[left].sum()))
-    with np.errstate(divide="ignore"):
-        ratio = np.where(simulated[either] > 0, predicted[either] / np.where(simulated[either] > 0, simulated[either], 1.0), np.inf)
+    ratio = np.divide(predicted[either], simulated[either], out=np.full(int(either.sum()), np.inf), where=simulated[either] > 0)
     weight = spacing[either]
     within = float(weight[(ratio >= 1 / WOBBLE_FACTOR) & (ratio <= WOBBLE_FACTOR)].sum()) / length
     order = np.argsort(ratio, kind="stable")
@@ -515,8 +514,8 @@ def drive_map(analysis, count: int, *, seed: int = 0, progress=None) -> DriveVal
         shares = [np.array([L[key] for L in per_drive], dtype=float) for key in (part, whole)]
         intervals[name] = _interval(*shares, resampled) if figures[name] is not None else None
     pts = np.vstack(points) if points else np.zeros((0, 2))
-    measured = np.unique(np.concatenate([m.scored for m in marks] + [np.zeros(0, dtype=int)])).astype(int)
-    measured = measured[measured >= base]  # the drives' own paths' samples scored
+    measured = np.flatnonzero(driven)
+    measured = measured[measured >= base]  # the drives' own paths' samples scored (`_score`)
     wobble = wobble_agreement(np.nan_to_num(sc.amplitude[measured]), swung[measured], sc.spacing[measured], LEAVES)
     return DriveValidation(figures["recall"], figures["precision"], tuple(drives), disagreements, lengths, counts, inputs,
                            time.perf_counter() - started, pts, by_kind, dp, intervals["recall"], intervals["precision"],
