@@ -1,4 +1,4 @@
-"""The loop driven along a route through the force across it (`maps.paths._driven`, docs/maps.md, "The loop driven
+"""The loop driven along a route through the force across it (`maps.driven._driven`, docs/maps.md, "The loop driven
 along the route"), its command form (`models.sampled.command_form`), and the drives' unmeasurable ends
 (`validation.map_drives`)."""
 
@@ -9,7 +9,7 @@ import math
 import numpy as np
 import pytest
 
-from pfm_stability.maps.paths import SampledTransition, _driven
+from pfm_stability.maps.driven import SampledTransition, _driven
 from pfm_stability.maps.verdicts import GrowthRate, effective_gain
 from pfm_stability.models import Loop, models_for
 from pfm_stability.models.sampled import closed_loop_matrix, command_form
@@ -68,9 +68,9 @@ def test_a_linear_force_drives_the_linear_loop(ratio, monkeypatch):
     started at the same offset, below, near and above NV*. The robot steers to the resultant's direction,
     atan(N·y) ≈ N·y − (N·y)³/3: started 1 µm off and compared while |y| <= 0.1 mm, the cubic term is below 1e-7 of
     the command (N·y <= 5e-4 here), so the two agree to 1e-12 m + 1e-6·|y| (round-off and that term, with margin)."""
-    import pfm_stability.maps.paths as paths
+    import pfm_stability.maps.driven as driven
 
-    monkeypatch.setattr(paths, "PREDICTION_OFFSET", 1e-6)
+    monkeypatch.setattr(driven, "PREDICTION_OFFSET", 1e-6)
     robot, controller = CARMEL.robot, CARMEL.controller
     model, loop, tr = _transition(robot, controller)
     N = ratio * model.boundary(loop).NV_critical / robot.V

@@ -21,7 +21,8 @@ from pfm_stability.laws.fields import make_law
 from pfm_stability.maps.analysis import analyze_map
 from pfm_stability.maps.episodes import AMPLITUDE_THRESHOLD, episodes, lateral_episodes
 from pfm_stability.maps.occupancy import load_map
-from pfm_stability.maps.paths import PATH_VERDICTS, SampledTransition
+from pfm_stability.maps.driven import SampledTransition
+from pfm_stability.maps.paths import PATH_VERDICTS
 from pfm_stability.models import Loop, models_for
 from pfm_stability.models.sampled import closed_loop_matrix
 from pfm_stability.parameters import CARMEL, Corridor
@@ -292,13 +293,13 @@ def test_excursion_is_how_far_the_loop_strays_however_irregular():
 @SHARED_CORRIDORS
 def test_driving_finds_the_unstable_corridor_and_nothing_in_the_stable_one(root, monkeypatch):
     """Validation by driving on two corridors: at 1.4 V* the simulator's drives oscillate and the unstable stretches
-    along their paths recall >= 80 % of the episodes' length with >= 80 % precision, and the predicted weave has the
+    along their paths recall >= 90 % of the episodes' length with >= 90 % precision, and the predicted weave has the
     simulated one's size; at 0.7 V* no drive oscillates,
     nothing is predicted unstable, and recall and precision are undefined (None: nothing to measure), not counted as
     agreement, and all the length driven is predicted stable (specificity 100 %, of each kind of drive too); each figure lies in its 95 %
-    interval over the drives, whose per-drive lengths add up to it. (Recall is 97 % here: the corridor's rate-limited
-    cycle, ~2 cm in the simulator, is 1.5 cm in the driven loop, at the episodes' threshold, so the first metre of a
-    short drive can be missed — docs/maps.md.)"""
+    interval over the drives, whose per-drive lengths add up to it. (Recall and precision are 100 % here: along the
+    drives' own paths the loop is driven as the robot drove them and judged on its track in the plane, as the
+    simulator's drives are — docs/maps.md, "Paths taken".)"""
     from pfm_stability.validation import map_drives
     from pfm_stability.validation.map_drives import drive_map
 
@@ -311,17 +312,17 @@ def test_driving_finds_the_unstable_corridor_and_nothing_in_the_stable_one(root,
     figures = (L["episode_recalled"], L["episode"], L["predicted_unstable_matched"], L["predicted_unstable_driven"])
     assert [v for pair in sums for v in pair] == pytest.approx(figures, rel=1e-12)
     assert unstable.counts["episodes"] > 0
-    assert unstable.recall >= 0.8 and unstable.precision >= 0.8, (unstable.lengths, unstable.disagreements)
+    assert unstable.recall >= 0.9 and unstable.precision >= 0.9, (unstable.lengths, unstable.disagreements)
     false_alarms = [d for d in unstable.disagreements if d.kind == "false alarm"]
     assert unstable.lengths["false_alarm_swinging"] <= sum(d.length for d in false_alarms) + 1e-9
     assert all(d.simulated_amplitude >= 0 and d.predicted_amplitude >= 0 for d in unstable.disagreements)
     for figure, (lo, hi) in ((unstable.recall, unstable.recall_interval), (unstable.precision, unstable.precision_interval)):
         assert 0.0 <= lo <= figure <= hi <= 1.0
     # the weaves' size where either passes the threshold: the loop and the simulator hold the same rate-limited cycle,
-    # so their ratio's quartiles lie within 25 % of 1 (measured 0.98, 1.01, 1.06: the grid's ripple and the drives'
-    # ends move single samples) and nearly all the length within a factor 2 (measured 92 %)
-    assert unstable.wobble.length > 0 and unstable.wobble.within >= 0.85, unstable.wobble
-    assert all(0.8 <= q <= 1.25 for q in unstable.wobble.ratio_quartiles), unstable.wobble
+    # so their ratio's quartiles lie within 15 % of 1 (measured 0.93, 0.98, 1.00: the grid's ripple and the drives'
+    # ends move single samples) and nearly all the length within a factor 2 (measured 98 %)
+    assert unstable.wobble.length > 0 and unstable.wobble.within >= 0.9, unstable.wobble
+    assert all(0.85 <= q <= 1.15 for q in unstable.wobble.ratio_quartiles), unstable.wobble
     stable = drive_map(corridor_analysis(0.6, 0.7 * V_star, root), 6, seed=1)
     assert stable.counts["episodes"] == 0 and stable.lengths["predicted_unstable_driven"] == 0
     assert stable.wobble.length == 0.0 and stable.wobble.within is None  # neither weaves past the threshold: no figure

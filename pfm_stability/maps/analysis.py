@@ -53,7 +53,8 @@ from ..io.serialize import json_number
 from .equilibria import Samples, grid_equilibria, power_equilibria
 from .field import UNKNOWN_AS, HistogramMap, histogram_of
 from .occupancy import OccupancyMap
-from .paths import PathVerdicts, SampledTransition, analyze_paths
+from .driven import SampledTransition
+from .paths import PathVerdicts, analyze_paths
 from .routes import Route, default_min_length, find_paths, find_routes
 from .wobble import SegmentWobble
 from .verdicts import END_FRACTION, TAPER_SLOPE, GrowthRate, drift_slope, critical_speed, is_weak, judged_run, segment_gain, wavelength

@@ -62,6 +62,17 @@ lateral offset y turns the attraction by y/D — the whole lateral gain of a pur
 which oscillates once V/D passes NV*. Such a path is judged the way it was driven; where a wall is
 ahead that way it is unjudged ("wall ahead").
 
+**A drive's own path** (a path taken whose aims are known, `RoutePath.aims`: the point the robot steered at as it
+passed each of its points) is driven as the robot drove it (`DrivenTrack`, `_driven`): the force at the loop's own
+point p(s) + y·nrm is the window sum there, the attraction is the unit vector from there to the point steered at,
+the loop moves along the path at its own pace, ds/dt = V·cos θ/(1 − κ·y) (`_TrackWalk`: a robot weaving about its path
+covers less of it than V·t, and keeps its phase only at that pace), and the path's frame turns under it — its heading
+loses the path's turn over each step (`SampledTransition.turn`), so a bend's onset kicks the loop as it kicks the
+robot, and a steady bend is held where the carrot's lead asks for the turn. Its episodes and weave are judged on its
+track in the plane by the drives' own judge (`episodes.episodes`, `episodes.swing`): the robot's weave is measured
+about its own one-period average, and the path (that average) ripples about it too. The window growth and the
+verdicts' N stay the linearization above.
+
 **Stretches**: runs of consecutive samples with one verdict (`PathStretch`), each with the
 numbers of its worst window: σ̄_w, e-folds σ̄_w·Λ/V, N_eff (`verdicts.effective_gain`:
 the uniform gain with that growth), margin NV*/(N_eff·V) − 1, and V* (the speed at which that
@@ -80,12 +91,13 @@ from ..models import gain_margin, verdict_label
 from ..models.verdicts import inside as in_set, judge_arrays
 from .equilibria import Samples, equilibria_at, lateral_force
 from .episodes import AMPLITUDE_THRESHOLD
+from .driven import LEAVES, DrivenTrack, SampledTransition, _driven
 from .relay import relay_amplitude, window_relay
 from .routes import RoutePath  # noqa: F401 (named in the docstrings and annotations)
 from .verdicts import EFOLDS, END_FRACTION, GrowthRate, critical_speed, effective_gain, wavelength
 
-__all__ = ["PATH_VERDICTS", "RENORMALIZE", "ROUND_OFF_EFOLDS", "UNJUDGED", "WINDOW_PERIODS", "PathStretch", "PathVerdicts", "SampledTransition",
-           "analyze_paths", "path_samples"]
+__all__ = ["PATH_VERDICTS", "RENORMALIZE", "ROUND_OFF_EFOLDS", "UNJUDGED", "WINDOW_PERIODS", "PathStretch", "PathVerdicts",
+           "SampledTransition", "analyze_paths", "path_samples"]
 
 WINDOW_PERIODS = 3.0
 """Length of the window whose accumulated growth decides a point, in oscillation wavelengths λ = 2πV/ω*: the
@@ -482,8 +494,9 @@ def analyze_paths(grid, law, paths, clearance: np.ndarray, W: float, V: float, b
     if transition is not None and boundary.omega_critical and boundary.omega_critical > 0:
         profile = lateral_profile(grid, law, x, y, tx, ty, LEAVES)
         stopped = np.stack([~np.isfinite(N_forward), ~np.isfinite(N_reverse)])
+        track = DrivenTrack.of(grid, law, paths, x, y, tx, ty, route, arc) if taken.any() else None
         oscillates, amplitude, excursion = _driven(route, arc, stopped, profile, pull, attraction, aim, V, transition,
-                                                   2 * math.pi / boundary.omega_critical, driven)
+                                                   2 * math.pi / boundary.omega_critical, driven, track)
         code = np.where((code == 0) & oscillates, 1, code)
     # the window-edge relay (`relay`): a restoring jump of F_n within a cell of the path, larger than its smooth change
     relay = np.zeros(x.size, dtype=bool)
@@ -511,68 +524,6 @@ def analyze_paths(grid, law, paths, clearance: np.ndarray, W: float, V: float, b
                            has, boundary, growth, heading_stable, V, window, efolds, oscillates, amplitude, relay)
     return PathVerdicts(paths, samples, arc, ds, px, py, N_forward, N_reverse, sig[0], sig[1], window_growth, code, local_verdict,
                         local_margin, window, stretches, oscillates, amplitude, relay)
-
-
-@dataclass(frozen=True)
-class SampledTransition:
-    """The sampled loop's one-period transition matrix Φ(NV) = Φ0 + NV·Φ1 (`models.sampled.closed_loop_matrix` is
-    affine in the loop gain: only the feedback row depends on it), and the same loop with its command apart
-    (`models.sampled.command_form`): x_(k+1) = M·x_k + n·sat(v_k), v_k = −F0·x_k − gk·δ_k with δ_k the heading the
-    lateral force asks for (−N·x to first order), sat the steering-rate limit.
-
-    Attributes
-    ----------
-    Phi0, Phi1 : ndarray, shape (n, n)
-        Φ at NV = 0 and its derivative in NV (s).
-    T : float
-        The period, s.
-    M : ndarray, shape (n, n)
-        The loop without the command.
-    command : ndarray, shape (n,)
-        Where the command v enters.
-    F0 : ndarray, shape (n,)
-        The command's feedback from the state at NV = 0 (the heading's).
-    steering_gain : float
-        g·k, 1/s: the command per radian of heading error, in motor units.
-    rate_limit : float
-        The largest |v|, rad/s: g·max_steering_rate with the command held (the simulator clips the held command);
-        inf with the reference held (the servo's limit acts inside the period, which the one-period map does not see).
-    lateral_index : int
-        The state that holds the lateral position, as x/V (s).
-    """
-
-    Phi0: np.ndarray
-    Phi1: np.ndarray
-    T: float
-    M: np.ndarray
-    command: np.ndarray
-    F0: np.ndarray
-    steering_gain: float
-    rate_limit: float
-    lateral_index: int
-
-    @classmethod
-    def of(cls, model, loop, max_steering_rate: float = math.inf) -> "SampledTransition":
-        """From a `models.Sampled` model and its loop (c = 0).
-
-        Parameters
-        ----------
-        model : Sampled
-            The loop model.
-        loop : Loop
-            KB's loop (τ, T, k, g, D, c).
-        max_steering_rate : float
-            The robot's limit on its steering command, rad/s (`Robot.max_steering_rate`; inf: none).
-        """
-        from ..models.sampled import closed_loop_matrix, command_form
-
-        def at(NV):  # Φ_cl at the loop gain NV (1/s)
-            return np.asarray(closed_loop_matrix(loop, loop.loop_gain(NV), model.hold, model.compute_delay), dtype=float)
-
-        Phi0 = at(0.0)
-        M, command, F0, F1 = command_form(loop, model.hold, model.compute_delay)
-        limit = loop.plant_gain * max_steering_rate if model.hold == "command" else math.inf
-        return cls(Phi0, at(1.0) - Phi0, float(loop.T), M, command, F0, float(loop.steering_gain), float(limit), int(np.flatnonzero(F1)[0]))
 
 
 RENORMALIZE = 8
@@ -627,16 +578,6 @@ def _window_product(N: np.ndarray, route: np.ndarray, arc: np.ndarray, half: flo
     return out, seconds
 
 
-PREDICTION_OFFSET = 0.03
-"""Lateral offset (m) of the loop's start from the route or path in `_driven` (the drives' start offset,
-`validation.maps.START_OFFSET`): the disturbance whose growth shows where the loop is unstable. On a path taken too:
-the loop's cycle is reached from above as from below (a rate-limited cycle at 1.7 cm, approached from 5 mm,
-overshoots and dips under the episodes' threshold for periods on its way)."""
-
-
-LEAVES = 1.0
-"""Lateral distance (m) from the route at which the loop's run stops: it has left any corridor (its amplitude
-is then "at least this")."""
 PROFILE_STEP = 0.25
 """Spacing of the lateral force profile across the route, histogram cells: a quarter cell, so that each jump of the
 window sum (at the cell boundaries) lies between two nodes a quarter cell apart, as in `relay.window_relay`."""
@@ -669,110 +610,6 @@ def lateral_profile(grid, law, x, y, tx, ty, reach: float):
     rep = lambda v: np.repeat(np.asarray(v, dtype=float), S)  # noqa: E731
     fn, ft = lateral_force(grid, law, rep(x), rep(y), rep(tx), rep(ty), np.tile(offsets, np.size(x)), phase_nodes=PROFILE_PHASE_NODES)
     return offsets, fn.reshape(-1, S), ft.reshape(-1, S)
-
-
-def _driven(route, arc, stopped, profile, pull, attraction, aim, V: float, transition: SampledTransition, period: float, taken):
-    """(oscillates, amplitude, excursion) per sample: the sampled loop driven along each route at V through the real
-    lateral force across it (module docstring, "The loop driven along the route"), in both directions (a path taken:
-    the way it was driven), started `PREDICTION_OFFSET` off it; its lateral position's episodes
-    (`episodes.lateral_episodes`, the drives' judge) mark the samples the robot passes meanwhile; amplitude is the
-    largest weave held there and excursion the farthest it strays from its one-period average within half a period
-    (`episodes.lateral_extent`, m); both `LEAVES` where the run left the corridor.
-
-    ``x_{k+1} = M·x_k + n·sat(v_k)``, ``v_k = −F0·x_k − gk·g_k(y_k)`` (`SampledTransition`),
-    g(y) = −atan2(F_n(y) − P − K·y, A ± F_r·t): the direction of the resultant the robot steers to (KB eq 4; the
-    linear loop's N·y for small y) with the lateral force itself (interpolated in `profile` between its quarter
-    cells), P and A what the goal balances across the path and its attraction along it (`_goal_pull`), K the goal's
-    pull back to the path (`_aim_stiffness`), sat the steering-rate limit. `stopped` (per direction and sample): the
-    direction is not judged there (a wall ahead, `END_FRACTION`): no lateral force. The run stops where it leaves the
-    profile or `LEAVES`.
-
-    Parameters
-    ----------
-    route, arc : ndarray
-        Route index and arc position (m) of each sample.
-    stopped : ndarray of bool, shape (2, samples)
-        Forward and reverse.
-    profile : tuple
-        `lateral_profile`'s (offsets, F_n, F_r·t).
-    pull, attraction : ndarray
-        The goal's pull across the path (P) and along it (A) per sample, F_ct units (0 and 1 on a route).
-    aim : ndarray
-        K per sample, F_ct/m (`_aim_stiffness`; 0 on a route).
-    V : float
-        Speed, m/s.
-    transition : SampledTransition
-        The loop.
-    period : float
-        The episodes' period P = 2π/ω*, s.
-    taken : bool or ndarray of bool
-        Per route (or all): a path the robot took.
-    """
-    from .episodes import lateral_episodes, lateral_extent
-
-    offsets, fn, ft = profile
-    taken = np.broadcast_to(np.asarray(taken, dtype=bool), (int(route.max()) + 1 if route.size else 0,))  # per route
-    y_index = transition.lateral_index
-    M, command, F0, gk, limit = transition.M, transition.command, transition.F0, transition.steering_gain, transition.rate_limit
-    step = V * transition.T
-    h = offsets[1] - offsets[0]
-    oscillates, amplitude, excursion = np.zeros(arc.size, dtype=bool), np.zeros(arc.size), np.zeros(arc.size)
-    centre = offsets.size // 2
-    runs = []  # (samples passed at each step, sign of travel) of each route and direction
-    for r in np.unique(route):
-        idx = np.flatnonzero(route == r)
-        a = arc[idx]
-        if a.size < 2:
-            continue
-        positions = (np.arange(int((a[-1] + (a[1] - a[0]) / 2) / step)) + 0.5) * step
-        if positions.size < 8:
-            continue
-        for d in ((0,) if taken[r] else (0, 1)):  # a path taken was driven one way, from its start
-            pos = positions if d == 0 else positions[::-1]
-            runs.append((idx[np.clip(np.searchsorted((a[:-1] + a[1:]) / 2, pos), 0, a.size - 1)], d, bool(taken[r])))
-    if not runs:
-        return oscillates, amplitude, excursion
-    steps = max(r[0].size for r in runs)
-    rows = np.zeros((len(runs), steps), dtype=int)
-    sign = np.array([1.0 if d == 0 else -1.0 for _, d, _ in runs])
-    length = np.array([n.size for n, _, _ in runs])
-    for i, (nearest, _, _) in enumerate(runs):
-        rows[i, :nearest.size] = nearest
-    state = np.zeros((len(runs), M.shape[0]))
-    state[:, y_index] = sign * PREDICTION_OFFSET / V  # to the left of the travel direction (the state is x/V, s)
-    lateral = np.full((len(runs), steps), np.nan)
-    alive = np.ones(len(runs), dtype=bool)
-    with np.errstate(invalid="ignore"):
-        for k in range(steps):
-            alive &= k < length
-            row = rows[:, k]
-            yk = V * state[:, y_index]  # m
-            u = (yk - offsets[0]) / h
-            i0 = np.clip(np.floor(u).astype(int), 0, offsets.size - 2)
-            frac = u - i0
-            f = fn[row, i0] * (1 - frac) + fn[row, i0 + 1] * frac
-            ahead = attraction[row] + sign * ft[row, centre]
-            g = -np.arctan2(f - pull[row] - aim[row] * yk, ahead)  # the resultant's direction (KB eq 4), ~ N·y for small y
-            g = np.where(stopped[(sign < 0).astype(int), row], 0.0, g)
-            inside = (u >= 0) & (u <= offsets.size - 1) & (np.abs(yk) <= LEAVES) & np.isfinite(g)
-            alive &= inside & np.isfinite(state).all(axis=1)
-            lateral[alive, k] = yk[alive]
-            v = np.clip(-(state @ F0) - gk * np.where(alive, g, 0.0), -limit, limit)  # the command, rate-limited
-            state = state @ M.T + v[:, None] * command[None, :]
-            state[~alive] = 0.0
-    t = np.arange(steps) * transition.T
-    for i, (nearest, d, _) in enumerate(runs):
-        m = nearest.size
-        ok = np.isfinite(lateral[i, :m])
-        found, _ = lateral_episodes(t[:m][ok], sign[i] * lateral[i, :m][ok], period)
-        for lo, hi in found:
-            oscillates[nearest[(t[:m] >= lo) & (t[:m] <= hi)]] = True
-        swing, strays = lateral_extent(t[:m][ok], lateral[i, :m][ok], period)
-        np.maximum.at(amplitude, nearest[ok], swing)
-        np.maximum.at(excursion, nearest[ok], strays)
-        amplitude[nearest[~ok]] = np.maximum(amplitude[nearest[~ok]], LEAVES)  # it left the corridor: at least that
-        excursion[nearest[~ok]] = LEAVES
-    return oscillates, amplitude, excursion
 
 
 def _stretches(paths, route, arc, ds, x, y, code, window_growth, worse, mean_N, N, has, boundary, growth, heading_stable, V, window,

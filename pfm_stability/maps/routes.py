@@ -87,6 +87,9 @@ class RoutePath:
         A path a robot took towards a point target: that target (x, y), m (None: a goal along the route, at infinity).
     lookahead : float
         A path a robot took following a plan: how far ahead along it the point it steered at lay, m (inf: none).
+    aims : ndarray, shape (n, 2), or None
+        A path a robot took: the point it steered at as it passed each vertex, m (its plan's carrot, or its point
+        target); None: not known (a route, whose goal lies along it).
     """
 
     points: np.ndarray
@@ -94,6 +97,7 @@ class RoutePath:
     source: str = "skeleton"
     goal: tuple | None = None
     lookahead: float = math.inf
+    aims: np.ndarray | None = None
 
     @property
     def length(self) -> float:
@@ -101,7 +105,7 @@ class RoutePath:
         return float(np.hypot(*np.diff(self.points, axis=0).T).sum())
 
 
-def path_of(points, branch: int = 0, source: str = "path", goal=None, lookahead: float = math.inf) -> RoutePath:
+def path_of(points, branch: int = 0, source: str = "path", goal=None, lookahead: float = math.inf, aims=None) -> RoutePath:
     """A `RoutePath` through `points` (m; repeated points dropped); ValueError if fewer than two distinct points.
 
     Parameters
@@ -116,17 +120,24 @@ def path_of(points, branch: int = 0, source: str = "path", goal=None, lookahead:
         The point target of the robot that took it, m (`RoutePath.goal`).
     lookahead : float
         The lookahead of the plan it followed, m (`RoutePath.lookahead`).
+    aims : array_like, shape (n, 2), optional
+        The point it steered at from each of `points`, m (`RoutePath.aims`).
     """
     p = np.asarray(points, dtype=float).reshape(-1, 2)
+    if aims is not None:
+        aims = np.asarray(aims, dtype=float).reshape(-1, 2)
+        if aims.shape != p.shape or not np.isfinite(aims).all():
+            raise ValueError(f"a {source} route's aims must be one finite point (m) per vertex, {len(p)}; got shape {aims.shape}")
     if not np.isfinite(p).all():
         raise ValueError(f"a {source} route's points must be finite numbers (m); got {p[~np.isfinite(p).all(axis=1)][:1].tolist()}")
     keep = np.concatenate([[True], np.hypot(*np.diff(p, axis=0).T) > 1e-9]) if len(p) else np.zeros(0, dtype=bool)
     p = p[keep]
+    aims = aims[keep] if aims is not None else None
     if len(p) < 2:
         raise ValueError(f"a {source} route needs at least two distinct points; got {len(p)}")
     if not lookahead > 0:
         raise ValueError(f"a {source} route's lookahead must be > 0 m; got {lookahead!r}")
-    return RoutePath(p, int(branch), source, None if goal is None else (float(goal[0]), float(goal[1])), float(lookahead))
+    return RoutePath(p, int(branch), source, None if goal is None else (float(goal[0]), float(goal[1])), float(lookahead), aims)
 
 
 def find_paths(grid: HistogramMap, skeleton: np.ndarray, clearance: np.ndarray) -> list:

@@ -16,8 +16,10 @@ that grow by an e-fold or stay above `AMPLITUDE_THRESHOLD`.
 
 **Each drive is judged along the path it took** (its positions averaged over one period, `maps.analysis.judge_routes`
 with ``taken``: the prediction the map makes along any route — the loop driven through the force across the path,
-`maps.paths` — made along that path, in the direction it was driven, with the pull back to it of the point the robot
-steered at: its plan's carrot or its goal, `RoutePath.lookahead` and `RoutePath.goal`). The VFF robot aims at a
+`maps.paths` — made along that path, in the direction it was driven, as the robot drove it: the window sum at the
+loop's own point, the attraction towards the point the robot steered at as it passed each point of the path (its
+plan's carrot or its goal, `RoutePath.aims`), the path's frame turning under the loop at the loop's own pace along
+it, and the loop's track judged in the plane by the drives' own judge; `maps.driven.DrivenTrack`). The VFF robot aims at a
 point, not along a route: it leaves the skeleton wherever the field bends it away (beside a rack it rides the
 window's edge, metres from the route), so comparing the skeleton's verdicts with a robot that drove elsewhere would
 compare two different paths.
@@ -174,7 +176,7 @@ class WobbleAgreement:
     ----------
     length : float
         Measured length where either side wove past the threshold, m (the loop still in the corridor: where it left,
-        its size is only "at least `maps.paths.LEAVES`", and the length is counted as ``left`` instead).
+        its size is only "at least `maps.driven.LEAVES`", and the length is counted as ``left`` instead).
     within : float or None
         Share of `length` where predicted / simulated lies within 1/`WOBBLE_FACTOR` .. `WOBBLE_FACTOR` (None: no
         length).
@@ -377,7 +379,8 @@ def drive_map(analysis, count: int, *, seed: int = 0, progress=None) -> DriveVal
     from scipy.spatial import cKDTree
 
     from ..maps.analysis import judge_routes
-    from ..maps.paths import LEAVES, PATH_VERDICTS, UNJUDGED
+    from ..maps.driven import LEAVES
+    from ..maps.paths import PATH_VERDICTS, UNJUDGED
 
     started = time.perf_counter()
     count = check_integer("count", count, 1, 100_000)
@@ -700,7 +703,23 @@ def _taken_path(x, y, period: float, T: float, cell: float, index: int, source: 
     step = np.flatnonzero(np.diff(np.concatenate([[-1.0], arc // cell])) > 0)  # a point every cell
     points = np.column_stack([x[step], y[step]]) if step.size >= 2 else np.column_stack([x[[0, -1]], y[[0, -1]]])
     return path_of(points, index, source, goal=(target.x, target.y) if target.is_point else None,
-                   lookahead=target.lookahead if target.is_path else math.inf)
+                   lookahead=target.lookahead if target.is_path else math.inf, aims=_aims(points, target))
+
+
+def _aims(points, target) -> np.ndarray:
+    """The point (m) a robot steering at `target` (a `Target`) aims at as it passes each of `points` (m) in order:
+    its plan's carrot (`sim.follow.PathFollower`, the simulator's own), or its point target."""
+    from ..sim.follow import PathFollower
+
+    if not target.is_path:
+        return np.tile([target.x, target.y], (len(points), 1))
+    follower = PathFollower([target])
+    aims = np.empty((len(points), 2))
+    for k, (px, py) in enumerate(points):
+        follower.advance(np.array([px]), np.array([py]))
+        cx, cy = follower.carrot()
+        aims[k] = cx[0], cy[0]
+    return aims
 
 
 def goal_routes(analysis, goals, progress=None) -> list:

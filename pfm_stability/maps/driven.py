@@ -1,0 +1,397 @@
+"""The sampled loop driven along a route through the force across it (docs/maps.md, "The loop driven along the
+route", "A drive's own path is driven as the robot drove it"; `maps.paths` judges with it).
+
+`SampledTransition` is the sampled loop's one-period map with its command apart (the window growth's Φ(NV) and the
+driven loop's step); `_driven` runs the loop along every route through the lateral force tabulated across it
+(`paths.lateral_profile`), and along a drive's own path as the robot drove it (`DrivenTrack`: the window sum at the
+loop's own point, the attraction towards the point the robot steered at, the path's frame turning under the loop at
+the loop's own pace, `_TrackWalk`; its track judged in the plane by the drives' own judge, `maps.episodes`).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .field import window_force
+
+__all__ = ["LEAVES", "OWN_STEPS", "PREDICTION_OFFSET", "DrivenTrack", "SampledTransition"]
+
+
+@dataclass(frozen=True)
+class SampledTransition:
+    """The sampled loop's one-period transition matrix Φ(NV) = Φ0 + NV·Φ1 (`models.sampled.closed_loop_matrix` is
+    affine in the loop gain: only the feedback row depends on it), and the same loop with its command apart
+    (`models.sampled.command_form`): x_(k+1) = M·x_k + n·sat(v_k), v_k = −F0·x_k − gk·δ_k with δ_k the heading the
+    lateral force asks for (−N·x to first order), sat the steering-rate limit.
+
+    Attributes
+    ----------
+    Phi0, Phi1 : ndarray, shape (n, n)
+        Φ at NV = 0 and its derivative in NV (s).
+    T : float
+        The period, s.
+    M : ndarray, shape (n, n)
+        The loop without the command.
+    command : ndarray, shape (n,)
+        Where the command v enters.
+    F0 : ndarray, shape (n,)
+        The command's feedback from the state at NV = 0 (the heading's).
+    steering_gain : float
+        g·k, 1/s: the command per radian of heading error, in motor units.
+    rate_limit : float
+        The largest |v|, rad/s: g·max_steering_rate with the command held (the simulator clips the held command);
+        inf with the reference held (the servo's limit acts inside the period, which the one-period map does not see).
+    lateral_index : int
+        The state that holds the lateral position, as x/V (s).
+    turn : ndarray, shape (n,)
+        The state's change per radian the path's frame turns through during one period at a steady rate (the frame's
+        rotation V·κ subtracted from the heading's rate: −turn·Δφ, Δφ the path's change of heading over the step; the
+        heading's column of ∫₀ᵀ e^(As) ds / T, padded with zeros for the commands on their way).
+    """
+
+    Phi0: np.ndarray
+    Phi1: np.ndarray
+    T: float
+    M: np.ndarray
+    command: np.ndarray
+    F0: np.ndarray
+    steering_gain: float
+    rate_limit: float
+    lateral_index: int
+    turn: np.ndarray
+
+    @classmethod
+    def of(cls, model, loop, max_steering_rate: float = math.inf) -> "SampledTransition":
+        """From a `models.Sampled` model and its loop (c = 0).
+
+        Parameters
+        ----------
+        model : Sampled
+            The loop model.
+        loop : Loop
+            KB's loop (τ, T, k, g, D, c).
+        max_steering_rate : float
+            The robot's limit on its steering command, rad/s (`Robot.max_steering_rate`; inf: none).
+        """
+        from ..models.sampled import closed_loop_matrix, command_form, continuous_plant
+        from ..numerics.matrix_exponential import zoh_blocks
+
+        def at(NV):  # Φ_cl at the loop gain NV (1/s)
+            return np.asarray(closed_loop_matrix(loop, loop.loop_gain(NV), model.hold, model.compute_delay), dtype=float)
+
+        Phi0 = at(0.0)
+        M, command, F0, F1 = command_form(loop, model.hold, model.compute_delay)
+        limit = loop.plant_gain * max_steering_rate if model.hold == "command" else math.inf
+        lateral = int(np.flatnonzero(F1)[0])
+        A = continuous_plant(loop, model.hold)[0]
+        turn = np.zeros(M.shape[0])
+        turn[:A.shape[0]] = zoh_blocks(A, loop.T)[1][:, lateral - 1] / loop.T  # the heading precedes the lateral state
+        return cls(Phi0, at(1.0) - Phi0, float(loop.T), M, command, F0, float(loop.steering_gain), float(limit), lateral, turn)
+
+
+PREDICTION_OFFSET = 0.03
+"""Lateral offset (m) of the loop's start from the route or path in `_driven` (the drives' start offset,
+`validation.maps.START_OFFSET`): the disturbance whose growth shows where the loop is unstable. On a path taken too:
+the loop's cycle is reached from above as from below (a rate-limited cycle at 1.7 cm, approached from 5 mm,
+overshoots and dips under the episodes' threshold for periods on its way)."""
+
+
+LEAVES = 1.0
+"""Lateral distance (m) from the route at which the loop's run stops: it has left any corridor (its amplitude
+is then "at least this")."""
+def _path_heading(tx, ty, route) -> np.ndarray:
+    """φ per sample, rad: the direction of each route's tangent, unwrapped along the route (continuous through its
+    bends, so that its change over a stretch is the angle the path turns through there)."""
+    heading = np.arctan2(ty, tx)
+    for r in np.unique(route):
+        on = route == r
+        heading[on] = np.unwrap(heading[on])
+    return heading
+
+
+@dataclass(frozen=True)
+class DrivenTrack:
+    """What the loop driven along a drive's own path knows besides the force across it (`_driven`): the path's
+    samples and direction, the point the robot steered at, and the field itself.
+
+    Attributes
+    ----------
+    x, y : ndarray
+        The samples, m.
+    heading : ndarray
+        φ per sample, rad (`_path_heading`).
+    aims : ndarray, shape (2, samples)
+        The point the robot steered at as it passed each sample, m (`RoutePath.aims`); nan where not known.
+    force : callable
+        ``force(x, y) -> (F_x, F_y)``: the VFF window sum at points (m), F_ct units (`field.window_force`).
+    """
+
+    x: np.ndarray
+    y: np.ndarray
+    heading: np.ndarray
+    aims: np.ndarray
+    force: object
+
+    @classmethod
+    def of(cls, grid, law, paths, x, y, tx, ty, route, arc) -> "DrivenTrack":
+        """The track of the samples of `paths` on the map's histogram grid under KB's grid law.
+
+        Parameters
+        ----------
+        grid : HistogramMap
+            The map's histogram grid.
+        law : GridWallLaw
+            KB's grid law.
+        paths : sequence of RoutePath
+            The routes (`RoutePath.aims`: a drive's own path's).
+        x, y, tx, ty : ndarray
+            The samples (m) and unit tangents (`paths.path_samples`).
+        route, arc : ndarray
+            Route index and arc position (m) of each sample.
+        """
+        aims = np.full((2, np.size(x)), np.nan)
+        for r, path in enumerate(paths):
+            if path.aims is None:
+                continue
+            on = route == r
+            vertices = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(path.points, axis=0).T))])
+            aims[0, on], aims[1, on] = (np.interp(arc[on], vertices, path.aims[:, k]) for k in (0, 1))
+        return cls(np.asarray(x, dtype=float), np.asarray(y, dtype=float), _path_heading(tx, ty, route), aims,
+                   lambda px, py: window_force(grid, law, px, py))
+
+
+def _driven(route, arc, stopped, profile, pull, attraction, aim, V: float, transition: SampledTransition, period: float, taken,
+            track: DrivenTrack | None = None):
+    """(oscillates, amplitude, excursion) per sample: the sampled loop driven along each route at V through the real
+    lateral force across it (`maps.paths` module docstring, "The loop driven along the route"), in both directions (a
+    path taken: the way it was driven), started `PREDICTION_OFFSET` off it; its lateral position's episodes
+    (`episodes.lateral_episodes`, the drives' judge) mark the samples the robot passes meanwhile; amplitude is the
+    largest weave held there and excursion the farthest it strays from its one-period average within half a period
+    (`episodes.lateral_extent`, m); both `LEAVES` where the run left the corridor.
+
+    ``x_{k+1} = M·x_k + n·sat(v_k)``, ``v_k = −F0·x_k − gk·g_k(y_k)`` (`SampledTransition`),
+    g(y) = −atan2(F_n(y) − P − K·y, A ± F_r·t): the direction of the resultant the robot steers to (KB eq 4; the
+    linear loop's N·y for small y) with the lateral force itself (interpolated in `profile` between its quarter
+    cells), P and A what the goal balances across the path and its attraction along it (`paths._goal_pull`), K the goal's
+    pull back to the path (`paths._aim_stiffness`), sat the steering-rate limit. `stopped` (per direction and sample): the
+    direction is not judged there (a wall ahead, `verdicts.END_FRACTION`): no lateral force. The run stops where it leaves the
+    profile or `LEAVES`.
+
+    **A drive's own path** (a path taken whose aims are known, `track`) is driven as the robot drove it (`maps.paths`
+    module docstring, "A drive's own path"): at the loop's own point q = p(s) + y·nrm(s) the force is the window sum there
+    (`DrivenTrack.force`, not the profile's value at the sample's cell middle), the attraction is the unit vector from q
+    to the point the robot steered at (`RoutePath.aims`: its carrot, whose pull back to the path is the K·y above
+    exactly), the loop moves along the path at its own pace (`_TrackWalk`), and it runs in the path's frame, which
+    turns under it: each step subtracts the path's change of direction over the step from the heading
+    (`SampledTransition.turn`); its episodes and weave are judged on its track q in the plane by the drives' own judge
+    (`episodes.episodes`, `episodes.swing`), which measures the path's own ripple about its one-period average with it,
+    as it does for the robot. It runs until it has come to the path's end (at most `OWN_STEPS` times the steps at V).
+
+    Parameters
+    ----------
+    route, arc : ndarray
+        Route index and arc position (m) of each sample.
+    stopped : ndarray of bool, shape (2, samples)
+        Forward and reverse.
+    profile : tuple
+        `paths.lateral_profile`'s (offsets, F_n, F_r·t).
+    pull, attraction : ndarray
+        The goal's pull across the path (P) and along it (A) per sample, F_ct units (0 and 1 on a route).
+    aim : ndarray
+        K per sample, F_ct/m (`paths._aim_stiffness`; 0 on a route).
+    V : float
+        Speed, m/s.
+    transition : SampledTransition
+        The loop.
+    period : float
+        The episodes' period P = 2π/ω*, s.
+    taken : bool or ndarray of bool
+        Per route (or all): a path the robot took.
+    track : DrivenTrack, optional
+        The drives' own paths' track (a path taken with its aims known is driven as the robot drove it).
+    """
+    from .episodes import episodes, lateral_episodes, lateral_extent, swing
+
+    offsets, fn, ft = profile
+    taken = np.broadcast_to(np.asarray(taken, dtype=bool), (int(route.max()) + 1 if route.size else 0,))  # per route
+    y_index = transition.lateral_index
+    M, command, F0, gk, limit = transition.M, transition.command, transition.F0, transition.steering_gain, transition.rate_limit
+    step = V * transition.T
+    h = offsets[1] - offsets[0]
+    oscillates, amplitude, excursion = np.zeros(arc.size, dtype=bool), np.zeros(arc.size), np.zeros(arc.size)
+    centre = offsets.size // 2
+    runs = []  # (samples passed at each step, sign of travel, whether it is a drive's own path) of each route and direction
+    for r in np.unique(route):
+        idx = np.flatnonzero(route == r)
+        a = arc[idx]
+        if a.size < 2:
+            continue
+        positions = (np.arange(int((a[-1] + (a[1] - a[0]) / 2) / step)) + 0.5) * step
+        if positions.size < 8:
+            continue
+        for d in ((0,) if taken[r] else (0, 1)):  # a path taken was driven one way, from its start
+            pos = positions if d == 0 else positions[::-1]
+            nearest = idx[np.clip(np.searchsorted((a[:-1] + a[1:]) / 2, pos), 0, a.size - 1)]
+            runs.append((nearest, d, taken[r] and track is not None and bool(np.isfinite(track.aims[:, idx]).all())))
+    if not runs:
+        return oscillates, amplitude, excursion
+    own = np.flatnonzero([mine for _, _, mine in runs])
+    length = np.array([n.size for n, _, _ in runs])
+    steps = int(max(length.max(), math.ceil(OWN_STEPS * length[own].max()) if own.size else 0))
+    length[own] = steps  # a drive's own path's loop runs until it has come to the path's end (`_TrackWalk`)
+    rows = np.zeros((len(runs), steps), dtype=int)
+    sign = np.array([1.0 if d == 0 else -1.0 for _, d, _ in runs])
+    for i, (nearest, _, _) in enumerate(runs):
+        rows[i, :nearest.size] = nearest
+    walk = _TrackWalk(track, route, arc, [runs[i][0][0] for i in own], step) if own.size else None
+    track_xy = np.full((2, len(runs), steps), np.nan)  # a drive's own path's point (m) and direction (rad) at each step
+    track_phi = np.full((len(runs), steps), np.nan)
+    state = np.zeros((len(runs), M.shape[0]))
+    state[:, y_index] = sign * PREDICTION_OFFSET / V  # to the left of the travel direction (the state is x/V, s)
+    lateral = np.full((len(runs), steps), np.nan)
+    alive = np.ones(len(runs), dtype=bool)
+    with np.errstate(invalid="ignore"):
+        for k in range(steps):
+            alive &= k < length
+            turn = np.zeros(len(runs))
+            if own.size:  # a drive's own path: where the loop has got to along it (its own progress, `_TrackWalk`)
+                alive[own] &= walk.going(k)
+                rows[own, k] = walk.rows()
+            row = rows[:, k]
+            yk = V * state[:, y_index]  # m
+            u = (yk - offsets[0]) / h
+            i0 = np.clip(np.floor(u).astype(int), 0, offsets.size - 2)
+            frac = u - i0
+            f = fn[row, i0] * (1 - frac) + fn[row, i0 + 1] * frac
+            g = -np.arctan2(f - pull[row] - aim[row] * yk, attraction[row] + sign * ft[row, centre])  # KB eq 4, ~ N·y
+            if own.size:
+                point = walk.here()
+                track_xy[:, own, k], track_phi[own, k] = point[0:2], point[2]
+                g[own] = _steered(track, point, yk[own])
+            g = np.where(stopped[(sign < 0).astype(int), row], 0.0, g)
+            inside = (u >= 0) & (u <= offsets.size - 1) & (np.abs(yk) <= LEAVES) & np.isfinite(g)
+            alive &= inside & np.isfinite(state).all(axis=1)
+            lateral[alive, k] = yk[alive]
+            if own.size:
+                turn[own] = walk.advance(state[own, y_index - 1], yk[own])
+            v = np.clip(-(state @ F0) - gk * np.where(alive, g, 0.0), -limit, limit)  # the command, rate-limited
+            state = state @ M.T + v[:, None] * command[None, :] - turn[:, None] * transition.turn[None, :]
+            state[~alive] = 0.0
+    t = np.arange(steps) * transition.T
+    ended = np.array(length)
+    if own.size:
+        ended[own] = walk.ended_at(steps)
+    for i, (_, _, mine) in enumerate(runs):
+        m = int(ended[i])
+        nearest = rows[i, :m]
+        ok = np.isfinite(lateral[i, :m])
+        tk, yk = t[:m][ok], lateral[i, :m][ok]
+        found, _ = lateral_episodes(tk, sign[i] * yk, period)
+        swung, strays = lateral_extent(tk, yk, period)
+        if mine:  # the drives' own judge on the loop's track in the plane
+            phi = track_phi[i, :m][ok]
+            px, py = track_xy[0, i, :m][ok] - np.sin(phi) * yk, track_xy[1, i, :m][ok] + np.cos(phi) * yk
+            found, _ = episodes(tk, px, py, period)
+            swung = swing(tk, px, py, period)
+        for lo, hi in found:
+            oscillates[nearest[(t[:m] >= lo) & (t[:m] <= hi)]] = True
+        np.maximum.at(amplitude, nearest[ok], swung)
+        np.maximum.at(excursion, nearest[ok], strays)
+        amplitude[nearest[~ok]] = np.maximum(amplitude[nearest[~ok]], LEAVES)  # it left the corridor: at least that
+        excursion[nearest[~ok]] = LEAVES
+    return oscillates, amplitude, excursion
+
+
+OWN_STEPS = 1.5
+"""A loop along a drive's own path is run for at most this many times the steps its path's length takes at V: it
+progresses along the path at V·cos θ/(1 − κ·y) (`_TrackWalk`), slower only by its heading off the path's."""
+
+
+class _TrackWalk:
+    """The loops along drives' own paths (`_driven`), each at its own progress s along its path: ds/dt = V·cos θ/(1 − κ·y)
+    (θ its heading from the path's, y its offset to the left, κ the path's curvature): a robot weaving about its path
+    covers less of it than V·t, and the loop must keep the robot's pace to keep its phase.
+
+    Parameters
+    ----------
+    track : DrivenTrack
+    route, arc : ndarray
+        Route index and arc position (m) of each sample.
+    first : sequence of int
+        Per loop, a sample of its path.
+    step : float
+        V·T, m.
+    """
+
+    GAP = 1.0
+    """m between consecutive routes on the walk's one arc axis (more than a sample's spacing: no interpolation across)."""
+
+    def __init__(self, track: DrivenTrack, route, arc, first, step: float):
+        lengths = np.array([arc[route == r].max() for r in range(int(route.max()) + 1)])
+        offset = np.concatenate([[0.0], np.cumsum(lengths + self.GAP)])[:-1]
+        self.axis = arc + offset[route]  # increasing: the samples are in route order, each route's by arc
+        self.middles = (self.axis[:-1] + self.axis[1:]) / 2
+        curvature = np.zeros(arc.size)
+        for r in np.unique(route):
+            on = np.flatnonzero(route == r)
+            if on.size >= 2:
+                curvature[on] = np.gradient(track.heading[on], arc[on])
+        self.values = np.stack([track.x, track.y, track.heading, track.aims[0], track.aims[1], curvature])
+        mine = route[np.asarray(first)]
+        ends = [np.flatnonzero(route == r)[[0, -1]] for r in mine]
+        self.lo = np.array([self.axis[i] for i, _ in ends])
+        self.hi = np.array([self.axis[j] for _, j in ends])
+        spacing = np.array([arc[j] - arc[j - 1] if j > i else 0.0 for i, j in ends])
+        self.stop = offset[mine] + np.array([arc[j] for _, j in ends]) + spacing / 2  # the static positions' end
+        self.s = offset[mine] + step / 2
+        self.step = step
+        self.ended = np.full(mine.size, -1)
+
+    def _at(self, s) -> np.ndarray:
+        return np.stack([np.interp(np.clip(s, self.lo, self.hi), self.axis, v) for v in self.values])
+
+    def going(self, k: int) -> np.ndarray:
+        """Whether each loop is still on its path at step `k` (recording the step it left it at)."""
+        on = self.s < self.stop
+        self.ended = np.where((self.ended < 0) & ~on, k, self.ended)
+        return on
+
+    def rows(self) -> np.ndarray:
+        """The sample each loop is passing."""
+        return np.searchsorted(self.middles, np.clip(self.s, self.lo, self.hi))
+
+    def here(self) -> np.ndarray:
+        """Shape (5, loops): the path's point (m), its direction φ (rad) and the point steered at (m) where each loop is."""
+        return self._at(self.s)[:5]
+
+    def advance(self, theta: np.ndarray, y: np.ndarray) -> np.ndarray:
+        """Move each loop on by one step (heading θ from the path's, rad; offset y, m); the path's turn over it, rad."""
+        now = self._at(self.s)
+        ahead = self.step * np.cos(np.nan_to_num(theta)) / np.maximum(1.0 - now[5] * np.nan_to_num(y), 0.1)
+        self.s = self.s + ahead
+        return self._at(self.s)[2] - now[2]
+
+    def ended_at(self, steps: int) -> np.ndarray:
+        """Per loop, the steps it spent on its path."""
+        return np.where(self.ended < 0, steps, self.ended)
+
+
+def _steered(track: DrivenTrack, at: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """g (rad, `_driven`'s sign) of loops at lateral offsets `y` (m) from their path's points: the direction of the
+    resultant of the window sum at q = p + y·nrm and the unit attraction from q to the point steered at, from the
+    path's tangent (KB eq 4). `at`: `_TrackWalk.here` at the loops' step, shape (5, loops)."""
+    px, py, phi, ax, ay = at
+    tx, ty = np.cos(phi), np.sin(phi)
+    qx, qy = px - ty * y, py + tx * y
+    fx, fy = track.force(qx, qy)
+    dx, dy = ax - qx, ay - qy
+    reach = np.hypot(dx, dy)
+    safe = np.where(reach > 0, reach, 1.0)
+    gx, gy = np.where(reach > 0, dx / safe, tx), np.where(reach > 0, dy / safe, ty)  # at the point itself: straight on
+    rx, ry = fx + gx, fy + gy
+    return -np.arctan2(-ty * rx + tx * ry, tx * rx + ty * ry)
+
+
