@@ -16,6 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .field import window_force
+from .routes import polyline_arcs
 
 __all__ = ["LEAVES", "OWN_STEPS", "PREDICTION_OFFSET", "DrivenTrack", "SampledTransition"]
 
@@ -157,7 +158,7 @@ class DrivenTrack:
             if path.aims is None:
                 continue
             on = route == r
-            vertices = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(path.points, axis=0).T))])
+            vertices = polyline_arcs(path.points)
             aims[0, on], aims[1, on] = (np.interp(arc[on], vertices, path.aims[:, k]) for k in (0, 1))
         return cls(np.asarray(x, dtype=float), np.asarray(y, dtype=float), _path_heading(tx, ty, route), aims,
                    lambda px, py: window_force(grid, law, px, py))

@@ -31,6 +31,8 @@ import math
 
 import numpy as np
 
+from .routes import polyline_arcs
+
 __all__ = [
     "has_zone",
     "OUTPUT_FILES",
@@ -217,7 +219,7 @@ def route_piece(points, start: float, stop: float) -> np.ndarray:
         Arc positions along the route, m (start <= stop).
     """
     p = np.asarray(points, dtype=float).reshape(-1, 2)
-    edges = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(p, axis=0).T))])
+    edges = polyline_arcs(p)
     a, b = max(float(start), 0.0), min(float(stop), float(edges[-1]))
     if b < a:
         return np.zeros((0, 2))

@@ -93,7 +93,7 @@ from .equilibria import Samples, equilibria_at, lateral_force
 from .episodes import AMPLITUDE_THRESHOLD
 from .driven import LEAVES, DrivenTrack, SampledTransition, _driven
 from .relay import relay_amplitude, window_relay
-from .routes import RoutePath  # noqa: F401 (named in the docstrings and annotations)
+from .routes import RoutePath, polyline_arcs  # noqa: F401 (RoutePath: named in the docstrings and annotations)
 from .verdicts import EFOLDS, END_FRACTION, GrowthRate, critical_speed, effective_gain, wavelength
 
 __all__ = ["PATH_VERDICTS", "RENORMALIZE", "ROUND_OFF_EFOLDS", "UNJUDGED", "WINDOW_PERIODS", "PathStretch", "PathVerdicts",
@@ -625,7 +625,7 @@ def _stretches(paths, route, arc, ds, x, y, code, window_growth, worse, mean_N, 
             first, last = run[0], run[-1]
             start, stop = float(arc[first] - ds[first] / 2), float(arc[last] + ds[last] / 2)
             points = paths[r].points
-            edges = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(points, axis=0).T))])
+            edges = polyline_arcs(points)
             ends = [float(np.interp(a, edges, points[:, k])) for a in (start, stop) for k in (0, 1)]
             base = dict(route=r, start=start, stop=stop, x0=ends[0], y0=ends[1], x1=ends[2], y1=ends[3], length=float(ds[run].sum()),
                         verdict=PATH_VERDICTS[code[first]], linearized_at_route=float(np.mean(~has[run])))

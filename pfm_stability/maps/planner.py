@@ -25,6 +25,8 @@ import math
 
 import numpy as np
 
+from .routes import polyline_arcs
+
 __all__ = ["REFINEMENTS", "SkeletonPlanner", "TOLERANCE_CELLS", "W_DATA", "W_SMOOTH", "smooth_plan"]
 
 TOLERANCE_CELLS = 1.0
@@ -122,7 +124,7 @@ def smooth_plan(points, spacing: float) -> np.ndarray:
     from scipy.linalg import solve_banded
 
     p = np.asarray(points, dtype=float)
-    arc = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(p, axis=0).T))])
+    arc = polyline_arcs(p)
     at = np.linspace(0.0, arc[-1], max(2, int(math.ceil(arc[-1] / spacing)) + 1))
     path = np.column_stack([np.interp(at, arc, p[:, 0]), np.interp(at, arc, p[:, 1])])
     inner = path.shape[0] - 2

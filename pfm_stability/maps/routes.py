@@ -35,7 +35,7 @@ from ..extras import require
 from .field import HistogramMap
 
 __all__ = ["JUNCTION_CUT", "MIN_LENGTH", "TOLERANCE_CELLS", "Route", "RoutePath", "default_min_length", "find_paths", "find_routes", "path_of",
-           "prune_spurs", "skeleton_of"]
+           "polyline_arcs", "prune_spurs", "skeleton_of"]
 
 MIN_LENGTH = 1.0
 """Shortest segment analysed, m (default; at least 1.25 W is used): shorter pieces are bends and junction stubs."""
@@ -103,6 +103,17 @@ class RoutePath:
     def length(self) -> float:
         """m."""
         return float(np.hypot(*np.diff(self.points, axis=0).T).sum())
+
+
+def polyline_arcs(points) -> np.ndarray:
+    """The arc position (m) of each vertex of a polyline: 0 at the first.
+
+    Parameters
+    ----------
+    points : ndarray, shape (n, 2)
+        Vertices, m.
+    """
+    return np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(points, axis=0).T))])
 
 
 def path_of(points, branch: int = 0, source: str = "path", goal=None, lookahead: float = math.inf, aims=None) -> RoutePath:
@@ -206,7 +217,7 @@ THROUGH_REACH = 1.0
 def _direction_at(points: np.ndarray, at_head: bool) -> np.ndarray:
     """Unit direction from a branch's end (head or tail) into the branch, over `THROUGH_REACH` m."""
     p = points if at_head else points[::-1]
-    arc = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(p, axis=0).T))])
+    arc = polyline_arcs(p)
     far = p[min(int(np.searchsorted(arc, THROUGH_REACH)), len(p) - 1)]
     d = far - p[0]
     n = math.hypot(*d)
@@ -331,7 +342,7 @@ def _cut(points: np.ndarray, start_cut: float, end_cut: float) -> np.ndarray:
     """The polyline `points` (m) without its first `start_cut` and last `end_cut` metres of arc length."""
     if len(points) < 2:
         return points[:0]
-    arc = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(points, axis=0).T))])
+    arc = polyline_arcs(points)
     lo, hi = start_cut, arc[-1] - end_cut
     if hi - lo <= 0:
         return points[:0]

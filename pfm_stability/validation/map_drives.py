@@ -57,6 +57,7 @@ from ..sim.engine import run_batch
 from ..sim.scenario import Pose, Scenario, Target
 from ..maps.episodes import AMPLITUDE_THRESHOLD, EPISODE_PERIODS, GROWTH_EFOLDS, NOISE_FLOOR, episodes, swing
 from ..maps.planner import SkeletonPlanner
+from ..maps.routes import polyline_arcs
 from .maps import START_OFFSET, _batches, _table_size, crop_grid, simulator_grid, stall_time
 
 __all__ = ["DRIVE_TIME_FACTOR", "MATCH_DISTANCE", "WOBBLE_FACTOR", "Disagreement", "Drive", "DriveValidation", "WobbleAgreement",
@@ -357,7 +358,7 @@ def _planned(planner, p, q) -> tuple | None:
     path = planner.plan(p, q)
     if path is None:
         return None
-    arc = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(path, axis=0).T))])
+    arc = polyline_arcs(path)
     ahead = [np.interp(min(LOOKAHEAD, arc[-1]), arc, path[:, k]) for k in (0, 1)]
     return path, math.atan2(ahead[0] - path[0, 0], ahead[1] - path[0, 1]), float(arc[-1])
 
