@@ -248,8 +248,7 @@ def _driven(route, arc, stopped, profile, pull, attraction, aim, V: float, trans
     for i, (nearest, _, _) in enumerate(runs):
         rows[i, :nearest.size] = nearest
     walk = _TrackWalk(track, route, arc, [runs[i][0][0] for i in own], step) if own.size else None
-    track_xy = np.full((2, len(runs), steps), np.nan)  # a drive's own path's point (m) and direction (rad) at each step
-    track_phi = np.full((len(runs), steps), np.nan)
+    track_at = np.full((3, len(runs), steps), np.nan)  # a drive's own path's point (m) and direction (rad) at each step
     state = np.zeros((len(runs), M.shape[0]))
     state[:, y_index] = sign * PREDICTION_OFFSET / V  # to the left of the travel direction (the state is x/V, s)
     lateral = np.full((len(runs), steps), np.nan)
@@ -270,7 +269,7 @@ def _driven(route, arc, stopped, profile, pull, attraction, aim, V: float, trans
             g = -np.arctan2(f - pull[row] - aim[row] * yk, attraction[row] + sign * ft[row, centre])  # KB eq 4, ~ N·y
             if own.size:
                 point = walk.here()
-                track_xy[:, own, k], track_phi[own, k] = point[0:2], point[2]
+                track_at[:, own, k] = point[:3]
                 g[own] = _steered(track, point, yk[own])
             g = np.where(stopped[(sign < 0).astype(int), row], 0.0, g)
             inside = (u >= 0) & (u <= offsets.size - 1) & (np.abs(yk) <= LEAVES) & np.isfinite(g)
@@ -293,8 +292,8 @@ def _driven(route, arc, stopped, profile, pull, attraction, aim, V: float, trans
         found, _ = lateral_episodes(tk, sign[i] * yk, period)
         swung, strays = lateral_extent(tk, yk, period)
         if mine:  # the drives' own judge on the loop's track in the plane
-            phi = track_phi[i, :m][ok]
-            px, py = track_xy[0, i, :m][ok] - np.sin(phi) * yk, track_xy[1, i, :m][ok] + np.cos(phi) * yk
+            x0, y0, phi = track_at[:, i, :m][:, ok]
+            px, py = x0 - np.sin(phi) * yk, y0 + np.cos(phi) * yk
             found, _ = episodes(tk, px, py, period)
             swung = swing(tk, px, py, period)
         for lo, hi in found:
@@ -350,6 +349,7 @@ class _TrackWalk:
         self.s = offset[mine] + step / 2
         self.step = step
         self.ended = np.full(mine.size, -1)
+        self.now = self._at(self.s)  # the path where each loop is: kept from one step to the next
 
     def _at(self, s) -> np.ndarray:
         return np.stack([np.interp(np.clip(s, self.lo, self.hi), self.axis, v) for v in self.values])
@@ -366,14 +366,15 @@ class _TrackWalk:
 
     def here(self) -> np.ndarray:
         """Shape (5, loops): the path's point (m), its direction φ (rad) and the point steered at (m) where each loop is."""
-        return self._at(self.s)[:5]
+        return self.now[:5]
 
     def advance(self, theta: np.ndarray, y: np.ndarray) -> np.ndarray:
         """Move each loop on by one step (heading θ from the path's, rad; offset y, m); the path's turn over it, rad."""
-        now = self._at(self.s)
+        now = self.now
         ahead = self.step * np.cos(np.nan_to_num(theta)) / np.maximum(1.0 - now[5] * np.nan_to_num(y), 0.1)
         self.s = self.s + ahead
-        return self._at(self.s)[2] - now[2]
+        self.now = self._at(self.s)
+        return self.now[2] - now[2]
 
     def ended_at(self, steps: int) -> np.ndarray:
         """Per loop, the steps it spent on its path."""
