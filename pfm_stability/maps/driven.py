@@ -289,13 +289,14 @@ def _driven(route, arc, stopped, profile, pull, attraction, aim, V: float, trans
         nearest = rows[i, :m]
         ok = np.isfinite(lateral[i, :m])
         tk, yk = t[:m][ok], lateral[i, :m][ok]
-        found, _ = lateral_episodes(tk, sign[i] * yk, period)
         swung, strays = lateral_extent(tk, yk, period)
         if mine:  # the drives' own judge on the loop's track in the plane
             x0, y0, phi = track_at[:, i, :m][:, ok]
             px, py = x0 - np.sin(phi) * yk, y0 + np.cos(phi) * yk
             found, _ = episodes(tk, px, py, period)
             swung = swing(tk, px, py, period)
+        else:
+            found, _ = lateral_episodes(tk, sign[i] * yk, period)
         for lo, hi in found:
             oscillates[nearest[(t[:m] >= lo) & (t[:m] <= hi)]] = True
         np.maximum.at(amplitude, nearest[ok], swung)
