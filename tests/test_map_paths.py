@@ -231,6 +231,33 @@ def test_episode_detector_on_closed_form_signals():
     assert found and amplitude == pytest.approx(0.08, rel=0.1) and AMPLITUDE_THRESHOLD < 0.08
 
 
+@pytest.mark.parametrize("reverse", [False, True])
+def test_where_the_judged_part_is_cut_the_weave_is_not_turning(reverse):
+    """The judge zeroes the first and last half period (the one-period average is not centred there); the samples next
+    to those cuts are no turning points. A steady 2 cm weave judged over five of its extremes, cut a sixteenth of a
+    period before the sixth (at cos(π/8) = 92 % of it, still rising), is no episode: five turning points, not the six
+    of three periods (before, the cut's 1.8 cm counted as the sixth, past the 1.5 cm threshold); a quarter period more
+    shows the sixth and is one. Likewise `lateral_extent`'s swing of two extremes cut before the third is 0, not the
+    cut's value; with the third it holds the weave's 2 cm · sin(π/8)/(π/8) = 1.95 cm (to 1 %: the P/8 smoothing,
+    `test_swing_is_the_weaves_amplitude_the_judge_sees`). Reversed in time, the cut lies just after an extreme at the
+    start: the same."""
+    from pfm_stability.maps.episodes import lateral_extent
+
+    T, omega = 0.025, 2.0
+    period = 2 * math.pi / omega
+    held = 0.02 * math.sin(math.pi / 8) / (math.pi / 8)
+
+    def weave(extremes: int, past: float):
+        t = np.arange(0.0, (2 * extremes + 3) * period / 4 + past * period + period / 2, T)
+        w = 0.02 * np.sin(omega * t)
+        return t, (w[::-1] if reverse else w)
+
+    assert not lateral_episodes(*weave(5, -1 / 16), period)[0]
+    assert lateral_episodes(*weave(5, 1 / 4), period)[0]
+    assert lateral_extent(*weave(2, -1 / 16), period)[0].max() == 0.0
+    assert lateral_extent(*weave(2, 1 / 4), period)[0].max() == pytest.approx(held, rel=0.01)
+
+
 def test_swing_is_the_weaves_amplitude_the_judge_sees():
     """`swing` (a disagreement's simulated amplitude): a 5 cm weave about a diagonal line is held at its amplitude
     smoothed over P/8 as the episodes' judge smooths it, 5 cm · sin(π/8)/(π/8) = 4.87 cm (a moving average of a

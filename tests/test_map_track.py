@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from pfm_stability.maps.driven import DrivenTrack, SampledTransition, _TrackWalk, _driven
+from pfm_stability.maps.driven import PREDICTION_OFFSET, DrivenTrack, SampledTransition, _TrackWalk, _driven
 from pfm_stability.maps.paths import path_samples
 from pfm_stability.maps.routes import path_of
 from pfm_stability.models import Loop, models_for
@@ -50,11 +50,11 @@ def test_a_drives_aims_are_its_carrot_or_its_goal():
     t = np.arange(0.0, 18.0, 0.05)
     x, y = 0.5 * t, np.full(t.size, 0.02)
     plan = Target.follow([(0.0, 0.0), (10.0, 0.0)], 2.0)
-    path = _taken_path(x, y, 2.0, 0.05, 0.1, 0, "drive", plan)
+    path = _taken_path(x, y, 2.0, 0.05, 0.1, 0, "drive", plan, None)
     expected = np.column_stack([np.minimum(path.points[:, 0] + 2.0, 10.0), np.zeros(len(path.points))])
     assert path.aims.shape == path.points.shape and np.abs(path.aims - expected).max() <= 1e-12
     goal = Target.point(9.0, 0.5, radius=0.3)
-    path = _taken_path(x, y, 2.0, 0.05, 0.1, 0, "drive", goal)
+    path = _taken_path(x, y, 2.0, 0.05, 0.1, 0, "drive", goal, None)
     assert np.all(path.aims == [9.0, 0.5])
 
 
@@ -68,7 +68,7 @@ def _circle_track(radius: float, lookahead: float, length: float, cell: float):
     x, y, tx, ty, route, arc, ds = path_samples([path], cell)
     no_field = lambda px, py: (np.zeros(np.shape(px)), np.zeros(np.shape(px)))  # noqa: E731
     track = DrivenTrack.of(None, None, [path], x, y, tx, ty, route, arc)
-    return x, route, arc, DrivenTrack(track.x, track.y, track.heading, track.aims, no_field)
+    return x, route, arc, DrivenTrack(track.x, track.y, track.heading, track.aims, no_field, track.start)
 
 
 @pytest.mark.parametrize("radius, lookahead", [(3.0, 1.0), (6.0, 2.0), (2.0, 0.6)])
@@ -129,3 +129,50 @@ def test_a_loop_weaving_about_its_path_covers_less_of_it():
     covered = 0.05 * math.cos(0.3) / (1 - 0.2 / radius)
     assert walk.s - start == pytest.approx([covered], abs=1e-9)
     assert turn == pytest.approx([covered / radius], abs=1e-8)
+
+
+@pytest.mark.parametrize("direction", [0.0, 2.3, -1.1])
+def test_the_loop_starts_where_the_robot_started(direction, monkeypatch):
+    """`DrivenTrack.start` and the loop's first steps (`_driven`): a straight path in any direction, the robot's start
+    pose (`RoutePath.start`, the simulator's `Pose`: heading from +Y towards +X) y0 to the left of its first sample and
+    turned θ0 to the left of it: the track records (y0, θ0) to round-off (1e-12), and the loop's lateral position starts
+    at y0 and moves V·T·θ0 in the first period, to round-off (with the command held and one period of compute delay
+    the first period's command is the one in flight, zero; no field, the path straight: nothing else moves it). At a
+    path without a start pose the loop starts `PREDICTION_OFFSET` off as on a route."""
+    robot = Robot(V=0.5, tau=0.3, k=2.0, W=0.3)
+    controller = Controller(f=0.8, n=2.0, T=0.065, hold="command", compute_delay=1)
+    transition = SampledTransition.of(models_for(controller, ["sampled"])[0], Loop.of(robot, controller, c=0.0))
+    ux, uy = math.cos(direction), math.sin(direction)
+    arcs = np.arange(0.0, 12.0, 0.05)
+    points = np.column_stack([3.0 + arcs * ux, -1.0 + arcs * uy])
+    y0, theta0 = 0.021, -0.07
+    sx, sy = 3.0 - uy * y0, -1.0 + ux * y0  # y0 to the left of the path's start
+    pose = math.pi / 2 - (direction + theta0)  # the simulator's heading: from +Y towards +X
+    no_field = lambda px, py: (np.zeros(np.shape(px)), np.zeros(np.shape(px)))  # noqa: E731
+    import pfm_stability.maps.episodes as episodes
+
+    original = episodes.lateral_extent
+    for start, first in (((sx, sy, pose), y0), (None, PREDICTION_OFFSET)):
+        path = path_of(points, 0, "drive", aims=points + 20.0 * np.array([ux, uy]), start=start)
+        x, y, tx, ty, route, arc, _ = path_samples([path], 0.05)
+        track = DrivenTrack.of(None, None, [path], x, y, tx, ty, route, arc)
+        if start is not None:
+            assert track.start[:, 0] == pytest.approx([y0, theta0], abs=1e-12)
+        else:
+            assert np.isnan(track.start).all()
+        captured = {}
+
+        def spy(t, lateral, period):
+            captured["lateral"] = np.array(lateral)
+            return original(t, lateral, period)
+
+        monkeypatch.setattr(episodes, "lateral_extent", spy)
+        n = x.size
+        offsets = np.arange(-1.0, 1.0 + 1e-9, 0.0125)
+        profile = (offsets, np.zeros((n, offsets.size)), np.zeros((n, offsets.size)))
+        _driven(route, arc, np.zeros((2, n), dtype=bool), profile, np.zeros(n), np.ones(n), np.zeros(n), robot.V, transition,
+                2.8, True, DrivenTrack(track.x, track.y, track.heading, track.aims, no_field, track.start))
+        lateral = captured["lateral"]
+        assert lateral[0] == pytest.approx(first, abs=1e-12)
+        if start is not None:
+            assert lateral[1] - lateral[0] == pytest.approx(robot.V * controller.T * theta0, abs=1e-12)

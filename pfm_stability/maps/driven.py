@@ -95,7 +95,8 @@ class SampledTransition:
 
 PREDICTION_OFFSET = 0.03
 """Lateral offset (m) of the loop's start from the route or path in `_driven` (the drives' start offset,
-`validation.maps.START_OFFSET`): the disturbance whose growth shows where the loop is unstable. On a path taken too:
+`validation.maps.START_OFFSET`): the disturbance whose growth shows where the loop is unstable. On a path taken too,
+unless the pose the robot started from is known (a drive's own path: the loop starts there, `DrivenTrack.start`):
 the loop's cycle is reached from above as from below (a rate-limited cycle at 1.7 cm, approached from 5 mm,
 overshoots and dips under the episodes' threshold for periods on its way)."""
 
@@ -128,6 +129,9 @@ class DrivenTrack:
         The point the robot steered at as it passed each sample, m (`RoutePath.aims`); nan where not known.
     force : callable
         ``force(x, y) -> (F_x, F_y)``: the VFF window sum at points (m), F_ct units (`field.window_force`).
+    start : ndarray, shape (2, routes)
+        Per route, where the robot started from its path's first sample: its offset to the left of the path (m) and
+        its heading from the path's (rad, anticlockwise) (`RoutePath.start`); nan where not known.
     """
 
     x: np.ndarray
@@ -135,6 +139,7 @@ class DrivenTrack:
     heading: np.ndarray
     aims: np.ndarray
     force: object
+    start: np.ndarray
 
     @classmethod
     def of(cls, grid, law, paths, x, y, tx, ty, route, arc) -> "DrivenTrack":
@@ -154,21 +159,30 @@ class DrivenTrack:
             Route index and arc position (m) of each sample.
         """
         aims = np.full((2, np.size(x)), np.nan)
+        heading = _path_heading(tx, ty, route)
+        start = np.full((2, len(paths)), np.nan)
         for r, path in enumerate(paths):
+            on = route == r
+            if path.start is not None and on.any():
+                first = np.flatnonzero(on)[0]
+                dx, dy = path.start[0] - x[first], path.start[1] - y[first]
+                phi = heading[first]
+                start[:, r] = (math.cos(phi) * dy - math.sin(phi) * dx,
+                               math.remainder(math.pi / 2 - path.start[2] - phi, 2 * math.pi))
             if path.aims is None:
                 continue
-            on = route == r
             vertices = polyline_arcs(path.points)
             aims[0, on], aims[1, on] = (np.interp(arc[on], vertices, path.aims[:, k]) for k in (0, 1))
-        return cls(np.asarray(x, dtype=float), np.asarray(y, dtype=float), _path_heading(tx, ty, route), aims,
-                   lambda px, py: window_force(grid, law, px, py))
+        return cls(np.asarray(x, dtype=float), np.asarray(y, dtype=float), heading, aims,
+                   lambda px, py: window_force(grid, law, px, py), start)
 
 
 def _driven(route, arc, stopped, profile, pull, attraction, aim, V: float, transition: SampledTransition, period: float, taken,
             track: DrivenTrack | None = None):
     """(oscillates, amplitude, excursion) per sample: the sampled loop driven along each route at V through the real
     lateral force across it (`maps.paths` module docstring, "The loop driven along the route"), in both directions (a
-    path taken: the way it was driven), started `PREDICTION_OFFSET` off it; its lateral position's episodes
+    path taken: the way it was driven), started `PREDICTION_OFFSET` off it (a drive's own path: where the robot started,
+    `DrivenTrack.start`); its lateral position's episodes
     (`episodes.lateral_episodes`, the drives' judge) mark the samples the robot passes meanwhile; amplitude is the
     largest weave held there and excursion the farthest it strays from its one-period average within half a period
     (`episodes.lateral_extent`, m); both `LEAVES` where the run left the corridor.
@@ -251,6 +265,10 @@ def _driven(route, arc, stopped, profile, pull, attraction, aim, V: float, trans
     track_at = np.full((3, len(runs), steps), np.nan)  # a drive's own path's point (m) and direction (rad) at each step
     state = np.zeros((len(runs), M.shape[0]))
     state[:, y_index] = sign * PREDICTION_OFFSET / V  # to the left of the travel direction (the state is x/V, s)
+    for i in own:  # a drive's own path: from where the robot started, its offset and heading off the path
+        y0, theta0 = track.start[:, route[runs[i][0][0]]]
+        if np.isfinite(y0):
+            state[i, y_index], state[i, y_index - 1] = y0 / V, theta0
     lateral = np.full((len(runs), steps), np.nan)
     alive = np.ones(len(runs), dtype=bool)
     with np.errstate(invalid="ignore"):

@@ -8,7 +8,9 @@ over P/8 (the cell ripple, at c/V, is faster). Its turning points give amplitude
 apart (an oscillation, not a bend of the path) — whose amplitudes grow (a least-squares fit of log amplitude
 against time rises by at least `GROWTH_EFOLDS` e-fold over them, and each side's amplitude rises period after period:
 a swerve after a quiet stretch is no growth) or all stay above `AMPLITUDE_THRESHOLD`.
-Amplitudes below `NOISE_FLOOR` are no oscillation.
+Amplitudes below `NOISE_FLOOR` are no oscillation. The first and last half period are not judged (the average is
+not centred there), and the samples where the judged part is cut are no turning points (the motion is cut there,
+not turning).
 """
 
 from __future__ import annotations
@@ -73,7 +75,7 @@ def lateral_extent(t, lateral, period: float) -> tuple:
     r, n = _about_average(t, lateral, period)
     if r is None:
         return np.zeros(t.size), np.zeros(t.size)
-    return _held(t, _smoothed(r, n), period), maximum_filter1d(np.abs(r), n, mode="nearest")
+    return _held(t, _smoothed(r, n), period, n), maximum_filter1d(np.abs(r), n, mode="nearest")
 
 
 def _about_average(t, lateral, period: float) -> tuple:
@@ -156,14 +158,14 @@ def swing(t, x, y, period: float) -> np.ndarray:
     """
     t = np.asarray(t, dtype=float)
     r, n = oscillation(t, x, y, period)
-    return np.zeros(t.size) if r is None else _held(t, _smoothed(r, n), period)
+    return np.zeros(t.size) if r is None else _held(t, _smoothed(r, n), period, n)
 
 
-def _held(t, r, period) -> np.ndarray:
-    """Per sample, the smallest amplitude (m) of the three turning points of the smoothed oscillation `r` that hold it
-    for a period around it, the largest such (0: none)."""
+def _held(t, r, period, n: int) -> np.ndarray:
+    """Per sample, the smallest amplitude (m) of the three turning points of the smoothed oscillation `r` (`n` samples
+    a period) that hold it for a period around it, the largest such (0: none)."""
     out = np.zeros(t.size)
-    kept, amplitude = _turning_points(t, r, period)
+    kept, amplitude = _turning_points(t, r, period, n)
     for sel, a in _oscillating(t, r, kept, amplitude, period, 3):
         inside = (t >= t[sel[0]] - period / 4) & (t <= t[sel[-1]])
         out[inside] = np.maximum(out[inside], a.min())
@@ -183,7 +185,7 @@ def _smoothed(r, n: int) -> np.ndarray:
 def _episodes(t, r, period, n) -> tuple:
     """The episodes of the oscillation `r` (m) about the average path (`n` samples a period)."""
     r = _smoothed(r, n)
-    kept, amplitude = _turning_points(t, r, period)
+    kept, amplitude = _turning_points(t, r, period, n)
     found = []
     for sel, a in _oscillating(t, r, kept, amplitude, period, 2 * EPISODE_PERIODS):
         span = t[sel[-1]] - t[sel[0]]
@@ -198,12 +200,14 @@ def _episodes(t, r, period, n) -> tuple:
     return tuple(found), float(amplitude.max()) if amplitude.size else 0.0
 
 
-def _turning_points(t, r, period) -> tuple:
-    """(indices, amplitudes (m)) of the turning points of the smoothed oscillation `r` above `NOISE_FLOOR`; of two closer
-    than a quarter period (ripple), the larger."""
+def _turning_points(t, r, period, n: int) -> tuple:
+    """(indices, amplitudes (m)) of the turning points of the smoothed oscillation `r` (`n` samples a period, its first
+    and last half period zeroed by `_smoothed`) above `NOISE_FLOOR`; of two closer than a quarter period (ripple), the
+    larger. The first and last samples judged are none: the oscillation is cut there, not turning (a weave still
+    rising where the judged part ends would count its value at the cut as an extreme)."""
     dr = np.diff(r)
     turn = np.flatnonzero((dr[:-1] > 0) & (dr[1:] <= 0) | (dr[:-1] < 0) & (dr[1:] >= 0)) + 1
-    turn = turn[np.abs(r[turn]) > NOISE_FLOOR]
+    turn = turn[(np.abs(r[turn]) > NOISE_FLOOR) & (turn > n // 2) & (turn < r.size - n // 2 - 1)]
     kept = []
     for k in turn:
         if kept and t[k] - t[kept[-1]] < period / 4:

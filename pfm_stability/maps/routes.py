@@ -90,6 +90,9 @@ class RoutePath:
     aims : ndarray, shape (n, 2), or None
         A path a robot took: the point it steered at as it passed each vertex, m (its plan's carrot, or its point
         target); None: not known (a route, whose goal lies along it).
+    start : tuple of float or None
+        A path a robot took: the pose it started from, (x, y) m and heading θ rad from +Y towards +X (the simulator's
+        `Pose`); None: not known.
     """
 
     points: np.ndarray
@@ -98,6 +101,7 @@ class RoutePath:
     goal: tuple | None = None
     lookahead: float = math.inf
     aims: np.ndarray | None = None
+    start: tuple | None = None
 
     @property
     def length(self) -> float:
@@ -116,7 +120,8 @@ def polyline_arcs(points) -> np.ndarray:
     return np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(points, axis=0).T))])
 
 
-def path_of(points, branch: int = 0, source: str = "path", goal=None, lookahead: float = math.inf, aims=None) -> RoutePath:
+def path_of(points, branch: int = 0, source: str = "path", goal=None, lookahead: float = math.inf, aims=None,
+            start=None) -> RoutePath:
     """A `RoutePath` through `points` (m; repeated points dropped); ValueError if fewer than two distinct points.
 
     Parameters
@@ -133,6 +138,8 @@ def path_of(points, branch: int = 0, source: str = "path", goal=None, lookahead:
         The lookahead of the plan it followed, m (`RoutePath.lookahead`).
     aims : array_like, shape (n, 2), optional
         The point it steered at from each of `points`, m (`RoutePath.aims`).
+    start : (float, float, float), optional
+        The pose it started from: x, y (m), θ (rad from +Y towards +X) (`RoutePath.start`).
     """
     p = np.asarray(points, dtype=float).reshape(-1, 2)
     if aims is not None:
@@ -148,7 +155,8 @@ def path_of(points, branch: int = 0, source: str = "path", goal=None, lookahead:
         raise ValueError(f"a {source} route needs at least two distinct points; got {len(p)}")
     if not lookahead > 0:
         raise ValueError(f"a {source} route's lookahead must be > 0 m; got {lookahead!r}")
-    return RoutePath(p, int(branch), source, None if goal is None else (float(goal[0]), float(goal[1])), float(lookahead), aims)
+    return RoutePath(p, int(branch), source, None if goal is None else (float(goal[0]), float(goal[1])), float(lookahead), aims,
+                     None if start is None else tuple(float(v) for v in start))
 
 
 def find_paths(grid: HistogramMap, skeleton: np.ndarray, clearance: np.ndarray) -> list:

@@ -419,7 +419,7 @@ def drive_map(analysis, count: int, *, seed: int = 0, progress=None) -> DriveVal
             continue
         runs.append(_Prepared(kind, (float(p[0]), float(p[1]), float(q[0]), float(q[1])), scenario,
                               _table_size(local, h)))
-    drives, traces, targets = [], [], []
+    drives, traces, scenarios = [], [], []
     batches = _batches(runs)
     for b, batch in enumerate(batches, 1):
         outcome = run_batch([r.scenario for r in batch], record="trajectory", metrics=False)
@@ -430,15 +430,16 @@ def drive_map(analysis, count: int, *, seed: int = 0, progress=None) -> DriveVal
             drives.append(Drive(len(drives), r.kind, *r.ends, event=event, duration=float(tr.t[-1] - tr.t[0]) if tr.t.size else 0.0,
                                 episodes=found, max_amplitude=amplitude))
             traces.append((tr.t, tr.x, tr.y))
-            targets.append(r.scenario.target)
+            scenarios.append(r.scenario)
         if progress:
             progress(f"map drives: batch {b}/{len(batches)}: {len(batch)} drives")
 
     # every drive's own path (period-averaged), judged like any route: prediction and episode on one path
     taken, own = [], {}
-    for d, (t, x, y), target in zip(drives, traces, targets):
+    for d, (t, x, y), scenario in zip(drives, traces, scenarios):
         try:
-            route = _taken_path(x, y, period, controller.T, analysis.grid.cell_size, len(taken), "drive", target)
+            route = _taken_path(x, y, period, controller.T, analysis.grid.cell_size, len(taken), "drive", scenario.target,
+                                scenario.start)
         except ValueError:  # fewer than two distinct points: the drive did not move
             continue
         own[d.index] = len(taken)
@@ -690,10 +691,10 @@ def _runs(kind: str, mask: np.ndarray, sc, passed_by, swung) -> tuple:
     return tuple(out)
 
 
-def _taken_path(x, y, period: float, T: float, cell: float, index: int, source: str, target):
+def _taken_path(x, y, period: float, T: float, cell: float, index: int, source: str, target, start=None):
     """The path a drive took: its positions (m) averaged over one period (s; the controller's step T, s), a point
     every `cell` m of arc (`routes.path_of`, route `index`, `source`), with the point `target` (a `Target`) the robot
-    steered at (`RoutePath.goal`, `RoutePath.lookahead`)."""
+    steered at (`RoutePath.goal`, `RoutePath.lookahead`) and the `Pose` it started from, if given (`RoutePath.start`)."""
     from scipy.ndimage import uniform_filter1d
 
     from ..maps.routes import path_of
@@ -704,7 +705,8 @@ def _taken_path(x, y, period: float, T: float, cell: float, index: int, source: 
     step = np.flatnonzero(np.diff(np.concatenate([[-1.0], arc // cell])) > 0)  # a point every cell
     points = np.column_stack([x[step], y[step]]) if step.size >= 2 else np.column_stack([x[[0, -1]], y[[0, -1]]])
     return path_of(points, index, source, goal=(target.x, target.y) if target.is_point else None,
-                   lookahead=target.lookahead if target.is_path else math.inf, aims=_aims(points, target))
+                   lookahead=target.lookahead if target.is_path else math.inf, aims=_aims(points, target),
+                   start=None if start is None else (start.x, start.y, start.theta))
 
 
 def _aims(points, target) -> np.ndarray:
@@ -764,7 +766,8 @@ def goal_routes(analysis, goals, progress=None) -> list:
         except ValueError as exc:
             raise ValueError(f"goal {k + 1} -> {k + 2}: {exc}") from None
     outcome = run_batch(scenarios, record="trajectory", metrics=False)
-    routes = [_taken_path(run.trajectory.x, run.trajectory.y, period, controller.T, analysis.grid.cell_size, k, "goals", s.target)
+    routes = [_taken_path(run.trajectory.x, run.trajectory.y, period, controller.T, analysis.grid.cell_size, k, "goals", s.target,
+                          s.start)
               for k, (s, run) in enumerate(zip(scenarios, outcome.runs))]
     if progress:
         progress(f"goals: {len(routes)} drives between {len(goals)} goals")
