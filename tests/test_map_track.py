@@ -176,3 +176,11 @@ def test_the_loop_starts_where_the_robot_started(direction, monkeypatch):
         assert lateral[0] == pytest.approx(first, abs=1e-12)
         if start is not None:
             assert lateral[1] - lateral[0] == pytest.approx(robot.V * controller.T * theta0, abs=1e-12)
+
+
+@pytest.mark.parametrize("start", [(0.0, 1.0), (0.0, float("nan"), 1.0), (0.0, 0.0, float("inf"))])
+def test_a_start_pose_must_be_three_finite_numbers(start):
+    """`path_of`'s ``start`` (`RoutePath.start`): anything but x, y (m) and a heading (rad), finite, is a ValueError naming
+    it, not a loop that dies on a NaN state (`_driven`)."""
+    with pytest.raises(ValueError, match="start must be a pose"):
+        path_of([(0.0, 0.0), (1.0, 0.0)], 0, "drive", start=start)

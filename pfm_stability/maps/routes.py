@@ -155,6 +155,8 @@ def path_of(points, branch: int = 0, source: str = "path", goal=None, lookahead:
         raise ValueError(f"a {source} route needs at least two distinct points; got {len(p)}")
     if not lookahead > 0:
         raise ValueError(f"a {source} route's lookahead must be > 0 m; got {lookahead!r}")
+    if start is not None and (np.shape(start) != (3,) or not np.isfinite(np.asarray(start, dtype=float)).all()):
+        raise ValueError(f"a {source} route's start must be a pose x, y (m), heading (rad), three finite numbers; got {start!r}")
     return RoutePath(p, int(branch), source, None if goal is None else (float(goal[0]), float(goal[1])), float(lookahead), aims,
                      None if start is None else tuple(float(v) for v in start))
 
