@@ -243,6 +243,8 @@ RANGES = {
     "max_steering_rate": Range(0.0, math.inf, high_open=True, unit="rad/s"),
     "dead_time": Range(0.0, 10.0, low_open=False, unit="s"),
     "plant_gain": Range(1e-3, 100.0, low_open=False),
+    "actuator_lag": Range(0.0, 10.0, low_open=False, unit="s"),
+    "yaw_accel_limit": Range(0.0, math.inf, high_open=True, unit="rad/s^2"),
     # where a computation needs a narrower range than the parameter's own
     "T_sampled": Range(0.0, 100.0, unit="s"),
     # simulator and validation options
@@ -304,6 +306,13 @@ inside floating point (f^(1/n) and Wⁿ of an equilibrium, a scan over k).
     gain g·k within [10⁻⁹, 10⁶] 1/s, inside floating point for every model.
 
 Entries beyond the robot, controller and geometry:
+
+``actuator_lag``, ``yaw_accel_limit``
+    The drive beyond the first-order plant: a second lag τ_a of an actuator filter, the plant
+    g·e^(−sD)/((τs + 1)(τ_a·s + 1)), in [0, 10] s (0: none, the first-order plant); and the largest rate of
+    change of the commanded yaw rate the drive's velocity smoother lets through (Nav2's
+    ``velocity_smoother`` ``max_accel`` on the angular axis), rad/s², > 0 (none by default: ``inf``,
+    which is not typed but left out).
 
 ``T_sampled``
     T where the computation samples (simulator, validation, root locus of the
@@ -417,6 +426,12 @@ class Robot:
     plant_gain : float
         Plant gain g, achieved over commanded turning rate, in [10⁻³, 100]
         (1 = KB's robot): the motor is τω̇ + ω = g·u(t − D).
+    actuator_lag : float
+        A second lag τ_a of the drive (an actuator filter), s, in [0, 10]: the plant is
+        g·e^(−sD)/((τs + 1)(τ_a·s + 1)) (0 = KB's first-order plant; docs/models.md).
+    yaw_accel_limit : float
+        The largest rate of change of the commanded yaw rate, rad/s², > 0 (a velocity smoother's angular
+        acceleration limit); ``inf`` (the default) = none. Nonlinear: the linear models do not see it.
     """
 
     V: float
@@ -426,10 +441,14 @@ class Robot:
     max_steering_rate: float = math.radians(120.0)
     dead_time: float = 0.0
     plant_gain: float = 1.0
+    actuator_lag: float = 0.0
+    yaw_accel_limit: float = math.inf
 
     def __post_init__(self):
-        for name in ("V", "tau", "k", "W", "max_steering_rate", "dead_time", "plant_gain"):
+        for name in ("V", "tau", "k", "W", "max_steering_rate", "dead_time", "plant_gain", "actuator_lag"):
             object.__setattr__(self, name, check_parameter(name, getattr(self, name)))
+        if self.yaw_accel_limit != math.inf:  # inf: no limit (the default, never typed)
+            object.__setattr__(self, "yaw_accel_limit", check_parameter("yaw_accel_limit", self.yaw_accel_limit))
 
     def replace(self, **changes) -> "Robot":
         """Return a copy with some fields changed (validated again)."""

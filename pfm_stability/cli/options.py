@@ -261,6 +261,9 @@ def add_parameter_options(parser: argparse.ArgumentParser, *, sampled: bool = Fa
         "W": "robot width",
         "dead_time": "dead time D of the steering plant g e^(-sD)/(tau s + 1) (pfm-stability identify measures it)",
         "plant_gain": "plant gain g, achieved over commanded turning rate",
+        "actuator_lag": "second lag tau_a of the drive (an actuator filter): plant g e^(-sD)/((tau s + 1)(tau_a s + 1))",
+        "yaw_accel_limit": "largest rate of change of the commanded yaw rate (a velocity smoother's angular acceleration limit; "
+                           "default: none)",
     }
     for name, text in helps.items():
         key = "T_sampled" if sampled and name == "T" else name
@@ -271,7 +274,7 @@ def add_parameter_options(parser: argparse.ArgumentParser, *, sampled: bool = Fa
     )
 
 
-_ROBOT_FIELDS = ("V", "tau", "k", "W", "dead_time", "plant_gain")
+_ROBOT_FIELDS = ("V", "tau", "k", "W", "dead_time", "plant_gain", "actuator_lag", "yaw_accel_limit")
 _CONTROLLER_FIELDS = ("f", "n", "T", "hold", "compute_delay")
 
 
