@@ -217,8 +217,10 @@ class ExactDelay(LoopModel):
         NV = _check_NV(NV)
         if NV < 0:
             return 0.0
-        if not loop.kb_form:  # the general loop: the search over k on the dominant root (`LoopModel.critical_gain_k`)
-            return super().critical_gain_k(NV, loop)
+        if not loop.kb_form:  # the general loop: the signed measure's first sign change over k (`_signed_gain_k`)
+            if NV * (loop.tau + loop.actuator_lag + loop.delay) >= 1.0 + loop.c:  # the k → 0 limit: kb_first_order's
+                return 0.0
+            return self._signed_gain_k(NV, loop, lambda loops: np.array([x.delay_stable(x.loop_gain(NV)) for x in loops]))
         if NV == 0 and loop.c == 0.0:
             return math.inf
         if loop.delay == 0:
@@ -237,18 +239,26 @@ class ExactDelay(LoopModel):
         return first_crossing(measure, lo, hi, start=lo)
 
     def _heading_gain_k(self, NV: float, loop: Loop) -> float:
-        """k* for c ≠ 0 (`critical_gain_k`): first sign change of the signed measure over k."""
+        """k* for c ≠ 0 (`critical_gain_k`): first sign change of the signed measure over k, the sign the vectorized
+        crossing count's."""
+        def stable(loops):
+            tau, T, k = (np.array([getattr(x, name) for x in loops]) for name in ("tau", "delay", "steering_gain"))
+            return delay_verdicts_from_gain(tau, T, k, k * NV, np.full(k.shape, loop.c))[0]
+
+        return self._signed_gain_k(NV, loop, stable)
+
+    def _signed_gain_k(self, NV: float, loop: Loop, stable) -> float:
+        """k*: the first sign change over k of a measure whose sign is the exact verdict's (``stable(loops)``, arrays)
+        and whose size is Padé(6)'s growth rate (batched eigenvalues: a stand-in that peaks where a root nears the axis,
+        so the search refines near-misses between grid points)."""
         from ..numerics.solve import first_crossing
 
         pade = Pade(6)  # one model for every probe
 
         def measure(ks):
             loops = [loop._with_steering_gain(k) for k in ks]
-            arrays = (np.array([getattr(x, name) for x in loops]) for name in ("tau", "delay", "steering_gain"))
-            tau, T, k = arrays
-            stable = delay_verdicts_from_gain(tau, T, k, k * NV, np.full(k.shape, loop.c))[0]
             size = np.abs(pade._growth_rates(NV, loops)) + 1e-300
-            return np.where(stable, -size, size)
+            return np.where(stable(loops), -size, size)
 
         lo, hi = gain_range(loop)
         if measure(np.array([lo]))[0] >= 0:

@@ -434,9 +434,8 @@ class QuasiPolynomial:
         eig = eig[np.isfinite(eig)]
         eig = eig[np.argsort(-eig.real)][: max(4 * count, 12)]
         polished = []
-        for s in eig:
-            s = self._newton(s, K)
-            if s is not None and not any(abs(s - p) <= 1e-8 * max(1.0, abs(s)) for p in polished):
+        for s in self._newton(eig, K):
+            if not any(abs(s - p) <= 1e-8 * max(1.0, abs(s)) for p in polished):
                 polished.append(s)
         polished = np.array(polished)
         return polished[np.argsort(-polished.real)][:count]
@@ -467,19 +466,29 @@ class QuasiPolynomial:
                 G[n - 1, l * n:(l + 1) * n] += weights[l] * row
         return G
 
-    def _newton(self, s, K: float, iterations: int = 50):
-        """Newton's method on Δ from s; None when it fails."""
+    def _newton(self, starts, K: float, iterations: int = 50) -> np.ndarray:
+        """Newton's method on Δ from every start at once; the roots it converged to (|Δs| < 1e-13·max(1, |s|), or a
+        residual below 1e-9·|p0(s)| after `iterations`), in the order of the starts."""
+        s = np.asarray(starts, dtype=complex).copy()
+        done = np.zeros(s.shape, bool)
+        alive = np.ones(s.shape, bool)
         with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
             for _ in range(iterations):
-                f, df = self.value(s, K), self.slope(s, K)
-                if df == 0 or not (np.isfinite(f) and np.isfinite(df)):
-                    return None
-                step = f / df
-                s = s - step
-                if abs(step) <= 1e-13 * max(1.0, abs(s)):
-                    return complex(s)
-            residual = abs(self.value(s, K))
-        return complex(s) if residual <= 1e-9 * max(1.0, abs(np.polyval(self.p0, s))) else None
+                active = alive & ~done
+                if not active.any():
+                    break
+                f, df = self.value(s[active], K), self.slope(s[active], K)
+                bad = (df == 0) | ~np.isfinite(f) | ~np.isfinite(df)
+                step = np.where(bad, 0.0, f / np.where(bad, 1.0, df))
+                index = np.flatnonzero(active)
+                alive[index[bad]] = False
+                s[active] = s[active] - step
+                done[index[~bad & (np.abs(step) <= 1e-13 * np.maximum(1.0, np.abs(s[active])))]] = True
+            rest = alive & ~done
+            if rest.any():
+                residual = np.abs(self.value(s[rest], K))
+                done[np.flatnonzero(rest)[residual <= 1e-9 * np.maximum(1.0, np.abs(np.polyval(self.p0, s[rest])))]] = True
+        return s[done & alive]
 
 
 def _lagrange_weights(x, c, point: float) -> np.ndarray:
