@@ -43,7 +43,7 @@ import numpy as np
 from scipy.optimize import brentq, minimize_scalar
 
 from .crossings import Crossing, StabilityInterval
-from .delay import single_blas_thread
+from .delay import chebyshev_collocation, single_blas_thread
 
 __all__ = ["DelayedTerm", "QuasiPolynomial"]
 
@@ -447,14 +447,8 @@ class QuasiPolynomial:
         A0[:-1, 1:] = np.eye(n - 1)
         A0[-1, :] = -self.p0[:0:-1] / lead
         delayed = [(np.asarray(t.poly)[::-1], t.delay) for t in self.terms] + [(np.array([K]), self.gain_delay)]
-        x = np.cos(math.pi * np.arange(nodes + 1) / nodes)
-        c = np.ones(nodes + 1)
-        c[0] = c[-1] = 2.0
-        c *= (-1.0) ** np.arange(nodes + 1)
-        X = np.subtract.outer(x, x)
-        D = np.outer(c, 1.0 / c) / (X + np.eye(nodes + 1))
-        D -= np.diag(D.sum(axis=1))
-        D *= 2.0 / h  # θ = h(x − 1)/2 ∈ [−h, 0]
+        x, c, D = chebyshev_collocation(nodes)
+        D = D * (2.0 / h)  # θ = h(x − 1)/2 ∈ [−h, 0]
         G = np.kron(D, np.eye(n))
         G[:n, :] = 0.0
         G[:n, :n] = A0
