@@ -175,3 +175,31 @@ def test_report_of_a_robot_no_period_helps():
         verdict = report["corridor"][name]
         assert verdict["verdict"] == "unstable" and verdict["T_critical"] == 0.0
         assert "T" not in verdict["to_stabilize"]
+
+
+@pytest.mark.parametrize("loop", [Loop(0.3, 0.0, 2.0, actuator_lag=0.05), Loop(0.3, 0.0, 2.0, heading_sampled=True),
+                                  Loop(0.0, 0.05, 2.0, actuator_lag=0.05)], ids=["T=0, tau_a", "T=0, heading sampled", "tau=0, tau_a"])
+def test_loops_without_a_delay_or_a_first_lag(loop):
+    """The general loop's edges: no delay at all (T = D = 0) is the polynomial loop in every continuous-time model
+    (NV* = `continuous`'s, 1e-12); a lone second lag is the motor's lag (τ = 0, τ_a > 0 is stored as τ = τ_a, and every
+    model answers as for that first-order plant); every query answers a float (no error, no NaN)."""
+    for name in ("continuous", "kb_first_order", "pade", "exact_delay", "sampled"):
+        model = make_model(name, hold="command", compute_delay=1)
+        b = model.boundary(loop)
+        if loop.T == 0 and name != "sampled":
+            assert b.NV_critical == pytest.approx(make_model("continuous").boundary(loop).NV_critical, rel=1e-12)
+        NV = 0.5 * b.NV_critical
+        answers = (model.critical_delay(NV, loop), model.critical_dead_time(NV, loop), model.critical_gain_k(NV, loop))
+        assert all(isinstance(x, float) and not math.isnan(x) for x in answers), (name, answers)
+        assert model.is_stable(NV, loop) and not model.is_stable(-1.0, loop)
+    assert Loop(0.0, 0.05, 2.0, actuator_lag=0.05) == Loop(0.05, 0.05, 2.0)
+
+
+def test_the_sampled_searches_stay_inside_the_delay_line():
+    """T = 1 µs with D = 0.01 s: 10⁴ commands in flight. T* and k* answer; D* beyond the longest dead time the delay line
+    carries at this period ((10⁵ − 2)·T = 0.1 s) is not given (None: the loop is still stable there), and no search
+    refuses a dead time the user never gave (it used to probe D up to 10 s, 10⁷ periods)."""
+    loop, model = Loop(0.3, 1e-6, 2.0, dead_time=0.01), Sampled("command", 1)
+    NV = 0.5 * model.boundary(loop).NV_critical
+    assert model.critical_dead_time(NV, loop) is None
+    assert 0 < model.critical_delay(NV, loop) < 1 and model.critical_gain_k(NV, loop) > 1

@@ -253,9 +253,13 @@ class Loop(Characteristic):
         return _unchecked(Loop, **{**vars(self), "T": T if T >= T_RESOLUTION else 0.0})  # τ, k, c, g and D kept
 
     def _with_steering_gain(self, k: float) -> "Loop":
-        """τ, T and c with steering gain k, 1/s, unchecked (a probe of k in `gain_range`); τ with τk < 10⁻⁹ is 0."""
+        """Every field but k kept, with steering gain k, 1/s, unchecked (a probe of k in `gain_range`); τ and τ_a with
+        their product with g·k below 10⁻⁹ are 0, and a lone τ_a is τ, as the constructor stores them."""
         k = float(k)
-        return _unchecked(Loop, **{**vars(self), "tau": self.tau if self.tau * self.plant_gain * k >= TAU_RESOLUTION else 0.0, "k": k})
+        tau, lag = (x if x * self.plant_gain * k >= TAU_RESOLUTION else 0.0 for x in (self.tau, self.actuator_lag))
+        if tau == 0.0 and lag > 0.0:
+            tau, lag = lag, 0.0
+        return _unchecked(Loop, **{**vars(self), "tau": tau, "actuator_lag": lag, "k": k})
 
     def delay_search(self, NV: float) -> tuple:
         """T* searched from 1 % of the loop's fastest time scale to 1e-7 relative (a report shows 4 digits).
@@ -311,6 +315,10 @@ class Loop(Characteristic):
         """KB's delay loop: K* among three phase levels (`delay.kb_critical_gain`); with c ≠ 0 every gain crossing
         that can bound the stable set (`models.heading.kb_heading_interval`)."""
         if not self.kb_form:
+            if self.delay == 0:  # no delay at all (T = D = 0): the polynomial loop, `continuous`'s
+                from ..numerics.crossings import first_stable_interval
+
+                return first_stable_interval(self.closed_plant, [1.0], "s")
             return self.quasi_terms().stable_gains(self.steering_gain * NV_MAX)
         if self.c != 0.0:
             from .heading import kb_heading_interval  # only with a heading gain: KB's reports never compile it
@@ -382,7 +390,7 @@ class Loop(Characteristic):
             quasi = QuasiPolynomial(base.lags, terms, base.delay)
         else:
             quasi = base.quasi_terms()
-        return quasi.shift_margin(K, flags)
+        return float(quasi.shift_margin(K, flags))
 
 
 def _one(x) -> np.ndarray:

@@ -94,11 +94,11 @@ import numpy as np
 
 from ..checks import check_choice, check_integer
 from ..numerics.matrix_exponential import zoh_blocks
-from ..parameters import HOLDS, dead_time_split
-from ..numerics.crossings import Crossing, stable_interval
+from ..parameters import HOLDS, RANGES, dead_time_split
+from ..numerics.crossings import StabilityInterval, walk_stable_set
+from ..numerics.quasi import sign_change_roots
 from ..numerics.routh import schur_cohn_stable
-from scipy.optimize import brentq
-from .base import AffineGainModel, checked
+from .base import AffineGainModel, LoopModel, checked
 from .continuous import Continuous
 from .family import Characteristic
 
@@ -302,24 +302,43 @@ class DelayLine:
         return -lead / gain
 
     def grid(self) -> np.ndarray:
-        """Angles in (0, π]: logarithmic near 0, then a step that resolves z^(m+1)'s turn (π/(16·N))."""
-        uniform = np.linspace(0.0, math.pi, 16 * self.degree + 2)[1:]
+        """Angles in (0, π]: logarithmic near 0, then a step over which z^(m+1) turns by at most π/4 (π/(4·N)); a faster
+        turn of χ (a root near the circle) is resolved by `_refine_turns`, a sign change of Im K by the step."""
+        uniform = np.linspace(0.0, math.pi, 4 * self.degree + 2)[1:]  # z^(m+1) turns by at most π/4 a step
         return np.unique(np.concatenate([np.geomspace(1e-9 * math.pi, math.pi, 512), uniform]))
 
     def crossings(self) -> list:
-        """Every gain K > 0 at which a pole crosses the unit circle, as `Crossing` (gain, ω = θ/T rad/s), sorted by gain."""
+        """Every gain K > 0 at which a pole crosses the unit circle: (K, ω = θ/T rad/s, change of the poles outside as K
+        grows: ±2 for a pair, ±1 for a real pole through z = −1, 0 for a touch), sorted by gain."""
         theta = self.grid()
-        imag = np.imag(self.gain(theta))
-        out = []
-        for i in np.flatnonzero(np.sign(imag[:-1]) * np.sign(imag[1:]) < 0):
-            root = brentq(lambda x: float(np.imag(self.gain(x))), theta[i], theta[i + 1], xtol=1e-15, rtol=1e-15)
-            K = float(np.real(self.gain(root)))
-            if K > 0:
-                out.append(Crossing(K, root / self.T))
-        K_pi = float(np.real(self.gain(math.pi)))  # z = −1: real there
+        roots = sign_change_roots(lambda x: np.imag(self.gain(x)), theta)
+        gains, slopes = np.real(self.gain(roots)), self._phase_slope(roots)
+        out = [(float(K), float(x) / self.T, 2 * _sign(slope)) for K, x, slope in zip(gains, roots, slopes) if K > 0]
+        K_pi = float(np.real(self.gain(math.pi)))  # z = −1: K is real there; one real pole passes
         if K_pi > 0:
-            out.append(Crossing(K_pi, math.pi / self.T))
-        return sorted(out, key=lambda c: (c.gain, c.frequency))
+            out.append((K_pi, math.pi / self.T, _sign(float(self._phase_slope(np.array([math.pi]))[0]))))
+        return sorted(out)
+
+    def _phase_slope(self, theta):
+        """d arg K/dθ: positive where a pole crossing at e^(jθ) moves outwards as K grows (Re(z̄·dz/dK) ∝ it)."""
+        z, w = np.exp(1j * theta), np.expm1(1j * theta) / self.T
+        m, T = self.m, self.T
+        der = lambda p: np.polyval(np.polyder(p), w) if len(p) > 1 else 0.0 * w  # noqa: E731
+        L = np.exp(1j * (m + 1) * theta) * np.polyval(self.p, w) + z * np.polyval(self.r0a, w) + np.polyval(self.r0b, w)
+        dL = ((m + 1) * np.exp(1j * m * theta) * np.polyval(self.p, w) + np.exp(1j * (m + 1) * theta) * der(self.p) / T
+              + np.polyval(self.r0a, w) + z * der(self.r0a) / T + der(self.r0b) / T)
+        M = z * np.polyval(self.r1a, w) + np.polyval(self.r1b, w)
+        dM = np.polyval(self.r1a, w) + z * der(self.r1a) / T + der(self.r1b) / T
+        dK_dz = -(dL * M - L * dM) / (M * M)
+        return np.imag(dK_dz * 1j * z / (-L / M))
+
+    def stable_gains(self) -> StabilityInterval:
+        """Every stable gain K: the poles outside at K → 0+ (the heading loop's: the neutral pole z = 1 moves in), moved by
+        each crossing's change (`numerics.crossings.walk_stable_set`; the crossings on 0 < θ <= π are all of them)."""
+        base = self.outside(0.0, neutral=True)
+        if base is None:
+            return StabilityInterval(0.0, None, (), ())
+        return walk_stable_set(base, self.crossings())
 
     def outside(self, K: float, neutral: bool = False) -> int | None:
         """Poles with |z| > 1 at gain K (argument principle); None when one is on the circle (a phase jump unresolved).
@@ -347,6 +366,11 @@ class DelayLine:
     def _characteristic(self, theta, K: float):
         lead, gain = self._parts(theta)
         return lead + K * gain
+
+
+def _sign(x: float) -> int:
+    """+1, −1, or 0 for a slope within round-off of 0 (a pole touching the circle and returning)."""
+    return 0 if abs(x) <= 1e-12 else (1 if x > 0 else -1)
 
 
 def _refine_turns(theta, values, f, step: float = math.pi / 4, rounds: int = 60):
@@ -579,9 +603,8 @@ class Sampled(AffineGainModel):
         """
         if loop.T == 0:
             return loop.delay_interval() if loop.dead_time > 0 else Continuous().stable_gains(loop)
-        if loop.dead_time > 0:  # the delay line's crossings of the unit circle (`DelayLine`), each stretch by its count
-            line = DelayLine(loop, self.hold, self.compute_delay)
-            return stable_interval(line.crossings(), lambda K: line.outside(K) == 0)
+        if loop.dead_time > 0:  # the delay line's crossings of the unit circle and the count they move (`DelayLine`)
+            return DelayLine(loop, self.hold, self.compute_delay).stable_gains()
         d, e = self.bilinear_polynomials(loop)
         return self._interval(d, e, lambda K: self._stable(loop.gain_of(K), loop), loop)
 
@@ -693,7 +716,9 @@ class Sampled(AffineGainModel):
     @checked
     def critical_dead_time(self, gain: float, loop: Characteristic) -> float | None:
         """D*, s (`LoopModel.critical_dead_time`); None with ``hold="reference"``: the sampled model takes no dead time
-        inside the continuous servo (`continuous_plant`), so it has no D* (the continuous-time models give theirs).
+        inside the continuous servo (`continuous_plant`), so it has no D* (the continuous-time models give theirs); None
+        too when the loop is still stable at the longest dead time the delay line carries at this T
+        ((`MAX_DELAY_STATES` − d − 1)·T, shorter than 10 s only for periods below 0.1 ms).
 
         Parameters
         ----------
@@ -704,7 +729,37 @@ class Sampled(AffineGainModel):
         """
         if self.hold == "reference":
             return None
-        return super().critical_dead_time.__wrapped__(self, gain, loop)
+        from .dead_time import search_dead_time
+
+        if loop.T == 0:  # the loop's own limit, the delay loop with delay D: its exact margin
+            return _limit(loop).critical_dead_time(gain, loop)
+        most = (MAX_DELAY_STATES - self.compute_delay - 1) * loop.T  # the longest dead time the delay line carries
+        if most >= RANGES["dead_time"].high:
+            return search_dead_time(self, gain, loop)
+        found = search_dead_time(self, gain, loop, high=most)
+        return None if math.isinf(found) else found  # stable as far as the model reaches: no D* it can give
+
+    @checked
+    def critical_delay(self, gain: float, loop: Characteristic) -> float:
+        """T*, s (`LoopModel.critical_delay`); with a dead time D the periods searched are those whose delay line the
+        model carries, T >= D/(`MAX_DELAY_STATES` − d − 1) (at T = 0 the loop's own limit, the delay loop with delay D,
+        is judged first: T* = 0 when it is unstable).
+
+        Parameters
+        ----------
+        gain : float
+            The family's loop gain: NV (1/s) or κ (1/s²).
+        loop : Characteristic
+            The loop judged; its own T, s, is replaced by the searched ones.
+        """
+        if loop.dead_time <= 0:
+            return LoopModel.critical_delay.__wrapped__(self, gain, loop)
+
+        def search():
+            start, rtol, atol = loop.delay_search(gain)
+            return max(start, loop.dead_time / (MAX_DELAY_STATES - self.compute_delay - 1)), RANGES["T"].high, {"rtol": rtol, "atol": atol}
+
+        return self._first_loss(gain, loop._with_delay, 0.0, search)
 
     def _searched_growth_rates(self, gain: float, loops) -> np.ndarray:
         """The growth rates the searches for T*, k* and D* measure (`LoopModel._searched_growth_rates`): `growth_rates`,

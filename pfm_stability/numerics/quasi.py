@@ -40,12 +40,11 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import brentq, minimize_scalar
 
-from .crossings import Crossing, StabilityInterval
+from .crossings import StabilityInterval, walk_stable_set
 from .delay import chebyshev_collocation, single_blas_thread
 
-__all__ = ["DelayedTerm", "QuasiPolynomial"]
+__all__ = ["DelayedTerm", "QuasiPolynomial", "sign_change_roots"]
 
 _TWO_PI = 2.0 * math.pi
 _PHASE_STEP = math.pi / 4
@@ -286,15 +285,11 @@ class QuasiPolynomial:
             raise ValueError(f"the gain crossings need {count} grid points, more than {_MAX_POINTS}")
         grid = np.unique(np.concatenate([np.linspace(low, high, count), np.geomspace(max(low, 1e-9 * high), high, 512)]))
         grid = grid[grid > 0]
-        imag = np.imag(self.gain_function(grid))
-        out = []
-        for i in np.flatnonzero(np.sign(imag[:-1]) * np.sign(imag[1:]) < 0):
-            w = brentq(lambda x: float(np.imag(self.gain_function(x))), grid[i], grid[i + 1], xtol=1e-15 * grid[i + 1], rtol=1e-15)
-            gain = float(np.real(self.gain_function(w)))
-            if gain > 0:
-                slope = float(self._gain_phase_slope(w))
-                out.append((gain, w, 0 if abs(slope) <= 1e-12 * self.gain_delay else int(np.sign(slope))))
-        return out
+        roots = sign_change_roots(lambda x: np.imag(self.gain_function(x)), grid)
+        gains, slopes = np.real(self.gain_function(roots)), self._gain_phase_slope(roots)
+        keep = gains > 0
+        directions = np.where(np.abs(slopes) <= 1e-12 * self.gain_delay, 0, np.sign(slopes)).astype(int)
+        return [(float(g), float(w), int(d)) for g, w, d in zip(gains[keep], roots[keep], directions[keep])]
 
     def gain_crossings(self) -> tuple:
         """The crossings (K > 0, ω, direction) that can bound the stable set, sorted by gain, and the count Z(0+).
@@ -332,26 +327,8 @@ class QuasiPolynomial:
         crossings, top, base = self.gain_crossings()
         if base is None:
             return StabilityInterval(0.0, None, (), ())
-        count, edges, intervals, start = base, [], [], 0.0 if base == 0 else None
-        for gain, w, direction in crossings:  # complete up to `top`; beyond it every crossing destabilises
-            count += 2 * direction
-            edges.append(Crossing(gain, w))
-            if start is not None and count > 0:
-                intervals.append((start, gain))
-                start = None
-            elif start is None and count == 0:
-                start = gain
-        if start is not None:
-            nxt = self._next_crossing(top, K_max)
-            intervals.append((start, math.inf if nxt is None else nxt[0]))
-            if nxt is not None:
-                edges.append(Crossing(*nxt))
-        intervals = [(lo, hi) for lo, hi in intervals if lo < hi]
-        if not intervals or intervals[0][0] > 0:
-            return StabilityInterval(0.0, None, tuple(edges), tuple(intervals))
-        end = intervals[0][1]
-        frequency = None if math.isinf(end) else next(c.frequency for c in edges if c.gain == end)
-        return StabilityInterval(end, frequency, tuple(edges), tuple(intervals))
+        return walk_stable_set(base, [(gain, w, 2 * direction) for gain, w, direction in crossings],
+                               tail=lambda last: self._next_crossing(top, K_max))
 
     def _next_crossing(self, above: float, K_max: float):
         """(K, ω) of the smallest crossing gain above `above` (every one destabilises there), None up to K_max."""
@@ -485,6 +462,29 @@ class QuasiPolynomial:
         return s[done & alive]
 
 
+def sign_change_roots(f, grid, values=None) -> np.ndarray:
+    """Every root of the real function f (arrays in, arrays out) in a cell of `grid` where f changes sign, all refined at
+    once to machine precision (`scipy.optimize.elementwise.find_root`, Chandrupatla's bracketing method).
+
+    Parameters
+    ----------
+    f : callable
+        ndarray → ndarray.
+    grid : ndarray
+        Ascending points.
+    values : ndarray, optional
+        f(grid), when already computed.
+    """
+    from scipy.optimize.elementwise import find_root
+
+    values = f(grid) if values is None else values
+    cells = np.flatnonzero(np.sign(values[:-1]) * np.sign(values[1:]) < 0)
+    if cells.size == 0:
+        return np.empty(0)
+    result = find_root(f, (grid[cells], grid[cells + 1]), tolerances={"xatol": 0.0, "xrtol": 4 * np.finfo(float).eps})
+    return np.asarray(result.x, dtype=float)
+
+
 def _lagrange_weights(x, c, point: float) -> np.ndarray:
     """The barycentric Lagrange weights of the Chebyshev points x (weights c) at `point` in [−1, 1]."""
     difference = point - x
@@ -525,15 +525,15 @@ def _refine_phase(omega, values, f):
 def _sign_changes(F, end: float, delay: float) -> list:
     """Every root ω in (0, end] of the real function F: its sign changes on a grid that resolves the exponentials
     (π/(16·delay)), and a pair of close roots found where a local minimum of |F| on the grid dips through 0."""
+    from scipy.optimize import brentq, minimize_scalar  # here: the report's cold start does not load scipy.optimize
+
     step = math.pi / (16.0 * delay) if delay > 0 else end / 256.0
     count = int(math.ceil(end / step)) + 1
     if count > _MAX_POINTS:
         raise ValueError(f"the delay margin needs {count} grid points, more than {_MAX_POINTS}")
     grid = np.unique(np.concatenate([np.linspace(0.0, end, count), np.geomspace(1e-9 * end, end, 1024)]))[1:]
     values = F(grid)
-    roots = []
-    for i in np.flatnonzero(np.sign(values[:-1]) * np.sign(values[1:]) < 0):
-        roots.append(brentq(F, grid[i], grid[i + 1], xtol=1e-15 * grid[i + 1], rtol=1e-15))
+    roots = list(sign_change_roots(F, grid, values))
     magnitude = np.abs(values)
     dips = (magnitude[1:-1] < 0.5 * magnitude[:-2]) & (magnitude[1:-1] < 0.5 * magnitude[2:])  # a sharp local minimum of |F|
     for i in np.flatnonzero(dips) + 1:
