@@ -147,8 +147,8 @@ class Window:
         x, y : float or ndarray
             m.
         """
-        x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
-        return (x >= self.x0) & (y >= self.y0) & ((x - self.x0) / self.resolution < self.nx) & ((y - self.y0) / self.resolution < self.ny)
+        x, y = np.asarray(x), np.asarray(y)
+        return (x >= self.x0) & (y >= self.y0) & (x < self.x0 + self.nx * self.resolution) & (y < self.y0 + self.ny * self.resolution)
 
 
 @dataclass(frozen=True)
@@ -183,6 +183,9 @@ class CorridorCostmap:
             object.__setattr__(self, name, check_number(name, getattr(self, name), self.resolution, 1e4, low_open=False, unit="m"))
         if self.half_width is not None:
             object.__setattr__(self, "half_width", check_number("half_width", self.half_width, self.resolution, 1e4, unit="m"))
+            n = self.wall_rows
+            table = self.inflation.cell_cost(n - np.abs(np.arange(-n, n + 1)), self.resolution).astype(np.float32)
+            object.__setattr__(self, "_rows", np.concatenate([table, [np.float32(LETHAL_OBSTACLE)]]))  # rows −n … n, then beyond
 
     @property
     def wall_rows(self) -> int | None:
@@ -254,13 +257,15 @@ class CorridorCostmap:
         window : Window, optional
             The local costmap's bounds (None: unbounded).
         """
-        x, y = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(y, dtype=float))
+        x, y = np.broadcast_arrays(np.asarray(x), np.asarray(y))
         if self.half_width is None:
-            cost = np.zeros(y.shape)
+            cost = np.zeros(y.shape, dtype=np.float32)
         elif self.exact:
-            cost = self.inflation.cost(self.half_width - np.abs(y))
+            cost = np.asarray(self.inflation.cost(self.half_width - np.abs(y.astype(float))), dtype=np.float32)
         else:
-            cost = self.row_cost(self.rows(y)).astype(float)
+            n = self.wall_rows
+            index = self.rows(y) + n
+            cost = self._rows[np.where((index < 0) | (index > 2 * n), 2 * n + 1, index)]
         if window is not None:
-            cost = np.where(window.contains(x, y), cost, float(NO_INFORMATION))
+            cost = np.where(window.contains(x, y), cost, np.float32(NO_INFORMATION))
         return np.asarray(cost, dtype=np.float32)

@@ -12,10 +12,10 @@ controller's ``LINEARIZATION_STEPS``, with its reason). A linear lateral control
 Koren & Borenstein's steering command u = −kθ − K·y with k = k_θ and N = k_y/k_θ, so NV = k_y·V/k_θ
 (`LateralGains.NV`; docs/controllers.md).
 
-Controllers with memory (MPPI's control sequence, DWB's and the Graceful controller's flags) are first warmed
-up: ``WARMUP_CYCLES`` cycles on the centre line, the robot advancing V·T along the plan each cycle and its
-measured speed the last command's, so that the memory is the one the controller carries while tracking; every
-perturbation then starts from that same memory. A sampling controller (MPPI) or one whose decision is
+Controllers with memory (MPPI's control sequence, DWB's oscillation flags) are first warmed up: ``WARMUP_CYCLES``
+cycles on the centre line, the robot advancing at the speed it commands and measuring that speed, so that the memory
+is the one the controller carries while tracking; every perturbation then starts from that same memory, and V is
+the warm-up's last command (its mean over the draws). A sampling controller (MPPI) or one whose decision is
 quantized (DWB: a lattice of velocity samples and of costmap cells) is linearised over `seeds` independent
 draws — MPPI's noise, and for every controller with ``RANDOM_PHASE`` the robot's place relative to the plan's
 poses and the costmap's cells — with common random numbers between the + and − perturbations; the result is
@@ -132,8 +132,12 @@ def _decide(module, params, plan, costmap, state, memory, rng):
     return module.command(state, plan, costmap, params, rng=copy.deepcopy(rng), memory=memory)
 
 
-def equilibrium_speed(name: str, params, costmap, *, spacing: float = 0.05, cycles: int = 8) -> float:
-    """The forward speed the controller commands on the centre line, measured speed fed back `cycles` times, m/s.
+def equilibrium_speed(name: str, params, costmap, *, T: float = 0.05, spacing: float = 0.05, cycles: int = 8, seed: int = 0) -> float:
+    """The forward speed the controller commands on the centre line, m/s: the last command of a warm-up.
+
+    The warm-up (`warm_up`) runs the controller's ``WARMUP_CYCLES``, at least `cycles`, the robot advancing at its
+    commanded speed and measuring it (the lookahead of RPP scales with the measured speed; MPPI's sequence has to
+    converge).
 
     Parameters
     ----------
@@ -143,28 +147,27 @@ def equilibrium_speed(name: str, params, costmap, *, spacing: float = 0.05, cycl
         Its parameters.
     costmap : CorridorCostmap
         The corridor (or free space).
+    T : float
+        Controller period, s.
     spacing : float
         The plan's poses, m.
     cycles : int
-        Fixed-point iterations (the lookahead of RPP scales with the measured speed).
+        The fewest cycles.
+    seed : int
+        The controller's random numbers.
     """
     module = _module(name)
-    plan = straight_plan(PLAN_BEHIND + PLAN_AHEAD, spacing, x0=-PLAN_BEHIND)
-    v = module.nominal_speed(params)
-    memory = None
-    rng = np.random.default_rng(0)
-    plan = prune(plan, RobotState(0.0, 0.0, 0.0), costmap.window(0.0, 0.0))
-    for _ in range(cycles):
-        cmd = module.command(RobotState(0.0, 0.0, 0.0, v, 0.0), plan, costmap, params, rng=rng, memory=memory)
-        v, memory = cmd.v, cmd.memory
+    cycles = max(int(cycles), int(getattr(module, "WARMUP_CYCLES", 0)))
+    plan = straight_plan(PLAN_BEHIND + PLAN_AHEAD + 2.0 * module.nominal_speed(params) * cycles * T, spacing, x0=-PLAN_BEHIND)
+    _, _, _, v = warm_up(name, params, plan, costmap, x=0.0, T=T, rng=np.random.default_rng(seed), cycles=cycles)
     return float(v)
 
 
-def warm_up(name: str, params, plan, costmap, *, x: float, V: float, T: float, rng, cycles: int | None = None):
+def warm_up(name: str, params, plan, costmap, *, x: float, T: float, rng, cycles: int | None = None):
     """A controller's memory after tracking the centre line for `cycles` cycles (module docstring).
 
-    The robot starts at (x, 0) heading along the plan, advances V·T per cycle, and measures the last command's
-    speed and no yaw rate.
+    The robot starts at (x, 0) heading along the plan at the controller's nominal speed, advances at the speed it
+    commands (v·T per cycle), and measures that speed and no yaw rate.
 
     Parameters
     ----------
@@ -178,8 +181,6 @@ def warm_up(name: str, params, plan, costmap, *, x: float, V: float, T: float, r
         The corridor.
     x : float
         Where the warm-up starts along the plan, m.
-    V : float
-        The speed it advances at, m/s.
     T : float
         Controller period, s.
     rng : numpy.random.Generator
@@ -195,13 +196,13 @@ def warm_up(name: str, params, plan, costmap, *, x: float, V: float, T: float, r
     """
     module = _module(name)
     cycles = int(getattr(module, "WARMUP_CYCLES", 0)) if cycles is None else int(cycles)
-    memory, v = None, V
+    memory, v = None, module.nominal_speed(params)
     for _ in range(cycles):
         state = RobotState(x, 0.0, 0.0, v, 0.0)
         plan = prune(plan, state, costmap.window(x, 0.0))
         cmd = module.command(state, plan, costmap, params, rng=rng, memory=memory)
         memory, v = cmd.memory, cmd.v
-        x += V * T
+        x += v * T
     return memory, prune(plan, RobotState(x, 0.0, 0.0), costmap.window(x, 0.0)), x, v
 
 
@@ -232,15 +233,19 @@ def linearize(name: str, params, costmap, *, T: float = 0.05, draws: int = 1, se
     draws = check_integer("draws", draws, 1, 100_000)
     T = check_number("T", T, 0.0, 100.0, unit="s")
     hy, ht, hw = module.LINEARIZATION_STEPS if steps is None else tuple(float(s) for s in steps)
-    V = equilibrium_speed(name, params, costmap, spacing=spacing)
     random_phase = bool(getattr(module, "RANDOM_PHASE", False))
     cycles = int(getattr(module, "WARMUP_CYCLES", 0))
-    plan = straight_plan(PLAN_BEHIND + PLAN_AHEAD + cycles * V * T + spacing, spacing, x0=-PLAN_BEHIND)
-    rows = []
+    if cycles == 0:  # a controller without memory: its speed's fixed point (RPP's lookahead follows the measured speed)
+        V = equilibrium_speed(name, params, costmap, T=T, spacing=spacing, seed=seed)
+    plan = straight_plan(PLAN_BEHIND + PLAN_AHEAD + 2.0 * module.nominal_speed(params) * cycles * T + spacing, spacing, x0=-PLAN_BEHIND)
+    rows, speeds = [], []
     for d in range(draws):
         rng = np.random.default_rng(seed + d)
         phase = float(rng.uniform(-0.5, 0.5)) if random_phase else 0.0
-        memory, pruned, x, v = warm_up(name, params, plan, costmap, x=phase * spacing, V=V, T=T, rng=rng)
+        memory, pruned, x, v = warm_up(name, params, plan, costmap, x=phase * spacing, T=T, rng=rng)
+        if cycles == 0:
+            v = V
+        speeds.append(v)
 
         def w(ey=0.0, et=0.0, wm=0.0):
             return _decide(module, params, pruned, costmap, RobotState(x, ey, et, v, wm), memory, rng).w
@@ -250,4 +255,4 @@ def linearize(name: str, params, costmap, *, T: float = 0.05, draws: int = 1, se
     a = np.array(rows)
     mean = a.mean(axis=0)
     se = a.std(axis=0, ddof=1) / math.sqrt(draws) if draws > 1 else np.zeros(4)
-    return LateralGains(name, V, *(float(m) for m in mean), *(float(e) for e in se), (hy, ht, hw), draws)
+    return LateralGains(name, float(np.mean(speeds)), *(float(m) for m in mean), *(float(e) for e in se), (hy, ht, hw), draws)

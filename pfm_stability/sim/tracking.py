@@ -221,8 +221,8 @@ class _Members:
         for s, p, rng in zip(scenarios, self.params, self.rngs):
             reach = 1.5 * s.robot.V * s.duration + PLAN_AHEAD
             cycles = int(getattr(controller_module(s.controller), "WARMUP_CYCLES", 0)) if s.warmup else 0
-            plan = straight_plan(PLAN_BEHIND + reach + cycles * s.robot.V * s.T, s.spacing, x0=-PLAN_BEHIND)
-            memory, plan, x, _ = warm_up(s.controller, p, plan, s.costmap, x=0.0, V=s.robot.V, T=s.T, rng=rng, cycles=cycles)
+            plan = straight_plan(PLAN_BEHIND + reach + 2.0 * s.robot.V * cycles * s.T, s.spacing, x0=-PLAN_BEHIND)
+            memory, plan, x, _ = warm_up(s.controller, p, plan, s.costmap, x=0.0, T=s.T, rng=rng, cycles=cycles)
             self.plans.append(plan)
             self.memory.append(memory)
             self.start.append(x)
