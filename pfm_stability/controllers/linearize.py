@@ -35,13 +35,49 @@ from ..checks import check_integer, check_number
 from .base import RobotState
 from .plan import prune, straight_plan
 
-__all__ = ["LateralGains", "linearize", "equilibrium_speed", "configure", "warm_up", "PLAN_BEHIND", "PLAN_AHEAD"]
+__all__ = ["LateralGains", "ImpulseResponse", "linearize", "equilibrium_speed", "configure", "warm_up", "PLAN_BEHIND", "PLAN_AHEAD"]
 
 PLAN_BEHIND = 1.0
 """Plan behind the robot's start, m: within the closest pose's search distance of a 3 m local costmap (1.5 m)."""
 
 PLAN_AHEAD = 10.0
 """Plan ahead of the robot's position after the warm-up, m: far beyond the prune distance and the window, so no goal is near."""
+
+
+@dataclass(frozen=True)
+class ImpulseResponse:
+    """A controller's response over several cycles to a perturbation at one (its memory: MPPI's sequence and filter).
+
+    Element j is the response j cycles after the perturbation (j = 0: the one-step gain), the robot back on the
+    centre line after it; ω_j = −Σ_i (y_i·e_y,(j−i) + theta_i·e_θ,(j−i)) + Σ_i w_i·ω_m,(j−i) to first order.
+
+    Attributes
+    ----------
+    y : tuple of float
+        −∂ω_j/∂e_y,0, 1/(m·s).
+    theta : tuple of float
+        −∂ω_j/∂e_θ,0, 1/s.
+    w : tuple of float
+        ∂ω_j/∂ω_m,0.
+    y_se, theta_se, w_se : tuple of float
+        Their standard errors over the draws.
+    """
+
+    y: tuple
+    theta: tuple
+    w: tuple
+    y_se: tuple
+    theta_se: tuple
+    w_se: tuple
+
+    @property
+    def cycles(self) -> int:
+        """Cycles measured."""
+        return len(self.y)
+
+    def to_dict(self) -> dict:
+        """The fields as a JSON-ready dict (SI units)."""
+        return {k: list(v) for k, v in self.__dict__.items()}
 
 
 @dataclass(frozen=True)
@@ -68,6 +104,8 @@ class LateralGains:
         The central differences' steps h in e_y (m), e_θ (rad) and ω_m (rad/s).
     draws : int
         Independent draws averaged.
+    memory : ImpulseResponse or None
+        The response over the following cycles, for a controller with memory (None: one cycle measured).
     """
 
     controller: str
@@ -82,6 +120,7 @@ class LateralGains:
     w0_se: float
     steps: tuple
     draws: int
+    memory: ImpulseResponse | None = None
 
     @property
     def N(self) -> float:
@@ -97,6 +136,7 @@ class LateralGains:
         """The fields and N, NV as a JSON-ready dict (SI units)."""
         out = dict(self.__dict__)
         out["steps"] = list(self.steps)
+        out["memory"] = self.memory.to_dict() if self.memory is not None else None
         out.update(N=self.N, NV=self.NV)
         return out
 
@@ -128,16 +168,11 @@ def configure(name: str, params, *, V: float | None = None, T: float | None = No
     return params
 
 
-def _decide(module, params, plan, costmap, state, memory, rng):
-    return module.command(state, plan, costmap, params, rng=copy.deepcopy(rng), memory=memory)
+def equilibrium_speed(name: str, params, costmap, *, x: float = 0.0, spacing: float = 0.05, cycles: int = 8, seed: int = 0) -> float:
+    """The forward speed a memoryless controller commands on the centre line at x, its measured speed fed back, m/s.
 
-
-def equilibrium_speed(name: str, params, costmap, *, T: float = 0.05, spacing: float = 0.05, cycles: int = 8, seed: int = 0) -> float:
-    """The forward speed the controller commands on the centre line, m/s: the last command of a warm-up.
-
-    The warm-up (`warm_up`) runs the controller's ``WARMUP_CYCLES``, at least `cycles`, the robot advancing at its
-    commanded speed and measuring it (the lookahead of RPP scales with the measured speed; MPPI's sequence has to
-    converge).
+    A fixed-point iteration at one place (the lookahead of RPP scales with the measured speed); a controller with
+    memory takes its warm-up's last command instead (`warm_up`).
 
     Parameters
     ----------
@@ -147,19 +182,23 @@ def equilibrium_speed(name: str, params, costmap, *, T: float = 0.05, spacing: f
         Its parameters.
     costmap : CorridorCostmap
         The corridor (or free space).
-    T : float
-        Controller period, s.
+    x : float
+        Where along the plan, m (0: on a pose).
     spacing : float
         The plan's poses, m.
     cycles : int
-        The fewest cycles.
+        Iterations.
     seed : int
         The controller's random numbers.
     """
     module = _module(name)
-    cycles = max(int(cycles), int(getattr(module, "WARMUP_CYCLES", 0)))
-    plan = straight_plan(PLAN_BEHIND + PLAN_AHEAD + 2.0 * module.nominal_speed(params) * cycles * T, spacing, x0=-PLAN_BEHIND)
-    _, _, _, v = warm_up(name, params, plan, costmap, x=0.0, T=T, rng=np.random.default_rng(seed), cycles=cycles)
+    plan = straight_plan(PLAN_BEHIND + PLAN_AHEAD + abs(x), spacing, x0=-PLAN_BEHIND)
+    plan = prune(plan, RobotState(x, 0.0, 0.0), costmap.window(x, 0.0))
+    rng = np.random.default_rng(seed)
+    v, memory = module.nominal_speed(params), None
+    for _ in range(int(cycles)):
+        cmd = module.command(RobotState(x, 0.0, 0.0, v, 0.0), plan, costmap, params, rng=rng, memory=memory)
+        v, memory = cmd.v, cmd.memory
     return float(v)
 
 
@@ -206,8 +245,44 @@ def warm_up(name: str, params, plan, costmap, *, x: float, T: float, rng, cycles
     return memory, prune(plan, RobotState(x, 0.0, 0.0), costmap.window(x, 0.0)), x, v
 
 
-def linearize(name: str, params, costmap, *, T: float = 0.05, draws: int = 1, seed: int = 0, spacing: float = 0.05,
-              steps: tuple | None = None) -> LateralGains:
+def _response(module, params, plan, costmap, T, memory, x, v, rng, channel: int, h: float, cycles: int):
+    """ω over `cycles` cycles after a perturbation of size `h` in one channel (0: e_y, 1: e_θ, 2: ω_m) at the first.
+
+    After the perturbed cycle the robot is back on the centre line, advancing at its commanded speed and measuring
+    it, with no yaw rate; the controller's memory and random numbers are the warm-up's (common to every call).
+    """
+    rng = copy.deepcopy(rng)
+    out = []
+    for k in range(cycles):
+        e = [0.0, 0.0, 0.0]
+        if k == 0:
+            e[channel] = h
+        state = RobotState(x, e[0], e[1], v, e[2])
+        plan = prune(plan, state, costmap.window(x, 0.0))
+        cmd = module.command(state, plan, costmap, params, rng=rng, memory=memory)
+        memory = cmd.memory
+        out.append(cmd.w)
+        x, v = x + cmd.v * T, cmd.v
+    return np.array(out)
+
+
+def _draw(module, name, params, plan, costmap, T, spacing, steps, cycles, seed, speed):
+    """One draw: (V, w0, responses (3, cycles)): −∂ω/∂e_y, −∂ω/∂e_θ and ∂ω/∂ω_m at every cycle after the perturbation."""
+    rng = np.random.default_rng(seed)  # the controller's: the same noise as a simulated run with this seed
+    phase = float(np.random.default_rng([seed, 1]).uniform(-0.5, 0.5)) if getattr(module, "RANDOM_PHASE", False) else 0.0
+    memory, pruned, x, v = warm_up(name, params, plan, costmap, x=phase * spacing, T=T, rng=rng)
+    v = v if speed is None else speed
+    w0 = _response(module, params, pruned, costmap, T, memory, x, v, rng, 0, 0.0, 1)[0]
+    rows = np.zeros((3, cycles))
+    for channel, (h, sign) in enumerate(zip(steps, (-1.0, -1.0, 1.0))):
+        if h > 0:
+            up, down = (_response(module, params, pruned, costmap, T, memory, x, v, rng, channel, s * h, cycles) for s in (1.0, -1.0))
+            rows[channel] = sign * (up - down) / (2.0 * h)
+    return v, w0, rows
+
+
+def linearize(name: str, params, costmap, *, T: float = 0.05, draws: int | None = None, seed: int = 0, spacing: float = 0.05,
+              steps: tuple | None = None, memory_cycles: int | None = None) -> LateralGains:
     """Numeric lateral gains of a controller about a straight plan (module docstring).
 
     Parameters
@@ -220,39 +295,35 @@ def linearize(name: str, params, costmap, *, T: float = 0.05, draws: int = 1, se
         The corridor whose centre line is the plan (or free space, ``half_width=None``).
     T : float
         Controller period, s: the warm-up's advance per cycle.
-    draws : int
-        Independent draws (seeds ``seed`` … ``seed + draws − 1``).
+    draws : int, optional
+        Independent draws (seeds ``seed`` … ``seed + draws − 1``); default the controller's ``DRAWS`` (1).
     seed : int
         The first draw's seed.
     spacing : float
         Between the plan's poses, m.
     steps : (float, float, float), optional
-        The steps in e_y (m), e_θ (rad) and ω_m (rad/s); default the controller's ``LINEARIZATION_STEPS``.
+        The steps in e_y (m), e_θ (rad) and ω_m (rad/s); default the controller's ``LINEARIZATION_STEPS`` (a step 0
+        skips its channel: a controller that does not read it).
+    memory_cycles : int, optional
+        Cycles of the response to a perturbation to measure (`LateralGains.memory`); default the controller's
+        ``MEMORY_CYCLES`` (1: the one-step gains only).
     """
     module = _module(name)
-    draws = check_integer("draws", draws, 1, 100_000)
+    draws = check_integer("draws", int(getattr(module, "DRAWS", 1)) if draws is None else draws, 1, 100_000)
+    cycles = check_integer("memory_cycles", int(getattr(module, "MEMORY_CYCLES", 1)) if memory_cycles is None else memory_cycles, 1, 10_000)
     T = check_number("T", T, 0.0, 100.0, unit="s")
-    hy, ht, hw = module.LINEARIZATION_STEPS if steps is None else tuple(float(s) for s in steps)
-    random_phase = bool(getattr(module, "RANDOM_PHASE", False))
-    cycles = int(getattr(module, "WARMUP_CYCLES", 0))
-    if cycles == 0:  # a controller without memory: its speed's fixed point (RPP's lookahead follows the measured speed)
-        V = equilibrium_speed(name, params, costmap, T=T, spacing=spacing, seed=seed)
-    plan = straight_plan(PLAN_BEHIND + PLAN_AHEAD + 2.0 * module.nominal_speed(params) * cycles * T + spacing, spacing, x0=-PLAN_BEHIND)
-    rows, speeds = [], []
-    for d in range(draws):
-        rng = np.random.default_rng(seed + d)
-        phase = float(rng.uniform(-0.5, 0.5)) if random_phase else 0.0
-        memory, pruned, x, v = warm_up(name, params, plan, costmap, x=phase * spacing, T=T, rng=rng)
-        if cycles == 0:
-            v = V
-        speeds.append(v)
-
-        def w(ey=0.0, et=0.0, wm=0.0):
-            return _decide(module, params, pruned, costmap, RobotState(x, ey, et, v, wm), memory, rng).w
-
-        rows.append(((w(-hy) - w(hy)) / (2 * hy), (w(et=-ht) - w(et=ht)) / (2 * ht),
-                     (w(wm=hw) - w(wm=-hw)) / (2 * hw) if hw > 0 else 0.0, w()))
-    a = np.array(rows)
-    mean = a.mean(axis=0)
-    se = a.std(axis=0, ddof=1) / math.sqrt(draws) if draws > 1 else np.zeros(4)
-    return LateralGains(name, float(np.mean(speeds)), *(float(m) for m in mean), *(float(e) for e in se), (hy, ht, hw), draws)
+    steps = module.LINEARIZATION_STEPS if steps is None else tuple(float(s) for s in steps)
+    warm = int(getattr(module, "WARMUP_CYCLES", 0))
+    speed = None if warm else equilibrium_speed(name, params, costmap, spacing=spacing, seed=seed)  # memoryless: its fixed point
+    reach = 2.0 * module.nominal_speed(params) * (warm + cycles) * T
+    plan = straight_plan(PLAN_BEHIND + PLAN_AHEAD + reach + spacing, spacing, x0=-PLAN_BEHIND)
+    results = [_draw(module, name, params, plan, costmap, T, spacing, steps, cycles, seed + d, speed) for d in range(draws)]
+    V = np.array([r[0] for r in results])
+    w0 = np.array([r[1] for r in results])
+    taps = np.array([r[2] for r in results])  # (draws, 3, cycles)
+    mean = taps.mean(axis=0)
+    se = taps.std(axis=0, ddof=1) / math.sqrt(draws) if draws > 1 else np.zeros_like(mean)
+    w0_se = float(w0.std(ddof=1) / math.sqrt(draws)) if draws > 1 else 0.0
+    memory = ImpulseResponse(*(tuple(float(v) for v in mean[c]) for c in range(3)), *(tuple(float(v) for v in se[c]) for c in range(3))) if cycles > 1 else None
+    return LateralGains(name, float(V.mean()), float(mean[0, 0]), float(mean[1, 0]), float(mean[2, 0]), float(w0.mean()),
+                        float(se[0, 0]), float(se[1, 0]), float(se[2, 0]), w0_se, tuple(steps), draws, memory)

@@ -56,7 +56,8 @@ from .plan import PRUNE_DISTANCE, local_plan
 
 __all__ = ["MPPIParams", "MPPIMemory", "ConstraintCritic", "CostCritic", "ObstaclesCritic", "GoalCritic", "GoalAngleCritic",
            "PathAlignCritic", "PathFollowCritic", "PathAngleCritic", "PreferForwardCritic", "DEFAULT_CRITICS", "command",
-           "with_speed", "nominal_speed", "savitzky_golay", "LINEARIZATION_STEPS", "WARMUP_CYCLES", "RANDOM_PHASE"]
+           "with_speed", "nominal_speed", "savitzky_golay", "LINEARIZATION_STEPS", "WARMUP_CYCLES", "RANDOM_PHASE", "DRAWS",
+           "MEMORY_CYCLES"]
 
 F = np.float32
 DEFAULT_CRITICS = ("ConstraintCritic", "CostCritic", "GoalCritic", "GoalAngleCritic", "PathAlignCritic", "PathFollowCritic",
@@ -71,10 +72,19 @@ sequence reaches its cruising speed in about 4 cycles (ax_max·T = 0.15 m/s each
 RANDOM_PHASE = True
 """The linearisation draws the robot's place relative to the plan's poses and the costmap's cells with the noise."""
 
-LINEARIZATION_STEPS = (0.01, 0.01, 0.02)
+DRAWS = 8
+"""Draws of the noise (and of the robot's place on the plan) a linearisation averages by default: standard errors of
+about 3 % of k_y and k_θ (`controllers.linearize`)."""
+
+MEMORY_CYCLES = 1
+"""Cycles of the response a default linearisation measures (1: the one-step gains); the memory of the optimizer
+lasts about 15 cycles (docs/controllers.md): ``linearize(..., memory_cycles=16)``."""
+
+LINEARIZATION_STEPS = (0.01, 0.01, 0.0)
 """Central-difference steps (e_y m, e_θ rad, ω_m rad/s); see docs/controllers.md, "MPPI's linearisation": the
 gains are flat in the step from 0.005 to 0.02 m with the exact costmap, and a step of a fifth of a cell keeps the
-grid costmap's cost steps from dominating the difference; ω_m moves only the initial speed's clamp."""
+grid costmap's cost steps from dominating the difference. The measured yaw rate enters only the initial speed's clamp
+(the last command within az_max·T = 0.175 rad/s of it), which small perturbations never reach: its channel is skipped."""
 
 
 @dataclass(frozen=True)

@@ -27,17 +27,24 @@ import numpy as np
 from ..checks import check_choice, check_integer, check_number
 from ..controllers import linearize
 from ..models import Loop, make_model
+from ..models.sampled import command_form
 from ..numerics.solve import bisect_batched
 from ..sim.tracking import TrackingScenario, simulate_tracking
 from ..sim.verdict import simulated_verdict
 
-__all__ = ["ControllerBoundary", "BOUNDARY_PARAMETERS", "scenario_at", "simulated_boundary", "predicted_boundary",
-           "loop_of", "boundary_check"]
+__all__ = ["ControllerBoundary", "BOUNDARY_PARAMETERS", "PREDICTIONS", "scenario_at", "simulated_boundary", "predicted_boundary",
+           "memory_loop_matrix", "loop_of", "boundary_check"]
 
-BOUNDARY_PARAMETERS = ("V", "lookahead_dist")
-"""What a boundary is bisected in: the robot's cruising speed V (m/s), or RPP's ``lookahead_dist`` (m)."""
+BOUNDARY_PARAMETERS = ("V", "lookahead_dist", "dead_time")
+"""What a boundary is bisected in: the robot's cruising speed V (m/s), RPP's ``lookahead_dist`` (m), or the plant's
+dead time D (s; the controller's gains do not depend on it, so they are linearised once)."""
 
-_STABLE_ABOVE = {"V": False, "lookahead_dist": True}
+PREDICTIONS = ("sampled", "memory")
+"""How a boundary is predicted: the `sampled` model with the one-step gains (KB's loop, the loop models' view), or
+the sampled plant closed by the controller's impulse response (`memory_loop_matrix`: its memory between cycles)."""
+
+_STABLE_ABOVE = {"V": False, "lookahead_dist": True, "dead_time": False}
+_PLANT_ONLY = {"dead_time"}
 
 
 @dataclass(frozen=True)
@@ -90,8 +97,8 @@ def scenario_at(template: TrackingScenario, parameter: str, value: float) -> Tra
         Its value (m/s or m).
     """
     check_choice("parameter", parameter, BOUNDARY_PARAMETERS)
-    if parameter == "V":
-        return template.replace(robot=template.robot.replace(V=float(value)))
+    if parameter in ("V", "dead_time"):
+        return template.replace(robot=template.robot.replace(**{parameter: float(value)}))
     return template.replace(params=template.params.replace(**{parameter: float(value)}))
 
 
@@ -142,14 +149,65 @@ def loop_of(gains, scenario: TrackingScenario) -> Loop:
     return Loop(r.tau, scenario.T, gains.k_theta, plant_gain=r.plant_gain, dead_time=r.dead_time)
 
 
-def _gains(scenario: TrackingScenario, draws: int, seed: int):
+def _gains(scenario: TrackingScenario, draws, seed: int, memory_cycles=None):
     return linearize(scenario.controller, scenario.controller_params(), scenario.costmap, T=scenario.T, draws=draws,
-                     seed=seed, spacing=scenario.spacing)
+                     seed=seed, spacing=scenario.spacing, memory_cycles=memory_cycles)
 
 
-def predicted_boundary(template: TrackingScenario, parameter: str, lo: float, hi: float, *, draws: int = 1, seed: int = 0,
-                       rtol: float = 1e-6, shift: float = 0.0):
-    """Bisect the sampled model's verdict with the linearised gains at each value (module docstring).
+def memory_loop_matrix(gains, scenario: TrackingScenario) -> np.ndarray:
+    """The sampled plant closed by a controller's impulse response: the transition matrix over one period.
+
+    The plant is the `sampled` model's (`models.sampled.command_form`: lag, plant gain, dead time, compute delay;
+    states (ω,) θ, y = x/V, the commands on their way), its input the motor's g·u; the command is
+    u_k = −Σ_j (theta_j·θ_(k−j) + y_j·V·y_(k−j)) + Σ_j w_j·ω_(k−j) over the response's J cycles (`ImpulseResponse`; the
+    one-step gains alone when the gains have none), the past samples kept as extra states. With one cycle it is the
+    `sampled` model's Φ_cl at NV = k_y·V/k_θ (the tests check it).
+
+    Parameters
+    ----------
+    gains : controllers.LateralGains
+    scenario : TrackingScenario
+        The plant (τ, g, D), T and the compute delay.
+    """
+    r = scenario.robot
+    loop = Loop(r.tau, scenario.T, 1.0, plant_gain=r.plant_gain, dead_time=r.dead_time)
+    M, feed, _, _ = command_form(loop, "command", scenario.compute_delay)
+    mem = gains.memory
+    y, th, w = (mem.y, mem.theta, mem.w) if mem is not None else ((gains.k_y,), (gains.k_theta,), (gains.k_w,))
+    lag = loop.tau > 0
+    if not lag and any(v != 0.0 for v in w):
+        raise ValueError("a controller that reads the measured yaw rate needs a plant with a lag (tau > 0) in the memory loop")
+    channels = [(1 + lag - 1, [-v for v in th]), (1 + lag, [-gains.V * v for v in y])] + ([(0, list(w))] if lag and any(w) else [])
+    J, n = len(y), M.shape[0]
+    size = n + len(channels) * (J - 1)
+    A = np.zeros((size, size))
+    A[:n, :n] = M
+    c = np.zeros(size)
+    for ch, (index, taps) in enumerate(channels):
+        c[index] += taps[0]
+        base = n + ch * (J - 1)
+        for j in range(1, J):
+            c[base + j - 1] = taps[j]
+            A[base + j - 1, index if j == 1 else base + j - 2] = 1.0  # the sample j periods back
+    A[:n] += r.plant_gain * np.outer(feed, c)
+    return A
+
+
+def _verdict(model, gains, scenario: TrackingScenario, prediction: str, shift: float) -> bool:
+    k_theta, k_y = gains.k_theta + shift * gains.k_theta_se, gains.k_y + shift * gains.k_y_se
+    if prediction == "memory":
+        return bool(np.max(np.abs(np.linalg.eigvals(memory_loop_matrix(gains, scenario)))) < 1.0)
+    if k_theta <= 0.0 or k_y <= 0.0:
+        return False
+    r = scenario.robot
+    loop = Loop(r.tau, scenario.T, k_theta, plant_gain=r.plant_gain, dead_time=r.dead_time)
+    return bool(model.is_stable(k_y * gains.V / k_theta, loop))
+
+
+def predicted_boundary(template: TrackingScenario, parameter: str, lo: float, hi: float, *, prediction: str = "sampled",
+                       draws: int | None = None, seed: int = 0, rtol: float = 1e-6, shift: float = 0.0,
+                       memory_cycles: int | None = None):
+    """Bisect the predicted verdict with the linearised controller at each value (module docstring).
 
     Parameters
     ----------
@@ -158,33 +216,36 @@ def predicted_boundary(template: TrackingScenario, parameter: str, lo: float, hi
         One of `BOUNDARY_PARAMETERS`.
     lo, hi : float
         The bracket; the predicted verdict must differ at its ends.
-    draws : int
-        Draws of the linearisation at each value (`controllers.linearize`).
+    prediction : str
+        One of `PREDICTIONS`.
+    draws : int, optional
+        Draws of the linearisation at each value (`controllers.linearize`; default the controller's).
     seed : int
         Its first seed.
     rtol : float
         Stop when hi − lo <= rtol·hi.
     shift : float
-        The gains are taken at their mean + `shift` standard errors (k_y and k_θ together): the prediction's spread.
+        With ``sampled``, the gains are taken at their mean + `shift` standard errors (k_y and k_θ together): the
+        prediction's spread.
+    memory_cycles : int, optional
+        Cycles of the impulse response for ``memory`` (default 16; ``sampled`` measures one).
 
     Returns
     -------
     float
         The boundary (the middle of the final bracket).
     """
+    check_choice("prediction", prediction, PREDICTIONS)
     model = make_model("sampled", hold="command", compute_delay=template.compute_delay)
+    cycles = (16 if memory_cycles is None else memory_cycles) if prediction == "memory" else 1
+    fixed = _gains(template, draws, seed, cycles) if parameter in _PLANT_ONLY else None
 
     def stable(values):
         out = []
         for v in values:
             s = scenario_at(template, parameter, v)
-            g = _gains(s, draws, seed)
-            k_theta, k_y = g.k_theta + shift * g.k_theta_se, g.k_y + shift * g.k_y_se
-            if k_theta <= 0.0 or k_y <= 0.0:
-                out.append(False)
-                continue
-            loop = Loop(s.robot.tau, s.T, k_theta, plant_gain=s.robot.plant_gain, dead_time=s.robot.dead_time)
-            out.append(bool(model.is_stable(k_y * g.V / k_theta, loop)))
+            g = fixed if fixed is not None else _gains(s, draws, seed, cycles)
+            out.append(_verdict(model, g, s, prediction, shift))
         return out
 
     b = bisect_batched(stable, lo, hi, members=5, rtol=rtol, max_rounds=60)
@@ -192,7 +253,7 @@ def predicted_boundary(template: TrackingScenario, parameter: str, lo: float, hi
 
 
 def boundary_check(template: TrackingScenario, parameter: str, lo: float, hi: float, *, members: int = 5,
-                   rtol: float = 2e-3, draws: int = 1, seed: int = 0) -> ControllerBoundary:
+                   rtol: float = 2e-3, prediction: str = "sampled", draws: int | None = None, seed: int = 0) -> ControllerBoundary:
     """The simulated and the predicted boundary of a controller in one parameter, side by side (module docstring).
 
     Parameters
@@ -206,14 +267,16 @@ def boundary_check(template: TrackingScenario, parameter: str, lo: float, hi: fl
         Simulations per round.
     rtol : float
         The simulated bracket's relative width at the end.
-    draws : int
-        Draws of the linearisation.
+    prediction : str
+        One of `PREDICTIONS`.
+    draws : int, optional
+        Draws of the linearisation (default the controller's).
     seed : int
         Its first seed.
     """
-    check_number(f"{parameter} lo", lo, 0.0)
+    check_number(f"{parameter} lo", lo, 0.0, low_open=False)
     check_number(f"{parameter} hi", hi, lo)
-    predicted = predicted_boundary(template, parameter, lo, hi, draws=draws, seed=seed)
+    predicted = predicted_boundary(template, parameter, lo, hi, prediction=prediction, draws=draws, seed=seed)
     bracket, runs = simulated_boundary(template, parameter, lo, hi, members=members, rtol=rtol)
     simulated = 0.5 * (bracket.lo + bracket.hi)
     return ControllerBoundary(template.controller, parameter, predicted, simulated, bracket.lo, bracket.hi,
