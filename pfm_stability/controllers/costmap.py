@@ -16,8 +16,9 @@ The distance is the Euclidean distance transform in cells between cell centres, 
 read from a table at 1/100 of a cell (``COST_LUT_PRECISION``, rounded: ``distance·100 + 0.5`` truncated).
 
 **The corridor** (`CorridorCostmap`): walls of lethal cells along x at y = ±half_width (none: a straight plan in
-free space), on a world-fixed lattice of square cells whose centres lie on multiples of the resolution, so the
-centre line y = 0 is a row of cell centres and the grid is symmetric about it. A robot's local costmap is the
+free space), on a world-fixed lattice of square cells whose centres lie on multiples of the resolution shifted by
+``lattice`` (default none: the centre line y = 0 is a row of cell centres and the grid is symmetric about it; a
+plan is rarely aligned with the costmap's cells, and a linearisation of a quantized controller draws the shift). A robot's local costmap is the
 rolling window of ``width`` × ``height`` around it (Nav2's ``rolling_window``: the origin moves in whole cells,
 ``Costmap2D::updateOrigin``); a point outside it has no information (255), a pose of the plan outside it ends
 the plan a controller sees (`controllers.plan.local_plan`). ``exact=True`` replaces each cell's cost by the
@@ -32,7 +33,7 @@ resolution 0.05 m, 3 m × 3 m, ``robot_radius`` 0.22 m, ``inflation_radius`` 0.7
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -168,6 +169,8 @@ class CorridorCostmap:
         The rolling window's size, m.
     exact : bool
         The cost at a point's own distance to the wall, in floating point, instead of its cell's (module docstring).
+    lattice : (float, float)
+        Where the cell centres are: (i·resolution + lattice[0], j·resolution + lattice[1]), m.
     """
 
     half_width: float | None = None
@@ -176,28 +179,54 @@ class CorridorCostmap:
     width: float = 3.0
     height: float = 3.0
     exact: bool = False
+    lattice: tuple = (0.0, 0.0)
 
     def __post_init__(self):
         object.__setattr__(self, "resolution", check_number("resolution", self.resolution, 0.0, 10.0, unit="m"))
         for name in ("width", "height"):
             object.__setattr__(self, name, check_number(name, getattr(self, name), self.resolution, 1e4, low_open=False, unit="m"))
+        object.__setattr__(self, "lattice", tuple(check_number("lattice", float(v), -self.resolution, self.resolution, unit="m") for v in self.lattice))
+        if len(self.lattice) != 2:
+            raise ValueError(f"lattice must be two offsets (x, y), m; got {self.lattice}")
         if self.half_width is not None:
             object.__setattr__(self, "half_width", check_number("half_width", self.half_width, self.resolution, 1e4, unit="m"))
-            n = self.wall_rows
-            table = self.inflation.cell_cost(n - np.abs(np.arange(-n, n + 1)), self.resolution).astype(np.float32)
-            object.__setattr__(self, "_rows", np.concatenate([table, [np.float32(LETHAL_OBSTACLE)]]))  # rows −n … n, then beyond
+            low, high = self.wall_rows
+            j = np.arange(low, high + 1)
+            table = self.inflation.cell_cost(np.minimum(high - j, j - low), self.resolution).astype(np.float32)
+            object.__setattr__(self, "_rows", np.concatenate([table, [np.float32(LETHAL_OBSTACLE)]]))  # rows low … high, then beyond
 
     @property
-    def wall_rows(self) -> int | None:
-        """The walls' rows of cells, ±n from the centre row (None: no walls)."""
-        return None if self.half_width is None else int(round(self.half_width / self.resolution))
+    def wall_rows(self) -> tuple | None:
+        """The walls' rows of cells (low, high): the rows whose centres are nearest y = ∓half_width (None: no walls)."""
+        if self.half_width is None:
+            return None
+        r, oy = self.resolution, self.lattice[1]
+        return int(round((-self.half_width - oy) / r)), int(round((self.half_width - oy) / r))
+
+    @property
+    def walls(self) -> tuple | None:
+        """Where the walls are, (y_low, y_high), m: the rows of cell centres in the grid, as given if exact (None: no walls)."""
+        if self.half_width is None:
+            return None
+        if self.exact:
+            return -self.half_width, self.half_width
+        low, high = self.wall_rows
+        return low * self.resolution + self.lattice[1], high * self.resolution + self.lattice[1]
 
     @property
     def wall_offset(self) -> float | None:
-        """Where the walls are, m from the centre line: the nearest cell centre in the grid, as given if exact."""
-        if self.half_width is None:
-            return None
-        return self.half_width if self.exact else self.wall_rows * self.resolution
+        """The nearer wall's distance from the centre line, m (None: no walls)."""
+        return None if self.half_width is None else min(-self.walls[0], self.walls[1])
+
+    def replace(self, **changes) -> "CorridorCostmap":
+        """A copy with some fields changed (validated again).
+
+        Parameters
+        ----------
+        **changes
+            Field values.
+        """
+        return replace(self, **changes)
 
     def window(self, x: float, y: float) -> Window:
         """The rolling window centred on a robot at (x, y): origin on the lattice, in whole cells (``updateOrigin``).
@@ -209,30 +238,30 @@ class CorridorCostmap:
         """
         r = self.resolution
         nx, ny = int(round(self.width / r)), int(round(self.height / r))
-        lattice = -0.5 * r  # cell centres on multiples of r
-        ox = lattice + math.trunc((x - 0.5 * nx * r - lattice) / r) * r
-        oy = lattice + math.trunc((y - 0.5 * ny * r - lattice) / r) * r
+        lx, ly = self.lattice[0] - 0.5 * r, self.lattice[1] - 0.5 * r  # cell corners
+        ox = lx + math.trunc((x - 0.5 * nx * r - lx) / r) * r
+        oy = ly + math.trunc((y - 0.5 * ny * r - ly) / r) * r
         return Window(ox, oy, nx, ny, r)
 
     def rows(self, y):
-        """The lattice row of each point (row j holds the centres at y = j·resolution).
+        """The lattice row of each point (row j holds the centres at y = j·resolution + lattice[1]).
 
         Parameters
         ----------
         y : float or ndarray
             m.
         """
-        return np.floor(np.asarray(y, dtype=float) / self.resolution + 0.5).astype(np.int64)
+        return np.floor((np.asarray(y, dtype=float) - self.lattice[1]) / self.resolution + 0.5).astype(np.int64)
 
     def columns(self, x):
-        """The lattice column of each point (column i holds the centres at x = i·resolution).
+        """The lattice column of each point (column i holds the centres at x = i·resolution + lattice[0]).
 
         Parameters
         ----------
         x : float or ndarray
             m.
         """
-        return np.floor(np.asarray(x, dtype=float) / self.resolution + 0.5).astype(np.int64)
+        return np.floor((np.asarray(x, dtype=float) - self.lattice[0]) / self.resolution + 0.5).astype(np.int64)
 
     def row_cost(self, rows):
         """The grid's cost of whole rows (uint8): the inflation of the nearer wall's row; lethal on and beyond it.
@@ -245,7 +274,8 @@ class CorridorCostmap:
         rows = np.asarray(rows)
         if self.half_width is None:
             return np.zeros(rows.shape, dtype=np.uint8)
-        return self.inflation.cell_cost(np.maximum(self.wall_rows - np.abs(rows), 0), self.resolution)
+        low, high = self.wall_rows
+        return self.inflation.cell_cost(np.maximum(np.minimum(high - rows, rows - low), 0), self.resolution)
 
     def cost(self, x, y, window: Window | None = None):
         """The costmap's cost at points (float32: 0 free … 254 lethal, 255 off the window).
@@ -263,9 +293,9 @@ class CorridorCostmap:
         elif self.exact:
             cost = np.asarray(self.inflation.cost(self.half_width - np.abs(y.astype(float))), dtype=np.float32)
         else:
-            n = self.wall_rows
-            index = self.rows(y) + n
-            cost = self._rows[np.where((index < 0) | (index > 2 * n), 2 * n + 1, index)]
+            low, high = self.wall_rows
+            index = self.rows(y) - low
+            cost = self._rows[np.where((index < 0) | (index > high - low), high - low + 1, index)]
         if window is not None:
             cost = np.where(window.contains(x, y), cost, np.float32(NO_INFORMATION))
         return np.asarray(cost, dtype=np.float32)

@@ -16,9 +16,10 @@ Controllers with memory (MPPI's control sequence, DWB's oscillation flags) are f
 cycles on the centre line, the robot advancing at the speed it commands and measuring that speed, so that the memory
 is the one the controller carries while tracking; every perturbation then starts from that same memory, and V is
 the warm-up's last command (its mean over the draws). A sampling controller (MPPI) or one whose decision is
-quantized (DWB: a lattice of velocity samples and of costmap cells) is linearised over `seeds` independent
+quantized (DWB: a lattice of velocity samples and of costmap cells) is linearised over `draws` independent
 draws — MPPI's noise, and for every controller with ``RANDOM_PHASE`` the robot's place relative to the plan's
-poses and the costmap's cells — with common random numbers between the + and − perturbations; the result is
+poses and the costmap's cells (``CorridorCostmap.lattice``, uniform over a cell) — with common random numbers
+between the + and − perturbations; the result is
 the mean and its standard error over the draws (`LateralGains.k_y_se`, …). A deterministic, smooth controller
 (RPP, Graceful) needs one draw at phase 0 (the robot on a pose of the plan) and has no sampling error.
 """
@@ -269,7 +270,10 @@ def _response(module, params, plan, costmap, T, memory, x, v, rng, channel: int,
 def _draw(module, name, params, plan, costmap, T, spacing, steps, cycles, seed, speed):
     """One draw: (V, w0, responses (3, cycles)): −∂ω/∂e_y, −∂ω/∂e_θ and ∂ω/∂ω_m at every cycle after the perturbation."""
     rng = np.random.default_rng(seed)  # the controller's: the same noise as a simulated run with this seed
-    phase = float(np.random.default_rng([seed, 1]).uniform(-0.5, 0.5)) if getattr(module, "RANDOM_PHASE", False) else 0.0
+    phase = 0.0
+    if getattr(module, "RANDOM_PHASE", False):
+        phase, ox, oy = np.random.default_rng([seed, 1]).uniform(-0.5, 0.5, 3)
+        costmap = costmap.replace(lattice=(ox * costmap.resolution, oy * costmap.resolution))
     memory, pruned, x, v = warm_up(name, params, plan, costmap, x=phase * spacing, T=T, rng=rng)
     v = v if speed is None else speed
     w0 = _response(module, params, pruned, costmap, T, memory, x, v, rng, 0, 0.0, 1)[0]

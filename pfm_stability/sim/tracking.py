@@ -108,9 +108,8 @@ class TrackingScenario:
         object.__setattr__(self, "spacing", check_number("spacing", self.spacing, 0.0, 10.0, unit="m"))
         object.__setattr__(self, "duration", check_number("duration", self.duration, 0.0, 1e5, unit="s"))
         object.__setattr__(self, "heading", check_number("heading", self.heading, -math.pi / 2, math.pi / 2, unit="rad"))
-        wall = self.costmap.wall_offset
-        room = math.inf if wall is None else wall - 0.5 * self.robot.W
-        object.__setattr__(self, "offset", check_number("offset", self.offset, -room, room, unit="m"))
+        walls = self.costmap.walls or (-math.inf, math.inf)
+        object.__setattr__(self, "offset", check_number("offset", self.offset, walls[0] + 0.5 * self.robot.W, walls[1] - 0.5 * self.robot.W, unit="m"))
         if self.params is None:
             object.__setattr__(self, "params", default_params(self.controller))
 
@@ -276,7 +275,8 @@ def simulate_tracking(scenarios, *, record: str = "offset", metrics: bool = True
     V0 = np.array([s.robot.V for s in scenarios])
     measured_v, pending_v, shaped = V0.copy(), V0.copy(), np.zeros(B)
     line = DelayLine(B, plant.history)
-    walls = np.array([math.inf if s.costmap.wall_offset is None else s.costmap.wall_offset for s in scenarios])
+    low = np.array([-math.inf if s.costmap.walls is None else s.costmap.walls[0] for s in scenarios])
+    high = np.array([math.inf if s.costmap.walls is None else s.costmap.walls[1] for s in scenarios])
     half = np.array([0.5 * s.robot.W for s in scenarios])
     alive = np.ones(B, dtype=bool)
     events, done = [None] * B, np.zeros(B, dtype=np.int64)
@@ -286,7 +286,7 @@ def simulate_tracking(scenarios, *, record: str = "offset", metrics: bool = True
         due = alive & (k <= plant.steps)
         done[due] = k
         rec[k] = np.stack([x, y, theta], axis=1)
-        hit = due & (np.abs(x) + half >= walls)
+        hit = due & ((x + half >= high) | (x - half <= low))
         for m in np.flatnonzero(hit):
             events[m] = Event("collision", float(k * plant.T[m]), float(x[m]), float(y[m]))
         alive &= ~hit
@@ -336,6 +336,6 @@ def _result(s: TrackingScenario, rows, steps: int, event, want_metrics: bool) ->
     m = None
     if want_metrics:
         m = oscillation_metrics(t, offset, s.T, order=s.loop_order(), collision_time=event.t if event and event.type == "collision" else None)
-    wall = s.costmap.wall_offset
-    clearance = None if wall is None else float(wall - np.max(np.abs(offset)) - 0.5 * s.robot.W)
+    walls = s.costmap.walls
+    clearance = None if walls is None else float(min(walls[1] - np.max(offset), np.min(offset) - walls[0]) - 0.5 * s.robot.W)
     return RunResult(s, (event,) if event else (), m, float(steps * s.T), int(steps), t, offset, clearance)
