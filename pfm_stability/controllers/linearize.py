@@ -36,7 +36,8 @@ from ..checks import check_integer, check_number
 from .base import RobotState
 from .plan import prune, straight_plan
 
-__all__ = ["LateralGains", "ImpulseResponse", "linearize", "equilibrium_speed", "configure", "warm_up", "PLAN_BEHIND", "PLAN_AHEAD"]
+__all__ = ["LateralGains", "ImpulseResponse", "linearize", "equilibrium_speed", "configure", "warm_up", "centre_plan", "PLAN_BEHIND",
+           "PLAN_AHEAD"]
 
 PLAN_BEHIND = 1.0
 """Plan behind the robot's start, m: within the closest pose's search distance of a 3 m local costmap (1.5 m)."""
@@ -142,6 +143,20 @@ class LateralGains:
         return out
 
 
+def centre_plan(length: float, spacing: float):
+    """A straight plan along y = 0 from `PLAN_BEHIND` behind x = 0 over `length`, with a pose at x = 0.
+
+    Parameters
+    ----------
+    length : float
+        Ahead of x = 0, m.
+    spacing : float
+        Between poses, m.
+    """
+    behind = spacing * math.ceil(PLAN_BEHIND / spacing - 1e-9)
+    return straight_plan(behind + length, spacing, x0=-behind)
+
+
 def _module(name: str):
     from . import controller_module
 
@@ -193,7 +208,7 @@ def equilibrium_speed(name: str, params, costmap, *, x: float = 0.0, spacing: fl
         The controller's random numbers.
     """
     module = _module(name)
-    plan = straight_plan(PLAN_BEHIND + PLAN_AHEAD + abs(x), spacing, x0=-PLAN_BEHIND)
+    plan = centre_plan(PLAN_AHEAD + abs(x), spacing)
     plan = prune(plan, RobotState(x, 0.0, 0.0), costmap.window(x, 0.0))
     rng = np.random.default_rng(seed)
     v, memory = module.nominal_speed(params), None
@@ -320,7 +335,7 @@ def linearize(name: str, params, costmap, *, T: float = 0.05, draws: int | None 
     warm = int(getattr(module, "WARMUP_CYCLES", 0))
     speed = None if warm else equilibrium_speed(name, params, costmap, spacing=spacing, seed=seed)  # memoryless: its fixed point
     reach = 2.0 * module.nominal_speed(params) * (warm + cycles) * T
-    plan = straight_plan(PLAN_BEHIND + PLAN_AHEAD + reach + spacing, spacing, x0=-PLAN_BEHIND)
+    plan = centre_plan(PLAN_AHEAD + reach + spacing, spacing)
     results = [_draw(module, name, params, plan, costmap, T, spacing, steps, cycles, seed + d, speed) for d in range(draws)]
     V = np.array([r[0] for r in results])
     w0 = np.array([r[1] for r in results])

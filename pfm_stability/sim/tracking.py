@@ -39,9 +39,9 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from ..checks import check_integer, check_number
-from ..controllers import CONTROLLER_NAMES, CorridorCostmap, NoValidControl, RobotState, configure, controller_module, default_params, straight_plan
+from ..controllers import CONTROLLER_NAMES, CorridorCostmap, NoValidControl, RobotState, configure, controller_module, default_params
 from ..controllers.plan import prune
-from ..controllers.linearize import PLAN_AHEAD, PLAN_BEHIND, warm_up
+from ..controllers.linearize import PLAN_AHEAD, centre_plan, warm_up
 from ..parameters import TAU_RESOLUTION, Robot
 from .events import Event
 from .metrics import oscillation_metrics
@@ -220,7 +220,7 @@ class _Members:
         for s, p, rng in zip(scenarios, self.params, self.rngs):
             reach = 1.5 * s.robot.V * s.duration + PLAN_AHEAD
             cycles = int(getattr(controller_module(s.controller), "WARMUP_CYCLES", 0)) if s.warmup else 0
-            plan = straight_plan(PLAN_BEHIND + reach + 2.0 * s.robot.V * cycles * s.T, s.spacing, x0=-PLAN_BEHIND)
+            plan = centre_plan(reach + 2.0 * s.robot.V * cycles * s.T, s.spacing)
             memory, plan, x, _ = warm_up(s.controller, p, plan, s.costmap, x=0.0, T=s.T, rng=rng, cycles=cycles)
             self.plans.append(plan)
             self.memory.append(memory)
