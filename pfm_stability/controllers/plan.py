@@ -28,7 +28,7 @@ back within reach of the robot (a straight plan, a corridor) as long as the robo
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -59,6 +59,7 @@ class Plan:
     x: np.ndarray
     y: np.ndarray
     yaw: np.ndarray
+    arc: np.ndarray = field(init=False, repr=False, compare=False)
 
     def __post_init__(self):
         arrays = [np.asarray(getattr(self, n), dtype=float).ravel() for n in ("x", "y", "yaw")]

@@ -12,8 +12,8 @@ The only place where the controllers' linearisation meets the loop models and th
   finds where the verdict changes.
 
 `boundary_check` runs both and returns a `ControllerBoundary`. The linearisation's sampling uncertainty
-(MPPI's noise, DWB's quantization) carries into the prediction: `prediction_spread` bisects the boundary with the
-gains at their mean ± one standard error. What the static gains leave out — the measured yaw rate's share k_ω
+(MPPI's noise, DWB's quantization) carries into the prediction: `prediction_spread` predicts the boundary once per
+draw (each draw its own noise and place on the plan's poses and cells) and gives their mean and standard error. What the static gains leave out — the measured yaw rate's share k_ω
 (DWB) and a controller's memory between cycles (MPPI's control sequence) — the loop models do not represent;
 their effect is what the simulated boundary measures against the prediction.
 """
@@ -32,8 +32,8 @@ from ..numerics.solve import bisect_batched
 from ..sim.tracking import TrackingScenario, simulate_tracking
 from ..sim.verdict import simulated_verdict
 
-__all__ = ["ControllerBoundary", "BOUNDARY_PARAMETERS", "PREDICTIONS", "scenario_at", "simulated_boundary", "predicted_boundary",
-           "memory_loop_matrix", "loop_of", "boundary_check"]
+__all__ = ["ControllerBoundary", "PredictionSpread", "BOUNDARY_PARAMETERS", "PREDICTIONS", "scenario_at", "simulated_boundary",
+           "predicted_boundary", "prediction_spread", "memory_loop_matrix", "loop_of", "boundary_check"]
 
 BOUNDARY_PARAMETERS = ("V", "lookahead_dist", "dead_time")
 """What a boundary is bisected in: the robot's cruising speed V (m/s), RPP's ``lookahead_dist`` (m), or the plant's
@@ -122,7 +122,7 @@ def simulated_boundary(template: TrackingScenario, parameter: str, lo: float, hi
 
     Returns
     -------
-    (numpy.solve.Bracket, int)
+    (numerics.solve.Bracket, int)
         The final bracket and the runs simulated.
     """
     members = check_integer("members", members, 3, 1000)
@@ -137,16 +137,19 @@ def simulated_boundary(template: TrackingScenario, parameter: str, lo: float, hi
     return bracket, sum(runs)
 
 
-def loop_of(gains, scenario: TrackingScenario) -> Loop:
+def loop_of(gains, scenario: TrackingScenario, k_theta: float | None = None) -> Loop:
     """KB's steering loop of a linearised controller on the scenario's robot: k = k_θ, the plant's g and D.
 
     Parameters
     ----------
     gains : controllers.LateralGains
     scenario : TrackingScenario
+    k_theta : float, optional
+        Instead of the gains' k_θ (1/s).
     """
     r = scenario.robot
-    return Loop(r.tau, scenario.T, gains.k_theta, plant_gain=r.plant_gain, dead_time=r.dead_time)
+    k = gains.k_theta if k_theta is None else k_theta
+    return Loop(r.tau, scenario.T, k, plant_gain=r.plant_gain, dead_time=r.dead_time)
 
 
 def _gains(scenario: TrackingScenario, draws, seed: int, memory_cycles=None):
@@ -193,15 +196,14 @@ def memory_loop_matrix(gains, scenario: TrackingScenario) -> np.ndarray:
     return A
 
 
-def _verdict(model, gains, scenario: TrackingScenario, prediction: str, shift: float) -> bool:
-    k_theta, k_y = gains.k_theta + shift * gains.k_theta_se, gains.k_y + shift * gains.k_y_se
+def _verdict(model, gains, scenario: TrackingScenario, prediction: str, shift) -> bool:
+    shift_y, shift_theta = (shift, shift) if np.ndim(shift) == 0 else shift
+    k_theta, k_y = gains.k_theta + shift_theta * gains.k_theta_se, gains.k_y + shift_y * gains.k_y_se
     if prediction == "memory":
         return bool(np.max(np.abs(np.linalg.eigvals(memory_loop_matrix(gains, scenario)))) < 1.0)
     if k_theta <= 0.0 or k_y <= 0.0:
         return False
-    r = scenario.robot
-    loop = Loop(r.tau, scenario.T, k_theta, plant_gain=r.plant_gain, dead_time=r.dead_time)
-    return bool(model.is_stable(k_y * gains.V / k_theta, loop))
+    return bool(model.is_stable(k_y * gains.V / k_theta, loop_of(gains, scenario, k_theta)))
 
 
 def predicted_boundary(template: TrackingScenario, parameter: str, lo: float, hi: float, *, prediction: str = "sampled",
@@ -224,9 +226,9 @@ def predicted_boundary(template: TrackingScenario, parameter: str, lo: float, hi
         Its first seed.
     rtol : float
         Stop when hi − lo <= rtol·hi.
-    shift : float
-        With ``sampled``, the gains are taken at their mean + `shift` standard errors (k_y and k_θ together): the
-        prediction's spread.
+    shift : float or (float, float)
+        With ``sampled``, the gains are taken at their mean + `shift` standard errors (k_y and k_θ together, or
+        (for k_y, for k_θ)): the prediction's sensitivity to the linearisation's sampling error.
     memory_cycles : int, optional
         Cycles of the impulse response for ``memory`` (default 16; ``sampled`` measures one).
 
@@ -252,8 +254,59 @@ def predicted_boundary(template: TrackingScenario, parameter: str, lo: float, hi
     return 0.5 * (b.lo + b.hi)
 
 
+@dataclass(frozen=True)
+class PredictionSpread:
+    """The predicted boundary draw by draw, and its mean and standard error (module docstring).
+
+    Attributes
+    ----------
+    values : tuple of float
+        One prediction per draw (seeds ``seed`` …).
+    mean : float
+    se : float
+        Standard error of the mean.
+    """
+
+    values: tuple
+    mean: float
+    se: float
+
+    def to_dict(self) -> dict:
+        """The fields as a JSON-ready dict."""
+        return {"values": list(self.values), "mean": self.mean, "se": self.se}
+
+
+def prediction_spread(template: TrackingScenario, parameter: str, lo: float, hi: float, *, prediction: str = "sampled",
+                      draws: int = 8, seed: int = 0, rtol: float = 1e-4, memory_cycles: int | None = None) -> PredictionSpread:
+    """`predicted_boundary` with one draw of the linearisation at a time, seeds ``seed`` … ``seed + draws − 1``.
+
+    Parameters
+    ----------
+    template : TrackingScenario
+    parameter : str
+        One of `BOUNDARY_PARAMETERS`.
+    lo, hi : float
+        The bracket.
+    prediction : str
+        One of `PREDICTIONS`.
+    draws : int
+        Draws (>= 2).
+    seed : int
+        The first seed.
+    rtol : float
+        Each bisection's relative width.
+    memory_cycles : int, optional
+        For ``memory``.
+    """
+    draws = check_integer("draws", draws, 2, 10_000)
+    values = [predicted_boundary(template, parameter, lo, hi, prediction=prediction, draws=1, seed=seed + d, rtol=rtol,
+                                 memory_cycles=memory_cycles) for d in range(draws)]
+    return PredictionSpread(tuple(values), float(np.mean(values)), float(np.std(values, ddof=1) / np.sqrt(draws)))
+
+
 def boundary_check(template: TrackingScenario, parameter: str, lo: float, hi: float, *, members: int = 5,
-                   rtol: float = 2e-3, prediction: str = "sampled", draws: int | None = None, seed: int = 0) -> ControllerBoundary:
+                   rtol: float = 2e-3, prediction: str = "sampled", draws: int | None = None, seed: int = 0,
+                   around: float | None = None) -> ControllerBoundary:
     """The simulated and the predicted boundary of a controller in one parameter, side by side (module docstring).
 
     Parameters
@@ -273,10 +326,16 @@ def boundary_check(template: TrackingScenario, parameter: str, lo: float, hi: fl
         Draws of the linearisation (default the controller's).
     seed : int
         Its first seed.
+    around : float, optional
+        Simulate in [p/around, p·around] ∩ [lo, hi] around the prediction p (far from a boundary the real algorithm
+        leaves the linear regime: saturates, rotates in place); default [lo, hi].
     """
     check_number(f"{parameter} lo", lo, 0.0, low_open=False)
     check_number(f"{parameter} hi", hi, lo)
     predicted = predicted_boundary(template, parameter, lo, hi, prediction=prediction, draws=draws, seed=seed)
+    if around is not None:
+        w = check_number("around", around, 1.0, 100.0)
+        lo, hi = max(lo, predicted / w), min(hi, predicted * w)
     bracket, runs = simulated_boundary(template, parameter, lo, hi, members=members, rtol=rtol)
     simulated = 0.5 * (bracket.lo + bracket.hi)
     return ControllerBoundary(template.controller, parameter, predicted, simulated, bracket.lo, bracket.hi,
