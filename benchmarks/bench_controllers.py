@@ -1,4 +1,4 @@
-"""Speed of the numeric linearisation of Nav2's controllers, MPPI's against the issue's target (<= 5 s on 2 cores).
+"""Speed of the numeric linearisation of Nav2's controllers, MPPI's against its target (<= 5 s on 2 cores).
 
 Each measurement runs as a fresh Python process (imports included), ``--repeat`` times, and the median wall and CPU
 (user + system of the child) times are printed, with the ratio to ``pfm-stability report --preset carmel --alpha 20

@@ -2,7 +2,7 @@
 them, and their numeric linearisation against closed forms derived independently.
 
 * RPP on a straight plan: the carrot at arc L is at y = −(e_y + L·e_θ) to first order, x² + y² = L², so
-  ω = v·2y/L² gives k_θ = 2V/L, k_y = 2V/L² (DESIGN's pure pursuit loop); `controllers.linearize` must reproduce it.
+  ω = v·2y/L² gives k_θ = 2V/L, k_y = 2V/L² (pure pursuit's lateral loop); `controllers.linearize` must reproduce it.
 * Graceful: the closed form is derived here with sympy from the control law written out in this file (Park &
   Kuipers' curvature as ``smooth_control_law.cpp`` and ``ego_polar_coords.hpp`` state it), independently of the
   module's own ``closed_form_gains``.

@@ -4,7 +4,7 @@
   rate and frequency the linear-prediction fit measures must equal the sampled model's dominant pole with the closed
   form's gains (random robots with lag, plant gain, dead time and compute delay).
 * The simulated boundary of the real algorithm in V (and RPP's lookahead) lands within 2 % of the sampled model's
-  prediction with the linearised gains, on random robots (the issue's target for RPP and Graceful).
+  prediction with the linearised gains, on random robots (the target for RPP and Graceful).
 * The memory loop (`validation.controllers.memory_loop_matrix`) with one cycle of response is the sampled model.
 """
 
@@ -47,7 +47,7 @@ def test_the_simulated_rpp_loop_has_the_sampled_models_pole(seed):
 @pytest.mark.parametrize("controller, seed", [("rpp", 0), ("graceful", 1)])
 def test_the_simulated_speed_boundary_is_the_sampled_prediction(controller, seed):
     """V* of the real algorithm (bisected to 0.5 %) against the sampled model with the linearised gains: within 2 % (the
-    issue's target; the plan's poses every 1 cm make the lookahead ripple by ±0.5 cm, the fit and the bisection's
+    target; the plan's poses every 1 cm make the lookahead ripple by ±0.5 cm, the fit and the bisection's
     bracket the rest; measured 0.02–0.3 %)."""
     r = np.random.default_rng(seed)
     robot = _robot(r, 1.0).replace(dead_time=r.uniform(0.08, 0.2))
