@@ -11,7 +11,8 @@ from scipy.signal import savgol_coeffs
 
 from pfm_stability.controllers import CorridorCostmap, NoValidControl, RobotState, linearize, straight_plan
 from pfm_stability.controllers import dwb, mppi
-from pfm_stability.controllers.mppi import F, _closest_path_points, _reset, _rollout_velocities
+from pfm_stability.controllers.mppi import _reset, _rollout_velocities
+from pfm_stability.controllers.mppi_critics import F, closest_path_points
 
 PLAN = straight_plan(12.0, 0.05, x0=-1.0)
 SMALL = mppi.MPPIParams(batch_size=64)
@@ -65,7 +66,7 @@ def test_path_align_matches_plan_points_as_nav2s_loop_does():
     r = np.random.default_rng(2)
     dists = np.concatenate([[0.0], np.cumsum(r.uniform(0.01, 0.1, 30))]).astype(F)
     traj = np.cumsum(r.uniform(0.0, 0.2, (13, 50)), axis=0).astype(F)
-    matched = _closest_path_points(dists, traj)
+    matched = closest_path_points(dists, traj)
     for t in range(50):
         init = 0
         for p in range(13):

@@ -241,6 +241,19 @@ class _Members:
         self.memory[m] = cmd.memory
         return cmd.v, cmd.w
 
+    def decide_all(self, k, T, running, alive, events, x, y, theta, v, omega):
+        """Every running member's command at sample k (sim frame); a member without one gets its event and stops
+        (`running`, `alive` and `events` updated in place). Returns (v, ω) arrays, 0 for the others."""
+        v_cmd, w_cmd = np.zeros(x.size), np.zeros(x.size)
+        for m in np.flatnonzero(running):
+            cmd = self.decide(m, y[m], x[m], theta[m], v[m], omega[m])
+            if cmd is None:
+                events[m] = Event("no_valid_control", float(k * T[m]), float(x[m]), float(y[m]))
+                alive[m] = running[m] = False
+                continue
+            v_cmd[m], w_cmd[m] = cmd
+        return v_cmd, w_cmd
+
 
 def simulate_tracking(scenarios, *, record: str = "offset", metrics: bool = True, progress=None) -> BatchResult:
     """Run Nav2 controllers on the simulator's robot, every scenario together (module docstring).
@@ -293,14 +306,7 @@ def simulate_tracking(scenarios, *, record: str = "offset", metrics: bool = True
         running = alive & (k < plant.steps)
         if not running.any():
             break
-        v_cmd, w_cmd = np.zeros(B), np.zeros(B)
-        for m in np.flatnonzero(running):
-            cmd = members.decide(m, y[m], x[m], theta[m], measured_v[m], omega[m])
-            if cmd is None:
-                events[m] = Event("no_valid_control", float(k * plant.T[m]), float(x[m]), float(y[m]))
-                alive[m] = running[m] = False
-                continue
-            v_cmd[m], w_cmd[m] = cmd
+        v_cmd, w_cmd = members.decide_all(k, plant.T, running, alive, events, x, y, theta, measured_v, omega)
         shaped = np.where(running, command_path(w_cmd, shaped, plant.max_rate), shaped)
         if k == 0:
             pending_v = np.where(running, v_cmd, pending_v)
