@@ -260,7 +260,21 @@ def _wrap(a):
 class CriticData:
     """``CriticData`` for one cycle: the plan, the costmap, the costs, and what the critics share (the furthest plan
     point reached, the plan's valid points). As in Nav2, `prepare` resets these once per cycle, not per iteration:
-    with ``iteration_count`` > 1 the costs accumulate and the furthest point of the first iteration is kept."""
+    with ``iteration_count`` > 1 the costs accumulate and the furthest point of the first iteration is kept.
+
+    Parameters
+    ----------
+    params : MPPIParams
+        The controller's parameters (its critics' among them).
+    state : RobotState
+        The robot's pose and measured velocity.
+    plan : LocalPlan
+        The plan the controller server handed over (global frame).
+    costmap : CorridorCostmap
+        The local costmap.
+    window : Window
+        Its bounds around the robot.
+    """
 
     def __init__(self, params, state, plan, costmap, window):
         self.params, self.state, self.costmap, self.window = params, state, costmap, window
@@ -271,7 +285,15 @@ class CriticData:
         self._furthest = self._valid = None
 
     def rollout(self, vx, wz, x, y, yaws):
-        """This iteration's trajectories: velocities and poses, (time_steps, batch) each."""
+        """This iteration's trajectories.
+
+        Parameters
+        ----------
+        vx, wz : ndarray of float32
+            Velocities, m/s and rad/s, (time_steps, batch).
+        x, y, yaws : ndarray of float32
+            Poses, m and rad, (time_steps, batch).
+        """
         self.vx, self.wz, self.x, self.y, self.yaws = vx, wz, x, y, yaws
 
     def furthest(self) -> int:
@@ -294,6 +316,15 @@ class CriticData:
         return self._valid
 
     def add(self, cost, power: int):
+        """Add a critic's costs to the batch's, raised to its ``cost_power``.
+
+        Parameters
+        ----------
+        cost : ndarray of float32
+            One per trajectory.
+        power : int
+            The critic's ``cost_power``.
+        """
         self.costs += (cost ** power if power > 1 else cost).astype(F)
 
 
@@ -353,8 +384,20 @@ def _goal_angle(d: CriticData, c: GoalAngleCritic):
 
 
 def closest_path_points(dists, traj_dist):
-    """``utils::findClosestPathPt`` along each trajectory's points (rows of `traj_dist`), each search starting at the
-    previous match."""
+    """``utils::findClosestPathPt`` along each trajectory's points, each search starting at the previous match.
+
+    Parameters
+    ----------
+    dists : ndarray of float32
+        The plan's integrated distances (increasing from 0), m.
+    traj_dist : ndarray of float32
+        The trajectories' integrated distances at their points, (points, batch), m.
+
+    Returns
+    -------
+    ndarray of int
+        The matched plan point of every trajectory point, (points, batch).
+    """
     size = dists.size
     matched = np.zeros(traj_dist.shape, dtype=np.int64)
     init = np.zeros(traj_dist.shape[1], dtype=np.int64)
@@ -426,7 +469,13 @@ _SCORE = {"ConstraintCritic": _constraint, "CostCritic": _cost, "ObstaclesCritic
 
 
 def score(d: CriticData):
-    """``CriticManager::evalTrajectoriesScores``: each enabled critic in order, stopping once one has failed."""
+    """``CriticManager::evalTrajectoriesScores``: each enabled critic in order, stopping once one has failed.
+
+    Parameters
+    ----------
+    d : CriticData
+        The cycle's data with this iteration's rollout; its costs and failure flag are updated.
+    """
     for name in d.params.critics:
         if d.fail:
             break
