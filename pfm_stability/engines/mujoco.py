@@ -45,6 +45,7 @@ from ..sim.grid import HistogramGrid
 from ..sim.metrics import oscillation_metrics
 from ..sim.results import BatchResult, RunResult, Trajectory
 from ..sim.vff import cell_repulsion, direction_of, steering_command, wrap_angle
+from ..controllers import CONTROLLER_NAMES
 from .robots import WALL_GROUP, check_drives, corridor_world, heading, load_robot_model, place
 
 __all__ = ["EngineOptions", "run_scenario", "run_scenarios", "MujocoRuns", "DriveLog", "drive_log", "write_csv_log",
@@ -79,6 +80,11 @@ class EngineOptions:
         Replaces the casters' sliding friction (0: no caster drag); None keeps the file's.
     torque_limit : float, optional
         Replaces the wheel motors' torque limit, N m (inf: no rate limit); None keeps the file's.
+    controller : str
+        What computes the command: ``vff`` (the project's VFF controller) or a Nav2 controller of
+        `pfm_stability.controllers` (``rpp``, ``graceful``, ``mppi``, ``dwb``; `_Nav2Driver`).
+    controller_params : dataclass, optional
+        The Nav2 controller's parameters (default Nav2's); its speed and period are set from the scenario's V and T.
     """
 
     robot_model: str = "diffdrive"
@@ -88,6 +94,8 @@ class EngineOptions:
     sensing: str = "rays"
     caster_friction: float | None = None
     torque_limit: float | None = None
+    controller: str = "vff"
+    controller_params: object = None
 
     def __post_init__(self):
         object.__setattr__(self, "command_delay", check_number("command_delay", self.command_delay, 0.0, 1.0, low_open=False, unit="s"))
@@ -98,6 +106,7 @@ class EngineOptions:
             object.__setattr__(self, "caster_friction", check_number("caster_friction", self.caster_friction, 0.0, 10.0, low_open=False))
         if self.torque_limit is not None:
             object.__setattr__(self, "torque_limit", (math.inf if self.torque_limit == math.inf else check_number("torque_limit", self.torque_limit, 0.0, 1e6, unit="N m")))
+        check_choice("controller", self.controller, ("vff",) + CONTROLLER_NAMES)
 
 
 _UPRIGHT = math.cos(math.radians(45.0))
@@ -142,6 +151,60 @@ def _window_force(grid: HistogramGrid, x: float, y: float, h: int, scale: float,
     cx, cy = grid.cell_center(ii + i0, jj + j0)
     fx, fy = cell_repulsion(np.array([[x]]), np.array([[y]]), cx[None, :], cy[None, :], block[ii, jj][None, :].astype(float), n)
     return scale * float(fx[0]), scale * float(fy[0])
+
+
+class _Nav2Driver:
+    """A Nav2 controller in the engine's loop: the corridor's plan and costmap, its memory, and the MuJoCo robot's state.
+
+    The controller sees the scenario's frame mirrored as `pfm_stability.sim.tracking` shows it (X along the corridor,
+    Y lateral, yaw = θ), a straight plan along the corridor's centre line with a pose every costmap cell, and the
+    corridor's costmap with its walls where the scenario draws them (Nav2's local costmap built from the walls, not
+    from the robot's scans); it measures the base's forward speed and yaw rate (wheel odometry without noise).
+    Controllers with memory are warmed up on the centre line first (`controllers.linearize.warm_up`).
+    """
+
+    def __init__(self, options: EngineOptions, scenario, L: float):
+        from ..controllers import CorridorCostmap, configure, controller_module, default_params, straight_plan
+        from ..controllers.linearize import warm_up
+
+        r, c = scenario.robot, scenario.controller
+        self.name = options.controller
+        self.module = controller_module(self.name)
+        params = options.controller_params if options.controller_params is not None else default_params(self.name)
+        self.params = configure(self.name, params, V=r.V, T=c.T)
+        self.costmap = CorridorCostmap(half_width=L, resolution=0.05)
+        self.centre = float(scenario.measure.origin[0])
+        plan = straight_plan(3.0 + 1.5 * r.V * scenario.duration + 12.0, self.costmap.resolution, x0=scenario.start.y - 1.0)
+        self.rng = np.random.default_rng(scenario.seed or 0)
+        self.memory, self.plan, _, _ = warm_up(self.name, self.params, plan, self.costmap, x=scenario.start.y, T=c.T, rng=self.rng)
+        self.max_rate = r.max_steering_rate
+
+    def decide(self, data, dof: int, x: float, y: float, theta: float):
+        """(forward speed m/s, steering rate θ̇ rad/s) commanded at the robot's pose (`sim.tracking.command_path`'s saturation).
+
+        Parameters
+        ----------
+        data : mujoco.MjData
+            The engine's state.
+        dof : int
+            The base's free joint's first velocity address.
+        x, y : float
+            The base's position, m.
+        theta : float
+            Its heading, rad (from +Y towards +X).
+        """
+        from ..controllers import NoValidControl, RobotState
+        from ..controllers.plan import prune
+
+        vx, vy = float(data.qvel[dof]), float(data.qvel[dof + 1])  # world frame; the angular part is the body's: z is up
+        state = RobotState(y, x - self.centre, theta, vx * math.sin(theta) + vy * math.cos(theta), -float(data.qvel[dof + 5]))
+        self.plan = prune(self.plan, state, self.costmap.window(state.x, state.y))
+        try:
+            cmd = self.module.command(state, self.plan, self.costmap, self.params, rng=self.rng, memory=self.memory)
+        except (NoValidControl, ValueError):
+            return 0.0, 0.0
+        self.memory = cmd.memory
+        return cmd.v, min(max(cmd.w, -self.max_rate), self.max_rate)
 
 
 def run_scenario(scenario, options: EngineOptions = EngineOptions(), *, record: str = "offset", metrics: bool = True) -> RunResult:
@@ -212,6 +275,8 @@ def _run(scenario, options: EngineOptions, record: str, metrics: bool, recorder)
     dist = np.zeros(options.rays)
 
     place(model, data, robot, scenario.start.x, scenario.start.y, scenario.start.theta, r.V)
+    driver = _Nav2Driver(options, scenario, L) if options.controller != "vff" else None
+    speed = r.V
     if recorder is not None:
         recorder.start(model, data, dt, base, lidar, group)
     steps = int(math.ceil(scenario.duration / c.T - 1e-9))
@@ -238,8 +303,10 @@ def _run(scenario, options: EngineOptions, record: str, metrics: bool, recorder)
             break
         if k == steps:
             break
-        # sense (KB eq 1–4) and compute the command (eq 5)
-        if options.sensing == "rays":
+        # sense (KB eq 1–4) and compute the command (eq 5), or a Nav2 controller's
+        if driver is not None:
+            speed, u = driver.decide(data, int(model.jnt_dofadr[model.body_jntadr[base]]), x, y, theta)
+        elif options.sensing == "rays":
             yaw = math.pi / 2 - theta
             vec = np.column_stack([np.cos(yaw + angles), np.sin(yaw + angles), np.zeros(options.rays)])
             pnt = data.site_xpos[lidar].copy()
@@ -247,17 +314,18 @@ def _run(scenario, options: EngineOptions, record: str, metrics: bool, recorder)
             hit = geomid >= 0
             if np.any(hit):
                 grid.add_readings(pnt[0] + dist[hit] * vec[hit, 0], pnt[1] + dist[hit] * vec[hit, 1])
-        fx, fy = _window_force(grid, x, y, h, scale, c.n)
-        delta = float(direction_of(fx + ax, fy + ay))
-        u = float(steering_command(delta, theta, r.k, r.max_steering_rate))
+        if driver is None:
+            fx, fy = _window_force(grid, x, y, h, scale, c.n)
+            delta = float(direction_of(fx + ax, fy + ay))
+            u = float(steering_command(delta, theta, r.k, r.max_steering_rate))
         if pending is None:  # the robot starts as if it had been running
             pending = u
-            data.ctrl[left], data.ctrl[right] = robot.wheel_speeds(r.V, u)
+            data.ctrl[left], data.ctrl[right] = robot.wheel_speeds(speed, u)
         applied = pending if c.compute_delay == 1 else u
         pending = u
-        queue.append((now + delay_steps, *robot.wheel_speeds(r.V, applied)))
+        queue.append((now + delay_steps, *robot.wheel_speeds(speed, applied)))
         if recorder is not None:
-            recorder.command(now * dt, -applied, r.V)  # published when applied to the command path; ROS yaw rate = −θ̇
+            recorder.command(now * dt, -applied, speed)  # published when applied to the command path; ROS yaw rate = −θ̇
         # advance one period, switching the wheels' targets when a command arrives
         end = now + per_period
         while now < end:

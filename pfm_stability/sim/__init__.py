@@ -51,6 +51,9 @@ Library API
     The limit cycle (or rest) of a robot beside a wall with velocity-gated repulsion.
 ``simulate_planar_batch(members) -> PlanarBatch``
     Many `PlanarMember` runs stepped together in arrays (the two above are batches of one).
+``simulate_tracking(scenarios) -> BatchResult``
+    Nav2's controllers (`pfm_stability.controllers`: RPP, Graceful, MPPI, DWB) driving the same plant along a
+    straight plan or corridor (`TrackingScenario`; docs/controllers.md).
 
 Predictions for a scenario (`predict`) and the simulated stability boundary
 (`boundary_by_bisection`) join simulations with the models: they are in
@@ -68,7 +71,8 @@ of the active windows), `vff` (KB eq 1–5, the measured wall force), `robot`
 walls), `scenario` (and `scenario_law`), `presets`, `engine` (batched
 stepping), `events`, `metrics` (docs/simulator.md, measuring oscillation),
 `verdict`, `results`, `api`, `reference`; the planar simulator: `planar`,
-`planar_batch` (batched stepping), `planar_field`, `planar_robots`, `movers`, `cycles`.
+`planar_batch` (batched stepping), `planar_field`, `planar_robots`, `movers`, `cycles`; Nav2's controllers on the
+plant: `tracking`.
 """
 
 from .api import simulate, simulate_batch
@@ -82,6 +86,7 @@ from .presets import SCENARIO_NAMES, barely_avoiding_ratio, make_scenario
 from .reference import simulate_reference
 from .results import BatchResult, RunResult, Trajectory
 from .scenario import MeasureAxis, Pose, Scenario, Target, scenario_law
+from .tracking import TrackingScenario, simulate_tracking
 from .verdict import linearly_stable, simulated_verdict
 from .vff import measured_wall_force
 
@@ -105,6 +110,7 @@ __all__ = [
     "Steering",
     "Target",
     "Trajectory",
+    "TrackingScenario",
     "WallCycle",
     "barely_avoiding_ratio",
     "linearly_stable",
@@ -118,6 +124,7 @@ __all__ = [
     "simulate_planar",
     "simulate_planar_batch",
     "simulate_reference",
+    "simulate_tracking",
     "simulated_verdict",
     "wall_cycle",
 ]

@@ -61,7 +61,7 @@ from .events import Event
 from .follow import PathFollower
 from .metrics import oscillation_metrics
 from .results import BatchResult, RunResult, Trajectory
-from .robot import advance_position, constant_input, constant_input_modes, delay_split, graded_rule, propagate, servo, servo_modes, slow_rate
+from .robot import DelayLine, advance_held, advance_position, constant_input, constant_input_modes, delay_split, graded_rule, propagate, servo, servo_modes, slow_rate
 from .vff import cell_repulsion, direction_of, steering_command, vff_speed, wrap_angle
 from .window import compile_window_table, stack_tables
 
@@ -100,7 +100,7 @@ class _Batch:
         self.steps = np.ceil(_array(scenarios, lambda s: s.duration) / self.T - 1e-9).astype(np.int64)
         self.split = self.switch > 0
         self.order = _array(scenarios, lambda s: s.loop_order(), np.int64)  # the sampled loop's state
-        self.history = int(np.max(np.minimum(self.lag, self.steps))) + 2  # the delay line's length (`_DelayLine`)
+        self.history = int(np.max(np.minimum(self.lag, self.steps))) + 2  # the delay line's length (`robot.DelayLine`)
         self.shared_lag = int(self.lag[0]) if self.lag.size and np.all(self.lag == self.lag[0]) else None
         self.any_split = bool(self.split.any())
         self.unit_gain = bool(np.all(self.gain == 1.0))
@@ -359,12 +359,6 @@ def _start_state(scenarios):
     return x, y, theta
 
 
-def _advance_command(coef, theta, omega, u, V, x, y):
-    delta, correction, theta_end, omega_end = propagate(coef, theta, omega, u)
-    x, y = advance_position(x, y, V, coef.rule, theta, delta, correction)
-    return x, y, theta_end, omega_end
-
-
 def _advance_commands(b, theta, omega, earlier, later, V, x, y):
     """The held-command members over one period: motor input g·u, the split members in two intervals (ε, T − ε).
 
@@ -372,42 +366,16 @@ def _advance_commands(b, theta, omega, earlier, later, V, x, y):
     """
     w, s = b.whole_idx, b.split_idx
     if s.size == 0 and b.unit_gain:  # KB's motor: the command itself (no product, as before g and D)
-        return _advance_command(b.command_coef, theta, omega, later, V, x, y)
+        return advance_held(b.command_coef, theta, omega, later, V, x, y)
     g = b.gain[b.command_idx]
     if s.size == 0:
-        return _advance_command(b.command_coef, theta, omega, g * later, V, x, y)
+        return advance_held(b.command_coef, theta, omega, g * later, V, x, y)
     x_new, y_new, th_new, om_new = x.copy(), y.copy(), theta.copy(), omega.copy()
     if w.size:
-        x_new[w], y_new[w], th_new[w], om_new[w] = _advance_command(b.command_coef, theta[w], omega[w], g[w] * later[w], V[w], x[w], y[w])
-    xs, ys, ts, os_ = _advance_command(b.before_coef, theta[s], omega[s], g[s] * earlier[s], V[s], x[s], y[s])
-    x_new[s], y_new[s], th_new[s], om_new[s] = _advance_command(b.after_coef, ts, os_, g[s] * later[s], V[s], xs, ys)
+        x_new[w], y_new[w], th_new[w], om_new[w] = advance_held(b.command_coef, theta[w], omega[w], g[w] * later[w], V[w], x[w], y[w])
+    xs, ys, ts, os_ = advance_held(b.before_coef, theta[s], omega[s], g[s] * earlier[s], V[s], x[s], y[s])
+    x_new[s], y_new[s], th_new[s], om_new[s] = advance_held(b.after_coef, ts, os_, g[s] * later[s], V[s], xs, ys)
     return x_new, y_new, th_new, om_new
-
-
-class _DelayLine:
-    """The values computed at t_0 … t_k, as far back as the loop's delay reaches (`robot.delay_split`).
-
-    A ring of `_Batch.history` rows; a value asked for from before t_0 is
-    u_0 (the robot starts as if it had been running). A lag shared by every
-    member (an int: KB's robots, one compute delay) reads one row.
-    """
-
-    def __init__(self, size: int, length: int):
-        self.ring = np.zeros((length, size))
-        self.members = np.arange(size)
-        self.first = None
-
-    def push(self, k: int, value):
-        if self.first is None:
-            self.first = value.copy()
-        self.ring[k % self.ring.shape[0]] = value
-
-    def back(self, k: int, lag):
-        """The value computed at t_(k − lag) (per member; `lag` an int or an int array), u_0 before t_0."""
-        j = k - lag
-        if isinstance(j, int):
-            return self.ring[j % self.ring.shape[0]].copy() if j >= 0 else self.first.copy()
-        return np.where(j >= 0, self.ring[j % self.ring.shape[0], self.members], self.first)
 
 
 def _advance_reference(b, theta, omega, ref, V, x, y):
@@ -470,7 +438,7 @@ def run_batch(scenarios, *, record: str = "trajectory", metrics: bool = True, pr
     x0, y0 = x.copy(), y.copy()
     omega = np.zeros(B)
     alive = np.ones(B, dtype=bool)
-    line = _DelayLine(B, b.history)
+    line = DelayLine(B, b.history)
     pending_V = b.V.copy()
     best = b.progress(x, y, x0, y0, b.target_distance(x, y))
     best_t = np.zeros(B)

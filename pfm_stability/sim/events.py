@@ -14,6 +14,8 @@ Events are checked at every sample instant t_k, before the controller senses:
   the finish distance of a direction target.
 * ``trapped`` — no progress of `trap_distance` towards the target within
   `trap_time` (KB §5.1's trap situations, or a robot stopped by the speed law).
+* ``no_valid_control`` — a Nav2 controller driven by `pfm_stability.sim.tracking` found no command (Nav2's
+  ``NoValidControl``: every trajectory it tried collides) or lost its plan (the closest pose off its costmap).
 """
 
 from __future__ import annotations
@@ -22,7 +24,7 @@ from dataclasses import dataclass
 
 __all__ = ["EVENT_TYPES", "Event"]
 
-EVENT_TYPES = ("collision", "target_reached", "trapped")
+EVENT_TYPES = ("collision", "target_reached", "trapped", "no_valid_control")
 
 
 @dataclass(frozen=True)
@@ -31,7 +33,7 @@ class Event:
 
     Attributes
     ----------
-    type : {"collision", "target_reached", "trapped"}
+    type : {"collision", "target_reached", "trapped", "no_valid_control"}
     t : float
         Time, s: a collision's first touch (between samples), else the sample's.
     x, y : float

@@ -100,7 +100,7 @@ from ..parameters import dead_time_split
 __all__ = [
     "NODES", "RESOLUTION", "MAX_PANELS", "delay_split", "gauss_legendre", "slow_rate", "constant_input_modes", "servo_modes",
     "panel_count", "graded_rule", "node_sum", "Rule", "Coefficients", "constant_input", "servo", "propagate",
-    "advance_position",
+    "advance_position", "advance_held", "DelayLine",
 ]
 
 NODES = 4
@@ -485,3 +485,73 @@ def advance_position(x, y, V, rule: Rule, theta0, delta, correction):
     along = node_sum(w * np.cos(delta))
     s0, c0 = np.sin(theta0), np.cos(theta0)
     return x + V * (s0 * along + c0 * across), y + V * (c0 * along - s0 * across)
+
+
+def advance_held(coef: Coefficients, theta, omega, u, V, x, y):
+    """One interval with a held motor input: (x, y, θ, ω) at its end (`propagate`, then `advance_position`).
+
+    Parameters
+    ----------
+    coef : Coefficients
+        The interval's linear maps and rule (`constant_input`).
+    theta, omega : ndarray, shape (B,)
+        Heading (rad) and rate (rad/s) at the start.
+    u : ndarray, shape (B,)
+        The motor's input over the interval, rad/s (g times the command).
+    V : ndarray, shape (B,)
+        Speed, m/s.
+    x, y : ndarray, shape (B,)
+        Position at the start, m.
+    """
+    delta, correction, theta_end, omega_end = propagate(coef, theta, omega, u)
+    x, y = advance_position(x, y, V, coef.rule, theta, delta, correction)
+    return x, y, theta_end, omega_end
+
+
+class DelayLine:
+    """The values computed at t_0 … t_k, as far back as the loop's delay reaches (`delay_split`).
+
+    A ring of `length` rows of `size` members; a value asked for from before t_0 is u_0 (the robot starts as if
+    it had been running). A lag shared by every member (an int: KB's robots, one compute delay) reads one row.
+
+    Parameters
+    ----------
+    size : int
+        Members.
+    length : int
+        Rows kept: the longest lag read plus two.
+    """
+
+    def __init__(self, size: int, length: int):
+        self.ring = np.zeros((length, size))
+        self.members = np.arange(size)
+        self.first = None
+
+    def push(self, k: int, value):
+        """Store the values computed at t_k.
+
+        Parameters
+        ----------
+        k : int
+            The sample.
+        value : ndarray, shape (size,)
+            One value per member.
+        """
+        if self.first is None:
+            self.first = value.copy()
+        self.ring[k % self.ring.shape[0]] = value
+
+    def back(self, k: int, lag):
+        """The value computed at t_(k − lag) (per member; `lag` an int or an int array), u_0 before t_0.
+
+        Parameters
+        ----------
+        k : int
+            The current sample.
+        lag : int or ndarray of int
+            Samples back.
+        """
+        j = k - lag
+        if isinstance(j, int):
+            return self.ring[j % self.ring.shape[0]].copy() if j >= 0 else self.first.copy()
+        return np.where(j >= 0, self.ring[j % self.ring.shape[0], self.members], self.first)
