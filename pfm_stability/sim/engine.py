@@ -23,7 +23,12 @@ One step, for every member still running (the `sampled` model, docs/models.md):
    reaches the motor at t_k + d·T + D = t_k + m·T + ε (`robot.delay_split`):
    a delay line of the computed values gives u_(k−m−1) for the first ε of the
    period and u_(k−m) for the rest. The speed is delayed by the compute delay
-   only (the dead time is the steering motor's).
+   only (the dead time is the steering motor's). A member with a yaw
+   acceleration limit R passes each command through the drive's velocity
+   smoother first (`robot.slew_limit`: at most R·T of change per period, from
+   0 at the start), and the delay line carries its outputs: the command path
+   (`_CommandPath`) is controller → saturation → smoother → compute delay and
+   dead time → motor, one function whatever computed the command.
 4. **Advance** over [t_k, t_k+1) exactly (`pfm_stability.sim.robot`):
    held command → constant-input solution of eq (6) with input g·u, in two
    intervals [t_k, t_k + ε) and [t_k + ε, t_k+1) when ε > 0, each with its
@@ -61,7 +66,7 @@ from .events import Event
 from .follow import PathFollower
 from .metrics import oscillation_metrics
 from .results import BatchResult, RunResult, Trajectory
-from .robot import advance_position, constant_input, constant_input_modes, delay_split, graded_rule, propagate, servo, servo_modes, slow_rate
+from .robot import advance_position, constant_input, constant_input_modes, delay_split, graded_rule, propagate, servo, servo_modes, slew_limit, slow_rate
 from .vff import cell_repulsion, direction_of, steering_command, vff_speed, wrap_angle
 from .window import compile_window_table, stack_tables
 
@@ -90,6 +95,9 @@ class _Batch:
         self.tau = np.where(self.tau * self.gain * self.k < TAU_RESOLUTION, 0.0, self.tau)  # an ideal motor, as the models take it
         self.max_rate = robot("max_steering_rate")
         self.n, self.T, self.f = ctrl("n"), ctrl("T"), ctrl("f")
+        self.slew_step = robot("yaw_accel_limit") * self.T  # the velocity smoother's largest change per period, rad/s
+        self.limited = np.isfinite(self.slew_step)
+        self.any_limited = bool(self.limited.any())
         self.reference = _array(scenarios, lambda s: s.controller.hold == "reference", bool)
         self.delayed = _array(scenarios, lambda s: s.controller.compute_delay == 1, bool)
         self.lag, self.switch = delay_split(self.T, self.delayed.astype(np.int64), robot("dead_time"))
@@ -410,6 +418,34 @@ class _DelayLine:
         return np.where(j >= 0, self.ring[j % self.ring.shape[0], self.members], self.first)
 
 
+class _CommandPath:
+    """The command's way from the controller to the motor: the drive's velocity smoother, then the delay line.
+
+    The members with a yaw acceleration limit (`_Batch.limited`) pass each computed value through
+    `robot.slew_limit` (its state the last output, 0 at the start: Nav2's first output moves from a zero
+    command); the others' values go to the `_DelayLine` untouched, so a batch without a limit runs the code it
+    ran before the smoother. Whatever computes a yaw-rate command (the VFF controller, a path tracker) hands it
+    to `push`; the motor's inputs come from `back`.
+    """
+
+    def __init__(self, b: "_Batch"):
+        self.line = _DelayLine(b.size, b.history)
+        self.limited = b.limited if b.any_limited else None
+        self.step = b.slew_step
+        self.last = np.zeros(b.size)
+
+    def push(self, k: int, value):
+        """The command computed at t_k (rad/s, per member; a servo's reference passes untouched)."""
+        if self.limited is not None:
+            value = np.where(self.limited, slew_limit(self.last, value, self.step), value)
+            self.last = value
+        self.line.push(k, value)
+
+    def back(self, k: int, lag):
+        """The smoother's output for the command computed at t_(k − lag) (`_DelayLine.back`)."""
+        return self.line.back(k, lag)
+
+
 def _advance_reference(b, theta, omega, ref, V, x, y):
     """Servo members over one period; saturated ones in SUBSTEPS sub-intervals (returned: which, bool per member).
 
@@ -470,7 +506,7 @@ def run_batch(scenarios, *, record: str = "trajectory", metrics: bool = True, pr
     x0, y0 = x.copy(), y.copy()
     omega = np.zeros(B)
     alive = np.ones(B, dtype=bool)
-    line = _DelayLine(B, b.history)
+    line = _CommandPath(b)
     pending_V = b.V.copy()
     best = b.progress(x, y, x0, y0, b.target_distance(x, y))
     best_t = np.zeros(B)

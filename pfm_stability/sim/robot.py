@@ -27,6 +27,19 @@ on its own length (ε and T − ε). A dead time in a continuous servo loop
 (``hold="reference"``) is a delay differential equation, not a sequence of
 such intervals: the simulator refuses it (`Scenario`).
 
+The drive's velocity smoother (docs/simulator.md, "The drive's rate limit").
+A limit R (rad/s², `Robot.yaw_accel_limit`) on the rate of change of the
+commanded yaw rate acts as Nav2's ``velocity_smoother`` does with
+``feedback: OPEN_LOOP`` at the controller's rate: each period its output
+moves from its last output towards the new command by at most R·T
+(`slew_limit`), starting from 0 (Nav2's first ``last_cmd_`` is a zero
+twist). It sits on the command's way to the base — cmd_vel → smoother →
+dead time → motor — after the steering-rate saturation, so the held values
+above are its outputs; it is a discrete operator on the sequence of
+commands, so it commutes with the compute delay and the dead time. With a
+servo (``hold="reference"``) there is no sequence of commands to limit: the
+simulator refuses it (`Scenario`).
+
 Positions (eq 14). With θ(t) = θ₀ + Δ(t),
 
     ∫₀ʰ sin θ dt = sin θ₀ ∫cos Δ dt + cos θ₀ ∫sin Δ dt,
@@ -100,7 +113,7 @@ from ..parameters import dead_time_split
 __all__ = [
     "NODES", "RESOLUTION", "MAX_PANELS", "delay_split", "gauss_legendre", "slow_rate", "constant_input_modes", "servo_modes",
     "panel_count", "graded_rule", "node_sum", "Rule", "Coefficients", "constant_input", "servo", "propagate",
-    "advance_position",
+    "advance_position", "slew_limit",
 ]
 
 NODES = 4
@@ -485,3 +498,21 @@ def advance_position(x, y, V, rule: Rule, theta0, delta, correction):
     along = node_sum(w * np.cos(delta))
     s0, c0 = np.sin(theta0), np.cos(theta0)
     return x + V * (s0 * along + c0 * across), y + V * (c0 * along - s0 * across)
+
+
+def slew_limit(previous, command, step):
+    """The velocity smoother's output: `previous` moved towards `command` by at most `step` (Nav2's ``applyConstraints``).
+
+    v_k = v_(k−1) + clip(u_k − v_(k−1), −R·T, R·T) (module docstring): open loop, the
+    same limit accelerating and decelerating.
+
+    Parameters
+    ----------
+    previous : ndarray
+        The smoother's last output, rad/s.
+    command : ndarray
+        The new command, rad/s.
+    step : ndarray
+        The largest change per period, R·T, rad/s (> 0; inf: none).
+    """
+    return previous + np.clip(command - previous, -step, step)
