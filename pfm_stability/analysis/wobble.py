@@ -61,7 +61,7 @@ from ..laws.effective_force import corridor_lateral_force
 from ..laws.force_law import ForceLaw, corridor_gain, wall_equilibrium, wall_gain
 from ..models import make_model
 from ..models.base import Loop
-from .describing import describing_function, harmonic_content, saturation_df_for_output
+from .describing import describing_function, harmonic_content, rate_limit_df, rate_limit_waveform, saturation_df_for_output
 
 __all__ = [
     "WOBBLE_MODELS",
@@ -81,6 +81,8 @@ __all__ = [
     "wall_wobble",
     "trusted_cycle",
     "RATE_HARMONIC_LIMIT",
+    "command_responses",
+    "limited_branch",
 ]
 
 WOBBLE_MODELS = ("exact_delay", "sampled")
@@ -184,6 +186,10 @@ class WobbleCycle:
         The rate limit's describing function n_s (1: not saturated).
     rate_harmonic : float
         The rate limit's third harmonic in the heading over the fundamental (module docstring).
+    limiter_gain : float
+        |N_r| of the drive's yaw acceleration limit (1: not limiting; `describing.rate_limit_df`).
+    limiter_lag : float
+        Its phase lag, rad (0: not limiting).
     """
 
     amplitude: float
@@ -193,6 +199,8 @@ class WobbleCycle:
     third_harmonic: float
     rate_gain: float
     rate_harmonic: float
+    limiter_gain: float = 1.0
+    limiter_lag: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -226,6 +234,9 @@ class WobbleBranch:
         β, 1/m²: V(A) = V*(1 − βA²) + O(A⁴).
     clearance : float
         L − W/2, m: an amplitude that reaches it touches a wall.
+    limiter_gains, limiter_lags : ndarray or None
+        |N_r| and the phase lag (rad) of the drive's yaw acceleration limit along the branch (`limited_branch`); None
+        without a limit.
     """
 
     model: str
@@ -240,6 +251,8 @@ class WobbleBranch:
     omega_critical: float
     beta: float
     clearance: float
+    limiter_gains: np.ndarray | None = None
+    limiter_lags: np.ndarray | None = None
 
     @property
     def criticality(self) -> str:
@@ -273,8 +286,9 @@ class WobbleBranch:
                 continue
             t = d[i] / (d[i] - d[i + 1])
             pick = lambda x: float(x[i] + t * (x[i + 1] - x[i]))
+            limiter = (pick(self.limiter_gains), pick(self.limiter_lags)) if self.limiter_gains is not None else (1.0, 0.0)
             out.append(WobbleCycle(pick(A), pick(self.headings), pick(self.omegas), bool(S[i + 1] > S[i]),
-                                   pick(self.third_harmonics), pick(self.rate_gains), pick(self.rate_harmonics)))
+                                   pick(self.third_harmonics), pick(self.rate_gains), pick(self.rate_harmonics), *limiter))
         return tuple(out)
 
     def tolerance_speed(self, tolerance: float) -> float:
@@ -585,6 +599,8 @@ def corridor_branch(robot, controller, law: ForceLaw, L: float, *, model: str = 
 
 def _branch(robot, controller, delta, N: float, A, Nf, clearance: float, model: str, beta_f: float) -> WobbleBranch:
     """The branch V(A) for the field's describing function `Nf` at amplitudes `A` (module docstring)."""
+    if math.isfinite(robot.yaw_accel_limit):
+        return limited_branch(robot, controller, delta, N, A, Nf, clearance, model, beta_f)
     loop_model = make_model(model, hold=controller.hold, compute_delay=controller.compute_delay)
     # in the motor's units: the plant gain g scales the command after the rate limit (docs/simulator.md), so
     # g·sat_M(u) = sat_gM(g·u): a robot (k, M, g) is the robot (g·k, g·M, 1); the dead time D stays in the loop
@@ -625,6 +641,167 @@ def _branch(robot, controller, delta, N: float, A, Nf, clearance: float, model: 
             + special.jv(3, theta) / (3.0 * special.j1(theta))
     beta = beta_f - w0**2 / (8.0 * V_star**2)
     return WobbleBranch(model, A, speeds, omegas, headings, gains, thirds, rates, V_star, w0, beta, clearance)
+
+
+def command_responses(robot, controller, model: str):
+    """ω ↦ (H₀, H₁): the loop seen from its command, in the motor's units, for the harmonic balance with the drive's limiter.
+
+    The applied command w (motor units, g·u after the limiter) drives the plant, the controller computes
+    v = −(H₀ + K·H₁)·w with K = g·k·NV, so a describing function N_c on the command closes the loop where
+    1 + N_c·(H₀ + K·H₁) = 0. `sampled` (T > 0): the sampled loop's own matrices (`models.sampled.command_form`,
+    x_(k+1) = M·x_k + n·w_k, v_k = −(F0 + K·F1)·x_k), H_i = F_i·(zI − M)⁻¹·n at z = e^(jωT); otherwise the
+    continuous loop with the whole command delayed by D and the field's term by T more,
+    H₀ = g·k·e^(−jωD)/(jω(jωτ + 1)), H₁ = e^(−jω(T + D))/((jω)²(jωτ + 1)): τs³ + s² + gk(s + NV·e^(−sT))·e^(−sD) = 0
+    with N_c = 1.
+
+    Parameters
+    ----------
+    robot : parameters.Robot
+        τ, k, g, D.
+    controller : parameters.Controller
+        T, compute delay (``hold="command"``).
+    model : {"exact_delay", "sampled"}
+
+    Returns
+    -------
+    callable
+        ω (array, rad/s) ↦ (H₀, H₁) (complex arrays).
+    """
+    from ..models.sampled import command_form
+
+    gk, D, T = robot.plant_gain * robot.k, robot.dead_time, controller.T
+    loop = Loop(robot.tau, T, gk, dead_time=D)
+    tau = loop.tau
+    if model == "sampled" and T > 0:
+        M, n, F0, F1 = command_form(loop, "command", controller.compute_delay)
+        eye = np.eye(M.shape[0])
+
+        def sampled(w):
+            z = np.exp(1j * np.asarray(w, dtype=float) * T)
+            X = np.linalg.solve(z[..., None, None] * eye - M, np.broadcast_to(n, z.shape + n.shape)[..., None])[..., 0]
+            return X @ F0, X @ F1
+
+        return sampled
+
+    def continuous(w):
+        s = 1j * np.asarray(w, dtype=float)
+        plant = np.exp(-s * D) / (s * (tau * s + 1.0))
+        return gk * plant, np.exp(-s * T) * plant / s
+
+    return continuous
+
+
+def _limiter_harmonic(rho: float) -> float:
+    """|3rd harmonic|/|fundamental| of the continuous rate limiter's output at ρ (1/9 for the triangle, 0 for ρ <= 1)."""
+    if rho <= 1.0:
+        return 0.0
+    theta = _circle_nodes()
+    spectrum = np.abs(np.fft.rfft(rate_limit_waveform(rho, theta)))
+    return float(spectrum[3] / spectrum[1])
+
+
+@functools.lru_cache(maxsize=1)
+def _circle_nodes():
+    return 2.0 * math.pi * np.arange(256) / 256
+
+
+def limited_branch(robot, controller, delta, N: float, A, Nf, clearance: float, model: str, beta_f: float) -> WobbleBranch:
+    """The branch V(A) with the drive's yaw acceleration limit R: the rate limiter as one more describing function.
+
+    The quasi-linear loop of the module docstring, with the command's describing function
+    N_c = n_s(E)·N_r(U, ω) (the saturation at g·ω_max, then the limiter at g·R, `describing.rate_limit_df`:
+    sampled at T for the `sampled` loop, as the simulator's smoother acts once per period, continuous for
+    `exact_delay`) complex — a phase lag the loop's own boundary cannot carry — so each amplitude A solves the
+    harmonic balance 1 + N_c·(H₀(ω) + K'·H₁(ω)) = 0 (`command_responses`) in (ω, U), U the limiter's input amplitude:
+    its output's fundamental |N_r|·U = Θ·ω·√(1 + ω²τ²) fixes Θ, K' = g·k·N_f(A)·A·ω/Θ and V = Aω/(2J₁(Θ)), as
+    without the limit. Newton (scipy ``root``) continues along A from the linear solution (NV*, ω*) at the smallest
+    amplitude, where the limiter is linear; an amplitude whose balance does not converge is left out (nan).
+
+    Below the limiter's threshold (ρ = Uω/(gR) <= 1, and every step within g·R·T for the sampled limiter) N_r = 1 and
+    the branch is the one without it, so β (the Hopf coefficient at V*) is unchanged: the limiter acts at finite
+    amplitude, where its phase lag bends V(A) down — cycles below V* (`WobbleBranch.fold_speed`).
+
+    Parameters
+    ----------
+    robot : parameters.Robot
+        τ, k, W, g, D, `max_steering_rate` and `yaw_accel_limit` (finite).
+    controller : parameters.Controller
+        T, compute delay; ``hold="command"`` (a servo has no command sequence to limit).
+    delta : callable
+        δ(y), the field's steering (for its third harmonic).
+    N : float
+        The field's gain at A → 0, 1/m.
+    A, Nf : ndarray
+        Amplitudes (m, increasing) and the field's describing function there (1/m).
+    clearance : float
+        m.
+    model : {"exact_delay", "sampled"}
+    beta_f : float
+        The field's cubic coefficient, 1/m².
+    """
+    if controller.hold != "command":
+        raise ValueError(f"yaw_accel_limit needs hold=command (a servo closing k(δ − θ) continuously has no command sequence to "
+                         f"limit; docs/wobble.md); got hold={controller.hold}")
+    loop_model = make_model(model, hold=controller.hold, compute_delay=controller.compute_delay)
+    g, D = robot.plant_gain, robot.dead_time
+    gk, M, R = g * robot.k, g * robot.max_steering_rate, g * robot.yaw_accel_limit
+    T = controller.T
+    tau = Loop(robot.tau, T, gk, dead_time=D).tau
+    limiter_T = T if model == "sampled" else 0.0
+    b = loop_model.boundary(Loop(tau, T, gk, dead_time=D))
+    NV0, w0 = b.NV_critical, b.omega_critical
+    if not (math.isfinite(NV0) and NV0 > 0 and w0):
+        raise ValueError(f"the {model} loop has no oscillatory stability boundary here (NV* = {NV0:g} 1/s): no wobble to predict")
+    responses = command_responses(robot, controller, model)
+    h3_field = harmonic_content(delta, A)
+
+    def state(x, a, nf):
+        w, U = math.exp(x[0]), math.exp(x[1])
+        n_s = 1.0 if U <= M else float(saturation_df_for_output(U, M))
+        step = 2.0 * U * math.sin(0.5 * w * limiter_T) / (R * limiter_T) if limiter_T > 0 else U * w / R  # <= 1: not limiting
+        N_r = complex(rate_limit_df(U, w, R, limiter_T)) if step > 1.0 else 1.0 + 0j
+        theta = abs(N_r) * U / (w * math.hypot(1.0, w * tau))
+        return w, U, n_s, N_r, theta, gk * nf * a * w / theta
+
+    def residual(x, a, nf):
+        w, U, n_s, N_r, theta, K = state(x, a, nf)
+        if not n_s > 0:
+            return [1e6, 1e6]
+        H0, H1 = responses(np.array([w]))
+        r = 1.0 + n_s * N_r * (complex(H0[0]) + K * complex(H1[0]))
+        return [r.real, r.imag]
+
+    speeds, omegas, headings, gains, thirds, rates, lim_gains, lim_lags = (np.full(A.size, np.nan) for _ in range(8))
+    theta0 = A[0] * w0 * Nf[0] / NV0
+    linear = np.array([math.log(w0), math.log(theta0 * w0 * math.hypot(1.0, w0 * tau))])  # U ∝ A on the linear part
+    guess = linear
+    for i, (a, nf) in enumerate(zip(A, Nf)):
+        if not math.isfinite(nf):
+            continue
+        solved = None
+        for start in (guess, linear + np.array([0.0, math.log(a / A[0])])):
+            sol = optimize.root(residual, start, args=(a, nf), method="hybr", options={"xtol": 1e-13})
+            if sol.success and math.hypot(*residual(sol.x, a, nf)) <= 1e-9:
+                solved = sol.x
+                break
+        if solved is None:
+            continue
+        guess = solved
+        w, U, n_s, N_r, theta, _ = state(solved, a, nf)
+        if not theta < _J1_PEAK:
+            continue
+        speeds[i] = a * w / (2.0 * special.j1(theta))
+        omegas[i], headings[i], gains[i] = w, theta, n_s
+        lim_gains[i], lim_lags[i] = abs(N_r), -math.atan2(N_r.imag, N_r.real)
+        h3_sat = harmonic_content(lambda x: np.clip(x, -M, M), U / n_s) if n_s < 1.0 else 0.0
+        h3_lim = _limiter_harmonic(U * w / R)
+        to_heading = math.hypot(1.0, w * tau) / (3.0 * math.hypot(1.0, 3.0 * w * tau))
+        rates[i] = h3_sat * to_heading
+        thirds[i] = (h3_field[i] + h3_sat + h3_lim) * _filtering(w, tau, gk * n_s * abs(N_r)) \
+            + special.jv(3, theta) / (3.0 * special.j1(theta))
+    V_star = NV0 / N
+    beta = beta_f - w0**2 / (8.0 * V_star**2)
+    return WobbleBranch(model, A, speeds, omegas, headings, gains, thirds, rates, V_star, w0, beta, clearance, lim_gains, lim_lags)
 
 
 def corridor_wobble(robot, controller, law: ForceLaw, L: float, tolerance: float | None = None, *, model: str = "sampled") -> Wobble:
