@@ -237,6 +237,8 @@ class WobbleBranch:
     limiter_gains, limiter_lags : ndarray or None
         |N_r| and the phase lag (rad) of the drive's yaw acceleration limit along the branch (`limited_branch`); None
         without a limit.
+    gain : float or None
+        The field's gain N at the equilibrium, 1/m (V* = NV*/N).
     """
 
     model: str
@@ -253,6 +255,7 @@ class WobbleBranch:
     clearance: float
     limiter_gains: np.ndarray | None = None
     limiter_lags: np.ndarray | None = None
+    gain: float | None = None
 
     @property
     def criticality(self) -> str:
@@ -345,6 +348,9 @@ class Wobble:
         Why the amplitude is null, or what to know about it.
     rate_harmonic : float or None
         The second trust measure: the rate limit's third harmonic in the heading over the fundamental.
+    limiter : tuple or None
+        With the drive's yaw acceleration limit: (|N_r|, lag in rad) at the cycle, (None, None) without one; None when the
+        robot has no limit (JSON ``limiter_gain``, ``limiter_lag`` only then).
     """
 
     amplitude: float | None
@@ -360,6 +366,7 @@ class Wobble:
     method: str
     reason: str | None = None
     rate_harmonic: float | None = None
+    limiter: tuple | None = None
 
     @classmethod
     def unavailable(cls, reason: str, tolerance: float | None) -> "Wobble":
@@ -391,6 +398,7 @@ class Wobble:
             "rate_harmonic": number(self.rate_harmonic),
             "method": self.method,
             "reason": self.reason,
+            **({"limiter_gain": number(self.limiter[0]), "limiter_lag": number(self.limiter[1])} if self.limiter is not None else {}),
         }
 
 
@@ -640,7 +648,7 @@ def _branch(robot, controller, delta, N: float, A, Nf, clearance: float, model: 
         thirds[i] = (h3[i] + h3_rate) * _filtering(w, tau, k * factor) \
             + special.jv(3, theta) / (3.0 * special.j1(theta))
     beta = beta_f - w0**2 / (8.0 * V_star**2)
-    return WobbleBranch(model, A, speeds, omegas, headings, gains, thirds, rates, V_star, w0, beta, clearance)
+    return WobbleBranch(model, A, speeds, omegas, headings, gains, thirds, rates, V_star, w0, beta, clearance, gain=N)
 
 
 def command_responses(robot, controller, model: str):
@@ -779,9 +787,10 @@ def limited_branch(robot, controller, delta, N: float, A, Nf, clearance: float, 
         if not math.isfinite(nf):
             continue
         solved = None
-        for start in (guess, linear + np.array([0.0, math.log(a / A[0])])):
-            sol = optimize.root(residual, start, args=(a, nf), method="hybr", options={"xtol": 1e-13})
-            if sol.success and math.hypot(*residual(sol.x, a, nf)) <= 1e-9:
+        attempts = ((guess, "hybr"), (guess, "lm"), (linear + np.array([0.0, math.log(a / A[0])]), "hybr"))
+        for start, method in attempts:  # Powell's hybrid, then Levenberg–Marquardt where the limiter's onset kinks N_r
+            sol = optimize.root(residual, start, args=(a, nf), method=method, options={"xtol": 1e-13})
+            if math.hypot(*residual(sol.x, a, nf)) <= 1e-9:
                 solved = sol.x
                 break
         if solved is None:
@@ -801,7 +810,7 @@ def limited_branch(robot, controller, delta, N: float, A, Nf, clearance: float, 
             + special.jv(3, theta) / (3.0 * special.j1(theta))
     V_star = NV0 / N
     beta = beta_f - w0**2 / (8.0 * V_star**2)
-    return WobbleBranch(model, A, speeds, omegas, headings, gains, thirds, rates, V_star, w0, beta, clearance, lim_gains, lim_lags)
+    return WobbleBranch(model, A, speeds, omegas, headings, gains, thirds, rates, V_star, w0, beta, clearance, lim_gains, lim_lags, N)
 
 
 def corridor_wobble(robot, controller, law: ForceLaw, L: float, tolerance: float | None = None, *, model: str = "sampled") -> Wobble:
@@ -872,7 +881,17 @@ def _wobble_at(branch: WobbleBranch, V: float, tolerance: float | None, method: 
         tolerance = DEFAULT_TOLERANCE_FRACTION * branch.clearance
     common = dict(criticality=branch.criticality, V_tolerance=branch.tolerance_speed(tolerance), tolerance=tolerance,
                   V_critical=branch.V_critical, V_fold=branch.fold_speed, method=method)
+    limited = branch.limiter_gains is not None
+    if limited:
+        common["limiter"] = (None, None)
     stable = [c for c in branch.cycles_at(V) if c.stable]
+    if limited and branch.fold_speed < V <= branch.V_critical:  # the limiter's lag bends the branch below V*
+        unstable = [c for c in branch.cycles_at(V) if not c.stable]
+        edge = f" beyond the unstable cycle of {unstable[0].amplitude:.3g} m" if unstable else ""
+        reason = (f"below V* = {branch.V_critical:.4g} m/s a small start settles, but cycles exist down to V_fold = {branch.fold_speed:.4g} "
+                  f"m/s (the yaw acceleration limit lags at finite amplitude): a start{edge} jumps to {'a large cycle' if stable else 'a wall'}; "
+                  "--disturbance D says which for a start of D")
+        return Wobble(None, None, None, not stable, third_harmonic=None, reason=reason, **common)
     if branch.criticality == "subcritical" and V > branch.fold_speed:
         unstable = [c for c in branch.cycles_at(V) if not c.stable]
         where = "a wall" if not stable else "a large cycle"
@@ -892,6 +911,8 @@ def _wobble_at(branch: WobbleBranch, V: float, tolerance: float | None, method: 
                       reason="no limit cycle clear of the walls: the wobble grows until the robot touches a wall", **common)
     cycle = stable[0]
     common["rate_harmonic"] = cycle.rate_harmonic
+    if limited:
+        common["limiter"] = (cycle.limiter_gain, cycle.limiter_lag)
     if not cycle.third_harmonic <= THIRD_HARMONIC_LIMIT:
         return Wobble(None, None, None, False, third_harmonic=cycle.third_harmonic,
                       reason=f"strong harmonics: predicted third harmonic {cycle.third_harmonic:.2f} of the fundamental "
