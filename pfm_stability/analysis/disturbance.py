@@ -35,7 +35,7 @@ from ..checks import check_number
 from ..io.serialize import json_number
 from ..laws.force_law import ForceLaw
 from ..models.base import Loop
-from .wobble import THIRD_HARMONIC_LIMIT, WobbleBranch, corridor_branch, corridor_steering, trusted_cycle, wall_branch, wall_steering
+from .wobble import THIRD_HARMONIC_LIMIT, WobbleBranch, corridor_branch, corridor_steering, reported_cycle, wall_branch, wall_steering
 
 __all__ = ["Disturbance", "start_amplitude", "disturbance_speed", "corridor_disturbance", "wall_disturbance"]
 
@@ -280,8 +280,10 @@ def _response(branch: WobbleBranch, robot, controller, disturbance: float, metho
             return Disturbance(settles=False, amplitude=None, omega=None, reaches_wall=True, limiter_gain=None, limiter_lag=None,
                                reason="no cycle inside the clearance holds the start: it grows until the robot touches a wall", **common)
         target = stable[0]
+    shown = reported_cycle(branch, V, target)
+    target = shown or target
     limiter = dict(limiter_gain=target.limiter_gain, limiter_lag=target.limiter_lag)
-    if not trusted_cycle(target):
+    if shown is None:
         return Disturbance(settles=False, amplitude=None, omega=None, reaches_wall=False, **limiter,
                            reason=f"a cycle of {target.amplitude:.3g} m, but the describing function is not trusted there (third harmonic "
                                   f"{target.third_harmonic:.2f} > {THIRD_HARMONIC_LIMIT:g} or the steering-rate limit's "

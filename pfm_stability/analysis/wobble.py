@@ -50,7 +50,7 @@ from __future__ import annotations
 
 import functools
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from scipy import interpolate, optimize, special
@@ -80,7 +80,9 @@ __all__ = [
     "wall_branch",
     "wall_wobble",
     "trusted_cycle",
+    "reported_cycle",
     "RATE_HARMONIC_LIMIT",
+    "HELD_COMMAND_RATE_HARMONIC_LIMIT",
     "command_responses",
     "limited_branch",
 ]
@@ -95,6 +97,15 @@ RATE_HARMONIC_LIMIT = 0.02
 """Largest `rate_harmonic` (the rate limit's third harmonic in the heading) at which the amplitude is reported: beyond
 it the limit shapes θ into a trapezoid the first harmonic misses — with a fast motor (τ <= 0.18 s) the amplitude came
 out 8–29 % low and ω 3–18 % high at 0.026–0.063 in experiments/wobble_amplitude.py, within 8 % and 3 % below 0.02."""
+
+HELD_COMMAND_RATE_HARMONIC_LIMIT = 0.04
+"""`RATE_HARMONIC_LIMIT` for a held command (``hold="command"``): there the saturation acts on the sampled command, not
+inside a continuous servo, and its describing function held to the simulator further: every held-command cycle measured
+with a `rate_harmonic` from 0.02 to 0.04 within 11 % in amplitude (the seven of experiments/wobble_amplitude.py within
+8 % and 3.7 % in ω, experiments/wobble_limiter.py's within 7 %, the 25 ms map robot of tests/test_map_wobble.py −5 % at
+0.022 and −11 % at 0.034), beyond it −5 % (0.042), −21 % (0.050), −14 % (0.053), −4 % (0.057), −19 % (0.063). The
+servo's (``hold="reference"``) reached −10 % at 0.023 and −29 % at 0.043: `RATE_HARMONIC_LIMIT` stays its limit
+(docs/wobble.md, "When the describing function is not trusted")."""
 
 DEFAULT_TOLERANCE_FRACTION = 0.1
 """`report --wobble` without a value: a tenth of the clearance L − W/2 (the play the robot has either side)."""
@@ -190,6 +201,11 @@ class WobbleCycle:
         |N_r| of the drive's yaw acceleration limit (1: not limiting; `describing.rate_limit_df`).
     limiter_lag : float
         Its phase lag, rad (0: not limiting).
+    hold : str or None
+        The controller's hold (`trusted_cycle` takes its rate limit by it; None: the servo's, the stricter).
+    cascade : bool
+        The steering-rate saturation clips the smoother's input there: the product of their describing functions misses
+        the ramps the smoother puts on the clipped command (`limited_branch`).
     """
 
     amplitude: float
@@ -201,6 +217,8 @@ class WobbleCycle:
     rate_harmonic: float
     limiter_gain: float = 1.0
     limiter_lag: float = 0.0
+    hold: str | None = None
+    cascade: bool = False
 
 
 @dataclass(frozen=True)
@@ -239,6 +257,13 @@ class WobbleBranch:
         without a limit.
     gain : float or None
         The field's gain N at the equilibrium, 1/m (V* = NV*/N).
+    hold : str or None
+        The controller's hold.
+    cascades : ndarray of bool or None
+        Where the saturation clips the smoother's input (`WobbleCycle.cascade`); None without a yaw acceleration limit.
+    heading_builder : callable or None
+        With such points: builds the branch with the steering-rate limit as the heading's rate limit (`limited_branch`,
+        ``heading_limit=True``; `heading_limited`, computed when first read); else None.
     """
 
     model: str
@@ -256,6 +281,14 @@ class WobbleBranch:
     limiter_gains: np.ndarray | None = None
     limiter_lags: np.ndarray | None = None
     gain: float | None = None
+    hold: str | None = None
+    cascades: np.ndarray | None = None
+    heading_builder: object = field(default=None, repr=False, compare=False)
+
+    @functools.cached_property
+    def heading_limited(self) -> "WobbleBranch | None":
+        """The branch with the steering-rate limit on the heading (`heading_builder`), or None."""
+        return self.heading_builder() if self.heading_builder is not None else None
 
     @property
     def criticality(self) -> str:
@@ -290,8 +323,9 @@ class WobbleBranch:
             t = d[i] / (d[i] - d[i + 1])
             pick = lambda x: float(x[i] + t * (x[i + 1] - x[i]))
             limiter = (pick(self.limiter_gains), pick(self.limiter_lags)) if self.limiter_gains is not None else (1.0, 0.0)
+            cascade = bool(self.cascades is not None and (self.cascades[i] or self.cascades[i + 1]))
             out.append(WobbleCycle(pick(A), pick(self.headings), pick(self.omegas), bool(S[i + 1] > S[i]),
-                                   pick(self.third_harmonics), pick(self.rate_gains), pick(self.rate_harmonics), *limiter))
+                                   pick(self.third_harmonics), pick(self.rate_gains), pick(self.rate_harmonics), *limiter, self.hold, cascade))
         return tuple(out)
 
     def tolerance_speed(self, tolerance: float) -> float:
@@ -402,15 +436,56 @@ class Wobble:
         }
 
 
+def reported_cycle(branch: "WobbleBranch", V: float, cycle: WobbleCycle) -> WobbleCycle | None:
+    """The cycle a report gives for `cycle` of `branch` at speed V, or None when the describing function is not trusted.
+
+    `cycle` itself when `trusted_cycle`. Where only the saturation clipping the smoother's input fails the test
+    (`WobbleCycle.cascade`), the heading-limited branch's (`WobbleBranch.heading_limited`: the steering-rate limit as
+    the heading's rate limit, the smoother on the unclipped command) stable cycle at V nearest in amplitude, if its own
+    third harmonic passes `THIRD_HARMONIC_LIMIT` (module docstring, "Trust").
+
+    Parameters
+    ----------
+    branch : WobbleBranch
+        The branch `cycle` is on.
+    V : float
+        Speed, m/s.
+    cycle : WobbleCycle
+        A cycle of the branch at V.
+    """
+    if trusted_cycle(cycle):
+        return cycle
+    if not cycle.cascade or branch.heading_limited is None or not cycle.third_harmonic <= THIRD_HARMONIC_LIMIT \
+            or not cycle.rate_harmonic <= rate_harmonic_limit(cycle.hold):
+        return None
+    shaped = [c for c in branch.heading_limited.cycles_at(V) if c.stable]
+    if not shaped:
+        return None
+    nearest = min(shaped, key=lambda c: abs(c.amplitude - cycle.amplitude))
+    return nearest if nearest.third_harmonic <= THIRD_HARMONIC_LIMIT else None
+
+
 def trusted_cycle(cycle: WobbleCycle) -> bool:
-    """The describing function's trust test at a cycle: `third_harmonic` <= `THIRD_HARMONIC_LIMIT`, `rate_harmonic` <= `RATE_HARMONIC_LIMIT`.
+    """The describing function's trust test at a cycle: `third_harmonic` <= `THIRD_HARMONIC_LIMIT`, `rate_harmonic` within its
+    hold's limit (`rate_harmonic_limit`), and no saturation clipping the smoother's input (`WobbleCycle.cascade`).
 
     Parameters
     ----------
     cycle : WobbleCycle
         A cycle of the branch.
     """
-    return cycle.third_harmonic <= THIRD_HARMONIC_LIMIT and cycle.rate_harmonic <= RATE_HARMONIC_LIMIT
+    return cycle.third_harmonic <= THIRD_HARMONIC_LIMIT and cycle.rate_harmonic <= rate_harmonic_limit(cycle.hold) and not cycle.cascade
+
+
+def rate_harmonic_limit(hold: str | None) -> float:
+    """The largest `rate_harmonic` trusted: `HELD_COMMAND_RATE_HARMONIC_LIMIT` for ``"command"``, else `RATE_HARMONIC_LIMIT`.
+
+    Parameters
+    ----------
+    hold : str or None
+        The controller's hold (None: a cycle of a branch that does not say; the stricter limit).
+    """
+    return HELD_COMMAND_RATE_HARMONIC_LIMIT if hold == "command" else RATE_HARMONIC_LIMIT
 
 
 def wall_steering(law: ForceLaw, alpha: float):
@@ -606,7 +681,18 @@ def corridor_branch(robot, controller, law: ForceLaw, L: float, *, model: str = 
 
 
 def _branch(robot, controller, delta, N: float, A, Nf, clearance: float, model: str, beta_f: float) -> WobbleBranch:
-    """The branch V(A) for the field's describing function `Nf` at amplitudes `A` (module docstring)."""
+    """The branch V(A) for the field's describing function `Nf` at amplitudes `A` (module docstring), and where the
+    steering-rate limit shapes the heading of a held command, the branch with it on the heading (`heading_limited`)."""
+    branch = _branch_of(robot, controller, delta, N, A, Nf, clearance, model, beta_f)
+    if branch.cascades is not None and np.any(branch.cascades):
+        build = functools.partial(limited_branch, robot, controller, delta, N, A, Nf, clearance, model, beta_f, heading_limit=True)
+        branch = replace(branch, heading_builder=build)
+    return branch
+
+
+def _branch_of(robot, controller, delta, N: float, A, Nf, clearance: float, model: str, beta_f: float) -> WobbleBranch:
+    """The branch with the steering-rate limit on the command: `limited_branch` with a yaw acceleration limit, else the
+    model's own boundary with the steering gain's factor (module docstring)."""
     if math.isfinite(robot.yaw_accel_limit):
         return limited_branch(robot, controller, delta, N, A, Nf, clearance, model, beta_f)
     loop_model = make_model(model, hold=controller.hold, compute_delay=controller.compute_delay)
@@ -648,7 +734,7 @@ def _branch(robot, controller, delta, N: float, A, Nf, clearance: float, model: 
         thirds[i] = (h3[i] + h3_rate) * _filtering(w, tau, k * factor) \
             + special.jv(3, theta) / (3.0 * special.j1(theta))
     beta = beta_f - w0**2 / (8.0 * V_star**2)
-    return WobbleBranch(model, A, speeds, omegas, headings, gains, thirds, rates, V_star, w0, beta, clearance, gain=N)
+    return WobbleBranch(model, A, speeds, omegas, headings, gains, thirds, rates, V_star, w0, beta, clearance, gain=N, hold=controller.hold)
 
 
 def command_responses(robot, controller, model: str):
@@ -713,7 +799,8 @@ def _circle_nodes():
     return 2.0 * math.pi * np.arange(256) / 256
 
 
-def limited_branch(robot, controller, delta, N: float, A, Nf, clearance: float, model: str, beta_f: float) -> WobbleBranch:
+def limited_branch(robot, controller, delta, N: float, A, Nf, clearance: float, model: str, beta_f: float, *,
+                   heading_limit: bool = False) -> WobbleBranch:
     """The branch V(A) with the drive's yaw acceleration limit R: the rate limiter as one more describing function.
 
     The quasi-linear loop of the module docstring, with the command's describing function
@@ -729,10 +816,15 @@ def limited_branch(robot, controller, delta, N: float, A, Nf, clearance: float, 
     the branch is the one without it, so β (the Hopf coefficient at V*) is unchanged: the limiter acts at finite
     amplitude, where its phase lag bends V(A) down — cycles below V* (`WobbleBranch.fold_speed`).
 
+    ``heading_limit``: the steering-rate limit as the heading's rate limit instead (`heading_limited_branch`): with a
+    fast motor the saturated command turns θ at g·ω_max, so θ = RL(θ_lin), the rate limiter's describing function
+    N_h(θ_lin·ω/(g·ω_max)) (continuous) on the linear servo's heading θ_lin, acting on the field's path only:
+    1 + N_r·(H₀ + N_h·K'·H₁) = 0, Θ = |N_h|·θ_lin; R = inf gives N_r = 1.
+
     Parameters
     ----------
     robot : parameters.Robot
-        τ, k, W, g, D, `max_steering_rate` and `yaw_accel_limit` (finite).
+        τ, k, W, g, D, `max_steering_rate` and `yaw_accel_limit` (finite unless ``heading_limit``).
     controller : parameters.Controller
         T, compute delay; ``hold="command"`` (a servo has no command sequence to limit).
     delta : callable
@@ -746,6 +838,8 @@ def limited_branch(robot, controller, delta, N: float, A, Nf, clearance: float, 
     model : {"exact_delay", "sampled"}
     beta_f : float
         The field's cubic coefficient, 1/m².
+    heading_limit : bool
+        The steering-rate limit on the heading (module docstring, "Trust").
     """
     if controller.hold != "command":
         raise ValueError(f"yaw_accel_limit needs hold=command (a servo closing k(δ − θ) continuously has no command sequence to "
@@ -765,21 +859,24 @@ def limited_branch(robot, controller, delta, N: float, A, Nf, clearance: float, 
 
     def state(x, a, nf):
         w, U = math.exp(x[0]), math.exp(x[1])
-        n_s = 1.0 if U <= M else float(saturation_df_for_output(U, M))
+        n_s = 1.0 if U <= M or heading_limit else float(saturation_df_for_output(U, M))
         step = 2.0 * U * math.sin(0.5 * w * limiter_T) / (R * limiter_T) if limiter_T > 0 else U * w / R  # <= 1: not limiting
         N_r = complex(rate_limit_df(U, w, R, limiter_T)) if step > 1.0 else 1.0 + 0j
         theta = abs(N_r) * U / (w * math.hypot(1.0, w * tau))
-        return w, U, n_s, N_r, theta, gk * nf * a * w / theta
+        N_h = complex(rate_limit_df(theta, w, M)) if heading_limit and theta * w > M else 1.0 + 0j
+        theta *= abs(N_h)
+        return w, U, n_s, N_r, N_h, theta, gk * nf * a * w / theta
 
     def residual(x, a, nf):
-        w, U, n_s, N_r, theta, K = state(x, a, nf)
+        w, U, n_s, N_r, N_h, theta, K = state(x, a, nf)
         if not n_s > 0:
             return [1e6, 1e6]
         H0, H1 = responses(np.array([w]))
-        r = 1.0 + n_s * N_r * (complex(H0[0]) + K * complex(H1[0]))
+        r = 1.0 + n_s * N_r * (complex(H0[0]) + N_h * K * complex(H1[0]))
         return [r.real, r.imag]
 
     speeds, omegas, headings, gains, thirds, rates, lim_gains, lim_lags = (np.full(A.size, np.nan) for _ in range(8))
+    cascades = np.zeros(A.size, dtype=bool)
     theta0 = A[0] * w0 * Nf[0] / NV0
     linear = np.array([math.log(w0), math.log(theta0 * w0 * math.hypot(1.0, w0 * tau))])  # U ∝ A on the linear part
     guess = linear
@@ -796,21 +893,28 @@ def limited_branch(robot, controller, delta, N: float, A, Nf, clearance: float, 
         if solved is None:
             continue
         guess = solved
-        w, U, n_s, N_r, theta, _ = state(solved, a, nf)
+        w, U, n_s, N_r, N_h, theta, _ = state(solved, a, nf)
         if not theta < _J1_PEAK:
             continue
         speeds[i] = a * w / (2.0 * special.j1(theta))
-        omegas[i], headings[i], gains[i] = w, theta, n_s
+        omegas[i], headings[i], gains[i] = w, theta, n_s * abs(N_h)
         lim_gains[i], lim_lags[i] = abs(N_r), -math.atan2(N_r.imag, N_r.real)
+        E = U / n_s  # the saturation's input: its clipped flank still rises at E·ω, which the smoother may not follow
+        flank = 2.0 * E * math.sin(0.5 * w * limiter_T) / (R * limiter_T) if limiter_T > 0 else E * w / R
+        cascades[i] = n_s < 1.0 and flank > 1.0
         h3_sat = harmonic_content(lambda x: np.clip(x, -M, M), U / n_s) if n_s < 1.0 else 0.0
-        h3_lim = _limiter_harmonic(U * w / R)
+        h3_lim = _limiter_harmonic(U * w / R) if math.isfinite(R) else 0.0
         to_heading = math.hypot(1.0, w * tau) / (3.0 * math.hypot(1.0, 3.0 * w * tau))
-        rates[i] = h3_sat * to_heading
-        thirds[i] = (h3_field[i] + h3_sat + h3_lim) * _filtering(w, tau, gk * n_s * abs(N_r)) \
+        h3_head = _limiter_harmonic(theta / abs(N_h) * w / M) if heading_limit else 0.0  # the heading's own triangle
+        rates[i] = h3_sat * to_heading + h3_head
+        thirds[i] = (h3_field[i] + h3_sat + h3_lim) * _filtering(w, tau, gk * n_s * abs(N_r)) + h3_head / 3.0 \
             + special.jv(3, theta) / (3.0 * special.j1(theta))
     V_star = NV0 / N
     beta = beta_f - w0**2 / (8.0 * V_star**2)
-    return WobbleBranch(model, A, speeds, omegas, headings, gains, thirds, rates, V_star, w0, beta, clearance, lim_gains, lim_lags, N)
+    limited = math.isfinite(R)
+    return WobbleBranch(model, A, speeds, omegas, headings, gains, thirds, rates, V_star, w0, beta, clearance,
+                        lim_gains if limited else None, lim_lags if limited else None, N, controller.hold,
+                        cascades if limited and not heading_limit else None)
 
 
 def corridor_wobble(robot, controller, law: ForceLaw, L: float, tolerance: float | None = None, *, model: str = "sampled") -> Wobble:
@@ -892,6 +996,7 @@ def _wobble_at(branch: WobbleBranch, V: float, tolerance: float | None, method: 
                   f"m/s (the yaw acceleration limit lags at finite amplitude): a start{edge} jumps to {'a large cycle' if stable else 'a wall'}; "
                   "--disturbance D says which for a start of D")
         return Wobble(None, None, None, not stable, third_harmonic=None, reason=reason, **common)
+    jump = None
     if branch.criticality == "subcritical" and V > branch.fold_speed:
         unstable = [c for c in branch.cycles_at(V) if not c.stable]
         where = "a wall" if not stable else "a large cycle"
@@ -899,9 +1004,11 @@ def _wobble_at(branch: WobbleBranch, V: float, tolerance: float | None, method: 
             edge = f" (beyond the unstable cycle of {unstable[0].amplitude:.3g} m)" if unstable else ""
             reason = (f"subcritical: between V_fold = {branch.fold_speed:.4g} and V* = {branch.V_critical:.4g} m/s a small start settles "
                       f"and a large one{edge} jumps to {where}; the describing function does not say which start the robot has")
-        else:
-            reason = f"subcritical: past V* = {branch.V_critical:.4g} m/s the wobble jumps to {where}; the describing function is not trusted there"
-        return Wobble(None, None, None, not stable, third_harmonic=None, reason=reason, **common)
+            return Wobble(None, None, None, not stable, third_harmonic=None, reason=reason, **common)
+        if not stable:
+            return Wobble(None, None, None, True, third_harmonic=None,
+                          reason=f"subcritical: past V* = {branch.V_critical:.4g} m/s the wobble jumps to a wall", **common)
+        jump = f"subcritical: past V* = {branch.V_critical:.4g} m/s the wobble jumps to the large cycle"  # read below, as any cycle
     if V <= branch.V_critical:
         below = "below V*: the robot settles" if branch.criticality == "supercritical" else \
             "below V_fold: every start clear of the walls settles"
@@ -917,9 +1024,21 @@ def _wobble_at(branch: WobbleBranch, V: float, tolerance: float | None, method: 
         return Wobble(None, None, None, False, third_harmonic=cycle.third_harmonic,
                       reason=f"strong harmonics: predicted third harmonic {cycle.third_harmonic:.2f} of the fundamental "
                              f"(> {THIRD_HARMONIC_LIMIT:g}); the describing function is not trusted", **common)
-    if not cycle.rate_harmonic <= RATE_HARMONIC_LIMIT:
+    limit = rate_harmonic_limit(cycle.hold)
+    if not cycle.rate_harmonic <= limit:
         return Wobble(None, None, None, False, third_harmonic=cycle.third_harmonic,
                       reason=f"the steering-rate limit shapes the heading (its third harmonic {cycle.rate_harmonic:.3f} of the "
-                             f"fundamental > {RATE_HARMONIC_LIMIT:g}; rate describing function {cycle.rate_gain:.2f}): "
+                             f"fundamental > {limit:g}; rate describing function {cycle.rate_gain:.2f}): "
                              "the describing function is not trusted", **common)
-    return Wobble(cycle.amplitude, cycle.heading_amplitude, cycle.omega, False, third_harmonic=cycle.third_harmonic, **common)
+    if cycle.cascade:
+        shaped = reported_cycle(branch, V, cycle)
+        if shaped is None:
+            return Wobble(None, None, None, False, third_harmonic=cycle.third_harmonic,
+                          reason="the steering-rate limit clips the smoother's input (the clipped command's flank changes faster than "
+                                 "the yaw acceleration limit): the describing function is not trusted", **common)
+        common["limiter"] = (shaped.limiter_gain, shaped.limiter_lag)
+        common["method"] += "; where the steering-rate limit clips the smoother's input, that limit as the heading's rate limit"
+        return Wobble(shaped.amplitude, shaped.heading_amplitude, shaped.omega, False, third_harmonic=shaped.third_harmonic,
+                      reason="the steering-rate limit clips the smoother's input: taken as the heading's rate limit (the rate limiter's "
+                             "describing function at g*max_steering_rate), the smoother on the command", **common)
+    return Wobble(cycle.amplitude, cycle.heading_amplitude, cycle.omega, False, third_harmonic=cycle.third_harmonic, reason=jump, **common)
