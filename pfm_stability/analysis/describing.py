@@ -59,6 +59,7 @@ __all__ = [
     "saturation_df",
     "saturation_df_for_output",
     "sine_df",
+    "J1_PEAK",
     "rate_limit_df",
     "rate_limit_waveform",
     "rate_limit_correction",
@@ -216,6 +217,11 @@ def saturation_df_for_output(U, M: float):
     return float(N) if np.ndim(N) == 0 else N
 
 
+J1_PEAK = 1.8411837813406593
+"""Θ where 2J₁(Θ), the fundamental of sin(Θ sin ωt), peaks (the first zero of J₁′): a larger heading swing makes less
+lateral motion."""
+
+
 def sine_df(A):
     """N(A) of sin x: 2·J₁(A)/A (1 at A = 0), dimensionless.
 
@@ -235,9 +241,20 @@ RATE_LIMIT_TRIANGLE = math.sqrt(4.0 + math.pi**2) / 2.0
 
 
 def _follow_start(r):
-    """θ₁ of the mixed regime (module docstring) for r = 1/ρ in (1/ρ_t, 1), rad: the root of r(θ + a) − √(1 − r²) − sin θ."""
+    """θ₁ of the mixed regime (module docstring) for r = 1/ρ in (1/ρ_t, 1), rad: the root of f(θ) = r(θ + a) − √(1 − r²) − sin θ.
+
+    f increases on (a, π − a) and is convex there (f″ = sin θ > 0), with f(π − a) >= 0: Newton from π − a falls onto the
+    root monotonically, no step leaving the bracket; it converges quadratically, linearly only as ρ → 1 (f′ → 0 at the
+    root), where `numerics.solve.newton_increasing` finishes what 40 steps leave.
+    """
     a = np.arccos(r)
     root = np.sqrt(1.0 - r * r)
+    t = math.pi - a
+    for _ in range(40):
+        step = (r * (t + a) - root - np.sin(t)) / (r - np.cos(t))
+        t = t - step
+        if np.all(np.abs(step) <= 1e-15 * t):
+            return t
     return newton_increasing(lambda t: (r * (t + a) - root - np.sin(t), r - np.cos(t)), a, math.pi - a, rtol=1e-15)
 
 
@@ -266,37 +283,52 @@ def rate_limit_df(A, omega, R: float, T: float = 0.0):
     -------
     complex or ndarray of complex
     """
-    A, omega = np.broadcast_arrays(np.asarray(A, dtype=float), np.asarray(omega, dtype=float))
     if not R > 0:
         raise ValueError(f"rate_limit_df needs a rate limit R > 0; got {R!r}")
+    if np.ndim(A) == 0 and np.ndim(omega) == 0:  # one value (a harmonic balance's Newton step): no masks
+        A, omega = float(A), float(omega)
+        if not T > 0:
+            return complex(_continuous_rate_df(A * omega / R))
+        s = 2.0 * A * math.sin(0.5 * omega * T) / (R * T)
+        return complex(_continuous_rate_df(s) * rate_limit_correction(s, omega * T)) if s > 1.0 else 1.0 + 0j
+    A, omega = np.broadcast_arrays(np.asarray(A, dtype=float), np.asarray(omega, dtype=float))
     if T > 0:
         wT = omega * T
         s = 2.0 * A * np.sin(0.5 * wT) / (R * T)
-        N = np.where(s > 1.0, _continuous_rate_df(s) * rate_limit_correction(s, wT), 1.0 + 0j)
-    else:
-        N = _continuous_rate_df(A * omega / R)
-    return complex(N) if np.ndim(N) == 0 else N
+        return np.where(s > 1.0, _continuous_rate_df(s) * rate_limit_correction(s, wT), 1.0 + 0j)
+    return _continuous_rate_df(A * omega / R)
 
 
 def _continuous_rate_df(rho):
-    """N(ρ) of the continuous rate limiter (module docstring), complex array."""
+    """N(ρ) of the continuous rate limiter (module docstring), complex (an array for an array ρ)."""
+    if np.ndim(rho) == 0:  # one value: its regime's formula alone (the same formulas, no masks)
+        rho = float(rho)
+        return 1.0 + 0j if rho <= 1.0 else complex(_triangle_df(1.0 / rho) if rho >= RATE_LIMIT_TRIANGLE else _mixed_df(1.0 / rho))
     rho = np.asarray(rho, dtype=float)
     N = np.ones(rho.shape, dtype=complex)
     triangle = rho >= RATE_LIMIT_TRIANGLE
-    r = 1.0 / rho[triangle]
-    N[triangle] = (4.0 * r / math.pi) * np.exp(-1j * np.arccos(0.5 * math.pi * r))
+    N[triangle] = _triangle_df(1.0 / rho[triangle])
     mixed = (rho > 1.0) & ~triangle
     if np.any(mixed):
-        r = 1.0 / rho[mixed]
-        t1, t2 = _follow_start(r), math.pi - np.arccos(r)
-        t3, top = t1 + math.pi, np.sqrt(1.0 - r * r)
-        ramp = lambda t: top - r * (t - t2)
-        sin_part = (0.5 * (t2 - t1) - 0.25 * (np.sin(2 * t2) - np.sin(2 * t1))
-                    + (-ramp(t3) * np.cos(t3) - r * np.sin(t3)) - (-ramp(t2) * np.cos(t2) - r * np.sin(t2)))
-        cos_part = (0.5 * (np.sin(t2) ** 2 - np.sin(t1) ** 2)
-                    + (ramp(t3) * np.sin(t3) - r * np.cos(t3)) - (ramp(t2) * np.sin(t2) - r * np.cos(t2)))
-        N[mixed] = (2.0 / math.pi) * (sin_part + 1j * cos_part)
+        N[mixed] = _mixed_df(1.0 / rho[mixed])
     return N
+
+
+def _triangle_df(r):
+    """(4r/π)·e^(−j·arccos(πr/2)): the triangle's N for r = 1/ρ <= 1/ρ_t."""
+    return (4.0 * r / math.pi) * np.exp(-1j * np.arccos(0.5 * math.pi * r))
+
+
+def _mixed_df(r):
+    """b₁ + j·a₁ of the follow-and-ramp output for r = 1/ρ in (1/ρ_t, 1) (module docstring), in closed form given θ₁."""
+    t1, t2 = _follow_start(r), math.pi - np.arccos(r)
+    t3, top = t1 + math.pi, np.sqrt(1.0 - r * r)
+    ramp = lambda t: top - r * (t - t2)
+    sin_part = (0.5 * (t2 - t1) - 0.25 * (np.sin(2 * t2) - np.sin(2 * t1))
+                + (-ramp(t3) * np.cos(t3) - r * np.sin(t3)) - (-ramp(t2) * np.cos(t2) - r * np.sin(t2)))
+    cos_part = (0.5 * (np.sin(t2) ** 2 - np.sin(t1) ** 2)
+                + (ramp(t3) * np.sin(t3) - r * np.cos(t3)) - (ramp(t2) * np.sin(t2) - r * np.cos(t2)))
+    return (2.0 / math.pi) * (sin_part + 1j * cos_part)
 
 
 def rate_limit_waveform(rho: float, theta):
@@ -390,7 +422,7 @@ def rate_limit_correction(s, omega_T):
     x = np.log(np.clip(np.asarray(s, dtype=float), _CORRECTION_S[0], _CORRECTION_S[-1]))
     y = np.clip(np.asarray(omega_T, dtype=float), 0.0, _CORRECTION_OMEGA_T)
     exponent = sum(spline(x) * y ** (i + 1) for i, spline in enumerate(splines))
-    return np.exp(exponent)
+    return complex(np.exp(exponent)) if np.ndim(exponent) == 0 else np.exp(exponent)
 
 
 def loeb_stable(delta, A: float, omega: float, *, step: float = 1e-6) -> bool:

@@ -140,7 +140,7 @@ def disturbance_speed(branch: WobbleBranch, robot, controller, disturbance: floa
         The field's δ(x) (`start_amplitude`).
     """
     A, S = branch.amplitudes, branch.speeds
-    reach_of = lambda v: start_amplitude(robot, controller, branch.gain, v, disturbance, branch.model, steering)
+    reach_of = _start_amplitudes(branch, robot, controller, disturbance, steering)
     best, at = branch.V_critical, reach_of(branch.V_critical)
     previous = None
     for a, v in zip(A, S):
@@ -159,6 +159,20 @@ def disturbance_speed(branch: WobbleBranch, robot, controller, disturbance: floa
             best, at = v, reach + a
         previous = (a, v, reach)
     return float(best), float(at)
+
+
+_SPEEDS = 24
+"""Speeds at which `disturbance_speed` runs the start (`start_amplitude`), interpolated between: a(V) is smooth in V."""
+
+
+def _start_amplitudes(branch: WobbleBranch, robot, controller, disturbance: float, steering):
+    """V ↦ a(V) over the branch's speeds: `start_amplitude` at `_SPEEDS` speeds from the branch's slowest to V*, linear between."""
+    finite = branch.speeds[np.isfinite(branch.speeds)]
+    lo = float(min(finite.min(), branch.V_critical)) if finite.size else branch.V_critical
+    hi = float(max(finite.max(), branch.V_critical)) if finite.size else branch.V_critical
+    grid = np.linspace(lo, hi, _SPEEDS) if hi > lo else np.array([lo])
+    values = np.array([start_amplitude(robot, controller, branch.gain, v, disturbance, branch.model, steering) for v in grid])
+    return lambda v: float(np.interp(v, grid, values))
 
 
 @dataclass(frozen=True)

@@ -61,7 +61,8 @@ from ..laws.effective_force import corridor_lateral_force
 from ..laws.force_law import ForceLaw, corridor_gain, wall_equilibrium, wall_gain
 from ..models import make_model
 from ..models.base import Loop
-from .describing import describing_function, harmonic_content, rate_limit_df, rate_limit_waveform, saturation_df_for_output
+from .describing import J1_PEAK, describing_function, harmonic_content, saturation_df_for_output
+from .limiter import limited_balance, loop_filtering
 
 __all__ = [
     "WOBBLE_MODELS",
@@ -83,7 +84,6 @@ __all__ = [
     "reported_cycle",
     "RATE_HARMONIC_LIMIT",
     "HELD_COMMAND_RATE_HARMONIC_LIMIT",
-    "command_responses",
     "limited_branch",
 ]
 
@@ -109,9 +109,6 @@ servo's (``hold="reference"``) reached −10 % at 0.023 and −29 % at 0.043: `R
 
 DEFAULT_TOLERANCE_FRACTION = 0.1
 """`report --wobble` without a value: a tenth of the clearance L − W/2 (the play the robot has either side)."""
-
-_J1_PEAK = 1.8411837813406593
-"""Θ where 2J₁(Θ) peaks (the first zero of J₁′): a larger heading swing makes less lateral motion."""
 
 _BRANCH_POINTS = 240
 
@@ -588,12 +585,6 @@ def _fundamental_input(U: float, M: float) -> float:
     return U / saturation_df_for_output(U, M)
 
 
-def _filtering(omega: float, tau: float, k: float) -> float:
-    """|L(3jω)|/|L(jω)| with L(s) = 1/(s(τs² + s + k))."""
-    L = lambda s: 1.0 / (s * (tau * s * s + s + k))
-    return abs(L(3j * omega)) / abs(L(1j * omega))
-
-
 class _GainTable:
     """NV*(k·f) and ω*(k·f) of the loop model for steering-gain factors f in [0.02, 1], splined in log f (computed once)."""
 
@@ -724,102 +715,34 @@ def _branch_of(robot, controller, delta, N: float, A, Nf, clearance: float, mode
                 continue
             NV, w = table(factor)
             theta = a * w * nf / NV
-        if not theta < _J1_PEAK:
+        if not theta < J1_PEAK:
             continue
         U = theta * w * math.hypot(1.0, w * tau)
         speeds[i] = a * w / (2.0 * special.j1(theta))
         omegas[i], headings[i], gains[i] = w, theta, factor
         h3_rate = harmonic_content(sat, _fundamental_input(U, M)) if factor < 1.0 else 0.0
         rates[i] = h3_rate * math.hypot(1.0, w * tau) / (3.0 * math.hypot(1.0, 3.0 * w * tau))
-        thirds[i] = (h3[i] + h3_rate) * _filtering(w, tau, k * factor) \
+        thirds[i] = (h3[i] + h3_rate) * loop_filtering(w, tau, k * factor) \
             + special.jv(3, theta) / (3.0 * special.j1(theta))
     beta = beta_f - w0**2 / (8.0 * V_star**2)
     return WobbleBranch(model, A, speeds, omegas, headings, gains, thirds, rates, V_star, w0, beta, clearance, gain=N, hold=controller.hold)
-
-
-def command_responses(robot, controller, model: str):
-    """ω ↦ (H₀, H₁): the loop seen from its command, in the motor's units, for the harmonic balance with the drive's limiter.
-
-    The applied command w (motor units, g·u after the limiter) drives the plant, the controller computes
-    v = −(H₀ + K·H₁)·w with K = g·k·NV, so a describing function N_c on the command closes the loop where
-    1 + N_c·(H₀ + K·H₁) = 0. `sampled` (T > 0): the sampled loop's own matrices (`models.sampled.command_form`,
-    x_(k+1) = M·x_k + n·w_k, v_k = −(F0 + K·F1)·x_k), H_i = F_i·(zI − M)⁻¹·n at z = e^(jωT); otherwise the
-    continuous loop with the whole command delayed by D and the field's term by T more,
-    H₀ = g·k·e^(−jωD)/(jω(jωτ + 1)), H₁ = e^(−jω(T + D))/((jω)²(jωτ + 1)): τs³ + s² + gk(s + NV·e^(−sT))·e^(−sD) = 0
-    with N_c = 1.
-
-    Parameters
-    ----------
-    robot : parameters.Robot
-        τ, k, g, D.
-    controller : parameters.Controller
-        T, compute delay (``hold="command"``).
-    model : {"exact_delay", "sampled"}
-
-    Returns
-    -------
-    callable
-        ω (array, rad/s) ↦ (H₀, H₁) (complex arrays).
-    """
-    from ..models.sampled import command_form
-
-    gk, D, T = robot.plant_gain * robot.k, robot.dead_time, controller.T
-    loop = Loop(robot.tau, T, gk, dead_time=D)
-    tau = loop.tau
-    if model == "sampled" and T > 0:
-        M, n, F0, F1 = command_form(loop, "command", controller.compute_delay)
-        eye = np.eye(M.shape[0])
-
-        def sampled(w):
-            z = np.exp(1j * np.asarray(w, dtype=float) * T)
-            X = np.linalg.solve(z[..., None, None] * eye - M, np.broadcast_to(n, z.shape + n.shape)[..., None])[..., 0]
-            return X @ F0, X @ F1
-
-        return sampled
-
-    def continuous(w):
-        s = 1j * np.asarray(w, dtype=float)
-        plant = np.exp(-s * D) / (s * (tau * s + 1.0))
-        return gk * plant, np.exp(-s * T) * plant / s
-
-    return continuous
-
-
-def _limiter_harmonic(rho: float) -> float:
-    """|3rd harmonic|/|fundamental| of the continuous rate limiter's output at ρ (1/9 for the triangle, 0 for ρ <= 1)."""
-    if rho <= 1.0:
-        return 0.0
-    theta = _circle_nodes()
-    spectrum = np.abs(np.fft.rfft(rate_limit_waveform(rho, theta)))
-    return float(spectrum[3] / spectrum[1])
-
-
-@functools.lru_cache(maxsize=1)
-def _circle_nodes():
-    return 2.0 * math.pi * np.arange(256) / 256
 
 
 def limited_branch(robot, controller, delta, N: float, A, Nf, clearance: float, model: str, beta_f: float, *,
                    heading_limit: bool = False) -> WobbleBranch:
     """The branch V(A) with the drive's yaw acceleration limit R: the rate limiter as one more describing function.
 
-    The quasi-linear loop of the module docstring, with the command's describing function
-    N_c = n_s(E)·N_r(U, ω) (the saturation at g·ω_max, then the limiter at g·R, `describing.rate_limit_df`:
-    sampled at T for the `sampled` loop, as the simulator's smoother acts once per period, continuous for
-    `exact_delay`) complex — a phase lag the loop's own boundary cannot carry — so each amplitude A solves the
-    harmonic balance 1 + N_c·(H₀(ω) + K'·H₁(ω)) = 0 (`command_responses`) in (ω, U), U the limiter's input amplitude:
-    its output's fundamental |N_r|·U = Θ·ω·√(1 + ω²τ²) fixes Θ, K' = g·k·N_f(A)·A·ω/Θ and V = Aω/(2J₁(Θ)), as
-    without the limit. Newton (scipy ``root``) continues along A from the linear solution (NV*, ω*) at the smallest
-    amplitude, where the limiter is linear; an amplitude whose balance does not converge is left out (nan).
+    The quasi-linear loop of the module docstring with the command's describing function N_c = n_s(E)·N_r(U, ω) (the
+    saturation at g·ω_max, then the limiter at g·R, `describing.rate_limit_df`: sampled at T for the `sampled` loop, as
+    the simulator's smoother acts once per period; continuous for `exact_delay`), complex: each amplitude solves
+    1 + N_c·(H₀(ω) + K'·H₁(ω)) = 0 on the loop seen from its command (`limiter.limited_balance`), U the limiter's input
+    amplitude, |N_r|·U = Θ·ω·√(1 + ω²τ²), K' = g·k·N_f(A)·A·ω/Θ, V = Aω/(2J₁(Θ)) as without the limit. Below the
+    limiter's threshold N_r = 1 and the branch is the one without it, so β is unchanged: the limiter acts at finite
+    amplitude, where its lag bends V(A) down — cycles below V* (`WobbleBranch.fold_speed`).
 
-    Below the limiter's threshold (ρ = Uω/(gR) <= 1, and every step within g·R·T for the sampled limiter) N_r = 1 and
-    the branch is the one without it, so β (the Hopf coefficient at V*) is unchanged: the limiter acts at finite
-    amplitude, where its phase lag bends V(A) down — cycles below V* (`WobbleBranch.fold_speed`).
-
-    ``heading_limit``: the steering-rate limit as the heading's rate limit instead (`heading_limited_branch`): with a
-    fast motor the saturated command turns θ at g·ω_max, so θ = RL(θ_lin), the rate limiter's describing function
-    N_h(θ_lin·ω/(g·ω_max)) (continuous) on the linear servo's heading θ_lin, acting on the field's path only:
-    1 + N_r·(H₀ + N_h·K'·H₁) = 0, Θ = |N_h|·θ_lin; R = inf gives N_r = 1.
+    ``heading_limit``: the steering-rate limit as the heading's rate limit instead — θ = RL(θ_lin), the rate limiter's
+    describing function N_h(θ_lin·ω/(g·ω_max)) on the linear servo's heading, on the field's path only:
+    1 + N_r·(H₀ + N_h·K'·H₁) = 0 — where the saturation clips the smoother's input (`WobbleCycle.cascade`).
 
     Parameters
     ----------
@@ -841,80 +764,12 @@ def limited_branch(robot, controller, delta, N: float, A, Nf, clearance: float, 
     heading_limit : bool
         The steering-rate limit on the heading (module docstring, "Trust").
     """
-    if controller.hold != "command":
-        raise ValueError(f"yaw_accel_limit needs hold=command (a servo closing k(δ − θ) continuously has no command sequence to "
-                         f"limit; docs/wobble.md); got hold={controller.hold}")
-    loop_model = make_model(model, hold=controller.hold, compute_delay=controller.compute_delay)
-    g, D = robot.plant_gain, robot.dead_time
-    gk, M, R = g * robot.k, g * robot.max_steering_rate, g * robot.yaw_accel_limit
-    T = controller.T
-    tau = Loop(robot.tau, T, gk, dead_time=D).tau
-    limiter_T = T if model == "sampled" else 0.0
-    b = loop_model.boundary(Loop(tau, T, gk, dead_time=D))
-    NV0, w0 = b.NV_critical, b.omega_critical
-    if not (math.isfinite(NV0) and NV0 > 0 and w0):
-        raise ValueError(f"the {model} loop has no oscillatory stability boundary here (NV* = {NV0:g} 1/s): no wobble to predict")
-    responses = command_responses(robot, controller, model)
-    h3_field = harmonic_content(delta, A)
-
-    def state(x, a, nf):
-        w, U = math.exp(x[0]), math.exp(x[1])
-        n_s = 1.0 if U <= M or heading_limit else float(saturation_df_for_output(U, M))
-        step = 2.0 * U * math.sin(0.5 * w * limiter_T) / (R * limiter_T) if limiter_T > 0 else U * w / R  # <= 1: not limiting
-        N_r = complex(rate_limit_df(U, w, R, limiter_T)) if step > 1.0 else 1.0 + 0j
-        theta = abs(N_r) * U / (w * math.hypot(1.0, w * tau))
-        N_h = complex(rate_limit_df(theta, w, M)) if heading_limit and theta * w > M else 1.0 + 0j
-        theta *= abs(N_h)
-        return w, U, n_s, N_r, N_h, theta, gk * nf * a * w / theta
-
-    def residual(x, a, nf):
-        w, U, n_s, N_r, N_h, theta, K = state(x, a, nf)
-        if not n_s > 0:
-            return [1e6, 1e6]
-        H0, H1 = responses(np.array([w]))
-        r = 1.0 + n_s * N_r * (complex(H0[0]) + N_h * K * complex(H1[0]))
-        return [r.real, r.imag]
-
-    speeds, omegas, headings, gains, thirds, rates, lim_gains, lim_lags = (np.full(A.size, np.nan) for _ in range(8))
-    cascades = np.zeros(A.size, dtype=bool)
-    theta0 = A[0] * w0 * Nf[0] / NV0
-    linear = np.array([math.log(w0), math.log(theta0 * w0 * math.hypot(1.0, w0 * tau))])  # U ∝ A on the linear part
-    guess = linear
-    for i, (a, nf) in enumerate(zip(A, Nf)):
-        if not math.isfinite(nf):
-            continue
-        solved = None
-        attempts = ((guess, "hybr"), (guess, "lm"), (linear + np.array([0.0, math.log(a / A[0])]), "hybr"))
-        for start, method in attempts:  # Powell's hybrid, then Levenberg–Marquardt where the limiter's onset kinks N_r
-            sol = optimize.root(residual, start, args=(a, nf), method=method, options={"xtol": 1e-13})
-            if math.hypot(*residual(sol.x, a, nf)) <= 1e-9:
-                solved = sol.x
-                break
-        if solved is None:
-            continue
-        guess = solved
-        w, U, n_s, N_r, N_h, theta, _ = state(solved, a, nf)
-        if not theta < _J1_PEAK:
-            continue
-        speeds[i] = a * w / (2.0 * special.j1(theta))
-        omegas[i], headings[i], gains[i] = w, theta, n_s * abs(N_h)
-        lim_gains[i], lim_lags[i] = abs(N_r), -math.atan2(N_r.imag, N_r.real)
-        E = U / n_s  # the saturation's input: its clipped flank still rises at E·ω, which the smoother may not follow
-        flank = 2.0 * E * math.sin(0.5 * w * limiter_T) / (R * limiter_T) if limiter_T > 0 else E * w / R
-        cascades[i] = n_s < 1.0 and flank > 1.0
-        h3_sat = harmonic_content(lambda x: np.clip(x, -M, M), U / n_s) if n_s < 1.0 else 0.0
-        h3_lim = _limiter_harmonic(U * w / R) if math.isfinite(R) else 0.0
-        to_heading = math.hypot(1.0, w * tau) / (3.0 * math.hypot(1.0, 3.0 * w * tau))
-        h3_head = _limiter_harmonic(theta / abs(N_h) * w / M) if heading_limit else 0.0  # the heading's own triangle
-        rates[i] = h3_sat * to_heading + h3_head
-        thirds[i] = (h3_field[i] + h3_sat + h3_lim) * _filtering(w, tau, gk * n_s * abs(N_r)) + h3_head / 3.0 \
-            + special.jv(3, theta) / (3.0 * special.j1(theta))
-    V_star = NV0 / N
-    beta = beta_f - w0**2 / (8.0 * V_star**2)
-    limited = math.isfinite(R)
-    return WobbleBranch(model, A, speeds, omegas, headings, gains, thirds, rates, V_star, w0, beta, clearance,
-                        lim_gains if limited else None, lim_lags if limited else None, N, controller.hold,
-                        cascades if limited and not heading_limit else None)
+    balance = limited_balance(robot, controller, delta, A, Nf, model, heading_limit=heading_limit)
+    V_star = balance.NV_critical / N
+    beta = beta_f - balance.omega_critical**2 / (8.0 * V_star**2)
+    b = balance
+    return WobbleBranch(model, A, b.speeds, b.omegas, b.headings, b.rate_gains, b.third_harmonics, b.rate_harmonics, V_star,
+                        b.omega_critical, beta, clearance, b.limiter_gains, b.limiter_lags, N, controller.hold, b.cascades)
 
 
 def corridor_wobble(robot, controller, law: ForceLaw, L: float, tolerance: float | None = None, *, model: str = "sampled") -> Wobble:

@@ -52,6 +52,7 @@ _LABELS = {
     "dead_time": "D (steering plant dead time)",
     "plant_gain": "g (steering plant gain)",
     "yaw_accel_limit": "R (drive's yaw accel limit)",
+    "max_steering_rate": "omega_max (steering-rate limit)",
     "f": "f (force ratio)",
     "n": "n (repulsion exponent)",
     "W": "W (robot width)",

@@ -54,9 +54,10 @@ PLANT_INPUTS = ("dead_time", "plant_gain")
 """The steering plant's dead time D and gain g (`parameters.Robot`), listed after k only when given: a value other than
 the default (D = 0, g = 1) or one the user typed (`plant_inputs`), so reports without them are as before."""
 
-DRIVE_INPUTS = ("yaw_accel_limit",)
-"""The drive's limits beyond the plant: its yaw acceleration limit R (`parameters.Robot`), listed after the plant only when
-the robot has one (finite), so reports without it are as before (`drive_inputs`)."""
+DRIVE_INPUTS = ("yaw_accel_limit", "max_steering_rate")
+"""The drive's limits beyond the plant: its yaw acceleration limit R and, when a file gave it with R (a Nav2 velocity
+smoother's velocity clamp), its steering-rate limit (`parameters.Robot`), listed after the plant only when the robot has
+a finite R, so reports without it are as before (`drive_inputs`)."""
 
 INPUTS = ("V", "tau", "T", "k", *PLANT_INPUTS, *DRIVE_INPUTS, "f", "n", "W", *LAW_INPUTS, "hold", "compute_delay", "pade_order", "alpha_deg", "L")
 """The report's inputs for a static law, in the order it lists them (``alpha_deg`` and ``L`` when given; f and n for KB's laws only)."""
@@ -520,7 +521,7 @@ def _static_report(robot, controller, law, alpha, alpha_deg, L, models, pade_ord
         raise ValueError(f"sources must be a dict of parameter name to provenance; got {sources!r}")
     model_objs = tuple(models_for(controller, tuple(dict.fromkeys(models)), pade_order=pade_order))
     sources = sources or {}
-    values = {"V": robot.V, "tau": robot.tau, "T": controller.T, "k": robot.k, **plant_inputs(robot, sources), **drive_inputs(robot), "f": controller.f,
+    values = {"V": robot.V, "tau": robot.tau, "T": controller.T, "k": robot.k, **plant_inputs(robot, sources), **drive_inputs(robot, sources), "f": controller.f,
               "n": controller.n, "W": robot.W, "hold": controller.hold, "compute_delay": controller.compute_delay, "pade_order": pade_order}
     law = law_in_force(robot, controller, law)
     values = _law_inputs(values, law)
@@ -635,25 +636,33 @@ def plant_inputs(robot: Robot, sources: dict | None) -> dict:
     return shown
 
 
-def drive_inputs(robot: Robot) -> dict:
-    """{"yaw_accel_limit": R} when the robot's drive limits its commanded yaw rate's change (R finite, rad/s²), else {}.
+def drive_inputs(robot: Robot, sources: dict | None = None) -> dict:
+    """{"yaw_accel_limit": R} when the robot's drive limits its commanded yaw rate's change (R finite, rad/s²), and its
+    ``max_steering_rate`` (rad/s) when `sources` says where it came from (a Nav2 velocity smoother's clamp); else {}.
 
-    The loop models are linear and do not see it: their verdicts are those of small disturbances, where the limiter
+    The loop models are linear and do not see them: their verdicts are those of small disturbances, where the limiter
     passes every command (docs/wobble.md, ``--disturbance``).
 
     Parameters
     ----------
     robot : parameters.Robot
         The robot, with `yaw_accel_limit` (inf: none).
+    sources : dict, optional
+        Parameter name → provenance.
     """
-    return {"yaw_accel_limit": robot.yaw_accel_limit} if math.isfinite(robot.yaw_accel_limit) else {}
+    if not math.isfinite(robot.yaw_accel_limit):
+        return {}
+    shown = {"yaw_accel_limit": robot.yaw_accel_limit}
+    if "max_steering_rate" in (sources or {}):
+        shown["max_steering_rate"] = robot.max_steering_rate
+    return shown
 
 
 def _family_inputs(robot, controller, family, law, mass, pade_order, wall, corridor, sources) -> dict:
     """The report's inputs: the robot family, the robot and controller, the law's parameters and choices, the geometry."""
     holonomic = family == "holonomic"
     values = {"robot": family, "V": robot.V, "tau": robot.tau, "T": controller.T, "k": robot.k, **plant_inputs(robot, sources),
-              **drive_inputs(robot)}
+              **drive_inputs(robot, sources)}
     if holonomic:
         values["mass"] = mass
     values.update(law.parameters)
