@@ -14,7 +14,13 @@ Where the simulator settles on a steady cycle clear of the walls (a "cycle" belo
   (`analysis.wobble.reported_cycle`);
 
 each either a number (a trusted cycle, `analysis.wobble.trusted_cycle`) or "not given" (with the reason). The table
-counts the cycles each gives a number for and how many of those are within 15 % of the simulated amplitude.
+counts the cycles each gives a number for and how many of those are within 15 % of the simulated amplitude. The same
+for the 30 random robots of experiments/wobble_amplitude.py (no limit) at 1.05–1.5·V*.
+
+Then the boundary for a start of a given size (`report --disturbance`): V*(D) predicted by the branch
+(`analysis.disturbance.disturbance_speed`) against the simulator's, bisected to 1 % (`validation.disturbance`), for
+CARMEL with a 2 rad/s² smoother in the 0.9 m corridor and for a skid-steer-like robot (11 Hz, a period of compute
+delay, 40 ms dead time, 2 rad/s²) in a narrow corridor (0.35 m of play).
 
     python experiments/wobble_limiter.py --out experiments/results [--quick]
 """
@@ -33,6 +39,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from _common import output_dir, row, save_figure, script_main, write_json  # noqa: E402
 
 from pfm_stability.analysis.wobble import THIRD_HARMONIC_LIMIT, corridor_branch, corridor_wobble  # noqa: E402
+from pfm_stability.parameters import CARMEL  # noqa: E402
+from pfm_stability.validation.disturbance import disturbance_boundary  # noqa: E402
 from pfm_stability.parameters import Controller, Robot  # noqa: E402
 from pfm_stability.validation.wobble import WobbleCase, case_law, simulate_wobbles  # noqa: E402
 
@@ -140,11 +148,27 @@ def summary(cases) -> dict:
     return out
 
 
-def _figure(cases, path):
+NARROW = (Robot(V=1.0, tau=0.2, k=3.0, W=0.5, max_steering_rate=math.radians(150.0), dead_time=0.04, plant_gain=0.9, yaw_accel_limit=2.0),
+          Controller(f=1.0, n=2.0, T=1 / 11, hold="command", compute_delay=1), 0.6)
+DISTURBANCE_SETS = (("CARMEL, 2 rad/s², L = 0.9 m", CARMEL.robot.replace(yaw_accel_limit=2.0), CARMEL.controller, 0.9, (0.01, 0.05, 0.1, 0.15, 0.2, 0.3)),
+                    ("skid-steer-like, 2 rad/s², L = 0.6 m", *NARROW, (0.01, 0.03, 0.05, 0.1)))
+
+
+def disturbance_check(quick: bool) -> list:
+    """V*(D) predicted and simulated for every start of `DISTURBANCE_SETS`."""
+    out = []
+    for name, robot, controller, L, starts in DISTURBANCE_SETS:
+        for D in starts[:2] if quick else starts:
+            b = disturbance_boundary(D, robot=robot, controller=controller, L=L, members=7, rtol=0.01)
+            out.append({"set": name, **b.to_dict()})
+    return out
+
+
+def _figure(cases, path, boundaries=()):
     import matplotlib.pyplot as plt
 
     cycles = [c for c in cases if c["cycle"]]
-    fig, axes = plt.subplots(1, 2, figsize=(12, 5.2))
+    fig, axes = plt.subplots(1, 3, figsize=(17, 5.2))
     for ax, key in zip(axes, ("before", "after")):
         for limited, colour, label in ((False, "C0", "no yaw acceleration limit"), (True, "C3", "with a yaw acceleration limit")):
             pick = [c for c in cycles if (c["yaw_accel_limit"] is not None) == limited]
@@ -160,6 +184,16 @@ def _figure(cases, path):
         ax.set(title=f"{key} the limiter's describing function", xlabel="simulated amplitude / (L - W/2)",
                ylabel="report --wobble amplitude / (L - W/2)  (x: not given)", xlim=(0, 1), ylim=(0, 1))
         ax.legend(fontsize=7, loc="upper left")
+    ax = axes[2]
+    for (name, *_), marker in zip(DISTURBANCE_SETS, ("o", "s")):
+        pick = [b for b in boundaries if b["set"] == name]
+        ax.plot([b["disturbance"] for b in pick], [b["predicted"] / b["V_critical"] for b in pick], "-", marker=marker, mfc="none",
+                label=f"{name}: describing function")
+        ax.errorbar([b["disturbance"] for b in pick], [b["simulated"] / b["V_critical"] for b in pick],
+                    yerr=[[(b["simulated"] - b["lo"]) / b["V_critical"] for b in pick], [(b["hi"] - b["simulated"]) / b["V_critical"] for b in pick]],
+                    fmt=marker, color="k", ms=4, label=f"{name}: simulated (bisected)")
+    ax.set(title="the speed at or below which a start of D settles", xlabel="start D, m", ylabel="V*(D) / V* (linear)", ylim=(0, 1.1))
+    ax.legend(fontsize=7, loc="lower left")
     fig.tight_layout()
     save_figure(fig, path)
 
@@ -170,13 +204,16 @@ def run(out, quick: bool = False) -> dict:
     result = check(robots(10 if quick else 44))
     earlier = check(earlier_robots(3 if quick else 30))
     s, e = summary(result["cases"]), summary(earlier["cases"])
-    _figure(result["cases"] + earlier["cases"], out / "wobble_limiter.png")
+    boundaries = disturbance_check(quick)
+    _figure(result["cases"] + earlier["cases"], out / "wobble_limiter.png", boundaries)
     describe = lambda s: (f"{s['cycles']} simulated cycles ({s['limited_cycles']} with a limit): a number for {s['before']['given']} before "
                           f"({s['before']['within']} within {100 * TOLERANCE:.0f} %), {s['after']['given']} after ({s['after']['within']} "
                           f"within); of the {s['unreliable_before']} not given before, {s['unreliable_given_after']} given after, "
                           f"{s['unreliable_within_after']} within {100 * TOLERANCE:.0f} %")
-    finding = (f"this set: {describe(s)}; wobble_amplitude.py's robots: {describe(e)}; {time.perf_counter() - started:.0f} s")
-    result.update({"summary": s, "earlier": earlier, "earlier_summary": e, "finding": finding,
+    worst = max(abs(b["error"]) for b in boundaries)
+    finding = (f"this set: {describe(s)}; wobble_amplitude.py's robots: {describe(e)}; V*(D) of {len(boundaries)} starts within "
+               f"{100 * worst:.1f} % of the simulator; {time.perf_counter() - started:.0f} s")
+    result.update({"summary": s, "earlier": earlier, "earlier_summary": e, "boundaries": boundaries, "finding": finding,
                    "rows": [row("wobble_limiter", "report --wobble with the yaw acceleration limit", "-",
                                 f"{s['after']['given']} of {s['cycles']} cycles given", f"{s['after']['within']} within 15 %", finding)]})
     write_json(out / "wobble_limiter.json", result)

@@ -42,8 +42,12 @@ its fundamental: the third harmonics of the field (of δ(A sin θ)) and of the r
 L(s) = 1/(s(τs² + s + k')), plus the heading's, J₃(Θ)/(3J₁(Θ)) (ẏ = V sin θ integrated once). Above `THIRD_HARMONIC_LIMIT`, where the rate limit holds the
 cycle — `rate_harmonic`, the third harmonic the limit puts into the heading over the
 fundamental, h₃(sat(E sin θ))·|P(3jω)|/|P(jω)| with P(s) = 1/(s(τs + 1)) (the rate's way to
-θ), above `RATE_HARMONIC_LIMIT` — on a subcritical branch, or where the heading swing passes
-the peak of 2J₁ (Θ > 1.84 rad), a report prints no amplitude and says why (`trusted_cycle`).
+θ), above its hold's limit (`rate_harmonic_limit`: `RATE_HARMONIC_LIMIT` for the servo,
+`HELD_COMMAND_RATE_HARMONIC_LIMIT` for a held command) — between a subcritical branch's fold and V*, or where the heading
+swing passes the peak of 2J₁ (Θ > 1.84 rad), a report prints no amplitude and says why (`trusted_cycle`).
+
+With the drive's yaw acceleration limit see `limited_branch` (and `reported_cycle` where the saturation clips the
+smoother's input).
 """
 
 from __future__ import annotations
@@ -100,12 +104,9 @@ out 8–29 % low and ω 3–18 % high at 0.026–0.063 in experiments/wobble_amp
 
 HELD_COMMAND_RATE_HARMONIC_LIMIT = 0.04
 """`RATE_HARMONIC_LIMIT` for a held command (``hold="command"``): there the saturation acts on the sampled command, not
-inside a continuous servo, and its describing function held to the simulator further: every held-command cycle measured
-with a `rate_harmonic` from 0.02 to 0.04 within 11 % in amplitude (the seven of experiments/wobble_amplitude.py within
-8 % and 3.7 % in ω, experiments/wobble_limiter.py's within 7 %, the 25 ms map robot of tests/test_map_wobble.py −5 % at
-0.022 and −11 % at 0.034), beyond it −5 % (0.042), −21 % (0.050), −14 % (0.053), −4 % (0.057), −19 % (0.063). The
-servo's (``hold="reference"``) reached −10 % at 0.023 and −29 % at 0.043: `RATE_HARMONIC_LIMIT` stays its limit
-(docs/wobble.md, "When the describing function is not trusted")."""
+inside a continuous servo: every held-command cycle measured with a `rate_harmonic` from 0.02 to 0.04 came within 11 %
+in amplitude (wobble_amplitude.py's seven within 8 % and 3.7 % in ω), beyond it −5 to −21 %; the servo's
+(``hold="reference"``) −10 % at 0.023, −29 % at 0.043 (docs/wobble.md, "When the describing function is not trusted")."""
 
 DEFAULT_TOLERANCE_FRACTION = 0.1
 """`report --wobble` without a value: a tenth of the clearance L − W/2 (the play the robot has either side)."""

@@ -442,23 +442,11 @@ def _with_wobble(wobble, robot, controller, *, family, law, L, **options) -> Sta
     hold and compute delay, the exact-delay loop for a continuous controller), or the reason it has none (N <= 0, …)."""
     from ..analysis.wobble import Wobble, corridor_wobble, wall_wobble
 
-    if (L is None and options["alpha"] is None and options["alpha_deg"] is None) or family == "holonomic" \
-            or (law is not None and not isinstance(law, ForceLaw)):
-        raise ValueError(_WOBBLE_REFUSED)
+    _check_nonlinear(_WOBBLE_REFUSED, family, law, L, options)
     tolerance = None if wobble is True else check_parameter("wobble", wobble)
     report = build_report(robot, controller, family=family, law=law, L=L, **options)
-    steering = robot.replace(tau=0.0) if family == "kinematic" else robot
-    force_law = law_in_force(robot, controller, law)
-    model = "sampled" if controller.T > 0 else "exact_delay"
-
-    def predicted(function, where):
-        try:
-            return function(steering, controller, force_law, where, tolerance, model=model)
-        except ValueError as exc:
-            return Wobble.unavailable(str(exc), tolerance)
-
-    corridor = predicted(corridor_wobble, report.corridor.L) if report.corridor is not None else None
-    wall = predicted(wall_wobble, math.radians(report.wall.alpha_deg)) if report.wall is not None else None
+    corridor, wall = _each_geometry(report, robot, controller, family, law, (corridor_wobble, wall_wobble), tolerance,
+                                    lambda reason: Wobble.unavailable(reason, tolerance))
     return replace(report, wobble=corridor, wall_wobble=wall)
 
 
@@ -469,28 +457,43 @@ _DISTURBANCE_REFUSED = ("--disturbance applies to a wall (--alpha) or a corridor
 
 def _with_disturbance(disturbance, robot, controller, *, family, law, L, **options) -> StabilityReport:
     """`build_report` (with its wobble, if asked) and what a start of size D does in the corridor and beside the wall
-    (`analysis.disturbance`; the sampled loop with the controller's hold and compute delay, `exact_delay` for T = 0), or
-    why it cannot be said (N <= 0, no oscillatory boundary, …)."""
+    (`analysis.disturbance`), or why it cannot be said (N <= 0, no oscillatory boundary, …)."""
     from ..analysis.disturbance import Disturbance, corridor_disturbance, wall_disturbance
 
-    if (L is None and options["alpha"] is None and options["alpha_deg"] is None) or family == "holonomic" \
-            or (law is not None and not isinstance(law, ForceLaw)):
-        raise ValueError(_DISTURBANCE_REFUSED)
+    _check_nonlinear(_DISTURBANCE_REFUSED, family, law, L, options)
     D = check_parameter("disturbance", disturbance)
     report = build_report(robot, controller, family=family, law=law, L=L, **options)
+    corridor, wall = _each_geometry(report, robot, controller, family, law, (corridor_disturbance, wall_disturbance), D,
+                                    lambda reason: Disturbance.unavailable(D, robot.yaw_accel_limit, reason))
+    return replace(report, disturbance=corridor, wall_disturbance=wall)
+
+
+def _check_nonlinear(refusal: str, family: str, law, L, options: dict) -> None:
+    """ValueError(`refusal`) unless a wall or corridor, a steering or kinematic robot and a static law: what the
+    describing functions take (``--wobble``, ``--disturbance``)."""
+    if (L is None and options["alpha"] is None and options["alpha_deg"] is None) or family == "holonomic" \
+            or (law is not None and not isinstance(law, ForceLaw)):
+        raise ValueError(refusal)
+
+
+def _each_geometry(report, robot, controller, family, law, functions, value, unavailable) -> tuple:
+    """(corridor, wall): ``function(robot, controller, law, L or α, value, model=…)`` for each geometry of `report`, the
+    sampled loop with the controller's hold and compute delay (`exact_delay` for T = 0), ``unavailable(reason)`` where it
+    raises ValueError; None for a geometry the report has not."""
     steering = robot.replace(tau=0.0) if family == "kinematic" else robot
     force_law = law_in_force(robot, controller, law)
     model = "sampled" if controller.T > 0 else "exact_delay"
 
     def predicted(function, where):
         try:
-            return function(steering, controller, force_law, where, D, model=model)
+            return function(steering, controller, force_law, where, value, model=model)
         except ValueError as exc:
-            return Disturbance.unavailable(D, robot.yaw_accel_limit, str(exc))
+            return unavailable(str(exc))
 
-    corridor = predicted(corridor_disturbance, report.corridor.L) if report.corridor is not None else None
-    wall = predicted(wall_disturbance, math.radians(report.wall.alpha_deg)) if report.wall is not None else None
-    return replace(report, disturbance=corridor, wall_disturbance=wall)
+    corridor_function, wall_function = functions
+    corridor = predicted(corridor_function, report.corridor.L) if report.corridor is not None else None
+    wall = predicted(wall_function, math.radians(report.wall.alpha_deg)) if report.wall is not None else None
+    return corridor, wall
 
 
 _NO_GEOMETRY = f"alpha or L must be given: a wall (--alpha DEG, in {RANGES['alpha_deg'].describe()}) and/or a corridor (--L M)"
