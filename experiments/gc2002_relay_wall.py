@@ -71,7 +71,7 @@ def khatib(duration: float) -> dict:
     from pfm_stability.laws.fields import KhatibLaw
     from pfm_stability.laws.force_law import wall_equilibria
     from pfm_stability.models import make_model
-    from pfm_stability.models.base import Loop
+    from pfm_stability.models.loop import Loop
     from pfm_stability.sim.cycles import measure_wall_cycle
     from pfm_stability.parameters import CARMEL
 

@@ -46,7 +46,7 @@ SIM_Q = (0.0, 0.5)
 
 def steering_table() -> dict:
     from pfm_stability.models import make_model
-    from pfm_stability.models.base import Loop
+    from pfm_stability.models.loop import Loop
 
     ex = make_model("exact_delay")
     by_q = []
@@ -71,7 +71,7 @@ def kinematic() -> dict:
 def curve(n: int) -> dict:
     """N_KB·V* against q for the exact-delay and sampled (command hold, 1-sample delay) models."""
     from pfm_stability.models import make_model
-    from pfm_stability.models.base import Loop
+    from pfm_stability.models.loop import Loop
 
     ex, sa = make_model("exact_delay"), make_model("sampled", hold="command", compute_delay=1)
     q = np.linspace(0.0, 0.8, n)
@@ -104,7 +104,7 @@ def simulated(quick: bool) -> list:
     from pfm_stability.laws.fields import KhatibLaw
     from pfm_stability.laws.force_law import corridor_gain
     from pfm_stability.models import make_model
-    from pfm_stability.models.base import Loop
+    from pfm_stability.models.loop import Loop
     from pfm_stability.sim.cycles import lateral_metrics
     from pfm_stability.sim.planar import simulate_planar_batch
 

@@ -145,7 +145,7 @@ def map_level(gaps, length: int = 500):
     from pfm_stability.maps.occupancy import load_map
     from pfm_stability.maps.paths import path_samples
     from pfm_stability.models import make_model
-    from pfm_stability.models.base import Loop
+    from pfm_stability.models.loop import Loop
     from pfm_stability.sim.engine import run_batch
     from pfm_stability.sim.scenario import Pose, Scenario, Target
     from pfm_stability.validation.maps import simulator_grid

@@ -34,7 +34,7 @@ from _common import output_dir, row, save_figure, script_main, write_json  # noq
 from pfm_stability.analysis.wobble import corridor_branch, trusted_cycle  # noqa: E402
 from pfm_stability.laws.force_law import corridor_gain  # noqa: E402
 from pfm_stability.models import make_model  # noqa: E402
-from pfm_stability.models.base import Loop  # noqa: E402
+from pfm_stability.models.loop import Loop  # noqa: E402
 from pfm_stability.parameters import CARMEL, Controller, Robot  # noqa: E402
 from pfm_stability.validation.wobble import WobbleCase, case_law, simulate_wobbles  # noqa: E402
 

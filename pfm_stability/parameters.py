@@ -76,8 +76,8 @@ sub-interval of 1e-9·T moves the robot by 1e-9 of a step while it adds a mode a
 simulator's linear-prediction fit and the sampled model would have to carry."""
 
 
-KB_PLANT = {"plant_gain": 1.0, "dead_time": 0.0}
-"""KB's steering plant τω̇ + ω = u: plant gain 1, no dead time (`Robot`'s and `models.Loop`'s defaults)."""
+KB_PLANT = {"plant_gain": 1.0, "dead_time": 0.0, "actuator_lag": 0.0}
+"""KB's steering plant τω̇ + ω = u: plant gain 1, no dead time, no second lag (`Robot`'s and `models.Loop`'s defaults)."""
 
 
 def plant_not_kb(source) -> dict:
@@ -86,7 +86,7 @@ def plant_not_kb(source) -> dict:
     Parameters
     ----------
     source : Robot or models.Loop
-        Anything with ``plant_gain`` and ``dead_time`` (s).
+        Anything with ``plant_gain``, ``dead_time`` (s) and ``actuator_lag`` (s).
     """
     return {name: getattr(source, name) for name, kb in KB_PLANT.items() if getattr(source, name) != kb}
 

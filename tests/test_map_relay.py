@@ -34,7 +34,7 @@ from scipy.optimize import brentq
 
 from pfm_stability.maps.relay import profile_cycle, relay_amplitude, window_cycle, window_relay
 from pfm_stability.models import make_model
-from pfm_stability.models.base import Loop
+from pfm_stability.models.loop import Loop
 from pfm_stability.parameters import CARMEL, HOLDS
 
 

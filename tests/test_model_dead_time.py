@@ -78,22 +78,40 @@ def test_a_whole_period_of_dead_time_is_a_compute_delay():
         assert np.max(np.abs(z_a - z_b)) < 1e-10
 
 
-def test_kb_first_order_closed_forms_with_the_delay_t_plus_d():
-    """KB eq (20) with the delay T + D: NV* = 1/(τ + T + D) for every g, ω*² = gk/(τ + T + D), T* = 1/NV − τ − D
-    (0 when D alone is too long), k* = inf or 0; with c ≠ 0 the closed form's k* is the loop's g·k*: the user's is /g."""
-    tau, T, k, g, D = 0.3, 0.065, 2.0, 0.7, 0.05
-    loop = Loop(tau, T, k, plant_gain=g, dead_time=D)
-    b = KBFirstOrder().boundary(loop)
-    assert b.NV_critical == pytest.approx(1 / (tau + T + D), rel=1e-12)
-    assert b.omega_critical == pytest.approx(math.sqrt(g * k / (tau + T + D)), rel=1e-12)
-    assert KBFirstOrder().critical_delay(1.5, loop) == pytest.approx(1 / 1.5 - tau - D, rel=1e-12)
-    assert KBFirstOrder().critical_delay(3.0, loop) == 0.0  # 1/3 − τ = 0.033 s < D
-    c = 0.5
-    heading = Loop(tau, T, k, c=c, plant_gain=g, dead_time=D)
-    NV = 1.0
-    L = T + D
-    expected = (1 + c - NV * (tau + L)) / (c * L * (1 + c - NV * L)) / g
-    assert KBFirstOrder().critical_gain_k(NV, heading) == pytest.approx(expected, rel=1e-12)
+def test_kb_first_order_closed_forms_with_the_plant():
+    """KB's step from eq (18) to (19), each delay to first order: e^(−sD) ≈ 1 − sD on the heading term, e^(−s(T+D)) ≈
+    1 − s(T + D) on the field's. The closed forms (docs/models.md, "Plant gain and dead time") are re-derived here with
+    sympy from Routh's conditions of that cubic, for the heading closed by the drive and sampled by the controller, c = 0
+    and c ≠ 0: NV* (1e-12: one closed form against the crossing route), and T*, D*, k* against the loop being critical
+    there (the model's NV* at T*, D*, k* equals NV to 1e-9) and against the generic searches (1e-6: their bracket is 1e-7)."""
+    sp = pytest.importorskip("sympy")
+    from pfm_stability.models import LoopModel
+    from pfm_stability.models.dead_time import search_dead_time
+
+    s_, tau_, gk_, h1_, hK_, c_, NV_ = sp.symbols("s tau gk h1 hK c NV", real=True)
+    cubic = sp.Poly(sp.expand(tau_ * s_**3 + s_**2 + gk_ * s_ * (1 - h1_ * s_) + gk_ * (c_ * s_ + NV_) * (1 - hK_ * s_)), s_)
+    a3, a2, a1, a0 = cubic.all_coeffs()
+    boundary = sp.solve(sp.Eq(a2 * a1, a3 * a0), NV_)[0]  # Routh's s¹ row vanishes: NV* (a2 > 0 checked below)
+    model = KBFirstOrder()
+    for tau, T, k, g, D, c, sampled in ((0.3, 0.065, 2.0, 0.7, 0.05, 0.0, False), (0.2, 0.1, 1.5, 1.2, 0.03, 0.4, False),
+                                        (0.4, 0.05, 3.0, 0.9, 0.02, 0.0, True), (0.25, 0.08, 1.0, 1.0, 0.1, -0.3, True)):
+        loop = Loop(tau, T, k, c=c, plant_gain=g, dead_time=D, heading_sampled=sampled)
+        values = {tau_: tau, gk_: g * k, h1_: D + (T if sampled else 0.0), hK_: T + D, c_: c}
+        assert float(a2.subs(values)) > 0
+        b = model.boundary(loop)
+        assert b.NV_critical == pytest.approx(float(boundary.subs(values)), rel=1e-12)
+        assert b.omega_critical == pytest.approx(math.sqrt(float(a0.subs({**values, NV_: b.NV_critical}) / a2.subs(values))), rel=1e-9)
+        NV = 0.6 * b.NV_critical
+        T_star, D_star, k_star = model.critical_delay(NV, loop), model.critical_dead_time(NV, loop), model.critical_gain_k(NV, loop)
+        assert model.boundary(loop.with_delay(T_star)).NV_critical == pytest.approx(NV, rel=1e-9)
+        assert model.boundary(loop.replace(dead_time=D_star)).NV_critical == pytest.approx(NV, rel=1e-9)
+        assert T_star == pytest.approx(LoopModel.critical_delay(model, NV, loop), rel=1e-6)
+        assert D_star == pytest.approx(search_dead_time(model, NV, loop), rel=1e-6)
+        if math.isfinite(k_star):
+            assert model.boundary(loop.replace(k=k_star)).NV_critical == pytest.approx(NV, rel=1e-9)
+            assert k_star == pytest.approx(LoopModel.critical_gain_k(model, NV, loop), rel=1e-6)
+    long = Loop(0.3, 0.065, 2.0, plant_gain=0.7, dead_time=0.6)  # g·k·D = 0.84 < 1, yet NV·(τ + T + D) > 1 + c at NV = 1.3
+    assert model.critical_delay(1.3, long) == 0.0 and model.critical_gain_k(1.3, long) == 0.0
 
 
 # ---------------------------------------------------------------- the sampled model with a fractional delay
@@ -126,12 +144,22 @@ def test_sampled_fractional_delay_equals_the_augmented_matrix_built_in_the_test(
 
 def test_sampled_refuses_a_dead_time_with_a_held_reference():
     """The same refusal as the simulator's (`Scenario`): one line naming both; the report exits 2 with it."""
-    with pytest.raises(ValueError, match=r"^dead_time must be 0 with hold=reference .*; got 0\.05$"):
+    with pytest.raises(ValueError, match=r"^dead_time must be 0 with hold=reference for the sampled model .*; got 0\.05$"):
         Sampled("reference", 0).boundary(Loop(0.3, 0.1, 2.0, dead_time=0.05))
-    with pytest.raises(ValueError, match=r"^dead_time must be at most 63 sampling periods, 4\.095 s with T = 0\.065 s .*; got 5\.0$"):
-        Sampled("command", 1).boundary(Loop(0.3, 0.065, 2.0, dead_time=5.0))  # more commands on their way than MAX_DELAY_STATES
+    with pytest.raises(ValueError, match=r"^dead_time must be at most 99999 sampling periods, 9\.9999 s with T = 0\.0001 s .*exact_delay.*; got 10\.0$"):
+        Sampled("command", 1).boundary(Loop(0.3, 1e-4, 2.0, dead_time=10.0))  # more commands on their way than MAX_DELAY_STATES
+    with pytest.raises(ValueError, match=r"^dead_time must be at most 63 sampling periods, .*characteristic polynomial.*; got 5\.0$"):
+        Sampled("command", 1).characteristic(1.0, Loop(0.3, 0.065, 2.0, dead_time=5.0))  # a polynomial in z of degree ~80
     code, out, err = run(["report", "--L", "0.9", "--hold", "reference", "--dead-time", "0.05"])
-    assert code == 2 and out == "" and err.count("\n") == 1 and "dead_time must be 0 with hold=reference" in err
+    assert code == 2 and out == "" and err.count("\n") == 1 and "dead_time must be 0 with hold=reference" in err and "got 0.05" in err
+    # D = 0 typed with a plant gain: the report's D* is not searched in the sampled model (it would probe D > 0)
+    code, out, err = run(["report", "--L", "0.9", "--hold", "reference", "--dead-time", "0", "--plant-gain", "0.7", "--format", "json"])
+    assert code == 0 and err == ""
+    corridor = json.loads(out)["corridor"]
+    assert "dead_time_critical" not in corridor["sampled"] and corridor["exact_delay"]["dead_time_critical"] > 0
+    # the continuous-time models take a dead time with a held reference (the heading closed by the drive, delayed by D)
+    code, out, err = run(["report", "--L", "0.9", "--hold", "reference", "--dead-time", "0.05", "--model", "exact_delay", "--format", "json"])
+    assert code == 0 and json.loads(out)["corridor"]["exact_delay"]["verdict"] in ("stable", "unstable")
 
 
 def test_sampled_critical_period_with_the_dead_time_fixed():
@@ -151,19 +179,18 @@ def test_sampled_critical_period_with_the_dead_time_fixed():
 def test_critical_dead_time_in_every_model():
     """D* (the largest dead time tolerated, T fixed) at CARMEL's loop with g = 0.85:
 
-    * `kb_first_order`: 1/NV − τ − T (KB eq 20 with the delay T + D), 1e-6 (the search's bracket 1e-7);
-    * `exact_delay`: D* + T = T* + D, both the one delay margin of T + D, and the loop at D* is critical (NV* = NV);
+    * `kb_first_order` and `exact_delay`: exact (Routh's quadratic in D; the first D at which a root of the two-delay
+      quasi-polynomial reaches the axis), and the loop at D* is critical (its NV* is NV to 1e-9);
     * `sampled`: D* with d = 0 is D* with d = 1 plus one period (a compute delay is a dead time of T), 1e-6; the loop
       is stable at 0.999·D* and unstable at 1.001·D*;
     * `continuous` has no delay: ``inf``; an unstable operating point: 0.
     """
     tau, T, k, g, NV = 0.3, 0.065, 2.0, 0.85, 1.2
     loop = Loop(tau, T, k, plant_gain=g, dead_time=0.07)
-    assert KBFirstOrder().critical_dead_time(NV, loop) == pytest.approx(1 / NV - tau - T, rel=1e-6)
-    exact = ExactDelay()
-    D_star = exact.critical_dead_time(NV, loop)
-    assert D_star + T == pytest.approx(exact.critical_delay(NV, loop) + loop.dead_time, rel=1e-12)
-    assert exact.boundary(loop.replace(dead_time=D_star)).NV_critical == pytest.approx(NV, rel=1e-9)
+    for model in (KBFirstOrder(), ExactDelay()):
+        D_star = model.critical_dead_time(NV, loop)
+        assert 0 < D_star < 1
+        assert model.boundary(loop.replace(dead_time=D_star)).NV_critical == pytest.approx(NV, rel=1e-9)
     now, late = Sampled("command", 1).critical_dead_time(NV, loop), Sampled("command", 0).critical_dead_time(NV, loop)
     assert late == pytest.approx(now + T, rel=1e-6)
     model = Sampled("command", 1)
@@ -171,14 +198,14 @@ def test_critical_dead_time_in_every_model():
     from pfm_stability.models import Continuous
 
     assert Continuous().critical_dead_time(NV, loop) == math.inf
-    assert exact.critical_dead_time(4.0, loop) == 0.0 and model.critical_dead_time(4.0, loop) == 0.0
+    assert ExactDelay().critical_dead_time(4.0, loop) == 0.0 and model.critical_dead_time(4.0, loop) == 0.0
 
 
 # ---------------------------------------------------------------- exact_delay against cxroots
 @pytest.mark.slow
 def test_exact_delay_with_g_and_d_against_the_argument_principle():
-    """τs³ + s² + gks + gkNV·e^(−s(T+D)) written out here: cxroots counts no root in Re s > 0 at NV*(1 − 1e-6) and a
-    pair at ±jω* (1e-6) at NV*(1 + 1e-6); the model's T* is the total delay margin less D (the loop at T* + D is critical).
+    """τs³ + s² + gk·s·e^(−sD) + gkNV·e^(−s(T+D)) written out here (D delays the whole command): cxroots counts no root
+    in Re s > 0 at NV*(1 − 1e-6) and a pair at ±jω* (1e-6) at NV*(1 + 1e-6); the loop at the model's T* is critical.
 
     cxroots counts by the argument principle on a rectangle holding every right-half-plane root
     (|s| < R where |a(s)| > gkNV); its Newton polishing is good to ~1e-10.
@@ -191,12 +218,12 @@ def test_exact_delay_with_g_and_d_against_the_argument_principle():
         b = ExactDelay().boundary(loop)
         gk, delay = g * k, T + D
         R = 1.0
-        while tau * R**3 - R**2 - gk * R <= 2 * gk * b.NV_critical:
+        while tau * R**3 - R**2 - gk * R <= 2 * gk * b.NV_critical:  # |p0(s)| > |the rest| for |s| >= R, Re s >= 0
             R *= 1.5
         for factor, expected in ((1 - 1e-6, 0), (1 + 1e-6, 2)):
             K = gk * b.NV_critical * factor
-            f = lambda s: tau * s**3 + s**2 + gk * s + K * np.exp(-s * delay)  # noqa: E731
-            df = lambda s: 3 * tau * s**2 + 2 * s + gk - K * delay * np.exp(-s * delay)  # noqa: E731
+            f = lambda s: tau * s**3 + s**2 + gk * s * np.exp(-s * D) + K * np.exp(-s * delay)  # noqa: E731
+            df = lambda s: 3 * tau * s**2 + 2 * s + gk * (1 - D * s) * np.exp(-s * D) - K * delay * np.exp(-s * delay)  # noqa: E731
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
                 roots = np.array(cxroots.Rectangle([-0.01, R], [-R, R]).roots(f, df).roots)

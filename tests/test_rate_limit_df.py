@@ -16,7 +16,7 @@ from pfm_stability.analysis.disturbance import start_amplitude
 from pfm_stability.analysis.describing import RATE_LIMIT_TRIANGLE, harmonic_balance, rate_limit_df, rate_limit_waveform
 from pfm_stability.analysis.limiter import command_responses
 from pfm_stability.laws.force_law import PowerLaw, corridor_gain
-from pfm_stability.models.base import Loop
+from pfm_stability.models.loop import Loop
 from pfm_stability.models.sampled import closed_loop_matrix, command_form
 from pfm_stability.parameters import CARMEL
 

@@ -13,7 +13,7 @@ import pytest
 
 from pfm_stability.laws.fields import KhatibLaw
 from pfm_stability.laws.force_law import PowerLaw, wall_equilibria
-from pfm_stability.models.base import Loop
+from pfm_stability.models.loop import Loop
 from pfm_stability.models.holonomic import HolonomicLoop, kinematic_loop
 from pfm_stability.models.sampled import Sampled
 from pfm_stability.sim.cycles import lateral_metrics, loop_order, wall_cycle

@@ -20,7 +20,7 @@ import pytest
 from table_helpers import read, same
 
 from pfm_stability.cli import main
-from pfm_stability.parameters import MODEL_NAMES
+from pfm_stability.parameters import CARMEL, MODEL_NAMES
 from pfm_stability.sweeps import (
     SweepError,
     SweepInterrupted,
@@ -306,16 +306,22 @@ def test_a_plant_gain_enters_every_model_as_the_steering_gain_g_times_k():
 
 
 def test_a_dead_time_delays_the_continuous_models_and_the_sampled_model_agrees_with_the_simulator():
-    """A dead time D adds to the continuous-time models' delay (KB eq 18 with T + D; `continuous` has none): at T = 0.05 s
-    and D = 0.07 s they give KB's plant's answers at T = 0.12 s (NV* to 1e-12). The sampled model carries the commands
-    on their way instead (its period stays T): with D = 0.12 s and g = 0.8 its verdict is the simulator's (the sweep's
+    """A dead time D delays the whole command (the heading term by D, the field's by T + D; `continuous` has none): at
+    T = 0.05 s and D = 0.07 s every model's column is the scalar model's on that loop (NV* to 1e-12), and the delay
+    models' NV* lie below KB's plant's at T = 0.12 s (the heading term's delay costs too). The sampled model carries the
+    commands on their way (its period stays T): with D = 0.12 s and g = 0.8 its verdict is the simulator's (the sweep's
     own sim column: the growth of the lateral motion, `validation.sweep`) at every point, among them V = 0.64 m/s,
     unstable with that plant and stable with KB's (NV = 1.80 1/s, NV* 1.57 against 2.33 1/s)."""
+    from pfm_stability.models import Loop, make_model
+
     plant = _plant_columns({"dead_time": 0.07}, list(MODEL_NAMES), {"V": {"from": 0.2, "to": 1.6, "num": 5}}, {"T": 0.05})
     kb = _plant_columns({}, list(MODEL_NAMES), {"V": {"from": 0.2, "to": 1.6, "num": 5}}, {"T": 0.12})
+    loop = Loop(CARMEL.robot.tau, 0.05, CARMEL.robot.k, dead_time=0.07)
     for m in ("continuous", "kb_first_order", "pade", "exact_delay"):
-        np.testing.assert_allclose(plant[f"{m}_NV_critical"], kb[f"{m}_NV_critical"], rtol=1e-12)
-        assert list(plant[f"{m}_verdict"]) == list(kb[f"{m}_verdict"])
+        scalar = make_model(m, hold=CARMEL.controller.hold, compute_delay=CARMEL.controller.compute_delay).boundary(loop).NV_critical
+        np.testing.assert_allclose(plant[f"{m}_NV_critical"], scalar, rtol=1e-12)
+        if m != "continuous":
+            assert np.all(plant[f"{m}_NV_critical"] < kb[f"{m}_NV_critical"])
     grid = {"V": {"from": 0.3, "to": 2.0, "num": 6}}
     plant = _plant_columns({"dead_time": 0.12, "plant_gain": 0.8}, ["sampled"], grid, {"T": 0.05}, simulate=True)
     kb = _plant_columns({}, ["sampled"], grid, {"T": 0.05})

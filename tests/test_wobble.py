@@ -17,7 +17,7 @@ from pfm_stability.analysis.wobble import (
 )
 from pfm_stability.laws.force_law import PowerLaw, corridor_gain, law_in_force
 from pfm_stability.models import make_model
-from pfm_stability.models.base import Loop
+from pfm_stability.models.loop import Loop
 from pfm_stability.parameters import CARMEL, Controller, Robot
 
 

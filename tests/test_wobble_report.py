@@ -8,7 +8,7 @@ from cli_helpers import report_json, run
 from pfm_stability.analysis.wobble import DEFAULT_TOLERANCE_FRACTION
 from pfm_stability.laws.force_law import corridor_gain, law_in_force
 from pfm_stability.models import make_model
-from pfm_stability.models.base import Loop
+from pfm_stability.models.loop import Loop
 from pfm_stability.parameters import CARMEL
 
 KEYS = {"amplitude", "heading_amplitude", "omega", "reaches_wall", "criticality", "V_tolerance", "tolerance", "V_critical", "V_fold",

@@ -8,7 +8,7 @@ import pytest
 from pfm_stability.analysis.wobble import corridor_branch, corridor_wobble, trusted_cycle
 from pfm_stability.laws.force_law import corridor_gain
 from pfm_stability.models import make_model
-from pfm_stability.models.base import Loop
+from pfm_stability.models.loop import Loop
 from pfm_stability.parameters import CARMEL, Controller, Robot
 from pfm_stability.validation.wobble import WobbleCase, case_law, simulate_wobbles
 

@@ -34,7 +34,7 @@ import numpy as np
 from ..checks import check_number
 from ..io.serialize import json_number
 from ..laws.force_law import ForceLaw
-from ..models.base import Loop
+from ..models.loop import Loop
 from .wobble import THIRD_HARMONIC_LIMIT, WobbleBranch, corridor_branch, corridor_steering, reported_cycle, wall_branch, wall_steering
 
 __all__ = ["Disturbance", "start_amplitude", "disturbance_speed", "corridor_disturbance", "wall_disturbance"]

@@ -19,7 +19,7 @@ import numpy as np
 from scipy import optimize, special
 
 from ..models import make_model
-from ..models.base import Loop
+from ..models.loop import Loop
 from .describing import J1_PEAK, harmonic_content, rate_limit_df, rate_limit_waveform, saturation_df_for_output
 
 __all__ = ["LimitedBalance", "command_responses", "limited_balance", "limiter_harmonic", "loop_filtering"]

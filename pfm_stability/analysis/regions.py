@@ -150,6 +150,12 @@ def _delay_loop(robot: Robot, controller: Controller) -> tuple:
     return robot.tau, controller.T + robot.dead_time, robot.plant_gain * robot.k
 
 
+def _array_delay_route(model: LoopModel, robot: Robot) -> bool:
+    """Whether `exact_delay`'s verdicts come from the vectorized crossing count: its one-delay loop, KB's plant or only a
+    plant gain (g·k); a dead time or a second lag makes the general loop, decided by the model's stable set."""
+    return isinstance(model, ExactDelay) and robot.dead_time == 0.0 and robot.actuator_lag == 0.0
+
+
 def _general_verdicts(robot: Robot, controller: Controller, NV):
     """`exact_delay` crossing-count verdicts for an array of NV (any force law)."""
     NV = np.asarray(NV, dtype=float)
@@ -163,7 +169,7 @@ def _region(robot: Robot, controller: Controller, model: LoopModel, axes, NV, st
     NV = np.asarray(NV, dtype=float)
     stable_set = None
     if stable is None:
-        if isinstance(model, ExactDelay):
+        if _array_delay_route(model, robot):
             stable = _general_verdicts(robot, controller, NV)
         else:
             b = model.boundary(loop_of(robot, controller))
@@ -211,7 +217,7 @@ def wall_f_region(robot: Robot, controller: Controller, alpha: float, V, f, law:
     axes = ("V", "m/s", "f", "", V, f)
     if law is None or isinstance(law, PowerLaw):
         n, W = _power_law_parameters(robot, controller, law)[1:]
-        if isinstance(model, ExactDelay):
+        if _array_delay_route(model, robot):
             r = exact_delay_verdicts(V[None, :], *_delay_loop(robot, controller), f[:, None], n, W, alpha=alpha)
             return _region(robot, controller, model, axes, r.NV, r.stable)
         NV = loop_gain_arrays(V[None, :], *_delay_loop(robot, controller), f[:, None], n, W, alpha=alpha)[3]
@@ -249,7 +255,7 @@ def wall_alpha_region(robot: Robot, controller: Controller, V, alpha, law: Force
     axes = ("V", "m/s", "alpha", "rad", V, alpha)
     if law is None or isinstance(law, PowerLaw):
         f, n, W = _power_law_parameters(robot, controller, law)
-        if isinstance(model, ExactDelay):
+        if _array_delay_route(model, robot):
             r = exact_delay_verdicts(V[None, :], *_delay_loop(robot, controller), f, n, W, alpha=alpha[:, None])
             return _region(robot, controller, model, axes, r.NV, r.stable)
         NV = loop_gain_arrays(V[None, :], *_delay_loop(robot, controller), f, n, W, alpha=alpha[:, None])[3]
@@ -287,7 +293,7 @@ def corridor_region(robot: Robot, controller: Controller, L, V, law: ForceLaw | 
     axes = ("L", "m", "V", "m/s", L, V)
     if law is None or isinstance(law, PowerLaw):
         f, n, W = _power_law_parameters(robot, controller, law)
-        if isinstance(model, ExactDelay):
+        if _array_delay_route(model, robot):
             r = exact_delay_verdicts(V[:, None], *_delay_loop(robot, controller), f, n, W, L=L[None, :])
             return _region(robot, controller, model, axes, r.NV, r.stable)
         NV = loop_gain_arrays(V[:, None], *_delay_loop(robot, controller), f, n, W, L=L[None, :])[3]

@@ -64,7 +64,7 @@ from ..io.serialize import json_number
 from ..laws.effective_force import corridor_lateral_force
 from ..laws.force_law import ForceLaw, corridor_gain, wall_equilibrium, wall_gain
 from ..models import make_model
-from ..models.base import Loop
+from ..models.loop import Loop
 from .describing import J1_PEAK, describing_function, harmonic_content, saturation_df_for_output
 from .limiter import limited_balance, loop_filtering
 

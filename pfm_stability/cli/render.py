@@ -51,6 +51,7 @@ _LABELS = {
     "k": "k (steering gain)",
     "dead_time": "D (steering plant dead time)",
     "plant_gain": "g (steering plant gain)",
+    "actuator_lag": "tau_a (drive's second lag)",
     "yaw_accel_limit": "R (drive's yaw accel limit)",
     "max_steering_rate": "omega_max (steering-rate limit)",
     "f": "f (force ratio)",
@@ -322,16 +323,17 @@ def _footnote(report) -> list[str]:
         from .render_families import HOLONOMIC_FOOTNOTE
 
         return ["", HOLONOMIC_FOOTNOTE]
-    plant = {name: report.inputs[name]["value"] for name in ("dead_time", "plant_gain") if name in report.inputs}
-    if plant.get("dead_time", 0.0) > 0 or plant.get("plant_gain", 1.0) != 1.0:  # the verdicts carry D* (`criteria._plant_given`)
+    plant = {name: report.inputs[name]["value"] for name in ("dead_time", "plant_gain", "actuator_lag") if name in report.inputs}
+    if plant.get("dead_time", 0.0) > 0 or plant.get("plant_gain", 1.0) != 1.0 or plant.get("actuator_lag", 0.0) > 0:  # the verdicts carry D* (`criteria._plant_given`)
         return ["", _FOOTNOTE + " " + _PLANT_FOOTNOTE]
     return ["", _FOOTNOTE]
 
 
 _PLANT_FOOTNOTE = (
     "With the steering plant's dead time D and gain g (docs/models.md, \"Plant gain and dead time\"): the loop's steering gain is "
-    "g*k and its delay T + D; T* is the controller's period with D fixed, k* is in the controller's k, and D* is the largest "
-    "dead time this operating point tolerates with T fixed (stable below it)."
+    "g*k, and D delays the whole command (the heading term by D, the field's by T + D: the equations above); T* is the "
+    "controller's period with D fixed, k* is in the controller's k, and D* is the largest dead time this operating point "
+    "tolerates with T fixed (stable below it)."
 )
 
 

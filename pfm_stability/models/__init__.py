@@ -31,7 +31,8 @@ from __future__ import annotations
 
 from ..checks import check_choice
 from ..parameters import MODEL_NAMES, Controller
-from .base import HEADING_GAIN_RANGE, STEERING, Boundary, Loop, LoopModel
+from .base import LoopModel
+from .loop import HEADING_GAIN_RANGE, STEERING, Boundary, Loop
 from .continuous import Continuous
 from .exact_delay import ExactDelay
 from .family import Characteristic, LoopFamily

@@ -17,7 +17,7 @@ from ..parameters import RANGES
 __all__ = ["search_dead_time"]
 
 
-def search_dead_time(model, gain: float, loop) -> float:
+def search_dead_time(model, gain: float, loop, high: float | None = None) -> float:
     """D*, s, of `model` at `gain` for `loop` (its own D replaced), by the search of T* over D.
 
     Parameters
@@ -28,9 +28,12 @@ def search_dead_time(model, gain: float, loop) -> float:
         Loop gain NV, 1/s, already checked.
     loop : Loop
         τ, T, k, c and g.
+    high : float, optional
+        The longest dead time searched, s (default the largest allowed, 10 s; ``inf`` is returned when the gain is
+        stable up to it): a model that carries at most so many periods in flight searches no further.
     """
     def search():
         start, rtol, atol = loop.delay_search(gain)
-        return start, RANGES["dead_time"].high, {"rtol": rtol, "atol": atol}
+        return start, RANGES["dead_time"].high if high is None else high, {"rtol": rtol, "atol": atol}
 
     return model._first_loss(gain, lambda D: loop.replace(dead_time=float(D)), 0.0, search)

@@ -51,7 +51,8 @@ import math
 import numpy as np
 
 from ..numerics.delay import DelayLoop, delay_verdicts_from_gain, kb_critical_gain
-from .base import Loop, LoopModel, _check_NV, _steering, checked, gain_range
+from .base import LoopModel, _check_NV, _steering, checked
+from .loop import Loop, gain_range
 from .family import Characteristic
 from .pade import Pade
 
@@ -86,7 +87,11 @@ class ExactDelay(LoopModel):
         return DelayLoop(loop.plant[:-1], loop.delay)
 
     def _quasi(self, gain: float, loop: Characteristic):
-        """(quasi-polynomial, K) of the roots the verdict judges: the loop's at its K, the heading loop's at gain 0."""
+        """(quasi-polynomial, K) of the roots the verdict judges: the loop's at its K, the heading loop's at gain 0
+        (the general steering loop's: `numerics.quasi.QuasiPolynomial.heading` at K = 0)."""
+        if not getattr(loop, "kb_form", True):
+            quasi = loop.quasi_terms()
+            return (quasi.heading(), 0.0) if gain == 0 else (quasi, loop.loop_gain(gain))
         return (self.heading_quasi_polynomial(loop), loop.damping) if gain == 0 else (self.quasi_polynomial(loop), loop.loop_gain(gain))
 
     def compute_boundary(self, loop: Characteristic):
@@ -152,7 +157,7 @@ class ExactDelay(LoopModel):
 
     @checked
     def critical_dead_time(self, gain: float, loop: Characteristic) -> float:
-        """D*: the crossing count's margin of the whole delay T + D (the loop with T = D = 0), less T, s; exact, as T*.
+        """D*: the first dead time at which a root reaches the imaginary axis, T fixed (`Loop.shift_margin`), s; exact, as T*.
 
         Parameters
         ----------
@@ -164,8 +169,7 @@ class ExactDelay(LoopModel):
         loop = _steering(loop, "critical_dead_time")
         if gain < 0:
             return 0.0
-        margin = loop.replace(T=0.0, dead_time=0.0).delay_margin(loop.loop_gain(gain))
-        return margin if math.isinf(margin) else max(margin - loop.T, 0.0)
+        return loop.shift_margin(loop.loop_gain(gain), "D")  # D delays the whole command: exact, from D = 0
 
     @checked
     def damping_range(self, gain: float, loop: Characteristic) -> tuple:
@@ -213,6 +217,10 @@ class ExactDelay(LoopModel):
         NV = _check_NV(NV)
         if NV < 0:
             return 0.0
+        if not loop.kb_form:  # the general loop: the signed measure's first sign change over k (`_signed_gain_k`)
+            if NV * (loop.tau + loop.actuator_lag + loop.delay) >= 1.0 + loop.c:  # the k → 0 limit: kb_first_order's
+                return 0.0
+            return self._signed_gain_k(NV, loop, lambda loops: np.array([x.delay_stable(x.loop_gain(NV)) for x in loops]))
         if NV == 0 and loop.c == 0.0:
             return math.inf
         if loop.delay == 0:
@@ -231,18 +239,26 @@ class ExactDelay(LoopModel):
         return first_crossing(measure, lo, hi, start=lo)
 
     def _heading_gain_k(self, NV: float, loop: Loop) -> float:
-        """k* for c ≠ 0 (`critical_gain_k`): first sign change of the signed measure over k."""
+        """k* for c ≠ 0 (`critical_gain_k`): first sign change of the signed measure over k, the sign the vectorized
+        crossing count's."""
+        def stable(loops):
+            tau, T, k = (np.array([getattr(x, name) for x in loops]) for name in ("tau", "delay", "steering_gain"))
+            return delay_verdicts_from_gain(tau, T, k, k * NV, np.full(k.shape, loop.c))[0]
+
+        return self._signed_gain_k(NV, loop, stable)
+
+    def _signed_gain_k(self, NV: float, loop: Loop, stable) -> float:
+        """k*: the first sign change over k of a measure whose sign is the exact verdict's (``stable(loops)``, arrays)
+        and whose size is Padé(6)'s growth rate (batched eigenvalues: a stand-in that peaks where a root nears the axis,
+        so the search refines near-misses between grid points)."""
         from ..numerics.solve import first_crossing
 
         pade = Pade(6)  # one model for every probe
 
         def measure(ks):
             loops = [loop._with_steering_gain(k) for k in ks]
-            arrays = (np.array([getattr(x, name) for x in loops]) for name in ("tau", "delay", "steering_gain"))
-            tau, T, k = arrays
-            stable = delay_verdicts_from_gain(tau, T, k, k * NV, np.full(k.shape, loop.c))[0]
             size = np.abs(pade._growth_rates(NV, loops)) + 1e-300
-            return np.where(stable, -size, size)
+            return np.where(stable(loops), -size, size)
 
         lo, hi = gain_range(loop)
         if measure(np.array([lo]))[0] >= 0:

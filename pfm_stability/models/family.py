@@ -2,7 +2,7 @@
 
 `Characteristic` is what the five models (`continuous`, `kb_first_order`, `pade`,
 `exact_delay`, `sampled`) read from the loop they judge, so that one implementation of
-each decides every family: KB's steering robot (`models.base.Loop`: a(s) = τs³ + s² + ks,
+each decides every family: KB's steering robot (`models.loop.Loop`: a(s) = τs³ + s² + ks,
 δ = kc, K = kNV; kinematic steering is τ = 0) and the holonomic robot
 (`models.holonomic.HolonomicLoop`: a(s) = s², δ = c_h, K = κ). `LoopFamily` names a
 family's gain and the equation each model solves for it; `StableSet` and `root_json` are
@@ -69,7 +69,7 @@ class Characteristic:
     family: LoopFamily
     T: float
     dead_time: float = 0.0
-    """D, s: the plant's dead time beyond T (`models.base.Loop.dead_time`; 0 for a family without one)."""
+    """D, s: the plant's dead time beyond T (`models.loop.Loop.dead_time`; 0 for a family without one)."""
 
     @property
     def delay(self) -> float:

@@ -68,7 +68,8 @@ from ..numerics.crossings import Crossing, StabilityInterval, stable_interval, s
 from ..numerics.solve import bisect_root
 from ..parameters import RANGES, T_RESOLUTION, check_parameter
 from ..io.serialize import json_number
-from .base import Loop, LoopModel
+from .base import LoopModel
+from .loop import Loop
 from .verdicts import interval_margin, interval_verdict
 from .continuous import Continuous
 from .family import Characteristic, LoopFamily, StableSet, _unchecked, root_json

@@ -85,15 +85,55 @@ class Pade(AffineGainModel):
         self.order = check_integer("pade_order", order, 1, MAX_PADE_ORDER)
 
     def polynomials(self, loop: Characteristic):
-        """D = a(s)·Q_m + δ·s·P_m, E = P_m (descending powers of s; Q_m(0) = P_m(0) = 1).
+        """D = a(s)·Q_m + δ·s·P_m, E = P_m (descending powers of s; Q_m(0) = P_m(0) = 1); the general steering loop's
+        with each of its delays replaced (`general_polynomials`).
 
         Parameters
         ----------
         loop : Characteristic
             The loop judged (`Loop`, `HolonomicLoop`).
         """
+        if not getattr(loop, "kb_form", True):
+            return self.general_polynomials(loop)
         D, E = self.batch_polynomials([loop])
         return np.trim_zeros(D[0], "f"), np.trim_zeros(E[0], "f")
+
+    def general_polynomials(self, loop):
+        """(D, E) of the general steering loop p0 + Σ_j p_j·e^(−s·h_j) + K·e^(−s·h_K) (`models.loop.Loop.quasi_terms`)
+        with every e^(−s·h) replaced by P_m(s·h)/Q_m(s·h), one approximant per distinct delay, cleared of denominators:
+
+            D = p0·Π_g Q_g + Σ_j p_j·P_(g(j))·Π_(g ≠ g(j)) Q_g,   E = P_(h_K)·Π_(g ≠ h_K) Q_g
+
+        (a delay of 0 is exactly 1). Descending; Q_m(0) = P_m(0) = 1.
+
+        Parameters
+        ----------
+        loop : models.loop.Loop
+            A steering loop that is not KB's form (a dead time, a second lag or a sampled heading).
+        """
+        quasi = loop.quasi_terms()
+        delays = sorted({t.delay for t in quasi.terms if t.delay > 0} | ({quasi.gain_delay} if quasi.gain_delay > 0 else set()))
+        approximants = {h: self._approximant(h) for h in delays}
+
+        def others(skip):
+            out = np.array([1.0])
+            for h in delays:
+                if h != skip:
+                    out = np.polymul(out, approximants[h][1])
+            return out
+
+        D = np.polymul(quasi.p0, others(None))
+        for t in quasi.terms:
+            numerator = approximants[t.delay][0] if t.delay > 0 else np.array([1.0])
+            D = np.polyadd(D, np.polymul(np.polymul(t.poly, numerator), others(t.delay)))
+        numerator = approximants[quasi.gain_delay][0] if quasi.gain_delay > 0 else np.array([1.0])
+        return np.trim_zeros(D, "f"), np.trim_zeros(np.polymul(numerator, others(quasi.gain_delay)), "f")
+
+    def _approximant(self, h: float) -> tuple:
+        """(P_m(s·h), Q_m(s·h)), descending, constant terms 1."""
+        c = np.array([_pade_term(self.order, j) for j in range(self.order + 1)])
+        powers = h ** np.arange(self.order + 1)
+        return (c * powers * (-1.0) ** np.arange(self.order + 1))[::-1], (c * powers)[::-1]
 
     def parts(self, loop: Characteristic):
         """(a(s)·Q_m, s·P_m, P_m), one length.
@@ -126,13 +166,16 @@ class Pade(AffineGainModel):
         return aQ, sP, P
 
     def batch_polynomials(self, loops):
-        """`polynomials` of many loops at once: rows of D = a(s)·Q_m + δ·s·P_m and E = P_m.
+        """`polynomials` of many loops at once: rows of D = a(s)·Q_m + δ·s·P_m and E = P_m (general loops one by one).
 
         Parameters
         ----------
         loops : sequence of Characteristic
             The loops, one row each.
         """
+        loops = list(loops)
+        if not all(getattr(loop, "kb_form", True) for loop in loops):
+            return AffineGainModel.batch_polynomials(self, loops)
         D, sP, E = self._rows(loops)
         damping = np.array([loop.damping for loop in loops])
         rows = np.flatnonzero(damping)

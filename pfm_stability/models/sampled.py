@@ -95,13 +95,15 @@ import numpy as np
 from ..checks import check_choice, check_integer
 from ..numerics.matrix_exponential import zoh_blocks
 from ..parameters import HOLDS, RANGES, dead_time_split
+from ..numerics.crossings import StabilityInterval, walk_stable_set
+from ..numerics.quasi import sign_change_roots
 from ..numerics.routh import schur_cohn_stable
-from .base import AffineGainModel, checked
+from .base import AffineGainModel, LoopModel, checked
 from .continuous import Continuous
 from .family import Characteristic
 
 __all__ = ["command_form", "Sampled", "continuous_plant", "discretize", "closed_loop_matrix", "delta_plant", "dead_time_plant", "bilinear_polynomial",
-           "MAX_DELAY_STATES"]
+           "MAX_DELAY_STATES", "MAX_EIGEN_STATES", "DelayLine"]
 
 
 def continuous_plant(loop: Characteristic, hold: str):
@@ -124,8 +126,9 @@ def continuous_plant(loop: Characteristic, hold: str):
     """
     hold = check_choice("hold", hold, HOLDS)
     if loop.dead_time > 0 and hold == "reference":
-        raise ValueError(f"dead_time must be 0 with hold=reference (a dead time inside the continuous steering servo is a delay "
-                         f"differential equation, which the sampled model does not solve; docs/models.md); got {loop.dead_time}")
+        raise ValueError(f"dead_time must be 0 with hold=reference for the sampled model (a dead time inside the continuous "
+                         f"steering servo makes a delay differential equation between samples, no finite sampled loop; "
+                         f"kb_first_order, pade and exact_delay take it, and hold=command with it: docs/models.md); got {loop.dead_time}")
     return loop._state_space(hold)
 
 
@@ -164,9 +167,20 @@ def delta_plant(loop: Characteristic, hold: str):
     return Psi, G, F0, F1
 
 
-MAX_DELAY_STATES = 64
-"""The most commands on their way (m + (ε > 0), `dead_time_plant`) the sampled model carries: a dead time of
-more than ~64 periods makes a characteristic polynomial of degree ~67, past what its coefficients resolve."""
+MAX_DELAY_STATES = 100_000
+"""The most commands on their way (m + (ε > 0), `dead_time_plant`) the sampled model carries: its crossings and verdicts
+come from the delay line's structured characteristic (`DelayLine`, work in proportion to the periods in flight); past
+this a dead time is a delay loop (`exact_delay`, whose T → 0 limit the sampled loop is)."""
+
+MAX_EIGEN_STATES = 400
+"""The most commands on their way for which the dominant pole comes from the eigenvalues of the closed-loop matrix
+(`Sampled.rightmost_root`; ~0.1 s at 400): the shift register is a Jordan block at z = 0, whose computed eigenvalues
+scatter on a circle of radius ε^(1/m) (0.91 at m = 400), well inside the loop's own poles z = e^(sT) at these periods.
+Beyond it the rightmost root is not reported (None) and the searches for T* and D* read the verdict's sign."""
+
+POLYNOMIAL_STATES = 64
+"""The most commands on their way for which the characteristic polynomial in z is formed (`Sampled.polynomials`,
+`jury_stable`): one of degree ~67 no longer resolves its coefficients."""
 
 
 @lru_cache(maxsize=4096)
@@ -189,19 +203,12 @@ def dead_time_plant(loop: Characteristic, hold: str, compute_delay: int):
     compute_delay : {0, 1}
         d, samples.
     """
-    A, B, F0, F1 = continuous_plant(loop, hold)
+    m, eps, after, before = _delay_split_blocks(loop, hold, compute_delay, MAX_EIGEN_STATES)
     Psi, G = delta_plant(loop, hold)[:2]
+    F0, F1 = delta_plant(loop, hold)[2:]
     T = loop.T
-    m, eps = dead_time_split(T, compute_delay, loop.dead_time)
     lines = m + (eps > 0)
-    if lines > MAX_DELAY_STATES:
-        most = (MAX_DELAY_STATES - compute_delay) * T
-        raise ValueError(f"dead_time must be at most {MAX_DELAY_STATES - compute_delay} sampling periods, {most:g} s with T = {T:g} s and "
-                         f"compute_delay {compute_delay}, for the sampled model (a longer dead time is a delay loop: exact_delay); "
-                         f"got {loop.dead_time}")
     n = Psi.shape[0]
-    after = zoh_blocks(A, T - eps)[1] @ B / T if eps > 0 else G  # Γ(T − ε)/T
-    before = G - after  # (Γ(T) − Γ(T − ε))/T = Φ(T − ε)Γ(ε)/T
     size = n + lines
     Psi_a = np.zeros((size, size))
     Psi_a[:n, :n] = Psi
@@ -220,6 +227,167 @@ def dead_time_plant(loop: Characteristic, hold: str, compute_delay: int):
     for array in (Psi_a, G_a, F0_a, F1_a):
         array.setflags(write=False)
     return Psi_a, G_a, F0_a, F1_a
+
+
+def _check_periods_in_flight(loop: Characteristic, compute_delay: int, most: int, what: str) -> tuple:
+    """(m, ε) of the loop (`parameters.dead_time_split`), or ValueError when more than `most` commands are on their way."""
+    T = loop.T
+    m, eps = dead_time_split(T, compute_delay, loop.dead_time)
+    if m + (eps > 0) > most:
+        longest = (most - compute_delay) * T
+        raise ValueError(f"dead_time must be at most {most - compute_delay} sampling periods, {longest:g} s with T = {T:g} s and "
+                         f"compute_delay {compute_delay}, for {what} (exact_delay takes a longer one: the sampled loop's "
+                         f"limit as T -> 0; docs/models.md); got {loop.dead_time}")
+    return m, eps
+
+
+def _delay_split_blocks(loop: Characteristic, hold: str, compute_delay: int, most: int) -> tuple:
+    """(m, ε, Γ(T − ε)/T, (Γ(T) − Γ(T − ε))/T): the whole periods a command waits (compute delay included), the
+    fraction ε, and the δ-form input columns of the command that arrives after ε and of the one before it."""
+    m, eps = _check_periods_in_flight(loop, compute_delay, most, "the sampled model's closed-loop matrix" if most == MAX_EIGEN_STATES else "the sampled model")
+    A, B = continuous_plant(loop, hold)[:2]
+    G = delta_plant(loop, hold)[1]
+    after = zoh_blocks(A, loop.T - eps)[1] @ B / loop.T if eps > 0 else G  # Γ(T − ε)/T
+    return m, eps, after, G - after  # (Γ(T) − Γ(T − ε))/T = Φ(T − ε)Γ(ε)/T
+
+
+class DelayLine:
+    """The characteristic of the sampled loop whose commands reach the motor m·T + ε late, in structured form.
+
+    With x_(k+1) = Φx_k + Γ_a·v_(k−m) + Γ_b·v_(k−m−1), v_k = −(F0 + K·F1)·x_k (`dead_time_plant`) and the δ form
+    Φ = I + TΨ, Γ = T·G, w = (z − 1)/T, the closed-loop poles are the roots of the polynomial of degree N = m + 1 + n
+
+        χ(z) = z^(m+1)·p(w) + z·(r0a + K·r1a)(w) + (r0b + K·r1b)(w),   p = det(wI − Ψ),  r_i· = F_i·adj(wI − Ψ)·G_·,
+
+    (the rank-one terms of `_rank_one`), evaluated without forming its m + n + 2 coefficients: work in proportion to the
+    periods in flight, accurate however many (`MAX_DELAY_STATES`). Its crossings of the unit circle are the angles
+    θ where K(θ) = −(z^(m+1)p + z·r0a + r0b)/(z·r1a + r1b) is real at z = e^(jθ) (a pole passes outwards as K grows where
+    arg K rises with θ, as in s); its poles outside the circle are N less the winding number of χ round it (the
+    argument principle, χ having real coefficients: twice the turn over 0 <= θ <= π).
+
+    Parameters
+    ----------
+    loop : Characteristic
+        T > 0 and a dead time D > 0.
+    hold : {"command"}
+    compute_delay : {0, 1}
+    """
+
+    def __init__(self, loop: Characteristic, hold: str, compute_delay: int):
+        self.T = loop.T
+        m, eps, after, before = _delay_split_blocks(loop, hold, compute_delay, MAX_DELAY_STATES)
+        Psi, _, F0, F1 = delta_plant(loop, hold)
+        self.m = m
+        self.degree = m + 1 + Psi.shape[0]
+        self.p = np.poly(Psi)
+        self.r0a, self.r1a = (_rank_one(Psi, after, F) for F in (F0, F1))
+        self.r0b, self.r1b = (_rank_one(Psi, before, F) if np.any(before) else np.zeros(1) for F in (F0, F1))
+
+    def _parts(self, theta):
+        """(lead, gain): χ = lead + K·gain at z = e^(jθ)."""
+        z = np.exp(1j * theta)
+        w = np.expm1(1j * theta) / self.T
+        lead = np.exp(1j * (self.m + 1) * theta) * np.polyval(self.p, w) + z * np.polyval(self.r0a, w) + np.polyval(self.r0b, w)
+        return lead, z * np.polyval(self.r1a, w) + np.polyval(self.r1b, w)
+
+    def gain(self, theta):
+        """K(θ): the gain that puts a pole at e^(jθ) (real there).
+
+        Parameters
+        ----------
+        theta : float or ndarray
+            Angle on the unit circle, rad (ω = θ/T).
+        """
+        lead, gain = self._parts(theta)
+        return -lead / gain
+
+    def grid(self) -> np.ndarray:
+        """Angles in (0, π]: logarithmic near 0, then a step over which z^(m+1) turns by at most π/4 (π/(4·N)); a faster
+        turn of χ (a root near the circle) is resolved by `_refine_turns`, a sign change of Im K by the step."""
+        uniform = np.linspace(0.0, math.pi, 4 * self.degree + 2)[1:]  # z^(m+1) turns by at most π/4 a step
+        return np.unique(np.concatenate([np.geomspace(1e-9 * math.pi, math.pi, 512), uniform]))
+
+    def crossings(self) -> list:
+        """Every gain K > 0 at which a pole crosses the unit circle: (K, ω = θ/T rad/s, change of the poles outside as K
+        grows: ±2 for a pair, ±1 for a real pole through z = −1, 0 for a touch), sorted by gain."""
+        theta = self.grid()
+        roots = sign_change_roots(lambda x: np.imag(self.gain(x)), theta)
+        gains, slopes = np.real(self.gain(roots)), self._phase_slope(roots)
+        out = [(float(K), float(x) / self.T, 2 * _sign(slope)) for K, x, slope in zip(gains, roots, slopes) if K > 0]
+        K_pi = float(np.real(self.gain(math.pi)))  # z = −1: K is real there; one real pole passes
+        if K_pi > 0:
+            out.append((K_pi, math.pi / self.T, _sign(float(self._phase_slope(np.array([math.pi]))[0]))))
+        return sorted(out)
+
+    def _phase_slope(self, theta):
+        """d arg K/dθ: positive where a pole crossing at e^(jθ) moves outwards as K grows (Re(z̄·dz/dK) ∝ it)."""
+        z, w = np.exp(1j * theta), np.expm1(1j * theta) / self.T
+        m, T = self.m, self.T
+        der = lambda p: np.polyval(np.polyder(p), w) if len(p) > 1 else 0.0 * w  # noqa: E731
+        L = np.exp(1j * (m + 1) * theta) * np.polyval(self.p, w) + z * np.polyval(self.r0a, w) + np.polyval(self.r0b, w)
+        dL = ((m + 1) * np.exp(1j * m * theta) * np.polyval(self.p, w) + np.exp(1j * (m + 1) * theta) * der(self.p) / T
+              + np.polyval(self.r0a, w) + z * der(self.r0a) / T + der(self.r0b) / T)
+        M = z * np.polyval(self.r1a, w) + np.polyval(self.r1b, w)
+        dM = np.polyval(self.r1a, w) + z * der(self.r1a) / T + der(self.r1b) / T
+        dK_dz = -(dL * M - L * dM) / (M * M)
+        return np.imag(dK_dz * 1j * z / (-L / M))
+
+    def stable_gains(self) -> StabilityInterval:
+        """Every stable gain K: the poles outside at K → 0+ (the heading loop's: the neutral pole z = 1 moves in), moved by
+        each crossing's change (`numerics.crossings.walk_stable_set`; the crossings on 0 < θ <= π are all of them)."""
+        base = self.outside(0.0, neutral=True)
+        if base is None:
+            return StabilityInterval(0.0, None, (), ())
+        return walk_stable_set(base, self.crossings())
+
+    def outside(self, K: float, neutral: bool = False) -> int | None:
+        """Poles with |z| > 1 at gain K (argument principle); None when one is on the circle (a phase jump unresolved).
+
+        Parameters
+        ----------
+        K : float
+            Loop gain, 1/s².
+        neutral : bool
+            At K = 0 (NV = 0): count without the neutral pole z = 1 (the heading loop's poles: χ/(z − 1), of degree N − 1).
+        """
+        theta = self.grid()
+        f = (lambda x: self._characteristic(x, K) / np.expm1(1j * x)) if neutral else (lambda x: self._characteristic(x, K))
+        values = f(theta)
+        start = np.real(values[0]) if neutral else f(0.0)  # χ/(z − 1) at z → 1: its real limit (real coefficients)
+        theta, values = np.concatenate([[0.0], theta]), np.concatenate([[start], values])
+        theta, values = _refine_turns(theta, values, f)
+        if theta is None:
+            return None
+        turn = float(np.sum((np.diff(np.angle(values)) + math.pi) % (2 * math.pi) - math.pi))
+        winding = turn / math.pi
+        inside = round(winding)
+        return None if abs(winding - inside) > 0.25 else self.degree - int(neutral) - int(inside)
+
+    def _characteristic(self, theta, K: float):
+        lead, gain = self._parts(theta)
+        return lead + K * gain
+
+
+def _sign(x: float) -> int:
+    """+1, −1, or 0 for a slope within round-off of 0 (a pole touching the circle and returning)."""
+    return 0 if abs(x) <= 1e-12 else (1 if x > 0 else -1)
+
+
+def _refine_turns(theta, values, f, step: float = math.pi / 4, rounds: int = 60):
+    """Grid points added where the phase of f turns by more than `step` between neighbours (a root near the circle),
+    until none does; (None, None) when an interval shrinks to round-off with the jump left (a root on it)."""
+    for _ in range(rounds):
+        jumps = np.flatnonzero(np.abs((np.diff(np.angle(values)) + math.pi) % (2 * math.pi) - math.pi) > step)
+        if jumps.size == 0:
+            return theta, values
+        lo, hi = theta[jumps], theta[jumps + 1]
+        if np.any(hi - lo <= 4e-16 * np.maximum(hi, 1e-300)):
+            return None, None
+        middle = 0.5 * (lo + hi)
+        theta, values = np.concatenate([theta, middle]), np.concatenate([values, f(middle)])
+        order = np.argsort(theta, kind="stable")
+        theta, values = theta[order], values[order]
+    return None, None
 
 
 def command_form(loop: Characteristic, hold: str, compute_delay: int) -> tuple:
@@ -369,6 +537,7 @@ class Sampled(AffineGainModel):
             τ (s), T (s), k (1/s) and the heading gain c.
         """
         if loop.dead_time > 0:  # the commands on their way are states (`dead_time_plant`): det(wI − Ψ_a) leads
+            _check_periods_in_flight(loop, self.compute_delay, POLYNOMIAL_STATES, "the sampled model's characteristic polynomial")
             Psi, G, F0, F1 = dead_time_plant(loop, self.hold, self.compute_delay)
             lead = np.poly(Psi)
         else:
@@ -434,6 +603,8 @@ class Sampled(AffineGainModel):
         """
         if loop.T == 0:
             return loop.delay_interval() if loop.dead_time > 0 else Continuous().stable_gains(loop)
+        if loop.dead_time > 0:  # the delay line's crossings of the unit circle and the count they move (`DelayLine`)
+            return DelayLine(loop, self.hold, self.compute_delay).stable_gains()
         d, e = self.bilinear_polynomials(loop)
         return self._interval(d, e, lambda K: self._stable(loop.gain_of(K), loop), loop)
 
@@ -486,6 +657,8 @@ class Sampled(AffineGainModel):
     def _stable(self, gain: float, loop: Characteristic) -> bool:
         if loop.T == 0:
             return _limit(loop)._stable(gain, loop)
+        if loop.dead_time > 0:  # the delay line's poles outside the circle (`DelayLine.outside`; NV = 0 without z = 1)
+            return DelayLine(loop, self.hold, self.compute_delay).outside(loop.loop_gain(gain), neutral=gain == 0) == 0
         lam = self._judged_eigenvalues(gain, loop)
         size = np.abs(lam)
         return bool(np.all(2.0 * lam.real + (loop.T * size) * size < 0.0))  # T|λ|·|λ|: no overflow of |λ|² at tiny T
@@ -518,6 +691,8 @@ class Sampled(AffineGainModel):
         """
         if loop.T == 0:
             return _limit(loop).rightmost_root(gain, loop)
+        if loop.dead_time > 0 and sum(dead_time_split(loop.T, self.compute_delay, loop.dead_time)) > MAX_EIGEN_STATES:
+            return None  # more commands in flight than the eigenvalues resolve (`MAX_EIGEN_STATES`); the verdict does not need it
         lam = self._judged_eigenvalues(gain, loop)
         T = loop.T
         sigma = _log_radius(lam, T) / T
@@ -538,14 +713,60 @@ class Sampled(AffineGainModel):
         """
         return self._delta_eigenvalues(gain, loop) if loop.T == 0 else 1.0 + loop.T * self._delta_eigenvalues(gain, loop)
 
+    @checked
+    def critical_dead_time(self, gain: float, loop: Characteristic) -> float | None:
+        """D*, s (`LoopModel.critical_dead_time`); None with ``hold="reference"``: the sampled model takes no dead time
+        inside the continuous servo (`continuous_plant`), so it has no D* (the continuous-time models give theirs); None
+        too when the loop is still stable at the longest dead time the delay line carries at this T
+        ((`MAX_DELAY_STATES` − d − 1)·T, shorter than 10 s only for periods below 0.1 ms).
+
+        Parameters
+        ----------
+        gain : float
+            Loop gain NV, 1/s.
+        loop : Loop
+            τ, T, k, c and g (its own D is replaced).
+        """
+        if self.hold == "reference":
+            return None
+        from .dead_time import search_dead_time
+
+        if loop.T == 0:  # the loop's own limit, the delay loop with delay D: its exact margin
+            return _limit(loop).critical_dead_time(gain, loop)
+        most = (MAX_DELAY_STATES - self.compute_delay - 1) * loop.T  # the longest dead time the delay line carries
+        if most >= RANGES["dead_time"].high:
+            return search_dead_time(self, gain, loop)
+        found = search_dead_time(self, gain, loop, high=most)
+        return None if math.isinf(found) else found  # stable as far as the model reaches: no D* it can give
+
+    @checked
+    def critical_delay(self, gain: float, loop: Characteristic) -> float:
+        """T*, s (`LoopModel.critical_delay`); with a dead time D the periods searched are those whose delay line the
+        model carries, T >= D/(`MAX_DELAY_STATES` − d − 1) (at T = 0 the loop's own limit, the delay loop with delay D,
+        is judged first: T* = 0 when it is unstable).
+
+        Parameters
+        ----------
+        gain : float
+            The family's loop gain: NV (1/s) or κ (1/s²).
+        loop : Characteristic
+            The loop judged; its own T, s, is replaced by the searched ones.
+        """
+        if loop.dead_time <= 0:
+            return LoopModel.critical_delay.__wrapped__(self, gain, loop)
+
+        def search():
+            start, rtol, atol = loop.delay_search(gain)
+            return max(start, loop.dead_time / (MAX_DELAY_STATES - self.compute_delay - 1)), RANGES["T"].high, {"rtol": rtol, "atol": atol}
+
+        return self._first_loss(gain, loop._with_delay, 0.0, search)
+
     def _searched_growth_rates(self, gain: float, loops) -> np.ndarray:
         """The growth rates the searches for T*, k* and D* measure (`LoopModel._searched_growth_rates`): `growth_rates`,
-        and for a loop with a dead time `_searched_growth` (the delay loop in place of one with too many delay states).
+        and for a loop with a dead time `_searched_growth`.
 
-        T* with a dead time D (docs/models.md, "Plant gain and dead time"): at T → 0 the loop is the exact delay
-        loop with delay D (T* = 0 if that is unstable); the sampled loop is searched wherever it carries the
-        commands on their way (at most `MAX_DELAY_STATES`, i.e. T >= ~D/63), the delay loop with the hold's mean
-        delay D + (d + 1/2)·T at shorter periods; D* beyond 64 periods likewise.
+        T* with a dead time D (docs/models.md, "Plant gain and dead time"): at T = 0 the loop is its own limit, the exact
+        delay loop with delay D (T* = 0 if that is unstable); at T > 0 the sampled loop itself, every probe.
         """
         loops = list(loops)
         if not any(loop.dead_time > 0 for loop in loops):
@@ -553,18 +774,12 @@ class Sampled(AffineGainModel):
         return np.array([self._searched_growth(gain, loop) for loop in loops])
 
     def _searched_growth(self, gain: float, loop: Characteristic) -> float:
-        """The growth rate (1/s) a search over T or D measures: the sampled loop's where it carries the commands on their
-        way (`MAX_DELAY_STATES`), else the delay loop with delay D + (d + 1/2)·T (the hold's mean delay), a stand-in."""
-        if loop.T > 0:
-            m, eps = dead_time_split(loop.T, self.compute_delay, loop.dead_time)
-            if m + (eps > 0) <= MAX_DELAY_STATES:
-                return float(self._growth_rates(gain, [loop])[0])
-        from .exact_delay import ExactDelay
-
-        exact = ExactDelay()
-        near = loop.replace(T=min((self.compute_delay + 0.5) * loop.T, RANGES["T"].high))  # exact_delay's delay: this T + D
-        root = exact.rightmost_root(gain, near)
-        return root.real if root is not None else (-1.0 if exact._stable(gain, near) else 1.0)
+        """The growth rate (1/s) a search over T or D measures: the dominant pole's where the eigenvalues resolve it
+        (`MAX_EIGEN_STATES`), else the verdict's sign (−1 stable, +1 not: the delay line's count, `DelayLine.outside`)."""
+        root = self.rightmost_root(gain, loop)
+        if root is not None:
+            return root.real
+        return -1.0 if self._stable(gain, loop) else 1.0
 
     def _growth_rates(self, NV: float, loops) -> np.ndarray:
         """σ = max ln|z|/T (1/s) at the gain for each loop, all exponentials and eigenvalues in one batch

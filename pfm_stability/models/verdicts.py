@@ -25,12 +25,9 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
-
 import numpy as np
 
-if TYPE_CHECKING:
-    from .base import Boundary
+from .family import StableSet
 
 __all__ = [
     "UNDECIDED_RTOL",
@@ -192,7 +189,7 @@ def interval_margin(gain: float, stable_set, critical: float, stable: bool) -> f
     return edge / gain - 1.0
 
 
-def verdict_label(NV: float, boundary: Boundary, stable: bool, rtol: float = UNDECIDED_RTOL) -> str:
+def verdict_label(NV: float, boundary: StableSet, stable: bool, rtol: float = UNDECIDED_RTOL) -> str:
     """"stable", "unstable" or "undecided" (within `rtol` of an edge of the stable set): `interval_verdict` in NV.
 
     Parameters
@@ -209,7 +206,7 @@ def verdict_label(NV: float, boundary: Boundary, stable: bool, rtol: float = UND
     return interval_verdict(NV, boundary.stable_set, boundary.NV_critical, stable, rtol)
 
 
-def gain_margin(NV: float, boundary: Boundary, stable: bool) -> float:
+def gain_margin(NV: float, boundary: StableSet, stable: bool) -> float:
     """NV_edge/NV − 1 (`interval_margin` in NV): with the usual stable set (0, NV*), NV*/NV − 1.
 
     Parameters

@@ -28,6 +28,7 @@ from .routh import routh_array, schur_cohn_stable, strip_leading_zeros
 __all__ = [
     "Crossing",
     "StabilityInterval",
+    "walk_stable_set",
     "affine_crossings",
     "first_stable_interval",
     "stable_interval",
@@ -285,3 +286,49 @@ def first_stable_interval(d, e, domain: str = "s") -> StabilityInterval:
     StabilityInterval
     """
     return stable_interval(affine_crossings(d, e, domain), lambda gain: verdict_at(d, e, gain, domain))
+
+
+def walk_stable_set(base: int, crossings, tail=None) -> StabilityInterval:
+    """The stable gains from the count of unstable roots at K → 0+ and the direction of every crossing above it.
+
+    The count changes only at a crossing, by its `change` (+2 when a root pair moves into the unstable region as K
+    grows, −2 when it leaves, ±1 for a real root through s = 0 or z = −1, 0 when it touches and returns), so the
+    stretches where it is 0 are the stable set; no verdict is asked between crossings.
+
+    Parameters
+    ----------
+    base : int
+        Unstable roots for small K > 0.
+    crossings : sequence of (float, float, int)
+        (gain K > 0, frequency, change), every crossing that can bound the stable set (any order).
+    tail : callable, optional
+        ``tail(gain) -> (gain, frequency) or None``: the next crossing above the last one, for a crossing set that is
+        complete only up to its last gain and beyond which every crossing destabilises; without it a stretch stable
+        past the last crossing is stable for every larger K.
+
+    Returns
+    -------
+    StabilityInterval
+        K* = 0 when the loop is unstable for every small K > 0.
+    """
+    crossings = sorted(crossings)
+    count, edges, intervals, start = base, [], [], 0.0 if base == 0 else None
+    for gain, frequency, change in crossings:
+        count += change
+        edges.append(Crossing(gain, frequency))
+        if start is not None and count > 0:
+            intervals.append((start, gain))
+            start = None
+        elif start is None and count == 0:
+            start = gain
+    if start is not None:
+        above = tail(crossings[-1][0] if crossings else 0.0) if tail is not None else None
+        intervals.append((start, math.inf if above is None else above[0]))
+        if above is not None:
+            edges.append(Crossing(*above))
+    intervals = [(lo, hi) for lo, hi in intervals if lo < hi]
+    if not intervals or intervals[0][0] > 0:
+        return StabilityInterval(0.0, None, tuple(edges), tuple(intervals))
+    end = intervals[0][1]
+    frequency = None if math.isinf(end) else next(c.frequency for c in edges if c.gain == end)
+    return StabilityInterval(end, frequency, tuple(edges), tuple(intervals))

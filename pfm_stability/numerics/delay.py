@@ -409,14 +409,7 @@ class DelayLoop:
         if self.d is not None:  # d(s)·x(t − T): derivatives of the delayed state, ascending powers
             b = self._b(K)[::-1]
             A1[-1, : len(b)] = -b / lead
-        x = np.cos(math.pi * np.arange(nodes + 1) / nodes)
-        c = np.ones(nodes + 1)
-        c[0] = c[-1] = 2.0
-        c *= (-1.0) ** np.arange(nodes + 1)
-        X = np.subtract.outer(x, x)
-        D = np.outer(c, 1.0 / c) / (X + np.eye(nodes + 1))
-        D -= np.diag(D.sum(axis=1))
-        D *= 2.0 / self.T  # θ = T(x − 1)/2 ∈ [−T, 0]
+        D = chebyshev_collocation(nodes)[2] * (2.0 / self.T)  # θ = T(x − 1)/2 ∈ [−T, 0]
         G = np.kron(D, np.eye(n))
         G[:n, :] = 0.0
         G[:n, :n] = A0
@@ -437,6 +430,25 @@ class DelayLoop:
                     return complex(s)
             residual = abs(self.value(s, K))
         return complex(s) if residual <= 1e-9 * max(1.0, abs(np.polyval(self.a, s))) else None
+
+
+def chebyshev_collocation(nodes: int) -> tuple:
+    """(x, c, D): the Chebyshev points x_l = cos(πl/N) (l = 0 … N, x_0 = 1), their barycentric weights c and the
+    differentiation matrix D on [−1, 1] (Trefethen, *Spectral Methods in MATLAB*, 2000, `cheb`): the collocation of the
+    pseudospectral roots (`DelayLoop.rightmost_roots`, `quasi.QuasiPolynomial.rightmost_roots`).
+
+    Parameters
+    ----------
+    nodes : int
+        N, >= 1.
+    """
+    x = np.cos(math.pi * np.arange(nodes + 1) / nodes)
+    c = np.ones(nodes + 1)
+    c[0] = c[-1] = 2.0
+    c *= (-1.0) ** np.arange(nodes + 1)
+    D = np.outer(c, 1.0 / c) / (np.subtract.outer(x, x) + np.eye(nodes + 1))
+    D -= np.diag(D.sum(axis=1))
+    return x, c, D
 
 
 # ----------------------------------------------------------------------------

@@ -50,7 +50,7 @@ LAW_INPUTS = parameter_keys(FORCE_LAWS)
 """The static laws' own parameters, listed after W when the law takes them (`laws.registry.parameter_keys`: in
 `laws.registry.PARAMETERS` order)."""
 
-PLANT_INPUTS = ("dead_time", "plant_gain")
+PLANT_INPUTS = ("dead_time", "plant_gain", "actuator_lag")
 """The steering plant's dead time D and gain g (`parameters.Robot`), listed after k only when given: a value other than
 the default (D = 0, g = 1) or one the user typed (`plant_inputs`), so reports without them are as before."""
 
@@ -545,7 +545,7 @@ def _static_report(robot, controller, law, alpha, alpha_deg, L, models, pade_ord
 
         passage = door_passage(law, check_parameter("door", door), obstacle=door_obstacle, post_radius=check_parameter("post_radius", post_radius),
                                robot_width=robot.W, find_smallest=True, name="door")
-    return StabilityReport(inputs, model_objs, STEERING, wall_result, corridor_result, _remedies(wall_result, corridor_result, fix),
+    return StabilityReport(inputs, model_objs, Loop.of(robot, controller).family, wall_result, corridor_result, _remedies(wall_result, corridor_result, fix),
                            LawDescription(law.key, law.name, json_ready(law.parameters())), passage,
                            kb_errors(robot, controller, wall_result, corridor_result, model_objs))
 
@@ -610,7 +610,7 @@ def _family_law_report(robot, controller, family, law, alpha, alpha_deg, L, mode
     def fix(geometry, verdict):  # what the verdict's critical values support: V, T, k (the law's own are not followed)
         return {k: v for k, v in remedies(geometry, verdict, robot, controller, static).items() if k in ("V", "T", "k")}
 
-    return StabilityReport(inputs, model_objs, STEERING, wall_result, corridor_result, _remedies(wall_result, corridor_result, fix),
+    return StabilityReport(inputs, model_objs, Loop.of(robot, controller).family, wall_result, corridor_result, _remedies(wall_result, corridor_result, fix),
                            LawDescription(**law.described()), None, kb_errors(robot, controller, wall_result, corridor_result, model_objs), schedule)
 
 
@@ -630,7 +630,7 @@ def plant_inputs(robot: Robot, sources: dict | None) -> dict:
         Parameter name → provenance (`build_report`'s ``sources``).
     """
     sources = sources or {}
-    defaults = {"dead_time": 0.0, "plant_gain": 1.0}
+    defaults = {"dead_time": 0.0, "plant_gain": 1.0, "actuator_lag": 0.0}
     shown = {}
     for name in PLANT_INPUTS:
         value, source = getattr(robot, name), sources.get(name)
@@ -839,6 +839,7 @@ def kb_errors(robot: Robot, controller: Controller, wall: WallAnalysis | None, c
     A static law gives one loop (c = 0, KB's own; also without a wall or corridor: a door's
     report); a velocity or fuzzy law one per heading gain, each compared as its table prints
     it. A loop whose c is beyond the models (`models.HEADING_GAIN_RANGE`: no table value) has none.
+    None with a held reference and a dead time: the sampled model takes no dead time inside the continuous servo.
 
     Parameters
     ----------
@@ -860,5 +861,7 @@ def kb_errors(robot: Robot, controller: Controller, wall: WallAnalysis | None, c
     if corridor is not None:
         loops.setdefault(corridor.c, []).append("corridor")
     low, high = HEADING_GAIN_RANGE
+    if controller.hold == "reference" and robot.dead_time > 0:  # no sampled loop to compare with (`models.sampled.continuous_plant`)
+        return ()
     return tuple(kb_error(robot, controller, c, tuple(where) if c != 0.0 else (), models)
                  for c, where in (loops or {0.0: []}).items() if low <= c <= high)

@@ -37,7 +37,7 @@ import numpy as np
 
 from ..numerics.delay import delay_verdicts_from_gain
 from ..laws.force_law import power_law_corridor_gain, power_law_wall_gain
-from ..models.base import HEADING_GAIN_RANGE, check_heading_gain
+from ..models.loop import HEADING_GAIN_RANGE, check_heading_gain
 from ..parameters import RANGES, T_RESOLUTION, TAU_RESOLUTION, check_parameter
 
 __all__ = ["VectorVerdicts", "exact_delay_verdicts", "heading_gain_array", "loop_gain_arrays", "delay_verdicts_from_gain", "resolved_lag_and_delay"]
