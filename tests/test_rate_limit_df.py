@@ -165,3 +165,31 @@ def test_unstable_cycle_of_a_sampled_loop_through_the_limiter():
     # (`analysis.disturbance.start_amplitude`: the loop run from it with the limiter, projected; measured 0.8 %)
     assert start_amplitude(robot.replace(yaw_accel_limit=R), controller, N, V, lo) == pytest.approx(lingering, rel=0.03)
     assert np.max(np.abs(np.linalg.eigvals(closed_loop_matrix(Loop(robot.tau, T, robot.k), K, "command", 1)))) < 1.0
+
+
+def test_command_responses_close_on_the_models_boundaries():
+    """Without the limiter the balance on the loop seen from its command, 1 + H₀(ω) + K·H₁(ω) = 0, is each model's own
+    boundary: solved for (ω, K) it gives the `sampled` model's (its own matrices, `command_form`) and `exact_delay`'s
+    (the continuous loop with the whole command delayed by D) NV* and ω* to 1e-9, on four random plants with dead times."""
+    from scipy import optimize
+
+    from pfm_stability.models import make_model
+    from pfm_stability.parameters import Controller, Robot
+
+    rng = np.random.default_rng(3)
+    for i in range(4):
+        robot = Robot(V=1.0, tau=rng.uniform(0.05, 0.5), k=rng.uniform(1, 4), W=0.5, plant_gain=rng.uniform(0.7, 1.3),
+                      dead_time=rng.uniform(0.01, 0.1) * (i % 2))
+        controller = Controller(f=1.0, n=2.0, T=rng.uniform(0.02, 0.12), hold="command", compute_delay=int(rng.integers(0, 2)))
+        gk = robot.plant_gain * robot.k
+        for model in ("sampled", "exact_delay"):
+            b = make_model(model, hold="command", compute_delay=controller.compute_delay).boundary(Loop.of(robot, controller))
+            H = command_responses(robot, controller, model)
+
+            def balance(x):
+                h0, h1 = H(np.array([x[0]]))
+                q = 1 + h0[0] + x[1] * h1[0]
+                return [q.real, q.imag]
+
+            w, K = optimize.root(balance, [1.05 * b.omega_critical, 0.95 * gk * b.NV_critical], options={"xtol": 1e-14}).x
+            assert w == pytest.approx(b.omega_critical, rel=1e-9) and K == pytest.approx(gk * b.NV_critical, rel=1e-9), model
