@@ -282,6 +282,7 @@ RANGES = {
     "door": Range(0.0, 1e4, unit="m"),
     "post_radius": Range(0.0, 1e4, low_open=False, unit="m"),
     "wobble": Range(0.0, 1e4, unit="m"),  # report --wobble: the tolerance on the corridor's wobble (docs/wobble.md)
+    "disturbance": Range(0.0, 1e4, unit="m"),  # report --disturbance: a start's offset from the equilibrium (docs/wobble.md)
     "sweep": Range(8, 100_000, low_open=False),
     "validate": Range(1, 1000, low_open=False),  # map: segments simulated
     "seed": Range(0, 2**63 - 1, low_open=False),

@@ -42,15 +42,19 @@ its fundamental: the third harmonics of the field (of δ(A sin θ)) and of the r
 L(s) = 1/(s(τs² + s + k')), plus the heading's, J₃(Θ)/(3J₁(Θ)) (ẏ = V sin θ integrated once). Above `THIRD_HARMONIC_LIMIT`, where the rate limit holds the
 cycle — `rate_harmonic`, the third harmonic the limit puts into the heading over the
 fundamental, h₃(sat(E sin θ))·|P(3jω)|/|P(jω)| with P(s) = 1/(s(τs + 1)) (the rate's way to
-θ), above `RATE_HARMONIC_LIMIT` — on a subcritical branch, or where the heading swing passes
-the peak of 2J₁ (Θ > 1.84 rad), a report prints no amplitude and says why (`trusted_cycle`).
+θ), above its hold's limit (`rate_harmonic_limit`: `RATE_HARMONIC_LIMIT` for the servo,
+`HELD_COMMAND_RATE_HARMONIC_LIMIT` for a held command) — between a subcritical branch's fold and V*, or where the heading
+swing passes the peak of 2J₁ (Θ > 1.84 rad), a report prints no amplitude and says why (`trusted_cycle`).
+
+With the drive's yaw acceleration limit see `limited_branch` (and `reported_cycle` where the saturation clips the
+smoother's input).
 """
 
 from __future__ import annotations
 
 import functools
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from scipy import interpolate, optimize, special
@@ -61,7 +65,8 @@ from ..laws.effective_force import corridor_lateral_force
 from ..laws.force_law import ForceLaw, corridor_gain, wall_equilibrium, wall_gain
 from ..models import make_model
 from ..models.loop import Loop
-from .describing import describing_function, harmonic_content, saturation_df_for_output
+from .describing import J1_PEAK, describing_function, harmonic_content, saturation_df_for_output
+from .limiter import limited_balance, loop_filtering
 
 __all__ = [
     "WOBBLE_MODELS",
@@ -80,7 +85,10 @@ __all__ = [
     "wall_branch",
     "wall_wobble",
     "trusted_cycle",
+    "reported_cycle",
     "RATE_HARMONIC_LIMIT",
+    "HELD_COMMAND_RATE_HARMONIC_LIMIT",
+    "limited_branch",
 ]
 
 WOBBLE_MODELS = ("exact_delay", "sampled")
@@ -94,11 +102,14 @@ RATE_HARMONIC_LIMIT = 0.02
 it the limit shapes θ into a trapezoid the first harmonic misses — with a fast motor (τ <= 0.18 s) the amplitude came
 out 8–29 % low and ω 3–18 % high at 0.026–0.063 in experiments/wobble_amplitude.py, within 8 % and 3 % below 0.02."""
 
+HELD_COMMAND_RATE_HARMONIC_LIMIT = 0.04
+"""`RATE_HARMONIC_LIMIT` for a held command (``hold="command"``): there the saturation acts on the sampled command, not
+inside a continuous servo: every held-command cycle measured with a `rate_harmonic` from 0.02 to 0.04 came within 11 %
+in amplitude (wobble_amplitude.py's seven within 8 % and 3.7 % in ω), beyond it −5 to −21 %; the servo's
+(``hold="reference"``) −10 % at 0.023, −29 % at 0.043 (docs/wobble.md, "When the describing function is not trusted")."""
+
 DEFAULT_TOLERANCE_FRACTION = 0.1
 """`report --wobble` without a value: a tenth of the clearance L − W/2 (the play the robot has either side)."""
-
-_J1_PEAK = 1.8411837813406593
-"""Θ where 2J₁(Θ) peaks (the first zero of J₁′): a larger heading swing makes less lateral motion."""
 
 _BRANCH_POINTS = 240
 
@@ -184,6 +195,15 @@ class WobbleCycle:
         The rate limit's describing function n_s (1: not saturated).
     rate_harmonic : float
         The rate limit's third harmonic in the heading over the fundamental (module docstring).
+    limiter_gain : float
+        |N_r| of the drive's yaw acceleration limit (1: not limiting; `describing.rate_limit_df`).
+    limiter_lag : float
+        Its phase lag, rad (0: not limiting).
+    hold : str or None
+        The controller's hold (`trusted_cycle` takes its rate limit by it; None: the servo's, the stricter).
+    cascade : bool
+        The steering-rate saturation clips the smoother's input there: the product of their describing functions misses
+        the ramps the smoother puts on the clipped command (`limited_branch`).
     """
 
     amplitude: float
@@ -193,6 +213,10 @@ class WobbleCycle:
     third_harmonic: float
     rate_gain: float
     rate_harmonic: float
+    limiter_gain: float = 1.0
+    limiter_lag: float = 0.0
+    hold: str | None = None
+    cascade: bool = False
 
 
 @dataclass(frozen=True)
@@ -226,6 +250,18 @@ class WobbleBranch:
         β, 1/m²: V(A) = V*(1 − βA²) + O(A⁴).
     clearance : float
         L − W/2, m: an amplitude that reaches it touches a wall.
+    limiter_gains, limiter_lags : ndarray or None
+        |N_r| and the phase lag (rad) of the drive's yaw acceleration limit along the branch (`limited_branch`); None
+        without a limit.
+    gain : float or None
+        The field's gain N at the equilibrium, 1/m (V* = NV*/N).
+    hold : str or None
+        The controller's hold.
+    cascades : ndarray of bool or None
+        Where the saturation clips the smoother's input (`WobbleCycle.cascade`); None without a yaw acceleration limit.
+    heading_builder : callable or None
+        With such points: builds the branch with the steering-rate limit as the heading's rate limit (`limited_branch`,
+        ``heading_limit=True``; `heading_limited`, computed when first read); else None.
     """
 
     model: str
@@ -240,6 +276,17 @@ class WobbleBranch:
     omega_critical: float
     beta: float
     clearance: float
+    limiter_gains: np.ndarray | None = None
+    limiter_lags: np.ndarray | None = None
+    gain: float | None = None
+    hold: str | None = None
+    cascades: np.ndarray | None = None
+    heading_builder: object = field(default=None, repr=False, compare=False)
+
+    @functools.cached_property
+    def heading_limited(self) -> "WobbleBranch | None":
+        """The branch with the steering-rate limit on the heading (`heading_builder`), or None."""
+        return self.heading_builder() if self.heading_builder is not None else None
 
     @property
     def criticality(self) -> str:
@@ -273,8 +320,10 @@ class WobbleBranch:
                 continue
             t = d[i] / (d[i] - d[i + 1])
             pick = lambda x: float(x[i] + t * (x[i + 1] - x[i]))
+            limiter = (pick(self.limiter_gains), pick(self.limiter_lags)) if self.limiter_gains is not None else (1.0, 0.0)
+            cascade = bool(self.cascades is not None and (self.cascades[i] or self.cascades[i + 1]))
             out.append(WobbleCycle(pick(A), pick(self.headings), pick(self.omegas), bool(S[i + 1] > S[i]),
-                                   pick(self.third_harmonics), pick(self.rate_gains), pick(self.rate_harmonics)))
+                                   pick(self.third_harmonics), pick(self.rate_gains), pick(self.rate_harmonics), *limiter, self.hold, cascade))
         return tuple(out)
 
     def tolerance_speed(self, tolerance: float) -> float:
@@ -331,6 +380,9 @@ class Wobble:
         Why the amplitude is null, or what to know about it.
     rate_harmonic : float or None
         The second trust measure: the rate limit's third harmonic in the heading over the fundamental.
+    limiter : tuple or None
+        With the drive's yaw acceleration limit: (|N_r|, lag in rad) at the cycle, (None, None) without one; None when the
+        robot has no limit (JSON ``limiter_gain``, ``limiter_lag`` only then).
     """
 
     amplitude: float | None
@@ -346,6 +398,7 @@ class Wobble:
     method: str
     reason: str | None = None
     rate_harmonic: float | None = None
+    limiter: tuple | None = None
 
     @classmethod
     def unavailable(cls, reason: str, tolerance: float | None) -> "Wobble":
@@ -377,18 +430,60 @@ class Wobble:
             "rate_harmonic": number(self.rate_harmonic),
             "method": self.method,
             "reason": self.reason,
+            **({"limiter_gain": number(self.limiter[0]), "limiter_lag": number(self.limiter[1])} if self.limiter is not None else {}),
         }
 
 
+def reported_cycle(branch: "WobbleBranch", V: float, cycle: WobbleCycle) -> WobbleCycle | None:
+    """The cycle a report gives for `cycle` of `branch` at speed V, or None when the describing function is not trusted.
+
+    `cycle` itself when `trusted_cycle`. Where only the saturation clipping the smoother's input fails the test
+    (`WobbleCycle.cascade`), the heading-limited branch's (`WobbleBranch.heading_limited`: the steering-rate limit as
+    the heading's rate limit, the smoother on the unclipped command) stable cycle at V nearest in amplitude, if its own
+    third harmonic passes `THIRD_HARMONIC_LIMIT` (module docstring, "Trust").
+
+    Parameters
+    ----------
+    branch : WobbleBranch
+        The branch `cycle` is on.
+    V : float
+        Speed, m/s.
+    cycle : WobbleCycle
+        A cycle of the branch at V.
+    """
+    if trusted_cycle(cycle):
+        return cycle
+    if not cycle.cascade or branch.heading_limited is None or not cycle.third_harmonic <= THIRD_HARMONIC_LIMIT \
+            or not cycle.rate_harmonic <= rate_harmonic_limit(cycle.hold):
+        return None
+    shaped = [c for c in branch.heading_limited.cycles_at(V) if c.stable]
+    if not shaped:
+        return None
+    nearest = min(shaped, key=lambda c: abs(c.amplitude - cycle.amplitude))
+    return nearest if nearest.third_harmonic <= THIRD_HARMONIC_LIMIT else None
+
+
 def trusted_cycle(cycle: WobbleCycle) -> bool:
-    """The describing function's trust test at a cycle: `third_harmonic` <= `THIRD_HARMONIC_LIMIT`, `rate_harmonic` <= `RATE_HARMONIC_LIMIT`.
+    """The describing function's trust test at a cycle: `third_harmonic` <= `THIRD_HARMONIC_LIMIT`, `rate_harmonic` within its
+    hold's limit (`rate_harmonic_limit`), and no saturation clipping the smoother's input (`WobbleCycle.cascade`).
 
     Parameters
     ----------
     cycle : WobbleCycle
         A cycle of the branch.
     """
-    return cycle.third_harmonic <= THIRD_HARMONIC_LIMIT and cycle.rate_harmonic <= RATE_HARMONIC_LIMIT
+    return cycle.third_harmonic <= THIRD_HARMONIC_LIMIT and cycle.rate_harmonic <= rate_harmonic_limit(cycle.hold) and not cycle.cascade
+
+
+def rate_harmonic_limit(hold: str | None) -> float:
+    """The largest `rate_harmonic` trusted: `HELD_COMMAND_RATE_HARMONIC_LIMIT` for ``"command"``, else `RATE_HARMONIC_LIMIT`.
+
+    Parameters
+    ----------
+    hold : str or None
+        The controller's hold (None: a cycle of a branch that does not say; the stricter limit).
+    """
+    return HELD_COMMAND_RATE_HARMONIC_LIMIT if hold == "command" else RATE_HARMONIC_LIMIT
 
 
 def wall_steering(law: ForceLaw, alpha: float):
@@ -491,12 +586,6 @@ def _fundamental_input(U: float, M: float) -> float:
     return U / saturation_df_for_output(U, M)
 
 
-def _filtering(omega: float, tau: float, k: float) -> float:
-    """|L(3jω)|/|L(jω)| with L(s) = 1/(s(τs² + s + k))."""
-    L = lambda s: 1.0 / (s * (tau * s * s + s + k))
-    return abs(L(3j * omega)) / abs(L(1j * omega))
-
-
 class _GainTable:
     """NV*(k·f) and ω*(k·f) of the loop model for steering-gain factors f in [0.02, 1], splined in log f (computed once)."""
 
@@ -584,7 +673,20 @@ def corridor_branch(robot, controller, law: ForceLaw, L: float, *, model: str = 
 
 
 def _branch(robot, controller, delta, N: float, A, Nf, clearance: float, model: str, beta_f: float) -> WobbleBranch:
-    """The branch V(A) for the field's describing function `Nf` at amplitudes `A` (module docstring)."""
+    """The branch V(A) for the field's describing function `Nf` at amplitudes `A` (module docstring), and where the
+    steering-rate limit shapes the heading of a held command, the branch with it on the heading (`heading_limited`)."""
+    branch = _branch_of(robot, controller, delta, N, A, Nf, clearance, model, beta_f)
+    if branch.cascades is not None and np.any(branch.cascades):
+        build = functools.partial(limited_branch, robot, controller, delta, N, A, Nf, clearance, model, beta_f, heading_limit=True)
+        branch = replace(branch, heading_builder=build)
+    return branch
+
+
+def _branch_of(robot, controller, delta, N: float, A, Nf, clearance: float, model: str, beta_f: float) -> WobbleBranch:
+    """The branch with the steering-rate limit on the command: `limited_branch` with a yaw acceleration limit, else the
+    model's own boundary with the steering gain's factor (module docstring)."""
+    if math.isfinite(robot.yaw_accel_limit):
+        return limited_branch(robot, controller, delta, N, A, Nf, clearance, model, beta_f)
     loop_model = make_model(model, hold=controller.hold, compute_delay=controller.compute_delay)
     # in the motor's units: the plant gain g scales the command after the rate limit (docs/simulator.md), so
     # g·sat_M(u) = sat_gM(g·u): a robot (k, M, g) is the robot (g·k, g·M, 1); the dead time D stays in the loop
@@ -614,17 +716,61 @@ def _branch(robot, controller, delta, N: float, A, Nf, clearance: float, model: 
                 continue
             NV, w = table(factor)
             theta = a * w * nf / NV
-        if not theta < _J1_PEAK:
+        if not theta < J1_PEAK:
             continue
         U = theta * w * math.hypot(1.0, w * tau)
         speeds[i] = a * w / (2.0 * special.j1(theta))
         omegas[i], headings[i], gains[i] = w, theta, factor
         h3_rate = harmonic_content(sat, _fundamental_input(U, M)) if factor < 1.0 else 0.0
         rates[i] = h3_rate * math.hypot(1.0, w * tau) / (3.0 * math.hypot(1.0, 3.0 * w * tau))
-        thirds[i] = (h3[i] + h3_rate) * _filtering(w, tau, k * factor) \
+        thirds[i] = (h3[i] + h3_rate) * loop_filtering(w, tau, k * factor) \
             + special.jv(3, theta) / (3.0 * special.j1(theta))
     beta = beta_f - w0**2 / (8.0 * V_star**2)
-    return WobbleBranch(model, A, speeds, omegas, headings, gains, thirds, rates, V_star, w0, beta, clearance)
+    return WobbleBranch(model, A, speeds, omegas, headings, gains, thirds, rates, V_star, w0, beta, clearance, gain=N, hold=controller.hold)
+
+
+def limited_branch(robot, controller, delta, N: float, A, Nf, clearance: float, model: str, beta_f: float, *,
+                   heading_limit: bool = False) -> WobbleBranch:
+    """The branch V(A) with the drive's yaw acceleration limit R: the rate limiter as one more describing function.
+
+    The quasi-linear loop of the module docstring with the command's describing function N_c = n_s(E)·N_r(U, ω) (the
+    saturation at g·ω_max, then the limiter at g·R, `describing.rate_limit_df`: sampled at T for the `sampled` loop, as
+    the simulator's smoother acts once per period; continuous for `exact_delay`), complex: each amplitude solves
+    1 + N_c·(H₀(ω) + K'·H₁(ω)) = 0 on the loop seen from its command (`limiter.limited_balance`), U the limiter's input
+    amplitude, |N_r|·U = Θ·ω·√(1 + ω²τ²), K' = g·k·N_f(A)·A·ω/Θ, V = Aω/(2J₁(Θ)) as without the limit. Below the
+    limiter's threshold N_r = 1 and the branch is the one without it, so β is unchanged: the limiter acts at finite
+    amplitude, where its lag bends V(A) down — cycles below V* (`WobbleBranch.fold_speed`).
+
+    ``heading_limit``: the steering-rate limit as the heading's rate limit instead — θ = RL(θ_lin), the rate limiter's
+    describing function N_h(θ_lin·ω/(g·ω_max)) on the linear servo's heading, on the field's path only:
+    1 + N_r·(H₀ + N_h·K'·H₁) = 0 — where the saturation clips the smoother's input (`WobbleCycle.cascade`).
+
+    Parameters
+    ----------
+    robot : parameters.Robot
+        τ, k, W, g, D, `max_steering_rate` and `yaw_accel_limit` (finite unless ``heading_limit``).
+    controller : parameters.Controller
+        T, compute delay; ``hold="command"`` (a servo has no command sequence to limit).
+    delta : callable
+        δ(y), the field's steering (for its third harmonic).
+    N : float
+        The field's gain at A → 0, 1/m.
+    A, Nf : ndarray
+        Amplitudes (m, increasing) and the field's describing function there (1/m).
+    clearance : float
+        m.
+    model : {"exact_delay", "sampled"}
+    beta_f : float
+        The field's cubic coefficient, 1/m².
+    heading_limit : bool
+        The steering-rate limit on the heading (module docstring, "Trust").
+    """
+    balance = limited_balance(robot, controller, delta, A, Nf, model, heading_limit=heading_limit)
+    V_star = balance.NV_critical / N
+    beta = beta_f - balance.omega_critical**2 / (8.0 * V_star**2)
+    b = balance
+    return WobbleBranch(model, A, b.speeds, b.omegas, b.headings, b.rate_gains, b.third_harmonics, b.rate_harmonics, V_star,
+                        b.omega_critical, beta, clearance, b.limiter_gains, b.limiter_lags, N, controller.hold, b.cascades)
 
 
 def corridor_wobble(robot, controller, law: ForceLaw, L: float, tolerance: float | None = None, *, model: str = "sampled") -> Wobble:
@@ -695,7 +841,18 @@ def _wobble_at(branch: WobbleBranch, V: float, tolerance: float | None, method: 
         tolerance = DEFAULT_TOLERANCE_FRACTION * branch.clearance
     common = dict(criticality=branch.criticality, V_tolerance=branch.tolerance_speed(tolerance), tolerance=tolerance,
                   V_critical=branch.V_critical, V_fold=branch.fold_speed, method=method)
+    limited = branch.limiter_gains is not None
+    if limited:
+        common["limiter"] = (None, None)
     stable = [c for c in branch.cycles_at(V) if c.stable]
+    if limited and branch.fold_speed < V <= branch.V_critical:  # the limiter's lag bends the branch below V*
+        unstable = [c for c in branch.cycles_at(V) if not c.stable]
+        edge = f" beyond the unstable cycle of {unstable[0].amplitude:.3g} m" if unstable else ""
+        reason = (f"below V* = {branch.V_critical:.4g} m/s a small start settles, but cycles exist down to V_fold = {branch.fold_speed:.4g} "
+                  f"m/s (the yaw acceleration limit lags at finite amplitude): a start{edge} jumps to {'a large cycle' if stable else 'a wall'}; "
+                  "--disturbance D says which for a start of D")
+        return Wobble(None, None, None, not stable, third_harmonic=None, reason=reason, **common)
+    jump = None
     if branch.criticality == "subcritical" and V > branch.fold_speed:
         unstable = [c for c in branch.cycles_at(V) if not c.stable]
         where = "a wall" if not stable else "a large cycle"
@@ -703,9 +860,11 @@ def _wobble_at(branch: WobbleBranch, V: float, tolerance: float | None, method: 
             edge = f" (beyond the unstable cycle of {unstable[0].amplitude:.3g} m)" if unstable else ""
             reason = (f"subcritical: between V_fold = {branch.fold_speed:.4g} and V* = {branch.V_critical:.4g} m/s a small start settles "
                       f"and a large one{edge} jumps to {where}; the describing function does not say which start the robot has")
-        else:
-            reason = f"subcritical: past V* = {branch.V_critical:.4g} m/s the wobble jumps to {where}; the describing function is not trusted there"
-        return Wobble(None, None, None, not stable, third_harmonic=None, reason=reason, **common)
+            return Wobble(None, None, None, not stable, third_harmonic=None, reason=reason, **common)
+        if not stable:
+            return Wobble(None, None, None, True, third_harmonic=None,
+                          reason=f"subcritical: past V* = {branch.V_critical:.4g} m/s the wobble jumps to a wall", **common)
+        jump = f"subcritical: past V* = {branch.V_critical:.4g} m/s the wobble jumps to the large cycle"  # read below, as any cycle
     if V <= branch.V_critical:
         below = "below V*: the robot settles" if branch.criticality == "supercritical" else \
             "below V_fold: every start clear of the walls settles"
@@ -715,13 +874,27 @@ def _wobble_at(branch: WobbleBranch, V: float, tolerance: float | None, method: 
                       reason="no limit cycle clear of the walls: the wobble grows until the robot touches a wall", **common)
     cycle = stable[0]
     common["rate_harmonic"] = cycle.rate_harmonic
+    if limited:
+        common["limiter"] = (cycle.limiter_gain, cycle.limiter_lag)
     if not cycle.third_harmonic <= THIRD_HARMONIC_LIMIT:
         return Wobble(None, None, None, False, third_harmonic=cycle.third_harmonic,
                       reason=f"strong harmonics: predicted third harmonic {cycle.third_harmonic:.2f} of the fundamental "
                              f"(> {THIRD_HARMONIC_LIMIT:g}); the describing function is not trusted", **common)
-    if not cycle.rate_harmonic <= RATE_HARMONIC_LIMIT:
+    limit = rate_harmonic_limit(cycle.hold)
+    if not cycle.rate_harmonic <= limit:
         return Wobble(None, None, None, False, third_harmonic=cycle.third_harmonic,
                       reason=f"the steering-rate limit shapes the heading (its third harmonic {cycle.rate_harmonic:.3f} of the "
-                             f"fundamental > {RATE_HARMONIC_LIMIT:g}; rate describing function {cycle.rate_gain:.2f}): "
+                             f"fundamental > {limit:g}; rate describing function {cycle.rate_gain:.2f}): "
                              "the describing function is not trusted", **common)
-    return Wobble(cycle.amplitude, cycle.heading_amplitude, cycle.omega, False, third_harmonic=cycle.third_harmonic, **common)
+    if cycle.cascade:
+        shaped = reported_cycle(branch, V, cycle)
+        if shaped is None:
+            return Wobble(None, None, None, False, third_harmonic=cycle.third_harmonic,
+                          reason="the steering-rate limit clips the smoother's input (the clipped command's flank changes faster than "
+                                 "the yaw acceleration limit): the describing function is not trusted", **common)
+        common["limiter"] = (shaped.limiter_gain, shaped.limiter_lag)
+        common["method"] += "; where the steering-rate limit clips the smoother's input, that limit as the heading's rate limit"
+        return Wobble(shaped.amplitude, shaped.heading_amplitude, shaped.omega, False, third_harmonic=shaped.third_harmonic,
+                      reason="the steering-rate limit clips the smoother's input: taken as the heading's rate limit (the rate limiter's "
+                             "describing function at g*max_steering_rate), the smoother on the command", **common)
+    return Wobble(cycle.amplitude, cycle.heading_amplitude, cycle.omega, False, third_harmonic=cycle.third_harmonic, reason=jump, **common)

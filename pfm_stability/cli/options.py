@@ -355,6 +355,8 @@ def resolve_parameters(args, *, fill=None) -> ResolvedParameters:
             raise ValueError(f"robot.family {config.family} of --config {config.path} is read by report only (--robot, "
                              "docs/velocity_and_fuzzy.md); this command analyses KB's steering robot: give robot.family steering or none")
         sources.update(_fill_scenario(args, config, SCENARIO_OPTIONS if fill is None else fill))
+        if "max_steering_rate" in config.sources:  # a Nav2 velocity smoother's clamp (io.nav2.read_velocity_smoother)
+            sources["max_steering_rate"] = config.sources["max_steering_rate"]
         for note in config.notes:
             print(f"pfm-stability: note: {note}", file=sys.stderr)
     return ResolvedParameters(preset, robot, controller, sources, config)

@@ -52,6 +52,8 @@ _LABELS = {
     "dead_time": "D (steering plant dead time)",
     "plant_gain": "g (steering plant gain)",
     "actuator_lag": "tau_a (drive's second lag)",
+    "yaw_accel_limit": "R (drive's yaw accel limit)",
+    "max_steering_rate": "omega_max (steering-rate limit)",
     "f": "f (force ratio)",
     "n": "n (repulsion exponent)",
     "W": "W (robot width)",
@@ -105,7 +107,7 @@ def _scenarios(report, data: dict):
     """Yield (title, header, rows, remedies, notes) of each geometry, by its result's type (`_sections_of`), with the values
     of the report's JSON form `data`."""
     for geometry, result in report.scenes():
-        verdicts = {k: v for k, v in data[geometry].items() if k != "wobble"} if data.get(geometry) is not None else None
+        verdicts = {k: v for k, v in data[geometry].items() if k not in ("wobble", "disturbance")} if data.get(geometry) is not None else None
         yield from _sections_of(result)(result, data["environment"][geometry], verdicts, report)
 
 
@@ -239,6 +241,46 @@ def _wobble_lines(data: dict) -> list[str]:
     return lines
 
 
+def _disturbance_lines(data: dict) -> list[str]:
+    """``report --disturbance D``: what a start of D does in each geometry, V*(D) against V*, the criticality; with a yaw
+    acceleration limit and no ``--disturbance``, one line saying the verdicts are those of small starts (docs/wobble.md)."""
+    limit = (data.get("inputs", {}).get("yaw_accel_limit") or {}).get("value")
+    lines = []
+    for geometry, where in (("wall", "beside the wall, off its equilibrium"), ("corridor", "in the corridor, off the centre line")):
+        d = (data.get(geometry) or {}).get("disturbance")
+        if d is None:
+            continue
+        lines += ([""] if lines else []) + [f"Disturbance {where}: a start {number(d['disturbance'])} m off (docs/wobble.md)"]
+        if d["V_disturbance"] is None:
+            lines.append(f"  not predicted: {d['reason']}")
+            continue
+        lines.append(f"  small starts (the linear verdict): settle at or below V* = {number(d['V_critical'])} m/s")
+        lines.append(f"  a start of {number(d['disturbance'])} m settles at or below V*(D) = {number(d['V_disturbance'])} m/s")
+        V = data["inputs"]["V"]["value"]
+        at = f"  at V = {number(V)} m/s (its oscillation starts at {number(d['start_amplitude'])} m): "
+        if d["settles"]:
+            lines.append(at + "it settles")
+        elif d["reaches_wall"]:
+            lines.append(at + "it grows until the robot touches a wall")
+        elif d["amplitude"] is not None:
+            lines.append(at + f"it ends on a limit cycle of {number(d['amplitude'])} m at omega {number(d['omega'])} rad/s")
+        else:
+            lines.append(at + f"it does not settle; {d['reason']}")
+        below = (f"; cycles exist below V* from V_fold = {number(d['V_fold'])} m/s: a large enough start grows where a small one "
+                 "settles") if d["cycles_below_critical"] else ""
+        lines.append(f"  Hopf at V*: {d['criticality']}{below}")
+        if d["yaw_accel_limit"] != "inf":
+            lag = f" (at that cycle |N| = {number(d['limiter_gain'])}, lag {number(d['limiter_lag'])} rad)" if d["limiter_gain"] is not None else ""
+            lines.append(f"  the drive's yaw acceleration limit {number(d['yaw_accel_limit'])} rad/s^2: linear while a command changes by "
+                         f"less than R*T a period, a lag beyond{lag}")
+        lines.append(f"  method: {d['method']}")
+    if limit is not None and not lines:
+        lines += ["The drive's yaw acceleration limit (docs/wobble.md)",
+                  f"  R = {number(limit)} rad/s^2 is not in these linear verdicts: they hold for small disturbances (the limiter passes "
+                  "every command that changes by less than R*T a period); --disturbance D gives the speed for a start of D m"]
+    return lines
+
+
 def _corridor_notes(env: dict) -> list[str]:
     """The corridor's lines beyond the table: the finite-goal gain, equilibria off the centre line."""
     notes = []
@@ -330,6 +372,8 @@ def render_text(report) -> str:
     lines += _tail(report, data)
     wobble = _wobble_lines(data)
     lines += ["", *wobble] if wobble else []
+    disturbance = _disturbance_lines(data)
+    lines += ["", *disturbance] if disturbance else []
     if data.get("door"):
         lines += ["", *render_door_text(data["door"]).rstrip("\n").splitlines()]
     lines += _footnote(report)
@@ -395,7 +439,7 @@ def render_markdown(report) -> str:
             lines.append("")
             lines.append("-" + _remedy_line(model, fix)[1:])
     lines += _tail(report, data)
-    for line in _wobble_lines(data):
+    for line in _wobble_lines(data) + _disturbance_lines(data):
         lines += ["", f"## {line}", ""] if line and not line.startswith(" ") else ([f"- {line.strip()}"] if line else [])
     if data.get("door"):
         lines += ["", "## Door", "", "```", *render_door_text(data["door"]).rstrip("\n").splitlines(), "```"]

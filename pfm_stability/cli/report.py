@@ -30,6 +30,10 @@ def add_parser(sub) -> None:
     p.add_argument("--wobble", type=number("wobble"), nargs="?", const=True, default=None, metavar="TOL",
                    help=f"corridor: the limit cycle past V* by describing functions (docs/wobble.md) and the fastest speed whose "
                         f"wobble stays under TOL, {describe('wobble')} (default a tenth of L - W/2)")
+    p.add_argument("--disturbance", type=number("disturbance"), default=None, metavar="D",
+                   help=f"a start D m off the equilibrium (corridor and/or wall): the speed at or below which it settles, the cycle "
+                        f"it grows into past it, sub- or supercritical, with the drive's --yaw-accel-limit (docs/wobble.md), "
+                        f"{describe('disturbance')}")
     p.add_argument("--model", action="append", choices=MODEL_NAMES, help="model to include (repeatable; default: all)")
     p.add_argument(
         "--pade-order", type=PADE_ORDER, default=DEFAULT_PADE_ORDER,
@@ -65,6 +69,7 @@ def run(args) -> int:
         post_radius=args.post_radius,
         simulate_cycle=None if args.no_simulate else _simulated_cycle,
         wobble=args.wobble,
+        disturbance=args.disturbance,
     )
     if args.format == "json":
         print(dumps(report.to_dict()))

@@ -381,6 +381,7 @@ NAV2_ASSUMED = {
     "dead_time": "a Nav2 file does not give the steering plant's dead time; this is the preset's (measure yours: pfm-stability identify, docs/diagnose.md)",
     "plant_gain": "a Nav2 file does not give the steering plant's gain; this is the preset's (measure yours: pfm-stability identify, docs/diagnose.md)",
     "actuator_lag": "a Nav2 file does not give the drive's second lag; this is the preset's (measure yours: pfm-stability identify, docs/diagnose.md)",
+    "yaw_accel_limit": "no velocity_smoother node in the Nav2 file; this is the preset's (none unless it gives one)",
 }
 """Why a loop parameter a Nav2 file cannot give is an assumption (marked ASSUMED in the report)."""
 
@@ -389,15 +390,21 @@ def _from_nav2(src: YamlFile, path: str, preset) -> Config:
     origin = src.origin
     base = _base(src, {}, preset)
     found = read_nav2(src)
-    robot = _build(src, "robot", Robot, base.robot, {k: v.value for k, v in found.values.items() if k in ROBOT_KEYS})
+    robot = _build(src, "robot", Robot, base.robot, {k: v.value for k, v in found.values.items() if k in ROBOT_KEYS or k == "max_steering_rate"})
     controller = _build(src, "controller", Controller, base.controller, {k: v.value for k, v in found.values.items() if k in CONTROLLER_KEYS})
     sources, assumed = {}, {}
     for name in PARAMETER_KEYS:
         if name in found.values:
-            sources[name] = f"{origin}: {found.values[name].describe()}"
+            value = found.values[name]
+            sources[name] = f"ASSUMED ({origin}): {value.describe()}; {value.assumed}" if value.assumed else f"{origin}: {value.describe()}"
+            if value.assumed:
+                assumed[name] = value.assumed
             continue
         assumed[name] = base.assumed.get(name) or NAV2_ASSUMED.get(name, f"not found in the Nav2 file: the preset {base.name}'s value")
         sources[name] = f"ASSUMED (preset {base.name}): {assumed[name]}"
+    if "max_steering_rate" in found.values:  # a velocity smoother's clamp: shown beside its yaw acceleration limit
+        value = found.values["max_steering_rate"]
+        sources["max_steering_rate"] = f"ASSUMED ({origin}): {value.describe()}; {value.assumed}" if value.assumed else f"{origin}: {value.describe()}"
     merged = Preset(
         name=origin, robot=robot, controller=controller, assumed=assumed,
         source=f"{origin} over preset {base.name}", cell_size=base.cell_size, window_cells=base.window_cells,

@@ -44,7 +44,7 @@ from ..laws.registry import FAMILY_CHOICE_DEFAULTS, FAMILY_DEFAULTS, FORCE_LAWS,
 from ..parameters import MODEL_NAMES, RANGES, ROBOT_FAMILIES, Controller, Corridor, Robot, Wall, check_parameter
 
 __all__ = ["StabilityReport", "KBError", "LawDescription", "build_report", "remedies", "kb_error", "kb_errors", "KINEMATIC_TAU_SOURCE",
-           "PLANT_INPUTS", "plant_inputs"]
+           "PLANT_INPUTS", "plant_inputs", "DRIVE_INPUTS", "drive_inputs"]
 
 LAW_INPUTS = parameter_keys(FORCE_LAWS)
 """The static laws' own parameters, listed after W when the law takes them (`laws.registry.parameter_keys`: in
@@ -54,7 +54,12 @@ PLANT_INPUTS = ("dead_time", "plant_gain", "actuator_lag")
 """The steering plant's dead time D and gain g (`parameters.Robot`), listed after k only when given: a value other than
 the default (D = 0, g = 1) or one the user typed (`plant_inputs`), so reports without them are as before."""
 
-INPUTS = ("V", "tau", "T", "k", *PLANT_INPUTS, "f", "n", "W", *LAW_INPUTS, "hold", "compute_delay", "pade_order", "alpha_deg", "L")
+DRIVE_INPUTS = ("yaw_accel_limit", "max_steering_rate")
+"""The drive's limits beyond the plant: its yaw acceleration limit R and, when a file gave it with R (a Nav2 velocity
+smoother's velocity clamp), its steering-rate limit (`parameters.Robot`), listed after the plant only when the robot has
+a finite R, so reports without it are as before (`drive_inputs`)."""
+
+INPUTS = ("V", "tau", "T", "k", *PLANT_INPUTS, *DRIVE_INPUTS, "f", "n", "W", *LAW_INPUTS, "hold", "compute_delay", "pade_order", "alpha_deg", "L")
 """The report's inputs for a static law, in the order it lists them (``alpha_deg`` and ``L`` when given; f and n for KB's laws only)."""
 
 UNITS = {name: RANGES[name].unit if name in RANGES else "" for name in INPUTS}
@@ -194,6 +199,9 @@ class StabilityReport:
         The corridor's wobble past V* (``report --wobble``; JSON ``corridor.wobble``).
     wall_wobble : analysis.wobble.Wobble or None
         The wall's (the biased describing function; JSON ``wall.wobble``).
+    disturbance, wall_disturbance : analysis.disturbance.Disturbance or None
+        What a start of a given size does in the corridor and beside the wall (``report --disturbance``; JSON
+        ``corridor.disturbance``, ``wall.disturbance``).
     """
 
     inputs: dict
@@ -209,6 +217,8 @@ class StabilityReport:
     tracking: object | None = None
     wobble: object | None = None
     wall_wobble: object | None = None
+    disturbance: object | None = None
+    wall_disturbance: object | None = None
 
     @property
     def kb_error(self) -> KBError | None:
@@ -238,6 +248,10 @@ class StabilityReport:
             out["corridor"]["wobble"] = self.wobble.to_dict()
         if self.wall_wobble is not None and "wall" in out:
             out["wall"]["wobble"] = self.wall_wobble.to_dict()
+        if self.disturbance is not None and "corridor" in out:
+            out["corridor"]["disturbance"] = self.disturbance.to_dict()
+        if self.wall_disturbance is not None and "wall" in out:
+            out["wall"]["disturbance"] = self.wall_disturbance.to_dict()
         if self.tracking is not None:
             t = self.tracking
             out["tracking"] = json_ready({"damping_ratio": t.damping_ratio, "natural_frequency": t.natural_frequency, "regime": t.regime})
@@ -329,6 +343,7 @@ def build_report(
     post_radius: float = 0.0,
     simulate_cycle=None,
     wobble=None,
+    disturbance=None,
 ) -> StabilityReport:
     """The report of any robot family and law for a wall (α) and/or a corridor (L, m), and a door with a static law.
 
@@ -373,6 +388,10 @@ def build_report(
         The wobble past V* in the corridor and beside the wall (`analysis.wobble.corridor_wobble`, `wall_wobble`,
         docs/wobble.md): the tolerance on its lateral amplitude, m, or True for the default (a tenth of the clearance:
         L − W/2, or the room before the wall); None or False: not computed. A steering or kinematic robot with a static law.
+    disturbance : float, optional
+        A start this far off the equilibrium, m, in the corridor and beside the wall (`analysis.disturbance`,
+        docs/wobble.md): the speed V*(D) at or below which it settles, what it grows into past it, the criticality, with
+        the robot's `yaw_accel_limit`; None: not computed. A steering or kinematic robot with a static law.
 
     Returns
     -------
@@ -386,6 +405,10 @@ def build_report(
         the law has no equilibrium.
     """
     check_choice("robot", family, ROBOT_FAMILIES)
+    if disturbance is not None:
+        return _with_disturbance(disturbance, robot, controller, family=family, law=law, alpha=alpha, alpha_deg=alpha_deg, L=L, models=models,
+                                 pade_order=pade_order, mass=mass, sources=sources, door=door, door_obstacle=door_obstacle,
+                                 post_radius=post_radius, simulate_cycle=simulate_cycle, wobble=wobble)
     if wobble is not None and wobble is not False:
         return _with_wobble(wobble, robot, controller, family=family, law=law, alpha=alpha, alpha_deg=alpha_deg, L=L, models=models,
                             pade_order=pade_order, mass=mass, sources=sources, door=door, door_obstacle=door_obstacle,
@@ -419,24 +442,58 @@ def _with_wobble(wobble, robot, controller, *, family, law, L, **options) -> Sta
     hold and compute delay, the exact-delay loop for a continuous controller), or the reason it has none (N <= 0, …)."""
     from ..analysis.wobble import Wobble, corridor_wobble, wall_wobble
 
-    if (L is None and options["alpha"] is None and options["alpha_deg"] is None) or family == "holonomic" \
-            or (law is not None and not isinstance(law, ForceLaw)):
-        raise ValueError(_WOBBLE_REFUSED)
+    _check_nonlinear(_WOBBLE_REFUSED, family, law, L, options)
     tolerance = None if wobble is True else check_parameter("wobble", wobble)
     report = build_report(robot, controller, family=family, law=law, L=L, **options)
+    corridor, wall = _each_geometry(report, robot, controller, family, law, (corridor_wobble, wall_wobble), tolerance,
+                                    lambda reason: Wobble.unavailable(reason, tolerance))
+    return replace(report, wobble=corridor, wall_wobble=wall)
+
+
+_DISTURBANCE_REFUSED = ("--disturbance applies to a wall (--alpha) or a corridor (--L) with --robot steering or kinematic and a static law "
+                        "(power, grid, khatib, gnron)")
+"""The message when a disturbance is asked of a report without a wall or corridor, or of a robot family or law it does not apply to."""
+
+
+def _with_disturbance(disturbance, robot, controller, *, family, law, L, **options) -> StabilityReport:
+    """`build_report` (with its wobble, if asked) and what a start of size D does in the corridor and beside the wall
+    (`analysis.disturbance`), or why it cannot be said (N <= 0, no oscillatory boundary, …)."""
+    from ..analysis.disturbance import Disturbance, corridor_disturbance, wall_disturbance
+
+    _check_nonlinear(_DISTURBANCE_REFUSED, family, law, L, options)
+    D = check_parameter("disturbance", disturbance)
+    report = build_report(robot, controller, family=family, law=law, L=L, **options)
+    corridor, wall = _each_geometry(report, robot, controller, family, law, (corridor_disturbance, wall_disturbance), D,
+                                    lambda reason: Disturbance.unavailable(D, robot.yaw_accel_limit, reason))
+    return replace(report, disturbance=corridor, wall_disturbance=wall)
+
+
+def _check_nonlinear(refusal: str, family: str, law, L, options: dict) -> None:
+    """ValueError(`refusal`) unless a wall or corridor, a steering or kinematic robot and a static law: what the
+    describing functions take (``--wobble``, ``--disturbance``)."""
+    if (L is None and options["alpha"] is None and options["alpha_deg"] is None) or family == "holonomic" \
+            or (law is not None and not isinstance(law, ForceLaw)):
+        raise ValueError(refusal)
+
+
+def _each_geometry(report, robot, controller, family, law, functions, value, unavailable) -> tuple:
+    """(corridor, wall): ``function(robot, controller, law, L or α, value, model=…)`` for each geometry of `report`, the
+    sampled loop with the controller's hold and compute delay (`exact_delay` for T = 0), ``unavailable(reason)`` where it
+    raises ValueError; None for a geometry the report has not."""
     steering = robot.replace(tau=0.0) if family == "kinematic" else robot
     force_law = law_in_force(robot, controller, law)
     model = "sampled" if controller.T > 0 else "exact_delay"
 
     def predicted(function, where):
         try:
-            return function(steering, controller, force_law, where, tolerance, model=model)
+            return function(steering, controller, force_law, where, value, model=model)
         except ValueError as exc:
-            return Wobble.unavailable(str(exc), tolerance)
+            return unavailable(str(exc))
 
-    corridor = predicted(corridor_wobble, report.corridor.L) if report.corridor is not None else None
-    wall = predicted(wall_wobble, math.radians(report.wall.alpha_deg)) if report.wall is not None else None
-    return replace(report, wobble=corridor, wall_wobble=wall)
+    corridor_function, wall_function = functions
+    corridor = predicted(corridor_function, report.corridor.L) if report.corridor is not None else None
+    wall = predicted(wall_function, math.radians(report.wall.alpha_deg)) if report.wall is not None else None
+    return corridor, wall
 
 
 _NO_GEOMETRY = f"alpha or L must be given: a wall (--alpha DEG, in {RANGES['alpha_deg'].describe()}) and/or a corridor (--L M)"
@@ -467,7 +524,7 @@ def _static_report(robot, controller, law, alpha, alpha_deg, L, models, pade_ord
         raise ValueError(f"sources must be a dict of parameter name to provenance; got {sources!r}")
     model_objs = tuple(models_for(controller, tuple(dict.fromkeys(models)), pade_order=pade_order))
     sources = sources or {}
-    values = {"V": robot.V, "tau": robot.tau, "T": controller.T, "k": robot.k, **plant_inputs(robot, sources), "f": controller.f,
+    values = {"V": robot.V, "tau": robot.tau, "T": controller.T, "k": robot.k, **plant_inputs(robot, sources), **drive_inputs(robot, sources), "f": controller.f,
               "n": controller.n, "W": robot.W, "hold": controller.hold, "compute_delay": controller.compute_delay, "pade_order": pade_order}
     law = law_in_force(robot, controller, law)
     values = _law_inputs(values, law)
@@ -582,10 +639,33 @@ def plant_inputs(robot: Robot, sources: dict | None) -> dict:
     return shown
 
 
+def drive_inputs(robot: Robot, sources: dict | None = None) -> dict:
+    """{"yaw_accel_limit": R} when the robot's drive limits its commanded yaw rate's change (R finite, rad/s²), and its
+    ``max_steering_rate`` (rad/s) when `sources` says where it came from (a Nav2 velocity smoother's clamp); else {}.
+
+    The loop models are linear and do not see them: their verdicts are those of small disturbances, where the limiter
+    passes every command (docs/wobble.md, ``--disturbance``).
+
+    Parameters
+    ----------
+    robot : parameters.Robot
+        The robot, with `yaw_accel_limit` (inf: none).
+    sources : dict, optional
+        Parameter name → provenance.
+    """
+    if not math.isfinite(robot.yaw_accel_limit):
+        return {}
+    shown = {"yaw_accel_limit": robot.yaw_accel_limit}
+    if "max_steering_rate" in (sources or {}):
+        shown["max_steering_rate"] = robot.max_steering_rate
+    return shown
+
+
 def _family_inputs(robot, controller, family, law, mass, pade_order, wall, corridor, sources) -> dict:
     """The report's inputs: the robot family, the robot and controller, the law's parameters and choices, the geometry."""
     holonomic = family == "holonomic"
-    values = {"robot": family, "V": robot.V, "tau": robot.tau, "T": controller.T, "k": robot.k, **plant_inputs(robot, sources)}
+    values = {"robot": family, "V": robot.V, "tau": robot.tau, "T": controller.T, "k": robot.k, **plant_inputs(robot, sources),
+              **drive_inputs(robot, sources)}
     if holonomic:
         values["mass"] = mass
     values.update(law.parameters)
@@ -598,7 +678,7 @@ def _family_inputs(robot, controller, family, law, mass, pade_order, wall, corri
     out = {}
     for name, value in values.items():
         source = sources.get(name, "default" if name in FAMILY_DEFAULTS or name in FAMILY_CHOICE_DEFAULTS else "user")
-        if holonomic and name in ("tau", "k", "hold", *PLANT_INPUTS):
+        if holonomic and name in ("tau", "k", "hold", *PLANT_INPUTS, *DRIVE_INPUTS):
             source = HOLONOMIC_UNUSED
         out[name] = {"value": value, "unit": UNITS.get(name, RANGES[name].unit if name in RANGES else ""), "source": source}
     return out

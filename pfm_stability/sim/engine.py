@@ -23,7 +23,12 @@ One step, for every member still running (the `sampled` model, docs/models.md):
    reaches the motor at t_k + d·T + D = t_k + m·T + ε (`robot.delay_split`):
    a delay line of the computed values gives u_(k−m−1) for the first ε of the
    period and u_(k−m) for the rest. The speed is delayed by the compute delay
-   only (the dead time is the steering motor's).
+   only (the dead time is the steering motor's). A member with a yaw
+   acceleration limit R passes each command through the drive's velocity
+   smoother first (`robot.slew_limit`: at most R·T of change per period, from
+   0 at the start), and the delay line carries its outputs: the command path
+   (`robot.CommandPath`) is controller → saturation → smoother → compute delay and
+   dead time → motor, one function whatever computed the command.
 4. **Advance** over [t_k, t_k+1) exactly (`pfm_stability.sim.robot`):
    held command → constant-input solution of eq (6) with input g·u, in two
    intervals [t_k, t_k + ε) and [t_k + ε, t_k+1) when ε > 0, each with its
@@ -61,7 +66,7 @@ from .events import Event
 from .follow import PathFollower
 from .metrics import oscillation_metrics
 from .results import BatchResult, RunResult, Trajectory
-from .robot import DelayLine, advance_held, advance_position, constant_input, constant_input_modes, delay_split, graded_rule, propagate, servo, servo_modes, slow_rate
+from .robot import CommandPath, advance_held, advance_position, constant_input, constant_input_modes, delay_split, graded_rule, propagate, servo, servo_modes, slow_rate
 from .vff import cell_repulsion, direction_of, steering_command, vff_speed, wrap_angle
 from .window import compile_window_table, stack_tables
 
@@ -90,6 +95,9 @@ class _Batch:
         self.tau = np.where(self.tau * self.gain * self.k < TAU_RESOLUTION, 0.0, self.tau)  # an ideal motor, as the models take it
         self.max_rate = robot("max_steering_rate")
         self.n, self.T, self.f = ctrl("n"), ctrl("T"), ctrl("f")
+        self.slew_step = robot("yaw_accel_limit") * self.T  # the velocity smoother's largest change per period, rad/s
+        self.limited = np.isfinite(self.slew_step)
+        self.any_limited = bool(self.limited.any())
         self.reference = _array(scenarios, lambda s: s.controller.hold == "reference", bool)
         self.delayed = _array(scenarios, lambda s: s.controller.compute_delay == 1, bool)
         self.lag, self.switch = delay_split(self.T, self.delayed.astype(np.int64), robot("dead_time"))
@@ -438,7 +446,7 @@ def run_batch(scenarios, *, record: str = "trajectory", metrics: bool = True, pr
     x0, y0 = x.copy(), y.copy()
     omega = np.zeros(B)
     alive = np.ones(B, dtype=bool)
-    line = DelayLine(B, b.history)
+    line = CommandPath(B, b.history, b.slew_step if b.any_limited else None)
     pending_V = b.V.copy()
     best = b.progress(x, y, x0, y0, b.target_distance(x, y))
     best_t = np.zeros(B)

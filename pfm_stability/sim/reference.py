@@ -17,7 +17,10 @@ The plant gain g and dead time D (docs/simulator.md, "Plant gain and dead
 time") take the route of the model, not of the engine's arrays: a list of the
 values computed so far, the motor's input g·u_(k−m−1) for the first ε of a
 period and g·u_(k−m) after (m and ε: `robot.delay_split`, the one rule), each
-piece its own `_Steering` interval; the servo closes g·k(δ̃ − θ).
+piece its own `_Steering` interval; the servo closes g·k(δ̃ − θ). A yaw
+acceleration limit R passes each held command through the velocity smoother
+written out with Python floats (v = v + min(max(u − v, −R·T), R·T), from 0)
+before the list.
 
 Collisions between samples take their own route too: a period that starts
 within its length V·T of an obstacle (the only ones the disc can touch) is
@@ -293,7 +296,8 @@ def simulate_reference(s: Scenario):
     sub = _Steering(tau, k, T / SUBSTEPS, wmax, ("servo", "constant"), g) if servo else None
     if switch > 0:  # the dead time ends within the period: two intervals of the held command
         before, after = _Steering(tau, k, switch, wmax, ("constant",), g), _Steering(tau, k, T - switch, wmax, ("constant",), g)
-    computed = []  # every value computed so far; before t_0, u_0
+    computed = []  # every value computed so far (with a yaw acceleration limit, the smoother's outputs); before t_0, u_0
+    smoothed = 0.0
     x, y, theta = s.start.x, s.start.y, s.start.theta
     if s.start_jitter > 0:
         shift = float(np.random.default_rng(s.seed).normal(0.0, s.start_jitter))
@@ -355,6 +359,9 @@ def simulate_reference(s: Scenario):
             pending_V = speed
         V = pending_V if c.compute_delay == 1 else speed  # the speed: the compute delay only
         pending_V = speed
+        if c.hold == "command" and math.isfinite(r.yaw_accel_limit):  # the velocity smoother, from a zero command
+            smoothed = smoothed + min(max(value - smoothed, -r.yaw_accel_limit * T), r.yaw_accel_limit * T)
+            value = smoothed
         computed.append(value)
         applied = computed[max(step - lag, 0)]
         earlier = computed[max(step - lag - 1, 0)]

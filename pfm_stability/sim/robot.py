@@ -27,6 +27,19 @@ on its own length (ε and T − ε). A dead time in a continuous servo loop
 (``hold="reference"``) is a delay differential equation, not a sequence of
 such intervals: the simulator refuses it (`Scenario`).
 
+The drive's velocity smoother (docs/simulator.md, "The drive's rate limit").
+A limit R (rad/s², `Robot.yaw_accel_limit`) on the rate of change of the
+commanded yaw rate acts as Nav2's ``velocity_smoother`` does with
+``feedback: OPEN_LOOP`` at the controller's rate: each period its output
+moves from its last output towards the new command by at most R·T
+(`slew_limit`), starting from 0 (Nav2's first ``last_cmd_`` is a zero
+twist). It sits on the command's way to the base — cmd_vel → smoother →
+dead time → motor — after the steering-rate saturation, so the held values
+above are its outputs; it is a discrete operator on the sequence of
+commands, so it commutes with the compute delay and the dead time. With a
+servo (``hold="reference"``) there is no sequence of commands to limit: the
+simulator refuses it (`Scenario`).
+
 Positions (eq 14). With θ(t) = θ₀ + Δ(t),
 
     ∫₀ʰ sin θ dt = sin θ₀ ∫cos Δ dt + cos θ₀ ∫sin Δ dt,
@@ -100,7 +113,7 @@ from ..parameters import dead_time_split
 __all__ = [
     "NODES", "RESOLUTION", "MAX_PANELS", "delay_split", "gauss_legendre", "slow_rate", "constant_input_modes", "servo_modes",
     "panel_count", "graded_rule", "node_sum", "Rule", "Coefficients", "constant_input", "servo", "propagate",
-    "advance_position", "advance_held", "DelayLine",
+    "advance_position", "advance_held", "DelayLine", "CommandPath", "slew_limit",
 ]
 
 NODES = 4
@@ -555,3 +568,73 @@ class DelayLine:
         if isinstance(j, int):
             return self.ring[j % self.ring.shape[0]].copy() if j >= 0 else self.first.copy()
         return np.where(j >= 0, self.ring[j % self.ring.shape[0], self.members], self.first)
+
+
+class CommandPath:
+    """The command's way from the controller to the motor: the drive's velocity smoother, then the delay line.
+
+    The members with a yaw acceleration limit (a finite `step`) pass each computed value through `slew_limit` (its
+    state the last output, 0 at the start: Nav2's first output moves from a zero command); the others' values go to
+    the `DelayLine` untouched, so a batch without a limit runs the code it ran before the smoother. Whatever computes
+    a yaw-rate command (the VFF controller, a path tracker) hands it to `push`; the motor's inputs come from `back`.
+
+    Parameters
+    ----------
+    size : int
+        Members.
+    length : int
+        Rows of the delay line (`DelayLine`).
+    step : ndarray or None
+        The smoother's largest change per period, R·T (rad/s, ``inf`` for a member without a limit); None: no member has one.
+    """
+
+    def __init__(self, size: int, length: int, step=None):
+        self.line = DelayLine(size, length)
+        self.limited = None if step is None else np.isfinite(step)
+        self.step = step
+        self.last = np.zeros(size)
+
+    def push(self, k: int, value):
+        """Store the command computed at t_k (rad/s, per member; a servo's reference passes untouched).
+
+        Parameters
+        ----------
+        k : int
+            The sample.
+        value : ndarray, shape (size,)
+            One command per member.
+        """
+        if self.limited is not None:
+            value = np.where(self.limited, slew_limit(self.last, value, self.step), value)
+            self.last = value
+        self.line.push(k, value)
+
+    def back(self, k: int, lag):
+        """The smoother's output for the command computed at t_(k − lag) (`DelayLine.back`).
+
+        Parameters
+        ----------
+        k : int
+            The current sample.
+        lag : int or ndarray of int
+            Samples back.
+        """
+        return self.line.back(k, lag)
+
+
+def slew_limit(previous, command, step):
+    """The velocity smoother's output: `previous` moved towards `command` by at most `step` (Nav2's ``applyConstraints``).
+
+    v_k = v_(k−1) + clip(u_k − v_(k−1), −R·T, R·T) (module docstring): open loop, the
+    same limit accelerating and decelerating.
+
+    Parameters
+    ----------
+    previous : ndarray
+        The smoother's last output, rad/s.
+    command : ndarray
+        The new command, rad/s.
+    step : ndarray
+        The largest change per period, R·T, rad/s (> 0; inf: none).
+    """
+    return previous + np.clip(command - previous, -step, step)

@@ -339,6 +339,9 @@ class Scenario:
         if self.robot.dead_time > 0 and self.controller.hold == "reference":
             raise ValueError(f"dead_time must be 0 with hold=reference (a dead time inside the continuous steering servo is a delay "
                              f"differential equation, which the simulator does not solve; docs/simulator.md); got {self.robot.dead_time}")
+        if math.isfinite(self.robot.yaw_accel_limit) and self.controller.hold == "reference":
+            raise ValueError(f"yaw_accel_limit needs hold=command (the velocity smoother limits a sequence of held yaw-rate commands; "
+                             f"a servo closing k(δ − θ) continuously has none; docs/simulator.md); got {self.robot.yaw_accel_limit} rad/s^2")
         object.__setattr__(self, "duration", check_number("duration", self.duration, 0.0, 1e6, unit="s"))
         samples = self.duration / self.controller.T
         if samples > MAX_SAMPLES:

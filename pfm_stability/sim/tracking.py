@@ -14,8 +14,8 @@ every period T as the controller server calls it. One step, for every member sti
 3. **Decide**: ``command(state, plan, costmap, params, rng, memory)``: the member's own seeded Generator, its
    memory carried from cycle to cycle.
 4. **Command path** (`command_path`): the commanded yaw rate saturated at the robot's ``max_steering_rate``,
-   before the plant gain — the one place the command is shaped on its way to the motor (a rate limiter on the
-   commanded yaw rate belongs here).
+   before the plant gain, then the drive's velocity smoother when the robot has a ``yaw_accel_limit``
+   (`sim.robot.CommandPath`, the VFF simulator's: at most R·T of change per period, from 0).
 5. **Hold and delays**: held over the period; applied d periods late (compute delay), and reaching the motor D
    later, at t_k + m·T + ε (`sim.robot.delay_split`), so a period may hold two commands, each solved exactly. The
    forward speed is delayed by the compute delay only, as in the VFF simulator (the dead time is the motor's).
@@ -46,7 +46,7 @@ from ..parameters import TAU_RESOLUTION, Robot
 from .events import Event
 from .metrics import oscillation_metrics
 from .results import BatchResult, RunResult, Trajectory
-from .robot import DelayLine, advance_held, constant_input, constant_input_modes, delay_split, graded_rule, slow_rate
+from .robot import CommandPath, advance_held, constant_input, constant_input_modes, delay_split, graded_rule, slow_rate
 from .scenario import MeasureAxis
 
 __all__ = ["TrackingScenario", "simulate_tracking", "command_path"]
@@ -153,9 +153,10 @@ class TrackingScenario:
 
 
 def command_path(w, previous, max_rate):
-    """The yaw-rate command on its way from the controller to the delay line: saturated at ±max_steering_rate.
+    """The yaw-rate command on its way from the controller to the drive: saturated at ±max_steering_rate (then the
+    drive's velocity smoother, `robot.CommandPath`, as in the VFF simulator, when the robot has a yaw acceleration limit).
 
-    The one place the command is shaped (module docstring, step 4).
+    The one place the command is shaped before the drive (module docstring, step 4).
 
     Parameters
     ----------
@@ -287,7 +288,8 @@ def simulate_tracking(scenarios, *, record: str = "offset", metrics: bool = True
     omega = np.zeros(B)
     V0 = np.array([s.robot.V for s in scenarios])
     measured_v, pending_v, shaped = V0.copy(), V0.copy(), np.zeros(B)
-    line = DelayLine(B, plant.history)
+    step = np.array([s.robot.yaw_accel_limit for s in scenarios]) * plant.T  # the velocity smoother's largest change a period
+    line = CommandPath(B, plant.history, step if np.isfinite(step).any() else None)
     low = np.array([-math.inf if s.costmap.walls is None else s.costmap.walls[0] for s in scenarios])
     high = np.array([math.inf if s.costmap.walls is None else s.costmap.walls[1] for s in scenarios])
     half = np.array([0.5 * s.robot.W for s in scenarios])
