@@ -103,3 +103,17 @@ def test_mujoco_runs_a_nav2_controller_on_a_straight_corridor():
                              L=1.0, offset=0.1, duration=5.0)
     run = run_scenario(scenario, EngineOptions(controller="rpp"))
     assert not run.events and abs(run.offset[-1]) < 0.03 and abs(run.offset[0]) == pytest.approx(0.1, abs=1e-3)
+
+
+def test_the_tracking_simulator_passes_the_drive_s_smoother():
+    """A robot with a yaw acceleration limit R: the tracking simulator's commanded yaw rate goes through the same smoother
+    as the VFF simulator's (`sim.robot.CommandPath`): started 0.3 m off the plan, the yaw rate of an RPP robot never
+    changes by more than R·T per period (τ = 0: the yaw rate is the held command, from rest), to round-off; without the
+    limit its first command alone is more than four times that."""
+    robot = Robot(V=0.5, tau=0.0, k=1.0, W=0.4, max_steering_rate=10.0)
+    T, R = 0.05, 0.5
+    runs = [simulate_tracking([TrackingScenario("rpp", r, T, spacing=0.025, duration=2.0, offset=0.3)], record="trajectory").runs[0]
+            for r in (robot, robot.replace(yaw_accel_limit=R))]
+    rates = [np.concatenate([[0.0], np.diff(run.trajectory.theta) / T]) for run in runs]  # τ = 0: the held command, from rest
+    assert np.max(np.abs(np.diff(rates[1]))) <= R * T * (1 + 1e-9)
+    assert np.max(np.abs(np.diff(rates[0]))) > 4 * R * T
