@@ -203,3 +203,66 @@ def test_the_sampled_searches_stay_inside_the_delay_line():
     NV = 0.5 * model.boundary(loop).NV_critical
     assert model.critical_dead_time(NV, loop) is None
     assert 0 < model.critical_delay(NV, loop) < 1 and model.critical_gain_k(NV, loop) > 1
+
+
+def _two_lag_poles(tau, lag, T, gk, K, D, d):
+    """Closed-loop poles of the held command with the drive g·e^(−sD)/((τs + 1)(τ_a·s + 1)), built here from scipy's expm
+    in the states (z, ω, θ, x/V): over [t_k, t_k+1) the motor's input is v_(k−m−1) for the first ε and v_(k−m) after,
+    m·T + ε = d·T + D, v_k = −gk·θ_k − K·y_k (the held command times g). The state adds the commands on their way."""
+    from scipy.linalg import expm
+
+    A = np.array([[-1 / lag, 0, 0, 0], [1 / tau, -1 / tau, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0]])
+    B = np.array([1 / lag, 0, 0, 0])
+
+    def zoh(h):  # (Φ(h), Γ(h)) of the input held over h
+        M = np.zeros((5, 5))
+        M[:4, :4], M[:4, 4] = A * h, B * h
+        E = expm(M)
+        return E[:4, :4], E[:4, 4]
+
+    whole = int(math.floor(D / T + 1e-12))
+    eps = D - whole * T
+    m = d + whole
+    lines = m + (eps > 1e-12)
+    n = 4 + lines
+    Phi_rest, Gamma_rest = zoh(T - eps)
+    Phi_eps, Gamma_eps = zoh(eps)
+    F = np.array([0, 0, gk, K])
+    Acl = np.zeros((n, n))
+    # x_(k+1) = Φ(T−ε)[Φ(ε)x + Γ(ε)v_(k−m−1)] + Γ(T−ε)v_(k−m); v_(k−j) is state 4 + j − 1 (j >= 1), v_k = −F·x
+    def column(j):  # where v_(k−j) lives: j = 0 is the new command, −F·x
+        return None if j == 0 else 4 + j - 1
+    Acl[:4, :4] = Phi_rest @ Phi_eps
+    for j, gamma in ((m + 1, Phi_rest @ Gamma_eps), (m, Gamma_rest)):
+        if eps <= 1e-12 and j == m + 1:
+            continue
+        c = column(j)
+        if c is None:
+            Acl[:4, :4] -= np.outer(gamma, F)
+        else:
+            Acl[:4, c] += gamma
+    if lines:
+        Acl[4, :4] = -F  # v_k enters the line
+        for j in range(1, lines):
+            Acl[4 + j, 4 + j - 1] = 1.0
+    return np.linalg.eigvals(Acl)
+
+
+def test_sampled_second_lag_equals_the_closed_loop_built_here():
+    """Eight random plants with a second lag τ_a, D below and above T, both compute delays: the sampled model's largest
+    pole modulus equals the test's own closed loop (`_two_lag_poles`) at 0.4, 0.9 and 1.3·NV* to 1e-9 (eigenvalues of
+    6–9-dimensional matrices of O(1) entries, formed two ways: the δ form and Tustin crossings against expm of the raw
+    blocks), and at NV* the test's loop is on the unit circle (1e-8)."""
+    rng = np.random.default_rng(17)
+    for _ in range(8):
+        tau, lag, T = rng.uniform(0.05, 0.4), rng.uniform(0.01, 0.1), rng.uniform(0.02, 0.15)
+        k, g, D, d = rng.uniform(0.5, 4.0), rng.uniform(0.6, 1.4), rng.uniform(0.0, 2.5) * T, int(rng.integers(2))
+        loop, model = Loop(tau, T, k, plant_gain=g, dead_time=D, actuator_lag=lag), Sampled("command", d)
+        NV_star = model.boundary(loop).NV_critical
+        assert NV_star > 0
+        for factor in (0.4, 0.9, 1.3):
+            NV = factor * NV_star
+            ours = np.abs(model.eigenvalues(NV, loop)).max()
+            theirs = np.abs(_two_lag_poles(tau, lag, T, g * k, g * k * NV, D, d)).max()
+            assert ours == pytest.approx(theirs, rel=1e-9)
+        assert np.abs(_two_lag_poles(tau, lag, T, g * k, g * k * NV_star, D, d)).max() == pytest.approx(1.0, abs=1e-8)

@@ -47,7 +47,7 @@ from .events import Event
 from .metrics import oscillation_metrics
 from .results import BatchResult, RunResult, Trajectory
 from .robot import CommandPath, advance_held, constant_input, constant_input_modes, delay_split, graded_rule, slow_rate
-from .scenario import MeasureAxis
+from .scenario import MeasureAxis, check_first_order
 
 __all__ = ["TrackingScenario", "simulate_tracking", "command_path"]
 
@@ -101,6 +101,7 @@ class TrackingScenario:
     name = "tracking"
 
     def __post_init__(self):
+        check_first_order(self.robot)
         if self.controller not in CONTROLLER_NAMES:
             raise ValueError(f"controller must be one of {', '.join(CONTROLLER_NAMES)}; got {self.controller!r}")
         object.__setattr__(self, "T", check_number("T", self.T, 0.0, 100.0, unit="s"))
