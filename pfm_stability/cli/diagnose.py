@@ -174,8 +174,19 @@ def _where(s) -> str:
 def _measured(m) -> str:
     if m.sigma is None:
         return f"no oscillation (the offset settles; largest swing {_num(m.amplitude, '.3g', 'm')})"
-    return (f"ω = {_num(m.omega, '.3f', 'rad/s')}, σ = {m.sigma:+.3g} 1/s, amplitude {_num(m.amplitude, '.3g', 'm')} "
-            f"({'growing' if m.sigma > 0 else 'decaying'}; {m.turning_points} turning points, {m.method})")
+    return (f"ω = {_num(m.omega, '.3f', 'rad/s')}{_omega_interval(m.frequency)}, σ = {m.sigma:+.3g} 1/s, "
+            f"amplitude {_num(m.amplitude, '.3g', 'm')} ({'growing' if m.sigma > 0 else 'decaying'}; "
+            f"{m.turning_points} turning points, {m.method})")
+
+
+def _omega_interval(f) -> str:
+    """ω's 95 % interval and the periods it rests on, or why it has none (`analysis.frequency`)."""
+    if f is None or f.omega is None:
+        return " (no zero crossings to time: the estimator's turning points)"
+    dropped = f", {f.dropped} transient crossing{'s' if f.dropped != 1 else ''} dropped" if f.dropped else ""
+    if f.few_periods:
+        return f" (too few periods for an interval: {f.periods:.1f} established{dropped})"
+    return f" [{_num(f.low, '.3f')} to {_num(f.high, '.3f')}] over {f.periods:.1f} periods{dropped}"
 
 
 def _rows(s) -> list[tuple]:

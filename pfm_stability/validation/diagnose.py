@@ -5,9 +5,10 @@
 or identified from the same log, `complete_from_log`). On every stretch along a wall or through a corridor
 (`analysis.stretches.find_stretches`) it
 
-1. **measures** the lateral oscillation with the project's one estimator (`sim.metrics.oscillation_metrics`
-   on the binned lateral offset): ω (rad/s), σ (1/s) and the amplitude (the limit cycle's, else the largest
-   half peak-to-peak swing, m);
+1. **measures** the lateral oscillation on the binned lateral offset: σ (1/s) and the amplitude (the limit cycle's,
+   else the largest half peak-to-peak swing, m) with the project's one estimator (`sim.metrics.oscillation_metrics`),
+   and ω (rad/s) with its 95 % interval from the zero crossings of the part of the stretch that oscillates, the start
+   transient dropped (`analysis.frequency.crossing_frequency`; a stretch of too few periods says so);
 2. **predicts** it with every loop model, at the loop gain NV of the corridor of the measured half-width L
    (`laws.force_law.corridor_gain`) or of the wall whose equilibrium is the measured d0 (α and N from the law's
    balance at d0, `laws.force_law.wall_gain_at_distance`), V the robot's measured speed there: each model's
@@ -32,6 +33,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from ..analysis.frequency import FrequencyEstimate, crossing_frequency
 from ..analysis.identification import ridge_point
 from ..analysis.stretches import MIN_DURATION, MIN_SPEED, LateralOffset, Stretch, find_stretches, lateral_offset
 from ..io.logs import LogData, PoseSeries
@@ -71,7 +73,7 @@ class Measured:
     Attributes
     ----------
     omega : float or None
-        ω, rad/s.
+        ω, rad/s: from the zero crossings of the established oscillation (`frequency`), else the estimator's.
     sigma : float or None
         σ, 1/s (> 0 growing); None when no oscillation was measured.
     amplitude : float or None
@@ -84,6 +86,10 @@ class Measured:
         Turning points of the offset.
     reason : str or None
         Why σ is undefined.
+    frequency : FrequencyEstimate or None
+        ω from the zero crossings: its 95 % interval, the crossings used and dropped (the start transient), the
+        established periods and whether they are too few for an interval (`analysis.frequency`); None without a
+        measured oscillation.
     """
 
     omega: float | None
@@ -93,10 +99,20 @@ class Measured:
     method: str
     turning_points: int
     reason: str | None = None
+    frequency: FrequencyEstimate | None = None
+
+    @property
+    def few_periods(self) -> bool:
+        """Whether ω rests on too few established periods for an interval (`analysis.frequency.MIN_CROSSINGS`)."""
+        return self.frequency is not None and self.frequency.few_periods
 
     def to_dict(self) -> dict:
-        """``{omega, sigma, amplitude, stable, method, turning_points, reason}`` (SI units)."""
-        return {"omega": json_number(self.omega), "sigma": json_number(self.sigma), "amplitude": json_number(self.amplitude),
+        """``{omega, omega_interval, frequency, sigma, amplitude, stable, method, turning_points, reason}`` (SI units)."""
+        f = self.frequency
+        return {"omega": json_number(self.omega),
+                "omega_interval": None if f is None or f.low is None else [json_number(f.low), json_number(f.high)],
+                "frequency": None if f is None else f.to_dict(),
+                "sigma": json_number(self.sigma), "amplitude": json_number(self.amplitude),
                 "stable": self.stable, "method": self.method, "turning_points": self.turning_points, "reason": self.reason}
 
 
@@ -366,8 +382,12 @@ def _measure(offset: LateralOffset) -> tuple[OscillationMetrics, Measured, tuple
     amplitude = metrics.amplitude if metrics.amplitude is not None else (float(swings.max()) if swings.size else None)
     envelope = (float((offset.t[points[0]] + offset.t[points[1]]) / 2), float(swings[0])) if swings.size else None
     stable = metrics.growth_rate < 0 if metrics.growth_rate is not None else metrics.stable
-    measured = Measured(metrics.angular_frequency if metrics.growth_rate is not None else None, metrics.growth_rate, amplitude,
-                        bool(stable), metrics.method, metrics.turning_points, metrics.reason)
+    omega, frequency = None, None
+    if metrics.growth_rate is not None:
+        frequency = crossing_frequency(offset.t, x)
+        omega = frequency.omega if frequency.omega is not None else metrics.angular_frequency
+    measured = Measured(omega, metrics.growth_rate, amplitude, bool(stable), metrics.method, metrics.turning_points,
+                        metrics.reason, frequency)
     return metrics, measured, envelope
 
 
@@ -475,7 +495,7 @@ def _judge(stretch: Stretch, pose: PoseSeries, robot: Robot, law: ForceLaw, mode
     metrics, measured, envelope = _measure(offset)
     if measured.amplitude is None or measured.amplitude < MIN_AMPLITUDE:  # the robot holds its line: noise, not a swing
         measured = Measured(None, None, measured.amplitude, True, measured.method, measured.turning_points,
-                            f"no swing larger than {1000 * MIN_AMPLITUDE:g} mm (the offset holds its line)")
+                            f"no swing larger than {1000 * MIN_AMPLITUDE:g} mm (the offset holds its line)", None)
         envelope = None
     if measured.sigma is None and not measured.stable:
         return StretchDiagnosis(stretch, False, f"no oscillation measured and the offset does not settle ({metrics.reason})",
