@@ -150,8 +150,13 @@ def parameters_table(result, sources: dict) -> dict:
     from ..parameters import RANGES
 
     r, c = result.robot, result.controller
-    values = {"V": r.V, "tau": r.tau, "dead_time": r.dead_time, "plant_gain": r.plant_gain, "k": r.k, "W": r.W, "T": c.T, "f": c.f, "n": c.n, "hold": c.hold, "compute_delay": c.compute_delay}
-    return {name: {"value": value, "unit": RANGES[name].unit if name in RANGES else "", "source": sources.get(name, "")}
+    values = {"V": r.V, "tau": r.tau, "dead_time": r.dead_time, "plant_gain": r.plant_gain, "actuator_lag": r.actuator_lag,
+              "yaw_accel_limit": r.yaw_accel_limit, "k": r.k, "W": r.W, "T": c.T, "f": c.f, "n": c.n, "hold": c.hold,
+              "compute_delay": c.compute_delay}
+    from ..io.serialize import json_number
+
+    return {name: {"value": json_number(value) if isinstance(value, float) else value,
+                   "unit": RANGES[name].unit if name in RANGES else "", "source": sources.get(name, "")}
             for name, value in values.items()}
 
 
@@ -219,6 +224,8 @@ def render_text(result, sources: dict, info: dict) -> str:
         The log's path, format, duration and topics.
     """
     out = [f"log: {info['path']} ({info['format']}, {info['duration']:.1f} s)", f"verdict: {result.verdict} — {result.reason}", ""]
+    if result.limiter is not None:
+        out[-1:-1] = [f"slew limit: {result.limiter.note}"]
     table = parameters_table(result, sources)
     out.append("parameters: " + ", ".join(f"{k} = {_num(v['value'], '.4g') if isinstance(v['value'], float) else v['value']}"
                                            f" ({v['source']})" for k, v in table.items()))
@@ -250,7 +257,10 @@ def render_markdown(result, sources: dict, info: dict) -> str:
         The log's path, format, duration and topics.
     """
     out = ["## Diagnosis from the log", "", f"Log: {info['path']} ({info['format']}, {info['duration']:.1f} s).", "",
-           f"**Verdict: {result.verdict}** — {result.reason}.", "", "| parameter | value | source |", "| --- | --- | --- |"]
+           f"**Verdict: {result.verdict}** — {result.reason}.", ""]
+    if result.limiter is not None:
+        out += [f"Slew limit: {result.limiter.note}.", ""]
+    out += ["| parameter | value | source |", "| --- | --- | --- |"]
     for name, v in parameters_table(result, sources).items():
         value = _num(v["value"], ".4g") if isinstance(v["value"], float) else v["value"]
         out.append(f"| {name} | {value} {v['unit']} | {v['source']} |")

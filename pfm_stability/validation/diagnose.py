@@ -46,14 +46,16 @@ from ..report.stability import build_report
 from ..sim.metrics import HYSTERESIS, OscillationMetrics, oscillation_metrics, turning_points
 
 __all__ = ["Measured", "Predicted", "StretchDiagnosis", "Diagnosis", "diagnose", "complete_from_log", "missing_parameters",
-           "needs_identification", "USER_PARAMETERS", "LOG_PARAMETERS", "MATCH", "MAX_GAP", "MIN_AMPLITUDE", "VERDICTS"]
+           "loop_takes_actuator_lag", "Limiter",
+           "needs_identification", "USER_PARAMETERS", "LOG_PARAMETERS", "MATCH", "MAX_GAP", "MIN_AMPLITUDE", "VERDICTS", "REACHED"]
 
 USER_PARAMETERS = ("k", "W", "f", "n")
 """What no log shows: the steering gain, the robot's width and KB's law (f, n): the user's (``--config`` or options)."""
-LOG_PARAMETERS = ("tau", "T", "dead_time", "plant_gain")
+LOG_PARAMETERS = ("tau", "T", "dead_time", "plant_gain", "actuator_lag", "yaw_accel_limit")
 """What the log shows (`analysis.identification`): the steering lag, the controller's period, the plant's dead time and
-gain, unless the user gives them. The log is identified when τ or T is missing (`needs_identification`); D and g alone
-keep their defaults (0 s and 1) rather than ask a log without commands for them."""
+gain, its second lag and the slew limit on its command (when the data support them), unless the user gives them. The
+log is identified when τ or T is missing (`needs_identification`); D, g, τ_a and the limit alone keep their defaults
+(0 s, 1, 0 s, none) rather than ask a log without commands for them."""
 MATCH = 0.15
 """A model matches when its root is within this relative distance of the measured σ + jω (and its verdict agrees)."""
 MIN_AMPLITUDE = 0.005
@@ -63,6 +65,10 @@ MAX_GAP = 1.0
 """A stretch whose odometry misses more than this (s) at once is not judged (interpolating over it would invent a swing)."""
 VERDICTS = ("oscillating", "stable", "nothing to diagnose")
 """The whole log's answer."""
+REACHED = 0.9
+"""The commands reached the slew limit A on a stretch when their |du/dt| (95th percentile) is at least this fraction of A:
+a discrete smoother's staircase shows slopes of about A while it ramps, and a command changing at 90 % of A is ramped
+every few ticks."""
 
 
 # ------------------------------------------------------------------------------------------ results
@@ -162,6 +168,39 @@ class Predicted:
 
 
 @dataclass(frozen=True)
+class Limiter:
+    """The slew limit on the commanded yaw rate the prediction was made with, and whether the log's commands reached it.
+
+    Attributes
+    ----------
+    yaw_accel_limit : float
+        A, rad/s² (`Robot.yaw_accel_limit`).
+    in_prediction : bool
+        Whether the predicted V* accounts for it (False: the loop models are linear; their V* holds for a disturbance
+        small enough that the commands never change faster than A).
+    commanded_acceleration : float or None
+        The 95th percentile of the commands' |du/dt| over the judged stretch, rad/s² (None: the log was read without
+        its commands).
+    reached : bool or None
+        commanded_acceleration ≥ `REACHED`·A: the limit shaped the measured oscillation, and the linear V* may be off
+        for it (None without the commands).
+    note : str
+        What this means for the prediction, in words.
+    """
+
+    yaw_accel_limit: float
+    in_prediction: bool
+    commanded_acceleration: float | None
+    reached: bool | None
+    note: str
+
+    def to_dict(self) -> dict:
+        """``{yaw_accel_limit, in_prediction, commanded_acceleration, reached, note}`` (SI units)."""
+        return {"yaw_accel_limit": json_number(self.yaw_accel_limit), "in_prediction": self.in_prediction,
+                "commanded_acceleration": json_number(self.commanded_acceleration), "reached": self.reached, "note": self.note}
+
+
+@dataclass(frozen=True)
 class StretchDiagnosis:
     """One stretch: what was measured and predicted there, or why it was not judged.
 
@@ -244,6 +283,8 @@ class Diagnosis:
         The odometry's pose (for the picture).
     law : ForceLaw
         The lateral law predicted with.
+    limiter : Limiter or None
+        The slew limit on the commanded yaw rate and what it means for the prediction (None: the robot has none).
     """
 
     verdict: str
@@ -254,6 +295,7 @@ class Diagnosis:
     controller: Controller
     pose: PoseSeries
     law: ForceLaw
+    limiter: Limiter | None = None
 
     @property
     def judged(self) -> StretchDiagnosis | None:
@@ -288,6 +330,7 @@ class Diagnosis:
                         "critical": None if best is None else {"model": best.model, "V": json_number(best.V_critical),
                                                                "T": json_number(best.T_critical), "k": json_number(best.k_critical)},
                         "remedies": worst.remedies})
+        out["limiter"] = None if self.limiter is None else self.limiter.to_dict()
         out["stretches"] = [s.to_dict() for s in self.stretches]
         return out
 
@@ -319,8 +362,49 @@ def needs_identification(sources: dict) -> bool:
     return _from_preset(sources, "tau") or _from_preset(sources, "T")
 
 
+def loop_takes_actuator_lag() -> bool:
+    """Whether the loop models take the drive's second lag (`Robot.actuator_lag` through `models.Loop.of`): a loop built
+    with τ_a differs from one without."""
+    robot, controller = Robot(V=1.0, tau=0.2, k=1.0, W=0.5), Controller(f=1.0, n=2.0, T=0.05)
+    return Loop.of(robot.replace(actuator_lag=0.05), controller) != Loop.of(robot, controller)
+
+
+def _linear_plant(fit) -> tuple[dict, str | None]:
+    """(τ, D, g as `Estimate`-like (value, low, high) by name, a note): the selected plant's, or — when it has a second lag
+    the loop models do not take yet — the first order's candidate (no interval), with the note saying so."""
+    if fit.actuator_lag is None or loop_takes_actuator_lag():
+        return {"tau": fit.tau, "dead_time": fit.dead_time, "plant_gain": fit.g}, None
+    linear = "slew_limited" if fit.yaw_accel_limit is not None else "first_order"  # the same plant without τ_a
+    first = next(m.parameters for m in fit.models if m.model == linear)
+    from ..analysis.identification import Estimate
+
+    nan = math.nan
+    note = (f"the {linear.replace('_', '-')} candidate's fit: the data support a second lag τ_a = {fit.actuator_lag.value:.3g} s, "
+            "which the loop models do not take yet")
+    return {"tau": Estimate(first.tau, nan, nan), "dead_time": Estimate(first.dead_time, nan, nan),
+            "plant_gain": Estimate(first.g, nan, nan)}, note
+
+
+def _drive_limits(robot: Robot, sources: dict, from_preset: set, identification) -> tuple[Robot, dict]:
+    """τ_a and the slew limit from the identification where the user gave neither (docs/diagnose.md, "What it needs")."""
+    fit, where = identification.plant, identification.log.path
+    for name, estimate, unit in (("actuator_lag", fit.actuator_lag, "s"), ("yaw_accel_limit", fit.yaw_accel_limit, "rad/s²")):
+        if name not in from_preset or not fit.identifiable:
+            continue
+        if estimate is None:
+            sources[name] = f"identified from {where}: none (the plant the data support, {fit.model}, has none)"
+        elif name == "actuator_lag" and not loop_takes_actuator_lag():
+            sources[name] = (f"identified from {where} as {estimate.value:.4g} s ({estimate.low:.4g} to {estimate.high:.4g} s); "
+                             "not in the loop models yet: predicted with the first order's τ, D and g")
+        else:
+            robot = robot.replace(**{name: estimate.value})
+            sources[name] = f"identified from {where} ({estimate.low:.4g} to {estimate.high:.4g} {unit})"
+    return robot, sources
+
+
 def complete_from_log(robot: Robot, controller: Controller, sources: dict, identification) -> tuple[Robot, Controller, dict]:
-    """τ, T, D and g from the identification where the user did not give them (their source is a preset); the new sources.
+    """τ, T, D, g, τ_a and the slew limit from the identification where the user did not give them (their source is a
+    preset); the new sources.
 
     Parameters
     ----------
@@ -348,9 +432,11 @@ def complete_from_log(robot: Robot, controller: Controller, sources: dict, ident
         raise ValueError(f"the steering plant could not be identified from {identification.log.path}: {identification.reason}; "
                          f"give {', '.join('robot.' + name for name in plant)} in --config "
                          f"(or {' '.join('--' + name.replace('_', '-') for name in plant)})")
+    if not identification.identified:
+        return robot, controller, sources
     fit = identification.plant
-    estimates = {"tau": (fit.tau, "s"), "dead_time": (fit.dead_time, "s"), "plant_gain": (fit.g, "")} if plant else {}
-    values = {name: estimates[name][0].value for name in plant}
+    linear, note = _linear_plant(fit)
+    values = {name: linear[name].value for name in plant}
     if plant and not fit.identifiable:  # stay on the ridge the log determines (docs/diagnose.md, "Identifiability")
         given = [name for name in ("tau", "dead_time", "plant_gain") if name not in plant]
         anchor = {given[0]: getattr(robot, given[0])} if len(given) == 1 else \
@@ -359,16 +445,19 @@ def complete_from_log(robot: Robot, controller: Controller, sources: dict, ident
         if point is not None:
             values.update((name, v) for name, v in zip(("plant_gain", "tau", "dead_time"), point) if name in plant)
     for name in plant:
-        estimate, unit = estimates[name]
+        estimate, unit = linear[name], ("" if name == "plant_gain" else "s")
         value = max(values[name], 0.0) if name == "dead_time" else values[name]  # a negative D: clocks differ (identify warns)
         robot = robot.replace(**{name: value})
-        if fit.identifiable:
+        if note is not None:
+            sources[name] = f"identified from {identification.log.path}, {note}"
+        elif fit.identifiable:
             sources[name] = f"identified from {identification.log.path} ({estimate.low:.4g} to {estimate.high:.4g}{' ' + unit if unit else ''})"
         else:  # a narrowband log: any plant of the ridge predicts the same loop near ω (docs/diagnose.md, "Identifiability")
             x = fit.excitation
             sources[name] = (f"identified from {identification.log.path}, not separately identifiable (narrowband at "
                              f"ω ≈ {x.omega:.3g} rad/s): the prediction uses the plant's gain {x.gain:.3g} and phase "
                              f"{math.degrees(x.phase):.0f}° there, which the log determines")
+    robot, sources = _drive_limits(robot, sources, from_preset, identification)
     return robot, controller, sources
 
 
@@ -582,4 +671,29 @@ def diagnose(log: LogData, robot: Robot, controller: Controller, *, law: ForceLa
     if worst is not None:  # the whole log's stretch: every critical value and the remedies
         judged = tuple(_full(d, robot, controller, law, tuple(models)) if d.stretch.index == worst else d for d in judged)
     V = judged[worst].V if worst is not None else robot.V
-    return Diagnosis(verdict, reason, judged, worst, robot.replace(V=V), controller, log.pose, law)
+    limiter = _limiter(robot, log, judged[worst].stretch if worst is not None else None)
+    return Diagnosis(verdict, reason, judged, worst, robot.replace(V=V), controller, log.pose, law, limiter)
+
+
+def _limiter(robot: Robot, log: LogData, stretch: Stretch | None) -> Limiter | None:
+    """The robot's slew limit set against the commands of the judged stretch (`Limiter`)."""
+    A = robot.yaw_accel_limit
+    if not math.isfinite(A):
+        return None
+    acceleration = None
+    if log.command is not None and stretch is not None:
+        t, u = log.command.t, log.command.value
+        inside = (t >= stretch.start) & (t <= stretch.end)
+        if np.count_nonzero(inside) >= 3:
+            dt = np.diff(t[inside])
+            ok = dt > 0
+            acceleration = float(np.percentile(np.abs(np.diff(u[inside])[ok] / dt[ok]), 95)) if np.any(ok) else None
+    reached = None if acceleration is None else bool(acceleration >= REACHED * A)
+    note = (f"the predictions are the linear loop's, which a slew limit of {A:.3g} rad/s² does not change: they hold for a "
+            "disturbance small enough that the commands never change faster than the limit; the boundary for a larger one "
+            "depends on its size (the limiter's describing function is not in this version)")
+    if reached is not None:
+        note += (f"; on the judged stretch the commands changed at up to {acceleration:.3g} rad/s² (95th percentile): the limit "
+                 + ("was reached, so the measured oscillation is the limited loop's and V* may be off for it" if reached
+                    else "was not reached"))
+    return Limiter(A, False, acceleration, reached, note)
