@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import shutil
 import sys
 import tempfile
 import time
@@ -68,7 +69,7 @@ def mujoco_robots() -> dict:
                                                                                         odom_jitter=0.1, seed=1))
     return {"A": ("diffdrive", 0.1, (0.9,), {}, dict(T=0.05, amplitude=0.1)),
             "B": ("diffdrive-filtered", 0.1, (0.9, 0.7), {}, dict(T=0.05, amplitude=0.1)),
-            "C": ("skid-steer", 1 / 11, (0.7, 0.9), nav2, dict(T=1 / 11, amplitude=0.5))}
+            "C": ("skid-steer", 1 / 11, (0.7, 0.9), nav2, dict(T=1 / 11, amplitude=0.3))}
 
 
 def identify_mujoco(name: str, options: dict, drive: dict, V: float, out_dir) -> dict:
@@ -85,9 +86,23 @@ def identify_mujoco(name: str, options: dict, drive: dict, V: float, out_dir) ->
     none = lambda e: None if e is None else e.to_dict()  # noqa: E731
     return {"V": V, "model": p.model, "g": p.g.to_dict(), "tau": p.tau.to_dict(), "dead_time": p.dead_time.to_dict(),
             "actuator_lag": none(p.actuator_lag), "yaw_accel_limit": none(p.yaw_accel_limit), "r2": p.quality.r2,
+            "smoother": none(p.smoother), "loop_dead_time": p.loop_dead_time,
             "T": result.controller.T, "csv": path.name,
-            "first_order": next({"g": m.parameters.g, "tau": m.parameters.tau, "dead_time": m.parameters.dead_time}
-                                for m in p.models if m.model == "first_order") if p.models else None}
+            "candidates": {m.model: {"g": m.parameters.g, "tau": m.parameters.tau, "dead_time": m.parameters.dead_time,
+                                     "actuator_lag": m.parameters.actuator_lag, "bic": m.bic} for m in p.models}}
+
+
+def prediction_plant(plant: dict) -> dict:
+    """The plant the predictions use, as diagnose does (`validation.diagnose.complete_from_log`): the selected one, or —
+    when it has a second lag the loop models do not take yet — its candidate without it (no intervals)."""
+    from pfm_stability.validation.diagnose import loop_takes_actuator_lag
+
+    if plant["actuator_lag"] is None or loop_takes_actuator_lag():
+        return plant
+    c = plant["candidates"]["slew_limited" if plant["yaw_accel_limit"] else "first_order"]
+    value = lambda v: {"value": v, "low": None, "high": None}  # noqa: E731
+    return {**plant, "g": value(c["g"]), "tau": value(c["tau"]), "dead_time": value(c["dead_time"]), "actuator_lag": None,
+            "used": "without the second lag (the loop models do not take it yet)"}
 
 
 def mujoco_pair(plant: dict, T: float, V: float = 1.0):
@@ -99,8 +114,9 @@ def mujoco_pair(plant: dict, T: float, V: float = 1.0):
         extra["actuator_lag"] = plant["actuator_lag"]["value"]
     if plant["yaw_accel_limit"] is not None:
         extra["yaw_accel_limit"] = plant["yaw_accel_limit"]["value"]
+    wait = plant["smoother"]["mean_wait"] if plant.get("smoother") else 0.0  # a small command's wait for the smoother's tick
     robot = Robot(V=V, tau=plant["tau"]["value"], k=K, W=W, plant_gain=plant["g"]["value"],
-                  dead_time=max(plant["dead_time"]["value"], 0.0), **extra)
+                  dead_time=max(plant["dead_time"]["value"] + wait, 0.0), **extra)
     return robot, Controller(f=F, n=N, T=T, hold="command", compute_delay=1)
 
 
@@ -108,7 +124,7 @@ def predicted_V(plant: dict, T: float, L: float) -> float:
     """The ``sampled`` model's V* with the identified plant and the grid's law."""
     from pfm_stability.validation.common import predicted_boundaries, scenario_law, validation_models
 
-    robot, controller = mujoco_pair(plant, T)
+    robot, controller = mujoco_pair(prediction_plant(plant), T)
     law = scenario_law("grid", robot, controller)
     return float(predicted_boundaries("corridor", "V", robot, controller, law, L, validation_models(controller))["sampled"])
 
@@ -123,13 +139,15 @@ def diagnose_run(name: str, options: dict, plant: dict, T: float, L: float, V: f
     from pfm_stability.sim.scenario import scenario_law
     from pfm_stability.validation.diagnose import diagnose
 
-    robot, controller = mujoco_pair(plant, T, V)
+    robot, controller = mujoco_pair(prediction_plant(plant), T, V)
     run = corridor_log(make_scenario("corridor", env="grid", robot=robot, controller=controller, L=L, offset=0.05, duration=30.0),
                        EngineOptions(robot_model=name, **options))
     synthetic = SyntheticLog(Plant(), Recording(T=T, scan_rate=10.0), run.cmd_t, run.cmd_wz, run.cmd_vx, run.odom_t, run.odom_wz,
                              scan_t=run.scan_t, odom_x=run.odom_x, odom_y=run.odom_y, odom_yaw=run.odom_yaw,
                              odom_vx=run.odom_vx, scan_ranges=run.scan_ranges)
-    bag = write_ros2(synthetic, Path(out_dir) / f"{name}_L{L:g}_V{V:.3f}", storage="mcap")
+    bag = Path(out_dir) / f"{name}_L{L:g}_V{V:.3f}"
+    shutil.rmtree(bag, ignore_errors=True)  # a bag of an earlier run of the experiment
+    bag = write_ros2(synthetic, bag, storage="mcap")
     log = read_log(bag, need=("command", "pose", "scan"), scan_reducer=wall_lines_batch, scan_batch=256)
     result = diagnose(log, robot, controller, law=scenario_law("grid", robot, controller), models=("sampled",))
     s = result.judged
@@ -154,7 +172,7 @@ def mujoco_case(key: str, L: float, quick: bool, out_dir) -> dict:
     plant = identify_mujoco(name, options, drive, 0.8, out_dir)
     for _ in range(2):  # the plant at the speed of the boundary it predicts
         plant = identify_mujoco(name, options, drive, round(predicted_V(plant, T, L), 2), out_dir)
-    robot, controller = mujoco_pair(plant, T)
+    robot, controller = mujoco_pair(prediction_plant(plant), T)
     bisections = {}
     for offset in OFFSETS:
         v = validate_boundary("corridor", "V", robot=robot, controller=controller, env="grid", L=L, offset=offset,
@@ -164,8 +182,11 @@ def mujoco_case(key: str, L: float, quick: bool, out_dir) -> dict:
                                    "sampled": v.predicted_boundary["sampled"], "error": v.relative_error["sampled"]}
     V_star = bisections[str(OFFSETS[0])]["V_mujoco"]
     runs = [diagnose_run(name, options, plant, T, L, factor * V_star, out_dir) for factor in (0.85, 1.15)]
-    return {"robot": key, "model": name, "L": L, "T": T, "plant": plant, "bisections": bisections, "diagnosed": runs,
-            "seconds": time.perf_counter() - started}
+    return {"robot": key, "model": name, "L": L, "T": T, "plant": plant, "predicted_with": prediction_plant(plant),
+            "first_order_V": predicted_V({**plant, **{k: {"value": v} for k, v in plant["candidates"]["first_order"].items()
+                                                       if k != "bic" and k != "actuator_lag"}, "actuator_lag": None,
+                                          "yaw_accel_limit": None}, T, L) if plant["candidates"] else None,
+            "bisections": bisections, "diagnosed": runs, "seconds": time.perf_counter() - started}
 
 
 def mujoco_table(cases) -> str:

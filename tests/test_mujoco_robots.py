@@ -119,11 +119,11 @@ def _fit(log):
 
 
 def test_robot_b_shows_its_actuator_filter(drives):
-    """The filter of robot B (dynprm 0.06 s) is the second lag `identify` selects, within 5 % (the yaw rate's other lag is
+    """The filter of robot B (dynprm 0.1 s) is the second lag `identify` selects, within 5 % (the yaw rate's other lag is
     the wheel servo's and the chassis', about 0.13 s), with the dead time near 0: the first order would fold it into a
-    dead time of about 40 ms."""
+    dead time of 30 ms or more."""
     fit = _fit(drives["B"])
-    assert fit.model == "two_lags" and fit.actuator_lag.value == pytest.approx(0.06, rel=0.05)
+    assert fit.model == "two_lags" and fit.actuator_lag.value == pytest.approx(0.1, rel=0.05)
     assert abs(fit.dead_time.value) < 0.005
     first = next(m for m in fit.models if m.model == "first_order")
     assert first.parameters.dead_time > 0.03 and first.bic > next(m for m in fit.models if m.selected).bic
@@ -142,7 +142,7 @@ def test_robot_c_shows_its_smoother(drives):
 
 def test_the_skid_steer_turns_linearly_by_skidding():
     """Robot C's steady yaw rate is the same fraction of a 0.01 and a 0.3 rad/s turn of its wheels (to 0.5 %: the loop
-    models' small-signal assumption holds) and well below it (it skids: 0.3–0.6); its base slides sideways in a turn
+    models' small-signal assumption holds) and well below it (it skids: 0.2–0.6); its base slides sideways in a turn
     (unlike a differential drive), more in a sharper one."""
     robot = load_robot_model("skid-steer")
     model = corridor_world(robot.path, math.inf, 0.0, 0.0)
@@ -156,7 +156,7 @@ def test_the_skid_steer_turns_linearly_by_skidding():
         gains.append(float(data.qvel[5]) / command)
         local = data.xmat[base].reshape(3, 3).T @ data.qvel[:3]
         side.append(abs(local[1] / local[0]))
-    assert gains[0] == pytest.approx(gains[1], rel=0.005) and 0.3 < gains[0] < 0.6
+    assert gains[0] == pytest.approx(gains[1], rel=0.005) and 0.2 < gains[0] < 0.6
     assert side[1] > 10 * side[0] > 0
 
 

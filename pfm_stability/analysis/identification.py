@@ -71,12 +71,13 @@ import numpy as np
 from ..io.logs import LogData, TimeSeries
 from ..io.serialize import json_number
 from .excitation import BAND, NARROWBAND, Excitation, command_spectrum, excitation_of, ridge_point
-from .plant_fit import (DEAD_TIME_BOUNDS, PLANT_MODELS, SELECT_SAMPLES, TAU_BOUNDS, Z95, CandidateFit, PlantParameters, Samples,
-                        autocorrelation, candidates, covariance, fit_first_order, fit_model, grid_start, jacobian, residuals)
-from .plant_response import lag_response
+from .plant_fit import (DEAD_TIME_BOUNDS, PLANT_MODELS, SELECT_SAMPLES, SMOOTHING_FREQUENCY, TAU_BOUNDS, Z95, CandidateFit,
+                        PlantParameters, Samples, autocorrelation, candidates, covariance, fit_first_order, fit_model, grid_start,
+                        jacobian, residuals)
+from .plant_response import lag_response, mean_wait
 
 __all__ = ["Estimate", "ControllerTiming", "FitWarning", "FitQuality", "Excitation", "PlantFit", "LogSummary",
-           "Identification", "CandidateFit", "controller_timing", "excitation_windows", "command_spectrum", "lag_response",
+           "Identification", "CandidateFit", "SmootherFit", "SMOOTHING_FREQUENCY", "controller_timing", "excitation_windows", "command_spectrum", "lag_response",
            "fit_plant", "identify", "ridge_point", "NARROWBAND", "BAND", "PLANT_MODELS",
            "MISSED_FACTOR", "SETTLE", "LEAD", "STALE", "DEAD_TIME_BOUNDS", "TAU_BOUNDS", "BETTER", "RATE_SOURCES"]
 
@@ -225,6 +226,31 @@ class FitQuality:
 
 
 @dataclass(frozen=True)
+class SmootherFit:
+    """The slew limit as a smoother on its own timer (`plant_response.smoothed`): its rate, the timer's phase found, and
+    the mean wait of the log's commands for its next tick.
+
+    Attributes
+    ----------
+    frequency : float
+        f, Hz (`plant_fit.SMOOTHING_FREQUENCY` unless told).
+    phase : float
+        φ, s, in [0, 1/f): the ticks are at φ + i/f on the log's clock.
+    mean_wait : float
+        s: how long the log's commands waited for a tick on average (h/2 for commands on a clock of their own). A small
+        command's response is delayed by it beyond D: the loop's dead time is D + mean_wait (`PlantFit.loop_dead_time`).
+    """
+
+    frequency: float
+    phase: float
+    mean_wait: float
+
+    def to_dict(self) -> dict:
+        """``{frequency, phase, mean_wait}`` (Hz, s, s)."""
+        return {"frequency": json_number(self.frequency), "phase": json_number(self.phase), "mean_wait": json_number(self.mean_wait)}
+
+
+@dataclass(frozen=True)
 class PlantFit:
     """The fitted plant g·e^(−sD)/((τs + 1)(τ_a·s + 1)) behind an optional slew limit A on the commanded yaw rate: the
     model the data support (`analysis.plant_fit`, "Which plant").
@@ -253,6 +279,8 @@ class PlantFit:
         The selected model (`plant_fit.PLANT_MODELS`).
     models : tuple of CandidateFit
         Every candidate compared (empty on a narrowband log: first order only, the log cannot tell them apart).
+    smoother : SmootherFit or None
+        The slew limit's timer when the selected model has a slew limit fitted as a smoother on its own timer.
     """
 
     g: Estimate
@@ -265,6 +293,12 @@ class PlantFit:
     yaw_accel_limit: Estimate | None = None
     model: str = "first_order"
     models: tuple = ()
+    smoother: SmootherFit | None = None
+
+    @property
+    def loop_dead_time(self) -> float:
+        """The dead time a small command sees (s): D, plus the smoother's mean wait for its next tick."""
+        return self.dead_time.value + (self.smoother.mean_wait if self.smoother is not None else 0.0)
 
     @property
     def identifiable(self) -> bool:
@@ -276,6 +310,7 @@ class PlantFit:
         none = lambda e: None if e is None else e.to_dict()  # noqa: E731
         return {"model": self.model, "g": self.g.to_dict(), "tau": self.tau.to_dict(), "dead_time": self.dead_time.to_dict(),
                 "actuator_lag": none(self.actuator_lag), "yaw_accel_limit": none(self.yaw_accel_limit),
+                "smoother": none(self.smoother), "loop_dead_time": json_number(self.loop_dead_time),
                 "identifiable": self.identifiable}
 
 
@@ -482,18 +517,19 @@ def _first_order(s: Samples) -> PlantParameters:
     return PlantParameters(g, tau, 0.0, delay, math.inf, b)
 
 
-def _which_plant(s: Samples, first: PlantParameters) -> tuple[str, PlantParameters, tuple]:
+def _which_plant(s: Samples, first: PlantParameters, frequency: float) -> tuple[str, PlantParameters, tuple]:
     """(the selected model, its plant fitted to every sample, every candidate) (`analysis.plant_fit.candidates`)."""
     chunk = s.chunk(SELECT_SAMPLES)
-    fits = candidates(chunk, first, _measured_acceleration(s))
+    fits = candidates(chunk, first, _measured_acceleration(s), frequency)
     chosen = next(c for c in fits if c.selected)
     if chosen.model == "first_order":
         return chosen.model, first, fits
-    p = chosen.parameters if chunk is s else fit_model(chosen.model, chosen.parameters, s, max_nfev=20)
+    p = chosen.parameters if chunk is s else fit_model(chosen.model, chosen.parameters, s, max_nfev=20, frequency=frequency)
     return chosen.model, p, fits
 
 
-def fit_plant(cmd_t: np.ndarray, u: np.ndarray, rate: TimeSeries, T: float) -> tuple[PlantFit | None, str | None]:
+def fit_plant(cmd_t: np.ndarray, u: np.ndarray, rate: TimeSeries, T: float,
+              smoothing_frequency: float = SMOOTHING_FREQUENCY) -> tuple[PlantFit | None, str | None]:
     """Fit the plant the data support (first order, a second lag, a slew limit; `analysis.plant_fit`) to the rate samples
     where the command excites the plant.
 
@@ -507,6 +543,8 @@ def fit_plant(cmd_t: np.ndarray, u: np.ndarray, rate: TimeSeries, T: float) -> t
         The achieved yaw rate (rad/s) and its times (s).
     T : float
         The controller's period (s): a sample whose newest command is older than max(0.5 s, `STALE`·T) is left out.
+    smoothing_frequency : float
+        The rate (Hz) of the smoother a slew limit is fitted as (Nav2's default 20); 0: a continuous ramp.
 
     Returns
     -------
@@ -514,6 +552,7 @@ def fit_plant(cmd_t: np.ndarray, u: np.ndarray, rate: TimeSeries, T: float) -> t
         (the fit, None), or (None, why nothing was identified).
     """
     cmd_t, u = np.asarray(cmd_t, dtype=float), np.asarray(u, dtype=float)
+    f = float(smoothing_frequency)
     if np.ptp(u) <= 1e-3:
         what = "stand still" if np.all(np.abs(u) <= 1e-3) else f"turn at a constant {float(np.median(u)):.3g} rad/s"
         return None, f"the command never changes (the robot was told to {what}): nothing excites the plant"
@@ -523,9 +562,9 @@ def fit_plant(cmd_t: np.ndarray, u: np.ndarray, rate: TimeSeries, T: float) -> t
                       "the log is too short or the rate topic is too sparse")
     first = _first_order(s)
     excitation = excitation_of(cmd_t, u, T, first.g, first.tau, first.dead_time)
-    model, p, fits = ("first_order", first, ()) if excitation.narrowband else _which_plant(s, first)
-    r = residuals(model, p, s)
-    J, names = jacobian(model, p, s)
+    model, p, fits = ("first_order", first, ()) if excitation.narrowband else _which_plant(s, first, f)
+    r = residuals(model, p, s, f)
+    J, names = jacobian(model, p, s, f)
     cov, L, rho = covariance(J, r, s.segment)
     estimates = _estimates(names, p, cov)
     g, g_est = p.g, estimates["g"]
@@ -544,8 +583,9 @@ def fit_plant(cmd_t: np.ndarray, u: np.ndarray, rate: TimeSeries, T: float) -> t
             f"gain {excitation.gain:.3g} and phase {math.degrees(excitation.phase):.0f}° there; record step turns "
             "(docs/diagnose.md)")))
         estimates = {name: Estimate(e.value, math.nan, math.nan) for name, e in estimates.items()}
+    smoother = SmootherFit(f, p.phase, mean_wait(cmd_t, f, p.phase)) if math.isfinite(p.slew) and f > 0 else None
     return PlantFit(estimates["g"], estimates["tau"], estimates["dead_time"], quality, tuple(warnings), excitation,
-                    estimates.get("actuator_lag"), estimates.get("yaw_accel_limit"), model, fits), None
+                    estimates.get("actuator_lag"), estimates.get("yaw_accel_limit"), model, fits, smoother), None
 
 
 # ------------------------------------------------------------------------------------------ what the model misses
@@ -642,7 +682,7 @@ def _rate_limit(s: Samples, p: PlantParameters) -> float | None:
 
 
 # ------------------------------------------------------------------------------------------ the whole
-def identify(log: LogData, rate_source: str = "odometry") -> Identification:
+def identify(log: LogData, rate_source: str = "odometry", smoothing_frequency: float = SMOOTHING_FREQUENCY) -> Identification:
     """The controller's timing and the yaw-rate plant identified from `log`.
 
     Parameters
@@ -651,6 +691,8 @@ def identify(log: LogData, rate_source: str = "odometry") -> Identification:
         A log read with the command and the rate source (`pfm_stability.io.logs.read_log`).
     rate_source : str
         ``"odometry"`` or ``"imu"`` (`RATE_SOURCES`): where the achieved yaw rate comes from.
+    smoothing_frequency : float
+        The rate (Hz) of the velocity smoother a slew limit is fitted as (Nav2's default 20); 0: a continuous ramp.
 
     Returns
     -------
@@ -669,5 +711,7 @@ def identify(log: LogData, rate_source: str = "odometry") -> Identification:
     command = log.command
     timing = controller_timing(command.t)
     summary = LogSummary(log.path, log.format, float(log.duration), command.topic, rate.topic, rate_source, command.stamps)
-    plant, reason = fit_plant(command.t, command.value, rate, timing.T)
+    if not (math.isfinite(smoothing_frequency) and 0.0 <= smoothing_frequency <= 1000.0):
+        raise ValueError(f"smoothing frequency must be in [0, 1000] Hz (0: a continuous ramp); got {smoothing_frequency!r}")
+    plant, reason = fit_plant(command.t, command.value, rate, timing.T, smoothing_frequency)
     return Identification(plant is not None, reason, timing, plant, summary)

@@ -28,15 +28,15 @@ and West's 4·(n/100)^(2/9) and three times the lag at which the residuals' auto
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from ..io.serialize import json_number
-from .plant_response import lag_at, lag_response, lag_states, plant_response, slew_limited
+from .plant_response import lag_at, lag_response, lag_states, plant_response, slew_limited, smoothed
 
 __all__ = ["Samples", "CandidateFit", "PlantParameters", "PLANT_MODELS", "MODEL_PARAMETERS", "DEAD_TIME_BOUNDS", "TAU_BOUNDS",
-           "RATIO_HIGH", "SLEW_BOUNDS", "SELECT_SAMPLES", "LJUNG_BOX_LAGS", "Z95", "grid_start", "fit_first_order",
+           "RATIO_HIGH", "SLEW_BOUNDS", "SMOOTHING_FREQUENCY", "PHASES", "SELECT_SAMPLES", "LJUNG_BOX_LAGS", "Z95", "grid_start", "fit_first_order",
            "fit_model", "residuals", "jacobian", "covariance", "autocorrelation", "ljung_box", "candidates"]
 
 DEAD_TIME_BOUNDS = (-0.1, 1.0)
@@ -50,6 +50,11 @@ RATIO_LOW = 1e-3
 """The smallest τ_a/τ searched (a second lag of 0.1 % of the first is none)."""
 SLEW_BOUNDS = (0.05, 1000.0)
 """The slew limit A searched (rad/s²): from a drive that takes 20 s to reach 1 rad/s to one that no command reaches."""
+SMOOTHING_FREQUENCY = 20.0
+"""The slew limit's timer (Hz): Nav2's velocity smoother's default ``smoothing_frequency``; 0 fits a continuous ramp."""
+PHASES = 10
+"""The smoother's timer phase φ is searched on this many points of [0, 1/f) (a phase moves which command each tick
+reads: no derivative; 5 ms apart at 20 Hz, below the odometry's period)."""
 SELECT_SAMPLES = 8_000
 """The candidates are compared on a contiguous stretch of at most this many samples (the same for all; speed)."""
 LJUNG_BOX_LAGS = 20
@@ -128,6 +133,8 @@ class PlantParameters:
         The slew limit A, rad/s² (inf: none).
     bias : float
         The offset b, rad/s.
+    phase : float
+        The smoother's timer phase φ, s (`plant_response.smoothed`; with a slew limit and a smoothing frequency only).
     """
 
     g: float
@@ -136,6 +143,7 @@ class PlantParameters:
     dead_time: float
     slew: float
     bias: float
+    phase: float = 0.0
 
     def vector(self) -> dict:
         """The fit's internal coordinates (g, τ, ρ = τ_a/τ, D, ln A, b)."""
@@ -143,17 +151,19 @@ class PlantParameters:
                 "log_slew": math.log(self.slew) if math.isfinite(self.slew) else math.inf, "b": self.bias}
 
     @classmethod
-    def of(cls, q: dict) -> "PlantParameters":
+    def of(cls, q: dict, phase: float = 0.0) -> "PlantParameters":
         """From the internal coordinates (absent ones: no second lag, no slew limit).
 
         Parameters
         ----------
         q : dict
             Some of g, tau, rho, D, log_slew, b.
+        phase : float
+            The smoother's timer phase, s.
         """
         rho, log_slew = q.get("rho", 0.0), q.get("log_slew", math.inf)
         return cls(float(q["g"]), float(q["tau"]), float(rho * q["tau"]), float(q["D"]),
-                   math.exp(log_slew) if math.isfinite(log_slew) else math.inf, float(q["b"]))
+                   math.exp(log_slew) if math.isfinite(log_slew) else math.inf, float(q["b"]), float(phase))
 
 
 @dataclass(frozen=True)
@@ -281,10 +291,12 @@ _UPPER = {"g": np.inf, "tau": TAU_BOUNDS[1], "rho": RATIO_HIGH, "D": DEAD_TIME_B
 
 
 class _Model:
-    """The response of one candidate on `s` as a function of its free parameters, the slew knots cached per A."""
+    """The response of one candidate on `s` as a function of its free parameters, the slew limit's input (a continuous
+    ramp's knots, or a smoother's held ticks at `frequency` Hz and `phase` s) cached per A."""
 
-    def __init__(self, model: str, s: Samples):
+    def __init__(self, model: str, s: Samples, frequency: float = SMOOTHING_FREQUENCY, phase: float = 0.0):
         self.names, self.s, self._knots = MODEL_PARAMETERS[model], s, {}
+        self.smoother = (frequency, phase) if frequency > 0 else None
 
     def unit(self, q: dict) -> np.ndarray:
         """The unit-gain response at the samples."""
@@ -294,11 +306,13 @@ class _Model:
             if log_slew not in self._knots:
                 if len(self._knots) > 4:
                     self._knots.clear()
-                self._knots[log_slew] = slew_limited(self.s.cmd_t, self.s.u, math.exp(log_slew))
+                A = math.exp(log_slew)
+                self._knots[log_slew] = smoothed(self.s.cmd_t, self.s.u, A, *self.smoother) if self.smoother else \
+                    slew_limited(self.s.cmd_t, self.s.u, A)
             knots = self._knots[log_slew]
         rho = q.get("rho", 0.0)
         return plant_response(self.s.cmd_t, self.s.u, self.s.t, q["tau"], q["D"], rho * q["tau"],
-                              math.exp(log_slew) if knots is not None else math.inf, knots)
+                              math.exp(log_slew) if knots is not None else math.inf, knots, self.smoother)
 
     def q(self, p) -> dict:
         return dict(zip(self.names, (float(v) for v in p)))
@@ -322,8 +336,9 @@ class _Model:
         return np.column_stack(columns)
 
 
-def fit_model(model: str, start: PlantParameters, s: Samples, max_nfev: int = 60) -> PlantParameters:
-    """The candidate `model` fitted to `s` from `start` (its absent parameters ignored).
+def fit_model(model: str, start: PlantParameters, s: Samples, max_nfev: int = 60,
+              frequency: float = SMOOTHING_FREQUENCY) -> PlantParameters:
+    """The candidate `model` fitted to `s` from `start` (its absent parameters ignored; a smoother's phase kept).
 
     Parameters
     ----------
@@ -335,18 +350,20 @@ def fit_model(model: str, start: PlantParameters, s: Samples, max_nfev: int = 60
         The problem.
     max_nfev : int
         The largest number of residual evaluations.
+    frequency : float
+        The slew limit's smoother's rate, Hz (0: a continuous ramp).
     """
     if model == "first_order":
         g, tau, D, b = fit_first_order((start.g, start.tau, start.dead_time, start.bias), s)
         return PlantParameters(g, tau, 0.0, D, math.inf, b)
-    m = _Model(model, s)
+    m = _Model(model, s, frequency, start.phase)
     v = start.vector()
     p0 = [min(max(v[n], _LOWER[n]), _UPPER[n]) for n in m.names]
     result = _solve(m.residuals, m.jacobian, p0, [_LOWER[n] for n in m.names], [_UPPER[n] for n in m.names], max_nfev)
-    return PlantParameters.of(m.q(result.x))
+    return PlantParameters.of(m.q(result.x), start.phase)
 
 
-def residuals(model: str, p: PlantParameters, s: Samples) -> np.ndarray:
+def residuals(model: str, p: PlantParameters, s: Samples, frequency: float = SMOOTHING_FREQUENCY) -> np.ndarray:
     """Fitted minus measured at the samples, rad/s.
 
     Parameters
@@ -357,13 +374,15 @@ def residuals(model: str, p: PlantParameters, s: Samples) -> np.ndarray:
         The plant.
     s : Samples
         The problem.
+    frequency : float
+        The slew limit's smoother's rate, Hz (0: a continuous ramp).
     """
-    m = _Model(model, s)
+    m = _Model(model, s, frequency, p.phase)
     v = p.vector()
     return m.residuals([v[n] for n in m.names])
 
 
-def jacobian(model: str, p: PlantParameters, s: Samples) -> tuple[np.ndarray, tuple]:
+def jacobian(model: str, p: PlantParameters, s: Samples, frequency: float = SMOOTHING_FREQUENCY) -> tuple[np.ndarray, tuple]:
     """(J, the parameters' names) of the residuals at `p` (analytic for the first order, else forward differences).
 
     Parameters
@@ -374,12 +393,23 @@ def jacobian(model: str, p: PlantParameters, s: Samples) -> tuple[np.ndarray, tu
         The plant.
     s : Samples
         The problem.
+    frequency : float
+        The slew limit's smoother's rate, Hz (0: a continuous ramp).
     """
     if model == "first_order":
         return _first_order_jacobian((p.g, p.tau, p.dead_time, p.bias), s)[1], MODEL_PARAMETERS[model]
-    m = _Model(model, s)
+    m = _Model(model, s, frequency, p.phase)
     v = p.vector()
     return m.jacobian([v[n] for n in m.names]), m.names
+
+
+def _best_phase(model: str, p: PlantParameters, s: Samples, frequency: float) -> PlantParameters:
+    """`p` with the smoother's phase of least residual on `PHASES` points of [0, 1/f), the other parameters kept."""
+    if frequency <= 0 or not math.isfinite(p.slew):
+        return p
+    trials = [replace(p, phase=k / (PHASES * frequency)) for k in range(PHASES)]
+    costs = [float(np.sum(residuals(model, q, s, frequency) ** 2)) for q in trials]
+    return trials[int(np.argmin(costs))]
 
 
 # ------------------------------------------------------------------------------------------ statistics
@@ -466,10 +496,10 @@ def _start(model: str, fitted: dict, first: PlantParameters, slope: float) -> Pl
         A = min(max(slope / max(abs(first.g), 1e-3), 2 * SLEW_BOUNDS[0]), SLEW_BOUNDS[1] / 4)
         return PlantParameters(first.g, first.tau, 0.0, first.dead_time, A, first.bias)
     lags, slew = fitted["two_lags"], fitted["slew_limited"]
-    return PlantParameters(lags.g, lags.tau, lags.actuator_lag, lags.dead_time, slew.slew, 0.5 * (lags.bias + slew.bias))
+    return PlantParameters(lags.g, lags.tau, lags.actuator_lag, lags.dead_time, slew.slew, 0.5 * (lags.bias + slew.bias), slew.phase)
 
 
-def candidates(s: Samples, first: PlantParameters, slope: float) -> tuple[CandidateFit, ...]:
+def candidates(s: Samples, first: PlantParameters, slope: float, frequency: float = SMOOTHING_FREQUENCY) -> tuple[CandidateFit, ...]:
     """Every candidate (`PLANT_MODELS`) fitted to the same samples `s` and scored; the smallest BIC selected.
 
     Parameters
@@ -480,13 +510,17 @@ def candidates(s: Samples, first: PlantParameters, slope: float) -> tuple[Candid
         The first-order plant fitted to the whole log (the start of every fit).
     slope : float
         The largest measured yaw acceleration (rad/s², its 99th percentile): where the slew limit's fit starts.
+    frequency : float
+        The slew limit's smoother's rate, Hz (`SMOOTHING_FREQUENCY`; 0: a continuous ramp).
     """
     n = int(s.t.size)
     fits, fitted = [], {}
     for model in PLANT_MODELS:
-        p = fit_model(model, first if model == "first_order" else _start(model, fitted, first, slope), s)
+        p = fit_model(model, first if model == "first_order" else _start(model, fitted, first, slope), s, frequency=frequency)
+        if "log_slew" in MODEL_PARAMETERS[model] and frequency > 0:  # the smoother's phase, then the fit again there
+            p = fit_model(model, _best_phase(model, p, s, frequency), s, frequency=frequency)
         fitted[model] = p
-        r = residuals(model, p, s)
+        r = residuals(model, p, s, frequency)
         ssr = float(r @ r)
         count = len(MODEL_PARAMETERS[model])
         log_l = n * math.log(max(ssr, 1e-300) / n)

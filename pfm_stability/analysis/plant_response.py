@@ -18,6 +18,11 @@ scan) and to D (−dx/dt) are exact too (`lag_response`).
 (`slew_limited`: r_(j+1) = r_j + clip(u_j − r_j, ±A·(c_(j+1) − c_j)), a recursion a clip makes sequential; one pass
 over the commands). r is continuous and piecewise linear, with a knot at each command and where each ramp ends.
 
+**A smoother on its own timer.** Nav2's velocity smoother does not ramp continuously: a timer every 1/f reads the newest
+command and moves its held output towards it by at most A/f (`smoothed`). Its output is a sequence of held commands
+at its ticks φ + i/f, and the lags' response to it is the held commands' (above). A small command then waits for the
+next tick (`mean_wait`: h/2 on average when the commands' clock is independent of the smoother's).
+
 **One lag, piecewise-linear input.** Over a segment of slope m from knot (s_k, v_k) the lag follows
 x(s_k + θ) = v_k + m(θ − τ) + (x_k − v_k + mτ)·e^(−θ/τ): again an affine recursion over the knots (`ramp_lag`).
 
@@ -45,7 +50,8 @@ def _decay(x) -> np.ndarray:
     return np.exp(np.maximum(x, _FLOOR))
 
 
-__all__ = ["affine_scan", "lag_response", "lag_states", "lag_at", "slew_limited", "ramp_lag", "plant_response"]
+__all__ = ["affine_scan", "lag_response", "lag_states", "lag_at", "slew_limited", "smoothed", "mean_wait", "ramp_lag",
+           "plant_response"]
 
 
 def affine_scan(a: np.ndarray, b: np.ndarray, x0: float) -> np.ndarray:
@@ -187,6 +193,59 @@ def slew_limited(cmd_t: np.ndarray, u: np.ndarray, limit: float) -> tuple[np.nda
     return np.asarray(times), np.asarray(values)
 
 
+def smoothed(cmd_t: np.ndarray, u: np.ndarray, limit: float, frequency: float, phase: float) -> tuple[np.ndarray, np.ndarray]:
+    """The held output (tick times s, values) of a velocity smoother on its own timer, as Nav2's computes it (module
+    docstring): at each tick φ + i/f it moves its last output towards the newest command by at most A/f.
+
+    Parameters
+    ----------
+    cmd_t : numpy.ndarray
+        The commands' times (s), non-decreasing.
+    u : numpy.ndarray
+        The commands (rad/s); the output starts at u[0].
+    limit : float
+        A, rad/s², > 0.
+    frequency : float
+        f, Hz, > 0.
+    phase : float
+        φ, s: the first tick at or after cmd_t[0] is cmd_t[0] + (φ − cmd_t[0]) mod (1/f).
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        The ticks (s) and the output held from each (rad/s): a sequence of held commands.
+    """
+    h = 1.0 / frequency
+    first = cmd_t[0] + (phase - cmd_t[0]) % h
+    ticks = np.arange(first, cmd_t[-1] + 4 * h, h)
+    newest = (np.searchsorted(cmd_t, ticks, side="right") - 1).tolist()
+    v, step = u.tolist(), limit * h
+    out = np.empty(ticks.size)
+    last = v[0]
+    for i, j in enumerate(newest):
+        gap = v[j] - last
+        last += step if gap > step else -step if gap < -step else gap
+        out[i] = last
+    return np.concatenate([[cmd_t[0]], ticks]), np.concatenate([[v[0]], out])
+
+
+def mean_wait(cmd_t: np.ndarray, frequency: float, phase: float) -> float:
+    """The mean time (s) a command waits for the smoother's next tick φ + i/f: what a small command's response is delayed
+    by beyond the dead time (h/2 when the commands' times are independent of the smoother's clock).
+
+    Parameters
+    ----------
+    cmd_t : numpy.ndarray
+        The commands' times (s).
+    frequency : float
+        f, Hz.
+    phase : float
+        φ, s.
+    """
+    h = 1.0 / frequency
+    return float(np.mean((phase - cmd_t) % h))
+
+
 def ramp_lag(knot_t: np.ndarray, knot_v: np.ndarray, t: np.ndarray, tau: float, dead_time: float) -> np.ndarray:
     """The unit-gain lag's response at `t` to the piecewise-linear input through (`knot_t`, `knot_v`), delayed by `dead_time`.
 
@@ -221,7 +280,7 @@ def ramp_lag(knot_t: np.ndarray, knot_v: np.ndarray, t: np.ndarray, tau: float, 
 
 
 def plant_response(cmd_t: np.ndarray, u: np.ndarray, t: np.ndarray, tau: float, dead_time: float, actuator_lag: float = 0.0,
-                   slew: float = math.inf, knots: tuple | None = None) -> np.ndarray:
+                   slew: float = math.inf, knots: tuple | None = None, smoother: tuple | None = None) -> np.ndarray:
     """The unit-gain response at `t` of e^(−sD)/((τs + 1)(τ_a·s + 1)) behind a slew limit to the held commands, exactly.
 
     Parameters
@@ -241,14 +300,20 @@ def plant_response(cmd_t: np.ndarray, u: np.ndarray, t: np.ndarray, tau: float, 
     slew : float
         The slew limit A (rad/s²), > 0 (inf: none).
     knots : tuple of numpy.ndarray, optional
-        `slew_limited(cmd_t, u, slew)` when already computed (a fit varies τ, τ_a and D at one A).
+        `slew_limited(cmd_t, u, slew)` when already computed (a fit varies τ, τ_a and D at one A); with `smoother`, the
+        `smoothed` ticks and outputs.
+    smoother : tuple of float, optional
+        (f Hz, φ s): the slew limit is a smoother on its own timer (`smoothed`), not a continuous ramp.
 
     Returns
     -------
     numpy.ndarray
         The response (rad/s), before the gain g.
     """
-    if math.isinf(slew):
+    if math.isfinite(slew) and smoother is not None:
+        held = knots if knots is not None else smoothed(cmd_t, u, slew, *smoother)
+        one = lambda lag: lag_response(held[0], held[1], t, lag, dead_time)  # noqa: E731
+    elif math.isinf(slew):
         one = lambda lag: lag_response(cmd_t, u, t, lag, dead_time)  # noqa: E731
     else:
         kt, kv = knots if knots is not None else slew_limited(cmd_t, u, slew)

@@ -180,9 +180,13 @@ def _plant_rows(plant) -> list[tuple[str, str, str]]:
     if plant.yaw_accel_limit is not None:
         rows.append(("A (slew limit)", plant.yaw_accel_limit, f"{plant.yaw_accel_limit.value:.4g} rad/s²",
                      lambda v: f"{v:.4g} rad/s²"))
+    if plant.smoother is not None:
+        sm = plant.smoother
+        rows.append((f"smoother {sm.frequency:g} Hz", None, f"wait {_ms(sm.mean_wait)}", None))
     if not plant.identifiable:  # one point of the ridge: no interval means anything
         return [(name, value, "not identifiable") for name, _, value, _ in rows]
-    return [(name, value, f"{unit(e.low)} to {unit(e.high)}") for name, e, value, unit in rows]
+    return [(name, value, f"{unit(e.low)} to {unit(e.high)}" if e is not None else "the mean wait of a command for its tick: "
+             f"the loop's dead time is D + wait = {_ms(plant.loop_dead_time)}") for name, e, value, unit in rows]
 
 
 def _models(plant) -> list[str]:
@@ -272,7 +276,8 @@ def robot_yaml(result) -> str:
     """
     plant, c, log = result.plant, result.controller, result.log
     name = os.path.basename(os.path.normpath(log.path))
-    D = max(plant.dead_time.value, 0.0)
+    D = max(plant.loop_dead_time, 0.0)
+    wait = "" if plant.smoother is None else f"; with the smoother's mean wait of {1000 * plant.smoother.mean_wait:.1f} ms"
     lines = [
         f"# Identified by `pfm-stability identify` from {name} ({log.duration:.0f} s;",
         f"# command {log.command_topic}, rate {log.rate_topic}). 95 % intervals in the comments.",
@@ -280,7 +285,7 @@ def robot_yaml(result) -> str:
         "# and the law (docs/config.md) before using it with `pfm-stability report --config`.",
         "robot:",
         f"  tau: {plant.tau.value:.6g}          # s, steering lag, identified from {name} ({plant.tau.low:.4g} to {plant.tau.high:.4g})",
-        f"  dead_time: {D:.6g}    # s, identified from {name} ({plant.dead_time.low:.4g} to {plant.dead_time.high:.4g})",
+        f"  dead_time: {D:.6g}    # s, identified from {name} ({plant.dead_time.low:.4g} to {plant.dead_time.high:.4g}{wait})",
         f"  plant_gain: {plant.g.value:.6g}   # -, achieved/commanded yaw rate, identified from {name} "
         f"({plant.g.low:.4g} to {plant.g.high:.4g})",
     ]

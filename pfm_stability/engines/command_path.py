@@ -68,7 +68,7 @@ class VelocitySmoother:
     velocity_timeout: float = 1.0
 
     def __post_init__(self):
-        for name, high in (("max_accel", 1e6), ("max_decel", 1e6), ("smoothing_frequency", 1e4), ("max_velocity", 1e3),
+        for name, high in (("max_accel", 1e9), ("max_decel", 1e9), ("smoothing_frequency", 1e4), ("max_velocity", 1e3),
                            ("odom_duration", 10.0), ("velocity_timeout", 1e3)):
             check_number(name, getattr(self, name), 0.0, high)
         check_choice("feedback", self.feedback, FEEDBACKS)

@@ -370,18 +370,21 @@ def loop_takes_actuator_lag() -> bool:
 
 
 def _linear_plant(fit) -> tuple[dict, str | None]:
-    """(τ, D, g as `Estimate`-like (value, low, high) by name, a note): the selected plant's, or — when it has a second lag
-    the loop models do not take yet — the first order's candidate (no interval), with the note saying so."""
-    if fit.actuator_lag is None or loop_takes_actuator_lag():
-        return {"tau": fit.tau, "dead_time": fit.dead_time, "plant_gain": fit.g}, None
-    linear = "slew_limited" if fit.yaw_accel_limit is not None else "first_order"  # the same plant without τ_a
-    first = next(m.parameters for m in fit.models if m.model == linear)
+    """(τ, D, g as `Estimate` by name, a note): the selected plant's, or — when it has a second lag the loop models do not
+    take yet — its candidate without it (no interval), with the note saying so. D is the loop's: a smoother's mean wait
+    for its tick added (`analysis.identification.PlantFit.loop_dead_time`)."""
     from ..analysis.identification import Estimate
 
+    wait = fit.smoother.mean_wait if fit.smoother is not None else 0.0
+    if fit.actuator_lag is None or loop_takes_actuator_lag():
+        D = fit.dead_time
+        return {"tau": fit.tau, "dead_time": Estimate(D.value + wait, D.low + wait, D.high + wait), "plant_gain": fit.g}, None
+    linear = "slew_limited" if fit.yaw_accel_limit is not None else "first_order"  # the same plant without τ_a
+    first = next(m.parameters for m in fit.models if m.model == linear)
     nan = math.nan
     note = (f"the {linear.replace('_', '-')} candidate's fit: the data support a second lag τ_a = {fit.actuator_lag.value:.3g} s, "
             "which the loop models do not take yet")
-    return {"tau": Estimate(first.tau, nan, nan), "dead_time": Estimate(first.dead_time, nan, nan),
+    return {"tau": Estimate(first.tau, nan, nan), "dead_time": Estimate(first.dead_time + wait, nan, nan),
             "plant_gain": Estimate(first.g, nan, nan)}, note
 
 
