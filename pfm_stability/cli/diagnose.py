@@ -21,6 +21,7 @@ diagnose" and why); a bad log or a missing parameter is one line, exit 2.
 
 from __future__ import annotations
 
+import math
 import time
 
 from .identify import FORMATS, add_topic_options
@@ -91,9 +92,8 @@ def run(args) -> int:
         The parsed command line.
     """
     from ..analysis.identification import identify
-    from ..analysis.stretches import wall_lines_batch
     from ..extras import require
-    from ..io.logs import LogTopics, log_format, read_log
+    from ..io.logs import LogTopics, log_format
     from ..io.serialize import SCHEMA_VERSION, dumps
     from ..validation.diagnose import complete_from_log, diagnose, missing_parameters, needs_identification
     from .options import resolve_parameters, typed
@@ -115,7 +115,7 @@ def run(args) -> int:
     to_identify = needs_identification(params.sources)
     topics = LogTopics(command=args.cmd_topic, odometry=args.odom_topic, scan=args.scan_topic)
     need = ("command", "odometry", "pose", "scan") if to_identify else ("pose", "scan")
-    log = read_log(args.log, topics, need=need, scan_reducer=wall_lines_batch, scan_batch=SCAN_BATCH)
+    log = _read(args.log, topics, need, want_commands=not to_identify and math.isfinite(params.robot.yaw_accel_limit))
     identification = identify(log, "odometry") if to_identify else None
     robot, controller, sources = complete_from_log(params.robot, params.controller, params.sources, identification)
     result = diagnose(log, robot, controller, law=_law(law, robot, controller))
@@ -135,6 +135,21 @@ def run(args) -> int:
     else:
         print(render_text(result, sources, info) + (f"figure written to {args.plot}\n" if args.plot else ""), end="")
     return 0
+
+
+def _read(path, topics, need, *, want_commands: bool):
+    """The log with `need`, and its commands too when `want_commands` and the log has them (a slew limit given in the
+    configuration is set against them: `validation.diagnose.Limiter`)."""
+    from ..analysis.stretches import wall_lines_batch
+    from ..io.logs import LogError, read_log
+
+    if want_commands:
+        try:
+            return read_log(path, topics, need=("command", *need), scan_reducer=wall_lines_batch, scan_batch=SCAN_BATCH)
+        except LogError as exc:
+            if f"command topic {topics.command}" not in str(exc):
+                raise
+    return read_log(path, topics, need=need, scan_reducer=wall_lines_batch, scan_batch=SCAN_BATCH)
 
 
 def parameters_table(result, sources: dict) -> dict:
