@@ -14,7 +14,10 @@ cannot read or compile and a robot missing a convention; `check_drives` refuses 
 
 The shipped robots (``data/robots/*.xml``, `ROBOT_MODELS`): ``diffdrive`` (a 0.5 m disc of 13.3 kg on
 0.075 m wheels 0.40 m apart) and ``diffdrive-heavy`` (0.6 m, 42 kg, 0.10 m wheels 0.50 m apart, a
-stiffer motor): two driven wheels with rounded tyres, one ball caster in front.
+stiffer motor): two driven wheels with rounded tyres, one ball caster in front; ``diffdrive-filtered`` (``diffdrive``
+with a 0.1-s actuator filter, MuJoCo's ``dyntype="filter"``, before each wheel servo) and ``skid-steer`` (four wheels,
+each side's front one chained to its driven rear one by a joint equality, turning by skidding). `place` starts an
+actuator filter's state and a chained wheel at the robot's speed.
 
 Frames: the package's angles are measured from +Y towards +X (docs/theory.md, notation); MuJoCo's yaw
 ψ from +X towards +Y, so a heading θ is the yaw ψ = π/2 − θ, and a turning rate θ̇ is the yaw rate −ψ̇.
