@@ -17,7 +17,7 @@ that transient into ω: measured 16–18 % high on such runs. Here ω comes from
 3. **Established.** The crossings of an established linear oscillation are equally spaced (by π/ω). Leading
    crossings are dropped while the period that starts at the first one (to the crossing after next: a whole
    period, so a centre error's alternation of long and short half-periods cancels) differs by more than
-   `ESTABLISHED` from the median period of those after it. What is dropped is the start transient.
+   `ESTABLISHED` from the median of the next `NEIGHBOURS` periods. What is dropped is the start transient.
 4. **Fit.** The established crossing times c_i against their index i: a straight line c_i = a + b·i by least
    squares; b = π/ω is the half-period, with its standard error s_b from the residuals (n − 2 degrees of
    freedom). The 95 % interval of ω is π/(b ± t·s_b), t the Student t quantile with n − 2 degrees of freedom.
@@ -39,7 +39,7 @@ import numpy as np
 
 from ..io.serialize import json_number
 
-__all__ = ["FrequencyEstimate", "crossing_frequency", "zero_crossings", "MIN_CROSSINGS", "ESTABLISHED", "HYSTERESIS",
+__all__ = ["FrequencyEstimate", "crossing_frequency", "zero_crossings", "MIN_CROSSINGS", "ESTABLISHED", "NEIGHBOURS", "HYSTERESIS",
            "CENTRE_PASSES"]
 
 MIN_CROSSINGS = 4
@@ -52,6 +52,10 @@ from the median of the later periods. An established linear oscillation's period
 runs they vary by at most 0.6 % in MuJoCo (three speeds) and 4.3 % in the VFF simulator (eight random corridors, the
 largest where a growing swing nears the walls at the run's end, which this rule does not touch); a transient that
 moves the turning points' ω by 16–18 % moves the first periods by far more."""
+NEIGHBOURS = 3
+"""A leading period is compared with the median of the next this many (not of all later ones: an oscillation that grows
+into the walls lengthens its periods steadily, by 2–4 % a period in the VFF simulator's corridors, and against all later
+periods each leading one would look like a transient until only the large swings were left)."""
 HYSTERESIS = 0.1
 """The Schmitt trigger's half-width h as a fraction of the record's half range about its centre (m for an offset):
 wider than the odometry's noise (0.5 mm on a centimetre swing: 5 %) and the ripple of a grid's cells, narrower than
@@ -144,7 +148,7 @@ def _established(c: np.ndarray) -> int:
     first = 0
     while c.size - first >= 4:  # at least two whole periods to compare
         periods = c[first + 2:] - c[first:-2]
-        if abs(periods[0] / np.median(periods[1:]) - 1.0) <= ESTABLISHED:
+        if abs(periods[0] / np.median(periods[1:1 + NEIGHBOURS]) - 1.0) <= ESTABLISHED:
             break
         first += 1
     return first
