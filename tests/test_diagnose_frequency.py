@@ -129,3 +129,18 @@ def test_bad_input_is_refused():
         crossing_frequency(np.arange(3.0), np.array([0.0, np.nan, 1.0]))
     f = crossing_frequency(np.arange(10.0), np.zeros(10))  # a constant: no crossing, no estimate
     assert f.omega is None and f.few_periods and f.crossings == 0
+
+
+def test_a_swing_growing_into_the_walls_keeps_its_small_swings():
+    """A growing oscillation whose period lengthens steadily by 3 % a period (a corridor run nearing the walls): no
+    crossing is a start transient (each period is within 5 % of the next three), so ω is the whole run's mean rate of
+    phase — not the large swings' alone (what comparing with all later periods measured: 5 % low on such a run)."""
+    t = np.arange(0.0, 20.0, STEP)
+    w0, drift = 3.0, 0.03 / (2 * math.pi / 3.0)  # ω falls by 3 % per period of 2π/3 s
+    omega = w0 * (1 - drift * t)
+    phase = np.cumsum(omega) * STEP
+    x = 0.02 * np.exp(0.08 * t) * np.sin(phase)
+    f = crossing_frequency(t, x)
+    assert f.dropped == 0
+    mean_rate = (phase[-1] - phase[0]) / (t[-1] - t[0])
+    assert f.omega == pytest.approx(mean_rate, rel=0.01)
