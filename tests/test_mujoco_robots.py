@@ -131,11 +131,13 @@ def test_robot_b_shows_its_actuator_filter(drives):
 
 def test_robot_c_shows_its_smoother(drives):
     """Robot C's commands pass Nav2's smoother (2 rad/s² at 20 Hz) and a jittered controller: `identify` selects a plant
-    with a slew limit, and its interval holds 2 rad/s² within 10 % (the smoother is a 20-Hz staircase, the model a
-    continuous ramp, and the skid adds dynamics neither model has); the controller's jitter is seen in the stamps."""
+    with a slew limit fitted as a 20-Hz smoother, within 10 % of 2 rad/s² and its interval holding it, and the mean wait
+    of the commands for a tick near half a tick (the controller's clock is its own); the jitter shows in the stamps.
+    (With 0.3 rad/s steps instead of 0.5 the limit comes out 5–11 % high and its interval misses 2: docs/mujoco.md.)"""
     fit = _fit(drives["C"])
     assert fit.yaw_accel_limit is not None and fit.yaw_accel_limit.value == pytest.approx(2.0, rel=0.1)
-    assert fit.yaw_accel_limit.low < 2.2 and fit.yaw_accel_limit.high > 1.8
+    assert fit.yaw_accel_limit.low <= 2.0 <= fit.yaw_accel_limit.high
+    assert fit.smoother.frequency == 20.0 and fit.smoother.mean_wait == pytest.approx(0.025, abs=0.003)
     timing = controller_timing(drives["C"].cmd_t)
     assert 0.077 < timing.p5 < timing.T < timing.p95 < 0.105
 
