@@ -19,7 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["Plant", "Recording", "SyntheticLog", "simulate", "write_ros2", "write_ros1", "write_csv", "write_log", "corridor_log",
+__all__ = ["Plant", "Recording", "SyntheticLog", "simulate", "smooth", "write_ros2", "write_ros1", "write_csv", "write_log", "corridor_log",
            "random_plant", "bad_log", "BAD_LOGS", "Leg", "LegTruth", "DrivenLog", "drive", "ray_cast", "random_corridor", "corridor_run"]
 
 
@@ -28,7 +28,9 @@ class Plant:
     """The yaw-rate plant g·e^(−sD)/((τs + 1)(τ2·s + 1)) with an optional rate limit and deadband.
 
     g (−), tau and dead_time (s); tau2 (s, 0: first order); rate_limit (rad/s², |dω/dt| at most; inf: none);
-    deadband (rad/s: a command u delivers sign(u)·max(|u| − deadband, 0)).
+    deadband (rad/s: a command u delivers sign(u)·max(|u| − deadband, 0)); slew (rad/s², inf: none): the commands pass
+    a velocity smoother as Nav2's does (`smooth`: every 1/smoothing s, OPEN_LOOP, the held output moves towards the
+    newest command by at most slew/smoothing; phase its first tick, s) before the plant.
     """
 
     g: float = 0.9
@@ -37,6 +39,9 @@ class Plant:
     tau2: float = 0.0
     rate_limit: float = math.inf
     deadband: float = 0.0
+    slew: float = math.inf
+    smoothing: float = 20.0
+    phase: float = 0.013
 
 
 @dataclass(frozen=True)
@@ -155,10 +160,27 @@ def _step(plant: Plant, state: list[float], v: float, dt: float) -> None:
     state[0] = state[1]
 
 
+def smooth(cmd_t: np.ndarray, cmd_wz: np.ndarray, slew: float, frequency: float, phase: float = 0.0):
+    """(tick times, outputs) of Nav2's velocity smoother on the angular axis (nav2_velocity_smoother, OPEN_LOOP, equal
+    max_accel and −max_decel = `slew`): a timer every 1/`frequency` s from `phase` on reads the newest command and
+    moves the previous output towards it by at most slew/frequency; the output is held until the next tick."""
+    ticks = np.arange(cmd_t[0] + phase, cmd_t[-1] + 5.0, 1.0 / frequency)
+    newest = np.searchsorted(cmd_t, ticks, side="right") - 1
+    out = np.empty(ticks.size)
+    last, step = float(cmd_wz[0]), slew / frequency
+    for i, j in enumerate(newest.tolist()):
+        last += min(max(float(cmd_wz[j]) - last, -step), step)
+        out[i] = last
+    return ticks, out
+
+
 def _respond(plant: Plant, cmd_t: np.ndarray, cmd_wz: np.ndarray, sample_t: np.ndarray, still: bool) -> np.ndarray:
-    """The plant's yaw rate at `sample_t` (sorted) for the command held from each `cmd_t` on, delayed by D."""
+    """The plant's yaw rate at `sample_t` (sorted) for the command held from each `cmd_t` on, delayed by D (after the
+    smoother when the plant has a slew limit)."""
     if still:
         return np.zeros_like(sample_t)
+    if math.isfinite(plant.slew):
+        cmd_t, cmd_wz = smooth(cmd_t, cmd_wz, plant.slew, plant.smoothing, plant.phase)
     u = np.sign(cmd_wz) * np.maximum(np.abs(cmd_wz) - plant.deadband, 0.0) if plant.deadband else cmd_wz
     events = np.concatenate([cmd_t + plant.dead_time, sample_t])
     kinds = np.concatenate([np.arange(len(cmd_t)), -1 - np.arange(len(sample_t))])

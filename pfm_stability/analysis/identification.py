@@ -1,4 +1,4 @@
-"""The controller's period and the yaw-rate plant g·e^(−sD)/(τs + 1), identified from a robot's log (docs/diagnose.md).
+"""The controller's period and the yaw-rate plant, identified from a robot's log (docs/diagnose.md).
 
 Controller period
 -----------------
@@ -9,31 +9,29 @@ second over the log) is set against the nominal 1/T.
 The plant
 ---------
 The commanded yaw rate u is held between its stamps (zero-order hold), delayed by D (any value, not a
-whole number of periods) and passed through the first-order lag of gain g and time constant τ; a constant
-offset b absorbs a gyro's bias (docs/diagnose.md, "Model"). Between two held commands the lag's response
-is exact: with the state X_j when command j takes effect (at its stamp c_j + D),
-
-    X_(j+1) = u_j + (X_j − u_j)·exp(−(c_(j+1) − c_j)/τ),       y(t) = g·(u_j + (X_j − u_j)·exp(−(t − c_j − D)/τ)) + b
-
-— an affine recursion in j, computed for every command at once by a doubling scan (`_affine_scan`,
-log₂ m passes over the arrays), and independent of D: D only moves where each sample falls. Its
-sensitivities to τ (a second scan) and to D (−dy/dt) are exact too, so the Jacobian is analytic.
+whole number of periods) and passed through the plant of gain g; a constant offset b absorbs a gyro's bias
+(docs/diagnose.md, "Model"). The plant is the one the data support (`analysis.plant_fit`, "Which plant"): the
+first-order lag 1/(τs + 1), two lags 1/((τs + 1)(τ_a·s + 1)), either behind a slew limit A on u (a velocity
+smoother's angular acceleration limit). Every response is exact between the commands (`analysis.plant_response`).
 
 The fit uses the samples where the command excites the plant (`excitation_windows`: from 0.5 s before
 each change of the command to `SETTLE` s after it; long constant stretches and a robot told to stand
 still are left out, and so is a sample whose newest command is older than `STALE` periods, when a base
-may have stopped on its command timeout). A coarse grid over (τ, D), with g and b solved linearly at each
-point, starts `scipy.optimize.least_squares` (D's residual has a local minimum per period of the
-command's oscillation; the grid finds the right one).
+may have stopped on its command timeout). The first order comes first: a coarse grid over (τ, D), with g and b
+solved linearly at each point, starts `scipy.optimize.least_squares` (D's residual has a local minimum per period
+of the command's oscillation; the grid finds the right one). Every candidate is then fitted from it on the same
+stretch of at most `plant_fit.SELECT_SAMPLES` samples and scored by BIC; the selected one is polished on every
+sample.
 
 Intervals
 ---------
 95 % intervals are value ± 1.96·σ from the covariance H⁻¹·S·H⁻¹, H = JᵀJ, with the Newey–West estimate
-S = Σ_l w_l·Σ_t (J_t r_t)(J_(t−l) r_(t−l))ᵀ (Bartlett weights, lags within one window only). With white
-residuals this is s²·(JᵀJ)⁻¹; with residuals correlated over L samples (unmodelled dynamics, a smoothed
+S = Σ_l w_l·Σ_t (J_t r_t)(J_(t−l) r_(t−l))ᵀ (Bartlett weights, lags within one window only; `plant_fit.covariance`).
+With white residuals this is s²·(JᵀJ)⁻¹; with residuals correlated over L samples (unmodelled dynamics, a smoothed
 odometry) it widens by the right amount for each parameter, where an effective sample count would
 widen every parameter alike. L is the larger of Newey and West's 4·(n/100)^(2/9) and three times the
-lag at which the residuals' autocorrelation falls below 0.1.
+lag at which the residuals' autocorrelation falls below 0.1. τ_a = ρ·τ and A = e^(ln A) (the fit's coordinates)
+get theirs by the delta method and as exp of ln A's interval (positive).
 
 Can the log separate g, τ and D?
 --------------------------------
@@ -50,11 +48,11 @@ not depend on where the optimizer stopped on the ridge.
 
 Does the model explain the data?
 --------------------------------
-`FitQuality` gives the normalized error (NRMSE = rms(r)/std(y)), R² and the residuals' whiteness, and
-`FitWarning` names what the model does not explain: a rate limit (the measured |dω/dt| saturates where
-the model asks for more), a deadband or backlash (a model whose small commands deliver nothing fits
-significantly better) and second-order behaviour (a second lag fits significantly better). "Significantly"
-is at least `BETTER` of the residual sum of squares on the same samples.
+`FitQuality` gives the normalized error (NRMSE = rms(r)/std(y)), R² and the residuals' whiteness of the selected
+plant, and `FitWarning` names what it does not explain: a rate limit the selected plant has not taken up (the
+measured |dω/dt| saturates where the model asks for more) and a deadband or backlash (a first-order plant whose
+small commands deliver nothing fits better by at least `BETTER` of the residual sum of squares on the same samples).
+A narrowband log is fitted with the first order alone: it cannot tell the candidates apart.
 
 Nothing identified
 ------------------
@@ -73,10 +71,14 @@ import numpy as np
 from ..io.logs import LogData, TimeSeries
 from ..io.serialize import json_number
 from .excitation import BAND, NARROWBAND, Excitation, command_spectrum, excitation_of, ridge_point
+from .plant_fit import (DEAD_TIME_BOUNDS, PLANT_MODELS, SELECT_SAMPLES, SMOOTHING_FREQUENCY, TAU_BOUNDS, Z95, CandidateFit,
+                        PlantParameters, Samples, autocorrelation, candidates, covariance, fit_first_order, fit_model, grid_start,
+                        jacobian, residuals)
+from .plant_response import lag_response, mean_wait
 
 __all__ = ["Estimate", "ControllerTiming", "FitWarning", "FitQuality", "Excitation", "PlantFit", "LogSummary",
-           "Identification", "controller_timing", "excitation_windows", "command_spectrum", "lag_response", "fit_plant",
-           "identify", "ridge_point", "NARROWBAND", "BAND",
+           "Identification", "CandidateFit", "SmootherFit", "SMOOTHING_FREQUENCY", "controller_timing", "excitation_windows", "command_spectrum", "lag_response",
+           "fit_plant", "identify", "ridge_point", "NARROWBAND", "BAND", "PLANT_MODELS",
            "MISSED_FACTOR", "SETTLE", "LEAD", "STALE", "DEAD_TIME_BOUNDS", "TAU_BOUNDS", "BETTER", "RATE_SOURCES"]
 
 MISSED_FACTOR = 1.5
@@ -85,18 +87,13 @@ LEAD, SETTLE = 0.5, 4.0
 """A window of excitation runs from LEAD s before a change of the command to SETTLE s after it."""
 STALE = 5.0
 """A sample whose newest command is older than max(0.5 s, STALE·T) is not used (the base may have stopped)."""
-DEAD_TIME_BOUNDS = (-0.1, 1.0)
-"""The dead time D searched (s); a negative D means the rate's stamps lead the command's (clocks differ)."""
-TAU_BOUNDS = (0.005, 5.0)
-"""The lag τ searched (s)."""
 BETTER = 0.1
-"""A richer model (second lag, deadband) is named when it lowers the residual sum of squares by this fraction."""
+"""A deadband is named when it lowers the residual sum of squares by this fraction."""
 RATE_SOURCES = ("odometry", "imu")
 """Where the achieved yaw rate comes from: the odometry's twist, or the IMU's angular velocity."""
-Z95 = 1.959963984540054
 GRID_SAMPLES, CHECK_SAMPLES, FIRST_SAMPLES = 5_000, 8_000, 20_000
-"""The grid search, the checks of richer models and a long log's first fit use a contiguous stretch of at most this
-many samples (speed: the final fit uses every sample)."""
+"""The grid search, the deadband's check and a long log's first fit use a contiguous stretch of at most this many
+samples (speed: the final fit uses every sample; the candidates are compared on `plant_fit.SELECT_SAMPLES`)."""
 
 
 # ------------------------------------------------------------------------------------------ results
@@ -229,24 +226,61 @@ class FitQuality:
 
 
 @dataclass(frozen=True)
+class SmootherFit:
+    """The slew limit as a smoother on its own timer (`plant_response.smoothed`): its rate, the timer's phase found, and
+    the mean wait of the log's commands for its next tick.
+
+    Attributes
+    ----------
+    frequency : float
+        f, Hz (`plant_fit.SMOOTHING_FREQUENCY` unless told).
+    phase : float
+        φ, s, in [0, 1/f): the ticks are at φ + i/f on the log's clock.
+    mean_wait : float
+        s: how long the log's commands waited for a tick on average (h/2 for commands on a clock of their own). A small
+        command's response is delayed by it beyond D: the loop's dead time is D + mean_wait (`PlantFit.loop_dead_time`).
+    """
+
+    frequency: float
+    phase: float
+    mean_wait: float
+
+    def to_dict(self) -> dict:
+        """``{frequency, phase, mean_wait}`` (Hz, s, s)."""
+        return {"frequency": json_number(self.frequency), "phase": json_number(self.phase), "mean_wait": json_number(self.mean_wait)}
+
+
+@dataclass(frozen=True)
 class PlantFit:
-    """The fitted plant g·e^(−sD)/(τs + 1).
+    """The fitted plant g·e^(−sD)/((τs + 1)(τ_a·s + 1)) behind an optional slew limit A on the commanded yaw rate: the
+    model the data support (`analysis.plant_fit`, "Which plant").
 
     Parameters
     ----------
     g : Estimate
         The plant gain (−) and its 95 % interval.
     tau : Estimate
-        The lag (s) and its 95 % interval.
+        The lag (s) and its 95 % interval (the slower lag of two).
     dead_time : Estimate
         The dead time D (s) from the command's publication (docs/diagnose.md, "Time") and its 95 % interval.
     quality : FitQuality
-        How well the model explains the samples.
+        How well the selected model explains the samples.
     warnings : tuple of FitWarning
         What the model does not explain, and ``narrowband``.
     excitation : Excitation or None
         How the commands excite the plant; when narrowband the values are one point of the ridge the log cannot
         resolve and the intervals are NaN.
+    actuator_lag : Estimate or None
+        The second lag τ_a (s) and its interval when the selected model has one, else None (none: 0).
+    yaw_accel_limit : Estimate or None
+        The slew limit A on the commanded yaw rate (rad/s²) and its interval when the selected model has one, else None
+        (none: inf).
+    model : str
+        The selected model (`plant_fit.PLANT_MODELS`).
+    models : tuple of CandidateFit
+        Every candidate compared (empty on a narrowband log: first order only, the log cannot tell them apart).
+    smoother : SmootherFit or None
+        The slew limit's timer when the selected model has a slew limit fitted as a smoother on its own timer.
     """
 
     g: Estimate
@@ -255,11 +289,29 @@ class PlantFit:
     quality: FitQuality
     warnings: tuple[FitWarning, ...]
     excitation: Excitation | None = None
+    actuator_lag: Estimate | None = None
+    yaw_accel_limit: Estimate | None = None
+    model: str = "first_order"
+    models: tuple = ()
+    smoother: SmootherFit | None = None
+
+    @property
+    def loop_dead_time(self) -> float:
+        """The dead time a small command sees (s): D, plus the smoother's mean wait for its next tick."""
+        return self.dead_time.value + (self.smoother.mean_wait if self.smoother is not None else 0.0)
 
     @property
     def identifiable(self) -> bool:
         """Whether g, τ and D are separately determined by the log (not `Excitation.narrowband`)."""
         return self.excitation is None or not self.excitation.narrowband
+
+    def to_dict(self) -> dict:
+        """The ``plant`` of the JSON output."""
+        none = lambda e: None if e is None else e.to_dict()  # noqa: E731
+        return {"model": self.model, "g": self.g.to_dict(), "tau": self.tau.to_dict(), "dead_time": self.dead_time.to_dict(),
+                "actuator_lag": none(self.actuator_lag), "yaw_accel_limit": none(self.yaw_accel_limit),
+                "smoother": none(self.smoother), "loop_dead_time": json_number(self.loop_dead_time),
+                "identifiable": self.identifiable}
 
 
 @dataclass(frozen=True)
@@ -327,13 +379,12 @@ class Identification:
         return {
             "identified": self.identified,
             "reason": self.reason,
-            "plant": None if plant is None else {"g": plant.g.to_dict(), "tau": plant.tau.to_dict(),
-                                                 "dead_time": plant.dead_time.to_dict(),
-                                                 "identifiable": plant.identifiable},
+            "plant": None if plant is None else plant.to_dict(),
             "controller": self.controller.to_dict(),
             "fit": {"quality": None if plant is None else plant.quality.to_dict(),
                     "warnings": [] if plant is None else [w.to_dict() for w in plant.warnings],
-                    "excitation": None if plant is None or plant.excitation is None else plant.excitation.to_dict()},
+                    "excitation": None if plant is None or plant.excitation is None else plant.excitation.to_dict(),
+                    "models": [] if plant is None else [m.to_dict() for m in plant.models]},
             "log": self.log.to_dict(),
         }
 
@@ -369,78 +420,7 @@ def controller_timing(t: np.ndarray) -> ControllerTiming:
                             (t.size - 1) / span, 1.0 / T)
 
 
-# ------------------------------------------------------------------------------------------ the excitation
-# ------------------------------------------------------------------------------------------ the exact response
-def _affine_scan(a: np.ndarray, b: np.ndarray, x0: float) -> np.ndarray:
-    """X with X_0 = x0 and X_(k+1) = a_k·X_k + b_k (length len(a) + 1), by doubling: log₂ n vector passes."""
-    A, B = a.astype(float).copy(), b.astype(float).copy()
-    shift = 1
-    while shift < A.size:
-        B[shift:] = A[shift:] * B[:-shift] + B[shift:]
-        A[shift:] = A[shift:] * A[:-shift]
-        shift *= 2
-    return np.concatenate([[x0], A * x0 + B])
-
-
-def lag_response(cmd_t: np.ndarray, u: np.ndarray, t: np.ndarray, tau: float, dead_time: float,
-                 derivatives: bool = False):
-    """The unit-gain lag's response at `t` to `u` held from each `cmd_t` on and delayed by `dead_time`, exactly.
-
-    Parameters
-    ----------
-    cmd_t : numpy.ndarray
-        The commands' times (s), non-decreasing.
-    u : numpy.ndarray
-        The commands (rad/s); before the first the plant rests at u[0].
-    t : numpy.ndarray
-        Where the response is wanted (s).
-    tau : float
-        The lag's time constant (s), > 0.
-    dead_time : float
-        The delay D (s).
-    derivatives : bool
-        Also return the derivatives with respect to τ and D.
-
-    Returns
-    -------
-    numpy.ndarray or tuple of numpy.ndarray
-        x(t) (rad/s); with `derivatives`, (x, ∂x/∂τ, ∂x/∂D).
-    """
-    u = np.asarray(u, dtype=float)
-    dt = np.diff(cmd_t)
-    a, X = _lag_states(dt, u, tau)
-    x, j, before, elapsed, e = _lag_at(cmd_t, u, X, t, tau, dead_time)
-    if not derivatives:
-        return x
-    gap = X[j] - u[j]
-    dX = _affine_scan(a, (X[:-1] - u[:-1]) * a * dt / tau**2, 0.0)
-    dx_dtau = np.where(before, 0.0, dX[j] * e + gap * e * elapsed / tau**2)
-    dx_dD = np.where(before, 0.0, (x - u[j]) / tau)
-    return x, dx_dtau, dx_dD
-
-
-def _lag_states(dt: np.ndarray, u: np.ndarray, tau: float) -> tuple[np.ndarray, np.ndarray]:
-    """(exp(−Δc_j/τ), X_j): the lag's state when each command takes effect (module docstring), unit gain."""
-    a = np.exp(-dt / tau)
-    return a, _affine_scan(a, (1.0 - a) * u[:-1], u[0])
-
-
-def _lag_at(cmd_t, u, X, t, tau: float, dead_time: float):
-    """(x, j, before, elapsed, e) at `t`: the response, the command in effect, t before the first, time since it, e^(−elapsed/τ)."""
-    j = np.searchsorted(cmd_t + dead_time, t, side="right") - 1
-    before = j < 0
-    j = np.maximum(j, 0)
-    elapsed = np.where(before, 0.0, t - (cmd_t[j] + dead_time))
-    e = np.exp(-elapsed / tau)
-    return u[j] + (X[j] - u[j]) * e, j, before, elapsed, e
-
-
-def _second_order(cmd_t, u, t, tau1: float, ratio: float, dead_time: float) -> np.ndarray:
-    """Unit-gain response of 1/((τ1·s + 1)(τ2·s + 1)), τ2 = ratio·τ1 < τ1, by partial fractions of two lags."""
-    tau2 = ratio * tau1
-    return (tau1 * lag_response(cmd_t, u, t, tau1, dead_time) - tau2 * lag_response(cmd_t, u, t, tau2, dead_time)) / (tau1 - tau2)
-
-
+# ------------------------------------------------------------------------------------------ the command's deadband
 def _deadband(u: np.ndarray, width: float) -> np.ndarray:
     return np.sign(u) * np.maximum(np.abs(u) - width, 0.0)
 
@@ -476,29 +456,7 @@ def excitation_windows(cmd_t: np.ndarray, u: np.ndarray) -> np.ndarray:
     return out
 
 
-@dataclass(frozen=True)
-class _Samples:
-    """The problem: commands (cmd_t, u) and the samples (t, y) used, with the segment each belongs to."""
-
-    cmd_t: np.ndarray
-    u: np.ndarray
-    t: np.ndarray
-    y: np.ndarray
-    segment: np.ndarray
-
-    def chunk(self, size: int) -> "_Samples":
-        """A contiguous stretch around the middle with at most `size` samples, and the commands it needs."""
-        if self.t.size <= size:
-            return self
-        first = (self.t.size - size) // 2
-        t0, t1 = self.t[first], self.t[first + size - 1]
-        c0 = max(int(np.searchsorted(self.cmd_t, t0 - 30.0)) - 1, 0)
-        c1 = int(np.searchsorted(self.cmd_t, t1, side="right"))
-        keep = slice(first, first + size)
-        return _Samples(self.cmd_t[c0:c1], self.u[c0:c1], self.t[keep], self.y[keep], self.segment[keep])
-
-
-def _select(cmd_t, u, rate: TimeSeries, T: float) -> tuple[_Samples, np.ndarray]:
+def _select(cmd_t, u, rate: TimeSeries, T: float) -> tuple[Samples, np.ndarray]:
     """The rate samples inside the excitation windows where the command is held and fresh; and the windows."""
     windows = excitation_windows(cmd_t, u)
     t, y = rate.t, rate.value
@@ -511,98 +469,69 @@ def _select(cmd_t, u, rate: TimeSeries, T: float) -> tuple[_Samples, np.ndarray]
     dt = np.diff(ts)
     typical = float(np.median(dt)) if dt.size else 0.0
     segment = np.concatenate([[0], np.cumsum(dt > 5.0 * typical)]) if ts.size else np.zeros(0, int)
-    return _Samples(cmd_t, u, ts, y[keep], segment), windows
+    return Samples(cmd_t, u, ts, y[keep], segment), windows
 
 
 # ------------------------------------------------------------------------------------------ the fit
-def _grid_start(s: _Samples) -> tuple[float, float, float, float]:
-    """(g, τ, D, b) of the best point of a (τ, D) grid, g and b solved by linear least squares at each."""
-    taus = np.geomspace(0.01, 3.0, 18)
-    delays = np.arange(DEAD_TIME_BOUNDS[0], DEAD_TIME_BOUNDS[1] + 1e-9, 0.02)
-    y = s.y - s.y.mean()
-    sst = float(y @ y)
-    best = (math.inf, 1.0, 0.1, 0.0)
-    dt = np.diff(s.cmd_t)
-    for tau in taus:
-        _, X = _lag_states(dt, s.u, tau)
-        x = np.stack([_lag_at(s.cmd_t, s.u, X, s.t, tau, d)[0] for d in delays])
-        xc = x - x.mean(axis=1, keepdims=True)
-        var = np.einsum("ij,ij->i", xc, xc)
-        cov = xc @ y
-        ssr = sst - np.where(var > 0, cov**2 / np.where(var > 0, var, 1.0), 0.0)
-        k = int(np.argmin(ssr))
-        if ssr[k] < best[0]:
-            best = (float(ssr[k]), float(tau), float(delays[k]), float(cov[k] / var[k]) if var[k] > 0 else 0.0)
-    _, tau, delay, g = best
-    b = float(s.y.mean() - g * lag_response(s.cmd_t, s.u, s.t, tau, delay).mean())
-    return g, tau, delay, b
-
-
-def _residuals_and_jacobian(p, s: _Samples):
-    g, tau, delay, b = p
-    x, dtau, dD = lag_response(s.cmd_t, s.u, s.t, tau, delay, derivatives=True)
-    r = g * x + b - s.y
-    return r, np.column_stack([x, g * dtau, g * dD, np.ones_like(x)])
-
-
-def _least_squares(p0, s: _Samples):
-    from scipy.optimize import least_squares
-
-    lower = [-np.inf, TAU_BOUNDS[0], DEAD_TIME_BOUNDS[0], -np.inf]
-    upper = [np.inf, TAU_BOUNDS[1], DEAD_TIME_BOUNDS[1], np.inf]
-    p0 = np.clip(np.asarray(p0, dtype=float), np.add(lower, 1e-9), np.subtract(upper, 1e-9))
-    cache = {}
-
-    def both(p):
-        key = p.tobytes()
-        if key not in cache:
-            cache.clear()
-            cache[key] = _residuals_and_jacobian(p, s)
-        return cache[key]
-
-    result = least_squares(lambda p: both(p)[0], p0, jac=lambda p: both(p)[1], bounds=(lower, upper), x_scale="jac",
-                           method="trf", xtol=1e-10, ftol=1e-10, gtol=1e-10, max_nfev=200)
-    return result.x
-
-
-def _autocorrelation(r: np.ndarray, segment: np.ndarray, lags: int) -> np.ndarray:
-    """ρ_1..ρ_lags of `r` counting only pairs within one segment."""
-    r = r - r.mean()
-    var = float(r @ r)
-    out = np.zeros(lags)
-    if var <= 0:
-        return out
-    for k in range(1, min(lags, r.size - 1) + 1):
-        same = segment[k:] == segment[:-k]
-        out[k - 1] = float(np.sum((r[k:] * r[:-k])[same])) / var
-    return out
-
-
-def _covariance(J: np.ndarray, r: np.ndarray, segment: np.ndarray) -> tuple[np.ndarray, int, np.ndarray]:
-    """Newey–West covariance of the parameters (module docstring, "Intervals"), its lag L and ρ_1..ρ_L of r."""
-    n = r.size
-    rule = int(math.floor(4.0 * (n / 100.0) ** (2.0 / 9.0)))
-    rho = _autocorrelation(r, segment, 400)
-    below = np.flatnonzero(rho < 0.1)
-    crossing = int(below[0]) + 1 if below.size else rho.size
-    L = int(min(max(rule, 3 * crossing), 400, max(n // 10, 1)))
-    scores = J * r[:, None]
-    S = scores.T @ scores
-    for lag in range(1, L + 1):
-        same = (segment[lag:] == segment[:-lag])[:, None]
-        G = (scores[lag:] * same).T @ scores[:-lag]
-        S += (1.0 - lag / (L + 1.0)) * (G + G.T)
-    H_inv = np.linalg.pinv(J.T @ J)
-    return H_inv @ S @ H_inv, L, rho[:L]
-
-
 def _interval(value: float, variance: float) -> Estimate:
     half = Z95 * math.sqrt(max(variance, 0.0))
     return Estimate(float(value), float(value - half), float(value + half))
 
 
-def fit_plant(cmd_t: np.ndarray, u: np.ndarray, rate: TimeSeries, T: float) -> tuple[PlantFit | None, str | None]:
-    """Fit g·e^(−sD)/(τs + 1) (and an offset) to the rate samples where the command excites the plant.
+def _estimates(names: tuple, p: PlantParameters, cov: np.ndarray) -> dict:
+    """Name → `Estimate` of g, tau, dead_time and, in the model, actuator_lag (τ_a = ρτ, the delta method) and
+    yaw_accel_limit (A = e^(ln A): exp of ln A's interval, positive)."""
+    at = {name: i for i, name in enumerate(names)}
+    out = {"g": _interval(p.g, cov[at["g"], at["g"]]), "tau": _interval(p.tau, cov[at["tau"], at["tau"]]),
+           "dead_time": _interval(p.dead_time, cov[at["D"], at["D"]])}
+    if "rho" in at:
+        grad = np.zeros(len(names))
+        grad[at["rho"]], grad[at["tau"]] = p.tau, p.actuator_lag / p.tau
+        out["actuator_lag"] = _interval(p.actuator_lag, float(grad @ cov @ grad))
+    if "log_slew" in at:
+        half = Z95 * math.sqrt(max(cov[at["log_slew"], at["log_slew"]], 0.0))
+        out["yaw_accel_limit"] = Estimate(p.slew, p.slew * math.exp(-half), p.slew * math.exp(half))
+    return out
+
+
+def _quality(s: Samples, r: np.ndarray, L: int, rho: np.ndarray, windows: np.ndarray, bias: float) -> FitQuality:
+    y = s.y
+    sst = float(np.sum((y - y.mean()) ** 2))
+    ssr = float(r @ r)
+    rho20 = autocorrelation(r, s.segment, 20)
+    outside = float(np.mean(np.abs(rho20) > 1.96 / math.sqrt(r.size)))
+    bartlett = 1.0 + 2.0 * float(np.sum((1.0 - np.arange(1, L + 1) / (L + 1.0)) * rho)) if L else 1.0
+    return FitQuality(
+        nrmse=math.sqrt(ssr / r.size) / max(float(np.std(y)), 1e-300), r2=1.0 - ssr / sst if sst > 0 else math.nan,
+        lag1=float(rho20[0]), outside=outside, white=outside <= 0.2, samples=int(r.size),
+        effective_samples=float(r.size / max(bartlett, 1.0)), windows=int(len(windows)),
+        excited=float(np.sum(windows[:, 1] - windows[:, 0])), bias=float(bias), hac_lags=L)
+
+
+def _first_order(s: Samples) -> PlantParameters:
+    """The first-order plant: a (τ, D) grid on a stretch, least squares there and then on every sample."""
+    start, chunk = grid_start(s.chunk(GRID_SAMPLES)), s.chunk(FIRST_SAMPLES)
+    if chunk is not s:  # a long log: fit a stretch first, then polish on every sample from there
+        start = fit_first_order(start, chunk)
+    g, tau, delay, b = fit_first_order(start, s)
+    return PlantParameters(g, tau, 0.0, delay, math.inf, b)
+
+
+def _which_plant(s: Samples, first: PlantParameters, frequency: float) -> tuple[str, PlantParameters, tuple]:
+    """(the selected model, its plant fitted to every sample, every candidate) (`analysis.plant_fit.candidates`)."""
+    chunk = s.chunk(SELECT_SAMPLES)
+    fits = candidates(chunk, first, _measured_acceleration(s), frequency)
+    chosen = next(c for c in fits if c.selected)
+    if chosen.model == "first_order":
+        return chosen.model, first, fits
+    p = chosen.parameters if chunk is s else fit_model(chosen.model, chosen.parameters, s, max_nfev=20, frequency=frequency)
+    return chosen.model, p, fits
+
+
+def fit_plant(cmd_t: np.ndarray, u: np.ndarray, rate: TimeSeries, T: float,
+              smoothing_frequency: float = SMOOTHING_FREQUENCY) -> tuple[PlantFit | None, str | None]:
+    """Fit the plant the data support (first order, a second lag, a slew limit; `analysis.plant_fit`) to the rate samples
+    where the command excites the plant.
 
     Parameters
     ----------
@@ -614,6 +543,8 @@ def fit_plant(cmd_t: np.ndarray, u: np.ndarray, rate: TimeSeries, T: float) -> t
         The achieved yaw rate (rad/s) and its times (s).
     T : float
         The controller's period (s): a sample whose newest command is older than max(0.5 s, `STALE`·T) is left out.
+    smoothing_frequency : float
+        The rate (Hz) of the smoother a slew limit is fitted as (Nav2's default 20); 0: a continuous ramp.
 
     Returns
     -------
@@ -621,6 +552,7 @@ def fit_plant(cmd_t: np.ndarray, u: np.ndarray, rate: TimeSeries, T: float) -> t
         (the fit, None), or (None, why nothing was identified).
     """
     cmd_t, u = np.asarray(cmd_t, dtype=float), np.asarray(u, dtype=float)
+    f = float(smoothing_frequency)
     if np.ptp(u) <= 1e-3:
         what = "stand still" if np.all(np.abs(u) <= 1e-3) else f"turn at a constant {float(np.median(u)):.3g} rad/s"
         return None, f"the command never changes (the robot was told to {what}): nothing excites the plant"
@@ -628,69 +560,52 @@ def fit_plant(cmd_t: np.ndarray, u: np.ndarray, rate: TimeSeries, T: float) -> t
     if s.t.size < 50:
         return None, (f"only {s.t.size} samples of the rate while the command changes (at least 50 are needed): "
                       "the log is too short or the rate topic is too sparse")
-    start, chunk = _grid_start(s.chunk(GRID_SAMPLES)), s.chunk(FIRST_SAMPLES)
-    if chunk is not s:  # a long log: fit a stretch first, then polish on every sample from there
-        start = _least_squares(start, chunk)
-    g, tau, delay, b = _least_squares(start, s)
-    r, J = _residuals_and_jacobian((g, tau, delay, b), s)
-    cov, L, rho = _covariance(J, r, s.segment)
-    estimates = [_interval(v, cov[i, i]) for i, v in enumerate((g, tau, delay))]
-    g_est = estimates[0]
+    first = _first_order(s)
+    excitation = excitation_of(cmd_t, u, T, first.g, first.tau, first.dead_time)
+    model, p, fits = ("first_order", first, ()) if excitation.narrowband else _which_plant(s, first, f)
+    r = residuals(model, p, s, f)
+    J, names = jacobian(model, p, s, f)
+    cov, L, rho = covariance(J, r, s.segment)
+    estimates = _estimates(names, p, cov)
+    g, g_est = p.g, estimates["g"]
     if abs(g) < 0.05 or g_est.low <= 0.0 <= g_est.high:
         return None, (f"the robot did not follow the commands (g = {g:.3g}, 95 % interval {g_est.low:.3g} to {g_est.high:.3g}): "
                       "it stood still (stopped, emergency stop) or the rate topic is not this robot's")
     if g_est.high - g_est.low > abs(g):
         return None, (f"the commands excite the plant too little for the noise (g = {g:.3g} ± {(g_est.high - g_est.low) / 2:.2g}): "
                       "record steps or turns of the yaw rate (docs/diagnose.md)")
-    y = s.y
-    sst = float(np.sum((y - y.mean()) ** 2))
-    ssr = float(r @ r)
-    rho20 = _autocorrelation(r, s.segment, 20)
-    outside = float(np.mean(np.abs(rho20) > 1.96 / math.sqrt(r.size)))
-    bartlett = 1.0 + 2.0 * float(np.sum((1.0 - np.arange(1, L + 1) / (L + 1.0)) * rho)) if L else 1.0
-    quality = FitQuality(
-        nrmse=math.sqrt(ssr / r.size) / max(float(np.std(y)), 1e-300), r2=1.0 - ssr / sst if sst > 0 else math.nan,
-        lag1=float(rho20[0]), outside=outside, white=outside <= 0.2, samples=int(r.size),
-        effective_samples=float(r.size / max(bartlett, 1.0)), windows=int(len(windows)),
-        excited=float(np.sum(windows[:, 1] - windows[:, 0])), bias=float(b), hac_lags=L)
-    excitation = excitation_of(cmd_t, u, T, g, tau, delay)
-    warnings = _checks(s, (g, tau, delay, b), estimates, quality, excitation.narrowband)
+    quality = _quality(s, r, L, rho, windows, p.bias)
+    warnings = _checks(s, model, p, first, estimates, quality, excitation.narrowband)
     if excitation.narrowband:  # one frequency: the fit is one point of a ridge, its intervals mean nothing
         warnings.insert(0, FitWarning("narrowband", (
             f"the commands excite one frequency (ω ≈ {excitation.omega:.3g} rad/s; {100 * (1 - excitation.outside):.1f} % "
             f"of their power within a factor {BAND:g} of it): g, τ and D are not separately identifiable, only the plant's "
             f"gain {excitation.gain:.3g} and phase {math.degrees(excitation.phase):.0f}° there; record step turns "
             "(docs/diagnose.md)")))
-        estimates = [Estimate(e.value, math.nan, math.nan) for e in estimates]
-    return PlantFit(estimates[0], estimates[1], estimates[2], quality, tuple(warnings), excitation), None
+        estimates = {name: Estimate(e.value, math.nan, math.nan) for name, e in estimates.items()}
+    smoother = SmootherFit(f, p.phase, mean_wait(cmd_t, f, p.phase)) if math.isfinite(p.slew) and f > 0 else None
+    return PlantFit(estimates["g"], estimates["tau"], estimates["dead_time"], quality, tuple(warnings), excitation,
+                    estimates.get("actuator_lag"), estimates.get("yaw_accel_limit"), model, fits, smoother), None
 
 
 # ------------------------------------------------------------------------------------------ what the model misses
-def _checks(s: _Samples, p, estimates, quality: FitQuality, narrowband: bool = False) -> list[FitWarning]:
-    g, tau, delay, b = p
+def _checks(s: Samples, model: str, p: PlantParameters, first: PlantParameters, estimates: dict, quality: FitQuality,
+            narrowband: bool = False) -> list[FitWarning]:
     warnings = []
     if quality.r2 < 0.8:
         warnings.append(FitWarning("poor_fit", f"the model explains only {100 * quality.r2:.0f} % of the rate's variance "
                                                f"(NRMSE {quality.nrmse:.2f}): its numbers are rough"))
-    if delay >= DEAD_TIME_BOUNDS[1] - 1e-3:
+    if p.dead_time >= DEAD_TIME_BOUNDS[1] - 1e-3:
         warnings.append(FitWarning("dead_time_at_bound", f"the dead time reached the largest searched, {DEAD_TIME_BOUNDS[1]:g} s: "
                                                          "the command and rate topics may not belong together"))
-    if estimates[2].high < 0 and not narrowband:  # on a ridge a negative D is where the fit stopped, not the clocks
-        warnings.append(FitWarning("negative_dead_time", f"the rate leads the command by {-1000 * delay:.0f} ms: "
+    if estimates["dead_time"].high < 0 and not narrowband:  # on a ridge a negative D is where the fit stopped, not the clocks
+        warnings.append(FitWarning("negative_dead_time", f"the rate leads the command by {-1000 * p.dead_time:.0f} ms: "
                                                          "their stamps come from different clocks"))
-    limit = _rate_limit(s, p)
-    if limit is not None:
+    limit = None if math.isfinite(p.slew) or narrowband else _rate_limit(s, first)
+    if limit is not None:  # the data saturate where the selected plant does not
         warnings.append(FitWarning("rate_limit", f"the yaw acceleration saturates near {limit:.2g} rad/s² where the model "
-                                                 f"asks for more: a rate limit the lag does not explain"))
-    c = s.chunk(CHECK_SAMPLES)
-    base = g * lag_response(c.cmd_t, c.u, c.t, tau, delay) + b - c.y
-    ssr = float(base @ base)
-    second = None if limit is not None else _better_second_order(c, p, ssr)  # a rate limit also makes a second lag fit better
-    if second is not None:
-        ratio, gain = second
-        warnings.append(FitWarning("second_order", f"a second lag of {ratio * tau:.2g} s (with the first {tau:.2g} s) "
-                                                   f"lowers the residual by {100 * gain:.0f} %: the plant is not first order"))
-    band = _better_deadband(c, p, ssr)
+                                                 f"asks for more: a rate limit the selected plant does not explain"))
+    band = _better_deadband(s.chunk(CHECK_SAMPLES), first)
     if band is not None:
         width, gain = band
         warnings.append(FitWarning("deadband", f"small commands are under-delivered: a deadband (or backlash) of {width:.2g} rad/s "
@@ -698,47 +613,43 @@ def _checks(s: _Samples, p, estimates, quality: FitQuality, narrowband: bool = F
     return warnings
 
 
-def _refit(model, starts, lower, upper, c: _Samples) -> tuple[float, np.ndarray]:
-    """(residual sum of squares, parameters) of the best fit of `model(p)` to c.y from each of `starts` (bounded)."""
+def _better_deadband(c: Samples, p: PlantParameters):
+    """(deadband rad/s, relative improvement) when a deadband on the first-order plant's command lowers the residual sum
+    of squares by `BETTER`, else None (refitted on a stretch)."""
     from scipy.optimize import least_squares
 
-    best = (math.inf, np.asarray(starts[0], dtype=float))
-    for start in starts:
-        start = np.clip(np.asarray(start, dtype=float), np.add(lower, 1e-9), np.subtract(upper, 1e-9))
-        result = least_squares(lambda q: model(q) - c.y, start, bounds=(lower, upper), x_scale="jac", max_nfev=40)
-        if 2.0 * result.cost < best[0]:
-            best = (2.0 * float(result.cost), result.x)
-    return best
-
-
-def _better_second_order(c: _Samples, p, ssr: float):
-    """(τ2/τ1, relative improvement) when a second lag lowers the residual by `BETTER` or more, else None."""
-    g, tau, delay, b = p
-    model = lambda q: q[0] * _second_order(c.cmd_t, c.u, c.t, q[1], q[2], q[3]) + q[4]
-    lower = [-np.inf, TAU_BOUNDS[0], 0.02, DEAD_TIME_BOUNDS[0], -np.inf]
-    upper = [np.inf, TAU_BOUNDS[1], 0.9, DEAD_TIME_BOUNDS[1], np.inf]
-    starts = [[g, tau / (1.0 + ratio), ratio, max(delay - 0.5 * ratio * tau, DEAD_TIME_BOUNDS[0]), b] for ratio in (0.3,)]
-    fitted, q = _refit(model, starts, lower, upper, c)
-    gain = 1.0 - fitted / ssr if ssr > 0 else 0.0
-    return (float(q[2]), gain) if gain >= BETTER else None
-
-
-def _better_deadband(c: _Samples, p, ssr: float):
-    """(deadband rad/s, relative improvement) when a deadband on the command lowers the residual by `BETTER`, else None."""
-    g, tau, delay, b = p
     top = float(np.max(np.abs(c.u)))
     if top <= 0:
         return None
-    model = lambda q: q[0] * lag_response(c.cmd_t, _deadband(c.u, q[4]), c.t, q[1], q[2]) + q[3]
+    base = p.g * lag_response(c.cmd_t, c.u, c.t, p.tau, p.dead_time) + p.bias - c.y
+    ssr = float(base @ base)
+    model = lambda q: q[0] * lag_response(c.cmd_t, _deadband(c.u, q[4]), c.t, q[1], q[2]) + q[3]  # noqa: E731
     lower = [-np.inf, TAU_BOUNDS[0], DEAD_TIME_BOUNDS[0], -np.inf, 0.0]
     upper = [np.inf, TAU_BOUNDS[1], DEAD_TIME_BOUNDS[1], np.inf, 0.5 * top]
-    starts = [[g / (1.0 - width), tau, delay, b, width * top] for width in (0.1,)]
-    fitted, q = _refit(model, starts, lower, upper, c)
-    gain = 1.0 - fitted / ssr if ssr > 0 else 0.0
-    return (float(q[4]), gain) if gain >= BETTER else None
+    start = np.clip([p.g / 0.9, p.tau, p.dead_time, p.bias, 0.1 * top], np.add(lower, 1e-9), np.subtract(upper, 1e-9))
+    result = least_squares(lambda q: model(q) - c.y, start, bounds=(lower, upper), x_scale="jac", max_nfev=40)
+    gain = 1.0 - 2.0 * result.cost / ssr if ssr > 0 else 0.0
+    return (float(result.x[4]), gain) if gain >= BETTER else None
 
 
-def _rate_limit(s: _Samples, p) -> float | None:
+def _slopes(s: Samples, y: np.ndarray) -> np.ndarray:
+    """|dy/dt| by the central difference over ±h samples (h·dt ≈ 40 ms) within one window, rad/s²."""
+    dt = float(np.median(np.diff(s.t)))
+    h = max(1, int(round(0.04 / dt)))
+    if s.t.size <= 2 * h:
+        return np.zeros(0)
+    span = s.t[2 * h:] - s.t[:-2 * h]
+    ok = (s.segment[2 * h:] == s.segment[:-2 * h]) & (span <= 2 * h * dt * 1.5) & (span > 0)
+    return np.abs((y[2 * h:] - y[:-2 * h]) / np.where(ok, span, 1.0))[ok]
+
+
+def _measured_acceleration(s: Samples) -> float:
+    """The measured yaw acceleration's 99th percentile (rad/s²): where a slew limit's fit starts."""
+    slopes = _slopes(s, s.y)
+    return float(np.percentile(slopes, 99)) if slopes.size else 1.0
+
+
+def _rate_limit(s: Samples, p: PlantParameters) -> float | None:
     """The measured |dω/dt| where it saturates, or None.
 
     The same central difference over ±h samples (h·dt ≈ 40 ms) is applied to the measured rate and to the model's;
@@ -747,16 +658,10 @@ def _rate_limit(s: _Samples, p) -> float | None:
     model's, over the upper half of the samples steeper than a quarter of the model's 99th percentile, is below 0.25
     (1 for a linear plant; a second lag gives 0.4–0.8). A log with one step size cannot show it.
     """
-    g, tau, delay, b = p
     if s.t.size < 200:
         return None
-    dt = float(np.median(np.diff(s.t)))
-    h = max(1, int(round(0.04 / dt)))
-    model = g * lag_response(s.cmd_t, s.u, s.t, tau, delay) + b
-    span = s.t[2 * h:] - s.t[:-2 * h]
-    ok = (s.segment[2 * h:] == s.segment[:-2 * h]) & (span <= 2 * h * dt * 1.5) & (span > 0)
-    measured = np.abs((s.y[2 * h:] - s.y[:-2 * h]) / np.where(ok, span, 1.0))[ok]
-    predicted = np.abs((model[2 * h:] - model[:-2 * h]) / np.where(ok, span, 1.0))[ok]
+    measured = _slopes(s, s.y)
+    predicted = _slopes(s, p.g * lag_response(s.cmd_t, s.u, s.t, p.tau, p.dead_time) + p.bias)
     if predicted.size < 200:
         return None
     top = predicted >= np.percentile(predicted, 98)
@@ -777,7 +682,7 @@ def _rate_limit(s: _Samples, p) -> float | None:
 
 
 # ------------------------------------------------------------------------------------------ the whole
-def identify(log: LogData, rate_source: str = "odometry") -> Identification:
+def identify(log: LogData, rate_source: str = "odometry", smoothing_frequency: float = SMOOTHING_FREQUENCY) -> Identification:
     """The controller's timing and the yaw-rate plant identified from `log`.
 
     Parameters
@@ -786,6 +691,8 @@ def identify(log: LogData, rate_source: str = "odometry") -> Identification:
         A log read with the command and the rate source (`pfm_stability.io.logs.read_log`).
     rate_source : str
         ``"odometry"`` or ``"imu"`` (`RATE_SOURCES`): where the achieved yaw rate comes from.
+    smoothing_frequency : float
+        The rate (Hz) of the velocity smoother a slew limit is fitted as (Nav2's default 20); 0: a continuous ramp.
 
     Returns
     -------
@@ -804,5 +711,7 @@ def identify(log: LogData, rate_source: str = "odometry") -> Identification:
     command = log.command
     timing = controller_timing(command.t)
     summary = LogSummary(log.path, log.format, float(log.duration), command.topic, rate.topic, rate_source, command.stamps)
-    plant, reason = fit_plant(command.t, command.value, rate, timing.T)
+    if not (math.isfinite(smoothing_frequency) and 0.0 <= smoothing_frequency <= 1000.0):
+        raise ValueError(f"smoothing frequency must be in [0, 1000] Hz (0: a continuous ramp); got {smoothing_frequency!r}")
+    plant, reason = fit_plant(command.t, command.value, rate, timing.T, smoothing_frequency)
     return Identification(plant is not None, reason, timing, plant, summary)

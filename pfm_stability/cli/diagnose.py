@@ -21,6 +21,7 @@ diagnose" and why); a bad log or a missing parameter is one line, exit 2.
 
 from __future__ import annotations
 
+import math
 import time
 
 from .identify import FORMATS, add_topic_options
@@ -91,9 +92,8 @@ def run(args) -> int:
         The parsed command line.
     """
     from ..analysis.identification import identify
-    from ..analysis.stretches import wall_lines_batch
     from ..extras import require
-    from ..io.logs import LogTopics, log_format, read_log
+    from ..io.logs import LogTopics, log_format
     from ..io.serialize import SCHEMA_VERSION, dumps
     from ..validation.diagnose import complete_from_log, diagnose, missing_parameters, needs_identification
     from .options import resolve_parameters, typed
@@ -115,7 +115,7 @@ def run(args) -> int:
     to_identify = needs_identification(params.sources)
     topics = LogTopics(command=args.cmd_topic, odometry=args.odom_topic, scan=args.scan_topic)
     need = ("command", "odometry", "pose", "scan") if to_identify else ("pose", "scan")
-    log = read_log(args.log, topics, need=need, scan_reducer=wall_lines_batch, scan_batch=SCAN_BATCH)
+    log = _read(args.log, topics, need, want_commands=not to_identify and math.isfinite(params.robot.yaw_accel_limit))
     identification = identify(log, "odometry") if to_identify else None
     robot, controller, sources = complete_from_log(params.robot, params.controller, params.sources, identification)
     result = diagnose(log, robot, controller, law=_law(law, robot, controller))
@@ -137,6 +137,21 @@ def run(args) -> int:
     return 0
 
 
+def _read(path, topics, need, *, want_commands: bool):
+    """The log with `need`, and its commands too when `want_commands` and the log has them (a slew limit given in the
+    configuration is set against them: `validation.diagnose.Limiter`)."""
+    from ..analysis.stretches import wall_lines_batch
+    from ..io.logs import LogError, read_log
+
+    if want_commands:
+        try:
+            return read_log(path, topics, need=("command", *need), scan_reducer=wall_lines_batch, scan_batch=SCAN_BATCH)
+        except LogError as exc:
+            if f"command topic {topics.command}" not in str(exc):
+                raise
+    return read_log(path, topics, need=need, scan_reducer=wall_lines_batch, scan_batch=SCAN_BATCH)
+
+
 def parameters_table(result, sources: dict) -> dict:
     """Parameter → {value, unit, source} of the robot and controller predicted with (V: the judged stretch's).
 
@@ -150,8 +165,13 @@ def parameters_table(result, sources: dict) -> dict:
     from ..parameters import RANGES
 
     r, c = result.robot, result.controller
-    values = {"V": r.V, "tau": r.tau, "dead_time": r.dead_time, "plant_gain": r.plant_gain, "k": r.k, "W": r.W, "T": c.T, "f": c.f, "n": c.n, "hold": c.hold, "compute_delay": c.compute_delay}
-    return {name: {"value": value, "unit": RANGES[name].unit if name in RANGES else "", "source": sources.get(name, "")}
+    values = {"V": r.V, "tau": r.tau, "dead_time": r.dead_time, "plant_gain": r.plant_gain, "actuator_lag": r.actuator_lag,
+              "yaw_accel_limit": r.yaw_accel_limit, "k": r.k, "W": r.W, "T": c.T, "f": c.f, "n": c.n, "hold": c.hold,
+              "compute_delay": c.compute_delay}
+    from ..io.serialize import json_number
+
+    return {name: {"value": json_number(value) if isinstance(value, float) else value,
+                   "unit": RANGES[name].unit if name in RANGES else "", "source": sources.get(name, "")}
             for name, value in values.items()}
 
 
@@ -174,8 +194,19 @@ def _where(s) -> str:
 def _measured(m) -> str:
     if m.sigma is None:
         return f"no oscillation (the offset settles; largest swing {_num(m.amplitude, '.3g', 'm')})"
-    return (f"ω = {_num(m.omega, '.3f', 'rad/s')}, σ = {m.sigma:+.3g} 1/s, amplitude {_num(m.amplitude, '.3g', 'm')} "
-            f"({'growing' if m.sigma > 0 else 'decaying'}; {m.turning_points} turning points, {m.method})")
+    return (f"ω = {_num(m.omega, '.3f', 'rad/s')}{_omega_interval(m.frequency)}, σ = {m.sigma:+.3g} 1/s, "
+            f"amplitude {_num(m.amplitude, '.3g', 'm')} ({'growing' if m.sigma > 0 else 'decaying'}; "
+            f"{m.turning_points} turning points, {m.method})")
+
+
+def _omega_interval(f) -> str:
+    """ω's 95 % interval and the periods it rests on, or why it has none (`analysis.frequency`)."""
+    if f is None or f.omega is None:
+        return " (no zero crossings to time: the estimator's turning points)"
+    dropped = f", {f.dropped} transient crossing{'s' if f.dropped != 1 else ''} dropped" if f.dropped else ""
+    if f.few_periods:
+        return f" (too few periods for an interval: {f.periods:.1f} established{dropped})"
+    return f" [{_num(f.low, '.3f')} to {_num(f.high, '.3f')}] over {f.periods:.1f} periods{dropped}"
 
 
 def _rows(s) -> list[tuple]:
@@ -208,6 +239,8 @@ def render_text(result, sources: dict, info: dict) -> str:
         The log's path, format, duration and topics.
     """
     out = [f"log: {info['path']} ({info['format']}, {info['duration']:.1f} s)", f"verdict: {result.verdict} — {result.reason}", ""]
+    if result.limiter is not None:
+        out[-1:-1] = [f"slew limit: {result.limiter.note}"]
     table = parameters_table(result, sources)
     out.append("parameters: " + ", ".join(f"{k} = {_num(v['value'], '.4g') if isinstance(v['value'], float) else v['value']}"
                                            f" ({v['source']})" for k, v in table.items()))
@@ -239,7 +272,10 @@ def render_markdown(result, sources: dict, info: dict) -> str:
         The log's path, format, duration and topics.
     """
     out = ["## Diagnosis from the log", "", f"Log: {info['path']} ({info['format']}, {info['duration']:.1f} s).", "",
-           f"**Verdict: {result.verdict}** — {result.reason}.", "", "| parameter | value | source |", "| --- | --- | --- |"]
+           f"**Verdict: {result.verdict}** — {result.reason}.", ""]
+    if result.limiter is not None:
+        out += [f"Slew limit: {result.limiter.note}.", ""]
+    out += ["| parameter | value | source |", "| --- | --- | --- |"]
     for name, v in parameters_table(result, sources).items():
         value = _num(v["value"], ".4g") if isinstance(v["value"], float) else v["value"]
         out.append(f"| {name} | {value} {v['unit']} | {v['source']} |")

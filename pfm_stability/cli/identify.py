@@ -5,12 +5,14 @@
 
 LOG is a ROS 2 bag (its directory, or a ``.db3``/``.mcap`` file), a ROS 1 ``.bag`` or a CSV
 (docs/diagnose.md, "Logs"). The commanded yaw rate (``/cmd_vel``) against the achieved one (the
-odometry's, or the IMU's with ``--rate-source imu``) gives the plant g·e^(−sD)/(τs + 1) with 95 %
-intervals; the command's stamps give the controller's period T, its jitter and missed cycles
+odometry's, or the IMU's with ``--rate-source imu``) gives the plant the data support — g·e^(−sD)/(τs + 1), a second
+lag τ_a, a slew limit A on the command (`pfm_stability.analysis.plant_fit`: the smallest BIC of the four, with each
+one's Ljung–Box whiteness) — with 95 % intervals; the command's stamps give the controller's period T, its jitter and missed cycles
 (`pfm_stability.analysis.identification`). JSON keys (`pfm_stability/io/schema/output.schema.json`):
-``schema_version``, ``command`` ("identify"), ``identified``, ``reason``, ``plant`` (``g``, ``tau``,
-``dead_time``, each ``{value, low, high}``, and ``identifiable``), ``controller`` (``T``, ``jitter``, ``missed``,
-…), ``fit`` (``quality``, ``warnings``, ``excitation``), ``log`` (path, format, duration, topics), ``timing``.
+``schema_version``, ``command`` ("identify"), ``identified``, ``reason``, ``plant`` (``model``, ``g``, ``tau``,
+``dead_time``, ``actuator_lag``, ``yaw_accel_limit``, each ``{value, low, high}`` or null, and ``identifiable``),
+``controller`` (``T``, ``jitter``, ``missed``, …), ``fit`` (``quality``, ``warnings``, ``excitation``, ``models``), ``log``
+(path, format, duration, topics), ``timing``.
 
 A log that shows nothing to identify (the command never changes, the robot does not move) is an
 answer, not an error: exit 0 with ``identified`` false and the reason (the controller's period is
@@ -91,13 +93,15 @@ def add_parser(sub) -> None:
     p = sub.add_parser(
         "identify",
         help="identify the steering plant (gain, lag, dead time) and the controller's period from a robot's log",
-        description="Read a ROS 2 bag (directory, .db3 or .mcap), a ROS 1 .bag or a CSV; fit the yaw-rate plant "
-        "g*exp(-sD)/(tau*s + 1) to the commanded and achieved yaw rates, with 95%% intervals, and measure the "
+        description="Read a ROS 2 bag (directory, .db3 or .mcap), a ROS 1 .bag or a CSV; fit the yaw-rate plant the data "
+        "support (g*exp(-sD)/(tau*s + 1), a second lag tau_a, a slew limit on the command: the smallest BIC) to the "
+        "commanded and achieved yaw rates, with 95%% intervals, and measure the "
         "controller's period T, its jitter and missed cycles from the command's stamps (docs/diagnose.md).",
     )
     p.add_argument("log", metavar="LOG", help="a ROS 2 bag directory, a .db3 or .mcap file, a ROS 1 .bag, or a .csv")
     p.add_argument("--out", type=output_path("out", ".yaml"), metavar="ROBOT.yaml",
-                   help="write the identified tau, dead_time, plant_gain and T as a configuration file (docs/config.md)")
+                   help="write the identified tau, dead_time, plant_gain (actuator_lag, yaw_accel_limit when the data show them) "
+                   "and T as a configuration file (docs/config.md)")
     p.add_argument("--format", choices=FORMATS, default="text")
     add_topic_options(p, ("cmd", "odom", "imu"))
     p.add_argument("--rate-source", choices=("odometry", "imu"), default="odometry",
@@ -161,14 +165,37 @@ def _lines(result) -> dict:
     }
 
 
+_MODEL_NAMES = {"first_order": "g·e^(−sD)/(τs + 1)", "two_lags": "g·e^(−sD)/((τs + 1)(τ_a·s + 1))",
+                "slew_limited": "g·e^(−sD)/(τs + 1) behind a slew limit A on the command",
+                "two_lags_slew_limited": "g·e^(−sD)/((τs + 1)(τ_a·s + 1)) behind a slew limit A on the command"}
+"""The plant of each model (`analysis.plant_fit.PLANT_MODELS`), as the renderings name it."""
+
+
 def _plant_rows(plant) -> list[tuple[str, str, str]]:
-    g, tau, D = plant.g, plant.tau, plant.dead_time
+    rows = [("g (plant gain)", plant.g, f"{plant.g.value:.4g}", lambda v: f"{v:.4g}"),
+            ("τ (lag)", plant.tau, f"{plant.tau.value:.4g} s", lambda v: f"{v:.4g} s"),
+            ("D (dead time)", plant.dead_time, _ms(plant.dead_time.value), _ms)]
+    if plant.actuator_lag is not None:
+        rows.append(("τ_a (second lag)", plant.actuator_lag, f"{plant.actuator_lag.value:.4g} s", lambda v: f"{v:.4g} s"))
+    if plant.yaw_accel_limit is not None:
+        rows.append(("A (slew limit)", plant.yaw_accel_limit, f"{plant.yaw_accel_limit.value:.4g} rad/s²",
+                     lambda v: f"{v:.4g} rad/s²"))
+    if plant.smoother is not None:
+        sm = plant.smoother
+        rows.append((f"smoother {sm.frequency:g} Hz", None, f"wait {_ms(sm.mean_wait)}", None))
     if not plant.identifiable:  # one point of the ridge: no interval means anything
-        return [(name, value, "not identifiable") for name, value in
-                (("g (plant gain)", f"{g.value:.4g}"), ("τ (lag)", f"{tau.value:.4g} s"), ("D (dead time)", _ms(D.value)))]
-    return [("g (plant gain)", f"{g.value:.4g}", f"{g.low:.4g} to {g.high:.4g}"),
-            ("τ (lag)", f"{tau.value:.4g} s", f"{tau.low:.4g} to {tau.high:.4g} s"),
-            ("D (dead time)", _ms(D.value), f"{_ms(D.low)} to {_ms(D.high)}")]
+        return [(name, value, "not identifiable") for name, _, value, _ in rows]
+    return [(name, value, f"{unit(e.low)} to {unit(e.high)}" if e is not None else "the mean wait of a command for its tick: "
+             f"the loop's dead time is D + wait = {_ms(plant.loop_dead_time)}") for name, e, value, unit in rows]
+
+
+def _models(plant) -> list[str]:
+    """One line per candidate plant: its BIC against the selected one's, its residuals' whiteness (Ljung–Box)."""
+    if not plant.models:
+        return []
+    best = next(m for m in plant.models if m.selected).bic
+    return [f"{m.model:22s} ΔBIC {m.bic - best:+10.1f}   Ljung–Box p {m.ljung_box_p:.3g}{'   selected' if m.selected else ''}"
+            for m in plant.models]
 
 
 def _ridge(plant) -> list[str]:
@@ -201,9 +228,12 @@ def render_text(result) -> str:
     if not result.identified:
         return "\n".join(out + [f"plant: not identified — {result.reason}", ""])
     plant = result.plant
-    out.append("plant g·e^(−sD)/(τs + 1), 95 % intervals")
-    out += [f"  {name:15s} {value:>10s}   [{interval}]" for name, value, interval in _plant_rows(plant)]
+    out.append(f"plant {_MODEL_NAMES[plant.model]}, 95 % intervals")
+    out += [f"  {name:17s} {value:>14s}   [{interval}]" for name, value, interval in _plant_rows(plant)]
     out += [f"  {line}" for line in _ridge(plant)]
+    if plant.models:
+        out += ["", f"which plant (the same {plant.models[0].samples} samples; the smallest BIC is selected):"]
+        out += [f"  {line}" for line in _models(plant)]
     out += ["", f"fit: {_quality(plant.quality)}"]
     out += [f"warning ({w.kind}): {w.message}" for w in plant.warnings] or ["warnings: none"]
     return "\n".join(out + [""])
@@ -223,16 +253,21 @@ def render_markdown(result) -> str:
     if not result.identified:
         return "\n".join(out + [f"**Plant not identified:** {result.reason}.", ""])
     plant = result.plant
-    out += ["| plant g·e^(−sD)/(τs + 1) | value | 95 % interval |", "| --- | --- | --- |"]
+    out += [f"| plant {_MODEL_NAMES[plant.model]} | value | 95 % interval |", "| --- | --- | --- |"]
     out += [f"| {name} | {value} | {interval} |" for name, value, interval in _plant_rows(plant)]
     out += [f"\n{line[0].upper()}{line[1:]}." for line in _ridge(plant)]
+    if plant.models:
+        best = next(m for m in plant.models if m.selected).bic
+        out += ["", "| candidate | ΔBIC | Ljung–Box p | |", "| --- | --- | --- | --- |"]
+        out += [f"| {m.model} | {m.bic - best:+.1f} | {m.ljung_box_p:.3g} | {'selected' if m.selected else ''} |" for m in plant.models]
     out += ["", f"Fit: {_quality(plant.quality)}.", ""]
     out += [f"- **{w.kind}**: {w.message}" for w in plant.warnings] or ["No warnings: the model explains the data."]
     return "\n".join(out + [""])
 
 
 def robot_yaml(result) -> str:
-    """The configuration file ``--out`` writes: ``robot: {tau, dead_time, plant_gain}``, ``controller: {T}``, commented.
+    """The configuration file ``--out`` writes: ``robot: {tau, dead_time, plant_gain}`` (and ``actuator_lag``,
+    ``yaw_accel_limit`` when the selected plant has them), ``controller: {T}``, commented.
 
     Parameters
     ----------
@@ -241,7 +276,8 @@ def robot_yaml(result) -> str:
     """
     plant, c, log = result.plant, result.controller, result.log
     name = os.path.basename(os.path.normpath(log.path))
-    D = max(plant.dead_time.value, 0.0)
+    D = max(plant.loop_dead_time, 0.0)
+    wait = "" if plant.smoother is None else f"; with the smoother's mean wait of {1000 * plant.smoother.mean_wait:.1f} ms"
     lines = [
         f"# Identified by `pfm-stability identify` from {name} ({log.duration:.0f} s;",
         f"# command {log.command_topic}, rate {log.rate_topic}). 95 % intervals in the comments.",
@@ -249,9 +285,18 @@ def robot_yaml(result) -> str:
         "# and the law (docs/config.md) before using it with `pfm-stability report --config`.",
         "robot:",
         f"  tau: {plant.tau.value:.6g}          # s, steering lag, identified from {name} ({plant.tau.low:.4g} to {plant.tau.high:.4g})",
-        f"  dead_time: {D:.6g}    # s, identified from {name} ({plant.dead_time.low:.4g} to {plant.dead_time.high:.4g})",
+        f"  dead_time: {D:.6g}    # s, identified from {name} ({plant.dead_time.low:.4g} to {plant.dead_time.high:.4g}{wait})",
         f"  plant_gain: {plant.g.value:.6g}   # -, achieved/commanded yaw rate, identified from {name} "
         f"({plant.g.low:.4g} to {plant.g.high:.4g})",
+    ]
+    if plant.actuator_lag is not None:
+        e = plant.actuator_lag
+        lines.append(f"  actuator_lag: {e.value:.6g}   # s, second lag of the drive, identified from {name} ({e.low:.4g} to {e.high:.4g})")
+    if plant.yaw_accel_limit is not None:
+        e = plant.yaw_accel_limit
+        lines.append(f"  yaw_accel_limit: {e.value:.6g}   # rad/s^2, slew limit on the commanded yaw rate, identified from {name} "
+                     f"({e.low:.4g} to {e.high:.4g})")
+    lines += [
         "controller:",
         f"  T: {c.T:.6g}            # s, median period of {log.command_topic} in {name} "
         f"(jitter {1000 * c.p5:.1f} to {1000 * c.p95:.1f} ms, {c.missed} missed)",

@@ -10,7 +10,8 @@ model: the engine must not agree with the predictions by construction. MuJoCo is
 
 __all__ = ["ROBOT_MODELS", "ENGINES"]
 
-ROBOT_MODELS = {"diffdrive": "diffdrive.xml", "diffdrive-heavy": "diffdrive_heavy.xml"}
+ROBOT_MODELS = {"diffdrive": "diffdrive.xml", "diffdrive-heavy": "diffdrive_heavy.xml", "diffdrive-filtered": "diffdrive_filtered.xml",
+                "skid-steer": "skidsteer.xml"}
 """The shipped robots: name → file under ``pfm_stability/data/robots`` (numpy-free, for the command line)."""
 
 ENGINES = ("sim", "mujoco")

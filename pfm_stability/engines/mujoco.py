@@ -35,7 +35,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -46,6 +46,7 @@ from ..sim.metrics import oscillation_metrics
 from ..sim.results import BatchResult, RunResult, Trajectory
 from ..sim.vff import cell_repulsion, direction_of, steering_command, wrap_angle
 from ..controllers import CONTROLLER_NAMES
+from .command_path import CommandPath, Timing, VelocitySmoother
 from .robots import WALL_GROUP, check_drives, corridor_world, heading, load_robot_model, place
 
 __all__ = ["EngineOptions", "run_scenario", "run_scenarios", "MujocoRuns", "DriveLog", "drive_log", "write_csv_log",
@@ -85,6 +86,10 @@ class EngineOptions:
         `pfm_stability.controllers` (``rpp``, ``graceful``, ``mppi``, ``dwb``; `_Nav2Driver`).
     controller_params : dataclass, optional
         The Nav2 controller's parameters (default Nav2's); its speed and period are set from the scenario's V and T.
+    smoother : VelocitySmoother, optional
+        Nav2's velocity smoother between the controller and the base (`engines.command_path`); None: none.
+    timing : Timing
+        The controller's period jitter and the odometry's rate and jitter (`engines.command_path.Timing`).
     """
 
     robot_model: str = "diffdrive"
@@ -96,6 +101,8 @@ class EngineOptions:
     torque_limit: float | None = None
     controller: str = "vff"
     controller_params: object = None
+    smoother: VelocitySmoother | None = None
+    timing: Timing = Timing()
 
     def __post_init__(self):
         object.__setattr__(self, "command_delay", check_number("command_delay", self.command_delay, 0.0, 1.0, low_open=False, unit="s"))
@@ -252,7 +259,6 @@ def _run(scenario, options: EngineOptions, record: str, metrics: bool, recorder)
     data = mujoco.MjData(model)
     dt = engine_timestep(robot.timestep, c.T)
     model.opt.timestep = dt
-    per_period = int(round(c.T / dt))
     delay_steps = int(round(options.command_delay / dt))
     base = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, "base")
     lidar = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, "lidar")
@@ -286,14 +292,17 @@ def _run(scenario, options: EngineOptions, record: str, metrics: bool, recorder)
     alg = np.zeros(steps + 1)
     pose = np.zeros((steps + 1, 3)) if record == "trajectory" else None
     theta = scenario.start.theta
-    pending = None
-    queue = []  # (engine step when it reaches the wheels, left, right)
-    now = 0
+    pending = path = None
+    ticks = options.timing.controller_ticks(c.T, dt)  # the controller's ticks (engine steps), jittered or not
+    now = next(ticks)
+    tick_t = np.zeros(steps + 1)
+    dof = model.jnt_dofadr[model.body_jntadr[base]]
     event = None
     done = steps
     for k in range(steps + 1):
         x, y = float(data.qpos[q]), float(data.qpos[q + 1])
         theta = theta + float(wrap_angle(heading(data.qpos[q + 3:q + 7]) - theta))  # unwrapped
+        tick_t[k] = now * dt
         off[k] = (x - ox_) * lat[0] + (y - oy_) * lat[1]
         alg[k] = (x - ox_) * along[0] + (y - oy_) * along[1]
         if pose is not None:
@@ -305,7 +314,7 @@ def _run(scenario, options: EngineOptions, record: str, metrics: bool, recorder)
             break
         # sense (KB eq 1–4) and compute the command (eq 5), or a Nav2 controller's
         if driver is not None:
-            speed, u = driver.decide(data, int(model.jnt_dofadr[model.body_jntadr[base]]), x, y, theta)
+            speed, u = driver.decide(data, int(dof), x, y, theta)
         elif options.sensing == "rays":
             yaw = math.pi / 2 - theta
             vec = np.column_stack([np.cos(yaw + angles), np.sin(yaw + angles), np.zeros(options.rays)])
@@ -321,18 +330,19 @@ def _run(scenario, options: EngineOptions, record: str, metrics: bool, recorder)
         if pending is None:  # the robot starts as if it had been running
             pending = u
             data.ctrl[left], data.ctrl[right] = robot.wheel_speeds(speed, u)
+            path = CommandPath(dt, delay_steps, options.smoother, options.timing, initial=-u)
         applied = pending if c.compute_delay == 1 else u
         pending = u
-        queue.append((now + delay_steps, *robot.wheel_speeds(speed, applied)))
+        path.publish(now, -applied)  # ROS yaw rate = −θ̇
         if recorder is not None:
-            recorder.command(now * dt, -applied, speed)  # published when applied to the command path; ROS yaw rate = −θ̇
-        # advance one period, switching the wheels' targets when a command arrives
-        end = now + per_period
+            recorder.command(now * dt, -applied, speed)  # published when applied to the command path
+        # advance to the next tick, switching the wheels' targets when the command path delivers
+        end = next(ticks)
         while now < end:
-            if queue and queue[0][0] <= now:
-                _, data.ctrl[left], data.ctrl[right] = queue.pop(0)
-                continue
-            nxt = min(end, queue[0][0]) if queue else end
+            reached = path.due(now, float(data.qvel[dof + 5]))
+            if reached is not None:
+                data.ctrl[left], data.ctrl[right] = robot.wheel_speeds(r.V, -reached)
+            nxt = min(end, path.next_event(now))
             if recorder is not None:
                 if recorder.due(now):
                     recorder.sample(now)
@@ -350,6 +360,11 @@ def _run(scenario, options: EngineOptions, record: str, metrics: bool, recorder)
         now = end
     n = done + 1
     t = np.arange(n) * c.T
+    if options.timing.period_jitter > 0:  # the estimator wants uniform samples: the offset between ticks, interpolated
+        t = t[t <= tick_t[n - 1]]
+        off, alg = np.interp(t, tick_t[:n], off[:n]), np.interp(t, tick_t[:n], alg[:n])
+        pose = None if pose is None else np.column_stack([np.interp(t, tick_t[:n], pose[:n, i]) for i in range(3)])
+        n = t.size
     window = alg[:n] >= scenario.measure.along_from
     if np.any(window):
         window[np.argmax(window):] = True
@@ -396,17 +411,19 @@ class CorridorLog:
 
 
 class _Recorder:
-    """Samples the odometry and the scans of a run at whole engine steps (`_run` stops the engine at each)."""
+    """Samples the odometry (jittered as `Timing` says) and the scans of a run at whole engine steps (`_run` stops the
+    engine at each)."""
 
-    def __init__(self, odom_rate: float, scan_rate: float, beams: int, scan_range: float):
-        self.odom_rate, self.scan_rate, self.beams, self.scan_range = odom_rate, scan_rate, beams, scan_range
+    def __init__(self, timing: Timing, scan_rate: float, beams: int, scan_range: float):
+        self.timing, self.scan_rate, self.beams, self.scan_range = timing, scan_rate, beams, scan_range
         self.cmd, self.odom, self.scans, self.scan_t = [], [], [], []
         self.done = -1
 
     def start(self, model, data, dt, base, lidar, group):
         self.model, self.data, self.dt, self.base, self.lidar, self.group = model, data, dt, base, lidar, group
         self.dof = model.jnt_dofadr[model.body_jntadr[base]]
-        self.odom_every = max(1, int(round(1.0 / (self.odom_rate * dt))))
+        self.odom_ticks = self.timing.odometry_ticks(dt)
+        self.next_odom = next(self.odom_ticks)
         self.scan_every = max(1, int(round(1.0 / (self.scan_rate * dt))))
         self.angles = -math.pi + 2 * math.pi * np.arange(self.beams) / self.beams
         self.geomid = np.zeros(self.beams, dtype=np.int32)
@@ -416,10 +433,10 @@ class _Recorder:
         self.cmd.append((t, wz, vx))
 
     def due(self, step: int) -> bool:
-        return step > self.done and (step % self.odom_every == 0 or step % self.scan_every == 0)
+        return step > self.done and (step >= self.next_odom or step % self.scan_every == 0)
 
     def next_step(self, step: int) -> int:
-        return min((step // e + 1) * e for e in (self.odom_every, self.scan_every))
+        return min(self.next_odom if self.next_odom > step else step + 1, (step // self.scan_every + 1) * self.scan_every)
 
     def sample(self, step: int):
         import mujoco
@@ -428,10 +445,12 @@ class _Recorder:
         data, t = self.data, step * self.dt
         R = data.xmat[self.base]
         yaw = math.atan2(R[3], R[0])
-        if step % self.odom_every == 0:
+        if step >= self.next_odom:
             v = data.qvel[self.dof:self.dof + 2]
             self.odom.append((t, float(data.xpos[self.base][0]), float(data.xpos[self.base][1]), yaw,
                               float(v[0] * math.cos(yaw) + v[1] * math.sin(yaw)), float(data.qvel[self.dof + 5])))
+            while self.next_odom <= step:
+                self.next_odom = next(self.odom_ticks)
         if step % self.scan_every == 0:
             a = yaw + self.angles
             vec = np.column_stack([np.cos(a), np.sin(a), np.zeros(self.beams)])
@@ -441,7 +460,7 @@ class _Recorder:
             self.scans.append(np.where(self.geomid >= 0, self.dist, np.inf))
 
 
-def corridor_log(scenario, options: EngineOptions = EngineOptions(), *, odom_rate: float = 50.0, scan_rate: float = 10.0,
+def corridor_log(scenario, options: EngineOptions = EngineOptions(), *, odom_rate: float | None = None, scan_rate: float = 10.0,
                  beams: int = 360, scan_range: float = 30.0) -> CorridorLog:
     """One corridor run (`run_scenario`) recorded as a robot's log: what ``pfm-stability diagnose`` reads
     (docs/mujoco.md, "Logs of corridor runs").
@@ -452,8 +471,9 @@ def corridor_log(scenario, options: EngineOptions = EngineOptions(), *, odom_rat
         A ``corridor`` scenario in the grid (`run_scenario`).
     options : EngineOptions
         The robot file and the engine's settings.
-    odom_rate : float
-        The odometry's rate, Hz, in (0, 1000] (rounded to whole engine steps).
+    odom_rate : float, optional
+        The odometry's rate, Hz, in (0, 1000] (rounded to whole engine steps); default `options.timing`'s (50 Hz), its
+        jitter always `options.timing`'s.
     scan_rate : float
         The scans' rate, Hz, in (0, 1000] (rounded to whole engine steps).
     beams : int
@@ -465,11 +485,12 @@ def corridor_log(scenario, options: EngineOptions = EngineOptions(), *, odom_rat
     -------
     CorridorLog
     """
-    odom_rate = check_number("odom_rate", odom_rate, 0.0, 1000.0, unit="Hz")
+    timing = options.timing if odom_rate is None else replace(
+        options.timing, odom_rate=check_number("odom_rate", odom_rate, 0.0, 1000.0, unit="Hz"))
     scan_rate = check_number("scan_rate", scan_rate, 0.0, 1000.0, unit="Hz")
     beams = check_integer("beams", beams, 8, 10_000)
     scan_range = check_number("scan_range", scan_range, 0.0, 100.0, unit="m")
-    rec = _Recorder(odom_rate, scan_rate, beams, scan_range)
+    rec = _Recorder(timing, scan_rate, beams, scan_range)
     run = _run(scenario, options, "offset", True, rec)
     cmd = np.asarray(rec.cmd, dtype=float).reshape(-1, 3)
     odom = np.asarray(rec.odom, dtype=float).reshape(-1, 6)
@@ -620,7 +641,7 @@ def drive_log(profile: str = "both", *, options: EngineOptions = EngineOptions()
     V : float
         Forward speed, m/s.
     T : float
-        The command's period, s.
+        The command's period, s (jittered as `options.timing` says; a smoother in `options` acts on the commands).
     amplitude : float
         The yaw-rate command's amplitude, rad/s (small: the loop models describe small oscillations,
         and MuJoCo's contacts make the lag depend on the amplitude; docs/mujoco.md).
@@ -648,31 +669,39 @@ def drive_log(profile: str = "both", *, options: EngineOptions = EngineOptions()
     dt = engine_timestep(robot.timestep, T)
     model.opt.timestep = dt
     place(model, data, robot, 0.0, 0.0, 0.0, V)
-    cmd_t = np.arange(int(math.floor(duration / T + 1e-9))) * T
-    cmd_wz = _profile(profile, cmd_t, amplitude, duration, seed)
-    every = max(1, int(round(1.0 / (rate * dt))))
-    cmd_step = np.round(cmd_t / dt).astype(np.int64) + int(round(options.command_delay / dt))
     total = int(round(duration / dt))
+    ticks = options.timing.controller_ticks(T, dt)
+    cmd_step = np.array([next(ticks) for _ in range(int(math.floor(duration / T + 1e-9)))], dtype=np.int64)
+    cmd_step = cmd_step[cmd_step <= total]
+    cmd_t = cmd_step * dt if options.timing.period_jitter > 0 else np.arange(cmd_step.size) * T
+    cmd_wz = _profile(profile, cmd_t, amplitude, duration, seed)
+    path = CommandPath(dt, int(round(options.command_delay / dt)), options.smoother, options.timing)
+    odometry = replace(options.timing, odom_rate=rate).odometry_ticks(dt)
+    next_odom = next(odometry)
     base = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, "base")
     dof = model.jnt_dofadr[model.body_jntadr[base]]
     left, right = (mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_ACTUATOR, s) for s in ("left", "right"))
     wl, wr = (model.jnt_dofadr[model.actuator_trnid[a, 0]] for a in (left, right))
-    events = sorted(set(cmd_step.tolist()) | set(range(0, total, every)))
     odom_t, odom_wz, imu_wz = [], [], []
     j, now = 0, 0
-    for step in events:
-        if step > total:
-            break
-        if step > now:
-            mujoco.mj_step(model, data, nstep=step - now)
-            now = step
+    while now <= total:
         while j < cmd_step.size and cmd_step[j] <= now:
-            data.ctrl[left], data.ctrl[right] = robot.wheel_speeds(V, -cmd_wz[j])  # ROS yaw rate = −θ̇
+            path.publish(now, float(cmd_wz[j]))
             j += 1
-        if now % every == 0:
+        reached = path.due(now, float(data.qvel[dof + 5]))
+        if reached is not None:
+            data.ctrl[left], data.ctrl[right] = robot.wheel_speeds(V, -reached)  # ROS yaw rate = −θ̇
+        if now == next_odom and now < total:
             odom_t.append(now * dt)
             odom_wz.append((data.qvel[wr] - data.qvel[wl]) * robot.wheel_radius / robot.track)
             imu_wz.append(float(data.qvel[dof + 5]))
+        while next_odom <= now:
+            next_odom = next(odometry)
+        nxt = min(int(cmd_step[j]) if j < cmd_step.size else total + 1, next_odom, path.next_event(now), total + 1)
+        if nxt > total:
+            break
+        mujoco.mj_step(model, data, nstep=nxt - now)
+        now = nxt
     odom_t = np.asarray(odom_t)
     return DriveLog(cmd_t, cmd_wz, np.full_like(cmd_t, V), odom_t, np.asarray(odom_wz), odom_t.copy(), np.asarray(imu_wz))
 

@@ -14,7 +14,10 @@ cannot read or compile and a robot missing a convention; `check_drives` refuses 
 
 The shipped robots (``data/robots/*.xml``, `ROBOT_MODELS`): ``diffdrive`` (a 0.5 m disc of 13.3 kg on
 0.075 m wheels 0.40 m apart) and ``diffdrive-heavy`` (0.6 m, 42 kg, 0.10 m wheels 0.50 m apart, a
-stiffer motor): two driven wheels with rounded tyres, one ball caster in front.
+stiffer motor): two driven wheels with rounded tyres, one ball caster in front; ``diffdrive-filtered`` (``diffdrive``
+with a 0.1-s actuator filter, MuJoCo's ``dyntype="filter"``, before each wheel servo) and ``skid-steer`` (four wheels,
+each side's front one chained to its driven rear one by a joint equality, turning by skidding). `place` starts an
+actuator filter's state and a chained wheel at the robot's speed.
 
 Frames: the package's angles are measured from +Y towards +X (docs/theory.md, notation); MuJoCo's yaw
 ψ from +X towards +Y, so a heading θ is the yaw ψ = π/2 − θ, and a turning rate θ̇ is the yaw rate −ψ̇.
@@ -300,10 +303,23 @@ def place(model, data, robot: RobotModel, x: float, y: float, theta: float, V: f
     data.qpos[q + 3:q + 7] = (math.cos(yaw / 2), 0.0, 0.0, math.sin(yaw / 2))
     data.qvel[v:v + 3] = (V * math.cos(yaw), V * math.sin(yaw), 0.0)
     for side in ("left", "right"):
-        joint = model.actuator_trnid[_name_id(model, mujoco.mjtObj.mjOBJ_ACTUATOR, side), 0]
-        data.qvel[model.jnt_dofadr[joint]] = V / robot.wheel_radius
-        data.ctrl[_name_id(model, mujoco.mjtObj.mjOBJ_ACTUATOR, side)] = V / robot.wheel_radius
+        a = _name_id(model, mujoco.mjtObj.mjOBJ_ACTUATOR, side)
+        data.qvel[model.jnt_dofadr[model.actuator_trnid[a, 0]]] = V / robot.wheel_radius
+        data.ctrl[a] = V / robot.wheel_radius
+        if model.actuator_actadr[a] >= 0:  # an actuator filter (dyntype filter): its state at the target already
+            data.act[model.actuator_actadr[a]] = V / robot.wheel_radius
+    for joint in range(model.njnt):  # wheels coupled to the driven ones (a skid-steer's chain) roll along
+        if int(model.jnt_type[joint]) == int(mujoco.mjtJoint.mjJNT_HINGE) and _coupled(model, joint):
+            data.qvel[model.jnt_dofadr[joint]] = V / robot.wheel_radius
     mujoco.mj_forward(model, data)
+
+
+def _coupled(model, joint: int) -> bool:
+    """Whether `joint` is tied to another by a joint equality (a wheel driven through a chain or belt)."""
+    import mujoco
+
+    return any(int(model.eq_type[e]) == int(mujoco.mjtEq.mjEQ_JOINT) and joint in (model.eq_obj1id[e], model.eq_obj2id[e])
+               for e in range(model.neq))
 
 
 def heading(quaternion) -> float:

@@ -5,9 +5,10 @@
 or identified from the same log, `complete_from_log`). On every stretch along a wall or through a corridor
 (`analysis.stretches.find_stretches`) it
 
-1. **measures** the lateral oscillation with the project's one estimator (`sim.metrics.oscillation_metrics`
-   on the binned lateral offset): ω (rad/s), σ (1/s) and the amplitude (the limit cycle's, else the largest
-   half peak-to-peak swing, m);
+1. **measures** the lateral oscillation on the binned lateral offset: σ (1/s) and the amplitude (the limit cycle's,
+   else the largest half peak-to-peak swing, m) with the project's one estimator (`sim.metrics.oscillation_metrics`),
+   and ω (rad/s) with its 95 % interval from the zero crossings of the part of the stretch that oscillates, the start
+   transient dropped (`analysis.frequency.crossing_frequency`; a stretch of too few periods says so);
 2. **predicts** it with every loop model, at the loop gain NV of the corridor of the measured half-width L
    (`laws.force_law.corridor_gain`) or of the wall whose equilibrium is the measured d0 (α and N from the law's
    balance at d0, `laws.force_law.wall_gain_at_distance`), V the robot's measured speed there: each model's
@@ -32,6 +33,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from ..analysis.frequency import FrequencyEstimate, crossing_frequency
 from ..analysis.identification import ridge_point
 from ..analysis.stretches import MIN_DURATION, MIN_SPEED, LateralOffset, Stretch, find_stretches, lateral_offset
 from ..io.logs import LogData, PoseSeries
@@ -44,14 +46,16 @@ from ..report.stability import build_report
 from ..sim.metrics import HYSTERESIS, OscillationMetrics, oscillation_metrics, turning_points
 
 __all__ = ["Measured", "Predicted", "StretchDiagnosis", "Diagnosis", "diagnose", "complete_from_log", "missing_parameters",
-           "needs_identification", "USER_PARAMETERS", "LOG_PARAMETERS", "MATCH", "MAX_GAP", "MIN_AMPLITUDE", "VERDICTS"]
+           "Limiter",
+           "needs_identification", "USER_PARAMETERS", "LOG_PARAMETERS", "MATCH", "MAX_GAP", "MIN_AMPLITUDE", "VERDICTS", "REACHED"]
 
 USER_PARAMETERS = ("k", "W", "f", "n")
 """What no log shows: the steering gain, the robot's width and KB's law (f, n): the user's (``--config`` or options)."""
-LOG_PARAMETERS = ("tau", "T", "dead_time", "plant_gain")
+LOG_PARAMETERS = ("tau", "T", "dead_time", "plant_gain", "actuator_lag", "yaw_accel_limit")
 """What the log shows (`analysis.identification`): the steering lag, the controller's period, the plant's dead time and
-gain, unless the user gives them. The log is identified when τ or T is missing (`needs_identification`); D and g alone
-keep their defaults (0 s and 1) rather than ask a log without commands for them."""
+gain, its second lag and the slew limit on its command (when the data support them), unless the user gives them. The
+log is identified when τ or T is missing (`needs_identification`); D, g, τ_a and the limit alone keep their defaults
+(0 s, 1, 0 s, none) rather than ask a log without commands for them."""
 MATCH = 0.15
 """A model matches when its root is within this relative distance of the measured σ + jω (and its verdict agrees)."""
 MIN_AMPLITUDE = 0.005
@@ -61,6 +65,10 @@ MAX_GAP = 1.0
 """A stretch whose odometry misses more than this (s) at once is not judged (interpolating over it would invent a swing)."""
 VERDICTS = ("oscillating", "stable", "nothing to diagnose")
 """The whole log's answer."""
+REACHED = 0.9
+"""The commands reached the slew limit A on a stretch when their |du/dt| (95th percentile) is at least this fraction of A:
+a discrete smoother's staircase shows slopes of about A while it ramps, and a command changing at 90 % of A is ramped
+every few ticks."""
 
 
 # ------------------------------------------------------------------------------------------ results
@@ -71,7 +79,7 @@ class Measured:
     Attributes
     ----------
     omega : float or None
-        ω, rad/s.
+        ω, rad/s: from the zero crossings of the established oscillation (`frequency`), else the estimator's.
     sigma : float or None
         σ, 1/s (> 0 growing); None when no oscillation was measured.
     amplitude : float or None
@@ -84,6 +92,10 @@ class Measured:
         Turning points of the offset.
     reason : str or None
         Why σ is undefined.
+    frequency : FrequencyEstimate or None
+        ω from the zero crossings: its 95 % interval, the crossings used and dropped (the start transient), the
+        established periods and whether they are too few for an interval (`analysis.frequency`); None without a
+        measured oscillation.
     """
 
     omega: float | None
@@ -93,10 +105,20 @@ class Measured:
     method: str
     turning_points: int
     reason: str | None = None
+    frequency: FrequencyEstimate | None = None
+
+    @property
+    def few_periods(self) -> bool:
+        """Whether ω rests on too few established periods for an interval (`analysis.frequency.MIN_CROSSINGS`)."""
+        return self.frequency is not None and self.frequency.few_periods
 
     def to_dict(self) -> dict:
-        """``{omega, sigma, amplitude, stable, method, turning_points, reason}`` (SI units)."""
-        return {"omega": json_number(self.omega), "sigma": json_number(self.sigma), "amplitude": json_number(self.amplitude),
+        """``{omega, omega_interval, frequency, sigma, amplitude, stable, method, turning_points, reason}`` (SI units)."""
+        f = self.frequency
+        return {"omega": json_number(self.omega),
+                "omega_interval": None if f is None or f.low is None else [json_number(f.low), json_number(f.high)],
+                "frequency": None if f is None else f.to_dict(),
+                "sigma": json_number(self.sigma), "amplitude": json_number(self.amplitude),
                 "stable": self.stable, "method": self.method, "turning_points": self.turning_points, "reason": self.reason}
 
 
@@ -143,6 +165,39 @@ class Predicted:
                 "T_critical": json_number(self.T_critical), "k_critical": json_number(self.k_critical),
                 "margin": json_number(self.margin), "omega": json_number(self.omega), "sigma": json_number(self.sigma),
                 "root_error": json_number(self.root_error), "matches": self.matches}
+
+
+@dataclass(frozen=True)
+class Limiter:
+    """The slew limit on the commanded yaw rate the prediction was made with, and whether the log's commands reached it.
+
+    Attributes
+    ----------
+    yaw_accel_limit : float
+        A, rad/s² (`Robot.yaw_accel_limit`).
+    in_prediction : bool
+        Whether the predicted V* accounts for it (False: the loop models are linear; their V* holds for a disturbance
+        small enough that the commands never change faster than A).
+    commanded_acceleration : float or None
+        The 95th percentile of the commands' |du/dt| over the judged stretch, rad/s² (None: the log was read without
+        its commands).
+    reached : bool or None
+        commanded_acceleration ≥ `REACHED`·A: the limit shaped the measured oscillation, and the linear V* may be off
+        for it (None without the commands).
+    note : str
+        What this means for the prediction, in words.
+    """
+
+    yaw_accel_limit: float
+    in_prediction: bool
+    commanded_acceleration: float | None
+    reached: bool | None
+    note: str
+
+    def to_dict(self) -> dict:
+        """``{yaw_accel_limit, in_prediction, commanded_acceleration, reached, note}`` (SI units)."""
+        return {"yaw_accel_limit": json_number(self.yaw_accel_limit), "in_prediction": self.in_prediction,
+                "commanded_acceleration": json_number(self.commanded_acceleration), "reached": self.reached, "note": self.note}
 
 
 @dataclass(frozen=True)
@@ -228,6 +283,8 @@ class Diagnosis:
         The odometry's pose (for the picture).
     law : ForceLaw
         The lateral law predicted with.
+    limiter : Limiter or None
+        The slew limit on the commanded yaw rate and what it means for the prediction (None: the robot has none).
     """
 
     verdict: str
@@ -238,6 +295,7 @@ class Diagnosis:
     controller: Controller
     pose: PoseSeries
     law: ForceLaw
+    limiter: Limiter | None = None
 
     @property
     def judged(self) -> StretchDiagnosis | None:
@@ -272,6 +330,7 @@ class Diagnosis:
                         "critical": None if best is None else {"model": best.model, "V": json_number(best.V_critical),
                                                                "T": json_number(best.T_critical), "k": json_number(best.k_critical)},
                         "remedies": worst.remedies})
+        out["limiter"] = None if self.limiter is None else self.limiter.to_dict()
         out["stretches"] = [s.to_dict() for s in self.stretches]
         return out
 
@@ -303,8 +362,33 @@ def needs_identification(sources: dict) -> bool:
     return _from_preset(sources, "tau") or _from_preset(sources, "T")
 
 
+def _linear_plant(fit) -> dict:
+    """τ, D and g of the selected plant as `Estimate` by name, D the loop's: a smoother's mean wait for its tick added
+    (`analysis.identification.PlantFit.loop_dead_time`)."""
+    from ..analysis.identification import Estimate
+
+    wait = fit.smoother.mean_wait if fit.smoother is not None else 0.0
+    D = fit.dead_time
+    return {"tau": fit.tau, "dead_time": Estimate(D.value + wait, D.low + wait, D.high + wait), "plant_gain": fit.g}
+
+
+def _drive_limits(robot: Robot, sources: dict, from_preset: set, identification) -> tuple[Robot, dict]:
+    """τ_a and the slew limit from the identification where the user gave neither (docs/diagnose.md, "What it needs")."""
+    fit, where = identification.plant, identification.log.path
+    for name, estimate, unit in (("actuator_lag", fit.actuator_lag, "s"), ("yaw_accel_limit", fit.yaw_accel_limit, "rad/s²")):
+        if name not in from_preset or not fit.identifiable:
+            continue
+        if estimate is None:
+            sources[name] = f"identified from {where}: none (the plant the data support, {fit.model}, has none)"
+        else:
+            robot = robot.replace(**{name: estimate.value})
+            sources[name] = f"identified from {where} ({estimate.low:.4g} to {estimate.high:.4g} {unit})"
+    return robot, sources
+
+
 def complete_from_log(robot: Robot, controller: Controller, sources: dict, identification) -> tuple[Robot, Controller, dict]:
-    """τ, T, D and g from the identification where the user did not give them (their source is a preset); the new sources.
+    """τ, T, D, g, τ_a and the slew limit from the identification where the user did not give them (their source is a
+    preset); the new sources.
 
     Parameters
     ----------
@@ -332,9 +416,11 @@ def complete_from_log(robot: Robot, controller: Controller, sources: dict, ident
         raise ValueError(f"the steering plant could not be identified from {identification.log.path}: {identification.reason}; "
                          f"give {', '.join('robot.' + name for name in plant)} in --config "
                          f"(or {' '.join('--' + name.replace('_', '-') for name in plant)})")
+    if not identification.identified:
+        return robot, controller, sources
     fit = identification.plant
-    estimates = {"tau": (fit.tau, "s"), "dead_time": (fit.dead_time, "s"), "plant_gain": (fit.g, "")} if plant else {}
-    values = {name: estimates[name][0].value for name in plant}
+    linear = _linear_plant(fit)
+    values = {name: linear[name].value for name in plant}
     if plant and not fit.identifiable:  # stay on the ridge the log determines (docs/diagnose.md, "Identifiability")
         given = [name for name in ("tau", "dead_time", "plant_gain") if name not in plant]
         anchor = {given[0]: getattr(robot, given[0])} if len(given) == 1 else \
@@ -343,7 +429,7 @@ def complete_from_log(robot: Robot, controller: Controller, sources: dict, ident
         if point is not None:
             values.update((name, v) for name, v in zip(("plant_gain", "tau", "dead_time"), point) if name in plant)
     for name in plant:
-        estimate, unit = estimates[name]
+        estimate, unit = linear[name], ("" if name == "plant_gain" else "s")
         value = max(values[name], 0.0) if name == "dead_time" else values[name]  # a negative D: clocks differ (identify warns)
         robot = robot.replace(**{name: value})
         if fit.identifiable:
@@ -353,6 +439,7 @@ def complete_from_log(robot: Robot, controller: Controller, sources: dict, ident
             sources[name] = (f"identified from {identification.log.path}, not separately identifiable (narrowband at "
                              f"ω ≈ {x.omega:.3g} rad/s): the prediction uses the plant's gain {x.gain:.3g} and phase "
                              f"{math.degrees(x.phase):.0f}° there, which the log determines")
+    robot, sources = _drive_limits(robot, sources, from_preset, identification)
     return robot, controller, sources
 
 
@@ -366,8 +453,12 @@ def _measure(offset: LateralOffset) -> tuple[OscillationMetrics, Measured, tuple
     amplitude = metrics.amplitude if metrics.amplitude is not None else (float(swings.max()) if swings.size else None)
     envelope = (float((offset.t[points[0]] + offset.t[points[1]]) / 2), float(swings[0])) if swings.size else None
     stable = metrics.growth_rate < 0 if metrics.growth_rate is not None else metrics.stable
-    measured = Measured(metrics.angular_frequency if metrics.growth_rate is not None else None, metrics.growth_rate, amplitude,
-                        bool(stable), metrics.method, metrics.turning_points, metrics.reason)
+    omega, frequency = None, None
+    if metrics.growth_rate is not None:
+        frequency = crossing_frequency(offset.t, x)
+        omega = frequency.omega if frequency.omega is not None else metrics.angular_frequency
+    measured = Measured(omega, metrics.growth_rate, amplitude, bool(stable), metrics.method, metrics.turning_points,
+                        metrics.reason, frequency)
     return metrics, measured, envelope
 
 
@@ -475,7 +566,7 @@ def _judge(stretch: Stretch, pose: PoseSeries, robot: Robot, law: ForceLaw, mode
     metrics, measured, envelope = _measure(offset)
     if measured.amplitude is None or measured.amplitude < MIN_AMPLITUDE:  # the robot holds its line: noise, not a swing
         measured = Measured(None, None, measured.amplitude, True, measured.method, measured.turning_points,
-                            f"no swing larger than {1000 * MIN_AMPLITUDE:g} mm (the offset holds its line)")
+                            f"no swing larger than {1000 * MIN_AMPLITUDE:g} mm (the offset holds its line)", None)
         envelope = None
     if measured.sigma is None and not measured.stable:
         return StretchDiagnosis(stretch, False, f"no oscillation measured and the offset does not settle ({metrics.reason})",
@@ -562,4 +653,29 @@ def diagnose(log: LogData, robot: Robot, controller: Controller, *, law: ForceLa
     if worst is not None:  # the whole log's stretch: every critical value and the remedies
         judged = tuple(_full(d, robot, controller, law, tuple(models)) if d.stretch.index == worst else d for d in judged)
     V = judged[worst].V if worst is not None else robot.V
-    return Diagnosis(verdict, reason, judged, worst, robot.replace(V=V), controller, log.pose, law)
+    limiter = _limiter(robot, log, judged[worst].stretch if worst is not None else None)
+    return Diagnosis(verdict, reason, judged, worst, robot.replace(V=V), controller, log.pose, law, limiter)
+
+
+def _limiter(robot: Robot, log: LogData, stretch: Stretch | None) -> Limiter | None:
+    """The robot's slew limit set against the commands of the judged stretch (`Limiter`)."""
+    A = robot.yaw_accel_limit
+    if not math.isfinite(A):
+        return None
+    acceleration = None
+    if log.command is not None and stretch is not None:
+        t, u = log.command.t, log.command.value
+        inside = (t >= stretch.start) & (t <= stretch.end)
+        if np.count_nonzero(inside) >= 3:
+            dt = np.diff(t[inside])
+            ok = dt > 0
+            acceleration = float(np.percentile(np.abs(np.diff(u[inside])[ok] / dt[ok]), 95)) if np.any(ok) else None
+    reached = None if acceleration is None else bool(acceleration >= REACHED * A)
+    note = (f"the predictions are the linear loop's, which a slew limit of {A:.3g} rad/s² does not change: they hold for a "
+            "disturbance small enough that the commands never change faster than the limit; the boundary for a larger one "
+            "depends on its size (the limiter's describing function is not in this version)")
+    if reached is not None:
+        note += (f"; on the judged stretch the commands changed at up to {acceleration:.3g} rad/s² (95th percentile): the limit "
+                 + ("was reached, so the measured oscillation is the limited loop's and V* may be off for it" if reached
+                    else "was not reached"))
+    return Limiter(A, False, acceleration, reached, note)
