@@ -157,11 +157,14 @@ class PurePursuit:
         The costmap's cost at the robot on the path (`corridor_pose_cost`; 0 in free space).
     inscribed_radius : float
         The costmap's inscribed radius, m.
+    half_width : float or None
+        The corridor's half-width L_c the cost is that of, m (None: free space).
     """
 
     values: dict
     pose_cost: int = FREE
     inscribed_radius: float = 0.1
+    half_width: float | None = None
 
     name = "rpp"
     shape = (1.0, 2.0)
@@ -235,7 +238,7 @@ class PurePursuit:
         value : float
             Its value.
         """
-        return PurePursuit({**self.values, name: value}, self.pose_cost, self.inscribed_radius)
+        return PurePursuit({**self.values, name: value}, self.pose_cost, self.inscribed_radius, self.half_width)
 
 
 @dataclass(frozen=True)
@@ -400,7 +403,7 @@ def path_law(controller: str, values: dict, *, costmap: dict, half_width: float 
         raise ValueError(f"L must exceed the robot's inscribed radius {costmap['inscribed_radius']:g} m for the robot to fit in the "
                          f"corridor; got {half_width:g} m")
     if controller == "rpp":
-        return PurePursuit(dict(values), corridor_pose_cost(half_width, costmap), costmap["inscribed_radius"])
+        return PurePursuit(dict(values), corridor_pose_cost(half_width, costmap), costmap["inscribed_radius"], half_width)
     if controller == "graceful":
         return Graceful(dict(values))
     if gains is None:

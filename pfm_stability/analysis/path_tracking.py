@@ -46,6 +46,11 @@ RATIO_POINTS_PER_DECADE = 8
 """Grid density of the search for ρ* (`numerics.solve.first_crossing`; its local maxima are refined, so a short
 excursion above 0 between grid points is still found)."""
 
+SERIAL_RTOL = 3e-2
+"""Where a search whose probes cost one at a time (`exact_delay`'s dead-time margins, `sampled` with a dead time) leaves
+`numerics.solve.first_crossing` (one round of its batched bisection from a grid cell) for `numerics.solve.bisect_root`
+(one probe a halving): the same bracket, about half the probes."""
+
 _RATIO_DECADES = 3.0
 """The search for ρ* spans this many decades below the loop's slowest scale and above its fastest (`_ratio_bracket`)."""
 
@@ -317,13 +322,24 @@ def ratio_critical(model, loop: Loop, shape: tuple) -> float:
     edges = [min(max(lo, 0.1 * estimate), 0.5 * top)]
     while edges[-1] < top:
         edges.append(min(10.0 * edges[-1], top))
+    serial = model.name == "exact_delay" or (model.name == "sampled" and loop.dead_time > 0)
     start = 0.0
     for low, high in zip(edges[:-1], edges[1:]):
-        found = first_crossing(measure, low, high, start=start, points_per_decade=RATIO_POINTS_PER_DECADE, rtol=RATIO_RTOL)
+        found = first_crossing(measure, low, high, start=start, points_per_decade=RATIO_POINTS_PER_DECADE,
+                               rtol=SERIAL_RTOL if serial else RATIO_RTOL)
         if found < math.inf:
-            return found
+            return _refined(lambda r: float(measure(r)[0]), found, RATIO_RTOL) if serial else found
         start = high
     return math.inf
+
+
+def _refined(measure, found: float, rtol: float) -> float:
+    """The sign change of `measure` in [found·(1 − SERIAL_RTOL), found] (a coarse first crossing) to `rtol`, by
+    `numerics.solve.bisect_root`; `found` itself when the bracket's low end is not below 0 (a crossing at its start)."""
+    low = found * (1.0 - SERIAL_RTOL)
+    if not measure(low) < 0:
+        return found
+    return bisect_root(measure, low, found, rtol=rtol)
 
 
 # ------------------------------------------------------------------ where ρ reaches ρ*
@@ -378,7 +394,7 @@ def _verdict(model, law, point: TrackingPoint, loop: Loop) -> PathVerdict:
     boundary = model.boundary(loop)
     judgement = judge(NV, N, boundary, lambda nv: model.is_stable(nv, loop))
     unstable_at_once = N < 0
-    T_star, D_star = (0.0, 0.0) if unstable_at_once else _delay_margins(model, NV, loop)
+    T_star, D_star = (0.0, 0.0) if unstable_at_once else _delay_margins(model, NV, loop, judgement.stable)
     root = None if unstable_at_once else model.rightmost_root(NV, loop)
     common = dict(model=model.name, verdict=judgement.verdict, NV=NV, NV_critical=boundary.NV_critical, omega_critical=boundary.omega_critical,
                   dead_time_critical=D_star, T_critical=T_star, rightmost_root=root, reason=judgement.reason)
@@ -396,39 +412,43 @@ def _verdict(model, law, point: TrackingPoint, loop: Loop) -> PathVerdict:
                        lookahead_time_critical=_lookahead_time_critical(law, point, rho_star), **common)
 
 
-def _delay_margins(model, NV: float, loop: Loop) -> tuple:
-    """(T*, D*), s, of the operating point: the model's own where they are exact or closed (`continuous`: ``inf`` or
-    0 for both, it has no delay; `kb_first_order`, `exact_delay`), else its own search (`LoopModel._first_loss`: the growth rate's first crossing)
-    with `RATIO_POINTS_PER_DECADE` and from the bottom up a decade at a time (`_searched_margin`); D* None for
-    `sampled` with a held reference (it has none)."""
+def _delay_margins(model, NV: float, loop: Loop, stable: bool) -> tuple:
+    """(T*, D*), s, of the operating point (`stable`: the model's verdict there).
+
+    The model's own where they are exact or closed (`kb_first_order`, `exact_delay`; `continuous` has no delay: ``inf``
+    or 0 for both). Searched otherwise (`LoopModel._first_loss`, a decade at a time from the bottom:
+    `_searched_margin`). The continuous-time models see T and D only as the loop's one delay h = T + D (the heading is
+    sampled), so `pade` searches h from 0 once: stable for every h < h*, so T* = h* − D and D* = h* − T when the
+    operating point lies below h* (else each is searched). `sampled` searches T from D/`PERIODS_IN_FLIGHT` and has no
+    D* with a held reference (None)."""
     from ..models.base import LoopModel
 
     if model.name == "continuous":  # no delay in the model: stable at every T and D, or at none (its own T*)
         T_star = model.critical_delay(NV, loop)
         return T_star, T_star
-    searched_T = type(model).critical_delay is LoopModel.critical_delay
-    searched_D = model.name in ("pade", "sampled")
-    if searched_T:
-        start, _, _ = loop.delay_search(NV)
-        if model.name == "sampled" and loop.dead_time > 0:
-            start = max(start, loop.dead_time / PERIODS_IN_FLIGHT)
-        T_star = _searched_margin(model, NV, loop._with_delay, start, RANGES["T"].high, loop.delay_search(NV))
-    else:
-        T_star = model.critical_delay(NV, loop)
+    if type(model).critical_delay is not LoopModel.critical_delay:  # exact or closed: kb_first_order, exact_delay
+        return model.critical_delay(NV, loop), model.critical_dead_time(NV, loop)
+    tolerances = loop.delay_search(NV)
+    start = tolerances[0]
+    dead_time = lambda D, base=loop: base.replace(dead_time=float(D))  # noqa: E731
+    if model.name != "sampled":  # pade: the whole delay h = T + D
+        h_star = _searched_margin(model, NV, lambda h: dead_time(h, loop.replace(T=0.0)), start, RANGES["dead_time"].high, tolerances)
+        if stable and h_star > loop.T + loop.dead_time:
+            return h_star - loop.dead_time, h_star - loop.T
+    if model.name == "sampled" and loop.dead_time > 0:
+        start = max(start, loop.dead_time / PERIODS_IN_FLIGHT)
+    T_star = _searched_margin(model, NV, loop._with_delay, start, RANGES["T"].high, tolerances)
     if model.name == "sampled" and model.hold == "reference":
         return T_star, None
-    if not searched_D:
-        return T_star, model.critical_dead_time(NV, loop)
-    start, _, _ = loop.delay_search(NV)
-    return T_star, _searched_margin(model, NV, lambda D: loop.replace(dead_time=float(D)), start, RANGES["dead_time"].high,
-                                    loop.delay_search(NV))
+    return T_star, _searched_margin(model, NV, dead_time, tolerances[0], RANGES["dead_time"].high, tolerances)
 
 
 def _searched_margin(model, NV: float, probe, low: float, high: float, tolerances) -> float:
     """The first x in (0, high] at which the loop `probe(x)` loses stability (0: already at x = 0; ``inf``: not up to
     `high`), by the model's search over [low, high] a decade at a time from the bottom, stopping at the first crossing."""
     _, rtol, atol = tolerances
-    options = {"rtol": rtol, "atol": atol, "points_per_decade": RATIO_POINTS_PER_DECADE}
+    serial = model.name == "sampled" and probe(low).dead_time > 0  # its growth rates come one loop at a time
+    options = {"rtol": SERIAL_RTOL if serial else rtol, "atol": atol, "points_per_decade": RATIO_POINTS_PER_DECADE}
     edges = [low]
     while edges[-1] < high:
         edges.append(min(10.0 * edges[-1], high))
@@ -436,6 +456,8 @@ def _searched_margin(model, NV: float, probe, low: float, high: float, tolerance
     for lo, hi in zip(edges[:-1], edges[1:]):
         found = model._first_loss(NV, probe, origin, lambda lo=lo, hi=hi: (lo, hi, options))
         if found < math.inf:
+            if serial and found > 0:
+                return _refined(lambda x: float(model._searched_growth_rates(NV, [probe(x)])[0]), found, rtol)
             return found
         origin = hi
     return math.inf
@@ -512,7 +534,7 @@ def analyze_path_tracking(robot, controller, law, models, *, V_set: float | None
     V_set : float, optional
         The cruising speed parameter, m/s (default robot.V).
     half_width : float, optional
-        The corridor's half-width L_c, m, that `law` was built for (None: free space).
+        The corridor's half-width L_c, m (default the law's: `PurePursuit.half_width`; None: free space).
     values : dict, optional
         The controller's Nav2 parameters (MPPI's ``model_dt`` and ``model_delay_wz`` for `ModelDelay`).
 
@@ -520,6 +542,7 @@ def analyze_path_tracking(robot, controller, law, models, *, V_set: float | None
     -------
     PathTracking
     """
+    half_width = getattr(law, "half_width", None) if half_width is None else half_width
     point = law.point(robot.V if V_set is None else V_set)
     if point.V <= 0:
         raise ValueError(f"the controller drives at V = {point.V:g} m/s on the path: the lateral loop needs V > 0")
