@@ -39,7 +39,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from ..checks import check_number
+from ..parameters import check_parameter
 
 __all__ = ["TrackingPoint", "PurePursuit", "Graceful", "MeasuredGains", "corridor_pose_cost", "inflation_cost", "regulated_distance",
            "path_law"]
@@ -347,11 +347,8 @@ class MeasuredGains:
     steering = None
 
     def __post_init__(self):
-        object.__setattr__(self, "k_theta", check_number("k_theta", self.k_theta, 0.0, 1e4, unit="1/s"))
-        object.__setattr__(self, "k_y", check_number("k_y", self.k_y, -1e6, 1e6, unit="1/(m s)"))
-        object.__setattr__(self, "V", check_number("V", self.V, 0.0, 100.0, high_open=False, unit="m/s"))
-        for name in ("k_theta_se", "k_y_se"):
-            object.__setattr__(self, name, check_number(name, getattr(self, name), 0.0, 1e6, low_open=False))
+        for name in ("k_theta", "k_y", "V", "k_theta_se", "k_y_se"):
+            object.__setattr__(self, name, check_parameter(name, getattr(self, name)))
 
     def point(self, V_set: float | None = None) -> TrackingPoint:
         """The gains as measured (`V_set` ignored: the gains hold at the speed they were measured).

@@ -198,6 +198,8 @@ class PathTracking:
         What the linearisation assumed or found inactive (the curvature heuristic on a straight path …).
     model_delay : ModelDelay or None
         MPPI's model delay recommended from D and T.
+    pose_cost : int or None
+        RPP: the costmap's cost at the robot (None for the other laws).
     """
 
     controller: str

@@ -582,13 +582,37 @@ def add_controller_options(parser: argparse.ArgumentParser) -> None:
                        help="the loop analysed: vff (the VFF force law, default) or a Nav2 controller tracking a straight path "
                             "(--L: a corridor): rpp, graceful, mppi, dwb, or auto (the --config Nav2 file's FollowPath plugin); "
                             "--V is its cruising speed")
-    group.add_argument("--param", action="append", metavar="NAME=VALUE", default=None,
+    group.add_argument("--param", action="append", metavar="NAME=VALUE", type=nav2_parameter,
                        help="a Nav2 parameter of the controller, e.g. lookahead_dist=0.8 (repeatable; overrides the --config file)")
-    group.add_argument("--gains", nargs=2, type=float, metavar=("KTHETA", "KY"),
-                       help="mppi, dwb: the lateral gains measured from the algorithm at --V, k_theta (1/s) and k_y (1/(m s)): "
-                            "omega = -k_theta e_theta - k_y e_y")
-    group.add_argument("--gains-se", nargs=2, type=float, metavar=("SE_THETA", "SE_Y"),
-                       help="their standard errors (the verdict is checked at +-2 of them too)")
+    group.add_argument("--k-theta", type=number("k_theta"),
+                       help=f"mppi, dwb: the measured gain k_theta = -d omega/d e_theta at --V, {describe('k_theta')}")
+    group.add_argument("--k-y", type=number("k_y"), help=f"mppi, dwb: the measured gain k_y = -d omega/d e_y at --V, {describe('k_y')}")
+    group.add_argument("--k-theta-se", type=number("k_theta_se"), help=f"its standard error, {describe('k_theta_se')} (default 0)")
+    group.add_argument("--k-y-se", type=number("k_y_se"), help=f"its standard error, {describe('k_y_se')} (default 0)")
+
+
+def nav2_parameter(text: str) -> tuple:
+    """An argparse ``type=`` for ``--param NAME=VALUE``: (name, value parsed by the YAML rule); the controller checks both
+    (`resolve_tracker`, the registry's ranges).
+
+    Parameters
+    ----------
+    text : str
+        ``NAME=VALUE``.
+    """
+    key, sep, raw = text.partition("=")
+    if not sep or not key.strip() or not raw.strip():
+        raise argparse.ArgumentTypeError(f"--param must be NAME=VALUE (a Nav2 parameter of the controller); got {text!r}")
+    from ..io.yaml_files import InputError, parse_yaml
+
+    try:
+        value = parse_yaml(raw.strip())
+    except InputError:
+        value = raw.strip()
+    return key.strip(), value
+
+
+nav2_parameter.kind = "nav2_param"  # the command-line fuzzer draws NAME=VALUE of the registry
 
 
 @dataclass(frozen=True)
@@ -651,16 +675,18 @@ def resolve_tracker(args, params: ResolvedParameters) -> ResolvedTracker | None:
     from ..controllers.registry import NAV2_CONTROLLERS, get_controller
 
     name = str(getattr(args, "controller", "vff"))
-    extras = [opt for opt, value in (("--param", args.param), ("--gains", args.gains), ("--gains-se", args.gains_se)) if value is not None]
+    extras = [opt for opt, value in (("--param", args.param), *((f"--{k.replace('_', '-')}", getattr(args, k)) for k in _GAINS))
+              if value is not None]
     if name == "vff":
         if extras:
             raise ValueError(f"{extras[0]} applies to --controller {', '.join(NAV2_CONTROLLERS)}, not to --controller vff")
         return None
     tracker = _tracker_of(args, params, name)
     entry = get_controller(tracker.controller)
-    if entry.linearisation == "closed form" and (args.gains is not None or args.gains_se is not None):
-        raise ValueError(f"{'--gains' if args.gains is not None else '--gains-se'} applies to --controller mppi or dwb "
-                         f"(numeric gains); --controller {tracker.controller} has a closed-form linearisation")
+    given = [f"--{k.replace('_', '-')}" for k in _GAINS if getattr(args, k) is not None]
+    if entry.linearisation == "closed form" and given:
+        raise ValueError(f"{given[0]} applies to --controller mppi or dwb (numeric gains); --controller {tracker.controller} "
+                         "has a closed-form linearisation")
     tracker = _with_params(tracker, entry, args.param or [])
     robot, controller, sources, tracker = _tracker_robot(args, params, tracker, entry)
     gains = _gains(args, tracker.controller, robot.V) if entry.linearisation == "numeric" else None
@@ -684,26 +710,21 @@ def _tracker_of(args, params: ResolvedParameters, name: str):
     return default_tracker(name, "no Nav2 file given" if params.config is None else f"--config {params.config.path} is no Nav2 file")
 
 
+_GAINS = ("k_theta", "k_y", "k_theta_se", "k_y_se")
+"""The measured gains' options (``--k-theta`` …)."""
+
+
 def _with_params(tracker, entry, given: list):
-    """The tracker with each ``--param NAME=VALUE`` set (the registry's check; the speed parameter is ``--V``)."""
+    """The tracker with each ``--param NAME=VALUE`` (`nav2_parameter`) set: the registry's check; the speed is ``--V``."""
     from dataclasses import replace
 
     from ..io.nav2 import Nav2Setting
-    from ..io.yaml_files import InputError, parse_yaml
 
     parameters = dict(tracker.parameters)
-    for text in given:
-        key, sep, raw = text.partition("=")
-        key = key.strip()
-        if not sep or not key:
-            raise ValueError(f"--param must be NAME=VALUE (a Nav2 parameter of {entry.package}); got {text!r}")
+    for key, value in given:
         parameter = entry.parameter(key)
         if parameter.name == entry.speed:
             raise ValueError(f"--param {key}: the cruising speed is --V (m/s)")
-        try:
-            value = parse_yaml(raw.strip()) if raw.strip() else raw
-        except InputError:
-            value = raw
         parameters[parameter.name] = Nav2Setting(parameter.check(value, f"--param {parameter.name}"), "user")
     return replace(tracker, parameters=parameters)
 
@@ -746,11 +767,10 @@ def _preset_of(source: str) -> str | None:
 
 
 def _gains(args, controller: str, V: float):
-    """MPPI's or DWB's `MeasuredGains` from ``--gains`` (required) and ``--gains-se``."""
+    """MPPI's or DWB's `MeasuredGains` from ``--k-theta`` and ``--k-y`` (required) and their standard errors."""
     from ..analysis.path_laws import MeasuredGains
 
-    if args.gains is None:
+    if args.k_theta is None or args.k_y is None:
         raise ValueError(f"--controller {controller} has no closed-form linearisation: give the gains measured from the algorithm, "
-                         "--gains KTHETA KY (docs/path_tracking.md)")
-    se = args.gains_se or (0.0, 0.0)
-    return MeasuredGains(controller, args.gains[0], args.gains[1], V, se[0], se[1])
+                         "--k-theta and --k-y (docs/path_tracking.md)")
+    return MeasuredGains(controller, args.k_theta, args.k_y, V, args.k_theta_se or 0.0, args.k_y_se or 0.0)

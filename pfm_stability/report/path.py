@@ -72,8 +72,24 @@ def path_remedies(result: PathTracking, verdict, values: dict, robot, controller
 
 def path_inputs(robot, controller, tracker, gains, L, pade_order: int, sources: dict) -> dict:
     """The report's inputs for a path tracker, in the order it lists them: the controller and its plugin, V (its cruising
-    speed parameter), the plant, T, the sampled structure, the corridor, the Nav2 parameters the loop reads, the costmap's,
-    and measured gains; each {"value", "unit", "source"}."""
+    speed parameter), the plant, T, the sampled structure, the corridor, the Nav2 parameters the loop reads, the costmap's
+    (with a corridor), and measured gains; each {"value", "unit", "source"}.
+
+    Parameters
+    ----------
+    robot, controller : parameters.Robot, parameters.Controller
+        The plant and V; T and the sampled structure.
+    tracker : io.nav2.Nav2Tracker
+        The controller and its parameters with their provenance.
+    gains : analysis.path_laws.MeasuredGains or None
+        Measured gains (MPPI, DWB).
+    L : float or None
+        The corridor's half-width, m.
+    pade_order : int
+        Order of the ``pade`` model.
+    sources : dict
+        Provenance of the robot's and the controller's values.
+    """
     entry = get_controller(tracker.controller)
     out = {"controller": {"value": tracker.controller, "unit": "", "source": sources.get("controller", "user")},
            "plugin": {"value": tracker.plugin, "unit": "", "source": sources.get("plugin", f"Nav2's {tracker.plugin_id}")}}
@@ -100,7 +116,7 @@ def path_inputs(robot, controller, tracker, gains, L, pade_order: int, sources: 
                 put(name, setting.value, "1/m" if name == "cost_scaling_factor" else "m", setting.source)
     if gains is not None:
         for name, unit in (("k_theta", "1/s"), ("k_y", "1/(m s)"), ("k_theta_se", "1/s"), ("k_y_se", "1/(m s)")):
-            put(name, getattr(gains, name), unit, sources.get("gains", "user"))
+            put(name, getattr(gains, name), unit, "user")
     return out
 
 
@@ -138,7 +154,15 @@ def path_report(robot, controller, tracker, *, gains=None, L=None, models=MODEL_
 
 def path_json(result: PathTracking, remedies: dict) -> tuple:
     """(environment entry, top-level verdicts) of a path-tracking result: ``environment.path`` (the controller, geometry, the
-    linearised law, notes, MPPI's model delay) and ``path.<model>`` (each verdict with its ``to_stabilize``)."""
+    linearised law, notes, MPPI's model delay) and ``path.<model>`` (each verdict with its ``to_stabilize``).
+
+    Parameters
+    ----------
+    result : analysis.path_tracking.PathTracking
+        The analysis.
+    remedies : dict
+        ("path", model) → the model's remedies (`path_remedies`).
+    """
     env = result.to_dict()
     verdicts = env.pop("models")
     for name, v in verdicts.items():
