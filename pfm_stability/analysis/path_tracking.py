@@ -47,9 +47,9 @@ RATIO_POINTS_PER_DECADE = 8
 excursion above 0 between grid points is still found)."""
 
 SERIAL_RTOL = 3e-2
-"""Where a search whose probes cost one at a time (`exact_delay`'s dead-time margins, `sampled` with a dead time) leaves
-`numerics.solve.first_crossing` (one round of its batched bisection from a grid cell) for `numerics.solve.bisect_root`
-(one probe a halving): the same bracket, about half the probes."""
+"""Where a search whose probes cost one at a time (`exact_delay`'s dead-time margins, `pade`'s polynomials, `sampled`
+with a dead time: `_serial`) leaves `numerics.solve.first_crossing` (one round of its batched bisection from a grid
+cell) for `numerics.solve.bisect_root` (one probe a halving): the same bracket, about half the probes."""
 
 _RATIO_DECADES = 3.0
 """The search for ρ* spans this many decades below the loop's slowest scale and above its fastest (`_ratio_bracket`)."""
@@ -324,7 +324,7 @@ def ratio_critical(model, loop: Loop, shape: tuple) -> float:
     edges = [min(max(lo, 0.1 * estimate), 0.5 * top)]
     while edges[-1] < top:
         edges.append(min(10.0 * edges[-1], top))
-    serial = model.name == "exact_delay" or (model.name == "sampled" and loop.dead_time > 0)
+    serial = _serial(model, loop)
     start = 0.0
     for low, high in zip(edges[:-1], edges[1:]):
         found = first_crossing(measure, low, high, start=start, points_per_decade=RATIO_POINTS_PER_DECADE,
@@ -333,6 +333,12 @@ def ratio_critical(model, loop: Loop, shape: tuple) -> float:
             return _refined(lambda r: float(measure(r)[0]), found, RATIO_RTOL) if serial else found
         start = high
     return math.inf
+
+
+def _serial(model, loop: Loop) -> bool:
+    """Whether the model's probes of this loop cost one at a time (`SERIAL_RTOL`): `exact_delay` (its margins), `pade` (its
+    polynomials are built loop by loop), `sampled` with a dead time (its eigenvalues loop by loop)."""
+    return model.name in ("exact_delay", "pade") or (model.name == "sampled" and loop.dead_time > 0)
 
 
 def _refined(measure, found: float, rtol: float) -> float:
@@ -449,7 +455,7 @@ def _searched_margin(model, NV: float, probe, low: float, high: float, tolerance
     """The first x in (0, high] at which the loop `probe(x)` loses stability (0: already at x = 0; ``inf``: not up to
     `high`), by the model's search over [low, high] a decade at a time from the bottom, stopping at the first crossing."""
     _, rtol, atol = tolerances
-    serial = model.name == "sampled" and probe(low).dead_time > 0  # its growth rates come one loop at a time
+    serial = _serial(model, probe(low))
     options = {"rtol": SERIAL_RTOL if serial else rtol, "atol": atol, "points_per_decade": RATIO_POINTS_PER_DECADE}
     edges = [low]
     while edges[-1] < high:
