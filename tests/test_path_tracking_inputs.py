@@ -196,3 +196,21 @@ def test_vff_default_is_todays_report():
     assert "path" not in data and "corridor" in data and data["inputs"]["T"]["value"] == pytest.approx(0.1)
     assert not VALIDATOR.is_valid({**data, "path": {"sampled": {}}})  # a path verdict has its required keys
     json.dumps(data)
+
+
+def test_readme_worked_example_is_what_the_report_prints():
+    """README's "Will my Nav2 robot weave?": its command, run, prints every table row the README shows (the numbers a
+    reader is told to read), and the remedies it quotes for --dead-time 0.7."""
+    readme = (Path(__file__).resolve().parents[1] / "README.md").read_text()
+    section = readme.split("## Will my Nav2 robot weave?", 1)[1].split("\n## ", 1)[0]
+    command = section.split("```bash\n", 1)[1].split("\n```", 1)[0]
+    assert command == "pfm-stability report --controller rpp --dead-time 0.364 --tau 0"
+    shown = section.split("```bash\n", 1)[1].split("\n```\n", 1)[1].split("```\n", 1)[1].split("```", 1)[0]
+    code, out, _ = run(command.split()[1:])
+    assert code == 0
+    rows = [line for line in shown.splitlines() if line.startswith("  ") and line.split()[0] in
+            ("model", "continuous", "kb_first_order", "pade", "exact_delay", "sampled")]
+    assert len(rows) == 6 and all(row in out for row in rows)
+    code, out, _ = run(["report", "--controller", "rpp", "--dead-time", "0.7", "--tau", "0", "--model", "sampled"])
+    assert "lower max_linear_vel to <= 0.4308 m/s (-14 %); raise lookahead_dist to >= 0.6964 m (+16 %); lower dead_time to <= 0.5997 s (-14 %)" in out
+    assert "lower max_linear_vel to <= 0.4308 m/s (-14 %); raise lookahead_dist to >= 0.6964 m (+16 %); lower dead_time to <= 0.5997 s (-14 %)" in section

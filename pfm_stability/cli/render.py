@@ -321,7 +321,8 @@ def render_text(report) -> str:
     for name, entry in data["inputs"].items():
         unit = f" {entry['unit']}" if entry["unit"] else ""
         mark = "  <-- " + entry["source"] if entry["source"].startswith("ASSUMED") else f"  ({entry['source']})"
-        lines.append(f"  {_label(name):<38} {_value(entry['value'])}{unit}{mark}")
+        label = "V (cruising speed)" if report.path is not None and name == "V" else _label(name)
+        lines.append(f"  {label:<38} {_value(entry['value'])}{unit}{mark}")
     lines += _law_line(data)
     lines += ["", "Models"] + ([] if data["models"] else ["  none: the law has no smooth equilibrium, so no linear model applies"])
     for name, entry in data["models"].items():
@@ -491,10 +492,12 @@ def _path_remedy_line(model: str, fix: dict, data: dict) -> str:
     """One model's remedies in Nav2's names and units (`report.path.path_remedies`)."""
     if not fix:
         return f"  to stabilize ({model}): no single change of the speed, the lookahead, D or T helps; change several"
-    units = {name: entry["unit"] for name, entry in data["inputs"].items()}
+    from ..controllers.registry import get_controller
+
+    controller = get_controller(data["environment"]["path"]["controller"])
     parts = []
     for name, entry in fix.items():
-        unit = units.get(name, "")
+        unit = RANGES[name].unit if name in RANGES else controller.parameter(name).unit
         bound = ">=" if entry["direction"] == "raise" else "<="
         change = f" ({entry['change_percent']:+.0f} %)" if "change_percent" in entry else ""
         extra = f" (controller_frequency >= {number(1.0 / entry['to'])} Hz)" if name == "T" else ""
