@@ -367,6 +367,23 @@ def test_measured_gains_hold_V_star_and_report_their_uncertainty():
     assert exact.models["exact_delay"].margin_range is None and exact.model_delay is None  # no parameters: no recommendation
 
 
+def test_measured_gains_from_a_linearisation_and_the_velocity_scaled_pure_delay_limit():
+    """The algorithm side's numeric linearisation (its ``LateralGains`` fields, read by name) becomes `MeasuredGains`;
+    and velocity-scaled RPP in its unclamped band has ρ = 1/lookahead_time, so without lags `exact_delay`'s D* is
+    0.5205·lookahead_time − T at any speed in the band (1e-6)."""
+    from types import SimpleNamespace
+
+    lin = SimpleNamespace(controller="dwb", V=0.3, k_theta=0.9, k_y=1.4, k_theta_se=0.02, k_y_se=0.05, k_w=0.1, draws=8)
+    g = MeasuredGains.from_linearisation(lin)
+    assert (g.name, g.V, g.k_theta, g.k_y, g.k_theta_se, g.k_y_se) == ("dwb", 0.3, 0.9, 1.4, 0.02, 0.05)
+    values = {**RPP, "use_velocity_scaled_lookahead_dist": True, "lookahead_time": 1.2, "min_lookahead_dist": 0.1, "max_lookahead_dist": 5.0}
+    law = path_law("rpp", values, costmap=FREE)
+    for V in (0.3, 0.9, 2.5):
+        robot, controller = Robot(V=V, tau=0.0, k=1.0, W=0.5, dead_time=0.1), Controller(T=0.02, f=1, n=2, compute_delay=0)
+        v = analyze_path_tracking(robot, controller, law, [make_model("exact_delay")]).models["exact_delay"]
+        assert v.dead_time_critical == pytest.approx(pure_delay_ratio((1.0, 2.0)) * 1.2 - 0.02, rel=1e-6)
+
+
 def test_tracking_loop_is_the_steering_loop_with_the_heading_sampled():
     """The loop every model decides: k = k_θ, the robot's plant, T, and heading_sampled (the continuous-time models
     delay the heading term by T + D)."""

@@ -350,6 +350,18 @@ class MeasuredGains:
         for name in ("k_theta", "k_y", "V", "k_theta_se", "k_y_se"):
             object.__setattr__(self, name, check_parameter(name, getattr(self, name)))
 
+    @classmethod
+    def from_linearisation(cls, gains) -> "MeasuredGains":
+        """From a numeric linearisation of the algorithm (the ``LateralGains`` of ``controllers.linearize``: its
+        ``controller``, ``V``, ``k_theta``, ``k_y``, ``k_theta_se``, ``k_y_se``; read by name, nothing imported).
+
+        Parameters
+        ----------
+        gains : object
+            The linearisation's result.
+        """
+        return cls(gains.controller, gains.k_theta, gains.k_y, gains.V, gains.k_theta_se, gains.k_y_se)
+
     def point(self, V_set: float | None = None) -> TrackingPoint:
         """The gains as measured (`V_set` ignored: the gains hold at the speed they were measured).
 
@@ -404,6 +416,6 @@ def path_law(controller: str, values: dict, *, costmap: dict, half_width: float 
     if controller == "graceful":
         return Graceful(dict(values))
     if gains is None:
-        raise ValueError(f"--controller {controller} has no closed-form linearisation: give its gains, --gains KTHETA KY "
+        raise ValueError(f"--controller {controller} has no closed-form linearisation: give its gains, --k-theta and --k-y "
                          "(measured from the algorithm about the corridor's centre line, docs/path_tracking.md)")
     return gains

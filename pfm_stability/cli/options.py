@@ -568,7 +568,7 @@ def resolve_family(args, params: ResolvedParameters) -> ResolvedFamily:
 
 # ------------------------------------------------------------------ path-tracking controllers (report --controller)
 def add_controller_options(parser: argparse.ArgumentParser) -> None:
-    """--controller, --param, --gains and --gains-se (``report`` only; docs/path_tracking.md).
+    """--controller, --param, --k-theta, --k-y, --k-theta-se and --k-y-se (``report`` only; docs/path_tracking.md).
 
     Parameters
     ----------
@@ -670,7 +670,7 @@ def resolve_tracker(args, params: ResolvedParameters) -> ResolvedTracker | None:
     ------
     ValueError
         An option the controller does not take, an unknown ``--param`` or a value out of its range, ``auto``
-        without a Nav2 file, MPPI or DWB without ``--gains``.
+        without a Nav2 file, MPPI or DWB without ``--k-theta`` and ``--k-y``.
     """
     from ..controllers.registry import NAV2_CONTROLLERS, get_controller
 
