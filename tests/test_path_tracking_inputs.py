@@ -92,6 +92,7 @@ def test_rotation_shim_primary_controller_both_spellings(tmp_path):
                      '        plugin: "nav2_graceful_controller::GracefulController"\n        max_lookahead: 1.4\n')
     t = _tracker(new)
     assert t.controller == "graceful" and t.values()["max_lookahead"] == 1.4 and any("Rotation Shim" in n for n in t.notes)
+    assert t.plugin_source.endswith("controller_server.FollowPath.primary_controller.plugin")
     old = _nav2_file(tmp_path, '      plugin: "nav2_rotation_shim_controller::RotationShimController"\n'
                      '      primary_controller: "nav2_regulated_pure_pursuit_controller::RegulatedPurePursuitController"\n'
                      '      lookahead_dist: 1.1\n')
@@ -187,6 +188,16 @@ def test_refusals_are_one_line_and_exit_2(argv, message):
     """Bad input: exit 2 and one line naming what the user gave and the allowed range or the option that applies."""
     code, out, err = run(["report", *argv])
     assert code == 2 and out == "" and message in err and len(err.strip().splitlines()) == 1, err
+
+
+def test_a_controllers_report_reads_its_own_keys_without_the_vff_notes(tmp_path):
+    """RPP's current name max_linear_vel is the cruising speed (the VFF reading's SPEED_KEYS do not list it: its note
+    "V is the preset's" would mislead, so a controller's report prints none); the Rotation Shim's note is in the report."""
+    path = _nav2_file(tmp_path, '      plugin: "nav2_rotation_shim_controller::RotationShimController"\n      primary_controller:\n'
+                      '        plugin: "nav2_regulated_pure_pursuit_controller::RegulatedPurePursuitController"\n'
+                      '        max_linear_vel: 0.65\n')
+    code, out, err = run(["report", "--controller", "auto", "--config", str(path), "--model", "sampled"])
+    assert code == 0 and err == "" and "V (cruising speed)                     0.65 m/s" in out and "Rotation Shim controller" in out
 
 
 def test_vff_default_is_todays_report():

@@ -554,6 +554,11 @@ def analyze_path_tracking(robot, controller, law, models, *, V_set: float | None
     point = law.point(robot.V if V_set is None else V_set)
     if point.V <= 0:
         raise ValueError(f"the controller drives at V = {point.V:g} m/s on the path: the lateral loop needs V > 0")
+    k = RANGES["k"]
+    if not k.low <= point.k_theta <= k.high:
+        what = f"V = {point.V:g} m/s over the lookahead L = {point.L:g} m" if point.L is not None else f"k_theta = {point.k_theta:g} 1/s"
+        raise ValueError(f"the controller's steering gain k_theta = {point.k_theta:g} 1/s ({what}) is outside the loop's "
+                         f"steering gains {k.describe()}")
     loop = tracking_loop(robot, controller, point)
     verdicts = {m.name: _verdict(m, law, point, loop) for m in models}
     return PathTracking(law.name, law, point, loop, half_width, verdicts, _notes(law, point, half_width),

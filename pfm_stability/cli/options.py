@@ -312,7 +312,7 @@ SCENARIO_OPTIONS = {"alpha": ("wall", "alpha", "alpha_deg"), "L": ("corridor", "
 option → (geometry, key, name in the sources)."""
 
 
-def resolve_parameters(args, *, fill=None) -> ResolvedParameters:
+def resolve_parameters(args, *, fill=None, notes: bool = True) -> ResolvedParameters:
     """Apply the user's overrides to the configuration file and the preset (validated by the dataclasses).
 
     Precedence: an option typed > ``--config FILE`` > the file's ``preset`` (or a
@@ -327,6 +327,8 @@ def resolve_parameters(args, *, fill=None) -> ResolvedParameters:
         The parsed options.
     fill : tuple of str, keyword only, optional
         The scenario options a configuration file may fill (None: every one the command has).
+    notes : bool, keyword only
+        Whether to print the file's notes (a Nav2 controller's report reads the file for its controller instead).
     """
     config = None
     if getattr(args, "config", None) is not None:
@@ -358,7 +360,7 @@ def resolve_parameters(args, *, fill=None) -> ResolvedParameters:
             raise ValueError(f"robot.family {config.family} of --config {config.path} is read by report only (--robot, "
                              "docs/velocity_and_fuzzy.md); this command analyses KB's steering robot: give robot.family steering or none")
         sources.update(_fill_scenario(args, config, SCENARIO_OPTIONS if fill is None else fill))
-        for note in config.notes:
+        for note in config.notes if notes else ():
             print(f"pfm-stability: note: {note}", file=sys.stderr)
     return ResolvedParameters(preset, robot, controller, sources, config)
 

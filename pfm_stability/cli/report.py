@@ -45,7 +45,7 @@ def run(args) -> int:
     from ..io.serialize import dumps
     from .render import render_markdown, render_text
 
-    params = resolve_parameters(args)
+    params = resolve_parameters(args, notes=str(args.controller) == "vff")  # a Nav2 controller's notes are its report's
     path = resolve_tracker(args, params)
     if path is not None:
         report = _path_report(args, path)

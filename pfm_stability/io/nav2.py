@@ -268,6 +268,8 @@ class Nav2Tracker:
         ``inscribed_radius``, ``inflation_radius`` (m), ``cost_scaling_factor`` (1/m), ``resolution`` (m) → `Nav2Setting`.
     notes : tuple of str
         What the file's structure implied (a Rotation Shim's primary controller, several controller plugins).
+    plugin_source : str
+        Where the plugin came from (the file's key, Nav2's default, the command line).
     """
 
     controller: str
@@ -277,6 +279,7 @@ class Nav2Tracker:
     frequency: Nav2Setting
     costmap: dict
     notes: tuple = ()
+    plugin_source: str = "--controller"
 
     def values(self) -> dict:
         """Parameter name → value."""
@@ -359,11 +362,14 @@ def read_path_tracker(source: "YamlFile", controller: str | None = None) -> Nav2
     plugin = node.get("plugin", DEFAULT_PLUGIN)
     if not isinstance(plugin, str):
         raise source.error(f"controller_server.{plugin_id}.plugin must be a plugin class name; got {plugin!r}", (*keys, "plugin"))
+    plugin_source = f"{origin}: controller_server.{plugin_id}.plugin"
     if "plugin" not in node:
         notes.append(f"{origin}: controller_server.{plugin_id}.plugin not given: Nav2's default {DEFAULT_PLUGIN}")
+        plugin_source = f"ASSUMED (Nav2's default, nav2_controller/include/nav2_controller/parameter_handler.hpp): {plugin_source} not in the file"
     if plugin_key(plugin) == SHIM_PLUGIN:
         node, keys, plugin = _shim_primary(source, node, keys, plugin_id)
         notes.append(f"{origin}: {plugin_id} is the Rotation Shim controller; on a straight path its primary controller {plugin} tracks")
+        plugin_source = f"{origin}: controller_server.{'.'.join(keys[2:])}" + (".plugin" if keys[-1] == "primary_controller" else ".primary_controller")
     entry = controller_of_plugin(plugin)
     if entry is None:
         analysed = ", ".join(p for c in ("rpp", "graceful", "mppi", "dwb") for p in get_controller(c).plugins)
@@ -374,7 +380,7 @@ def read_path_tracker(source: "YamlFile", controller: str | None = None) -> Nav2
     parameters = {p.name: _setting(source, p, node, keys, f"controller_server.{'.'.join(keys[2:])}", entry.source) for p in entry.parameters}
     frequency = _setting(source, SERVER[0], server, server_keys, "controller_server", "nav2_controller/src/parameter_handler.cpp")
     costmap = _read_costmap(source, {p.name: p for p in COSTMAP})
-    return Nav2Tracker(entry.name, plugin_key(plugin), plugin_id, parameters, frequency, costmap, tuple(notes))
+    return Nav2Tracker(entry.name, plugin_key(plugin), plugin_id, parameters, frequency, costmap, tuple(notes), plugin_source)
 
 
 def _shim_primary(source, node, keys, plugin_id):

@@ -11,6 +11,7 @@ user). The result is the one `StabilityReport`, its ``path`` set.
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 from ..analysis.path_laws import MeasuredGains, PurePursuit, path_law
 from ..analysis.path_tracking import PathTracking, analyze_path_tracking
@@ -92,7 +93,7 @@ def path_inputs(robot, controller, tracker, gains, L, pade_order: int, sources: 
     """
     entry = get_controller(tracker.controller)
     out = {"controller": {"value": tracker.controller, "unit": "", "source": sources.get("controller", "user")},
-           "plugin": {"value": tracker.plugin, "unit": "", "source": sources.get("plugin", f"Nav2's {tracker.plugin_id}")}}
+           "plugin": {"value": tracker.plugin, "unit": "", "source": tracker.plugin_source}}
 
     def put(name, value, unit, source):
         out[name] = {"value": value, "unit": unit, "source": source}
@@ -147,6 +148,7 @@ def path_report(robot, controller, tracker, *, gains=None, L=None, models=MODEL_
     law = path_law(tracker.controller, values, costmap=tracker.costmap_values(), half_width=L, gains=gains)
     model_objs = tuple(models_for(controller, tuple(dict.fromkeys(models)), pade_order=pade_order))
     result = analyze_path_tracking(robot, controller, law, model_objs, V_set=robot.V, half_width=L, values=values)
+    result = replace(result, notes=(*tracker.notes, *result.notes))
     remedies = {("path", name): path_remedies(result, v, values, robot, controller) for name, v in result.models.items()}
     inputs = path_inputs(robot, controller, tracker, gains if isinstance(law, MeasuredGains) else None, L, pade_order, sources)
     return inputs, model_objs, result.loop.family, result, remedies
