@@ -10,7 +10,6 @@ user). The result is the one `StabilityReport`, its ``path`` set.
 
 from __future__ import annotations
 
-import math
 from dataclasses import replace
 
 from ..analysis.path_laws import MeasuredGains, PurePursuit, path_law
