@@ -321,7 +321,7 @@ def render_text(report) -> str:
     for name, entry in data["inputs"].items():
         unit = f" {entry['unit']}" if entry["unit"] else ""
         mark = "  <-- " + entry["source"] if entry["source"].startswith("ASSUMED") else f"  ({entry['source']})"
-        label = "V (cruising speed)" if report.path is not None and name == "V" else _label(name)
+        label = _path_label(name) if report.path is not None else _label(name)
         lines.append(f"  {label:<38} {_value(entry['value'])}{unit}{mark}")
     lines += _law_line(data)
     lines += ["", "Models"] + ([] if data["models"] else ["  none: the law has no smooth equilibrium, so no linear model applies"])
@@ -401,7 +401,7 @@ def render_markdown(report) -> str:
              "| input | value | unit | source |", "| --- | --- | --- | --- |"]
     for name, entry in data["inputs"].items():
         source = f"**{entry['source']}**" if entry["source"].startswith("ASSUMED") else entry["source"]
-        lines.append(f"| {_label(name)} | {_value(entry['value'])} | {entry['unit']} | {source} |")
+        lines.append(f"| {_path_label(name) if report.path is not None else _label(name)} | {_value(entry['value'])} | {entry['unit']} | {source} |")
     if report.path is not None:
         lines += ["", "## Models", "", *(f"- {name}: `{entry['equation']}`" for name, entry in data["models"].items()), f"- {_path_substitution(data)}"]
         for title, header, rows, fixes, notes in _path_sections(data):
@@ -435,6 +435,11 @@ _PATH_COLUMNS = (("(V/L)* 1/s", "ratio_critical"), ("V* m/s", "V_critical"), ("L
                  ("t_la* s", "lookahead_time_critical"), ("D* s", "dead_time_critical"), ("T* s", "T_critical"),
                  ("NV* 1/s", "NV_critical"), ("omega* rad/s", "omega_critical"))
 """The path-tracking table's critical-value columns and their JSON keys (a column every model leaves undefined is left out)."""
+
+
+def _path_label(name: str) -> str:
+    """A path-tracking report's input label: the loop's own (`_LABELS`), the cruising speed, or Nav2's parameter name."""
+    return "V (cruising speed)" if name == "V" else _LABELS.get(name, name)
 
 
 def _path_title(data: dict) -> str:
