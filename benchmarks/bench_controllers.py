@@ -32,7 +32,7 @@ CASES = {
     "graceful": "linearize('graceful', GracefulParams(), CorridorCostmap(half_width=0.6))",
     "dwb": "linearize('dwb', DWBParams(), CorridorCostmap(half_width=0.6))",
 }
-PRELUDE = ("from pfm_stability.controllers import CorridorCostmap, linearize; from pfm_stability.controllers.mppi import MPPIParams; "
+PRELUDE = ("from pfm_stability.controllers.costmap import CorridorCostmap; from pfm_stability.controllers.linearize import linearize; from pfm_stability.controllers.mppi import MPPIParams; "
            "from pfm_stability.controllers.rpp import RPPParams; from pfm_stability.controllers.graceful import GracefulParams; "
            "from pfm_stability.controllers.dwb import DWBParams; ")
 REFERENCE = [sys.executable, "-m", "pfm_stability", "report", "--preset", "carmel", "--alpha", "20", "--L", "0.9"]

@@ -27,7 +27,13 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from _common import DEFAULT_OUT, output_dir, save_figure, write_json  # noqa: E402
 
-from pfm_stability.controllers import CONTROLLER_NAMES, CorridorCostmap, default_params, linearize  # noqa: E402
+from pfm_stability.controllers.registry import NAV2_CONTROLLERS as CONTROLLER_NAMES
+
+from pfm_stability.controllers.costmap import CorridorCostmap
+
+from pfm_stability.controllers.base import default_params
+
+from pfm_stability.controllers.linearize import linearize  # noqa: E402
 from pfm_stability.controllers import graceful, rpp  # noqa: E402
 from pfm_stability.parameters import Robot  # noqa: E402
 from pfm_stability.sim.tracking import TrackingScenario  # noqa: E402

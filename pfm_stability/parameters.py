@@ -273,6 +273,11 @@ RANGES = {
     "step": Range(0.0, 1e6, unit="m"),
     "min_length": Range(0.0, 1e4, unit="m"),  # map: shortest segment analysed
     "dilate_upstream": Range(0.0, 1e6, unit="m/s^2"),  # map: braking deceleration of the mask's upstream dilation
+    # a Nav2 controller's measured lateral gains (report --controller mppi|dwb, docs/path_tracking.md)
+    "k_theta": Range(0.0, 1e4, unit="1/s"),
+    "k_y": Range(-1e6, 1e6, low_open=False, unit="1/(m s)"),
+    "k_theta_se": Range(0.0, 1e4, low_open=False, unit="1/s"),
+    "k_y_se": Range(0.0, 1e6, low_open=False, unit="1/(m s)"),
     # integers (closed bounds, checked with `checks.check_integer`)
     "compute_delay": Range(0, 1, low_open=False, unit="samples"),
     "pade_order": Range(1, 12, low_open=False),

@@ -190,6 +190,8 @@ def command_lines(draw, command, outdir):
             value, ok = draw(_integer_values(command, action.type.range_key, action.type.odd))
         elif kind in ("path", "directory"):  # a directory option gets the same paths: new, existing, empty, bad
             value, ok = _path(draw(_mostly(st.just("ok"), st.sampled_from(PATH_KINDS))), outdir), False
+        elif kind == "nav2_param":  # report --param NAME=VALUE: a registry parameter (of some controller) or not, any value
+            value, ok = draw(_nav2_parameters()), False
         else:
             raise AssertionError(f"{command} {name}: an option without a range (type {action.type!r}); give it one in RANGES")
         groups.append([name, value])
@@ -204,6 +206,18 @@ def command_lines(draw, command, outdir):
     if extra:
         groups.insert(draw(st.integers(0, len(groups))), [extra])
     return [command] + [token for group in groups for token in group], inside
+
+
+@st.composite
+def _nav2_parameters(draw):
+    """``NAME=VALUE`` for ``report --param``: a parameter of one of the Nav2 controllers (the controller drawn may not have
+    it), or a made-up name, with a number in or far outside any range, a switch, a text or nothing."""
+    from pfm_stability.controllers.registry import CONTROLLERS
+
+    names = sorted({p.name for c in CONTROLLERS.values() for p in c.parameters})
+    name = draw(_mostly(st.sampled_from(names), st.text(max_size=6)))
+    value = draw(st.one_of(st.floats(allow_nan=True, allow_infinity=True).map(repr), st.sampled_from(["true", "false", "", "x", "[1, 2]"])))
+    return f"{name}={value}"
 
 
 def _reject_constant(token):
@@ -397,7 +411,7 @@ def test_every_option_is_fuzzed():
     for command in SUBPARSERS:
         options, _ = _options(command)
         for name, action in options.items():
-            assert action.nargs == 0 or action.choices is not None or getattr(action.type, "kind", None) in ("number", "integer", "path", "directory", "address", "topic"), (command, name)
+            assert action.nargs == 0 or action.choices is not None or getattr(action.type, "kind", None) in ("number", "integer", "path", "directory", "address", "topic", "nav2_param"), (command, name)
 
 
 # -------------------------------------------- once tracebacks, now defined answers

@@ -9,7 +9,13 @@ import numpy as np
 import pytest
 from scipy.signal import savgol_coeffs
 
-from pfm_stability.controllers import CorridorCostmap, NoValidControl, RobotState, linearize, straight_plan
+from pfm_stability.controllers.costmap import CorridorCostmap
+
+from pfm_stability.controllers.base import NoValidControl, RobotState
+
+from pfm_stability.controllers.linearize import linearize
+
+from pfm_stability.controllers.plan import straight_plan
 from pfm_stability.controllers import dwb, mppi
 from pfm_stability.controllers.mppi import _reset, _rollout_velocities
 from pfm_stability.controllers.mppi_critics import F, closest_path_points

@@ -11,7 +11,11 @@ import math
 import numpy as np
 import pytest
 
-from pfm_stability.controllers import CorridorCostmap, Inflation, Plan, RobotState, local_plan, lookahead_point, straight_plan
+from pfm_stability.controllers.costmap import CorridorCostmap, Inflation
+
+from pfm_stability.controllers.plan import Plan, local_plan, lookahead_point, straight_plan
+
+from pfm_stability.controllers.base import RobotState
 from pfm_stability.controllers.plan import closest_pose, prune
 
 

@@ -14,7 +14,13 @@ import numpy as np
 import pytest
 import sympy as sp
 
-from pfm_stability.controllers import CorridorCostmap, RobotState, linearize, straight_plan
+from pfm_stability.controllers.costmap import CorridorCostmap
+
+from pfm_stability.controllers.base import RobotState
+
+from pfm_stability.controllers.linearize import linearize
+
+from pfm_stability.controllers.plan import straight_plan
 from pfm_stability.controllers import graceful, rpp
 
 FREE = CorridorCostmap(width=6.0, height=6.0)  # 3 m of plan ahead: the lookaheads drawn (<= 2 m) fit

@@ -13,7 +13,9 @@ import math
 import numpy as np
 import pytest
 
-from pfm_stability.controllers import CorridorCostmap, linearize
+from pfm_stability.controllers.costmap import CorridorCostmap
+
+from pfm_stability.controllers.linearize import linearize
 from pfm_stability.controllers import graceful, rpp
 from pfm_stability.models import Loop, make_model
 from pfm_stability.parameters import Robot

@@ -39,6 +39,9 @@ __all__ = [
     "add_family_options",
     "resolve_family",
     "ResolvedFamily",
+    "add_controller_options",
+    "resolve_tracker",
+    "ResolvedTracker",
 ]
 
 def _shown(key: str) -> str:
@@ -309,7 +312,7 @@ SCENARIO_OPTIONS = {"alpha": ("wall", "alpha", "alpha_deg"), "L": ("corridor", "
 option → (geometry, key, name in the sources)."""
 
 
-def resolve_parameters(args, *, fill=None) -> ResolvedParameters:
+def resolve_parameters(args, *, fill=None, notes: bool = True) -> ResolvedParameters:
     """Apply the user's overrides to the configuration file and the preset (validated by the dataclasses).
 
     Precedence: an option typed > ``--config FILE`` > the file's ``preset`` (or a
@@ -324,6 +327,8 @@ def resolve_parameters(args, *, fill=None) -> ResolvedParameters:
         The parsed options.
     fill : tuple of str, keyword only, optional
         The scenario options a configuration file may fill (None: every one the command has).
+    notes : bool, keyword only
+        Whether to print the file's notes (a Nav2 controller's report reads the file for its controller instead).
     """
     config = None
     if getattr(args, "config", None) is not None:
@@ -357,7 +362,7 @@ def resolve_parameters(args, *, fill=None) -> ResolvedParameters:
         sources.update(_fill_scenario(args, config, SCENARIO_OPTIONS if fill is None else fill))
         if "max_steering_rate" in config.sources:  # a Nav2 velocity smoother's clamp (io.nav2.read_velocity_smoother)
             sources["max_steering_rate"] = config.sources["max_steering_rate"]
-        for note in config.notes:
+        for note in config.notes if notes else ():
             print(f"pfm-stability: note: {note}", file=sys.stderr)
     return ResolvedParameters(preset, robot, controller, sources, config)
 
@@ -563,3 +568,213 @@ def resolve_family(args, params: ResolvedParameters) -> ResolvedFamily:
     built = make_family_law(law.name, choices, **given, **filed)
     sources.update({s.key: "user" if s.key in given else config.sources[s.key] if s.key in filed else s.source for s in law.settings})
     return ResolvedFamily(family, built, mass, sources)
+
+
+# ------------------------------------------------------------------ path-tracking controllers (report --controller)
+def add_controller_options(parser: argparse.ArgumentParser) -> None:
+    """--controller, --param, --k-theta, --k-y, --k-theta-se and --k-y-se (``report`` only; docs/path_tracking.md).
+
+    Parameters
+    ----------
+    parser : argparse.ArgumentParser
+        The ``report`` subcommand's parser.
+    """
+    from ..controllers.registry import CONTROLLER_NAMES, DEFAULT_CONTROLLER
+
+    group = parser.add_argument_group("path-tracking controller (docs/path_tracking.md)")
+    group.add_argument("--controller", choices=(*CONTROLLER_NAMES, "auto"), default=Default(DEFAULT_CONTROLLER),
+                       help="the loop analysed: vff (the VFF force law, default) or a Nav2 controller tracking a straight path "
+                            "(--L: a corridor): rpp, graceful, mppi, dwb, or auto (the --config Nav2 file's FollowPath plugin); "
+                            "--V is its cruising speed")
+    group.add_argument("--param", action="append", metavar="NAME=VALUE", type=nav2_parameter,
+                       help="a Nav2 parameter of the controller, e.g. lookahead_dist=0.8 (repeatable; overrides the --config file)")
+    group.add_argument("--k-theta", type=number("k_theta"),
+                       help=f"mppi, dwb: the measured gain k_theta = -d omega/d e_theta at --V, {describe('k_theta')}")
+    group.add_argument("--k-y", type=number("k_y"), help=f"mppi, dwb: the measured gain k_y = -d omega/d e_y at --V, {describe('k_y')}")
+    group.add_argument("--k-theta-se", type=number("k_theta_se"), help=f"its standard error, {describe('k_theta_se')} (default 0)")
+    group.add_argument("--k-y-se", type=number("k_y_se"), help=f"its standard error, {describe('k_y_se')} (default 0)")
+
+
+def nav2_parameter(text: str) -> tuple:
+    """An argparse ``type=`` for ``--param NAME=VALUE``: (name, value parsed by the YAML rule); the controller checks both
+    (`resolve_tracker`, the registry's ranges).
+
+    Parameters
+    ----------
+    text : str
+        ``NAME=VALUE``.
+    """
+    key, sep, raw = text.partition("=")
+    if not sep or not key.strip() or not raw.strip():
+        raise argparse.ArgumentTypeError(f"--param must be NAME=VALUE (a Nav2 parameter of the controller); got {text!r}")
+    from ..io.yaml_files import InputError, parse_yaml
+
+    try:
+        value = parse_yaml(raw.strip())
+    except InputError:
+        value = raw.strip()
+    return key.strip(), value
+
+
+nav2_parameter.kind = "nav2_param"  # the command-line fuzzer draws NAME=VALUE of the registry
+
+
+@dataclass(frozen=True)
+class ResolvedTracker:
+    """A Nav2 controller of ``report --controller`` after the options.
+
+    Attributes
+    ----------
+    tracker : io.nav2.Nav2Tracker
+        The controller with its parameters (the ``--config`` Nav2 file's, Nav2's defaults, ``--param``).
+    gains : analysis.path_laws.MeasuredGains or None
+        MPPI's or DWB's measured gains.
+    robot, controller : Robot, Controller
+        With V the controller's cruising speed and T its period unless typed.
+    sources : dict
+        The provenance of every robot and controller value and of the controller's name.
+    """
+
+    tracker: object
+    gains: object
+    robot: Robot
+    controller: Controller
+    sources: dict
+
+
+_PLANT_ASSUMED = {
+    "tau": "the robot's steering lag is not in a Nav2 file; this is the preset's (measure yours: pfm-stability identify, docs/diagnose.md)",
+    "dead_time": "the latency from cmd_vel to the robot's turning is not in a Nav2 file; this is the preset's (measure yours: "
+                 "pfm-stability identify, docs/diagnose.md)",
+    "plant_gain": "the turning the drive delivers per commanded yaw rate is not in a Nav2 file; this is the preset's (pfm-stability identify)",
+    "actuator_lag": "a second lag of the drive is not in a Nav2 file; this is the preset's (pfm-stability identify)",
+    "hold": "the base holds the last cmd_vel between controller cycles",
+    "compute_delay": "the controller server publishes a command as soon as it is computed: 0 samples (the computation time is part of "
+                     "the dead time D)",
+}
+"""Why a plant or structure value of a Nav2 controller's report that came from a preset is an assumption."""
+
+
+def resolve_tracker(args, params: ResolvedParameters) -> ResolvedTracker | None:
+    """``--controller`` and its options: None for ``vff``; else the controller, its parameters and the robot it drives.
+
+    The controller's parameters: ``--param`` > the ``--config`` Nav2 file (``controller_server``'s first controller
+    plugin, `io.nav2.read_path_tracker`) > Nav2's declared defaults (ASSUMED). V: ``--V`` > the controller's speed
+    parameter; T: ``--T`` > the file's ``controller_frequency`` > Nav2's 20 Hz. The plant and the structure a preset
+    gave are marked ASSUMED (`_PLANT_ASSUMED`; the compute delay 0 samples).
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed options.
+    params : ResolvedParameters
+        The robot and controller (`resolve_parameters`).
+
+    Raises
+    ------
+    ValueError
+        An option the controller does not take, an unknown ``--param`` or a value out of its range, ``auto``
+        without a Nav2 file, MPPI or DWB without ``--k-theta`` and ``--k-y``.
+    """
+    from ..controllers.registry import NAV2_CONTROLLERS, get_controller
+
+    name = str(getattr(args, "controller", "vff"))
+    extras = [opt for opt, value in (("--param", args.param), *((f"--{k.replace('_', '-')}", getattr(args, k)) for k in _GAINS))
+              if value is not None]
+    if name == "vff":
+        if extras:
+            raise ValueError(f"{extras[0]} applies to --controller {', '.join(NAV2_CONTROLLERS)}, not to --controller vff")
+        return None
+    tracker = _tracker_of(args, params, name)
+    entry = get_controller(tracker.controller)
+    given = [f"--{k.replace('_', '-')}" for k in _GAINS if getattr(args, k) is not None]
+    if entry.linearisation == "closed form" and given:
+        raise ValueError(f"{given[0]} applies to --controller mppi or dwb (numeric gains); --controller {tracker.controller} "
+                         "has a closed-form linearisation")
+    tracker = _with_params(tracker, entry, args.param or [])
+    robot, controller, sources, tracker = _tracker_robot(args, params, tracker, entry)
+    gains = _gains(args, tracker.controller, robot.V) if entry.linearisation == "numeric" else None
+    sources["controller"] = "user" if name != "auto" else f"auto: {tracker.plugin_id}.plugin of --config {params.config.path}"
+    return ResolvedTracker(tracker, gains, robot, controller, sources)
+
+
+def _tracker_of(args, params: ResolvedParameters, name: str):
+    """The controller from the ``--config`` Nav2 file (its plugin must be `name`, unless ``auto``), else Nav2's defaults."""
+    from ..io.nav2 import default_tracker, is_nav2, read_path_tracker
+    from ..io.yaml_files import read_yaml
+
+    if params.config is not None and params.config.path is not None:
+        document = read_yaml(params.config.path, "config")
+        if is_nav2(document.data):
+            from dataclasses import replace
+
+            return read_path_tracker(replace(document, origin=f"Nav2 {params.config.path}"), None if name == "auto" else name)
+    if name == "auto":
+        raise ValueError("--controller auto takes the controller from a Nav2 parameters file: give --config nav2_params.yaml")
+    return default_tracker(name, "no Nav2 file given" if params.config is None else f"--config {params.config.path} is no Nav2 file")
+
+
+_GAINS = ("k_theta", "k_y", "k_theta_se", "k_y_se")
+"""The measured gains' options (``--k-theta`` …)."""
+
+
+def _with_params(tracker, entry, given: list):
+    """The tracker with each ``--param NAME=VALUE`` (`nav2_parameter`) set: the registry's check; the speed is ``--V``."""
+    from dataclasses import replace
+
+    from ..io.nav2 import Nav2Setting
+
+    parameters = dict(tracker.parameters)
+    for key, value in given:
+        parameter = entry.parameter(key)
+        if parameter.name == entry.speed:
+            raise ValueError(f"--param {key}: the cruising speed is --V (m/s)")
+        parameters[parameter.name] = Nav2Setting(parameter.check(value, f"--param {parameter.name}"), "user")
+    return replace(tracker, parameters=parameters)
+
+
+def _tracker_robot(args, params: ResolvedParameters, tracker, entry) -> tuple:
+    """(robot, controller, sources, tracker): V the controller's speed and T its period unless typed; the preset's plant
+    and structure ASSUMED (`_PLANT_ASSUMED`)."""
+    from dataclasses import replace
+
+    from ..io.nav2 import Nav2Setting
+
+    sources = dict(params.sources)
+    robot, controller = params.robot, params.controller
+    speed = tracker.parameters[entry.speed]
+    if sources["V"] == "user":
+        tracker = replace(tracker, parameters={**tracker.parameters, entry.speed: Nav2Setting(robot.V, "user")})
+    else:
+        if not speed.value > 0:
+            raise ValueError(f"--controller {entry.name}: {entry.speed} is {speed.value:g} m/s ({speed.source}); give the cruising speed, --V")
+        robot, sources["V"] = robot.replace(V=speed.value), speed.named(entry.speed, f"{speed.value:g} m/s")
+    if not (sources["T"] == "user" or sources["T"].startswith("Nav2 ")):
+        frequency = tracker.frequency
+        controller = replace(controller, T=1.0 / frequency.value)
+        sources["T"] = frequency.named("controller_frequency", f"{frequency.value:g} Hz")
+    for name, why in _PLANT_ASSUMED.items():
+        preset = _preset_of(sources.get(name, ""))
+        if preset is not None:
+            sources[name] = f"ASSUMED (preset {preset}): {why}"
+            if name == "compute_delay":
+                controller = replace(controller, compute_delay=0)
+    return robot, controller, sources, tracker
+
+
+def _preset_of(source: str) -> str | None:
+    """The preset a value came from (``"preset carmel"``, ``"ASSUMED (preset carmel): why"``), or None."""
+    for head in ("preset ", "ASSUMED (preset "):
+        if source.startswith(head):
+            return source[len(head):].split(")")[0].split()[0]
+    return None
+
+
+def _gains(args, controller: str, V: float):
+    """MPPI's or DWB's `MeasuredGains` from ``--k-theta`` and ``--k-y`` (required) and their standard errors."""
+    from ..analysis.path_laws import MeasuredGains
+
+    if args.k_theta is None or args.k_y is None:
+        raise ValueError(f"--controller {controller} has no closed-form linearisation: give the gains measured from the algorithm, "
+                         "--k-theta and --k-y (docs/path_tracking.md)")
+    return MeasuredGains(controller, args.k_theta, args.k_y, V, args.k_theta_se or 0.0, args.k_y_se or 0.0)

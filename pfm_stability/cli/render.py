@@ -196,6 +196,11 @@ def _starred(verdict: dict, key: str, marked: bool) -> str:
     return f"{'<=' if side == 'below' else '>='} {number(value)}"
 
 
+def _value(value) -> str:
+    """An input's value as text: a number by `number`, true/false for a Nav2 switch."""
+    return str(value).lower() if isinstance(value, bool) else number(value)
+
+
 def _label(name: str) -> str:
     """An input's label (`_LABELS`, or the robot families' `render_families.FAMILY_LABELS`)."""
     if name in _LABELS:
@@ -353,16 +358,26 @@ def render_text(report) -> str:
         The report.
     """
     data = report.to_dict()
-    lines = ["pfm-stability report (Koren & Borenstein 1991 robot-environment loop)", "", "Inputs"]
+    title = "pfm-stability report (Koren & Borenstein 1991 robot-environment loop)" if report.path is None else _path_title(data)
+    lines = [title, "", "Inputs"]
     for name, entry in data["inputs"].items():
         unit = f" {entry['unit']}" if entry["unit"] else ""
         mark = "  <-- " + entry["source"] if entry["source"].startswith("ASSUMED") else f"  ({entry['source']})"
-        lines.append(f"  {_label(name):<38} {number(entry['value'])}{unit}{mark}")
+        label = _path_label(name) if report.path is not None else _label(name)
+        lines.append(f"  {label:<38} {_value(entry['value'])}{unit}{mark}")
     lines += _law_line(data)
     lines += ["", "Models"] + ([] if data["models"] else ["  none: the law has no smooth equilibrium, so no linear model applies"])
     for name, entry in data["models"].items():
         options = ", ".join(f"{k}={v}" for k, v in entry.items() if k != "equation")
         lines.append(f"  {name:<15} {entry['equation']}{'  [' + options + ']' if options else ''}")
+    if report.path is not None:
+        lines.append(f"  {_path_substitution(data)}")
+        for title, header, rows, fixes, notes in _path_sections(data):
+            lines += ["", title, *notes]
+            lines += ["  " + line for line in table(header, rows)]
+            lines += [_path_remedy_line(model, fix, data) for model, fix in fixes.items()]
+        lines += ["", *_path_footnote(data)]
+        return "\n".join(lines) + "\n"
     for title, header, rows, fixes, notes in _scenarios(report, data):
         lines += ["", title]
         lines += ["  " + line for line in table(header, rows)]
@@ -426,10 +441,19 @@ def render_markdown(report) -> str:
         The report.
     """
     data = report.to_dict()
-    lines = ["# pfm-stability report", "", "| input | value | unit | source |", "| --- | --- | --- | --- |"]
+    lines = ["# pfm-stability report" + ("" if report.path is None else f": {_path_title(data)[len('pfm-stability report: '):]}"), "",
+             "| input | value | unit | source |", "| --- | --- | --- | --- |"]
     for name, entry in data["inputs"].items():
         source = f"**{entry['source']}**" if entry["source"].startswith("ASSUMED") else entry["source"]
-        lines.append(f"| {_label(name)} | {number(entry['value'])} | {entry['unit']} | {source} |")
+        lines.append(f"| {_path_label(name) if report.path is not None else _label(name)} | {_value(entry['value'])} | {entry['unit']} | {source} |")
+    if report.path is not None:
+        lines += ["", "## Models", "", *(f"- {name}: `{entry['equation']}`" for name, entry in data["models"].items()), f"- {_path_substitution(data)}"]
+        for title, header, rows, fixes, notes in _path_sections(data):
+            lines += ["", f"## {title}", "", *(f"- {note.strip()}" for note in notes), "", "| " + " | ".join(header) + " |", "|" + " --- |" * len(header)]
+            lines += ["| " + " | ".join(str(c) for c in r) + " |" for r in rows]
+            lines += ["", *("-" + _path_remedy_line(model, fix, data)[1:] for model, fix in fixes.items())] if fixes else []
+        lines += ["", *_path_footnote(data)]
+        return "\n".join(lines) + "\n"
     lines += _law_line(data)
     for title, header, rows, fixes, notes in _scenarios(report, data):
         lines += ["", f"## {title}", "", "| " + " | ".join(header) + " |", "|" + " --- |" * len(header)]
@@ -446,6 +470,99 @@ def render_markdown(report) -> str:
     lines += _footnote(report)
     lines += _kb_error_line(report)
     return "\n".join(lines) + "\n"
+
+
+# ------------------------------------------------------------------ report --controller (docs/path_tracking.md)
+_PATH_TITLES = {"rpp": "Regulated Pure Pursuit", "graceful": "the Graceful controller", "mppi": "MPPI", "dwb": "DWB"}
+
+_PATH_COLUMNS = (("(V/L)* 1/s", "ratio_critical"), ("V* m/s", "V_critical"), ("L* m", "lookahead_critical"),
+                 ("t_la* s", "lookahead_time_critical"), ("D* s", "dead_time_critical"), ("T* s", "T_critical"),
+                 ("NV* 1/s", "NV_critical"), ("omega* rad/s", "omega_critical"))
+"""The path-tracking table's critical-value columns and their JSON keys (a column every model leaves undefined is left out)."""
+
+
+def _path_label(name: str) -> str:
+    """A path-tracking report's input label: the loop's own (`_LABELS`), the cruising speed, or Nav2's parameter name."""
+    return "V (cruising speed)" if name == "V" else _LABELS.get(name, name)
+
+
+def _path_title(data: dict) -> str:
+    env = data["environment"]["path"]
+    where = f"in a corridor of half-width L = {number(env['L_corridor'])} m" if env["L_corridor"] is not None else "on a straight path"
+    return f"pfm-stability report: Nav2's {_PATH_TITLES[env['controller']]} tracking {where} (docs/path_tracking.md)"
+
+
+def _path_substitution(data: dict) -> str:
+    """The line after the models' equations: what k and NV are for this controller."""
+    env = data["environment"]["path"]
+    law = env["law"]
+    forms = {"rpp": "k = k_theta = 2 V/L, NV = k_y V/k_theta = V/L (the carrot's curvature 2 y_L/L^2 times V)",
+             "graceful": "k = k_theta = V (1 + k_phi + k_delta)/L, NV = V (1 + k_phi)(1 + k_delta)/(L (1 + k_phi + k_delta)) "
+                         "(the smooth control law about the motion target)"}
+    form = forms.get(env["controller"], "k = k_theta, NV = k_y V/k_theta (the measured gains)")
+    return f"with omega = -k_theta e_theta - k_y e_y: {form}; the heading is sampled by the controller (delayed T + D)"
+
+
+def _path_sections(data: dict):
+    """Yield (title, header, rows, remedies, notes) of the path-tracking table, from the report's JSON form."""
+    env, verdicts = data["environment"]["path"], data["path"]
+    law = env["law"]
+    lookahead = f", L = {number(law['L'])} m (V/L = {number(law['ratio'])} 1/s)" if law["L"] is not None else ""
+    regulated = f" (regulated from {number(law['V_set'])})" if law["V"] != law["V_set"] else ""
+    title = (f"Lateral loop: V = {number(law['V'])} m/s{regulated}{lookahead}: k_theta = {number(law['k_theta'])} 1/s, "
+             f"k_y = {number(law['k_y'])} 1/(m s); NV = {number(law['NV'])} 1/s")
+    notes = [f"  {note}" for note in env["notes"]]
+    if "k_theta_se" in law and (law["k_theta_se"] or law["k_y_se"]):
+        notes.append(f"  gains' standard errors: k_theta +- {number(law['k_theta_se'])} 1/s, k_y +- {number(law['k_y_se'])} 1/(m s) "
+                     "(the verdict over +-2 of them: column 'over gains')")
+    notes += _reason_lines(verdicts)
+    columns = [(head, key) for head, key in _PATH_COLUMNS if any(v.get(key) is not None for v in verdicts.values())]
+    ranged = any("margin_range" in v for v in verdicts.values())
+    header = ["model", "verdict", "margin"] + (["over gains"] if ranged else []) + [head for head, _ in columns]
+    rows = []
+    for name, v in verdicts.items():
+        cells = [name, v["verdict"].upper() if v["verdict"] != "stable" else "stable", percent(v["margin"])]
+        if ranged:
+            low, high = v.get("margin_range", (None, None))
+            cells.append(f"{v.get('verdict_range')} ({percent(low)} .. {percent(high)})" if low is not None else "-")
+        cells += [number(v.get(key)) for _, key in columns]
+        rows.append(cells)
+    fixes = {name: v["to_stabilize"] for name, v in verdicts.items() if v["verdict"] != "stable"}
+    yield title, header, rows, fixes, notes
+    delay = env.get("model_delay")
+    if delay is not None:
+        yield ("MPPI's model delay", [], [], {}, [
+            f"  set model_delay_wz (and model_delay_vx) to {number(delay['recommended'])} s = {delay['steps']} x model_dt "
+            f"{number(delay['model_dt'])} s: the latency D + d T = {number(delay['latency'])} s rounded as MPPI rounds it "
+            f"(now {number(delay['current'])} s; model_dt should be the controller's period)"])
+
+
+def _path_remedy_line(model: str, fix: dict, data: dict) -> str:
+    """One model's remedies in Nav2's names and units (`report.path.path_remedies`)."""
+    if not fix:
+        return f"  to stabilize ({model}): no single change of the speed, the lookahead, D or T helps; change several"
+    from ..controllers.registry import get_controller
+
+    controller = get_controller(data["environment"]["path"]["controller"])
+    parts = []
+    for name, entry in fix.items():
+        unit = RANGES[name].unit if name in RANGES else controller.parameter(name).unit
+        bound = ">=" if entry["direction"] == "raise" else "<="
+        change = f" ({entry['change_percent']:+.0f} %)" if "change_percent" in entry else ""
+        extra = f" (controller_frequency >= {number(1.0 / entry['to'])} Hz)" if name == "T" else ""
+        parts.append(f"{entry['direction']} {name} to {bound} {number(entry['to'])}{(' ' + unit) if unit else ''}{change}{extra}")
+    return f"  to stabilize ({model}), change one of: " + "; ".join(parts)
+
+
+def _path_footnote(data: dict) -> list[str]:
+    env = data["environment"]["path"]
+    measured = env["controller"] in ("mppi", "dwb")
+    margin = ("margin = NV*/NV - 1 with the measured gains held (how much V may grow)" if measured else
+              "margin = (V/L)*/(V/L) - 1: how much the speed over the lookahead may grow before the first loss of stability")
+    return [margin + ". Starred values are critical with the other inputs fixed: stable below (V/L)*, V* (the cruising speed, "
+            "the regulated speed and lookahead moving with it), D* (the robot's dead time, T fixed) and T* (the controller's period, "
+            "D fixed); above L* (the lookahead that steers) and t_la* (lookahead_time, velocity-scaled). inf = no limit; "
+            "0 = none stable; - = undefined. The loop's plant is g e^(-sD)/((tau s + 1)(tau_a s + 1)); docs/path_tracking.md."]
 
 
 # ---------------------------------------------------------------- derivation

@@ -3,9 +3,10 @@ and force law (``--law``, docs/fields.md, docs/velocity_and_fuzzy.md): `report.s
 
 from __future__ import annotations
 
-from ..laws.registry import FAMILY_LAWS, FORCE_LAWS
+from ..laws.registry import FAMILY_LAWS, FORCE_LAWS, choice_keys, option_name, parameter_keys
 from ..parameters import DOOR_OBSTACLES, MODEL_NAMES
-from .options import PADE_ORDER, add_family_options, add_law_options, add_parameter_options, describe, number, resolve_family, resolve_parameters
+from .options import (PADE_ORDER, typed, add_controller_options, add_family_options, add_law_options, add_parameter_options, describe, number,
+                      resolve_family, resolve_parameters, resolve_tracker)
 
 FORMATS = ("text", "json", "markdown")
 DEFAULT_PADE_ORDER = 3
@@ -20,6 +21,7 @@ def add_parser(sub) -> None:
     add_parameter_options(p)
     add_law_options(p, FORCE_LAWS + FAMILY_LAWS)
     add_family_options(p)
+    add_controller_options(p)
     p.add_argument("--alpha", type=number("alpha_deg"), help=f"wall: target angle from the wall normal, {describe('alpha_deg')}")
     p.add_argument("--L", type=number("L"), help=f"corridor half-width, {describe('L')}, and more than W/2")
     p.add_argument("--door", type=number("door"), metavar="WIDTH",
@@ -45,12 +47,48 @@ def add_parser(sub) -> None:
 
 def run(args) -> int:
     from ..io.serialize import dumps
-    from ..report.stability import build_report
     from .render import render_markdown, render_text
 
-    params = resolve_parameters(args)
+    params = resolve_parameters(args, notes=str(args.controller) == "vff")  # a Nav2 controller's notes are its report's
+    path = resolve_tracker(args, params)
+    if path is not None:
+        report = _path_report(args, path)
+    else:
+        report = _vff_report(args, params)
+    if args.format == "json":
+        print(dumps(report.to_dict()))
+    elif args.format == "markdown":
+        print(render_markdown(report), end="")
+    else:
+        print(render_text(report), end="")
+    return 0
+
+
+def _path_report(args, path):
+    """A Nav2 controller's report (`report.stability.build_report` with its ``tracker``; docs/path_tracking.md)."""
+    from ..report.stability import build_report
+
+    vff_only = [("--law", typed(args, "law")), ("--robot", typed(args, "robot")), ("--mass", args.mass is not None)]
+    vff_only += [(f"--{key.replace('_', '-')}", path.sources.get(key) == "user") for key in ("k", "f", "n", "W")]
+    vff_only += [(option_name(key), getattr(args, key, None) is not None) for key in (*parameter_keys(), *choice_keys())]
+    for option, given in vff_only:
+        if given:
+            raise ValueError(f"{option} applies to --controller vff (the VFF loop), not to --controller {path.tracker.controller} "
+                             "(its gains are its own law's, docs/path_tracking.md)")
+    return build_report(
+        path.robot, path.controller, alpha_deg=args.alpha, L=args.L, door=args.door, wobble=args.wobble,
+        models=tuple(dict.fromkeys(args.model)) if args.model else MODEL_NAMES, pade_order=args.pade_order,
+        sources={"L": "user", **path.sources, "pade_order": "user" if args.pade_order != DEFAULT_PADE_ORDER else "default"},
+        tracker=path.tracker, gains=path.gains,
+    )
+
+
+def _vff_report(args, params):
+    """Today's report: the VFF loop for the robot family and law of the options."""
+    from ..report.stability import build_report
+
     chosen = resolve_family(args, params)
-    report = build_report(
+    return build_report(
         params.robot,
         params.controller,
         family=chosen.family,
@@ -71,13 +109,6 @@ def run(args) -> int:
         wobble=args.wobble,
         disturbance=args.disturbance,
     )
-    if args.format == "json":
-        print(dumps(report.to_dict()))
-    elif args.format == "markdown":
-        print(render_markdown(report), end="")
-    else:
-        print(render_text(report), end="")
-    return 0
 
 
 def _simulated_cycle(*args, **kwargs) -> dict:

@@ -18,7 +18,7 @@ import numpy as np
 
 from ..checks import check_number
 
-__all__ = ["RobotState", "Command", "NoValidControl", "normalize_angle"]
+__all__ = ["RobotState", "Command", "NoValidControl", "normalize_angle", "controller_module", "default_params"]
 
 
 @dataclass(frozen=True)
@@ -92,3 +92,35 @@ def normalize_angle(angle):
     a = np.asarray(angle)
     wrapped = np.mod(a + math.pi, 2.0 * math.pi) - math.pi
     return float(wrapped) if np.ndim(wrapped) == 0 else wrapped
+
+
+_PARAMS = {"rpp": "RPPParams", "graceful": "GracefulParams", "mppi": "MPPIParams", "dwb": "DWBParams"}
+"""Each Nav2 controller's parameters class, in its module."""
+
+
+def controller_module(name: str):
+    """The module of a Nav2 controller (its ``command``, parameters class, ``with_speed``, ``LINEARIZATION_STEPS``).
+
+    Parameters
+    ----------
+    name : str
+        One of `controllers.registry.NAV2_CONTROLLERS`.
+    """
+    import importlib
+
+    from .registry import NAV2_CONTROLLERS
+
+    if name not in NAV2_CONTROLLERS:
+        raise ValueError(f"controller must be one of {', '.join(NAV2_CONTROLLERS)}; got {name!r}")
+    return importlib.import_module(f"{__package__}.{name}")
+
+
+def default_params(name: str):
+    """A Nav2 controller's parameters with Nav2's defaults.
+
+    Parameters
+    ----------
+    name : str
+        One of `controllers.registry.NAV2_CONTROLLERS`.
+    """
+    return getattr(controller_module(name), _PARAMS[name])()

@@ -158,7 +158,7 @@ def centre_plan(length: float, spacing: float):
 
 
 def _module(name: str):
-    from . import controller_module
+    from .base import controller_module
 
     return controller_module(name)
 

@@ -24,7 +24,6 @@ Nothing here computes a command or reads a sensor: the controller is `engines.mu
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np

@@ -45,7 +45,7 @@ from ..sim.grid import HistogramGrid
 from ..sim.metrics import oscillation_metrics
 from ..sim.results import BatchResult, RunResult, Trajectory
 from ..sim.vff import cell_repulsion, direction_of, steering_command, wrap_angle
-from ..controllers import CONTROLLER_NAMES
+from ..controllers.registry import NAV2_CONTROLLERS as CONTROLLER_NAMES
 from .command_path import CommandPath, Timing, VelocitySmoother
 from .robots import WALL_GROUP, check_drives, corridor_world, heading, load_robot_model, place
 
@@ -171,7 +171,10 @@ class _Nav2Driver:
     """
 
     def __init__(self, options: EngineOptions, scenario, L: float):
-        from ..controllers import CorridorCostmap, configure, controller_module, default_params, straight_plan
+        from ..controllers.costmap import CorridorCostmap
+        from ..controllers.linearize import configure
+        from ..controllers.base import controller_module, default_params
+        from ..controllers.plan import straight_plan
         from ..controllers.linearize import warm_up
 
         r, c = scenario.robot, scenario.controller
@@ -200,7 +203,7 @@ class _Nav2Driver:
         theta : float
             Its heading, rad (from +Y towards +X).
         """
-        from ..controllers import NoValidControl, RobotState
+        from ..controllers.base import NoValidControl, RobotState
         from ..controllers.plan import prune
 
         vx, vy = float(data.qvel[dof]), float(data.qvel[dof + 1])  # world frame; the angular part is the body's: z is up

@@ -220,22 +220,8 @@ def _width(data, source):
 
 
 def _footprint_ys(source, key, location, footprint) -> list:
-    """The y of each vertex of a footprint (a list, or Nav2's string ``"[[x, y], …]"``, read by the file rule), m."""
-    error = source.error(f"{key} must be a polygon [[x, y], ...] of at least 3 points of finite numbers (m); got {footprint!r}", location)
-    points = footprint
-    if isinstance(footprint, str):
-        try:
-            points = parse_yaml(footprint)
-        except InputError:
-            raise error from None
-    if not isinstance(points, list) or len(points) < 3:
-        raise error
-    ys = []
-    for point in points:
-        if not (isinstance(point, list) and len(point) == 2 and all(_finite(c) for c in point)):
-            raise error
-        ys.append(float(point[1]))
-    return ys
+    """The y of each vertex of a footprint (`_footprint_points`), m."""
+    return [y for _, y in _footprint_points(source, key, location, footprint)]
 
 
 def _finite(value) -> bool:
@@ -247,6 +233,274 @@ def _check(source, key, location, value, low, high, unit, *, low_open=True, high
         return check_number(key, value, low, high, low_open=low_open, high_open=high_open, unit=unit)
     except ValueError as exc:
         raise source.error(str(exc), location) from None
+
+
+# ------------------------------------------------------------------ the path tracker (report --controller)
+@dataclass(frozen=True)
+class Nav2Setting:
+    """One value the path-tracking analysis reads, with where it came from.
+
+    Attributes
+    ----------
+    value : object
+        The value (SI units).
+    source : str
+        ``"Nav2 FILE: controller_server.FollowPath.lookahead_dist = 0.8"``, or ``"ASSUMED (…): why"`` for a default.
+    """
+
+    value: object
+    source: str
+
+    @property
+    def assumed(self) -> bool:
+        """Whether the value is an assumption (not in the file)."""
+        return self.source.startswith("ASSUMED")
+
+    def named(self, name: str, shown: str) -> str:
+        """The source naming the parameter it is the value of: an assumed default as ``ASSUMED (Nav2's default
+        name = shown, file): why`` (a value the file or the user gave names itself already).
+
+        Parameters
+        ----------
+        name : str
+            The parameter's name.
+        shown : str
+            Its value as text, with its unit.
+        """
+        head = "ASSUMED (Nav2's default, "
+        if self.source.startswith(head):
+            return f"ASSUMED (Nav2's default {name} = {shown}, {self.source[len(head):]}"
+        return self.source
+
+
+@dataclass(frozen=True)
+class Nav2Tracker:
+    """A Nav2 path tracker as a parameters file (or Nav2's defaults) gives it (`read_path_tracker`, `default_tracker`).
+
+    Attributes
+    ----------
+    controller : str
+        Its short name (`controllers.registry.CONTROLLER_NAMES`).
+    plugin : str
+        The pluginlib class followed (``nav2_regulated_pure_pursuit_controller::RegulatedPurePursuitController``).
+    plugin_id : str
+        Its name in ``controller_plugins`` (``FollowPath``).
+    parameters : dict
+        Every registry parameter of the controller → `Nav2Setting`.
+    frequency : Nav2Setting
+        ``controller_frequency``, Hz.
+    costmap : dict
+        ``inscribed_radius``, ``inflation_radius`` (m), ``cost_scaling_factor`` (1/m), ``resolution`` (m) → `Nav2Setting`.
+    notes : tuple of str
+        What the file's structure implied (a Rotation Shim's primary controller, several controller plugins).
+    plugin_source : str
+        Where the plugin came from (the file's key, Nav2's default, the command line).
+    """
+
+    controller: str
+    plugin: str
+    plugin_id: str
+    parameters: dict
+    frequency: Nav2Setting
+    costmap: dict
+    notes: tuple = ()
+    plugin_source: str = "--controller"
+
+    def values(self) -> dict:
+        """Parameter name → value."""
+        return {name: s.value for name, s in self.parameters.items()}
+
+    def costmap_values(self) -> dict:
+        """``inscribed_radius``, ``inflation_radius``, ``cost_scaling_factor``, ``resolution`` → value."""
+        return {name: s.value for name, s in self.costmap.items()}
+
+
+def _default(source_file: str, why: str = "not in the file") -> str:
+    return f"ASSUMED (Nav2's default, {source_file}): {why}"
+
+
+def default_tracker(controller: str, why: str = "no Nav2 file given") -> Nav2Tracker:
+    """A Nav2 controller with every parameter at Nav2's declared default, each marked ASSUMED with `why`.
+
+    Parameters
+    ----------
+    controller : str
+        ``rpp``, ``graceful``, ``mppi`` or ``dwb``.
+    why : str
+        The reason the defaults are assumed.
+    """
+    from ..controllers.registry import COSTMAP, SERVER, get_controller
+
+    entry = get_controller(controller)
+    parameters = {p.name: Nav2Setting(p.default, _default(entry.source, why)) for p in entry.parameters}
+    server = {p.name: p for p in SERVER}
+    costmap = _default_costmap({p.name: p for p in COSTMAP}, why)
+    frequency = Nav2Setting(server["controller_frequency"].default, _default("nav2_controller/src/parameter_handler.cpp", why))
+    return Nav2Tracker(controller, entry.plugins[0], "FollowPath", parameters, frequency, costmap)
+
+
+def _default_costmap(params: dict, why: str) -> dict:
+    radius = params["robot_radius"].default
+    where = "nav2_costmap_2d/src/costmap_2d_ros.cpp"
+    inflation = "nav2_costmap_2d/plugins/inflation_layer.cpp"
+    return {
+        "inscribed_radius": Nav2Setting(radius * math.cos(math.pi / 16), _default(where, f"{why}; robot_radius {radius:g} m (a 16-gon)")),
+        "inflation_radius": Nav2Setting(params["inflation_radius"].default, _default(inflation, why)),
+        "cost_scaling_factor": Nav2Setting(params["cost_scaling_factor"].default, _default(inflation, why)),
+        "resolution": Nav2Setting(params["resolution"].default, _default(where, why)),
+    }
+
+
+def read_path_tracker(source: "YamlFile", controller: str | None = None) -> Nav2Tracker:
+    """The path tracker of a Nav2 parameters file: ``controller_server``'s first controller plugin, its parameters,
+    ``controller_frequency``, and the local costmap's inscribed radius and inflation layer (docs/config.md).
+
+    A parameter the file does not give is Nav2's declared default (`controllers.registry`), marked ASSUMED.
+
+    Parameters
+    ----------
+    source : io.yaml_files.YamlFile
+        The parsed file (`is_nav2`).
+    controller : str, optional
+        The controller the user asked for (``--controller``): the file's plugin must be that one.
+
+    Raises
+    ------
+    ValueError
+        One line naming the file, the line and the key: a plugin the report does not analyse, a plugin other than
+        `controller`, a parameter of the wrong type or out of range.
+    """
+    from ..controllers.registry import (COSTMAP, DEFAULT_PLUGIN, SERVER, SHIM_PLUGIN, controller_of_plugin, get_controller, plugin_key)
+
+    data, origin = source.data, source.origin
+    server = _node(data, ("controller_server",)) or {}
+    server_keys = ("controller_server", PARAMETERS)
+    ids = server.get("controller_plugins", list(SERVER[1].default))
+    ids = [ids] if isinstance(ids, str) else ids
+    if not (isinstance(ids, list) and ids and all(isinstance(i, str) for i in ids)):
+        raise source.error(f"controller_server.controller_plugins must be a list of plugin names; got {ids!r}", (*server_keys, "controller_plugins"))
+    plugin_id, notes = ids[0], []
+    if len(ids) > 1:
+        notes.append(f"{origin}: controller_plugins lists {', '.join(ids)}; the first, {plugin_id}, is analysed (the controller server's default)")
+    node = server.get(plugin_id) if isinstance(server.get(plugin_id), dict) else {}
+    keys = (*server_keys, plugin_id)
+    plugin = node.get("plugin", DEFAULT_PLUGIN)
+    if not isinstance(plugin, str):
+        raise source.error(f"controller_server.{plugin_id}.plugin must be a plugin class name; got {plugin!r}", (*keys, "plugin"))
+    plugin_source = f"{origin}: controller_server.{plugin_id}.plugin"
+    if "plugin" not in node:
+        notes.append(f"{origin}: controller_server.{plugin_id}.plugin not given: Nav2's default {DEFAULT_PLUGIN}")
+        plugin_source = f"ASSUMED (Nav2's default, nav2_controller/include/nav2_controller/parameter_handler.hpp): {plugin_source} not in the file"
+    if plugin_key(plugin) == SHIM_PLUGIN:
+        node, keys, plugin = _shim_primary(source, node, keys, plugin_id)
+        notes.append(f"{origin}: {plugin_id} is the Rotation Shim controller; on a straight path its primary controller {plugin} tracks")
+        plugin_source = f"{origin}: controller_server.{'.'.join(keys[2:])}" + (".plugin" if keys[-1] == "primary_controller" else ".primary_controller")
+    entry = controller_of_plugin(plugin)
+    if entry is None:
+        analysed = ", ".join(p for c in ("rpp", "graceful", "mppi", "dwb") for p in get_controller(c).plugins)
+        raise source.error(f"controller_server.{plugin_id}.plugin {plugin} is not a controller the report analyses ({analysed})", (*keys, "plugin"))
+    if controller is not None and entry.name != controller:
+        raise source.error(f"the file's controller_server.{plugin_id}.plugin is {plugin} (--controller {entry.name}); got --controller "
+                           f"{controller}: give --controller {entry.name} or auto", (*keys, "plugin"))
+    parameters = {p.name: _setting(source, p, node, keys, f"controller_server.{'.'.join(keys[2:])}", entry.source) for p in entry.parameters}
+    frequency = _setting(source, SERVER[0], server, server_keys, "controller_server", "nav2_controller/src/parameter_handler.cpp")
+    costmap = _read_costmap(source, {p.name: p for p in COSTMAP})
+    return Nav2Tracker(entry.name, plugin_key(plugin), plugin_id, parameters, frequency, costmap, tuple(notes), plugin_source)
+
+
+def _shim_primary(source, node, keys, plugin_id):
+    """(parameters node, its keys, plugin) of a Rotation Shim's primary controller: ``primary_controller: {plugin: …, …}``
+    (Nav2 after Kilted: its parameters in that namespace), or ``primary_controller: "pkg::Class"`` (before: beside it)."""
+    primary = node.get("primary_controller")
+    if isinstance(primary, dict) and isinstance(primary.get("plugin"), str):
+        return primary, (*keys, "primary_controller"), primary["plugin"]
+    if isinstance(primary, str):
+        return node, keys, primary
+    raise source.error(f"controller_server.{plugin_id}.primary_controller must name the Rotation Shim's primary controller "
+                       f"(primary_controller: {{plugin: pkg::Class}}); got {primary!r}", (*keys, "primary_controller"))
+
+
+def _setting(source, parameter, node: dict, keys: tuple, shown_prefix: str, source_file: str) -> Nav2Setting:
+    """A registry parameter from `node` (a critic's ``Critic.name`` nested, or an alias), checked, or its default ASSUMED."""
+    for name in (parameter.name, *parameter.aliases):
+        path = name.split(".")
+        value = node
+        for part in path:
+            value = value.get(part) if isinstance(value, dict) else None
+        if value is None:
+            continue
+        shown = f"{shown_prefix}.{name}"
+        try:
+            checked = parameter.check(value, shown)
+        except ValueError as exc:
+            raise source.error(str(exc), (*keys, *path)) from None
+        given = f"{value:g}" if isinstance(value, float) else str(value).lower() if isinstance(value, bool) else str(value)
+        return Nav2Setting(checked, f"{source.origin}: {shown} = {given}{' ' + parameter.unit if parameter.unit else ''}")
+    return Nav2Setting(parameter.default, _default(source_file))
+
+
+def _read_costmap(source, params: dict) -> dict:
+    """The local costmap's inscribed radius (footprint, else robot_radius as Nav2's 16-gon), resolution, and its
+    inflation layer's ``inflation_radius`` and ``cost_scaling_factor`` (the first plugin of class InflationLayer)."""
+    from ..controllers.registry import INFLATION_PLUGIN, plugin_key
+
+    out = _default_costmap(params, "not in the file")
+    for path in COSTMAPS[:2]:  # the local costmap only: the controller's
+        costmap = _node(source.data, path)
+        if costmap is None:
+            continue
+        where, keys = ".".join(path), (*path, PARAMETERS)
+        footprint = costmap.get("footprint")
+        if footprint not in (None, "", "[]", []):
+            points = _footprint_points(source, f"{where}.footprint", (*keys, "footprint"), footprint)
+            out["inscribed_radius"] = Nav2Setting(_inscribed_radius(points), f"{source.origin}: {where}.footprint = {footprint} "
+                                                  "(its inscribed radius)")
+        elif "robot_radius" in costmap:
+            radius = _setting(source, params["robot_radius"], costmap, keys, where, "").value
+            out["inscribed_radius"] = Nav2Setting(radius * math.cos(math.pi / 16), f"{source.origin}: {where}.robot_radius = {radius:g} m "
+                                                  "(inscribed radius of Nav2's 16-gon)")
+        if "resolution" in costmap:
+            out["resolution"] = _setting(source, params["resolution"], costmap, keys, where, "")
+        plugins = costmap.get("plugins", [])
+        for name in plugins if isinstance(plugins, list) else ():
+            layer = costmap.get(name)
+            if isinstance(layer, dict) and isinstance(layer.get("plugin"), str) and plugin_key(layer["plugin"]) == INFLATION_PLUGIN:
+                for key in ("inflation_radius", "cost_scaling_factor"):
+                    if key in layer:
+                        out[key] = _setting(source, params[key], layer, (*keys, name), f"{where}.{name}", "")
+                break
+        break
+    return out
+
+
+def _footprint_points(source, key, location, footprint) -> list:
+    """A footprint's vertices [(x, y), …] (a list, or Nav2's string ``"[[x, y], …]"``), m."""
+    error = source.error(f"{key} must be a polygon [[x, y], ...] of at least 3 points of finite numbers (m); got {footprint!r}", location)
+    points = footprint
+    if isinstance(footprint, str):
+        try:
+            points = parse_yaml(footprint)
+        except InputError:
+            raise error from None
+    if not isinstance(points, list) or len(points) < 3:
+        raise error
+    if not all(isinstance(p, list) and len(p) == 2 and all(_finite(c) for c in p) for p in points):
+        raise error
+    return [(float(x), float(y)) for x, y in points]
+
+
+def _inscribed_radius(points: list) -> float:
+    """The footprint's inscribed radius as Nav2 computes it (``footprint.cpp``, ``calculateMinAndMaxDistances``): the
+    smallest distance from the robot's centre to a vertex or an edge, m."""
+    def to_edge(x0, y0, x1, y1):
+        dx, dy = x1 - x0, y1 - y0
+        t = -(x0 * dx + y0 * dy) / (dx * dx + dy * dy) if dx or dy else 0.0
+        t = min(max(t, 0.0), 1.0)
+        return math.hypot(x0 + t * dx, y0 + t * dy)
+
+    edges = zip(points, points[1:] + points[:1])
+    return min(min(math.hypot(x0, y0), to_edge(x0, y0, x1, y1)) for (x0, y0), (x1, y1) in edges)
+
 
 
 # ------------------------------------------------------------------ the velocity smoother

@@ -42,6 +42,7 @@ from ..models import HEADING_GAIN_RANGE, STEERING, KBFirstOrder, Loop, LoopFamil
 from ..models.family import root_json
 from ..laws.registry import FAMILY_CHOICE_DEFAULTS, FAMILY_DEFAULTS, FORCE_LAWS, HOLONOMIC_LAWS, LAW_PARAMETERS, parameter_keys
 from ..parameters import MODEL_NAMES, RANGES, ROBOT_FAMILIES, Controller, Corridor, Robot, Wall, check_parameter
+from .remedy import change as _change
 
 __all__ = ["StabilityReport", "KBError", "LawDescription", "build_report", "remedies", "kb_error", "kb_errors", "KINEMATIC_TAU_SOURCE",
            "PLANT_INPUTS", "plant_inputs", "DRIVE_INPUTS", "drive_inputs"]
@@ -202,6 +203,9 @@ class StabilityReport:
     disturbance, wall_disturbance : analysis.disturbance.Disturbance or None
         What a start of a given size does in the corridor and beside the wall (``report --disturbance``; JSON
         ``corridor.disturbance``, ``wall.disturbance``).
+    path : analysis.path_tracking.PathTracking or None
+        A Nav2 controller tracking a straight path or a corridor's centre line (``report --controller``,
+        docs/path_tracking.md; JSON ``environment.path`` and ``path.<model>``, its remedies under ("path", model)).
     """
 
     inputs: dict
@@ -219,6 +223,7 @@ class StabilityReport:
     wall_wobble: object | None = None
     disturbance: object | None = None
     wall_disturbance: object | None = None
+    path: object | None = None
 
     @property
     def kb_error(self) -> KBError | None:
@@ -257,6 +262,10 @@ class StabilityReport:
             out["tracking"] = json_ready({"damping_ratio": t.damping_ratio, "natural_frequency": t.natural_frequency, "regime": t.regime})
         if self.door is not None:
             out["door"] = self.door.to_dict()
+        if self.path is not None:
+            from .path import path_json
+
+            out.setdefault("environment", {})["path"], out["path"] = path_json(self.path, self.remedies)
         if self.kb_errors:
             out["kb_error"] = self.kb_errors[0].to_dict()
         if len(self.kb_errors) > 1:
@@ -344,6 +353,8 @@ def build_report(
     simulate_cycle=None,
     wobble=None,
     disturbance=None,
+    tracker=None,
+    gains=None,
 ) -> StabilityReport:
     """The report of any robot family and law for a wall (α) and/or a corridor (L, m), and a door with a static law.
 
@@ -392,6 +403,12 @@ def build_report(
         A start this far off the equilibrium, m, in the corridor and beside the wall (`analysis.disturbance`,
         docs/wobble.md): the speed V*(D) at or below which it settles, what it grows into past it, the criticality, with
         the robot's `yaw_accel_limit`; None: not computed. A steering or kinematic robot with a static law.
+    tracker : io.nav2.Nav2Tracker, optional
+        A Nav2 path-tracking controller with its parameters (docs/path_tracking.md): the report is then its loop about a
+        straight path, or in the corridor of half-width `L`, for every model (`report.path.path_report`); robot.V is its
+        cruising speed parameter, robot.k is not used. No wall, door, law or wobble with it.
+    gains : analysis.path_laws.MeasuredGains, optional
+        MPPI's or DWB's gains measured from the algorithm (required for them with `tracker`).
 
     Returns
     -------
@@ -405,6 +422,9 @@ def build_report(
         the law has no equilibrium.
     """
     check_choice("robot", family, ROBOT_FAMILIES)
+    if tracker is not None:
+        return _path_report(robot, controller, tracker, gains, family=family, law=law, alpha=alpha, alpha_deg=alpha_deg, L=L, models=models,
+                            pade_order=pade_order, sources=sources, door=door, wobble=wobble, disturbance=disturbance)
     if disturbance is not None:
         return _with_disturbance(disturbance, robot, controller, family=family, law=law, alpha=alpha, alpha_deg=alpha_deg, L=L, models=models,
                                  pade_order=pade_order, mass=mass, sources=sources, door=door, door_obstacle=door_obstacle,
@@ -494,6 +514,26 @@ def _each_geometry(report, robot, controller, family, law, functions, value, una
     corridor = predicted(corridor_function, report.corridor.L) if report.corridor is not None else None
     wall = predicted(wall_function, math.radians(report.wall.alpha_deg)) if report.wall is not None else None
     return corridor, wall
+
+
+_PATH_REFUSED = "{what} applies to --controller vff (the VFF loop); a Nav2 controller tracks a straight path or a corridor (--L)"
+"""The message when a path tracker's report is asked for what only the VFF loop has."""
+
+
+def _path_report(robot, controller, tracker, gains, *, family, law, alpha, alpha_deg, L, models, pade_order, sources, door, wobble,
+                 disturbance=None):
+    """A Nav2 controller's report (`report.path.path_report`): refuses the VFF loop's geometries and options."""
+    for what, given in (("alpha", alpha is not None or alpha_deg is not None), ("--door", door is not None), ("--law", law is not None),
+                        ("--wobble", wobble not in (None, False)), ("--disturbance", disturbance is not None),
+                        (f"--robot {family}", family != "steering")):
+        if given:
+            raise ValueError(_PATH_REFUSED.format(what=what))
+    from .path import path_report
+
+    L = None if L is None else check_parameter("L", L)
+    inputs, model_objs, loop_family, result, fixes = path_report(robot, controller, tracker, gains=gains, L=L, models=models,
+                                                                 pade_order=pade_order, sources=sources)
+    return StabilityReport(inputs, model_objs, loop_family, remedies=fixes, path=result)
 
 
 _NO_GEOMETRY = f"alpha or L must be given: a wall (--alpha DEG, in {RANGES['alpha_deg'].describe()}) and/or a corridor (--L M)"
@@ -715,22 +755,6 @@ def _(wall: WallAnalysis) -> tuple:
 def _(corridor: CorridorAnalysis) -> tuple:
     """The verdicts under ("corridor", model)."""
     return tuple((("corridor", name), v) for name, v in corridor.models.items())
-
-
-def _change(name: str, target: float, direction: str | None, now: float | None) -> dict | None:
-    """One remedy: move `name` from `now` to `target` ("raise" or "lower"), or None when that is no change that helps.
-
-    None when there is no direction, the target is not finite and positive (α* >= 90° is none
-    either), or it lies on the wrong side of the present value (on the boundary).
-    """
-    if direction is None or not math.isfinite(target) or target <= 0 or (name == "alpha_deg" and target >= 90):
-        return None
-    if now is not None and (target >= now if direction == "lower" else target <= now):
-        return None
-    entry = {"to": target, "direction": direction}
-    if now:
-        entry["change_percent"] = (target / now - 1.0) * 100
-    return entry
 
 
 def _delay_remedy(verdict, T: float) -> dict:

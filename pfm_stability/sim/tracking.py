@@ -39,7 +39,10 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from ..checks import check_integer, check_number
-from ..controllers import CONTROLLER_NAMES, CorridorCostmap, NoValidControl, RobotState, configure, controller_module, default_params
+from ..controllers.registry import NAV2_CONTROLLERS as CONTROLLER_NAMES
+from ..controllers.costmap import CorridorCostmap
+from ..controllers.base import NoValidControl, RobotState, controller_module, default_params
+from ..controllers.linearize import configure
 from ..controllers.plan import prune
 from ..controllers.linearize import PLAN_AHEAD, centre_plan, warm_up
 from ..parameters import TAU_RESOLUTION, Robot

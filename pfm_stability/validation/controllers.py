@@ -25,7 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..checks import check_choice, check_integer, check_number
-from ..controllers import linearize
+from ..controllers.linearize import linearize
 from ..models import Loop, make_model
 from ..models.sampled import command_form
 from ..numerics.solve import bisect_batched
