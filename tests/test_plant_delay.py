@@ -266,3 +266,13 @@ def test_sampled_second_lag_equals_the_closed_loop_built_here():
             theirs = np.abs(_two_lag_poles(tau, lag, T, g * k, g * k * NV, D, d)).max()
             assert ours == pytest.approx(theirs, rel=1e-9)
         assert np.abs(_two_lag_poles(tau, lag, T, g * k, g * k * NV_star, D, d)).max() == pytest.approx(1.0, abs=1e-8)
+
+
+def test_a_fast_motor_with_a_dead_time():
+    """τ = 1e-6 s with D = 0.05 s (the motor's pole 10⁶ rad/s beyond everything the delay does): exact_delay's NV* equals
+    Padé(12)'s (1e-9: both converge on the same loop; it used to exceed the axis sweep's grid budget) and τ = 0's within
+    1e-4 (the lag's own O(τ·ω*) effect)."""
+    fast, ideal = Loop(1e-6, 0.065, 2.0, dead_time=0.05), Loop(0.0, 0.065, 2.0, dead_time=0.05)
+    NV = ExactDelay().boundary(fast).NV_critical
+    assert NV == pytest.approx(make_model("pade", pade_order=12).boundary(fast).NV_critical, rel=1e-9)
+    assert NV == pytest.approx(ExactDelay().boundary(ideal).NV_critical, rel=1e-4)

@@ -103,6 +103,9 @@ class QuasiPolynomial:
         self.n = len(self.p0) - 1
         self.lead = float(self.p0[0])
         self.max_delay = max([self.gain_delay] + [t.delay for t in self.terms])
+        self.p0_roots = np.roots(self.p0)
+        if np.any(self.p0_roots.real > 1e-12 * max(1.0, float(np.max(np.abs(self.p0_roots), initial=0.0)))):
+            raise ValueError("p0(s) must have its roots in Re s <= 0 (the drive's lags and the integrators)")
 
     # ------------------------------------------------------------------ values
     def rest(self, s):
@@ -191,11 +194,11 @@ class QuasiPolynomial:
         """
         if self.value(0.0, K) == 0.0:
             return None
-        w = self._root_radius(K)
-        q = lambda s: self.lead * (s + w) ** self.n
-        f = lambda om: self.value(1j * om, K) / q(1j * om)
-        end = self._flat_end(w, K)
-        omega = self._axis_grid(end, w)
+        w = 1.0 / self.max_delay if self.max_delay > 0 else 1.0
+        q = self._reference(w)
+        f = lambda om: self.value(1j * om, K) / np.polyval(q, 1j * om)
+        end, fine = self._flat_end(q, K)
+        omega = self._axis_grid(end, fine, w)
         values = f(omega)
         omega, values = _refine_phase(omega, values, f)
         if omega is None:
@@ -217,27 +220,59 @@ class QuasiPolynomial:
         """
         return self.unstable_root_count(K) == 0
 
-    def _flat_end(self, w: float, K: float) -> float:
-        """ω beyond which |f(jω) − 1| < 1/2, f = Δ/(lead·(s + w)^n): a decreasing majorant of it is below 1/2."""
-        q = np.polynomial.polynomial.polypow([w, 1.0], self.n)[::-1] * self.lead  # descending
-        difference = np.polysub(self.p0, q)[1:]  # degree < n
-        bound = lambda x: (_majorant(difference, x) + self._others_majorant(x, K)) / (abs(self.lead) * x ** self.n)
-        x = max(w, 1.0 / self.max_delay if self.max_delay > 0 else w)
-        while bound(x) >= 0.5:
-            x *= 2.0
-        return x
+    def _modulus(self, x):
+        """|p0(jx)|."""
+        return np.abs(np.polyval(self.p0, 1j * np.asarray(x, dtype=float)))  # (a resonant p0 may dip: `_settled` scans it)
 
-    def _axis_grid(self, end: float, scale: float) -> np.ndarray:
-        """A grid on [0, end]: logarithmic near 0 (64 points a decade from 1e-6·scale) and uniform at a step that resolves
-        the fastest exponential (π/(8·max h))."""
+    def _lower_modulus(self, roots, x):
+        """|lead|·Π(x − |r|), 0 below max |r|: a lower bound of |p(jx)| for the polynomial of `roots` (|jx − r| >= x − |r|)
+        that increases with x, so that a ratio with it in the denominator and a lower-degree majorant above decreases."""
+        x = np.asarray(x, dtype=float)
+        gaps = x[..., None] - np.abs(np.asarray(roots))[None, :] if x.ndim else x - np.abs(np.asarray(roots))
+        return abs(self.lead) * np.prod(np.maximum(gaps, 0.0), axis=-1)
+
+    def _reference(self, w: float) -> np.ndarray:
+        """q(s): p0 with its roots at 0 moved to −w (descending): no root in Re s >= 0, p0's leading term and lags."""
+        roots = np.where(np.abs(self.p0_roots) <= 1e-12 * max(1.0, float(np.max(np.abs(self.p0_roots), initial=0.0))), -w, self.p0_roots)
+        return np.real(self.lead * np.poly(roots))
+
+    def _settled(self, bound, threshold: float, start: float) -> float:
+        """The smallest x >= start beyond which bound(x) < threshold: scanned on a log grid (64 points a decade) up to
+        where its analytic majorant (`_lower_modulus` for the polynomial's modulus: above `bound`, and decreasing) is
+        below the threshold itself. `bound(x, analytic)` takes arrays of x."""
+        top = max(start, 1.0)
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):  # the analytic bound is inf below the roots' moduli
+            while not bound(np.array([top]), True)[0] < threshold:
+                top *= 2.0
+            if top <= start:
+                return start
+            grid = np.geomspace(start, top, max(2, int(64 * math.log10(top / start)) + 1))
+            over = np.flatnonzero(~(bound(grid, False) < threshold))
+        return float(grid[min(over[-1] + 1, grid.size - 1)]) if over.size else start
+
+    def _flat_end(self, q, K: float) -> tuple:
+        """(end, fine): beyond `end` |f(jω) − 1| < 1/4 for f = Δ/q (the rest of the turn is −arg f there), beyond `fine`
+        the delayed terms are below 1/8 of |q| (their exponentials turn f by less than 0.13 rad: a log grid follows it)."""
+        difference = np.polysub(self.p0, q)[1:]  # degree < n
+        q_roots = np.roots(q)
+        modulus = lambda x, analytic: self._lower_modulus(q_roots, x) if analytic else np.abs(
+            self.lead * np.prod(1j * x[:, None] - q_roots[None, :], axis=1))
+        start = 1e-6 / self.max_delay if self.max_delay > 0 else 1e-6
+        end = self._settled(lambda x, a: (_majorant(difference, x) + self._others_majorant(x, K)) / modulus(x, a), 0.25, start)
+        fine = self._settled(lambda x, a: self._others_majorant(x, K) / modulus(x, a), 0.125, start)
+        return max(end, 1.0 / self.max_delay if self.max_delay > 0 else end), min(fine, end)
+
+    def _axis_grid(self, end: float, fine: float, scale: float) -> np.ndarray:
+        """A grid on [0, end]: logarithmic (64 points a decade from 1e-6·scale), and uniform up to `fine` at a step that
+        resolves the fastest exponential (π/(8·max h)); beyond `fine` the delayed terms are too small to turn the phase."""
         step = math.pi / (8.0 * self.max_delay) if self.max_delay > 0 else end / 64.0
-        count = int(math.ceil(end / step)) + 1
+        count = int(math.ceil(fine / step)) + 1
         if count > _MAX_POINTS:
             raise ValueError(f"the quasi-polynomial's axis needs {count} grid points (delay {self.max_delay:g} s over "
-                             f"{end:g} rad/s), more than {_MAX_POINTS}")
+                             f"{fine:g} rad/s), more than {_MAX_POINTS}")
         low = 1e-6 * min(scale, end)
         log = np.geomspace(low, end, max(16, int(64 * math.log10(end / low))))
-        return np.unique(np.concatenate([[0.0], log, np.linspace(0.0, end, count)]))
+        return np.unique(np.concatenate([[0.0], log, np.linspace(0.0, fine, count)]))
 
     # --------------------------------------------------------- gain crossings
     def gain_function(self, omega):
@@ -263,19 +298,25 @@ class QuasiPolynomial:
             raise ValueError("a gain term without delay makes a polynomial loop, not a quasi-polynomial")
         if np.any(np.roots(self.p0).real > 0):
             raise ValueError("the gain crossings need p0(s) without roots in Re s > 0 (its phase must not fall)")
-        lead = abs(self.lead)
+        def excess(x, analytic):  # < 1 where the ratio is below 1/2 and the phase's wobble below h_K/2
+            modulus = self._lower_modulus(self.p0_roots, x) if analytic else self._modulus(x)
+            with np.errstate(divide="ignore", invalid="ignore"):
+                ratio = sum(_majorant(t.poly, x) for t in self.terms) / modulus if self.terms else 0.0 * x
+                slope = sum(_majorant(np.polyder(np.asarray(t.poly)), x) + t.delay * _majorant(t.poly, x) for t in self.terms) / modulus if self.terms else 0.0 * x
+            with np.errstate(divide="ignore", over="ignore"):
+                wobble = np.where(ratio < 1.0, (slope + ratio * self.n / x) / np.maximum(1.0 - ratio, 1e-300), np.inf)
+            return np.maximum(2.0 * ratio, wobble / (0.5 * self.gain_delay))
 
-        def bounds(x):
-            ratio = sum(_majorant(t.poly, x) for t in self.terms) / (lead * x ** self.n) if self.terms else 0.0
-            slope = sum(_majorant(np.polyder(np.asarray(t.poly)), x) + t.delay * _majorant(t.poly, x) for t in self.terms) / (lead * x ** self.n) if self.terms else 0.0
-            return ratio, (slope + ratio * self.n / x)
+        return self._settled(excess, 1.0, 1e-6 / self.gain_delay)
 
-        x = 1.0 / self.gain_delay
-        while True:
-            ratio, slope = bounds(x)
-            if ratio < 0.5 and slope / (1.0 - ratio) < 0.5 * self.gain_delay:
-                return x
-            x *= 2.0
+    def _gains_above(self, gain: float, start: float) -> float:
+        """ω beyond which every crossing's gain exceeds `gain`: |G(jω)| >= |p0(jω)| − Σ|p_j(jω)| > gain there."""
+        def ratio(x, analytic):
+            modulus = self._lower_modulus(self.p0_roots, x) if analytic else self._modulus(x)
+            with np.errstate(divide="ignore"):
+                return (self._others_majorant(x, 0.0) + gain) / modulus
+
+        return self._settled(ratio, 1.0, start)
 
     def _crossings_between(self, low: float, high: float) -> list:
         """Every crossing (gain > 0, frequency, direction ±1; 0 tangent) with low < ω <= high."""
@@ -306,10 +347,7 @@ class QuasiPolynomial:
         safe = self._monotone_from()
         found = self._crossings_between(0.0, safe)
         top = max([c[0] for c in found], default=0.0)
-        lower = lambda x: abs(self.lead) * x ** self.n - _majorant(self.p0[1:], x) - self._others_majorant(x, 0.0)
-        high = safe
-        while lower(high) <= top:  # beyond: every crossing destabilises with a gain above every one found
-            high *= 2.0
+        high = max(safe, self._gains_above(top, safe))  # beyond: every crossing destabilises with a gain above every one found
         found += [c for c in self._crossings_between(safe, high) if c[0] <= top]
         return sorted(found), top, self.heading().unstable_root_count(0.0)
 
@@ -333,7 +371,6 @@ class QuasiPolynomial:
     def _next_crossing(self, above: float, K_max: float):
         """(K, ω) of the smallest crossing gain above `above` (every one destabilises there), None up to K_max."""
         low = self._monotone_from()
-        lower = lambda x: abs(self.lead) * x ** self.n - _majorant(self.p0[1:], x) - self._others_majorant(x, 0.0)
         best = None
         while True:
             high = 2.0 * low
@@ -341,7 +378,7 @@ class QuasiPolynomial:
                 if gain > above and (best is None or gain < best[0]):
                     best = (gain, w)
             limit = K_max if best is None else best[0]
-            if lower(high) > limit:
+            if high >= self._gains_above(limit, low):
                 return best if best is not None and best[0] <= K_max else None
             low = high
 
@@ -373,11 +410,14 @@ class QuasiPolynomial:
         U = lambda w: np.polyval(p0, 1j * w) + sum(np.polyval(p, 1j * w) * np.exp(-1j * w * h) for p, h, moves in terms if not moves)
         V = lambda w: sum(np.polyval(p, 1j * w) * np.exp(-1j * w * h) for p, h, moves in terms if moves)
         F = lambda w: np.abs(U(w)) ** 2 - np.abs(V(w)) ** 2
-        n, lead = len(p0) - 1, abs(p0[0])
-        others = lambda x: _majorant(p0[1:], x) + sum(_majorant(p, x) for p, _, _ in terms)
-        end = 1.0
-        while lead * end ** n <= others(end):
-            end *= 2.0
+        roots = np.roots(p0)
+
+        def ratio(x, analytic):  # < 1 where |U| >= |p0| − Σ|unshifted| > Σ|shifted| >= |V|: no root of |U|² − |V|² beyond
+            modulus = self._lower_modulus(roots, x) if analytic else np.abs(np.polyval(p0, 1j * x))
+            with np.errstate(divide="ignore"):
+                return sum(_majorant(p, x) for p, _, _ in terms) / modulus
+
+        end = self._settled(ratio, 1.0, 1e-6 / self.max_delay if self.max_delay > 0 else 1e-6)
         roots = _sign_changes(F, end, max([h for _, h, _ in terms] + [self.max_delay]))
         margin = math.inf
         for w in roots:
