@@ -99,3 +99,29 @@ def test_a_lattice_shift_moves_the_cells_and_walls():
     assert ((w.y0 - 0.02 + 0.025) / 0.05) == pytest.approx(round((w.y0 - 0.02 + 0.025) / 0.05))
     with pytest.raises(ValueError):
         CorridorCostmap(half_width=0.6, lattice=(0.0, 0.2))
+
+
+def test_the_algorithms_defaults_are_the_registry_s():
+    """One declaration of Nav2's defaults (`controllers.registry`, the sources' declare_parameter values): every field
+    of RPP's, Graceful's, MPPI's and DWB's parameters that the registry declares has the registry's default, except the
+    fields each module names in ``BRINGUP_DEFAULTS`` with its reason (MPPI's critics, DWB's limits and critics: the source
+    declares none a controller can run with). A default that drifts from Nav2's source fails here."""
+    from dataclasses import MISSING, fields
+
+    from pfm_stability.controllers import dwb, graceful, mppi, rpp
+    from pfm_stability.controllers.registry import get_controller
+
+    for name, module, cls in (("rpp", rpp, rpp.RPPParams), ("graceful", graceful, graceful.GracefulParams),
+                              ("mppi", mppi, mppi.MPPIParams), ("dwb", dwb, dwb.DWBParams)):
+        declared = {p.name: p.default for p in get_controller(name).parameters}
+        exceptions = set(getattr(module, "BRINGUP_DEFAULTS", ()))
+        shared = [f for f in fields(cls) if f.name in declared and f.name not in exceptions]
+        assert len(shared) >= 8, name
+        for f in shared:
+            default = f.default if f.default is not MISSING else f.default_factory()
+            expected = declared[f.name]
+            if f.name == "trajectory_generator_name":
+                expected = expected.split("::")[-1]
+            assert default == pytest.approx(expected) if isinstance(expected, float) else default == expected, (name, f.name)
+        for field_name in exceptions:
+            assert field_name in declared, (name, field_name)

@@ -39,12 +39,13 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from ..controllers.costmap import FREE_SPACE, INSCRIBED_INFLATED_OBSTACLE, LETHAL_OBSTACLE, Inflation
 from ..parameters import check_parameter
 
 __all__ = ["TrackingPoint", "PurePursuit", "Graceful", "MeasuredGains", "corridor_pose_cost", "inflation_cost", "regulated_distance",
            "path_law"]
 
-LETHAL, INSCRIBED, FREE = 254, 253, 0
+FREE, INSCRIBED, LETHAL = FREE_SPACE, INSCRIBED_INFLATED_OBSTACLE, LETHAL_OBSTACLE
 """The costmap's costs (``nav2_costmap_2d/cost_values.hpp``)."""
 
 
@@ -89,10 +90,11 @@ class TrackingPoint:
 
 
 def inflation_cost(distance: float, inflation_radius: float, cost_scaling_factor: float, inscribed_radius: float) -> int:
-    """The inflation layer's cost at `distance` (m) from the nearest obstacle (``InflationLayer::computeCost``).
+    """The inflation layer's cost at `distance` (m) from the nearest obstacle (``InflationLayer::computeCost``), as the
+    costmap stores it: `controllers.costmap.Inflation.cost` truncated to an integer (the cast to ``unsigned char``).
 
     254 at the obstacle, 253 within the inscribed radius, ⌊252·exp(−cost_scaling_factor·(d − r))⌋ up to
-    ``inflation_radius`` (the cast to ``unsigned char`` truncates), 0 (free) beyond.
+    ``inflation_radius``, 0 (free) beyond.
 
     Parameters
     ----------
@@ -101,13 +103,7 @@ def inflation_cost(distance: float, inflation_radius: float, cost_scaling_factor
     inflation_radius, cost_scaling_factor, inscribed_radius : float
         m, 1/m, m.
     """
-    if distance <= 0:
-        return LETHAL
-    if distance <= inscribed_radius:
-        return INSCRIBED
-    if distance > inflation_radius:
-        return FREE
-    return int(math.floor((INSCRIBED - 1) * math.exp(-cost_scaling_factor * (distance - inscribed_radius))))
+    return int(math.floor(Inflation(inflation_radius, cost_scaling_factor, inscribed_radius).cost(distance)))
 
 
 def corridor_pose_cost(half_width: float | None, costmap: dict) -> int:

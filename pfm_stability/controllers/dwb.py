@@ -147,6 +147,14 @@ class Oscillation:
     x_only_threshold: float = 0.05
 
 
+BRINGUP_DEFAULTS = ("max_vel_x", "max_vel_theta", "max_speed_xy", "acc_lim_x", "decel_lim_x", "acc_lim_theta", "decel_lim_theta",
+                    "linear_granularity", "critics")
+"""The fields whose default is nav2_bringup's DWB configuration, not the source's declaration (`controllers.registry`):
+the source declares every speed and acceleration limit 0 and no critics (a planner that cannot move), a 0.5 m linear
+granularity where bringup samples every 0.05 m. Every other field's default is the registry's
+(tests/test_controllers_plan.py; the trajectory generator is the same class, named with and without its namespace)."""
+
+
 @dataclass(frozen=True)
 class DWBParams:
     """DWB's parameters (Nav2's names; defaults: module docstring).

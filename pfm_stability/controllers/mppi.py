@@ -82,6 +82,12 @@ grid costmap's cost steps from dominating the difference. The measured yaw rate 
 (the last command within az_max·T = 0.175 rad/s of it), which small perturbations never reach: its channel is skipped."""
 
 
+BRINGUP_DEFAULTS = ("critics",)
+"""The fields whose default is nav2_bringup's, not the source's declaration (`controllers.registry`): MPPI's source
+declares no critics (an optimizer without them weighs nothing), so the default is bringup's list. Every other field's
+default is the registry's (tests/test_controllers_plan.py)."""
+
+
 @dataclass(frozen=True)
 class MPPIParams:
     """MPPI's parameters (Nav2's names; defaults from ``src/optimizer.cpp`` and the critics' sources).
