@@ -320,7 +320,7 @@ def ratio_critical(model, loop: Loop, shape: tuple) -> float:
             lam = np.atleast_1d(np.asarray(rhos, dtype=float)) / top
             scaled = [top_loop.replace(tau=top_loop.tau * x, actuator_lag=top_loop.actuator_lag * x, T=top_loop.T * x,
                                        dead_time=top_loop.dead_time * x) for x in lam]
-            return lam * np.asarray(model._searched_growth_rates(NV_top, scaled), dtype=float)
+            return lam * np.asarray(model.searched_growth_rates(NV_top, scaled), dtype=float)
     edges = [min(max(lo, 0.1 * estimate), 0.5 * top)]
     while edges[-1] < top:
         edges.append(min(10.0 * edges[-1], top))
@@ -424,7 +424,7 @@ def _delay_margins(model, NV: float, loop: Loop, stable: bool) -> tuple:
     """(T*, D*), s, of the operating point (`stable`: the model's verdict there).
 
     The model's own where they are exact or closed (`kb_first_order`, `exact_delay`; `continuous` has no delay: ``inf``
-    or 0 for both). Searched otherwise (`LoopModel._first_loss`, a decade at a time from the bottom:
+    or 0 for both). Searched otherwise (`LoopModel.first_loss`, a decade at a time from the bottom:
     `_searched_margin`). The continuous-time models see T and D only as the loop's one delay h = T + D (the heading is
     sampled), so `pade` searches h from 0 once: stable for every h < h*, so T* = h* − D and D* = h* − T when the
     operating point lies below h* (else each is searched). `sampled` searches T from D/`PERIODS_IN_FLIGHT` and has no
@@ -462,10 +462,10 @@ def _searched_margin(model, NV: float, probe, low: float, high: float, tolerance
         edges.append(min(10.0 * edges[-1], high))
     origin = 0.0
     for lo, hi in zip(edges[:-1], edges[1:]):
-        found = model._first_loss(NV, probe, origin, lambda lo=lo, hi=hi: (lo, hi, options))
+        found = model.first_loss(NV, probe, origin, lambda lo=lo, hi=hi: (lo, hi, options))
         if found < math.inf:
             if serial and found > 0:
-                return _refined(lambda x: float(model._searched_growth_rates(NV, [probe(x)])[0]), found, rtol)
+                return _refined(lambda x: float(model.searched_growth_rates(NV, [probe(x)])[0]), found, rtol)
             return found
         origin = hi
     return math.inf

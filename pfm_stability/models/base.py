@@ -229,7 +229,7 @@ class LoopModel:
             start, rtol, atol = loop.delay_search(gain)
             return start, RANGES["T"].high, {"rtol": rtol, "atol": atol}
 
-        return self._first_loss(gain, loop._with_delay, 0.0, search)
+        return self.first_loss(gain, loop._with_delay, 0.0, search)
 
     @checked
     def critical_gain_k(self, NV: float, loop: Loop) -> float:
@@ -248,21 +248,44 @@ class LoopModel:
         """
         loop = _steering(loop, "critical_gain_k")
         lo, hi = gain_range(loop)  # probes of the checked loop: k in gain_range
-        return self._first_loss(NV, loop._with_steering_gain, lo, lambda: (lo, hi, {"start": lo, "rtol": _DELAY_RTOL, "atol": 1e-12 * lo}))
+        return self.first_loss(NV, loop._with_steering_gain, lo, lambda: (lo, hi, {"start": lo, "rtol": _DELAY_RTOL, "atol": 1e-12 * lo}))
 
-    def _first_loss(self, gain: float, probe, origin: float, search) -> float:
-        """The first value x > `origin` at which the gain loses stability, the loop `probe(x)` (T*, k*, D*): 0 when
-        unstable already at `origin` (or gain < 0), else `solve.first_crossing` of the growth rate on the interval
-        ``search()`` gives, ``(low, high, first_crossing's keywords)`` (asked only then; ``inf``: stable up to high)."""
+    def first_loss(self, gain: float, probe, origin: float, search) -> float:
+        """The first value x > `origin` at which the gain loses stability, the loop `probe(x)`: the one search behind every
+        critical value of a parameter (T*, k*, D* here; a path tracker's lookahead and speed, `analysis.path_tracking`).
+
+        0 when unstable already at `origin` (or gain < 0), else `solve.first_crossing` of the growth rate
+        (`searched_growth_rates`) on the interval ``search()`` gives (asked only then; ``inf``: stable up to its high end).
+
+        Parameters
+        ----------
+        gain : float
+            The family's loop gain, already checked.
+        probe : callable
+            x → the loop at x (an unchecked copy of a checked loop, its x kept in range by `search`).
+        origin : float
+            Where the search starts; the loop there is judged first.
+        search : callable
+            () → (low, high, keyword arguments of `solve.first_crossing`).
+        """
         from ..numerics.solve import first_crossing
 
-        if gain < 0 or self._searched_growth_rates(gain, [probe(origin)])[0] >= 0:
+        if gain < 0 or self.searched_growth_rates(gain, [probe(origin)])[0] >= 0:
             return 0.0
         low, high, options = search()
-        return first_crossing(lambda xs: self._searched_growth_rates(gain, [probe(x) for x in xs]), low, high, **options)
+        return first_crossing(lambda xs: self.searched_growth_rates(gain, [probe(x) for x in xs]), low, high, **options)
 
-    def _searched_growth_rates(self, gain: float, loops) -> np.ndarray:
-        """The growth rates (1/s) the searches for T*, k* and D* measure: `_growth_rates` (`sampled`'s has a stand-in)."""
+    def searched_growth_rates(self, gain: float, loops) -> np.ndarray:
+        """The growth rates (1/s) `first_loss` measures: the dominant root's real part (`sampled` with more commands in flight
+        than its eigenvalues resolve reads the verdict's sign, ±1).
+
+        Parameters
+        ----------
+        gain : float
+            The family's loop gain, already checked.
+        loops : sequence of Characteristic
+            The probed loops.
+        """
         return self._growth_rates(gain, loops)
 
     @checked

@@ -4,7 +4,7 @@ The robot's plant g·e^(−sD)/(τs + 1) (`Loop.plant_gain`, `Loop.dead_time`): 
 T and the rest fixed, the loop is stable for every D in [0, D*). `search_dead_time`
 finds D* as `LoopModel.critical_delay` finds T*: the dominant growth rate on a
 geometric grid of D, every local maximum before the first sign change refined, the
-first sign change narrowed to 1e-7 relative (`numerics.solve.first_crossing` through `LoopModel._first_loss`). 0 if
+first sign change narrowed to 1e-7 relative (`numerics.solve.first_crossing` through `LoopModel.first_loss`). 0 if
 the gain is unstable already without a dead time; ``inf`` if it stays stable up to the
 largest allowed D (10 s). `exact_delay` has the exact route instead (the crossing
 count's margin of the whole delay T + D, less T) and `continuous` does not depend on D.
@@ -23,7 +23,7 @@ def search_dead_time(model, gain: float, loop, high: float | None = None) -> flo
     Parameters
     ----------
     model : LoopModel
-        The model whose growth rates are searched (`LoopModel._searched_growth_rates`).
+        The model whose growth rates are searched (`LoopModel.searched_growth_rates`).
     gain : float
         Loop gain NV, 1/s, already checked.
     loop : Loop
@@ -36,4 +36,4 @@ def search_dead_time(model, gain: float, loop, high: float | None = None) -> flo
         start, rtol, atol = loop.delay_search(gain)
         return start, RANGES["dead_time"].high if high is None else high, {"rtol": rtol, "atol": atol}
 
-    return model._first_loss(gain, lambda D: loop.replace(dead_time=float(D)), 0.0, search)
+    return model.first_loss(gain, lambda D: loop.replace(dead_time=float(D)), 0.0, search)

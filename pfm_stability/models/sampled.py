@@ -759,14 +759,21 @@ class Sampled(AffineGainModel):
             start, rtol, atol = loop.delay_search(gain)
             return max(start, loop.dead_time / (MAX_DELAY_STATES - self.compute_delay - 1)), RANGES["T"].high, {"rtol": rtol, "atol": atol}
 
-        return self._first_loss(gain, loop._with_delay, 0.0, search)
+        return self.first_loss(gain, loop._with_delay, 0.0, search)
 
-    def _searched_growth_rates(self, gain: float, loops) -> np.ndarray:
-        """The growth rates the searches for T*, k* and D* measure (`LoopModel._searched_growth_rates`): `growth_rates`,
+    def searched_growth_rates(self, gain: float, loops) -> np.ndarray:
+        """The growth rates the searches for T*, k* and D* measure (`LoopModel.searched_growth_rates`): `growth_rates`,
         and for a loop with a dead time `_searched_growth`.
 
         T* with a dead time D (docs/models.md, "Plant gain and dead time"): at T = 0 the loop is its own limit, the exact
         delay loop with delay D (T* = 0 if that is unstable); at T > 0 the sampled loop itself, every probe.
+
+        Parameters
+        ----------
+        gain : float
+            The family's loop gain, already checked.
+        loops : sequence of Characteristic
+            The probed loops.
         """
         loops = list(loops)
         if not any(loop.dead_time > 0 for loop in loops):
