@@ -27,7 +27,7 @@ import numpy as np
 from ..checks import check_choice, check_integer, check_number
 from ..controllers.linearize import linearize
 from ..models import Loop, make_model
-from ..models.sampled import command_form
+from ..models.sampled import memory_loop_matrix as models_memory_loop
 from ..numerics.solve import bisect_batched
 from ..sim.tracking import TrackingScenario, simulate_tracking
 from ..sim.verdict import simulated_verdict
@@ -158,13 +158,8 @@ def _gains(scenario: TrackingScenario, draws, seed: int, memory_cycles=None):
 
 
 def memory_loop_matrix(gains, scenario: TrackingScenario) -> np.ndarray:
-    """The sampled plant closed by a controller's impulse response: the transition matrix over one period.
-
-    The plant is the `sampled` model's (`models.sampled.command_form`: lag, plant gain, dead time, compute delay;
-    states (ω,) θ, y = x/V, the commands on their way), its input the motor's g·u; the command is
-    u_k = −Σ_j (theta_j·θ_(k−j) + y_j·V·y_(k−j)) + Σ_j w_j·ω_(k−j) over the response's J cycles (`ImpulseResponse`; the
-    one-step gains alone when the gains have none), the past samples kept as extra states. With one cycle it is the
-    `sampled` model's Φ_cl at NV = k_y·V/k_θ (the tests check it).
+    """The scenario's sampled plant closed by a linearised controller's impulse response (`models.sampled.memory_loop_matrix`:
+    the one-step gains alone when the gains have no memory).
 
     Parameters
     ----------
@@ -173,27 +168,10 @@ def memory_loop_matrix(gains, scenario: TrackingScenario) -> np.ndarray:
         The plant (τ, g, D), T and the compute delay.
     """
     r = scenario.robot
-    loop = Loop(r.tau, scenario.T, 1.0, plant_gain=r.plant_gain, dead_time=r.dead_time)
-    M, feed, _, _ = command_form(loop, "command", scenario.compute_delay)
     mem = gains.memory
-    y, th, w = (mem.y, mem.theta, mem.w) if mem is not None else ((gains.k_y,), (gains.k_theta,), (gains.k_w,))
-    lag = loop.tau > 0
-    if not lag and any(v != 0.0 for v in w):
-        raise ValueError("a controller that reads the measured yaw rate needs a plant with a lag (tau > 0) in the memory loop")
-    channels = [(1 + lag - 1, [-v for v in th]), (1 + lag, [-gains.V * v for v in y])] + ([(0, list(w))] if lag and any(w) else [])
-    J, n = len(y), M.shape[0]
-    size = n + len(channels) * (J - 1)
-    A = np.zeros((size, size))
-    A[:n, :n] = M
-    c = np.zeros(size)
-    for ch, (index, taps) in enumerate(channels):
-        c[index] += taps[0]
-        base = n + ch * (J - 1)
-        for j in range(1, J):
-            c[base + j - 1] = taps[j]
-            A[base + j - 1, index if j == 1 else base + j - 2] = 1.0  # the sample j periods back
-    A[:n] += r.plant_gain * np.outer(feed, c)
-    return A
+    taps = (mem.theta, mem.y, mem.w) if mem is not None else ((gains.k_theta,), (gains.k_y,), (gains.k_w,))
+    loop = Loop(r.tau, scenario.T, 1.0, plant_gain=r.plant_gain, dead_time=r.dead_time)
+    return models_memory_loop(loop, taps, gains.V, scenario.compute_delay)
 
 
 def _verdict(model, gains, scenario: TrackingScenario, prediction: str, shift) -> bool:
