@@ -391,3 +391,26 @@ def test_tracking_loop_is_the_steering_loop_with_the_heading_sampled():
     loop = tracking_loop(Robot(V=0.5, tau=0.2, k=9.0, W=0.5, dead_time=0.1, plant_gain=0.8, actuator_lag=0.02), Controller(T=0.05, f=1, n=2), point)
     assert (loop.k, loop.tau, loop.T, loop.dead_time, loop.plant_gain, loop.actuator_lag) == (point.k_theta, 0.2, 0.05, 0.1, 0.8, 0.02)
     assert loop.heading_sampled and loop.heading_delay == pytest.approx(0.15)
+
+
+def test_the_memory_loop_with_one_cycle_is_the_sampled_model():
+    """A measured controller's memory of one cycle closes the `sampled` model's loop (k = k_θ, NV = k_y·V/k_θ): the memory
+    verdict's growth rate is the sampled model's dominant root (1e-9: two constructions of one matrix), and with a longer
+    response D* is where the memory loop's spectral radius crosses 1 (the loop at 0.99·D* inside, at 1.01·D* outside)."""
+    import numpy as np
+
+    from pfm_stability.analysis.path_laws import MeasuredGains
+    from pfm_stability.analysis.path_tracking import memory_verdict
+    from pfm_stability.models import Loop, make_model
+    from pfm_stability.models.sampled import memory_loop_matrix
+
+    loop = Loop(0.1, 0.05, 1.1, plant_gain=0.9, dead_time=0.08, heading_sampled=True)
+    one = MeasuredGains("mppi", 1.1, 1.9, 0.45, memory=((1.1,), (1.9,), (0.0,)))
+    root = make_model("sampled", hold="command", compute_delay=0).rightmost_root(1.9 * 0.45 / 1.1, loop)
+    assert memory_verdict(loop, one, 0).growth_rate == pytest.approx(root.real, rel=1e-9)
+    taps = ((1.1, 0.6, 0.35, 0.1), (1.9, 1.1, 0.6, 0.2), (0.0, 0.0, 0.0, 0.0))
+    longer = MeasuredGains("mppi", 1.1, 1.9, 0.45, memory=taps)
+    D_star = memory_verdict(loop, longer, 0).dead_time_critical
+    radius = lambda D: np.abs(np.linalg.eigvals(memory_loop_matrix(loop.replace(dead_time=D), taps, 0.45, 0))).max()  # noqa: E731
+    assert 0 < D_star < memory_verdict(loop, one, 0).dead_time_critical
+    assert radius(0.99 * D_star) < 1 < radius(1.01 * D_star)

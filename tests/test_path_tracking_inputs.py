@@ -174,7 +174,7 @@ def test_auto_takes_the_files_plugin_and_mppi_takes_gains(tmp_path):
     (["--controller", "rpp", "--param", "nope=1"], "'nope' is not a parameter of nav2_regulated_pure_pursuit_controller (rpp)"),
     (["--controller", "rpp", "--param", "lookahead_dist=0"], "--param lookahead_dist must be a finite number in (0, 100] m; got 0"),
     (["--controller", "rpp", "--param", "max_linear_vel=1"], "--param max_linear_vel: the cruising speed is --V"),
-    (["--controller", "mppi"], "give the gains measured from the algorithm, --k-theta and --k-y"),
+    (["--controller", "mppi", "--k-theta", "1.1"], "give both --k-theta and --k-y, or neither"),
     (["--controller", "rpp", "--k-theta", "1"], "--k-theta applies to --controller mppi or dwb"),
     (["--controller", "rpp", "--param", "lookahead_dist"], "--param must be NAME=VALUE"),
     (["--controller", "rpp", "--alpha", "20"], "alpha applies to --controller vff"),
@@ -225,3 +225,30 @@ def test_readme_worked_example_is_what_the_report_prints():
     code, out, _ = run(["report", "--controller", "rpp", "--dead-time", "0.7", "--tau", "0", "--model", "sampled"])
     assert "lower max_linear_vel to <= 0.4308 m/s (-14 %); raise lookahead_dist to >= 0.6964 m (+16 %); lower dead_time to <= 0.5997 s (-14 %)" in out
     assert "lower max_linear_vel to <= 0.4308 m/s (-14 %); raise lookahead_dist to >= 0.6964 m (+16 %); lower dead_time to <= 0.5997 s (-14 %)" in section
+
+
+def test_mppi_without_typed_gains_measures_them_with_the_files_values(tmp_path, monkeypatch):
+    """No --k-theta/--k-y: the report measures MPPI's gains from its algorithm (`MeasuredGains.measure`, stubbed here with
+    known taps: the measurement itself is tests/test_controllers_mppi_dwb.py's) with the values the Nav2 file gave and
+    not the assumed ones, at the report's V, T and corridor; its memory gives the report's memory verdict (schema-checked)
+    and the stderr note says the gains were measured."""
+    from pfm_stability.analysis import path_laws
+
+    seen = {}
+
+    def measure(cls, name, given, costmap, *, V, T, half_width=None, seed=0, memory_cycles=path_laws.MEMORY_CYCLES):
+        seen.update(name=name, given=given, V=V, T=T, half_width=half_width)
+        return cls(name, 1.1, 1.9, V, 0.05, 0.1, ((1.1, 0.6, 0.3), (1.9, 1.0, 0.5), (0.0, 0.0, 0.0)))
+
+    monkeypatch.setattr(path_laws.MeasuredGains, "measure", classmethod(measure))
+    path = tmp_path / "nav2.yaml"
+    path.write_text("controller_server:\n  ros__parameters:\n    controller_frequency: 20.0\n    FollowPath:\n"
+                    "      plugin: \"nav2_mppi_controller::MPPIController\"\n      vx_max: 0.4\n      CostCritic:\n        cost_weight: 4.0\n")
+    code, out, err = run(["report", "--controller", "auto", "--config", str(path), "--L", "0.8", "--dead-time", "0.1", "--format", "json"])
+    assert code == 0 and "measuring mppi's gains from its algorithm" in err
+    data = json.loads(out)
+    assert not [e.message for e in VALIDATOR.iter_errors(data)]
+    assert seen["name"] == "mppi" and seen["given"]["vx_max"] == 0.4 and seen["given"]["CostCritic.cost_weight"] == 4.0
+    assert "batch_size" not in seen["given"] and seen["T"] == pytest.approx(0.05) and seen["half_width"] == 0.8
+    memory = data["environment"]["path"]["memory"]
+    assert memory["cycles"] == 3 and 0 < memory["dead_time_critical"] < data["path"]["sampled"]["dead_time_critical"]

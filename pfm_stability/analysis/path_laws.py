@@ -42,7 +42,7 @@ from dataclasses import dataclass
 from ..controllers.costmap import FREE_SPACE, INSCRIBED_INFLATED_OBSTACLE, LETHAL_OBSTACLE, Inflation
 from ..parameters import check_parameter
 
-__all__ = ["TrackingPoint", "PurePursuit", "Graceful", "MeasuredGains", "corridor_pose_cost", "inflation_cost", "regulated_distance",
+__all__ = ["TrackingPoint", "PurePursuit", "Graceful", "MeasuredGains", "MEMORY_CYCLES", "algorithm_params", "corridor_pose_cost", "inflation_cost", "regulated_distance",
            "path_law"]
 
 FREE, INSCRIBED, LETHAL = FREE_SPACE, INSCRIBED_INFLATED_OBSTACLE, LETHAL_OBSTACLE
@@ -316,9 +316,17 @@ class Graceful:
         return Graceful({**self.values, name: value})
 
 
+MEMORY_CYCLES = 16
+"""Cycles of a measured controller's response the prediction carries (`MeasuredGains.measure`): MPPI's answer to a
+one-cycle pose error keeps moving its next commands through its warm-started sequence and Savitzky–Golay filter (taps
+1.53, 0.84, 0.57, 0.19 … of the first, summing to 2.4 times it), and with its static one-step gains the predicted
+largest dead time was twice the simulated one; over 16 cycles the taps have died out and the prediction is within the
+simulation's spread (docs/controllers.md, experiments/nav2_controllers.py)."""
+
+
 @dataclass(frozen=True)
 class MeasuredGains:
-    """A controller linearised numerically (MPPI, DWB): its gains at the speed they were measured.
+    """A controller linearised numerically (MPPI, DWB): its gains at the speed they were measured, and its memory.
 
     Attributes
     ----------
@@ -330,6 +338,9 @@ class MeasuredGains:
         The speed the robot drove when they were measured, m/s.
     k_theta_se, k_y_se : float
         Their standard errors over the draws (0: exact).
+    memory : tuple or None
+        The response over the following cycles to a one-cycle perturbation, ((θ_j 1/s), (y_j 1/(m·s)), (w_j)),
+        j = 0 … J − 1 (`controllers.linearize.ImpulseResponse`; None: the one-step gains alone, e.g. typed).
     """
 
     name: str
@@ -338,6 +349,7 @@ class MeasuredGains:
     V: float
     k_theta_se: float = 0.0
     k_y_se: float = 0.0
+    memory: tuple | None = None
 
     shape = None
     steering = None
@@ -349,14 +361,50 @@ class MeasuredGains:
     @classmethod
     def from_linearisation(cls, gains) -> "MeasuredGains":
         """From a numeric linearisation of the algorithm (the ``LateralGains`` of ``controllers.linearize``: its
-        ``controller``, ``V``, ``k_theta``, ``k_y``, ``k_theta_se``, ``k_y_se``; read by name, nothing imported).
+        ``controller``, ``V``, ``k_theta``, ``k_y``, their standard errors and ``memory``, read by name).
 
         Parameters
         ----------
         gains : object
             The linearisation's result.
         """
-        return cls(gains.controller, gains.k_theta, gains.k_y, gains.V, gains.k_theta_se, gains.k_y_se)
+        memory = getattr(gains, "memory", None)
+        taps = None if memory is None else (tuple(memory.theta), tuple(memory.y), tuple(memory.w))
+        return cls(gains.controller, gains.k_theta, gains.k_y, gains.V, gains.k_theta_se, gains.k_y_se, taps)
+
+    @classmethod
+    def measure(cls, name: str, given: dict, costmap: dict, *, V: float, T: float, half_width: float | None = None,
+                seed: int = 0, memory_cycles: int = MEMORY_CYCLES) -> "MeasuredGains":
+        """The gains measured from the algorithm as Nav2 runs it (`controllers.linearize`: seeded draws, their standard
+        errors and the response over `memory_cycles` cycles), about the centre line of the corridor (or a straight path).
+
+        The parameters are the algorithm's defaults (Nav2's declarations; bringup's where the source declares none a
+        controller can run with, `controllers.mppi.BRINGUP_DEFAULTS`) with the values a Nav2 file gave (`algorithm_params`).
+
+        Parameters
+        ----------
+        name : str
+            ``mppi`` or ``dwb``.
+        given : dict
+            The Nav2 parameters a file gave, registry name → value (assumed defaults left out).
+        costmap : dict
+            ``inflation_radius``, ``cost_scaling_factor``, ``inscribed_radius`` (m, 1/m, m) and ``resolution`` (m).
+        V, T : float
+            The cruising speed (m/s) and the controller's period (s).
+        half_width : float, optional
+            The corridor's half-width, m (None: free space).
+        seed : int
+            The first draw's seed.
+        memory_cycles : int
+            Cycles of the response measured.
+        """
+        from ..controllers.costmap import CorridorCostmap
+        from ..controllers.linearize import configure, linearize
+
+        params = configure(name, algorithm_params(name, given), V=V, T=T)
+        grid = CorridorCostmap(half_width=half_width, resolution=costmap["resolution"],
+                               inflation=Inflation(costmap["inflation_radius"], costmap["cost_scaling_factor"], costmap["inscribed_radius"]))
+        return cls.from_linearisation(linearize(name, params, grid, T=T, seed=seed, memory_cycles=memory_cycles))
 
     def point(self, V_set: float | None = None) -> TrackingPoint:
         """The gains as measured (`V_set` ignored: the gains hold at the speed they were measured).
@@ -381,6 +429,36 @@ class MeasuredGains:
             for dy in (-1.0, 1.0):
                 out.append((max(self.k_theta + dt * spread * self.k_theta_se, 1e-9 * self.k_theta), self.k_y + dy * spread * self.k_y_se))
         return tuple(out)
+
+
+def algorithm_params(name: str, given: dict):
+    """The algorithm's parameters (`controllers.<name>`) with the values a Nav2 file gave: a registry name is a field
+    (``vx_max``) or a critic's (``CostCritic.cost_weight``: that critic's field); a list becomes a tuple; names the
+    algorithm does not read are left out.
+
+    Parameters
+    ----------
+    name : str
+        ``rpp``, ``graceful``, ``mppi`` or ``dwb``.
+    given : dict
+        Registry name → value, as the file gave them.
+    """
+    from dataclasses import fields, replace
+
+    from ..controllers.base import default_params
+
+    params = default_params(name)
+    own = {f.name for f in fields(params)}
+    for key, value in given.items():
+        value = tuple(value) if isinstance(value, list) else value
+        head, _, tail = key.partition(".")
+        if tail and head in own:
+            part = getattr(params, head)
+            if tail in {f.name for f in fields(part)}:
+                params = replace(params, **{head: replace(part, **{tail: value})})
+        elif not tail and key in own:
+            params = replace(params, **{key: value})
+    return params
 
 
 def path_law(controller: str, values: dict, *, costmap: dict, half_width: float | None = None, gains=None):

@@ -172,6 +172,70 @@ class PathVerdict:
         return out
 
 
+@dataclass(frozen=True)
+class MemoryVerdict:
+    """The `sampled` loop closed by a measured controller's memory, its impulse response over several cycles
+    (`models.sampled.memory_loop_matrix`; MPPI's warm-started sequence: docs/path_tracking.md).
+
+    Attributes
+    ----------
+    cycles : int
+        Cycles of the response carried.
+    stable : bool
+        Every pole inside the unit circle.
+    spectral_radius : float
+        The largest pole modulus.
+    growth_rate : float
+        ln(spectral_radius)/T, 1/s.
+    dead_time_critical : float
+        D*, s: the largest dead time the loop with memory tolerates (0: unstable without one; ``inf``: stable up to the
+        longest searched, `MEMORY_DEAD_TIME_PERIODS` periods or 10 s).
+    """
+
+    cycles: int
+    stable: bool
+    spectral_radius: float
+    growth_rate: float
+    dead_time_critical: float
+
+    def to_dict(self) -> dict:
+        """The fields, JSON-ready."""
+        return {"cycles": self.cycles, "stable": self.stable, "spectral_radius": self.spectral_radius,
+                "growth_rate": self.growth_rate, "dead_time_critical": json_number(self.dead_time_critical)}
+
+
+MEMORY_DEAD_TIME_PERIODS = 399
+"""The longest dead time `memory_verdict` searches, in controller periods: the closed-loop matrix carries the commands
+on their way as states, as many as the eigenvalues resolve (`models.sampled.MAX_EIGEN_STATES`, less one)."""
+
+
+def memory_verdict(loop: Loop, law: MeasuredGains, compute_delay: int) -> MemoryVerdict:
+    """The loop with the measured controller's memory: its verdict and D* (`MemoryVerdict`).
+
+    Parameters
+    ----------
+    loop : models.Loop
+        The plant (τ, τ_a, g, D) and the period T.
+    law : MeasuredGains
+        With ``memory``.
+    compute_delay : {0, 1}
+        Samples from measurement to actuation.
+    """
+    from ..models.sampled import memory_loop_matrix
+
+    def rate(D: float) -> float:
+        A = memory_loop_matrix(loop.replace(dead_time=float(D)), law.memory, law.V, compute_delay)
+        return float(np.log(np.max(np.abs(np.linalg.eigvals(A))))) / loop.T
+
+    sigma = rate(loop.dead_time)
+    if rate(0.0) >= 0:
+        D_star = 0.0
+    else:
+        high = min(MEMORY_DEAD_TIME_PERIODS * loop.T, RANGES["dead_time"].high)
+        D_star = first_crossing(lambda Ds: np.array([rate(D) for D in Ds]), 1e-2 * loop.T, high, rtol=1e-6)
+    return MemoryVerdict(len(law.memory[0]), sigma < 0, float(math.exp(sigma * loop.T)), sigma, D_star)
+
+
 def _nan(x) -> bool:
     return isinstance(x, float) and math.isnan(x)
 
@@ -200,6 +264,8 @@ class PathTracking:
         MPPI's model delay recommended from D and T.
     pose_cost : int or None
         RPP: the costmap's cost at the robot (None for the other laws).
+    memory : MemoryVerdict or None
+        A measured controller's loop with its memory (MPPI, DWB measured over several cycles; None otherwise).
     """
 
     controller: str
@@ -211,6 +277,7 @@ class PathTracking:
     notes: tuple = ()
     model_delay: ModelDelay | None = None
     pose_cost: int | None = field(default=None)
+    memory: MemoryVerdict | None = None
 
     def to_dict(self) -> dict:
         """The geometry, the linearised law and every model's verdict, JSON-ready (SI units)."""
@@ -222,6 +289,8 @@ class PathTracking:
         out = {"controller": self.controller, "geometry": "corridor" if self.half_width is not None else "straight path",
                "L_corridor": self.half_width, "pose_cost": self.pose_cost, "law": law, "notes": list(self.notes),
                "models": {name: v.to_dict() for name, v in self.models.items()}}
+        if self.memory is not None:
+            out["memory"] = self.memory.to_dict()
         if self.model_delay is not None:
             out["model_delay"] = self.model_delay.to_dict()
         return out
@@ -561,5 +630,8 @@ def analyze_path_tracking(robot, controller, law, models, *, V_set: float | None
                          f"steering gains {k.describe()}")
     loop = tracking_loop(robot, controller, point)
     verdicts = {m.name: _verdict(m, law, point, loop) for m in models}
+    memory = None
+    if isinstance(law, MeasuredGains) and law.memory is not None and len(law.memory[0]) > 1 and loop.T > 0:
+        memory = memory_verdict(loop, law, controller.compute_delay)
     return PathTracking(law.name, law, point, loop, half_width, verdicts, _notes(law, point, half_width),
-                        _model_delay(law, values, robot, controller), getattr(law, "pose_cost", None))
+                        _model_delay(law, values, robot, controller), getattr(law, "pose_cost", None), memory)

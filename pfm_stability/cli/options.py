@@ -693,7 +693,7 @@ def resolve_tracker(args, params: ResolvedParameters) -> ResolvedTracker | None:
                          "has a closed-form linearisation")
     tracker = _with_params(tracker, entry, args.param or [])
     robot, controller, sources, tracker = _tracker_robot(args, params, tracker, entry)
-    gains = _gains(args, tracker.controller, robot.V) if entry.linearisation == "numeric" else None
+    gains = _gains(args, tracker, robot.V, controller.T) if entry.linearisation == "numeric" else None
     sources["controller"] = "user" if name != "auto" else f"auto: {tracker.plugin_id}.plugin of --config {params.config.path}"
     return ResolvedTracker(tracker, gains, robot, controller, sources)
 
@@ -770,11 +770,23 @@ def _preset_of(source: str) -> str | None:
     return None
 
 
-def _gains(args, controller: str, V: float):
-    """MPPI's or DWB's `MeasuredGains` from ``--k-theta`` and ``--k-y`` (required) and their standard errors."""
-    from ..analysis.path_laws import MeasuredGains
+def _gains(args, tracker, V: float, T: float):
+    """MPPI's or DWB's `MeasuredGains`: from ``--k-theta`` and ``--k-y`` (and their standard errors) when typed, else
+    measured from the algorithm with the file's parameters about the corridor's centre line (`MeasuredGains.measure`:
+    seeded, its response over `analysis.path_laws.MEMORY_CYCLES` cycles; a note on stderr, it takes seconds)."""
+    from ..analysis.path_laws import MEMORY_CYCLES, MeasuredGains
 
-    if args.k_theta is None or args.k_y is None:
-        raise ValueError(f"--controller {controller} has no closed-form linearisation: give the gains measured from the algorithm, "
-                         "--k-theta and --k-y (docs/path_tracking.md)")
-    return MeasuredGains(controller, args.k_theta, args.k_y, V, args.k_theta_se or 0.0, args.k_y_se or 0.0)
+    controller = tracker.controller
+    if (args.k_theta is None) != (args.k_y is None):
+        raise ValueError(f"--controller {controller}: give both --k-theta and --k-y, or neither (then they are measured from the "
+                         "algorithm, docs/path_tracking.md)")
+    if args.k_theta is not None:
+        return MeasuredGains(controller, args.k_theta, args.k_y, V, args.k_theta_se or 0.0, args.k_y_se or 0.0)
+    if args.k_theta_se is not None or args.k_y_se is not None:
+        raise ValueError("--k-theta-se and --k-y-se go with --k-theta and --k-y (measured gains carry their own standard errors)")
+    print(f"pfm-stability: note: measuring {controller}'s gains from its algorithm about the centre line (seeded, "
+          f"{MEMORY_CYCLES} cycles of its response)", file=sys.stderr)
+    given = {name: setting.value for name, setting in tracker.parameters.items() if not setting.assumed}
+    return MeasuredGains.measure(controller, given, tracker.costmap_values(), V=V, T=T, half_width=getattr(args, "L", None))
+
+

@@ -529,6 +529,16 @@ def _path_sections(data: dict):
         rows.append(cells)
     fixes = {name: v["to_stabilize"] for name, v in verdicts.items() if v["verdict"] != "stable"}
     yield title, header, rows, fixes, notes
+    memory = env.get("memory")
+    if memory is not None:
+        static = verdicts.get("sampled", {}).get("dead_time_critical")
+        versus = f" (with the one-step gains alone: {number(static)} s)" if static is not None else ""
+        yield ("With the controller's memory (sampled)", [], [], {}, [
+            f"  the {memory['cycles']}-cycle response to a pose error closes the sampled loop: "
+            f"{'stable' if memory['stable'] else 'UNSTABLE'}, largest pole |z| = {number(memory['spectral_radius'])} "
+            f"(sigma = {number(memory['growth_rate'])} 1/s); D* = {number(memory['dead_time_critical'])} s{versus}",
+            "  (the table's models see the first cycle's gains; this loop is the one the simulated controller closes, "
+            "docs/path_tracking.md)"])
     delay = env.get("model_delay")
     if delay is not None:
         yield ("MPPI's model delay", [], [], {}, [
