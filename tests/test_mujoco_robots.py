@@ -181,10 +181,20 @@ def test_a_corridor_run_of_robot_c_is_recorded_as_its_log(corridor_c):
     assert np.allclose(np.diff(log.run.offset_t), 1 / 11) and log.run.metrics.angular_frequency > 0
 
 
+def _grid_law(config):
+    """The grid law of a configuration file, as diagnose builds it."""
+    from pfm_stability.laws.force_law import law_in_force
+    from pfm_stability.sim.scenario import scenario_law
+
+    return law_in_force(config.robot, config.controller, scenario_law("grid", config.robot, config.controller))
+
+
 def test_diagnose_sets_the_slew_limit_against_the_commands(corridor_c, tmp_path):
     """`diagnose` of robot C's run (logged as a bag) with the slew limit in the configuration: the JSON (valid) carries
-    the limit, that the prediction is the linear loop's, and the commands' 95th-percentile |du/dt| over the judged
-    stretch — recomputed here from the logged commands; from 5 cm off at 0.6 m/s it stays below the limit."""
+    the limit, that the table's prediction is the linear loop's, the limited loop's V* for a weave the size the judged
+    stretch shows (wired: the value `analysis.disturbance` gives there, which tests/test_rate_limit_disturbance.py checks
+    against the simulator), and the commands' 95th-percentile |du/dt| over the judged stretch — recomputed here from the
+    logged commands; from 5 cm off at 0.6 m/s it stays below the limit."""
     import json
 
     from cli_helpers import VALIDATOR, run as run_cli
@@ -203,7 +213,19 @@ def test_diagnose_sets_the_slew_limit_against_the_commands(corridor_c, tmp_path)
     data = json.loads(out)
     assert [f"{list(e.absolute_path)}: {e.message[:120]}" for e in VALIDATOR.iter_errors(data)] == []
     limiter = data["limiter"]
-    assert limiter["yaw_accel_limit"] == 2.0 and limiter["in_prediction"] is False and "linear" in limiter["note"]
+    assert limiter["yaw_accel_limit"] == 2.0 and "linear" in limiter["note"]
+    # the limited loop asked at the weave the judged stretch shows: analysis.disturbance's V*(D) at that amplitude
+    from pfm_stability.analysis.disturbance import corridor_disturbance
+    from pfm_stability.io.config import load_config
+
+    judged = data["stretches"][data["measured"]["stretch"]]
+    filed = load_config(config)
+    robot = filed.robot.replace(V=judged["V"], tau=data["parameters"]["tau"]["value"], dead_time=data["parameters"]["dead_time"]["value"],
+                                plant_gain=data["parameters"]["plant_gain"]["value"])
+    expected = corridor_disturbance(robot, filed.controller.replace(T=data["parameters"]["T"]["value"]), _grid_law(filed),
+                                    judged["L"], limiter["disturbance"]).V_disturbance
+    assert limiter["in_prediction"] is True and limiter["disturbance"] == pytest.approx(judged["measured"]["amplitude"])
+    assert limiter["V_disturbance"] == pytest.approx(expected, rel=1e-9) and limiter["V_disturbance"] > 0
     stretch = data["stretches"][data["measured"]["stretch"]]
     inside = (log.cmd_t >= stretch["start"]) & (log.cmd_t <= stretch["end"])
     rates = np.abs(np.diff(log.cmd_wz[inside]) / np.diff(log.cmd_t[inside]))

@@ -374,7 +374,7 @@ def render_text(report) -> str:
         lines.append(f"  {_path_substitution(data)}")
         for title, header, rows, fixes, notes in _path_sections(data):
             lines += ["", title, *notes]
-            lines += ["  " + line for line in table(header, rows)]
+            lines += ["  " + line for line in table(header, rows)] if header else []
             lines += [_path_remedy_line(model, fix, data) for model, fix in fixes.items()]
         lines += ["", *_path_footnote(data)]
         return "\n".join(lines) + "\n"
@@ -449,8 +449,10 @@ def render_markdown(report) -> str:
     if report.path is not None:
         lines += ["", "## Models", "", *(f"- {name}: `{entry['equation']}`" for name, entry in data["models"].items()), f"- {_path_substitution(data)}"]
         for title, header, rows, fixes, notes in _path_sections(data):
-            lines += ["", f"## {title}", "", *(f"- {note.strip()}" for note in notes), "", "| " + " | ".join(header) + " |", "|" + " --- |" * len(header)]
-            lines += ["| " + " | ".join(str(c) for c in r) + " |" for r in rows]
+            lines += ["", f"## {title}", "", *(f"- {note.strip()}" for note in notes)]
+            if header:  # a section of notes only (the memory, MPPI's model delay) has no table
+                lines += ["", "| " + " | ".join(header) + " |", "|" + " --- |" * len(header)]
+                lines += ["| " + " | ".join(str(c) for c in r) + " |" for r in rows]
             lines += ["", *("-" + _path_remedy_line(model, fix, data)[1:] for model, fix in fixes.items())] if fixes else []
         lines += ["", *_path_footnote(data)]
         return "\n".join(lines) + "\n"

@@ -186,6 +186,11 @@ class Limiter:
         for it (None without the commands).
     note : str
         What this means for the prediction, in words.
+    disturbance : float or None
+        The size of the weave the judged stretch shows (its measured amplitude, m) at which the limited loop is asked.
+    V_disturbance : float or None
+        V*(disturbance), m/s: the fastest speed at which a start that size settles with the limit (the limiter's
+        describing function on the sampled loop, `analysis.disturbance`; None where it gives none, see `note`).
     """
 
     yaw_accel_limit: float
@@ -193,11 +198,14 @@ class Limiter:
     commanded_acceleration: float | None
     reached: bool | None
     note: str
+    disturbance: float | None = None
+    V_disturbance: float | None = None
 
     def to_dict(self) -> dict:
-        """``{yaw_accel_limit, in_prediction, commanded_acceleration, reached, note}`` (SI units)."""
+        """``{yaw_accel_limit, in_prediction, commanded_acceleration, reached, note, disturbance, V_disturbance}`` (SI units)."""
         return {"yaw_accel_limit": json_number(self.yaw_accel_limit), "in_prediction": self.in_prediction,
-                "commanded_acceleration": json_number(self.commanded_acceleration), "reached": self.reached, "note": self.note}
+                "commanded_acceleration": json_number(self.commanded_acceleration), "reached": self.reached, "note": self.note,
+                "disturbance": json_number(self.disturbance), "V_disturbance": json_number(self.V_disturbance)}
 
 
 @dataclass(frozen=True)
@@ -653,15 +661,17 @@ def diagnose(log: LogData, robot: Robot, controller: Controller, *, law: ForceLa
     if worst is not None:  # the whole log's stretch: every critical value and the remedies
         judged = tuple(_full(d, robot, controller, law, tuple(models)) if d.stretch.index == worst else d for d in judged)
     V = judged[worst].V if worst is not None else robot.V
-    limiter = _limiter(robot, log, judged[worst].stretch if worst is not None else None)
+    limiter = _limiter(robot, controller, law, log, judged[worst] if worst is not None else None)
     return Diagnosis(verdict, reason, judged, worst, robot.replace(V=V), controller, log.pose, law, limiter)
 
 
-def _limiter(robot: Robot, log: LogData, stretch: Stretch | None) -> Limiter | None:
-    """The robot's slew limit set against the commands of the judged stretch (`Limiter`)."""
+def _limiter(robot: Robot, controller: Controller, law: ForceLaw, log: LogData, judged: StretchDiagnosis | None) -> Limiter | None:
+    """The robot's slew limit set against the commands of the judged stretch, and the limited loop's V* for a disturbance
+    the size of the weave it shows (`Limiter`)."""
     A = robot.yaw_accel_limit
     if not math.isfinite(A):
         return None
+    stretch = judged.stretch if judged is not None else None
     acceleration = None
     if log.command is not None and stretch is not None:
         t, u = log.command.t, log.command.value
@@ -671,11 +681,31 @@ def _limiter(robot: Robot, log: LogData, stretch: Stretch | None) -> Limiter | N
             ok = dt > 0
             acceleration = float(np.percentile(np.abs(np.diff(u[inside])[ok] / dt[ok]), 95)) if np.any(ok) else None
     reached = None if acceleration is None else bool(acceleration >= REACHED * A)
-    note = (f"the predictions are the linear loop's, which a slew limit of {A:.3g} rad/s² does not change: they hold for a "
-            "disturbance small enough that the commands never change faster than the limit; the boundary for a larger one "
-            "depends on its size (the limiter's describing function is not in this version)")
+    size, V_size, why = _limited_boundary(robot, controller, law, judged)
+    note = (f"the predictions' table is the linear loop's, which a slew limit of {A:.3g} rad/s² does not change: it holds for a "
+            "disturbance small enough that the commands never change faster than the limit")
+    note += (f"; with the limit, a weave of {size:.3g} m (the judged stretch's) settles at or below V* = {V_size:.4g} m/s "
+             "(the limiter's describing function on the sampled loop, docs/wobble.md)") if V_size is not None else f"; {why}"
     if reached is not None:
         note += (f"; on the judged stretch the commands changed at up to {acceleration:.3g} rad/s² (95th percentile): the limit "
-                 + ("was reached, so the measured oscillation is the limited loop's and V* may be off for it" if reached
-                    else "was not reached"))
-    return Limiter(A, False, acceleration, reached, note)
+                 + ("was reached, so the measured oscillation is the limited loop's" if reached else "was not reached"))
+    return Limiter(A, V_size is not None, acceleration, reached, note, size, V_size)
+
+
+def _limited_boundary(robot: Robot, controller: Controller, law: ForceLaw, judged: StretchDiagnosis | None) -> tuple:
+    """(size m, V*(size) m/s, why none): the limited corridor loop asked at the judged stretch's measured amplitude
+    (`analysis.disturbance.corridor_disturbance`); a wall's stretch, or no amplitude, gives no V*(size) and says why."""
+    if judged is None or judged.measured is None or not judged.measured.amplitude:
+        return None, None, "the judged stretch has no measured amplitude to ask the limited loop at"
+    if judged.stretch.kind != "corridor":
+        return judged.measured.amplitude, None, "V*(size) is computed for a corridor's stretch (a wall's biased cycle is not)"
+    from ..analysis.disturbance import corridor_disturbance
+
+    clearance = judged.geometry - robot.W / 2
+    size = min(judged.measured.amplitude, 0.95 * clearance)
+    try:
+        d = corridor_disturbance(robot.replace(V=judged.V), controller, law, judged.geometry, size)
+    except ValueError as exc:
+        return size, None, f"the limited loop gives no V*(size): {exc}"
+    V = d.V_disturbance
+    return size, (V if V is not None and math.isfinite(V) else None), (d.reason or "the describing function gives no V*(size)")
