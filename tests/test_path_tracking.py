@@ -402,7 +402,7 @@ def test_the_memory_loop_with_one_cycle_is_the_sampled_model():
     from pfm_stability.analysis.path_laws import MeasuredGains
     from pfm_stability.analysis.path_tracking import memory_verdict
     from pfm_stability.models import Loop, make_model
-    from pfm_stability.models.sampled import memory_loop_matrix
+    from pfm_stability.models.memory import memory_loop_matrix
 
     loop = Loop(0.1, 0.05, 1.1, plant_gain=0.9, dead_time=0.08, heading_sampled=True)
     one = MeasuredGains("mppi", 1.1, 1.9, 0.45, memory=((1.1,), (1.9,), (0.0,)))

@@ -175,7 +175,7 @@ class PathVerdict:
 @dataclass(frozen=True)
 class MemoryVerdict:
     """The `sampled` loop closed by a measured controller's memory, its impulse response over several cycles
-    (`models.sampled.memory_loop_matrix`; MPPI's warm-started sequence: docs/path_tracking.md).
+    (`models.memory.memory_loop_matrix`; MPPI's warm-started sequence: docs/path_tracking.md).
 
     Attributes
     ----------
@@ -221,7 +221,7 @@ def memory_verdict(loop: Loop, law: MeasuredGains, compute_delay: int) -> Memory
     compute_delay : {0, 1}
         Samples from measurement to actuation.
     """
-    from ..models.sampled import memory_loop_matrix
+    from ..models.memory import memory_loop_matrix
 
     def rate(D: float) -> float:
         A = memory_loop_matrix(loop.replace(dead_time=float(D)), law.memory, law.V, compute_delay)

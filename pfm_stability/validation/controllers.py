@@ -27,7 +27,7 @@ import numpy as np
 from ..checks import check_choice, check_integer, check_number
 from ..controllers.linearize import linearize
 from ..models import Loop, make_model
-from ..models.sampled import memory_loop_matrix as models_memory_loop
+from ..models.memory import memory_loop_matrix as models_memory_loop
 from ..numerics.solve import bisect_batched
 from ..sim.tracking import TrackingScenario, simulate_tracking
 from ..sim.verdict import simulated_verdict
@@ -158,7 +158,7 @@ def _gains(scenario: TrackingScenario, draws, seed: int, memory_cycles=None):
 
 
 def memory_loop_matrix(gains, scenario: TrackingScenario) -> np.ndarray:
-    """The scenario's sampled plant closed by a linearised controller's impulse response (`models.sampled.memory_loop_matrix`:
+    """The scenario's sampled plant closed by a linearised controller's impulse response (`models.memory.memory_loop_matrix`:
     the one-step gains alone when the gains have no memory).
 
     Parameters
