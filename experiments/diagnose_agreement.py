@@ -116,6 +116,20 @@ def predicted_V(plant: dict, T: float, L: float) -> float:
     return float(predicted_boundaries("corridor", "V", robot, controller, law, L, validation_models(controller))["sampled"])
 
 
+def limited_V(robot, controller, L: float, offset: float):
+    """V*(D) of the sampled loop with the identified slew limit for a start `offset` m off (the limiter's describing
+    function, `analysis.disturbance`); None without a limit."""
+    import math
+
+    from pfm_stability.analysis.disturbance import corridor_disturbance
+    from pfm_stability.sim.scenario import scenario_law
+
+    if not math.isfinite(robot.yaw_accel_limit):
+        return None
+    V = corridor_disturbance(robot, controller, scenario_law("grid", robot, controller), L, offset).V_disturbance
+    return float(V) if V is not None and math.isfinite(V) else None
+
+
 def diagnose_run(name: str, options: dict, plant: dict, T: float, L: float, V: float, out_dir) -> dict:
     """A 30-s corridor run at V from 5 cm off, logged as a bag, diagnosed with the identified plant and the grid's law."""
     from log_helpers import Plant, Recording, SyntheticLog, write_ros2
@@ -165,8 +179,10 @@ def mujoco_case(key: str, L: float, quick: bool, out_dir) -> dict:
         v = validate_boundary("corridor", "V", robot=robot, controller=controller, env="grid", L=L, offset=offset,
                               duration=15.0 if quick else 30.0, rtol=0.03 if quick else 0.01, members=7,
                               runner=MujocoRuns.factory(EngineOptions(robot_model=name, **options)))
+        limited = limited_V(robot, controller, L, offset)
         bisections[str(offset)] = {"V_mujoco": v.simulated_boundary, "bracket": list(v.bracket), "runs": v.runs,
-                                   "sampled": v.predicted_boundary["sampled"], "error": v.relative_error["sampled"]}
+                                   "sampled": v.predicted_boundary["sampled"], "error": v.relative_error["sampled"],
+                                   "limited": limited, "limited_error": None if limited is None else limited / v.simulated_boundary - 1}
     V_star = bisections[str(OFFSETS[0])]["V_mujoco"]
     runs = [diagnose_run(name, options, plant, T, L, factor * V_star, out_dir) for factor in (0.85, 1.15)]
     return {"robot": key, "model": name, "L": L, "T": T, "plant": plant, "predicted_with": plant,
@@ -178,8 +194,8 @@ def mujoco_case(key: str, L: float, quick: bool, out_dir) -> dict:
 
 def mujoco_table(cases) -> str:
     """The Markdown table of docs/diagnose.md and docs/mujoco.md."""
-    head = ("| robot | L (m) | plant identified | V* MuJoCo 1 cm | V* MuJoCo 5 cm | sampled V* (gap to 1 cm) | diagnose V* at 0.85·V* "
-            "(gap) | verdicts 0.85 / 1.15 | ω measured / predicted at 1.15 |")
+    head = ("| robot | L (m) | plant identified | V* MuJoCo 1 cm | V* MuJoCo 5 cm | sampled V* (gap to 1 cm) | with the limit V*(1 cm), "
+            "V*(5 cm) (gaps) | diagnose V* at 0.85·V* (gap) | verdicts 0.85 / 1.15 | ω measured / predicted at 1.15 |")
     out = [head, "|" + " --- |" * (head.count("|") - 1)]
     for c in cases:
         p = c["plant"]
@@ -193,8 +209,10 @@ def mujoco_table(cases) -> str:
         diag = f"{low['V_critical']:.3f} ({100 * (low['V_critical'] / b1['V_mujoco'] - 1):+.1f} %)" if low["judged"] else "—"
         omega = (f"{high['omega']:.3f} / {high['omega_predicted']:.3f} ({100 * (high['omega_predicted'] / high['omega'] - 1):+.1f} %)"
                  if high["judged"] and high["omega"] and high["omega_predicted"] else "—")
+        limited = (f"{b1['limited']:.3f} ({100 * b1['limited_error']:+.1f} %), {b5['limited']:.3f} ({100 * b5['limited_error']:+.1f} %)"
+                   if b1.get("limited") is not None and b5.get("limited") is not None else "—")
         out.append(f"| {c['robot']} ({c['model']}) | {c['L']:g} | {plant} | {b1['V_mujoco']:.3f} | {b5['V_mujoco']:.3f} | "
-                   f"{b1['sampled']:.3f} ({100 * b1['error']:+.1f} %) | {diag} | {verdict(low)}, {verdict(high)} | {omega} |")
+                   f"{b1['sampled']:.3f} ({100 * b1['error']:+.1f} %) | {limited} | {diag} | {verdict(low)}, {verdict(high)} | {omega} |")
     return "\n".join(out) + "\n"
 
 

@@ -65,6 +65,7 @@ from .environment import segment_clearance, wall_coordinates
 from .events import Event
 from .follow import PathFollower
 from .metrics import oscillation_metrics
+from .scenario import check_first_order
 from .results import BatchResult, RunResult, Trajectory
 from .robot import CommandPath, advance_held, advance_position, constant_input, constant_input_modes, delay_split, graded_rule, propagate, servo, servo_modes, slow_rate
 from .vff import cell_repulsion, direction_of, steering_command, vff_speed, wrap_angle
@@ -86,6 +87,8 @@ class _Batch:
     """Member arrays and the compiled environments of a batch."""
 
     def __init__(self, scenarios):
+        for s in scenarios:
+            check_first_order(s.robot)
         self.scenarios = scenarios
         B = self.size = len(scenarios)
         robot = lambda name: _array(scenarios, lambda s: getattr(s.robot, name))

@@ -44,7 +44,7 @@ from .events import Event
 from .grid import HistogramGrid
 from .results import Trajectory
 from .robot import constant_input_modes, delay_split, graded_rule, servo_modes, slow_rate
-from .scenario import Scenario
+from .scenario import Scenario, check_first_order
 
 __all__ = ["simulate_reference", "PATH_SAMPLES"]
 
@@ -285,6 +285,7 @@ def simulate_reference(s: Scenario):
     -------
     (Trajectory, Event or None)
     """
+    check_first_order(s.robot)
     r, c = s.robot, s.controller
     T, k, wmax, g = c.T, r.k, r.max_steering_rate, r.plant_gain
     sense = _grid_sense if s.env == "grid" else _wall_sense

@@ -269,7 +269,8 @@ class MeasureAxis:
 def check_first_order(robot) -> None:
     """ValueError unless the robot's drive is first order (`Robot.actuator_lag` = 0): the simulator's solution between
     samples is the exact one of τω̇ + ω = g·u (`sim.robot`); a second lag is the loop models' (docs/models.md), and the
-    MuJoCo robots carry one of their own (docs/mujoco.md).
+    MuJoCo robots carry one of their own (docs/mujoco.md). Asked where the simulator steps a robot (`sim.engine.run_batch`,
+    `sim.reference.simulate_reference`, `sim.tracking.simulate_tracking`), not of a scenario MuJoCo runs.
 
     Parameters
     ----------
@@ -353,7 +354,6 @@ class Scenario:
         if self.robot.dead_time > 0 and self.controller.hold == "reference":
             raise ValueError(f"dead_time must be 0 with hold=reference (a dead time inside the continuous steering servo is a delay "
                              f"differential equation, which the simulator does not solve; docs/simulator.md); got {self.robot.dead_time}")
-        check_first_order(self.robot)
         if math.isfinite(self.robot.yaw_accel_limit) and self.controller.hold == "reference":
             raise ValueError(f"yaw_accel_limit needs hold=command (the velocity smoother limits a sequence of held yaw-rate commands; "
                              f"a servo closing k(δ − θ) continuously has none; docs/simulator.md); got {self.robot.yaw_accel_limit} rad/s^2")

@@ -104,7 +104,6 @@ class TrackingScenario:
     name = "tracking"
 
     def __post_init__(self):
-        check_first_order(self.robot)
         if self.controller not in CONTROLLER_NAMES:
             raise ValueError(f"controller must be one of {', '.join(CONTROLLER_NAMES)}; got {self.controller!r}")
         object.__setattr__(self, "T", check_number("T", self.T, 0.0, 100.0, unit="s"))
@@ -284,6 +283,8 @@ def simulate_tracking(scenarios, *, record: str = "offset", metrics: bool = True
     if record not in ("offset", "trajectory"):
         raise ValueError(f"record must be 'offset' or 'trajectory'; got {record!r}")
     started = time.perf_counter()
+    for s in scenarios:
+        check_first_order(s.robot)
     plant, members = _Plant(scenarios), _Members(scenarios)
     B = len(scenarios)
     x = np.array([s.offset for s in scenarios])  # lateral (ROS y)
