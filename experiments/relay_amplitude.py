@@ -143,7 +143,7 @@ def map_level(gaps, length: int = 500):
     from pfm_stability.maps.analysis import analyze_map
     from pfm_stability.maps.episodes import episodes
     from pfm_stability.maps.occupancy import load_map
-    from pfm_stability.maps.paths import path_samples
+    from pfm_stability.maps.decide import path_samples
     from pfm_stability.models import make_model
     from pfm_stability.models.loop import Loop
     from pfm_stability.sim.engine import run_batch

@@ -22,7 +22,8 @@ from pfm_stability.maps.analysis import analyze_map
 from pfm_stability.maps.episodes import AMPLITUDE_THRESHOLD, episodes, lateral_episodes
 from pfm_stability.maps.occupancy import load_map
 from pfm_stability.maps.driven import SampledTransition
-from pfm_stability.maps.paths import PATH_VERDICTS
+from pfm_stability.maps.decide import PATH_VERDICTS, WINDOW_PERIODS
+from pfm_stability.maps.verdicts import EFOLDS
 from pfm_stability.models import Loop, models_for
 from pfm_stability.models.sampled import closed_loop_matrix
 from pfm_stability.parameters import CARMEL, Corridor
@@ -119,19 +120,48 @@ def test_straight_corridor_growth_and_verdict_are_the_reports(root, L, factor):
     assert pv.summary()["decided_fraction"] == 1.0
 
 
+def _window_efolds(N: float, V: float) -> float:
+    """e-folds of the report's loop (the model's rightmost root at N·V) over the map's window of three periods
+    (`paths.WINDOW_PERIODS` wavelengths at V take 3·2π/ω* s): the map's linear rule for a uniform gain."""
+    model, loop = _model()
+    omega = model.boundary(loop).omega_critical
+    return model.rightmost_root(N * V, loop).real * WINDOW_PERIODS * 2 * math.pi / omega
+
+
 @SHARED_CORRIDORS
-def test_unstable_corridor_stretch_has_the_reports_critical_speed(root):
-    """The unstable stretch of a corridor driven at 1.4 V*: margin < 0, and its V* (the speed at which its worst window's
-    growth turns positive) at most the report's (2 % for the map's N against the law's) and above 0.7 of it: the worst
-    window lies at the corridor's ends, where the window sees truncated walls and N rises (docs/maps.md, "Checked":
-    up to twice the middle's N in the last samples, averaged over the window)."""
+def test_unstable_corridor_stretch_speed_is_calm_by_the_reports_loop(root):
+    """The unstable stretch of a corridor driven at 1.4 V*: V* < V and margin V*/V − 1 < 0 (one answer); V* is a rung of
+    the ladder where the stretch is calm, so the report's loop at the report's N (the corridor's middle) grows less than
+    one e-fold over the window there (an independent route: the model's rightmost root, not the map's window product),
+    and V* lies above the report's V* (no growth at all below it) less the ladder's half-step (5 % of V) and the ends'
+    higher N (0.7 of it, as the corridor's last samples reach twice the middle's N, docs/maps.md, "Checked")."""
     ref = _report(0.6)
     V_star = ref.models["sampled"].critical["V_critical"]
-    pv = corridor_analysis(0.6, 1.4 * V_star, root).paths
+    V = 1.4 * V_star
+    pv = corridor_analysis(0.6, V, root).paths
     unstable = [s for s in pv.stretches if s.verdict == "unstable"]
     assert unstable and max(s.length for s in unstable) > 10
     worst = max(unstable, key=lambda s: s.length)
-    assert worst.margin < 0 and 0.7 * V_star < worst.V_critical <= 1.02 * V_star
+    assert worst.V_critical < V and worst.margin == pytest.approx(worst.V_critical / V - 1, rel=1e-12) and worst.margin < 0
+    assert _window_efolds(ref.N, worst.V_critical) < EFOLDS
+    assert 0.7 * V_star < worst.V_critical
+
+
+@SHARED_CORRIDORS
+def test_stable_corridor_stretch_speed_is_the_window_efold_edge(root):
+    """The stable stretch of a corridor driven at 0.7 V*: V* >= V (one answer), and V* is where its worst window first
+    grows one e-fold: the report's loop at the middle's N grows at most that much there (the worst window lies where N
+    is highest; 2 % for the map's N against the law's and the window's discretisation), and V* lies above the report's
+    V* (below it nothing grows)."""
+    ref = _report(0.6)
+    V_star = ref.models["sampled"].critical["V_critical"]
+    V = 0.7 * V_star
+    pv = corridor_analysis(0.6, V, root).paths
+    stable = [s for s in pv.stretches if s.verdict == "stable"]
+    longest = max(stable, key=lambda s: s.length)
+    assert longest.length > 10 and longest.V_critical >= V and longest.margin >= 0
+    assert V_star * (1 - 1e-6) < longest.V_critical
+    assert _window_efolds(ref.N, longest.V_critical) <= EFOLDS * 1.02  # the middle grows no faster than the worst window
 
 
 def test_open_hall_is_a_verdict_nothing_grows(tmp_path):
@@ -146,7 +176,7 @@ def test_open_hall_is_a_verdict_nothing_grows(tmp_path):
     assert np.all(pv.N_forward[centre] == 0) and np.all(pv.code[centre] == PATH_VERDICTS.index("stable"))
     assert pv.summary()["decided_fraction"] == 1.0
     open_stretches = [s for s in pv.stretches if s.N == 0.0]
-    assert all(s.label == "nothing grows" and s.margin == math.inf for s in open_stretches)
+    assert all(s.verdict == "stable" and s.cause is None and s.V_critical == math.inf and s.margin == math.inf for s in open_stretches)
 
 
 @pytest.mark.parametrize("factor", [0.6, 2.0])
@@ -585,14 +615,14 @@ def test_window_edge_relay_where_a_rack_enters_the_window():
 
 def test_a_relay_stands_only_where_the_loop_driven_through_the_profile_strays_as_far(tmp_path, monkeypatch):
     """The window-edge relay with the sampled model (`maps.paths`, docs/maps.md): the describing function of one jump
-    is an estimate of the cycle; the loop driven through the whole profile (`paths._driven`) is run there too, and the
+    is an estimate of the cycle; the loop driven through the whole profile (`decide._driven`) is run there too, and the
     relay stands only where that loop strays as far from its one-period average (its excursion) as well. In a 3 m
     aisle between a one-cell wall and a solid rack (the test robot; the equilibrium at the window's edge, a restoring
     jump on every sample of the skeleton's route), the describing function alone predicts a relay cycle past the
     threshold on every sample: with the driven loop's excursion replaced by 1 m those are the relay samples, with 0
     none remain. The real driven loop strays less than the threshold there, so the route is stable — and the VFF
     simulator agrees: four drives along the aisle find no episode (their largest weave held a period is under 2 cm)."""
-    import pfm_stability.maps.paths as paths
+    import pfm_stability.maps.decide as decide
     from pfm_stability.maps.analysis import judge_routes
     from pfm_stability.validation.map_drives import drive_map
 
@@ -602,7 +632,7 @@ def test_a_relay_stands_only_where_the_loop_driven_through_the_profile_strays_as
     pixels[:, 1 + gap:] = 0
     analysis = analyze_map(load_map(write_map(tmp_path, pixels)), ROBOT, CONTROLLER, make_law("grid", ROBOT, CONTROLLER))
     routes = analysis.paths.paths
-    real = paths._driven
+    real = decide._driven
 
     def swinging(value):
         def driven(*args):
@@ -610,12 +640,12 @@ def test_a_relay_stands_only_where_the_loop_driven_through_the_profile_strays_as
             return oscillates, amplitude, np.full_like(excursion, value)
         return driven
 
-    monkeypatch.setattr(paths, "_driven", swinging(1.0))
+    monkeypatch.setattr(decide, "_driven", swinging(1.0))
     alone = judge_routes(analysis, routes)
     assert alone.relay.all() and alone.relay.size > 100
-    monkeypatch.setattr(paths, "_driven", swinging(0.0))
+    monkeypatch.setattr(decide, "_driven", swinging(0.0))
     assert not judge_routes(analysis, routes).relay.any()
-    monkeypatch.setattr(paths, "_driven", real)
+    monkeypatch.setattr(decide, "_driven", real)
     pv = analysis.paths
     assert not pv.relay.any() and (pv.code == PATH_VERDICTS.index("stable")).all()
     drives = drive_map(analysis, 4, seed=0)

@@ -12,7 +12,7 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from pfm_stability.maps.driven import PREDICTION_OFFSET, DrivenTrack, SampledTransition, _TrackWalk, _driven
-from pfm_stability.maps.paths import path_samples
+from pfm_stability.maps.decide import path_samples
 from pfm_stability.maps.routes import path_of
 from pfm_stability.models import Loop, models_for
 from pfm_stability.models.sampled import continuous_plant

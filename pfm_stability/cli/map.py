@@ -127,8 +127,8 @@ def _drive(analysis, count: int, seed: int, progress):
 
 
 def _write_outputs(analysis, out_dir: str, drives=None, a_max=None) -> dict:
-    """The files of ``--out-dir``, all or none (`files.atomic_directory`): the four of the segments, and with the routes'
-    verdicts their picture (with the drives' episodes) and CSV."""
+    """The files of ``--out-dir``, all or none (`files.atomic_directory`): the result set's picture and CSV (the routes'
+    stretches, with the drives' episodes; the segments with the power law) and the speed mask."""
     import os
 
     import matplotlib
@@ -137,25 +137,22 @@ def _write_outputs(analysis, out_dir: str, drives=None, a_max=None) -> dict:
     import matplotlib.pyplot as plt
 
     from ..io.files import atomic_directory, open_new
-    from ..maps.outputs import OUTPUT_FILES, ROUTE_FILES, routes_csv, segments_csv, speed_mask_pgm, speed_mask_yaml
+    from ..maps.outputs import MASK_FILES, ROUTE_FILES, SEGMENT_FILES, routes_csv, segments_csv, speed_mask_pgm, speed_mask_yaml
     from ..plots.map import plot_map_stability
     from ..plots.map_routes import plot_route_verdicts
 
-    names = OUTPUT_FILES + (ROUTE_FILES if analysis.paths is not None else ())
+    by_route = analysis.paths is not None
+    names = (ROUTE_FILES if by_route else SEGMENT_FILES) + MASK_FILES
+    picture, table = names[:2]
     with atomic_directory(out_dir, names, what="map outputs") as paths:
-        figures = [("stability.png", lambda: plot_map_stability(analysis))]
-        if analysis.paths is not None:
-            figures.append(("routes.png", lambda: plot_route_verdicts(analysis, drives)))
-            with open_new(paths["routes.csv"], "wb") as fh:
-                fh.write(routes_csv(analysis).encode("utf-8"))
-        for name, draw in figures:
-            fig = draw()
-            try:
-                with open_new(paths[name], "wb") as fh:
-                    fig.savefig(fh, format="png", dpi=110)
-            finally:
-                plt.close(fig)
-        for name, content in (("segments.csv", segments_csv(analysis).encode("utf-8")), ("speed_mask.pgm", speed_mask_pgm(analysis, a_max)),
+        fig = plot_route_verdicts(analysis, drives) if by_route else plot_map_stability(analysis)
+        try:
+            with open_new(paths[picture], "wb") as fh:
+                fig.savefig(fh, format="png", dpi=110)
+        finally:
+            plt.close(fig)
+        for name, content in ((table, (routes_csv if by_route else segments_csv)(analysis).encode("utf-8")),
+                              ("speed_mask.pgm", speed_mask_pgm(analysis, a_max)),
                               ("speed_mask.yaml", speed_mask_yaml(analysis.occupancy).encode("utf-8"))):
             with open_new(paths[name], "wb") as fh:
                 fh.write(content)
@@ -184,6 +181,8 @@ def run(args) -> int:
     with line_progress("map", quiet=args.quiet) as progress:
         routes = _user_routes(args.route or ())
         analysis = analyze_map(occupancy, params.robot, params.controller, law, model=args.model, unknown=args.unknown,
+                               corridors=args.wobble is not None,  # the wobble reads the segments too (maps.wobble)
+                              
                                cell_size=args.cell_size, min_length=args.min_length, progress=progress,
                                warn=lambda line: print(f"pfm-stability: warning: {line}", file=sys.stderr, flush=True), routes=routes)
         if args.goals:
@@ -194,13 +193,14 @@ def run(args) -> int:
             analysis = with_wobble(analysis, args.wobble)
             if progress is not None:
                 progress("wobble done")
-        validation = _validate(analysis, args.validate, args.seed, progress) if args.validate and analysis.segments else None
         drives = _drive(analysis, args.validate, args.seed, progress) if args.validate and analysis.paths is not None else None
+        validation = drives if drives is not None else (_validate(analysis, args.validate, args.seed, progress)
+                                                         if args.validate and analysis.segments else None)
         outputs = _write_outputs(analysis, args.out_dir, drives, args.dilate_upstream) if args.out_dir else None
     data = {
         **analysis.to_dict(),
-        "validation": validation.to_dict() if validation is not None else None,
-        "drives": drives.to_dict() if drives is not None else None,
+        "validation": ({"kind": "drives" if drives is not None else "segments", **validation.to_dict()}
+                       if validation is not None else None),
         "outputs": outputs,
         "timing": {"seconds": time.perf_counter() - started, **{f"{k}_seconds": v for k, v in analysis.timing.items()}},
     }

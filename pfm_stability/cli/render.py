@@ -732,14 +732,15 @@ MAP_ROWS = 15
 
 
 def render_map_text(data: dict) -> str:
-    """``pfm-stability map``: the map, the robot, the worst segments (lowest margin first), a summary, validation, outputs.
+    """``pfm-stability map``: the map, the robot, the one result set (the routes' unstable stretches, slowest V* first,
+    and their summary; the segments with the power law), the validation, the outputs.
 
     Parameters
     ----------
     data : dict
         The map analysis's JSON form.
     """
-    m, i, s = data["map"], data["inputs"], data["summary"]
+    m, i = data["map"], data["inputs"]
     lines = [
         f"map {m['name']}: {m['width']} x {m['height']} cells of {m['resolution']:g} m, origin {m['origin'][:2]}; "
         f"histogram grid {i['grid_cells'][0]} x {i['grid_cells'][1]} cells of {i['cell_size']:g} m (unknown = {i['unknown']})",
@@ -747,48 +748,11 @@ def render_map_text(data: dict) -> str:
         f"law {i['law']}; model {i['model']} (hold {i['hold']}, compute delay {i['compute_delay']}): NV* = {number(data['NV_critical'])} 1/s",
         "",
     ]
-    decided = [g for g in data["segments"] if g["margin"] is not None]
-    decided.sort(key=lambda g: (g["margin"] if not isinstance(g["margin"], str) else math.inf))
-    rows = [[f"({g['x0']:.1f}, {g['y0']:.1f}) -> ({g['x1']:.1f}, {g['y1']:.1f})", f"{g['length']:.1f}", number(g["N"]),
-             number(g["V_critical"]), percent(g["margin"]), g["verdict"]] for g in decided[:MAP_ROWS]]
-    if rows:
-        lines.append(f"worst {len(rows)} of {len(decided)} segments with a verdict (margin = NV*/NV - 1):")
-        lines += ["  " + line for line in table(["segment (m)", "length m", "N 1/m", "V* m/s", "margin", "verdict"], rows)]
-    counts = ", ".join(f"{n} {v}" for v, n in s["verdicts"].items() if n)
-    worst = s["V_critical_min"]
-    lines += [
-        "",
-        f"{s['segments']} segments, {s['route_length_m']:.1f} m of routes: {counts}",
-        f"unstable: {s['unstable_length_m']:.1f} m; slowest V* = {number(worst)} m/s"
-        + (f" -> the robot oscillates somewhere at V = {i['V']:g} m/s" if s["unstable_length_m"] > 0 else f" -> stable everywhere at V = {i['V']:g} m/s"),
-    ]
-    p = (data.get("paths") or {}).get("summary")
-    if p:  # the verdict along every route (docs/maps.md, "Verdicts along every route")
-        unjudged = ", ".join(f"{length:.1f} m {reason}" for reason, length in p["unjudged_length_m"].items() if length > 0)
-        lines.append(f"routes: {p['routes']} routes, {p['route_length_m']:.1f} m: {percent(p['decided_fraction'])[1:]} decided; "
-                     f"unstable {p['unstable_length_m']:.1f} m" + (f" (window-edge relay {p['relay_length_m']:.1f} m)" if p.get("relay_length_m") else "")
-                     + f", stable {p['stable_length_m']:.1f} m" + (f"; no verdict: {unjudged}" if unjudged else ""))
-    d = data.get("drives")
-    if d is not None:
-        share = {k: (percent(d[k])[1:] + _interval_text(d.get(f"{k}_interval")) if d.get(k) is not None else "n/a (nothing to measure)")
-                 for k in ("recall", "precision", "specificity")}
-        lines.append(f"validation by driving: {d['counts']['drives']} drives, {d['counts']['episodes']} oscillation episodes; "
-                     f"recall {share['recall']}, precision {share['precision']}, specificity {share['specificity']} "
-                     f"(of {d['lengths']['quiet_driven']:.1f} m driven with a verdict and without an episode, the share predicted stable) by length along the paths driven "
-                     f"({d['lengths']['drive_paths_driven']:.1f} m measured, {d['lengths']['drive_paths_unmeasured']:.1f} m passed "
-                     f"only in a drive's last three periods, not measurable; {d['lengths']['driven']:.1f} of {d['lengths']['route']:.1f} m "
-                     f"of route covered); {len(d['disagreements'])} disagreements"
-                     + (f" (false alarms where a drive wove past {100 * d['inputs']['amplitude_threshold']:.1f} cm for a period, "
-                        f"not {d['inputs']['episode_periods']}: {d['lengths']['false_alarm_swinging']:.1f} m)"
-                        if d['lengths'].get('false_alarm_swinging') else ""))
-        w = d.get("wobble")
-        if w and w.get("within") is not None:  # how big the predicted weave is against the simulated one
-            q = ", ".join(f"{v:.2f}" if isinstance(v, (int, float)) else str(v) for v in w["ratio_quartiles"])
-            lines.append(f"  wobble: where either wove past {100 * d['inputs']['amplitude_threshold']:.1f} cm for a period "
-                         f"({w['length']:.1f} m), the predicted weave is within a factor {w['factor']:g} of the simulated on "
-                         f"{percent(w['within'])[1:]} of it (predicted/simulated quartiles {q})")
+    lines += _map_stretch_lines(data) if data.get("paths") else _map_segment_lines(data)
     v = data.get("validation")
-    if v is not None:
+    if v is not None and v.get("kind") == "drives":
+        lines += _map_drive_lines(v)
+    elif v is not None:
         share = f"{percent(v['agreement'])[1:]} of the {v['measured']} measured" if v.get("agreement") is not None else "- (none measured)"
         lines.append(f"validation: {len(v['cases'])} simulated segments: {v['agreed']} agree, {v['disagreed']} disagree, "
                      f"{v['not_measurable']} not measurable; agreement {share}")
@@ -796,6 +760,72 @@ def render_map_text(data: dict) -> str:
     for name, path in (data.get("outputs") or {}).items():
         lines.append(f"{name}: {path}")
     return "\n".join(lines) + "\n"
+
+
+def _map_stretch_lines(data: dict) -> list[str]:
+    """The routes' unstable stretches (slowest V* first: cause, V*, margin, predicted weave) and their summary."""
+    V, p = data["inputs"]["V"], data["paths"]["summary"]
+    unstable = sorted((s for s in data["paths"]["stretches"] if s["verdict"] == "unstable"), key=lambda s: (s["V_critical"], -s["length"]))
+    rows = [[f"({s['x0']:.1f}, {s['y0']:.1f}) -> ({s['x1']:.1f}, {s['y1']:.1f})", f"{s['length']:.1f}", s["cause"], number(s["V_critical"]),
+             percent(s["margin"]), f"{100 * s['amplitude']:.1f}"] for s in unstable[:MAP_ROWS]]
+    lines = []
+    if rows:
+        lines.append(f"slowest {len(rows)} of {len(unstable)} unstable route stretches (V* = the speed to slow to, margin = V*/V - 1, "
+                     f"weave = the predicted lateral oscillation):")
+        lines += ["  " + line for line in table(["stretch (m)", "length m", "cause", "V* m/s", "margin", "weave cm"], rows)]
+        lines.append("")
+    unjudged = ", ".join(f"{length:.1f} m {reason}" for reason, length in p["unjudged_length_m"].items() if length > 0)
+    causes = ", ".join(f"{length:.1f} m {cause}" for cause, length in p["unstable_length_by_cause_m"].items() if length > 0)
+    lines.append(f"routes: {p['routes']} routes, {p['route_length_m']:.1f} m: {percent(p['decided_fraction'])[1:]} decided; "
+                 f"unstable {p['unstable_length_m']:.1f} m" + (f" ({causes})" if causes else "") + f", stable {p['stable_length_m']:.1f} m"
+                 + (f"; no verdict: {unjudged}" if unjudged else ""))
+    lines.append(f"slowest V* = {number(p['V_critical_min'])} m/s" + (f" -> the robot weaves somewhere at V = {V:g} m/s"
+                                                                      if p["unstable_length_m"] > 0 else f" -> calm everywhere at V = {V:g} m/s"))
+    return lines
+
+
+def _map_segment_lines(data: dict) -> list[str]:
+    """The corridor segments (the power law's result set): the worst, lowest margin first, and their summary."""
+    i, s = data["inputs"], data["summary"]
+    decided = [g for g in data["segments"] if g["margin"] is not None]
+    decided.sort(key=lambda g: (g["margin"] if not isinstance(g["margin"], str) else math.inf))
+    rows = [[f"({g['x0']:.1f}, {g['y0']:.1f}) -> ({g['x1']:.1f}, {g['y1']:.1f})", f"{g['length']:.1f}", number(g["N"]),
+             number(g["V_critical"]), percent(g["margin"]), g["verdict"]] for g in decided[:MAP_ROWS]]
+    lines = []
+    if rows:
+        lines.append(f"worst {len(rows)} of {len(decided)} segments with a verdict (margin = NV*/NV - 1):")
+        lines += ["  " + line for line in table(["segment (m)", "length m", "N 1/m", "V* m/s", "margin", "verdict"], rows)]
+    counts = ", ".join(f"{n} {v}" for v, n in s["verdicts"].items() if n)
+    lines += [
+        "",
+        f"{s['segments']} segments, {s['route_length_m']:.1f} m of routes: {counts}",
+        f"unstable: {s['unstable_length_m']:.1f} m; slowest V* = {number(s['V_critical_min'])} m/s"
+        + (f" -> the robot oscillates somewhere at V = {i['V']:g} m/s" if s["unstable_length_m"] > 0 else f" -> stable everywhere at V = {i['V']:g} m/s"),
+    ]
+    return lines
+
+
+def _map_drive_lines(d: dict) -> list[str]:
+    """The validation by driving: recall, precision, specificity with their intervals, lengths, the wobble's agreement."""
+    lines = []
+    share = {k: (percent(d[k])[1:] + _interval_text(d.get(f"{k}_interval")) if d.get(k) is not None else "n/a (nothing to measure)")
+             for k in ("recall", "precision", "specificity")}
+    lines.append(f"validation by driving: {d['counts']['drives']} drives, {d['counts']['episodes']} oscillation episodes; "
+                 f"recall {share['recall']}, precision {share['precision']}, specificity {share['specificity']} "
+                 f"(of {d['lengths']['quiet_driven']:.1f} m driven with a verdict and without an episode, the share predicted stable) by length along the paths driven "
+                 f"({d['lengths']['drive_paths_driven']:.1f} m measured, {d['lengths']['drive_paths_unmeasured']:.1f} m passed "
+                 f"only in a drive's last three periods, not measurable; {d['lengths']['driven']:.1f} of {d['lengths']['route']:.1f} m "
+                 f"of route covered); {len(d['disagreements'])} disagreements"
+                 + (f" (false alarms where a drive wove past {100 * d['inputs']['amplitude_threshold']:.1f} cm for a period, "
+                    f"not {d['inputs']['episode_periods']}: {d['lengths']['false_alarm_swinging']:.1f} m)"
+                    if d['lengths'].get('false_alarm_swinging') else ""))
+    w = d.get("wobble")
+    if w and w.get("within") is not None:  # how big the predicted weave is against the simulated one
+        q = ", ".join(f"{v:.2f}" if isinstance(v, (int, float)) else str(v) for v in w["ratio_quartiles"])
+        lines.append(f"  wobble: where either wove past {100 * d['inputs']['amplitude_threshold']:.1f} cm for a period "
+                     f"({w['length']:.1f} m), the predicted weave is within a factor {w['factor']:g} of the simulated on "
+                     f"{percent(w['within'])[1:]} of it (predicted/simulated quartiles {q})")
+    return lines
 
 
 def _interval_text(interval) -> str:

@@ -264,7 +264,10 @@ class MapAnalysis:
         }
 
     def to_dict(self) -> dict:
-        """``map``, ``inputs``, ``segments``, ``summary``, ``warnings`` (the JSON of ``pfm-stability map``, without validation)."""
+        """``map``, ``inputs``, ``NV_critical``, ``segments``, ``summary``, ``warnings``, ``paths`` (the JSON of
+        ``pfm-stability map``, without validation): one result set — the routes' stretches (``paths``, its summary
+        the ``summary``) where the routes are judged, else the corridor segments (``segments``, their summary);
+        ``segments`` is null when they were not decided (`analyze_map`'s ``corridors``)."""
         g = self.grid
         return {
             "map": self.occupancy.to_dict(),
@@ -277,8 +280,8 @@ class MapAnalysis:
                 "grid_cells": [int(g.shape[0]), int(g.shape[1])],
             },
             "NV_critical": json_number(self.NV_critical),
-            "segments": [s.to_dict() for s in self.segments],
-            "summary": self.summary(),
+            "segments": [s.to_dict() for s in self.segments] if self.samples is not None else None,
+            "summary": self.paths.summary() if self.paths is not None else self.summary(),
             "warnings": list(self.warnings),
             "paths": self.paths.to_dict() if self.paths is not None else None,
         }
@@ -352,7 +355,7 @@ def corridor_warnings(occupancy: OccupancyMap, grid: HistogramMap, routes, clear
 def analyze_map(occupancy: OccupancyMap, robot: Robot, controller: Controller, law: ForceLaw, *, model: str = "sampled",
                 unknown: str = "occupied", cell_size: float | None = None, min_length: float | None = None,
                 progress=None, end_fraction: float = END_FRACTION, taper_slope: float = TAPER_SLOPE, warn=None,
-                routes=(), along_routes: bool = True) -> MapAnalysis:
+                routes=(), along_routes: bool = True, corridors: bool = True) -> MapAnalysis:
     """Every corridor segment of a map, decided (module docstring).
 
     Parameters
@@ -386,6 +389,10 @@ def analyze_map(occupancy: OccupancyMap, robot: Robot, controller: Controller, l
     along_routes : bool
         Judge every route (`MapAnalysis.paths`, the grid law's); False: the straight segments alone (``paths`` None,
         the user's routes refused), for work that reads only the segments (their validation by simulation).
+    corridors : bool
+        Decide the straight corridor segments too (`MapSegment`; the corridor model `report` checks against). False
+        with the grid law: only the routes' stretches, the map's one result set (``pfm-stability map``), and no
+        segments (``segments`` empty, ``samples`` None). The power law has no routes' verdicts: always True there.
 
     Raises
     ------
@@ -437,7 +444,10 @@ def analyze_map(occupancy: OccupancyMap, robot: Robot, controller: Controller, l
     if not warnings and routes:  # one cause, one line: a resolution already flagged makes the corridors wide too
         caution(corridor_warnings(occupancy, grid, routes, clearance, robot.W))
     stage("routes")
-    if is_grid:
+    corridors = corridors or not (is_grid and along_routes)
+    if not corridors:
+        samples, routes = None, []
+    elif is_grid:
         samples = grid_equilibria(grid, law, routes, clearance, robot.W)
     else:
         blocked = occupancy.occupied | (occupancy.unknown if unknown == "occupied" else False)

@@ -349,7 +349,8 @@ class _TrackWalk:
     """m between consecutive routes on the walk's one arc axis (more than a sample's spacing: no interpolation across)."""
 
     def __init__(self, track: DrivenTrack, route, arc, first, step: float):
-        lengths = np.array([arc[route == r].max() for r in range(int(route.max()) + 1)])
+        lengths = np.zeros(int(route.max()) + 1)  # per route; 0 for a route without samples (a subset's)
+        np.maximum.at(lengths, route, arc)
         offset = np.concatenate([[0.0], np.cumsum(lengths + self.GAP)])[:-1]
         self.axis = arc + offset[route]  # increasing: the samples are in route order, each route's by arc
         self.middles = (self.axis[:-1] + self.axis[1:]) / 2

@@ -4,14 +4,14 @@ The speed mask (docs/maps.md, "The speed mask") has the input map's size, resolu
 and origin. Each cell holds a speed limit as a percentage of the robot's V, for the
 Nav2 speed filter with ``type: 1`` (percentage), ``base: 0``, ``multiplier: 1``:
 
-* cells within W/2 of a segment, or of a route stretch (`maps.paths`), whose V* is below V:
-  100·V*/V rounded down (never above what is stable), at least 1 (the filter reads 0 as
+* cells within W/2 of every unstable route stretch (`maps.paths`; with the power law, of every unstable segment whose
+  V* is below V): 100·V*/V rounded down (never above what is stable), at least 1 (the filter reads 0 as
   "no limit"); with a braking deceleration a_max (``--dilate-upstream``) each route
   stretch's zone reaches (V² − V*²)/(2·a_max) further along its route at both ends
   (`upstream_distance`: Nav2's filter slows the robot only once it is inside a zone);
 * with a wobble tolerance (``map --wobble TOL``, `maps.wobble`) a segment's or route stretch's zone holds
   100·V_limit/V instead: V_tolerance, the fastest speed whose wobble stays under TOL, where the describing function
-  is trusted, else V* (`ZoneWobble.V_limit`); a zone only where the verdict is unstable and 0 < V* < V, none where V_limit >= V; a stretch's upstream dilation brakes to
+  is trusted, else V* (`ZoneWobble.V_limit`); a zone only where the verdict is unstable, none where V_limit >= V; a stretch's upstream dilation brakes to
   V_limit;
 * every other cell — free, occupied or unknown — 100: the robot may drive at V.
   Occupied cells are never driven through, and 100 % is the filter's "no
@@ -35,7 +35,8 @@ from .routes import polyline_arcs
 
 __all__ = [
     "has_zone",
-    "OUTPUT_FILES",
+    "MASK_FILES",
+    "SEGMENT_FILES",
     "ROUTE_COLUMNS",
     "ROUTE_FILES",
     "routes_csv",
@@ -49,10 +50,14 @@ __all__ = [
     "upstream_distance",
 ]
 
-OUTPUT_FILES = ("stability.png", "segments.csv", "speed_mask.pgm", "speed_mask.yaml")
 ROUTE_FILES = ("routes.png", "routes.csv")
-"""Also written with the routes' verdicts (`MapAnalysis.paths`, the grid law): their picture and their stretches."""
-ROUTE_COLUMNS = ("route", "start", "stop", "x0", "y0", "x1", "y1", "length", "verdict", "label", "growth_rate", "efolds", "N", "margin",
+"""Written with the routes' verdicts (`MapAnalysis.paths`, the grid law: the map's result set): their picture and
+their stretches."""
+SEGMENT_FILES = ("stability.png", "segments.csv")
+"""Written instead with the power law (no routes' verdicts): the corridor segments' picture and table."""
+MASK_FILES = ("speed_mask.pgm", "speed_mask.yaml")
+"""The Nav2 speed filter mask, always."""
+ROUTE_COLUMNS = ("route", "start", "stop", "x0", "y0", "x1", "y1", "length", "verdict", "cause", "growth_rate", "efolds", "N", "margin",
                  "V_critical", "direction", "oscillates", "amplitude", "linearized_at_route")
 """What ``--out-dir`` receives."""
 CSV_COLUMNS = ("x0", "y0", "x1", "y1", "length", "N", "c", "V_critical", "margin", "stable", "verdict", "offset", "samples", "analysed",
@@ -143,12 +148,12 @@ def speed_limits(analysis, a_max: float | None = None) -> np.ndarray:
     occupancy = analysis.occupancy
     V, half = analysis.robot.V, analysis.robot.W / 2
     limits = np.full(occupancy.values.shape, 100, dtype=np.int64)
-    for s in analysis.segments:
+    pv = getattr(analysis, "paths", None)
+    for s in (analysis.segments if pv is None else ()):  # the result set: the routes' stretches, else the segments
         limit = _limit(s, V)
         if limit is None:
             continue
         _stamp(limits, occupancy, s.x0, s.y0, s.x1, s.y1, half, _percent(limit, V))
-    pv = getattr(analysis, "paths", None)
     for s in (pv.stretches if pv is not None else ()):
         limit = _limit(s, V)
         if limit is None:
@@ -161,11 +166,10 @@ def speed_limits(analysis, a_max: float | None = None) -> np.ndarray:
 
 
 def has_zone(zone, V: float) -> bool:
-    """Whether the speed mask draws a zone for a segment or route stretch at speed V (m/s), at V* (or at V_limit with
-    ``--wobble``): where a speed limit helps — the verdict is unstable and 0 < V* < V. No zone for a stable stretch
-    whose V* lies below V (a window where the field pushes the robot off its line on average, σ̄ > 0 only at low
-    speeds: stable at V), nor where V* = 0 (unstable at any speed, or a weave whose window does not grow at any speed:
-    a zone at the 1 % floor would stop the robot there — 47.5 m of the warehouse's routes — and not make it stable).
+    """Whether the speed mask draws a zone for a route stretch (or, with the power law, a segment) at speed V (m/s):
+    wherever its verdict is unstable. A stretch's V* is below V exactly then (`maps.stretch_speed`); a V* of 0 (no
+    speed down to a tenth of V calms it) is drawn at the filter's slowest, `MIN_PERCENT`. A segment's V* can lie above V
+    with an unstable verdict (its mean growth changes sign more than once): no zone, nothing to slow to.
 
     Parameters
     ----------
@@ -175,7 +179,7 @@ def has_zone(zone, V: float) -> bool:
         The robot's speed, m/s.
     """
     V_star = zone.V_critical
-    return zone.verdict == "unstable" and V_star is not None and 0 < V_star < V
+    return zone.verdict == "unstable" and V_star is not None and V_star < V
 
 
 def _limit(zone, V: float) -> float | None:

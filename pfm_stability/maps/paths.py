@@ -25,7 +25,8 @@ steps s_k = s + k·V·T through the window (`SampledTransition`), σ̄_w = log �
 (for a uniform N exactly σ(N·V)); a gain spike shorter than a period adds what it really adds,
 not its frozen σ. With the other models, σ̄_w is the mean of σ(N·V) over the window,
 exp(∫σ(s)/V ds). The point is unstable when a disturbance gains at least `verdicts.EFOLDS` (one)
-e-fold over the window, σ̄_w·duration >= 1, in the worse travel direction; stable otherwise. A
+e-fold in the worse travel direction over the window, σ̄_w·duration >= 1, or over the run of consecutive growing
+windows around it (`decide.run_efolds`: a long corridor that grows slowly); stable otherwise. A
 field too weak to move the robot, or none (an open hall: N = 0, σ = σ(0) = 0 when the
 heading loop is stable), is a verdict: "nothing grows here", stable, margin inf or large.
 **A wall ahead.** Where the repulsion along the route cancels more than `verdicts.END_FRACTION` of the
@@ -38,7 +39,7 @@ analysis' end rule, `verdicts.judged_run`), the other direction still is. What c
 **The window-edge relay** (`relay.window_relay`): where F_n jumps within a cell of the path (the window gaining or
 losing a wall's column as the robot moves a cell sideways) by more than its smooth change over a cell, and the jump
 restores (pushes the robot back across it), the robot holds a sustained oscillation of about a cell's amplitude
-there, which the smooth linearization cannot see: such a sample is unstable, its stretch labelled "relay", where
+there, which the smooth linearization cannot see: such a sample is unstable, its cause "relay", where
 the cycle reaches the episodes' threshold — by the describing function of the jump (`relay.relay_amplitude`) and,
 with the sampled model, by the loop driven along the route there too (below: it runs the whole profile, the
 sampling and the rate limit; the one jump's first harmonic runs high near the threshold): its lateral excursion
@@ -47,7 +48,7 @@ about its one-period average within half a period of the sample must reach the t
 **The loop driven along the route** (`_driven`): the sampled loop is also run along each route through the force
 across it (`lateral_profile`, every quarter cell: the window sum's jumps, a rack's staircase, a one-sided field), with
 the steering-rate limit on its command (`SampledTransition`, `models.sampled.command_form`); its episodes (the
-drives' own definition, `maps.episodes`) mark the route unstable ("oscillates"): a forced weave, or a cycle the
+drives' own definition, `maps.episodes`) mark the route unstable (cause "forced weave"): a forced weave, or a cycle the
 nonlinearity holds, that the window growth cannot see.
 
 **Paths taken** (``taken``: the paths the simulated robot drove, between goals or in the validation,
@@ -73,47 +74,26 @@ track in the plane by the drives' own judge (`episodes.episodes`, `episodes.swin
 about its own one-period average, and the path (that average) ripples about it too. The window growth and the
 verdicts' N stay the linearization above.
 
-**Stretches**: runs of consecutive samples with one verdict (`PathStretch`), each with the
-numbers of its worst window: σ̄_w, e-folds σ̄_w·Λ/V, N_eff (`verdicts.effective_gain`:
-the uniform gain with that growth), margin NV*/(N_eff·V) − 1, and V* (the speed at which that
-window's mean growth crosses 0, `verdicts.critical_speed`).
+**Stretches**: runs of consecutive samples with one verdict and cause (`PathStretch`), each with the
+numbers of its worst window: σ̄_w, its e-folds, N_eff (`verdicts.effective_gain`: the uniform gain with that
+growth); V* by the same rule at other speeds (`stretch_speed`: at or below it the stretch does not weave) and the
+margin V*/V − 1, which has the verdict's sign (docs/maps.md, "One answer per stretch").
 """
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
 
 from ..io.serialize import json_number
-from ..models import gain_margin, verdict_label
 from ..models.verdicts import inside as in_set, judge_arrays
-from .equilibria import Samples, equilibria_at, lateral_force
-from .episodes import AMPLITUDE_THRESHOLD
-from .driven import LEAVES, DrivenTrack, SampledTransition, _driven
-from .relay import relay_amplitude, window_relay
-from .routes import RoutePath, polyline_arcs  # noqa: F401 (RoutePath: named in the docstrings and annotations)
-from .verdicts import EFOLDS, END_FRACTION, GrowthRate, critical_speed, effective_gain, wavelength
+from .decide import CAUSES, PATH_VERDICTS, UNJUDGED, DecisionRule, RouteGeometry, SampleDecision, decide, route_geometry
+from .routes import polyline_arcs
+from .stretch_speed import stretch_speeds
+from .verdicts import END_FRACTION, GrowthRate, effective_gain
 
-__all__ = ["PATH_VERDICTS", "RENORMALIZE", "ROUND_OFF_EFOLDS", "UNJUDGED", "WINDOW_PERIODS", "PathStretch", "PathVerdicts",
-           "SampledTransition", "analyze_paths", "path_samples"]
-
-WINDOW_PERIODS = 3.0
-"""Length of the window whose accumulated growth decides a point, in oscillation wavelengths λ = 2πV/ω*: the
-simulator's oscillation metrics need three periods to call a growth (`validation.map_selection.MIN_PERIODS`), and an
-episode of the driving validation is a growth over at least three periods (`validation.map_drives`)."""
-PATH_NEWTON_STEPS = 12
-"""Newton steps per equilibrium along the routes (`equilibria.equilibria_at`): the corridor analysis' `NEWTON_STEPS`.
-With 6 (a jump located to < 1 mm) the depot's north-wall weave at CARMEL's preset, predicted near the episode
-threshold, was lost (recall 97 % -> 54 %): the forced weave is that sensitive to where the line is."""
-UNJUDGED = ("wall ahead both ways", "inside an obstacle", "wall ahead")
-"""Reasons a sample gets no verdict: a wall ahead in both travel directions (the repulsion along the route cancels more
-than `verdicts.END_FRACTION` of the attraction either way: the robot turns there, a narrow dead end), or the sample
-lies in an occupied cell (the field is not finite)."""
-PATH_VERDICTS = ("stable", "unstable", *UNJUDGED)
-"""Verdict codes of a sample, in this order (`PathVerdicts.code` indexes it)."""
-
+__all__ = ["PathStretch", "PathVerdicts", "analyze_paths"]
 
 @dataclass(frozen=True)
 class PathStretch:
@@ -131,27 +111,32 @@ class PathStretch:
         m.
     verdict : str
         "stable", "unstable", or a reason of `UNJUDGED`.
-    label : str or None
-        The worst window's label (`models.verdict_label`; "nothing grows" for a window with no field).
+    cause : str or None
+        Why it is unstable (`CAUSES`): "growth" (the linear loop), "forced weave" (the field's ripple drives a weave),
+        "relay" (the window's edge) or "collision course" (the driven loop meets an obstacle); None when stable.
     growth_rate : float or None
-        σ̄_w of the worst window, 1/s.
+        σ̄_w of the worst window at V, 1/s: the linear loop's (a forced weave or a relay weaves with it negative).
     efolds : float or None
-        e-folds a disturbance gains (< 0: loses) over the worst window of the stretch (σ̄_w times the window's time).
+        e-folds a disturbance gains (< 0: loses) over the worst window (σ̄_w times the window's time).
     N : float or None
-        N_eff of the worst window, 1/m.
+        N_eff of the worst window, 1/m (the uniform gain with its growth, `verdicts.effective_gain`; 0: no field).
     margin : float or None
-        NV*/(N_eff·V) − 1 (inf: no field).
+        V*/V − 1: how much faster (> 0) the robot may drive, or how much slower (< 0) it must (inf: no speed weaves).
+        It is the report's NV*/NV − 1 where the gain is uniform.
     V_critical : float or None
-        V* of the worst window, m/s.
+        V*, m/s, the edge of the calm speeds nearest V (`stretch_speed`): for a stable stretch the first speed above V
+        at which it weaves (inf: none), for an unstable one the fastest speed below V at which it does not (0: none
+        down to `stretch_speed.SPEED_STEPS` steps). So V* >= V exactly when the verdict is stable.
     direction : str or None
         "forward" (along the route's order) or "reverse": the worse travel direction of the worst window.
     linearized_at_route : float
         Fraction of the stretch's samples without a lateral equilibrium (linearized about the route).
     oscillates : bool
-        The linear loop driven along the route weaves over part of it (`maps.episodes`).
+        The loop driven along the route weaves over part of it (`maps.episodes`).
     amplitude : float
-        The largest lateral oscillation the loop driven along the route predicts on it, m (`maps.episodes.lateral_extent`;
-        `LEAVES` where it left the corridor: at least that; a relay's cycle where that is larger).
+        The weave's predicted size: the largest lateral oscillation the loop driven along the route holds on it, m
+        (`maps.episodes.lateral_extent`; `LEAVES` where it left the corridor: at least that; a relay's cycle where that
+        is larger).
     """
 
     route: int
@@ -163,7 +148,7 @@ class PathStretch:
     y1: float
     length: float
     verdict: str
-    label: str | None = None
+    cause: str | None = None
     growth_rate: float | None = None
     efolds: float | None = None
     N: float | None = None
@@ -194,7 +179,7 @@ class PathVerdicts:
     Attributes
     ----------
     paths : tuple of RoutePath
-    samples : Samples
+    samples : equilibria.Samples
         The equilibria at the samples (`segment`: the route index; nan N without an equilibrium).
     arc : ndarray
         Arc position of each sample along its route, m.
@@ -221,10 +206,12 @@ class PathVerdicts:
         The predicted lateral oscillation at each sample, m (the largest of the runs passing it; as on `PathStretch`).
     relay : ndarray of bool
         The window-edge relay holds the robot in a sustained oscillation here (`maps.relay`): unstable ("relay").
+    cause : ndarray of int
+        Index into `CAUSES` where unstable, −1 elsewhere.
     """
 
     paths: tuple
-    samples: Samples
+    samples: object
     arc: np.ndarray
     spacing: np.ndarray
     px: np.ndarray
@@ -242,6 +229,7 @@ class PathVerdicts:
     oscillates: np.ndarray = None
     amplitude: np.ndarray = None
     relay: np.ndarray = None
+    cause: np.ndarray = None
 
     @property
     def route_length(self) -> float:
@@ -260,7 +248,8 @@ class PathVerdicts:
 
     def summary(self) -> dict:
         """``route_length_m``, ``decided_length_m``, ``decided_fraction``, ``unstable_length_m``, ``stable_length_m``,
-        ``no_equilibrium_length_m`` (linearized about the route), ``unjudged_length_m`` per reason, ``V_critical_min``."""
+        ``linearized_at_route_length_m``, ``unstable_length_by_cause_m`` (`CAUSES`), ``unjudged_length_m`` per reason,
+        ``window_m``, ``V_critical_min`` (the smallest V* of a decided stretch, m/s)."""
         total = float(self.spacing.sum())
         decided = self.length_of("stable") + self.length_of("unstable")
         values = [s.V_critical for s in self.stretches if s.verdict == "unstable" and s.V_critical is not None]
@@ -273,7 +262,8 @@ class PathVerdicts:
             "unstable_length_m": self.length_of("unstable"),
             "stable_length_m": self.length_of("stable"),
             "linearized_at_route_length_m": float(self.spacing[~np.isfinite(self.samples.offset)].sum()),
-            "relay_length_m": float(self.spacing[self.relay].sum()) if self.relay is not None else 0.0,
+            "unstable_length_by_cause_m": {c: float(self.spacing[self.cause == k].sum()) if self.cause is not None else 0.0
+                                           for k, c in enumerate(CAUSES)},
             "unjudged_length_m": {r: self.length_of(r) for r in UNJUDGED},
             "window_m": json_number(self.window),
             "V_critical_min": json_number(min(values)) if values else None,
@@ -288,121 +278,9 @@ class PathVerdicts:
         }
 
 
-def path_samples(paths, spacing: float):
-    """(x, y, tx, ty, route, arc, ds): points every ~`spacing` m along each route (piece midpoints), their unit
-    tangents, route index, arc position (m) and the route length each stands for (m).
-
-    Parameters
-    ----------
-    paths : sequence of RoutePath
-        The routes.
-    spacing : float
-        Largest distance between samples, m.
-    """
-    out = [[] for _ in range(7)]
-    for k, path in enumerate(paths):
-        p = path.points
-        pieces = np.hypot(*np.diff(p, axis=0).T)
-        total = float(pieces.sum())
-        count = max(1, int(math.ceil(total / spacing - 1e-9)))
-        arc = (np.arange(count) + 0.5) * total / count
-        edges = np.concatenate([[0.0], np.cumsum(pieces)])
-        piece = np.clip(np.searchsorted(edges, arc, side="right") - 1, 0, len(pieces) - 1)
-        u = (arc - edges[piece]) / np.where(pieces[piece] > 0, pieces[piece], 1.0)
-        d = p[piece + 1] - p[piece]
-        length = np.where(pieces[piece] > 0, pieces[piece], 1.0)
-        for target, value in zip(out, (p[piece, 0] + u * d[:, 0], p[piece, 1] + u * d[:, 1], d[:, 0] / length, d[:, 1] / length,
-                                       np.full(count, k), arc, np.full(count, total / count))):
-            target.append(value)
-    if not out[0]:
-        empty = np.zeros(0)
-        return empty, empty, empty, empty, np.zeros(0, dtype=int), empty, empty
-    return tuple(np.concatenate(a) for a in out)
-
-
-def _window_mean(values: np.ndarray, route: np.ndarray, arc: np.ndarray, ds: np.ndarray, half: float) -> np.ndarray:
-    """Mean of the finite `values` over the samples of the same route within `half` m of arc (nan: none finite)."""
-    out = np.full(values.shape, np.nan)
-    for r in np.unique(route):
-        idx = np.flatnonzero(route == r)
-        v, a, w = values[idx], arc[idx], ds[idx]
-        ok = np.isfinite(v)
-        csum = np.concatenate([[0.0], np.cumsum(np.where(ok, v * w, 0.0))])
-        cw = np.concatenate([[0.0], np.cumsum(np.where(ok, w, 0.0))])
-        lo = np.searchsorted(a, a - half, side="left")
-        hi = np.searchsorted(a, a + half, side="right")
-        weight = cw[hi] - cw[lo]
-        with np.errstate(invalid="ignore", divide="ignore"):
-            out[idx] = np.where(weight > 0, (csum[hi] - csum[lo]) / np.where(weight > 0, weight, 1.0), np.nan)
-    return out
-
-
-def _goal_pull(grid, law, x, y, tx, ty, route, arc, ds, taken, wavelength_m: float):
-    """(P, A) per sample, F_ct units: the lateral force F_n that the goal's pull balances where the robot holds its
-    path, and the goal's attraction along the path (module docstring, "Paths taken"; P = 0, A = 1 on a route,
-    whose goal lies along it).
-
-    On a path the robot took, P is the field's mean over one wavelength λ of travel (the path is the robot's position
-    averaged over a period: the goal and the path's curvature balance that mean, its ripple forces the loop) and
-    across one cell (`_cell_mean`: where the path runs along a jump of the window sum, the robot holds the jump's
-    middle, not the value on one side of it). The attraction has unit size, so its part along the path is
-    A = √(1 − P²): the forward force the robot steers against is A ± F_r·t, not 1 ± F_r·t, when the goal lies off to
-    the side (a robot sliding along a wall towards a goal behind it).
-
-    Parameters
-    ----------
-    grid : HistogramMap
-        The map's histogram grid.
-    law : GridWallLaw
-        KB's grid law.
-    x, y, tx, ty : ndarray
-        Samples (m) and unit tangents.
-    route, arc, ds : ndarray
-        Route index, arc position (m) and length (m) of each sample.
-    taken : ndarray of bool
-        Per sample: on a path the robot took.
-    wavelength_m : float
-        λ = 2πV/ω*, m.
-    """
-    pull = np.zeros(np.size(x))
-    on = np.flatnonzero(taken)
-    if on.size and math.isfinite(wavelength_m):
-        fn = np.full(np.size(x), np.nan)
-        fn[on] = _cell_mean(grid, law, x[on], y[on], tx[on], ty[on])
-        pull = np.where(taken, np.nan_to_num(_window_mean(fn, route, arc, ds, wavelength_m / 2)), 0.0)
-    return pull, np.sqrt(np.clip(1.0 - pull ** 2, 0.0, None))
-
-
-def _aim_stiffness(paths, route, x, y, attraction, W: float) -> np.ndarray:
-    """K per sample, F_ct/m: how much the goal's pull across the path grows per metre of lateral offset on a path
-    taken towards a point at distance D, K = A²/D, the derivative of the unit attraction's lateral part at the path
-    (A its part along the path, `_goal_pull`). D is the plan's lookahead (`RoutePath.lookahead`: its carrot) or the
-    point target's distance (`RoutePath.goal`), whichever is nearer, the target's at least W (within W of its goal
-    the robot arrives); 0 on a route, whose goal lies along it at infinity (module docstring, "Paths taken")."""
-    stiffness = np.zeros(np.size(x))
-    for r, path in enumerate(paths):
-        if path.goal is None and not math.isfinite(path.lookahead):
-            continue  # a goal at infinity: K = 0 (every skeleton route)
-        on = route == r
-        D = np.full(int(on.sum()), path.lookahead)
-        if path.goal is not None:
-            D = np.minimum(D, np.maximum(np.hypot(path.goal[0] - x[on], path.goal[1] - y[on]), W))
-        stiffness[on] = attraction[on] ** 2 / D
-    return stiffness
-
-
-def _cell_mean(grid, law, x, y, tx, ty) -> np.ndarray:
-    """F_n at the points averaged across the path over one cell, s in [−c/2, c/2] (F_ct units; the trapezoid rule on
-    `lateral_profile`'s nodes within half a cell)."""
-    _, fn, _ = lateral_profile(grid, law, x, y, tx, ty, grid.cell_size / 2)
-    weights = np.full(fn.shape[1], 1.0)
-    weights[[0, -1]] = 0.5
-    return fn @ (weights / weights.sum())
-
-
 def analyze_paths(grid, law, paths, clearance: np.ndarray, W: float, V: float, boundary, growth: GrowthRate,
                   heading_stable: bool, transition=None, end_fraction: float = END_FRACTION, taken=False) -> PathVerdicts:
-    """The verdict at every point of every route (module docstring).
+    """The verdict at every point of every route, and each stretch's one answer (module docstring).
 
     Parameters
     ----------
@@ -426,8 +304,9 @@ def analyze_paths(grid, law, paths, clearance: np.ndarray, W: float, V: float, b
         The model's verdict at NV = 0 (its heading loop).
     transition : SampledTransition, optional
         The sampled loop's Φ(NV) (`SampledTransition`): the window's growth is then that of the product of the
-        transition matrices along the window (the loop with a gain varying along the path, exactly); without it,
-        the mean of σ(N·V) over the window.
+        transition matrices along the window (the loop with a gain varying along the path, exactly), and the loop is
+        driven along the routes (the forced weave, the relay's confirmation); without it, the mean of σ(N·V) over the
+        window.
     end_fraction : float
         A travel direction is not judged where the repulsion ahead cancels more than this fraction of the attraction
         (1 ± F_r·t < 1 − end_fraction: `verdicts.END_FRACTION`): the robot turns there (module docstring).
@@ -437,234 +316,71 @@ def analyze_paths(grid, law, paths, clearance: np.ndarray, W: float, V: float, b
         (linearized there, no pull towards the equilibrium), judged the way it was driven (module docstring, "Paths
         taken").
     """
-    paths = tuple(paths)
-    x, y, tx, ty, route, arc, ds = path_samples(paths, grid.cell_size)
-    driven = np.broadcast_to(np.asarray(taken, dtype=bool), (len(paths),))  # per route
-    taken = driven[route] if route.size else np.zeros(0, dtype=bool)  # per sample
-    samples = equilibria_at(grid, law, x, y, tx, ty, route, clearance, W, newton_steps=PATH_NEWTON_STEPS)
-    has = np.isfinite(samples.offset)
-    along, slope = np.array(samples.along, dtype=float), samples.N * samples.forward  # −dF_n/ds at the equilibrium
-    if taken.any():  # an equilibrium the robot's own path keeps away from is not the one it follows
-        far = has & taken & (np.abs(np.nan_to_num(samples.offset)) > W / 2)
-        has = has & ~far
-        slope = np.where(far, np.nan, slope)
-    offset = np.where(has, samples.offset, 0.0)
-    px, py = x - ty * offset, y + tx * offset
-    # the gradient at the route's own point where there is no equilibrium (and at an equilibrium the repulsion stops
-    # the robot at in one direction, where the corridor search keeps no N)
-    redo = np.flatnonzero(~np.isfinite(slope))
-    if redo.size:
-        _, ft0, df0 = lateral_force(grid, law, x[redo], y[redo], tx[redo], ty[redo], offset[redo], jacobian=True)
-        along[redo], slope[redo] = ft0, -df0
-    inside = ~(np.isfinite(along) & np.isfinite(slope))
-    lam = wavelength(V, boundary.omega_critical)
-    pull, attraction = _goal_pull(grid, law, x, y, tx, ty, route, arc, ds, taken, lam)
-    aim = _aim_stiffness(paths, route, x, y, attraction, W)
-    slope = slope + aim
-    forward = np.stack([attraction + along, attraction - along])  # the forward force of each travel direction
-    with np.errstate(divide="ignore", invalid="ignore"):  # a wall ahead (the repulsion along the path) stops the robot
-        N_forward = np.where((1 + along >= 1 - end_fraction) & (forward[0] > 0), slope / forward[0], np.nan)
-        N_reverse = np.where((1 - along >= 1 - end_fraction) & (forward[1] > 0), slope / forward[1], np.nan)
-    N_forward[inside], N_reverse[inside] = np.nan, np.nan
-    N_reverse[taken] = np.nan  # the robot drove a path taken one way, from its start: the reverse is not its path
-    sig = [np.where(np.isfinite(n), growth(np.nan_to_num(n) * V), np.nan) for n in (N_forward, N_reverse)]
-    window = WINDOW_PERIODS * lam if math.isfinite(lam) else math.inf
-    half = window / 2
-    if transition is not None and math.isfinite(window):
-        pairs = [_window_product(n, route, arc, half, V, transition, reverse=k == 1) for k, n in enumerate((N_forward, N_reverse))]
-        means, seconds = [m for m, _ in pairs], [t for _, t in pairs]
-    else:
-        means = [_window_mean(s, route, arc, ds, half) for s in sig]
-        seconds = [_window_mean(np.where(np.isfinite(s), 1.0, np.nan), route, arc, ds, half) * 0 + min(window, 1e9) / V for s in sig]
-    mean_N = [_window_mean(n, route, arc, ds, half) for n in (N_forward, N_reverse)]
-    with np.errstate(invalid="ignore"):
-        worse = np.where(np.nan_to_num(means[1], nan=-np.inf) > np.nan_to_num(means[0], nan=-np.inf), 1, 0)
-    rows = np.arange(x.size)
-    window_growth = np.stack(means)[worse, rows]
-    efolds = window_growth * np.stack(seconds)[worse, rows]
-    code = np.where(efolds >= EFOLDS, 1, 0)  # a disturbance grows by at least one e-fold over the window
-    stopped = ~np.isfinite(N_forward) & ~np.isfinite(N_reverse)
-    wall = np.where(taken, PATH_VERDICTS.index("wall ahead"), PATH_VERDICTS.index("wall ahead both ways"))
-    code = np.where(stopped, wall, code)
-    code = np.where(inside, PATH_VERDICTS.index("inside an obstacle"), code)
-    code = np.where(~np.isfinite(window_growth) & (code < 2), wall, code)
-    oscillates = np.zeros(x.size, dtype=bool)
-    amplitude = np.zeros(x.size)
-    excursion = None  # the driven loop's, where it ran
-    if transition is not None and boundary.omega_critical and boundary.omega_critical > 0:
-        profile = lateral_profile(grid, law, x, y, tx, ty, LEAVES)
-        stopped = np.stack([~np.isfinite(N_forward), ~np.isfinite(N_reverse)])
-        track = DrivenTrack.of(grid, law, paths, x, y, tx, ty, route, arc) if taken.any() else None
-        oscillates, amplitude, excursion = _driven(route, arc, stopped, profile, pull, attraction, aim, V, transition,
-                                                   2 * math.pi / boundary.omega_critical, driven, track)
-        code = np.where((code == 0) & oscillates, 1, code)
-    # the window-edge relay (`relay`): a restoring jump of F_n within a cell of the path, larger than its smooth change
-    relay = np.zeros(x.size, dtype=bool)
-    check = np.flatnonzero((code == 0) & (has | taken))  # where the robot's path is known: its equilibrium, or driven
-    if check.size and boundary.NV_critical and math.isfinite(boundary.NV_critical) and boundary.NV_critical > 0:
-        found, jump = window_relay(grid, law, x[check], y[check], tx[check], ty[check], offset[check], reference=~has[check])
-        # the describing function of one jump beside the smooth slope, per unit forward force, in the worse direction
-        # (`relay.relay_amplitude`; the whole profile's, `relay.window_cycle`, is what the driven loop above runs through)
-        d = worse[check]
-        ahead = forward[d, check]
-        N_smooth = np.nan_to_num(np.where(d == 0, N_forward[check], N_reverse[check]))
-        with np.errstate(invalid="ignore", divide="ignore"):
-            cycle = np.minimum(relay_amplitude(jump / np.where(ahead > 0, ahead, np.nan), boundary.NV_critical / V, N_smooth), LEAVES)
-        cycle = np.nan_to_num(cycle)
-        if excursion is not None:  # the loop driven through the whole profile must stray as far there (docstring)
-            cycle = np.minimum(cycle, excursion[check])
-        relay[check] = found & (cycle >= AMPLITUDE_THRESHOLD)  # a limit cycle the episodes' judge would see
-        amplitude[check] = np.where(relay[check], np.maximum(amplitude[check], cycle), amplitude[check])
-    code = np.where(relay, 1, code)
-    N_worse = np.stack([N_forward, N_reverse])[worse, rows]
-    NV = np.nan_to_num(N_worse) * V
+    rule = DecisionRule(grid, law, W, boundary, growth, heading_stable, transition, end_fraction)
+    geometry = route_geometry(grid, law, tuple(paths), clearance, W, taken, drive=rule.drives)
+    at = decide(geometry, rule, V)
+    runs = _runs(geometry, at)
+    speeds = stretch_speeds(geometry, rule, V, at, runs)
+    stretches = tuple(_stretch(geometry, rule, V, at, run, speed) for run, speed in zip(runs, speeds))
+    NV = np.nan_to_num(at.N_worse) * V
     local_stable = np.array([bool(heading_stable) if v == 0 else in_set(boundary, float(v)) for v in NV]) if NV.size else np.zeros(0, bool)
     local_verdict, local_margin = judge_arrays(NV, np.full(NV.shape, boundary.NV_critical), local_stable)
-    stretches = _stretches(paths, route, arc, ds, x, y, code, window_growth, worse, np.stack(mean_N), np.stack([N_forward, N_reverse]),
-                           has, boundary, growth, heading_stable, V, window, efolds, oscillates, amplitude, relay)
-    return PathVerdicts(paths, samples, arc, ds, px, py, N_forward, N_reverse, sig[0], sig[1], window_growth, code, local_verdict,
-                        local_margin, window, stretches, oscillates, amplitude, relay)
+    return PathVerdicts(geometry.paths, geometry.samples, geometry.arc, geometry.ds, geometry.px, geometry.py, at.N_forward, at.N_reverse,
+                        at.sigma[0], at.sigma[1], at.window_growth, at.code, local_verdict, local_margin, at.window, stretches,
+                        at.oscillates, at.amplitude, at.cause == CAUSES.index("relay"), at.cause)
 
 
-RENORMALIZE = 8
-"""Steps between renormalizations of the window products (their scale is kept as a logarithm)."""
-ROUND_OFF_EFOLDS = 1e-9
-"""|e-folds| over a window below which a window product's growth is round-off (the neutral lateral mode, z = 1,
-of a window with no field): 0."""
+@dataclass(frozen=True)
+class _Run:
+    """A run of samples with one verdict and cause along one route: its sample indices and its worst window's sample."""
+
+    route: int
+    samples: np.ndarray
+    worst: int | None
 
 
-def _window_product(N: np.ndarray, route: np.ndarray, arc: np.ndarray, half: float, V: float, transition: SampledTransition,
-                    reverse: bool = False) -> np.ndarray:
-    """The growth rate (1/s) over the window around each sample of the sampled loop driven along the route at V:
-    log ρ(Φ(N_M·V)···Φ(N_1·V)) / (M·T), the robot at arc V·T apart taking the N of its nearest sample (nan N: the
-    robot is stopped there that way; those steps are left out); nan for a window with no step."""
-    out, seconds = np.full(N.shape, np.nan), np.zeros(N.shape)
-    step = V * transition.T
-    n = transition.Phi0.shape[0]
-    for r in np.unique(route):
-        idx = np.flatnonzero(route == r)
-        a, g = arc[idx], N[idx]
-        edges = (a[:-1] + a[1:]) / 2
-        centre = a
-        steps = int(math.ceil(2 * half / step))
-        offsets = (np.arange(steps) + 0.5) * step - half
-        if reverse:
-            offsets = offsets[::-1]
-        positions = centre[:, None] + offsets[None, :]
-        inside = (positions >= a[0] - (a[1] - a[0] if a.size > 1 else step) / 2) & (positions <= a[-1] + (a[-1] - a[-2] if a.size > 1 else step) / 2)
-        gains = g[np.searchsorted(edges, np.clip(positions, a[0], a[-1]))]
-        valid = inside & np.isfinite(gains)
-        P = np.broadcast_to(np.eye(n), (idx.size, n, n)).copy()
-        log_scale = np.zeros(idx.size)
-        for m in range(steps):
-            Phi = transition.Phi0[None] + (np.where(valid[:, m], gains[:, m], 0.0) * V)[:, None, None] * transition.Phi1[None]
-            Phi = np.where(valid[:, m][:, None, None], Phi, np.eye(n)[None])
-            P = Phi @ P
-            if (m + 1) % RENORMALIZE == 0 or m == steps - 1:
-                scale = np.abs(P).max(axis=(1, 2))
-                scale[scale == 0] = 1.0
-                P /= scale[:, None, None]
-                log_scale += np.log(scale)
-        rho = np.abs(np.linalg.eigvals(P)).max(axis=1)
-        with np.errstate(divide="ignore"):
-            log_rho = np.log(rho) + log_scale
-        count = valid.sum(axis=1)
-        duration = count * transition.T
-        with np.errstate(invalid="ignore", divide="ignore"):
-            rate = np.where(count > 0, log_rho / np.where(duration > 0, duration, 1.0), np.nan)
-        efolds = rate * duration
-        out[idx] = np.where(np.abs(efolds) < ROUND_OFF_EFOLDS, 0.0, rate)
-        seconds[idx] = duration
-    return out, seconds
-
-
-PROFILE_STEP = 0.25
-"""Spacing of the lateral force profile across the route, histogram cells: a quarter cell, so that each jump of the
-window sum (at the cell boundaries) lies between two nodes a quarter cell apart, as in `relay.window_relay`."""
-PROFILE_PHASE_NODES = 1
-"""Positions along the route within a cell over which the profile's force is averaged (`equilibria.lateral_force`'s
-phase average; one: the cell's middle — the robot's run crosses every along-track position of the cell anyway)."""
-
-
-def lateral_profile(grid, law, x, y, tx, ty, reach: float):
-    """(offsets, F_n, F_r·t): the VFF force across each route point p, at p + s·nrm for the offsets s (m, every
-    `PROFILE_STEP` cells within ±`reach`), in F_ct units, shape (points, offsets); nan inside an obstacle.
-
-    Parameters
-    ----------
-    grid : HistogramMap
-        The map's histogram grid.
-    law : GridWallLaw
-        KB's grid law.
-    x, y : ndarray
-        Route points, m.
-    tx, ty : ndarray
-        Unit travel directions.
-    reach : float
-        Largest |s|, m.
-    """
-    step = PROFILE_STEP * grid.cell_size
-    half = int(math.ceil(reach / step))
-    offsets = np.arange(-half, half + 1) * step
-    S = offsets.size
-    rep = lambda v: np.repeat(np.asarray(v, dtype=float), S)  # noqa: E731
-    fn, ft = lateral_force(grid, law, rep(x), rep(y), rep(tx), rep(ty), np.tile(offsets, np.size(x)), phase_nodes=PROFILE_PHASE_NODES)
-    return offsets, fn.reshape(-1, S), ft.reshape(-1, S)
-
-
-def _stretches(paths, route, arc, ds, x, y, code, window_growth, worse, mean_N, N, has, boundary, growth, heading_stable, V, window,
-               efolds, oscillates, amplitude, relay):
-    """The runs of one verdict along each route, with their worst window's numbers (module docstring)."""
+def _runs(g: RouteGeometry, at: SampleDecision) -> list:
+    """The runs of one verdict and cause along each route, with the sample of the worst window of each decided run."""
     out = []
-    for r in range(len(paths)):
-        idx = np.flatnonzero(route == r)
+    for r in range(len(g.paths)):
+        idx = np.flatnonzero(g.route == r)
         if idx.size == 0:
             continue
-        breaks = np.flatnonzero(np.diff(code[idx] + 10 * relay[idx]) != 0) + 1
+        breaks = np.flatnonzero(np.diff(at.code[idx] * 10 + at.cause[idx]) != 0) + 1
         for run in np.split(idx, breaks):
-            first, last = run[0], run[-1]
-            start, stop = float(arc[first] - ds[first] / 2), float(arc[last] + ds[last] / 2)
-            points = paths[r].points
-            edges = polyline_arcs(points)
-            ends = [float(np.interp(a, edges, points[:, k])) for a in (start, stop) for k in (0, 1)]
-            base = dict(route=r, start=start, stop=stop, x0=ends[0], y0=ends[1], x1=ends[2], y1=ends[3], length=float(ds[run].sum()),
-                        verdict=PATH_VERDICTS[code[first]], linearized_at_route=float(np.mean(~has[run])))
-            if code[first] >= 2:
-                out.append(PathStretch(**base))
-                continue
-            k = run[int(np.nanargmax(window_growth[run]))]
-            d = int(worse[k])
-            sigma = float(window_growth[k])
-            near = np.flatnonzero((route == r) & (np.abs(arc - arc[k]) <= window / 2))
-            Nw = N[d, near]
-            Nw = Nw[np.isfinite(Nw)]
-            numbers = _window_numbers(sigma, float(mean_N[d, k]), Nw, V, float(efolds[k]), code[first] == 0, boundary, growth, heading_stable)
-            numbers["efolds"] = float(efolds[k])
-            if relay[first]:
-                numbers["label"] = "relay"  # the window-edge relay (`maps.relay`): a sustained oscillation of ~ a cell
-            elif code[first] == 1 and not numbers["efolds"] >= EFOLDS:
-                numbers["label"] = "oscillates"  # a forced weave (`_forced`), the loop itself damped
-            out.append(PathStretch(**base, **numbers, direction=("forward", "reverse")[d], oscillates=bool(oscillates[run].any()),
-                                   amplitude=float(amplitude[run].max())))
-    return tuple(out)
+            worst = int(run[int(np.nanargmax(at.window_growth[run]))]) if at.code[run[0]] < 2 else None
+            out.append(_Run(r, run, worst))
+    return out
 
 
-def _window_numbers(sigma, mean_N, N, V, efolds, verdict_stable, boundary, growth, heading_stable) -> dict:
-    """label, growth_rate, N, margin, V_critical of one window with mean growth `sigma` (1/s), gains `N` (1/m) and
-    `efolds` over it; `verdict_stable` is the point's verdict (less than one e-fold of growth: stable, "nothing grows")."""
-    grows = sigma > 0
-    if N.size == 0 or not np.any(N != 0):  # no field: the heading loop's verdict at NV = 0
-        return dict(label="nothing grows" if heading_stable else "unstable", growth_rate=sigma, N=0.0,
-                    margin=math.inf if heading_stable else -1.0, V_critical=math.inf if heading_stable else 0.0)
-    N_eff = effective_gain(sigma, mean_N, V, growth, boundary.NV_critical)
-    V_star = critical_speed(N, growth, boundary.NV_critical)
-    if N_eff <= 0 or not math.isfinite(N_eff):
-        margin = -1.0 if N_eff < 0 or grows else math.inf
-        label = "unstable" if grows else "nothing grows"
-    else:
-        NV = N_eff * V
-        margin = float(gain_margin(NV, boundary, not grows))
-        label = verdict_label(NV, boundary, not grows)
-    if verdict_stable and (grows or abs(efolds) < EFOLDS):
-        label = "nothing grows"  # less than one e-fold either way over the window
-    return dict(label=label, growth_rate=sigma, N=float(N_eff), margin=margin, V_critical=float(V_star))
+def _stretch(g: RouteGeometry, rule: DecisionRule, V: float, at: SampleDecision, run: _Run, V_star) -> PathStretch:
+    """A run's `PathStretch`: its ends, verdict and cause, V* (`stretch_speed.stretch_speeds`), the speed margin, the
+    predicted weave, and the worst window's linear numbers."""
+    r, idx = run.route, run.samples
+    first, last = idx[0], idx[-1]
+    start, stop = float(g.arc[first] - g.ds[first] / 2), float(g.arc[last] + g.ds[last] / 2)
+    points = g.paths[r].points
+    edges = polyline_arcs(points)
+    ends = [float(np.interp(a, edges, points[:, k])) for a in (start, stop) for k in (0, 1)]
+    base = dict(route=r, start=start, stop=stop, x0=ends[0], y0=ends[1], x1=ends[2], y1=ends[3], length=float(g.ds[idx].sum()),
+                verdict=PATH_VERDICTS[at.code[first]], linearized_at_route=float(np.mean(~g.has[idx])))
+    if run.worst is None:
+        return PathStretch(**base)
+    k = run.worst
+    d = int(at.worse[k])
+    near = np.flatnonzero((g.route == r) & (np.abs(g.arc - g.arc[k]) <= at.window / 2))
+    N = np.stack([at.N_forward, at.N_reverse])[d, near]
+    N_eff = _effective(float(at.window_growth[k]), float(at.mean_N[d, k]), N[np.isfinite(N)], V, rule)
+    cause = CAUSES[at.cause[first]] if at.cause[first] >= 0 else None
+    return PathStretch(**base, cause=cause, growth_rate=float(at.window_growth[k]), efolds=float(at.efolds[k]), N=N_eff,
+                       margin=V_star / V - 1.0, V_critical=float(V_star), direction=("forward", "reverse")[d],
+                       oscillates=bool(at.oscillates[idx].any()), amplitude=float(at.amplitude[idx].max()))
+
+
+def _effective(sigma: float, mean_N: float, N: np.ndarray, V: float, rule: DecisionRule) -> float:
+    """N_eff of a window (`verdicts.effective_gain`; 0 for a window with no field), 1/m."""
+    if N.size == 0 or not np.any(N != 0):
+        return 0.0
+    return float(effective_gain(sigma, mean_N, V, rule.growth, rule.boundary.NV_critical))
+
+

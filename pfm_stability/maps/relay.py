@@ -59,7 +59,7 @@ import numpy as np
 
 from .equilibria import lateral_force
 
-__all__ = ["CYCLE_NODES", "CYCLE_REACH_CELLS", "CYCLE_STEP_CELLS", "RELAY_RATIO", "RELAY_STEPS", "profile_cycle",
+__all__ = ["CYCLE_NODES", "ON_THE_JUMP", "CYCLE_REACH_CELLS", "CYCLE_STEP_CELLS", "RELAY_RATIO", "RELAY_STEPS", "profile_cycle",
            "relay_amplitude", "window_cycle", "window_relay"]
 
 RELAY_RATIO = 1.0
@@ -72,6 +72,13 @@ CYCLE_STEP_CELLS = 0.0625
 """Spacing of that profile, cells (a jump is smeared over one step: O(step/A) in the describing function)."""
 CYCLE_NODES = 128
 """Phases θ of the describing function's averages (midpoint rule over the period)."""
+
+
+ON_THE_JUMP = 1e-3
+"""|F_n| at an end of a jump's interval, as a fraction of the jump, below which the net force counts as zero there:
+the equilibrium search locates s0 on a jump to its bracket (~10 µm, `equilibria.NEWTON_STEPS`), so F_n(s0) is
+that bracket's share of the jump, and its sign is round-off (it flipped a tb3_sandbox sample's relay between numpy's
+AVX2 and AVX-512 kernels)."""
 
 
 def window_relay(grid, law, x, y, tx, ty, s0, reference=None):
@@ -116,7 +123,8 @@ def window_relay(grid, law, x, y, tx, ty, s0, reference=None):
         for span in (1, 2):
             for k in range(jumps.shape[1] - span + 1):
                 part = jumps[:, k:k + span]
-                across = (part < 0).all(axis=1) & (fn[:, k] >= 0) & (fn[:, k + span] <= 0)
+                zero = ON_THE_JUMP * np.abs(np.nan_to_num(part.sum(axis=1)))  # the equilibrium found on the jump itself
+                across = (part < 0).all(axis=1) & (fn[:, k] >= -zero) & (fn[:, k + span] <= zero)
                 jump = np.maximum(jump, np.where(across, -np.nan_to_num(part.sum(axis=1)), 0.0))
         relay = jump > RELAY_RATIO * smooth
     return relay, np.where(relay, jump, 0.0)

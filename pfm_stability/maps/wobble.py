@@ -19,9 +19,11 @@ The speed written in the mask (`ZoneWobble.V_limit`) is V_tolerance only where t
 can be trusted: a supercritical branch whose cycle at V_tolerance passes the describing
 function's trust test (`analysis.wobble.trusted_cycle`), and whose V* agrees with the zone's
 own to `V_CRITICAL_AGREEMENT` (otherwise the zone is not the straight corridor the wobble
-models: walls thicker than a cell, one-sided, bent). Everywhere else the mask keeps V*, and
+models: walls thicker than a cell, one-sided, bent; a route stretch's own speed of zero growth, NV*/N of its worst
+window, is compared, since its V* lies above it where the stretch is too short for a slow growth to reach an e-fold),
+and which is faster than the zone's V* (the tolerance only relaxes the mask). Everywhere else the mask keeps V*, and
 `ZoneWobble.reason` says why (`ZoneWobble.kept` its short name). One rule for both kinds of zone, except that an
-unstable route stretch labelled "relay" (the window-edge relay, `maps.relay`) or "oscillates" (a forced weave along the
+unstable route stretch whose cause is "relay" (the window-edge relay, `maps.relay`) or "forced weave" (a forced weave along the
 route) is not a Hopf cycle of the straight corridor: it keeps V*.
 """
 
@@ -38,7 +40,8 @@ from ..laws.effective_force import GridWallLaw
 from ..checks import check_number
 from .equilibria import RAY_LENGTH
 from .outputs import has_zone
-from .paths import PathStretch, path_samples
+from .decide import path_samples
+from .paths import PathStretch
 
 __all__ = ["KEPT", "V_CRITICAL_AGREEMENT", "SegmentWobble", "WobbleStretch", "WobbleSummary", "ZoneWobble", "corridor_half_width",
            "segment_half_width", "stretch_half_width", "wobble_summary", "with_wobble"]
@@ -47,7 +50,7 @@ V_CRITICAL_AGREEMENT = 0.02
 """Largest |V*_wobble/V*_segment − 1| for which a segment counts as the straight corridor the wobble models (the
 map's straight corridors agree with the grid law's to 0.7 %, tests/test_map_corridors.py)."""
 KEPT = ("no verdict", "V* = 0", "stable at any speed", "no half-width", "no wobble branch", "not a straight corridor",
-        "subcritical", "not trusted", "relay", "oscillates", "no zone")
+        "subcritical", "not trusted", "V* above V_tolerance", "relay", "forced weave", "collision course", "no zone")
 """Short names of the reasons a zone keeps V* (`ZoneWobble.kept`; the text output counts them)."""
 _RAY_STEP = 0.125
 """Step of a ray across the segment, histogram cells."""
@@ -255,22 +258,26 @@ def _stretch_wobble(analysis, index: int, tolerance: float) -> ZoneWobble:
     """A route stretch's wobble: the segments' rule (`_zone_wobble`) on the half-width across its worst window, except
     for what is not a Hopf cycle of the straight corridor (a window-edge relay, a forced weave: V* kept)."""
     s = analysis.paths.stretches[index]
-    if s.verdict == "unstable" and s.label in _NOT_A_HOPF_CYCLE:
-        return ZoneWobble(tolerance, None, None, None, s.V_critical, _NOT_A_HOPF_CYCLE[s.label], s.label)
+    if s.verdict == "unstable" and s.cause in _NOT_A_HOPF_CYCLE:
+        return ZoneWobble(tolerance, None, None, None, s.V_critical, _NOT_A_HOPF_CYCLE[s.cause], s.cause)
     if s.verdict == "stable" and s.V_critical is not None and not s.V_critical < analysis.robot.V:
         return ZoneWobble(tolerance, None, None, None, s.V_critical, "stable, V* at or above V: no slow zone", "no zone")
-    return _zone_wobble(analysis, s.V_critical, lambda: stretch_half_width(analysis, index), tolerance)
+    V_linear = analysis.NV_critical / s.N if s.N and s.N > 0 else math.inf  # its worst window's zero growth
+    return _zone_wobble(analysis, s.V_critical, lambda: stretch_half_width(analysis, index), tolerance, V_linear)
 
 
 _NOT_A_HOPF_CYCLE = {
     "relay": "a window-edge relay (a sustained oscillation of about a cell), not a Hopf cycle of the straight corridor: V* kept",
-    "oscillates": "a forced weave along the route, not a Hopf cycle of the straight corridor: V* kept",
+    "forced weave": "a forced weave along the route, not a Hopf cycle of the straight corridor: V* kept",
+    "collision course": "a collision course, not a Hopf cycle of the straight corridor: V* kept",
 }
 
 
-def _zone_wobble(analysis, V_star, half_width, tolerance: float) -> ZoneWobble:
+def _zone_wobble(analysis, V_star, half_width, tolerance: float, V_linear: float | None = None) -> ZoneWobble:
     """The one rule of a zone (segment or route stretch) with V* `V_star` whose corridor half-width `half_width()`
-    measures (module docstring): V_tolerance where trusted, else V* and the reason."""
+    measures (module docstring): V_tolerance where trusted and faster than V*, else V* and the reason. `V_linear`
+    (default V*) is the zone's speed of zero linear growth, compared with the straight corridor's V*."""
+    V_linear = V_star if V_linear is None else V_linear
 
     def keep(kept, reason, L=None, V_tol=None, criticality=None):
         return ZoneWobble(tolerance, L, V_tol, criticality, V_star, reason, kept)
@@ -290,16 +297,19 @@ def _zone_wobble(analysis, V_star, half_width, tolerance: float) -> ZoneWobble:
         return keep("no wobble branch", f"no wobble branch: {error}", L)
     V_tol = branch.tolerance_speed(tolerance)
     common = dict(L=L, V_tol=V_tol, criticality=branch.criticality)
-    if abs(branch.V_critical / V_star - 1.0) > V_CRITICAL_AGREEMENT:
+    if not abs(branch.V_critical / V_linear - 1.0) <= V_CRITICAL_AGREEMENT:
         return keep("not a straight corridor",
                     f"not the straight corridor of half-width {L:.3g} m the wobble models (its V* {branch.V_critical:.4g} m/s, "
-                    f"the zone's {V_star:.4g} m/s): V* kept", **common)
+                    f"the zone's {V_linear:.4g} m/s): V* kept", **common)
     if branch.criticality != "supercritical":
         return keep("subcritical", "subcritical: past V* the wobble jumps to a large cycle; V* kept", **common)
     cycles = [c for c in branch.cycles_at(V_tol) if c.stable]
     if not math.isfinite(V_tol) or (V_tol > branch.V_critical and not (cycles and trusted_cycle(cycles[0]))):
         return keep("not trusted", "the describing function is not trusted at V_tolerance (strong harmonics or the steering-rate "
                     "limit): V* kept", **common)
+    if not V_tol > V_star:
+        return keep("V* above V_tolerance", f"V* {V_star:.4g} m/s is above V_tolerance (the zone ends before its weave grows an e-fold): "
+                    "V* kept", **common)
     return ZoneWobble(tolerance, L, V_tol, branch.criticality, V_tol)
 
 
@@ -310,7 +320,7 @@ class WobbleStretch(PathStretch):
 
     Attributes
     ----------
-    route, start, stop, x0, y0, x1, y1, length, verdict, label, growth_rate, efolds, N, margin, V_critical, direction, linearized_at_route, oscillates, amplitude
+    route, start, stop, x0, y0, x1, y1, length, verdict, cause, growth_rate, efolds, N, margin, V_critical, direction, linearized_at_route, oscillates, amplitude
         As `paths.PathStretch`.
     wobble : ZoneWobble or None
         The stretch's wobble (`with_wobble`).

@@ -3,6 +3,8 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from .map import OCCUPIED_GREY, UNKNOWN_GREY, map_frame
@@ -10,23 +12,25 @@ from .map import OCCUPIED_GREY, UNKNOWN_GREY, map_frame
 __all__ = ["ROUTE_STYLES", "plot_route_verdicts"]
 
 ROUTE_STYLES = {
-    "nothing grows": dict(color="#a6d96a", lw=1.6, label="stable: nothing grows (< 1 e-fold, or no field)"),
-    "stable": dict(color="#1a9641", lw=2.6, label="stable (a disturbance decays)"),
-    "oscillates": dict(color="#fdae61", lw=3.2, label="unstable: the loop weaves (an episode over 3 periods)"),
-    "unstable": dict(color="#d7191c", lw=3.6, label="unstable: a disturbance grows (>= 1 e-fold)"),
+    "nothing grows": dict(color="#a6d96a", lw=1.6, label="stable: no field (calm at any speed)"),
+    "stable": dict(color="#1a9641", lw=2.6, label="stable (< 1 e-fold over the window, no weave)"),
+    "forced weave": dict(color="#fdae61", lw=3.2, label="unstable: forced weave (the field's ripple)"),
+    "growth": dict(color="#d7191c", lw=3.6, label="unstable: a disturbance grows (>= 1 e-fold)"),
     "relay": dict(color="#7b3294", lw=3.6, label="unstable: window-edge relay (a jump of the window's force)"),
+    "collision course": dict(color="#000000", lw=3.6, label="unstable: collision course (the path meets an obstacle)"),
     "wall ahead both ways": dict(color="0.45", lw=1.4, label="no verdict: wall ahead both ways", ls=(0, (1.5, 2.0))),
     "wall ahead": dict(color="0.45", lw=1.4, label="no verdict: wall ahead (a path driven one way)", ls=(0, (1.5, 2.0))),
     "inside an obstacle": dict(color="0.3", lw=1.4, label="no verdict: inside an obstacle", ls=(0, (4.0, 2.0))),
 }
-"""Style of a stretch by its kind: the label of a stable or unstable stretch, else its verdict (a reason)."""
+"""Style of a stretch by its kind: the cause of an unstable stretch, stable (with or without a field), else its
+verdict (a reason)."""
 
 
 def _kind(stretch) -> str:
     if stretch.verdict == "stable":
-        return "nothing grows" if stretch.label == "nothing grows" else "stable"
+        return "nothing grows" if stretch.V_critical == math.inf else "stable"
     if stretch.verdict == "unstable":
-        return stretch.label if stretch.label in ("oscillates", "relay") else "unstable"
+        return stretch.cause
     return stretch.verdict if stretch.verdict in ROUTE_STYLES else "inside an obstacle"
 
 

@@ -381,7 +381,7 @@ def drive_map(analysis, count: int, *, seed: int = 0, progress=None) -> DriveVal
 
     from ..maps.analysis import judge_routes
     from ..maps.driven import LEAVES
-    from ..maps.paths import PATH_VERDICTS, UNJUDGED
+    from ..maps.decide import PATH_VERDICTS, UNJUDGED
 
     started = time.perf_counter()
     count = check_integer("count", count, 1, 100_000)
@@ -612,7 +612,7 @@ class _Prepared:
 
 def _omega(analysis) -> float | None:
     """ω* of the analysis' model (rad/s), from its routes' window (Λ = 3·2πV/ω*), or None."""
-    from ..maps.paths import WINDOW_PERIODS
+    from ..maps.decide import WINDOW_PERIODS
 
     w = analysis.paths.window
     if not math.isfinite(w) or w <= 0:
