@@ -31,11 +31,12 @@ def main() -> None:
     wall = time.perf_counter() - started
     usage = resource.getrusage(resource.RUSAGE_CHILDREN)
     data = json.loads(out.stdout)
-    drives = data["drives"]
+    drives = data["validation"]  # kind "drives": the map's one validation
     print(f"{args.map} --validate {args.drives}: {wall:.1f} s wall, {usage.ru_utime + usage.ru_stime:.1f} s CPU, "
           f"peak {usage.ru_maxrss / 1024:.0f} MB")
     print("stages: " + ", ".join(f"{k} {v:.2f} s" for k, v in data["timing"].items()))
-    print(f"drives: {drives['timing']['seconds']:.1f} s; recall {drives['recall']}, precision {drives['precision']}; "
+    print(f"drives: {drives['timing']['seconds']:.1f} s; recall {drives['recall']}, precision {drives['precision']}, "
+          f"specificity {drives.get('specificity')}; "
           f"{drives['counts']}")
 
 

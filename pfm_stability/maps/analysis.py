@@ -491,7 +491,7 @@ TAKEN_SOURCES = ("goals", "drive")
 """Route sources that are paths the simulated robot took (`validation.map_drives`): judged as taken."""
 
 
-def judge_routes(analysis: MapAnalysis, routes, taken=False) -> PathVerdicts:
+def judge_routes(analysis: MapAnalysis, routes, taken=False, speeds: bool = True) -> PathVerdicts:
     """The verdicts along `routes` alone (`paths.analyze_paths` with the analysis' grid, law, robot and loop model;
     grid law only): e.g. the paths the simulated robot took (`validation.map_drives`).
 
@@ -503,6 +503,8 @@ def judge_routes(analysis: MapAnalysis, routes, taken=False) -> PathVerdicts:
         The routes, in map coordinates (m).
     taken : bool or sequence of bool
         The routes (all, or each) are paths the simulated robot took (`paths.analyze_paths`' ``taken``).
+    speeds : bool
+        Each stretch's V* too (`paths.analyze_paths`' ``speeds``).
     """
     if analysis.paths is None:
         raise ValueError("routes need --law grid: a route is judged with the histogram grid's field")
@@ -512,7 +514,7 @@ def judge_routes(analysis: MapAnalysis, routes, taken=False) -> PathVerdicts:
     growth = GrowthRate(lambda NV: loop_model.rightmost_root(NV, loop), boundary.NV_critical)
     transition = SampledTransition.of(loop_model, loop, analysis.robot.max_steering_rate) if loop_model.name == "sampled" else None
     return analyze_paths(analysis.grid, analysis.law, list(routes), analysis.clearance, analysis.robot.W, analysis.robot.V, boundary, growth,
-                         loop_model.is_stable(0.0, loop), transition, taken=taken)
+                         loop_model.is_stable(0.0, loop), transition, taken=taken, speeds=speeds)
 
 
 def sample_verdict(N: float, V: float, boundary, heading_stable: bool) -> Judgement:

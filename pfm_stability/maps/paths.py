@@ -279,7 +279,8 @@ class PathVerdicts:
 
 
 def analyze_paths(grid, law, paths, clearance: np.ndarray, W: float, V: float, boundary, growth: GrowthRate,
-                  heading_stable: bool, transition=None, end_fraction: float = END_FRACTION, taken=False) -> PathVerdicts:
+                  heading_stable: bool, transition=None, end_fraction: float = END_FRACTION, taken=False,
+                  speeds: bool = True) -> PathVerdicts:
     """The verdict at every point of every route, and each stretch's one answer (module docstring).
 
     Parameters
@@ -315,12 +316,15 @@ def analyze_paths(grid, law, paths, clearance: np.ndarray, W: float, V: float, b
         lateral equilibrium farther than W/2 from the path is not the robot's, the path itself is the line it follows
         (linearized there, no pull towards the equilibrium), judged the way it was driven (module docstring, "Paths
         taken").
+    speeds : bool
+        Find each stretch's V* (`stretch_speed`); False: the verdicts alone, V* and margin None (the validation's
+        drives' own paths, whose samples' verdicts alone are scored: the V* search reruns the driven loop per speed).
     """
     rule = DecisionRule(grid, law, W, boundary, growth, heading_stable, transition, end_fraction)
     geometry = route_geometry(grid, law, tuple(paths), clearance, W, taken, drive=rule.drives)
     at = decide(geometry, rule, V)
     runs = _runs(geometry, at)
-    speeds = stretch_speeds(geometry, rule, V, at, runs)
+    speeds = stretch_speeds(geometry, rule, V, at, runs) if speeds else [None] * len(runs)
     stretches = tuple(_stretch(geometry, rule, V, at, run, speed) for run, speed in zip(runs, speeds))
     NV = np.nan_to_num(at.N_worse) * V
     local_stable = np.array([bool(heading_stable) if v == 0 else in_set(boundary, float(v)) for v in NV]) if NV.size else np.zeros(0, bool)
@@ -373,7 +377,8 @@ def _stretch(g: RouteGeometry, rule: DecisionRule, V: float, at: SampleDecision,
     N_eff = _effective(float(at.window_growth[k]), float(at.mean_N[d, k]), N[np.isfinite(N)], V, rule)
     cause = CAUSES[at.cause[first]] if at.cause[first] >= 0 else None
     return PathStretch(**base, cause=cause, growth_rate=float(at.window_growth[k]), efolds=float(at.efolds[k]), N=N_eff,
-                       margin=V_star / V - 1.0, V_critical=float(V_star), direction=("forward", "reverse")[d],
+                       margin=None if V_star is None else V_star / V - 1.0, V_critical=None if V_star is None else float(V_star),
+                       direction=("forward", "reverse")[d],
                        oscillates=bool(at.oscillates[idx].any()), amplitude=float(at.amplitude[idx].max()))
 
 

@@ -444,7 +444,7 @@ def drive_map(analysis, count: int, *, seed: int = 0, progress=None) -> DriveVal
             continue
         own[d.index] = len(taken)
         taken.append(route)
-    dp = judge_routes(analysis, taken, taken=True) if taken else None
+    dp = judge_routes(analysis, taken, taken=True, speeds=False) if taken else None  # their samples' verdicts are scored
     sc = _Scored.of(pv, dp)
     base = pv.code.size
 
