@@ -182,7 +182,6 @@ def run(args) -> int:
         routes = _user_routes(args.route or ())
         analysis = analyze_map(occupancy, params.robot, params.controller, law, model=args.model, unknown=args.unknown,
                                corridors=args.wobble is not None,  # the wobble reads the segments too (maps.wobble)
-                              
                                cell_size=args.cell_size, min_length=args.min_length, progress=progress,
                                warn=lambda line: print(f"pfm-stability: warning: {line}", file=sys.stderr, flush=True), routes=routes)
         if args.goals:

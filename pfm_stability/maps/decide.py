@@ -24,7 +24,7 @@ from .verdicts import EFOLDS, END_FRACTION, GrowthRate, wavelength
 
 __all__ = ["CAUSES", "PATH_NEWTON_STEPS", "PATH_VERDICTS", "PROFILE_PHASE_NODES", "PROFILE_STEP", "RENORMALIZE", "ROUND_OFF_EFOLDS",
            "UNJUDGED", "WINDOW_PERIODS", "DecisionRule", "RouteGeometry", "SampleDecision", "decide", "lateral_profile", "path_samples",
-           "product_efolds", "relay_cycle", "route_geometry", "run_efolds"]
+           "route_geometry", "run_efolds"]
 
 WINDOW_PERIODS = 3.0
 """Length of the window whose accumulated growth decides a point, in oscillation wavelengths λ = 2πV/ω*: the
@@ -322,10 +322,11 @@ def route_geometry(grid, law, paths: tuple, clearance: np.ndarray, W: float, tak
 
 CAUSES = ("growth", "forced weave", "relay", "collision course")
 """Why a sample is unstable (`SampleDecision.cause` indexes it; −1: stable or unjudged), in the order they are tried:
-the linear loop grows at least `verdicts.EFOLDS` e-folds over the window; the loop driven along the route through the
-field weaves though the linear loop is damped (the field's ripple forcing it, `maps.episodes`); the window-edge relay
-holds a cycle of at least the episodes' amplitude (`maps.relay`); the loop driven along the route leaves the
-corridor without a weave first (its path meets an obstacle)."""
+the linear loop grows at least `verdicts.EFOLDS` e-folds over the window or the run of growing windows; the loop
+driven along the route through the field weaves though the linear loop is damped (the field's ripple forcing it,
+`maps.episodes`); the window-edge relay holds a cycle of at least the episodes' amplitude (`maps.relay`).
+"collision course" (the driven loop leaving the corridor without a weave first) is reserved: `decide` does not
+assign it yet (a loop that leaves the corridor marks its amplitude `driven.LEAVES`)."""
 
 
 @dataclass(frozen=True)
@@ -400,8 +401,8 @@ def _gains(g: RouteGeometry, rule: DecisionRule, V: float, lam: float) -> tuple:
 
 def decide(g: RouteGeometry, rule: DecisionRule, V: float, centres: np.ndarray | None = None, drive: bool = True) -> SampleDecision:
     """Every sample's verdict and cause at speed V (module docstring): the growth over the window or over the run of
-    growing windows around it (`run_efolds`), then the loop driven along the route (a forced weave, a collision
-    course), then the window-edge relay.
+    growing windows around it (`run_efolds`), then the loop driven along the route (a forced weave), then the
+    window-edge relay.
 
     Parameters
     ----------
@@ -462,7 +463,7 @@ def decide(g: RouteGeometry, rule: DecisionRule, V: float, centres: np.ndarray |
                           oscillates, amplitude)
 
 
-def relay_cycle(jump, ahead, N_smooth, NV_critical: float, V):
+def _relay_cycle(jump, ahead, N_smooth, NV_critical: float, V):
     """The window-edge relay's cycle (m) by the describing function of one jump beside the smooth slope, per unit
     forward force (`relay.relay_amplitude`; capped at `driven.LEAVES`, 0 where not finite).
 
@@ -495,7 +496,7 @@ def _relay(g: RouteGeometry, rule: DecisionRule, V: float, code, worse, forward,
         return relay, cycle
     d = worse[check]
     N_smooth = np.nan_to_num(np.where(d == 0, N_forward[check], N_reverse[check]))
-    cycle[check] = relay_cycle(g.relay_jump[check], forward[d, check], N_smooth, NV_star, V)
+    cycle[check] = _relay_cycle(g.relay_jump[check], forward[d, check], N_smooth, NV_star, V)
     if excursion is not None:  # the loop driven through the whole profile must stray as far there (docstring)
         cycle[check] = np.minimum(cycle[check], excursion[check])
     relay[check] = cycle[check] >= AMPLITUDE_THRESHOLD  # a limit cycle the episodes' judge would see
@@ -535,7 +536,7 @@ def _window_product(N: np.ndarray, route: np.ndarray, arc: np.ndarray, half: flo
         inside = (positions >= a[0] - (a[1] - a[0] if a.size > 1 else step) / 2) & (positions <= a[-1] + (a[-1] - a[-2] if a.size > 1 else step) / 2)
         gains = g[np.searchsorted(edges, np.clip(positions, a[0], a[-1]))]
         valid = inside & np.isfinite(gains)
-        log_rho = product_efolds(np.where(valid, gains, 0.0) * V, valid, transition)
+        log_rho = _product_efolds(np.where(valid, gains, 0.0) * V, valid, transition)
         count = valid.sum(axis=1)
         duration = count * transition.T
         with np.errstate(invalid="ignore", divide="ignore"):
@@ -545,7 +546,7 @@ def _window_product(N: np.ndarray, route: np.ndarray, arc: np.ndarray, half: flo
     return out, seconds
 
 
-def product_efolds(NV: np.ndarray, valid: np.ndarray, transition: SampledTransition) -> np.ndarray:
+def _product_efolds(NV: np.ndarray, valid: np.ndarray, transition: SampledTransition) -> np.ndarray:
     """log ρ(Φ(NV_M)···Φ(NV_1)) of each row: the e-folds of the sampled loop over a window of M steps with gains
     NV (1/s, shape (windows, M)); a step not `valid` (the robot stopped there) is left out (the identity).
 

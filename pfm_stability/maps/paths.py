@@ -113,7 +113,7 @@ class PathStretch:
         "stable", "unstable", or a reason of `UNJUDGED`.
     cause : str or None
         Why it is unstable (`CAUSES`): "growth" (the linear loop), "forced weave" (the field's ripple drives a weave),
-        "relay" (the window's edge) or "collision course" (the driven loop meets an obstacle); None when stable.
+        "relay" (the window's edge); None when stable. ("collision course" is reserved in `CAUSES`, not assigned yet.)
     growth_rate : float or None
         σ̄_w of the worst window at V, 1/s: the linear loop's (a forced weave or a relay weaves with it negative).
     efolds : float or None
@@ -204,10 +204,8 @@ class PathVerdicts:
         The linear loop driven along the route weaves here (`maps.episodes`: a forced or growing oscillation).
     amplitude : ndarray
         The predicted lateral oscillation at each sample, m (the largest of the runs passing it; as on `PathStretch`).
-    relay : ndarray of bool
-        The window-edge relay holds the robot in a sustained oscillation here (`maps.relay`): unstable ("relay").
     cause : ndarray of int
-        Index into `CAUSES` where unstable, −1 elsewhere.
+        Index into `CAUSES` where unstable, −1 elsewhere (`relay`: where it is the window-edge relay).
     """
 
     paths: tuple
@@ -228,8 +226,13 @@ class PathVerdicts:
     stretches: tuple
     oscillates: np.ndarray = None
     amplitude: np.ndarray = None
-    relay: np.ndarray = None
     cause: np.ndarray = None
+
+    @property
+    def relay(self) -> np.ndarray:
+        """Per sample: the window-edge relay holds the robot in a sustained oscillation here (`maps.relay`; cause
+        "relay")."""
+        return self.cause == CAUSES.index("relay")
 
     @property
     def route_length(self) -> float:
@@ -331,7 +334,7 @@ def analyze_paths(grid, law, paths, clearance: np.ndarray, W: float, V: float, b
     local_verdict, local_margin = judge_arrays(NV, np.full(NV.shape, boundary.NV_critical), local_stable)
     return PathVerdicts(geometry.paths, geometry.samples, geometry.arc, geometry.ds, geometry.px, geometry.py, at.N_forward, at.N_reverse,
                         at.sigma[0], at.sigma[1], at.window_growth, at.code, local_verdict, local_margin, at.window, stretches,
-                        at.oscillates, at.amplitude, at.cause == CAUSES.index("relay"), at.cause)
+                        at.oscillates, at.amplitude, at.cause)
 
 
 @dataclass(frozen=True)
