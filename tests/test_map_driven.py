@@ -280,3 +280,41 @@ def test_wobble_agreement_compares_the_weaves_where_either_passed_the_threshold(
     quiet = wobble_agreement([0.01, 0.004], [0.014, 0.0], [1.0, 1.0], 1.0)
     assert quiet.length == 0.0 and quiet.within is None and quiet.ratio_quartiles is None
     assert quiet.to_dict()["within"] is None and got.to_dict()["ratio_quartiles"][2] == pytest.approx(1.0)
+
+
+def test_speeds_driven_together_are_each_speed_driven_alone():
+    """`driven_loops` steps the runs of several speeds together (the V* search's ladder and halvings, `stretch_speed`);
+    each speed's `DrivenLoop` is what that speed driven alone gives (`_driven`): the same episodes, and the weave and
+    excursion to 1e-12 relative (a run's arithmetic is its own; only the batched matrix product's blocking may
+    differ in the last bits). Two routes of different gains — one of them driven at one speed only — at three speeds
+    (k = 20 1/s; 1.3·NV* at the fastest speed on the first route, which grows until it leaves; the others damped)."""
+    from pfm_stability.maps.driven import DriveRequest, driven_loops
+
+    robot = CARMEL.robot.replace(W=0.4, tau=0.1, k=20.0, V=1.0)
+    controller = CARMEL.controller.replace(T=0.025, f=2.0)
+    model, loop, tr = _transition(robot, controller)
+    NV_star = model.boundary(loop).NV_critical
+    period = 2 * math.pi / model.boundary(loop).omega_critical
+    steps = 1200
+    spacing = robot.V * controller.T
+    profiles = [_straight(1.3 * NV_star / robot.V, steps, spacing, reach=2.0), _straight(0.6 * NV_star / robot.V, steps, spacing, reach=2.0)]
+    offsets = profiles[0][0]
+    profile = (offsets, np.concatenate([p[1] for p in profiles]), np.concatenate([p[2] for p in profiles]))
+    route = np.repeat([0, 1], steps)
+    arc = np.tile((np.arange(steps) + 0.5) * spacing, 2)
+    n = route.size
+    def goal(P):  # a goal's pull P across the path (each speed its own: a mixed-up request shows)
+        return dict(stopped=np.zeros((2, n), dtype=bool), pull=np.full(n, P), attraction=np.full(n, math.sqrt(1 - P * P)), aim=np.zeros(n))
+
+    asked = ((1.0, None, 0.0), (0.8, np.array([True, False]), 0.05), (0.55, None, -0.02))
+    requests = [DriveRequest(V, routes=routes, **goal(P)) for V, routes, P in asked]
+    together = driven_loops(route, arc, profile, requests, tr, period, taken=False)
+    assert together[0].oscillates[route == 0].any() and not together[2].oscillates.any()  # the case exercises a weave
+    for (V, routes, P), loop_together in zip(asked, together):
+        keep = np.ones(n, dtype=bool) if routes is None else routes[route]
+        alone = driven_loops(route[keep], arc[keep], (offsets, profile[1][keep], profile[2][keep]),
+                             [DriveRequest(V, **{k: v[..., keep] for k, v in goal(P).items()})], tr, period, taken=False)[0]
+        assert np.array_equal(loop_together.oscillates[keep], alone.oscillates)
+        for name in ("amplitude", "excursion"):
+            assert np.allclose(getattr(loop_together, name)[keep], getattr(alone, name), rtol=1e-12, atol=1e-15), name
+        assert not loop_together.oscillates[~keep].any() and not loop_together.amplitude[~keep].any()

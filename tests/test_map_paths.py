@@ -9,6 +9,7 @@ the geometry of the test maps for the routes, and the simulator for the validati
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 from functools import lru_cache
 from pathlib import Path
 
@@ -615,7 +616,7 @@ def test_window_edge_relay_where_a_rack_enters_the_window():
 
 def test_a_relay_stands_only_where_the_loop_driven_through_the_profile_strays_as_far(tmp_path, monkeypatch):
     """The window-edge relay with the sampled model (`maps.paths`, docs/maps.md): the describing function of one jump
-    is an estimate of the cycle; the loop driven through the whole profile (`decide._driven`) is run there too, and the
+    is an estimate of the cycle; the loop driven through the whole profile (`decide.driven_loops`) is run there too, and the
     relay stands only where that loop strays as far from its one-period average (its excursion) as well. In a 3 m
     aisle between a one-cell wall and a solid rack (the test robot; the equilibrium at the window's edge, a restoring
     jump on every sample of the skeleton's route), the describing function alone predicts a relay cycle past the
@@ -632,20 +633,19 @@ def test_a_relay_stands_only_where_the_loop_driven_through_the_profile_strays_as
     pixels[:, 1 + gap:] = 0
     analysis = analyze_map(load_map(write_map(tmp_path, pixels)), ROBOT, CONTROLLER, make_law("grid", ROBOT, CONTROLLER))
     routes = analysis.paths.paths
-    real = decide._driven
+    real = decide.driven_loops
 
     def swinging(value):
         def driven(*args):
-            oscillates, amplitude, excursion = real(*args)
-            return oscillates, amplitude, np.full_like(excursion, value)
+            return [replace(loop, excursion=np.full_like(loop.excursion, value)) for loop in real(*args)]
         return driven
 
-    monkeypatch.setattr(decide, "_driven", swinging(1.0))
+    monkeypatch.setattr(decide, "driven_loops", swinging(1.0))
     alone = judge_routes(analysis, routes)
     assert alone.relay.all() and alone.relay.size > 100
-    monkeypatch.setattr(decide, "_driven", swinging(0.0))
+    monkeypatch.setattr(decide, "driven_loops", swinging(0.0))
     assert not judge_routes(analysis, routes).relay.any()
-    monkeypatch.setattr(decide, "_driven", real)
+    monkeypatch.setattr(decide, "driven_loops", real)
     pv = analysis.paths
     assert not pv.relay.any() and (pv.code == PATH_VERDICTS.index("stable")).all()
     drives = drive_map(analysis, 4, seed=0)

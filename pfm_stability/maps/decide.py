@@ -12,18 +12,19 @@ The rule itself is described in `maps.paths`' module docstring.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, fields, replace
 
 import numpy as np
 
-from .driven import LEAVES, DrivenTrack, SampledTransition, _driven
+from .contact import free_band
+from .driven import LEAVES, DriveRequest, DrivenTrack, SampledTransition, driven_loops
 from .episodes import AMPLITUDE_THRESHOLD
 from .equilibria import equilibria_at, lateral_force
 from .relay import relay_amplitude, window_relay
 from .verdicts import EFOLDS, END_FRACTION, GrowthRate, wavelength
 
 __all__ = ["CAUSES", "PATH_NEWTON_STEPS", "PATH_VERDICTS", "PROFILE_PHASE_NODES", "PROFILE_STEP", "RENORMALIZE", "ROUND_OFF_EFOLDS",
-           "UNJUDGED", "WINDOW_PERIODS", "DecisionRule", "RouteGeometry", "SampleDecision", "decide", "lateral_profile", "path_samples",
+           "UNJUDGED", "WINDOW_PERIODS", "DecisionRule", "RouteGeometry", "SampleDecision", "SpeedQuery", "decide", "decide_speeds", "lateral_profile", "path_samples",
            "route_geometry", "run_efolds"]
 
 WINDOW_PERIODS = 3.0
@@ -221,7 +222,8 @@ class RouteGeometry:
     cell_force : ndarray
         F_n averaged across one cell on paths taken (`_cell_mean`; nan elsewhere).
     profile : tuple or None
-        `lateral_profile` within `driven.LEAVES` (where the loop is driven).
+        `lateral_profile` within `driven.LEAVES` (where the loop is driven) and the free band across each sample
+        (`contact.free_band`, shape (samples, 2): where the robot's disc meets an obstacle).
     track : DrivenTrack or None
         A drive's own paths' track.
     relay_found, relay_jump : ndarray
@@ -262,12 +264,16 @@ class RouteGeometry:
         grid, law : HistogramMap, GridWallLaw
             For the drives' own track.
         """
-        cut = {f: getattr(self, f)[keep] for f in ("x", "y", "tx", "ty", "route", "arc", "ds", "taken", "has", "offset", "px", "py",
-                                                   "along", "slope", "inside", "cell_force", "relay_found", "relay_jump")}
+        cut = {f: getattr(self, f)[keep] for f in _PER_SAMPLE}
         profile = tuple(a if a.ndim == 1 else a[keep] for a in self.profile) if self.profile is not None else None
         track = (DrivenTrack.of(grid, law, self.paths, cut["x"], cut["y"], cut["tx"], cut["ty"], cut["route"], cut["arc"])
                  if self.track is not None else None)
         return replace(self, samples=None, profile=profile, track=track, **cut)
+
+
+_PER_SAMPLE = ("x", "y", "tx", "ty", "route", "arc", "ds", "taken", "has", "offset", "px", "py", "along", "slope", "inside", "cell_force",
+               "relay_found", "relay_jump")
+"""`RouteGeometry`'s fields with a value per sample (what a subset cuts)."""
 
 
 def route_geometry(grid, law, paths: tuple, clearance: np.ndarray, W: float, taken=False, drive: bool = True) -> RouteGeometry:
@@ -310,7 +316,10 @@ def route_geometry(grid, law, paths: tuple, clearance: np.ndarray, W: float, tak
     cell_force = np.full(x.size, np.nan)
     if taken.any():
         cell_force[taken] = _cell_mean(grid, law, x[taken], y[taken], tx[taken], ty[taken])
-    profile = lateral_profile(grid, law, x, y, tx, ty, LEAVES) if drive and x.size else None
+    profile = None
+    if drive and x.size:
+        offsets, fn, ft = lateral_profile(grid, law, x, y, tx, ty, LEAVES)
+        profile = (offsets, fn, ft, free_band(grid, clearance, x, y, tx, ty, W, offsets).T)
     track = DrivenTrack.of(grid, law, paths, x, y, tx, ty, route, arc) if drive and taken.any() else None
     found, jump = np.zeros(x.size, dtype=bool), np.zeros(x.size)
     check = np.flatnonzero((has | taken) & ~inside)  # where the robot's path is known: its equilibrium, or driven
@@ -321,12 +330,12 @@ def route_geometry(grid, law, paths: tuple, clearance: np.ndarray, W: float, tak
 
 
 CAUSES = ("growth", "forced weave", "relay", "collision course")
-"""Why a sample is unstable (`SampleDecision.cause` indexes it; −1: stable or unjudged), in the order they are tried:
-the linear loop grows at least `verdicts.EFOLDS` e-folds over the window or the run of growing windows; the loop
-driven along the route through the field weaves though the linear loop is damped (the field's ripple forcing it,
-`maps.episodes`); the window-edge relay holds a cycle of at least the episodes' amplitude (`maps.relay`).
-"collision course" (the driven loop leaving the corridor without a weave first) is reserved: `decide` does not
-assign it yet (a loop that leaves the corridor marks its amplitude `driven.LEAVES`)."""
+"""Why a sample is unstable (`SampleDecision.cause` indexes it; −1: stable or unjudged), tried in the order: the
+linear loop grows at least `verdicts.EFOLDS` e-folds over the window or the run of growing windows ("growth"); the
+loop driven along the route through the field weaves though the linear loop is damped (the field's ripple forcing
+it, `maps.episodes`: "forced weave"); the driven loop's disc meets an obstacle within one period after the sample
+without a weave first ("collision course", `contact.free_band`); the window-edge relay holds a cycle of at least the
+episodes' amplitude (`maps.relay`: "relay")."""
 
 
 @dataclass(frozen=True)
@@ -402,7 +411,7 @@ def _gains(g: RouteGeometry, rule: DecisionRule, V: float, lam: float) -> tuple:
 def decide(g: RouteGeometry, rule: DecisionRule, V: float, centres: np.ndarray | None = None, drive: bool = True) -> SampleDecision:
     """Every sample's verdict and cause at speed V (module docstring): the growth over the window or over the run of
     growing windows around it (`run_efolds`), then the loop driven along the route (a forced weave), then the
-    window-edge relay.
+    window-edge relay (`decide_speeds` at one speed).
 
     Parameters
     ----------
@@ -417,6 +426,55 @@ def decide(g: RouteGeometry, rule: DecisionRule, V: float, centres: np.ndarray |
         Drive the loop along the routes (where the rule does); False: the growth and the relay's describing function
         alone (`stretch_speed` above V).
     """
+    return decide_speeds(g, rule, [SpeedQuery(V, centres)], drive)[0]
+
+
+@dataclass(frozen=True)
+class SpeedQuery:
+    """One speed `decide_speeds` decides the samples at.
+
+    Attributes
+    ----------
+    V : float
+        m/s.
+    centres : ndarray of bool or None
+        As `decide`'s.
+    routes : ndarray of bool or None
+        Per route index: drive the loop along these routes only (None: all); the other routes' samples are decided
+        without a forced weave (a caller reads only its routes' samples).
+    """
+
+    V: float
+    centres: np.ndarray | None = None
+    routes: np.ndarray | None = None
+
+
+def decide_speeds(g: RouteGeometry, rule: DecisionRule, queries, drive: bool = True) -> list:
+    """`decide` at several speeds (one `SampleDecision` each): the loop driven along the routes at all of them in one
+    run (`driven.driven_loops`), each speed's samples decided by the same rule as `decide` alone.
+
+    Parameters
+    ----------
+    g : RouteGeometry
+    rule : DecisionRule
+    queries : sequence of SpeedQuery
+        The speeds, each with its centres and the routes it drives.
+    drive : bool
+        As `decide`'s.
+    """
+    linear = [_linear_decision(g, rule, q.V, q.centres) if q.routes is None else _on_routes(g, rule, q) for q in queries]
+    loops = [None] * len(queries)
+    if drive and rule.drives and g.profile is not None and g.x.size:
+        requests = [DriveRequest(d.V, np.stack([~np.isfinite(d.N_forward), ~np.isfinite(d.N_reverse)]), *goal, q.routes)
+                    for q, (d, goal) in zip(queries, linear)]
+        loops = driven_loops(g.route, g.arc, g.profile, requests, rule.transition, 2 * math.pi / rule.boundary.omega_critical,
+                             g.driven[: int(g.route.max()) + 1], g.track)
+    return [_with_the_drive(g, rule, d, loop) for (d, _), loop in zip(linear, loops)]
+
+
+def _linear_decision(g: RouteGeometry, rule: DecisionRule, V: float, centres) -> tuple:
+    """(decision, (pull, attraction, aim)): the samples decided at V by the window's growth alone (`decide`), and the
+    goal's terms the driven loop needs (`_gains`)."""
     boundary = rule.boundary
     lam = wavelength(V, boundary.omega_critical)
     N_forward, N_reverse, forward, pull, attraction, aim = _gains(g, rule, V, lam)
@@ -424,9 +482,7 @@ def decide(g: RouteGeometry, rule: DecisionRule, V: float, centres: np.ndarray |
     window = WINDOW_PERIODS * lam if math.isfinite(lam) else math.inf
     half = window / 2
     if rule.transition is not None and math.isfinite(window):
-        pairs = [_window_product(n, g.route, g.arc, half, V, rule.transition, reverse=k == 1, centres=centres)
-                 for k, n in enumerate((N_forward, N_reverse))]
-        means, seconds = [m for m, _ in pairs], [t for _, t in pairs]
+        means, seconds = _window_products((N_forward, N_reverse), g.route, g.arc, half, V, rule.transition, centres)
         if centres is not None:
             means = [_between(m, g.route, g.arc, centres, n) for m, n in zip(means, (N_forward, N_reverse))]
             seconds = [_between(t, g.route, g.arc, centres, n) for t, n in zip(seconds, (N_forward, N_reverse))]
@@ -441,26 +497,56 @@ def decide(g: RouteGeometry, rule: DecisionRule, V: float, centres: np.ndarray |
     window_growth = np.stack(means)[worse, rows]
     efolds = np.where(np.isfinite(window_growth), gained[worse, rows], np.nan)
     code = np.where(efolds >= EFOLDS, 1, 0)  # a disturbance grows by at least one e-fold over the window
-    cause = np.where(code == 1, CAUSES.index("growth"), -1)
     stopped = ~np.isfinite(N_forward) & ~np.isfinite(N_reverse)
     wall = np.where(g.taken, PATH_VERDICTS.index("wall ahead"), PATH_VERDICTS.index("wall ahead both ways"))
     code = np.where(stopped, wall, code)
     code = np.where(g.inside, PATH_VERDICTS.index("inside an obstacle"), code)
     code = np.where(~np.isfinite(window_growth) & (code < 2), wall, code)
-    cause = np.where(code == 1, cause, -1)
-    oscillates, amplitude, excursion = np.zeros(g.x.size, dtype=bool), np.zeros(g.x.size), None
-    if drive and rule.drives and g.profile is not None and g.x.size:
-        blocked = np.stack([~np.isfinite(N_forward), ~np.isfinite(N_reverse)])
-        oscillates, amplitude, excursion = _driven(g.route, g.arc, blocked, g.profile, pull, attraction, aim, V, rule.transition,
-                                                   2 * math.pi / boundary.omega_critical, g.driven[: int(g.route.max()) + 1], g.track)
+    cause = np.where(code == 1, CAUSES.index("growth"), -1)
+    N_worse = np.stack([N_forward, N_reverse])[worse, rows]
+    decision = SampleDecision(V, window, N_forward, N_reverse, sig, forward, worse, N_worse, window_growth, efolds, mean_N, code, cause,
+                              np.zeros(g.x.size, dtype=bool), np.zeros(g.x.size))
+    return decision, (pull, attraction, aim)
+
+
+_OUTSIDE = {"code": PATH_VERDICTS.index("wall ahead both ways"), "worse": 0, "cause": -1, "oscillates": False, "amplitude": 0.0}
+"""What a sample off a query's routes holds in its `SampleDecision` (`_on_routes`; nan where not named): unjudged."""
+
+
+def _on_routes(g: RouteGeometry, rule: DecisionRule, query: SpeedQuery) -> tuple:
+    """`_linear_decision` of the query's routes' samples alone (each route is decided on its own), spread back over
+    every sample of `g` (off its routes: `_OUTSIDE`, and no goal's terms: P = K = 0, A = 1)."""
+    keep = query.routes[g.route]
+    part = replace(g, profile=None, track=None, **{f: getattr(g, f)[keep] for f in _PER_SAMPLE})
+    d, goal = _linear_decision(part, rule, query.V, None if query.centres is None else query.centres[keep])
+    spread = {f.name: _spread(value, keep, _OUTSIDE.get(f.name, np.nan)) for f in fields(SampleDecision)
+              if isinstance(value := getattr(d, f.name), np.ndarray)}
+    return replace(d, **spread), tuple(_spread(value, keep, fill) for value, fill in zip(goal, (0.0, 1.0, 0.0)))
+
+
+def _spread(value: np.ndarray, keep: np.ndarray, fill) -> np.ndarray:
+    """`value` (per sample of `keep`'s True ones, last axis) at those samples of all, `fill` elsewhere."""
+    full = np.full(value.shape[:-1] + keep.shape, fill, dtype=value.dtype)
+    full[..., keep] = value
+    return full
+
+
+
+def _with_the_drive(g: RouteGeometry, rule: DecisionRule, d: SampleDecision, loop) -> SampleDecision:
+    """The linear decision `d` with the driven loop's forced weave (`loop`: a `driven.DrivenLoop`, None: not driven)
+    and the window-edge relay (module docstring)."""
+    code, cause, excursion = d.code, d.cause, None
+    oscillates, amplitude = d.oscillates, d.amplitude
+    if loop is not None:
+        oscillates, amplitude, excursion = loop.oscillates, loop.amplitude, loop.excursion
         weave = (code == 0) & oscillates
         code, cause = np.where(weave, 1, code), np.where(weave, CAUSES.index("forced weave"), cause)
-    N_worse = np.stack([N_forward, N_reverse])[worse, rows]
-    relay, cycle = _relay(g, rule, V, code, worse, forward, N_forward, N_reverse, excursion)
+        course = (code == 0) & loop.collides
+        code, cause = np.where(course, 1, code), np.where(course, CAUSES.index("collision course"), cause)
+    relay, cycle = _relay(g, rule, d.V, code, d.worse, d.forward, d.N_forward, d.N_reverse, excursion)
     amplitude = np.where(relay, np.maximum(amplitude, cycle), amplitude)
     code, cause = np.where(relay, 1, code), np.where(relay, CAUSES.index("relay"), cause)
-    return SampleDecision(V, window, N_forward, N_reverse, sig, forward, worse, N_worse, window_growth, efolds, mean_N, code, cause,
-                          oscillates, amplitude)
+    return replace(d, code=code, cause=cause, oscillates=oscillates, amplitude=amplitude)
 
 
 def _relay_cycle(jump, ahead, N_smooth, NV_critical: float, V):
@@ -512,38 +598,54 @@ ROUND_OFF_EFOLDS = 1e-9
 of a window with no field): 0."""
 
 
-def _window_product(N: np.ndarray, route: np.ndarray, arc: np.ndarray, half: float, V: float, transition: SampledTransition,
-                    reverse: bool = False, centres: np.ndarray | None = None) -> tuple:
-    """(rate, seconds): the growth rate (1/s) over the window around each sample of the sampled loop driven along the
-    route at V, log ρ(Φ(N_M·V)···Φ(N_1·V)) / (M·T), the robot at arc V·T apart taking the N of its nearest sample (nan
-    N: the robot is stopped there that way; those steps are left out), and the window's time M·T (s); nan for a
-    window with no step, and for the samples not among `centres` (bool, default all)."""
-    out, seconds = np.full(N.shape, np.nan), np.zeros(N.shape)
+def _window_products(Ns: tuple, route: np.ndarray, arc: np.ndarray, half: float, V: float, transition: SampledTransition,
+                     centres: np.ndarray | None = None) -> tuple:
+    """(rates, seconds), one array each per travel direction of `Ns` (forward, reverse): the growth rate (1/s) over the
+    window around each sample of the sampled loop driven along the route at V, log ρ(Φ(N_M·V)···Φ(N_1·V)) / (M·T), the
+    robot at arc V·T apart taking the N of its nearest sample (nan N: the robot is stopped there that way; those steps
+    are left out), and the window's time M·T (s); nan for a window with no step, and for the samples not among
+    `centres` (bool, default all). Every route's windows in both directions have the same M steps: they are multiplied
+    out together (`_product_efolds`)."""
     step = V * transition.T
-    for r in np.unique(route):
-        on = np.flatnonzero(route == r)
-        a, g = arc[on], N[on]
-        idx = on if centres is None else on[centres[on]]
-        if idx.size == 0:
-            continue
-        edges = (a[:-1] + a[1:]) / 2
-        centre = arc[idx]
-        steps = int(math.ceil(2 * half / step))
-        offsets = (np.arange(steps) + 0.5) * step - half
-        if reverse:
-            offsets = offsets[::-1]
-        positions = centre[:, None] + offsets[None, :]
-        inside = (positions >= a[0] - (a[1] - a[0] if a.size > 1 else step) / 2) & (positions <= a[-1] + (a[-1] - a[-2] if a.size > 1 else step) / 2)
-        gains = g[np.searchsorted(edges, np.clip(positions, a[0], a[-1]))]
-        valid = inside & np.isfinite(gains)
-        log_rho = _product_efolds(np.where(valid, gains, 0.0) * V, valid, transition)
-        count = valid.sum(axis=1)
-        duration = count * transition.T
-        with np.errstate(invalid="ignore", divide="ignore"):
-            rate = np.where(count > 0, log_rho / np.where(duration > 0, duration, 1.0), np.nan)
-        out[idx] = np.where(np.abs(log_rho) < ROUND_OFF_EFOLDS, 0.0, rate)
-        seconds[idx] = duration
-    return out, seconds
+    steps = int(math.ceil(2 * half / step))
+    offsets = (np.arange(steps) + 0.5) * step - half
+    where, gains, valid = [], [], []
+    for k, N in enumerate(Ns):
+        for r in np.unique(route):
+            on = np.flatnonzero(route == r)
+            idx = on if centres is None else on[centres[on]]
+            if idx.size:
+                rows, ok = _window_gains(N[on], arc[on], arc[idx], offsets[::-1] if k == 1 else offsets, step)
+                where.append((k, idx))
+                gains.append(rows)
+                valid.append(ok)
+    rates, seconds = [np.full(route.shape, np.nan) for _ in Ns], [np.zeros(route.shape) for _ in Ns]
+    if not where:
+        return rates, seconds
+    gains, valid = np.concatenate(gains), np.concatenate(valid)
+    log_rho = _product_efolds(np.where(valid, gains, 0.0) * V, valid, transition)
+    duration = valid.sum(axis=1) * transition.T
+    with np.errstate(invalid="ignore", divide="ignore"):
+        rate = np.where(duration > 0, log_rho / np.where(duration > 0, duration, 1.0), np.nan)
+    rate = np.where(np.abs(log_rho) < ROUND_OFF_EFOLDS, 0.0, rate)
+    first = 0
+    for k, idx in where:
+        rates[k][idx], seconds[k][idx] = rate[first:first + idx.size], duration[first:first + idx.size]
+        first += idx.size
+    return rates, seconds
+
+
+def _window_gains(N: np.ndarray, a: np.ndarray, centre: np.ndarray, offsets: np.ndarray, step: float) -> tuple:
+    """(gains, valid), shape (windows, steps): the N (1/m) of the sample nearest each step of the windows centred at
+    arc positions `centre` (m) of one route (samples at arcs `a` with gains `N`), the steps `offsets` (m) from the
+    centre in the order driven, V·T = `step` (m) apart; valid where the step lies on the route (within half a sample
+    spacing of its ends) and N is finite."""
+    edges = (a[:-1] + a[1:]) / 2
+    positions = centre[:, None] + offsets[None, :]
+    first_gap, last_gap = (a[1] - a[0], a[-1] - a[-2]) if a.size > 1 else (step, step)
+    inside = (positions >= a[0] - first_gap / 2) & (positions <= a[-1] + last_gap / 2)
+    gains = N[np.searchsorted(edges, np.clip(positions, a[0], a[-1]))]
+    return gains, inside & np.isfinite(gains)
 
 
 def _product_efolds(NV: np.ndarray, valid: np.ndarray, transition: SampledTransition) -> np.ndarray:

@@ -18,7 +18,7 @@ import numpy as np
 from .field import window_force
 from .routes import polyline_arcs
 
-__all__ = ["LEAVES", "OWN_STEPS", "PREDICTION_OFFSET", "DrivenTrack", "SampledTransition"]
+__all__ = ["LEAVES", "OWN_STEPS", "PREDICTION_OFFSET", "DriveRequest", "DrivenLoop", "DrivenTrack", "SampledTransition", "driven_loops"]
 
 
 @dataclass(frozen=True)
@@ -177,23 +177,79 @@ class DrivenTrack:
                    lambda px, py: window_force(grid, law, px, py), start)
 
 
+@dataclass(frozen=True)
+class DriveRequest:
+    """One speed the loop is driven at (`driven_loops`), with what the rule at that speed says of each sample.
+
+    Attributes
+    ----------
+    V : float
+        Speed, m/s.
+    stopped : ndarray of bool, shape (2, samples)
+        Forward and reverse: the direction is not judged there (a wall ahead, `verdicts.END_FRACTION`): no lateral force.
+    pull, attraction : ndarray
+        The goal's pull across the path (P) and along it (A) per sample, F_ct units (0 and 1 on a route).
+    aim : ndarray
+        K per sample, F_ct/m (`decide._aim_stiffness`; 0 on a route).
+    routes : ndarray of bool or None
+        Per route index: drive the loop along these routes only (None: every route with samples).
+    """
+
+    V: float
+    stopped: np.ndarray
+    pull: np.ndarray
+    attraction: np.ndarray
+    aim: np.ndarray
+    routes: np.ndarray | None = None
+
+
+@dataclass(frozen=True)
+class DrivenLoop:
+    """What the loop driven at one speed shows at each sample (`driven_loops`).
+
+    Attributes
+    ----------
+    oscillates : ndarray of bool
+        An episode (`maps.episodes`) of the loop's lateral motion passes the sample.
+    collides : ndarray of bool
+        The loop meets an obstacle within one period P after passing the sample (its disc leaves the free band,
+        `contact.free_band`): the robot is on a collision course there.
+    amplitude : ndarray
+        The largest weave held there, m (`episodes.lateral_extent`; `LEAVES` where the run left the corridor).
+    excursion : ndarray
+        The farthest the loop strays from its one-period average within half a period, m (`LEAVES` likewise).
+    """
+
+    oscillates: np.ndarray
+    collides: np.ndarray
+    amplitude: np.ndarray
+    excursion: np.ndarray
+
+
 def _driven(route, arc, stopped, profile, pull, attraction, aim, V: float, transition: SampledTransition, period: float, taken,
             track: DrivenTrack | None = None):
-    """(oscillates, amplitude, excursion) per sample: the sampled loop driven along each route at V through the real
-    lateral force across it (`maps.paths` module docstring, "The loop driven along the route"), in both directions (a
-    path taken: the way it was driven), started `PREDICTION_OFFSET` off it (a drive's own path: where the robot started,
-    `DrivenTrack.start`); its lateral position's episodes
-    (`episodes.lateral_episodes`, the drives' judge) mark the samples the robot passes meanwhile; amplitude is the
-    largest weave held there and excursion the farthest it strays from its one-period average within half a period
-    (`episodes.lateral_extent`, m); both `LEAVES` where the run left the corridor.
+    """(oscillates, amplitude, excursion) of the loop driven at one speed V (`driven_loops` with one `DriveRequest`)."""
+    loop = driven_loops(route, arc, profile, [DriveRequest(V, stopped, pull, attraction, aim)], transition, period, taken, track)[0]
+    return loop.oscillates, loop.amplitude, loop.excursion
+
+
+def driven_loops(route, arc, profile, requests, transition: SampledTransition, period: float, taken,
+                 track: DrivenTrack | None = None) -> list:
+    """The sampled loop driven along the routes at each requested speed (`DrivenLoop` per `DriveRequest`), all speeds'
+    runs stepped together (one step of every run per period T).
+
+    The loop is driven along each route at V through the real lateral force across it (`maps.paths` module docstring,
+    "The loop driven along the route"), in both directions (a path taken: the way it was driven), started
+    `PREDICTION_OFFSET` off it (a drive's own path: where the robot started, `DrivenTrack.start`); its lateral
+    position's episodes (`episodes.lateral_episodes`, the drives' judge) mark the samples the robot passes meanwhile;
+    amplitude is the largest weave held there and excursion the farthest it strays from its one-period average within
+    half a period (`episodes.lateral_extent`, m); both `LEAVES` where the run left the corridor.
 
     ``x_{k+1} = M·x_k + n·sat(v_k)``, ``v_k = −F0·x_k − gk·g_k(y_k)`` (`SampledTransition`),
     g(y) = −atan2(F_n(y) − P − K·y, A ± F_r·t): the direction of the resultant the robot steers to (KB eq 4; the
     linear loop's N·y for small y) with the lateral force itself (interpolated in `profile` between its quarter
-    cells), P and A what the goal balances across the path and its attraction along it (`paths._goal_pull`), K the goal's
-    pull back to the path (`paths._aim_stiffness`), sat the steering-rate limit. `stopped` (per direction and sample): the
-    direction is not judged there (a wall ahead, `verdicts.END_FRACTION`): no lateral force. The run stops where it leaves the
-    profile or `LEAVES`.
+    cells), P and A what the goal balances across the path and its attraction along it, K the goal's pull back to
+    the path, sat the steering-rate limit (`DriveRequest`). The run stops where it leaves the profile or `LEAVES`.
 
     **A drive's own path** (a path taken whose aims are known, `track`) is driven as the robot drove it (`maps.paths`
     module docstring, "A drive's own path"): at the loop's own point q = p(s) + y·nrm(s) the force is the window sum there
@@ -209,16 +265,11 @@ def _driven(route, arc, stopped, profile, pull, attraction, aim, V: float, trans
     ----------
     route, arc : ndarray
         Route index and arc position (m) of each sample.
-    stopped : ndarray of bool, shape (2, samples)
-        Forward and reverse.
     profile : tuple
-        `paths.lateral_profile`'s (offsets, F_n, F_r·t).
-    pull, attraction : ndarray
-        The goal's pull across the path (P) and along it (A) per sample, F_ct units (0 and 1 on a route).
-    aim : ndarray
-        K per sample, F_ct/m (`paths._aim_stiffness`; 0 on a route).
-    V : float
-        Speed, m/s.
+        `decide.lateral_profile`'s (offsets, F_n, F_r·t), and optionally the free band across each sample
+        (`contact.free_band`, shape (samples, 2); without it the loop meets no obstacle).
+    requests : sequence of DriveRequest
+        The speeds.
     transition : SampledTransition
         The loop.
     period : float
@@ -228,100 +279,172 @@ def _driven(route, arc, stopped, profile, pull, attraction, aim, V: float, trans
     track : DrivenTrack, optional
         The drives' own paths' track (a path taken with its aims known is driven as the robot drove it).
     """
-    from .episodes import episodes, lateral_episodes, lateral_extent, swing
-
-    offsets, fn, ft = profile
     taken = np.broadcast_to(np.asarray(taken, dtype=bool), (int(route.max()) + 1 if route.size else 0,))  # per route
+    plan = _RunPlan.of(route, arc, requests, transition.T, taken, track)
+    loops = [DrivenLoop(np.zeros(arc.size, dtype=bool), np.zeros(arc.size, dtype=bool), np.zeros(arc.size), np.zeros(arc.size))
+             for _ in requests]
+    if plan is None:
+        return loops
+    lateral, track_at, ended, contact = _step_loops(plan, route, arc, profile, requests, transition, period, track)
+    _judge_runs(plan, lateral, track_at, ended, contact, transition.T, period, loops)
+    return loops
+
+
+@dataclass(frozen=True)
+class _RunPlan:
+    """The runs of `driven_loops`: each route at each requested speed, in each direction driven.
+
+    Attributes
+    ----------
+    rows : ndarray of int, shape (runs, steps)
+        The sample each run passes at each step (a drive's own path's: filled in as it goes, `_TrackWalk`).
+    length : ndarray of int
+        Steps of each run.
+    sign : ndarray
+        +1 along the route's order, −1 against it.
+    V : ndarray
+        Each run's speed, m/s.
+    request : ndarray of int
+        Each run's `DriveRequest`.
+    own : ndarray of int
+        The runs along a drive's own path.
+    """
+
+    rows: np.ndarray
+    length: np.ndarray
+    sign: np.ndarray
+    V: np.ndarray
+    request: np.ndarray
+    own: np.ndarray
+
+    @classmethod
+    def of(cls, route, arc, requests, T: float, taken, track) -> "_RunPlan | None":
+        """The runs (None: none long enough, 8 steps, to judge)."""
+        runs = []  # (samples passed at each step, sign of travel, a drive's own path, request)
+        for q, request in enumerate(requests):
+            step = request.V * T
+            for r in np.unique(route):
+                idx = np.flatnonzero(route == r)
+                if (request.routes is not None and not request.routes[r]) or idx.size < 2:
+                    continue
+                a = arc[idx]
+                positions = (np.arange(int((a[-1] + (a[1] - a[0]) / 2) / step)) + 0.5) * step
+                if positions.size < 8:
+                    continue
+                mine = bool(taken[r] and track is not None and np.isfinite(track.aims[:, idx]).all())
+                for d in ((0,) if taken[r] else (0, 1)):  # a path taken was driven one way, from its start
+                    pos = positions if d == 0 else positions[::-1]
+                    runs.append((idx[np.clip(np.searchsorted((a[:-1] + a[1:]) / 2, pos), 0, a.size - 1)], d, mine, q))
+        if not runs:
+            return None
+        own = np.flatnonzero([mine for _, _, mine, _ in runs])
+        length = np.array([n.size for n, _, _, _ in runs])
+        steps = int(max(length.max(), math.ceil(OWN_STEPS * length[own].max()) if own.size else 0))
+        length[own] = steps  # a drive's own path's loop runs until it has come to the path's end (`_TrackWalk`)
+        rows = np.zeros((len(runs), steps), dtype=int)
+        for i, (nearest, _, _, _) in enumerate(runs):
+            rows[i, :nearest.size] = nearest
+        request = np.array([q for _, _, _, q in runs])
+        V = np.array([requests[q].V for q in request], dtype=float)
+        return cls(rows, length, np.array([1.0 if d == 0 else -1.0 for _, d, _, _ in runs]), V, request, own)
+
+
+def _step_loops(plan: _RunPlan, route, arc, profile, requests, transition: SampledTransition, period: float, track) -> tuple:
+    """(lateral, track_at, ended, contact): every run stepped together (`driven_loops`): its lateral offset at each
+    step (m; nan after it stopped), a drive's own path's point (m) and direction (rad) at each step (shape (3, own
+    runs, steps)), the steps each run spent on its path, and the step at which its disc met an obstacle after its
+    first period P (the start's transient from its offset start; −1: never; the run stops there)."""
+    offsets, fn, ft = profile[:3]
+    band = profile[3] if len(profile) > 3 else np.tile([-np.inf, np.inf], (arc.size, 1))
     y_index = transition.lateral_index
     M, command, F0, gk, limit = transition.M, transition.command, transition.F0, transition.steering_gain, transition.rate_limit
-    step = V * transition.T
-    h = offsets[1] - offsets[0]
-    oscillates, amplitude, excursion = np.zeros(arc.size, dtype=bool), np.zeros(arc.size), np.zeros(arc.size)
-    centre = offsets.size // 2
-    runs = []  # (samples passed at each step, sign of travel, whether it is a drive's own path) of each route and direction
-    for r in np.unique(route):
-        idx = np.flatnonzero(route == r)
-        a = arc[idx]
-        if a.size < 2:
-            continue
-        positions = (np.arange(int((a[-1] + (a[1] - a[0]) / 2) / step)) + 0.5) * step
-        if positions.size < 8:
-            continue
-        for d in ((0,) if taken[r] else (0, 1)):  # a path taken was driven one way, from its start
-            pos = positions if d == 0 else positions[::-1]
-            nearest = idx[np.clip(np.searchsorted((a[:-1] + a[1:]) / 2, pos), 0, a.size - 1)]
-            runs.append((nearest, d, taken[r] and track is not None and bool(np.isfinite(track.aims[:, idx]).all())))
-    if not runs:
-        return oscillates, amplitude, excursion
-    own = np.flatnonzero([mine for _, _, mine in runs])
-    length = np.array([n.size for n, _, _ in runs])
-    steps = int(max(length.max(), math.ceil(OWN_STEPS * length[own].max()) if own.size else 0))
-    length[own] = steps  # a drive's own path's loop runs until it has come to the path's end (`_TrackWalk`)
-    rows = np.zeros((len(runs), steps), dtype=int)
-    sign = np.array([1.0 if d == 0 else -1.0 for _, d, _ in runs])
-    for i, (nearest, _, _) in enumerate(runs):
-        rows[i, :nearest.size] = nearest
-    walk = _TrackWalk(track, route, arc, [runs[i][0][0] for i in own], step) if own.size else None
-    track_at = np.full((3, len(runs), steps), np.nan)  # a drive's own path's point (m) and direction (rad) at each step
-    state = np.zeros((len(runs), M.shape[0]))
+    runs, steps = plan.rows.shape
+    own, V, sign = plan.own, plan.V, plan.sign
+    h, centre, samples = offsets[1] - offsets[0], offsets.size // 2, arc.size
+    pull, attraction, aim = (np.concatenate([getattr(r, f) for r in requests]) for f in ("pull", "attraction", "aim"))
+    stopped = np.concatenate([r.stopped[:, None, :] for r in requests], axis=1)  # (direction, request, sample)
+    base, direction = plan.request * samples, (sign < 0).astype(int)
+    walk = _TrackWalk(track, route, arc, [plan.rows[i, 0] for i in own], V[own] * transition.T) if own.size else None
+    track_at = np.full((3, own.size, steps), np.nan)
+    state = np.zeros((runs, M.shape[0]))
     state[:, y_index] = sign * PREDICTION_OFFSET / V  # to the left of the travel direction (the state is x/V, s)
-    for i in own:  # a drive's own path: from where the robot started, its offset and heading off the path
-        y0, theta0 = track.start[:, route[runs[i][0][0]]]
+    for n, i in enumerate(own):  # a drive's own path: from where the robot started, its offset and heading off the path
+        y0, theta0 = track.start[:, route[plan.rows[i, 0]]]
         if np.isfinite(y0):
-            state[i, y_index], state[i, y_index - 1] = y0 / V, theta0
-    lateral = np.full((len(runs), steps), np.nan)
-    alive = np.ones(len(runs), dtype=bool)
+            state[i, y_index], state[i, y_index - 1] = y0 / V[i], theta0
+    lateral = np.full((runs, steps), np.nan)
+    alive = np.ones(runs, dtype=bool)
+    contact = np.full(runs, -1)
+    transient = int(round(period / transition.T))  # the start's transient (the drives' judge leaves it out too)
+    rows = plan.rows
     with np.errstate(invalid="ignore"):
         for k in range(steps):
-            alive &= k < length
-            turn = np.zeros(len(runs))
+            alive &= k < plan.length
+            turn = np.zeros(runs)
             if own.size:  # a drive's own path: where the loop has got to along it (its own progress, `_TrackWalk`)
                 alive[own] &= walk.going(k)
                 rows[own, k] = walk.rows()
             row = rows[:, k]
+            at = base + row
+            judged = k >= transient
             yk = V * state[:, y_index]  # m
             u = (yk - offsets[0]) / h
-            i0 = np.clip(np.floor(u).astype(int), 0, offsets.size - 2)
+            i0 = np.minimum(np.maximum(np.floor(u).astype(int), 0), offsets.size - 2)  # np.clip's overhead is a step's
             frac = u - i0
             f = fn[row, i0] * (1 - frac) + fn[row, i0 + 1] * frac
-            g = -np.arctan2(f - pull[row] - aim[row] * yk, attraction[row] + sign * ft[row, centre])  # KB eq 4, ~ N·y
+            g = -np.arctan2(f - pull[at] - aim[at] * yk, attraction[at] + sign * ft[row, centre])  # KB eq 4, ~ N·y
             if own.size:
                 point = walk.here()
-                track_at[:, own, k] = point[:3]
+                track_at[:, :, k] = point[:3]
                 g[own] = _steered(track, point, yk[own])
-            g = np.where(stopped[(sign < 0).astype(int), row], 0.0, g)
+            g = np.where(stopped[direction, plan.request, row], 0.0, g)
             inside = (u >= 0) & (u <= offsets.size - 1) & (np.abs(yk) <= LEAVES) & np.isfinite(g)
-            alive &= inside & np.isfinite(state).all(axis=1)
+            touching = alive & judged & ((yk <= band[row, 0]) | (yk >= band[row, 1]))  # the disc meets an obstacle: it stops
+            contact[touching] = k
+            alive &= inside & ~touching & np.isfinite(state).all(axis=1)
             lateral[alive, k] = yk[alive]
             if own.size:
                 turn[own] = walk.advance(state[own, y_index - 1], yk[own])
-            v = np.clip(-(state @ F0) - gk * np.where(alive, g, 0.0), -limit, limit)  # the command, rate-limited
+            v = np.minimum(np.maximum(-(state @ F0) - gk * np.where(alive, g, 0.0), -limit), limit)  # the command, rate-limited
             state = state @ M.T + v[:, None] * command[None, :] - turn[:, None] * transition.turn[None, :]
             state[~alive] = 0.0
-    t = np.arange(steps) * transition.T
-    ended = np.array(length)
+    ended = np.array(plan.length)
     if own.size:
         ended[own] = walk.ended_at(steps)
-    for i, (_, _, mine) in enumerate(runs):
+    return lateral, track_at, ended, contact
+
+
+def _judge_runs(plan: _RunPlan, lateral, track_at, ended, contact, T: float, period: float, loops: list) -> None:
+    """Each run's episodes, collision course (the samples passed within one period before its disc met an obstacle),
+    weave and excursion marked on the samples it passed, in its request's `DrivenLoop` (`driven_loops`; a drive's own
+    path's judged on its track in the plane)."""
+    from .episodes import episodes, lateral_episodes, lateral_extent, swing
+
+    t = np.arange(plan.rows.shape[1]) * T
+    mine = {i: n for n, i in enumerate(plan.own)}
+    for i in range(plan.rows.shape[0]):
         m = int(ended[i])
-        nearest = rows[i, :m]
+        nearest = plan.rows[i, :m]
         ok = np.isfinite(lateral[i, :m])
         tk, yk = t[:m][ok], lateral[i, :m][ok]
         swung, strays = lateral_extent(tk, yk, period)
-        if mine:  # the drives' own judge on the loop's track in the plane
-            x0, y0, phi = track_at[:, i, :m][:, ok]
+        if i in mine:  # the drives' own judge on the loop's track in the plane
+            x0, y0, phi = track_at[:, mine[i], :m][:, ok]
             px, py = x0 - np.sin(phi) * yk, y0 + np.cos(phi) * yk
             found, _ = episodes(tk, px, py, period)
             swung = swing(tk, px, py, period)
         else:
-            found, _ = lateral_episodes(tk, sign[i] * yk, period)
+            found, _ = lateral_episodes(tk, plan.sign[i] * yk, period)
+        loop = loops[plan.request[i]]
         for lo, hi in found:
-            oscillates[nearest[(t[:m] >= lo) & (t[:m] <= hi)]] = True
-        np.maximum.at(amplitude, nearest[ok], swung)
-        np.maximum.at(excursion, nearest[ok], strays)
-        amplitude[nearest[~ok]] = np.maximum(amplitude[nearest[~ok]], LEAVES)  # it left the corridor: at least that
-        excursion[nearest[~ok]] = LEAVES
-    return oscillates, amplitude, excursion
+            loop.oscillates[nearest[(t[:m] >= lo) & (t[:m] <= hi)]] = True
+        if contact[i] >= 0:
+            hit = int(contact[i])
+            loop.collides[plan.rows[i, max(0, hit - int(round(period / T))):hit + 1]] = True
+        np.maximum.at(loop.amplitude, nearest[ok], swung)
+        np.maximum.at(loop.excursion, nearest[ok], strays)
+        loop.amplitude[nearest[~ok]] = np.maximum(loop.amplitude[nearest[~ok]], LEAVES)  # it left the corridor: at least that
+        loop.excursion[nearest[~ok]] = LEAVES
 
 
 OWN_STEPS = 1.5
@@ -341,8 +464,8 @@ class _TrackWalk:
         Route index and arc position (m) of each sample.
     first : sequence of int
         Per loop, a sample of its path.
-    step : float
-        V·T, m.
+    step : float or ndarray
+        V·T per loop, m.
     """
 
     GAP = 1.0

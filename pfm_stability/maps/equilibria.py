@@ -334,11 +334,12 @@ def equilibria_at(grid: HistogramMap, law: GridWallLaw, x, y, tx, ty, segment, c
     # to the jump, to the bracket / 2^NEWTON_STEPS
     sign = np.where(sign_lo[chosen] < 0, 1.0, -1.0)
 
-    def increasing(at):
-        f, _, df = lateral_force(grid, law, x[k], y[k], tx[k], ty[k], at, jacobian=True)
-        return sign * f, sign * df
+    def increasing(at, index):  # the roots still moving alone (a window sum per point is the costly part)
+        kk = k[index]
+        f, _, df = lateral_force(grid, law, x[kk], y[kk], tx[kk], ty[kk], at, jacobian=True)
+        return sign[index] * f, sign[index] * df
 
-    s0 = newton_increasing(increasing, lo, hi, atol=ROOT_TOLERANCE, iterations=newton_steps)
+    s0 = newton_increasing(increasing, lo, hi, atol=ROOT_TOLERANCE, iterations=newton_steps, moving=True)
     f, ft, df = lateral_force(grid, law, x[k], y[k], tx[k], ty[k], s0, jacobian=True)
     forward = 1.0 - np.abs(ft)
     offset, N, F_t, along = (np.full(x.size, np.nan) for _ in range(4))

@@ -113,7 +113,8 @@ class PathStretch:
         "stable", "unstable", or a reason of `UNJUDGED`.
     cause : str or None
         Why it is unstable (`CAUSES`): "growth" (the linear loop), "forced weave" (the field's ripple drives a weave),
-        "relay" (the window's edge); None when stable. ("collision course" is reserved in `CAUSES`, not assigned yet.)
+        "relay" (the window's edge), "collision course" (the driven loop meets an obstacle without a weave first);
+        None when stable.
     growth_rate : float or None
         σ̄_w of the worst window at V, 1/s: the linear loop's (a forced weave or a relay weaves with it negative).
     efolds : float or None

@@ -33,7 +33,7 @@ import math
 
 import numpy as np
 
-from .decide import WINDOW_PERIODS, decide
+from .decide import WINDOW_PERIODS, SpeedQuery, decide_speeds
 from .verdicts import wavelength
 
 __all__ = ["BISECT_STEPS", "CENTRES_PER_WINDOW", "HEADROOM_GROWTH", "HEADROOM_MAX", "HEADROOM_RTOL", "SPEED_STEP", "SPEED_STEPS", "stretch_speeds"]
@@ -82,23 +82,21 @@ def stretch_speeds(geometry, rule, V: float, at, runs) -> list:
 
 
 def _slower(geometry, rule, V: float, runs: list) -> list:
-    """Each unstable run's V*: the first rung of the ladder below V where none of its samples is unstable, then
-    `BISECT_STEPS` halvings of the step above it (module docstring)."""
+    """Each unstable run's V*: the fastest rung of the ladder below V where none of its samples is unstable, then
+    `BISECT_STEPS` halvings of the step above it (module docstring). Every rung is decided at once (`_Calm.at`: the
+    loop driven at all of them in one run), for every run: a run calm at a rung is not decided again below it in
+    effect, as its fastest calm rung is kept."""
     if not runs:
         return []
     calm = _Calm(geometry, rule, runs, drive=True)
-    found = [None] * len(runs)
-    for k in range(1, SPEED_STEPS + 1):
-        pending = [i for i in range(len(runs)) if found[i] is None]
-        if not pending:
-            break
-        for i, quiet in zip(pending, calm(V * (1.0 - k * SPEED_STEP), pending)):
-            if quiet:
-                found[i] = V * (1.0 - k * SPEED_STEP)
+    everyone = list(range(len(runs)))
+    rungs = [V * (1.0 - k * SPEED_STEP) for k in range(1, SPEED_STEPS + 1)]
+    quiet = calm.at([(v, everyone) for v in rungs])
+    found = [next((v for v, q in zip(rungs, quiet) if q[i]), None) for i in everyone]
     brackets = {i: (f, f + V * SPEED_STEP) for i, f in enumerate(found) if f is not None}  # (calm, unstable)
     for _ in range(BISECT_STEPS):
         brackets = _halve(calm, brackets)
-    return [brackets[i][0] if i in brackets else 0.0 for i in range(len(runs))]
+    return [brackets[i][0] if i in brackets else 0.0 for i in everyone]
 
 
 def _faster(geometry, rule, V: float, runs: list) -> list:
@@ -112,7 +110,7 @@ def _faster(geometry, rule, V: float, runs: list) -> list:
     while v < HEADROOM_MAX * V and len(brackets) < len(runs):
         pending = [i for i in range(len(runs)) if i not in brackets]
         faster = v * HEADROOM_GROWTH
-        for i, quiet in zip(pending, calm(faster, pending)):
+        for i, quiet in zip(pending, calm.at([(faster, pending)])[0]):
             if not quiet:
                 brackets[i] = (v, faster)
         v = faster
@@ -122,39 +120,52 @@ def _faster(geometry, rule, V: float, runs: list) -> list:
 
 
 def _halve(calm, brackets: dict) -> dict:
-    """Each run's bracket (calm speed, unstable speed) halved: the runs sharing a bracket are decided together."""
+    """Each run's bracket (calm speed, unstable speed) halved: every bracket's middle decided at once, the runs
+    sharing a bracket together."""
+    shared = sorted(set(brackets.values()))
+    chosen = [[i for i, b in brackets.items() if b == bracket] for bracket in shared]
+    middles = [0.5 * (lo + hi) for lo, hi in shared]
     out = dict(brackets)
-    for bracket in sorted(set(brackets.values())):
-        chosen = [i for i, b in brackets.items() if b == bracket]
-        mid = 0.5 * (bracket[0] + bracket[1])
-        for i, quiet in zip(chosen, calm(mid, chosen)):
-            out[i] = (mid, bracket[1]) if quiet else (bracket[0], mid)
+    for (lo, hi), mid, runs, quiet in zip(shared, middles, chosen, calm.at(list(zip(middles, chosen)))):
+        for i, q in zip(runs, quiet):
+            out[i] = (mid, hi) if q else (lo, mid)
     return out
 
 
 class _Calm:
-    """Whether runs have no unstable sample at a speed: `decide.decide` on their own routes alone (each set of routes'
-    geometry cut once, `RouteGeometry.subset`), deciding only their samples."""
+    """Whether runs have no unstable sample at speeds: `decide.decide_speeds` on their own routes alone (each set of
+    routes' geometry cut once, `RouteGeometry.subset`), deciding only their samples, every speed asked at once."""
 
     def __init__(self, geometry, rule, runs: list, drive: bool):
         self.geometry, self.rule, self.runs, self.drive = geometry, rule, runs, drive
         self._parts = {}
 
-    def __call__(self, v: float, chosen: list) -> list:
-        """Per run of `chosen` (indices into the runs): calm at v (m/s)."""
-        routes = tuple(sorted({self.runs[i].route for i in chosen}))
+    def at(self, asked: list) -> list:
+        """Per (v, chosen) of `asked` (m/s; indices into the runs), per run of chosen: calm at v."""
+        routes = tuple(sorted({self.runs[i].route for _, chosen in asked for i in chosen}))
         if routes not in self._parts:
             keep = np.isin(self.geometry.route, routes)
             self._parts[routes] = (self.geometry.subset(keep, self.rule.grid, self.rule.law), np.cumsum(keep) - 1)
         part, where = self._parts[routes]
-        members = [where[self.runs[i].samples] for i in chosen]
+        queries, members = [], []
+        for v, chosen in asked:
+            mine = [where[self.runs[i].samples] for i in chosen]
+            driven = np.zeros(len(self.geometry.paths), dtype=bool)
+            driven[[self.runs[i].route for i in chosen]] = True
+            queries.append(SpeedQuery(v, self._centres(part, where, v, chosen, mine), driven))
+            members.append(mine)
+        decisions = decide_speeds(part, self.rule, queries, self.drive)
+        return [[not (d.code[m] == 1).any() for m in mine] for d, mine in zip(decisions, members)]
+
+    def _centres(self, part, where: np.ndarray, v: float, chosen: list, members: list) -> np.ndarray:
+        """The samples whose windows are multiplied out at v: every `CENTRES_PER_WINDOW`-th of a window of each run,
+        its ends and its worst window (`where`: a sample's index in `part`)."""
         omega = self.rule.boundary.omega_critical
         centres = np.zeros(part.x.size, dtype=bool)
-        for i, m in zip(chosen, members):  # every `CENTRES_PER_WINDOW`-th of a window, the ends and the worst window
+        for i, m in zip(chosen, members):
             ds = float(np.median(part.ds[m]))
             stride = max(1, int(WINDOW_PERIODS * wavelength(v, omega) / CENTRES_PER_WINDOW / ds)) if omega and omega > 0 else 1
             centres[m[::stride]] = centres[m[-1]] = True
             if self.runs[i].worst is not None:
                 centres[where[self.runs[i].worst]] = True
-        code = decide(part, self.rule, v, centres, self.drive).code
-        return [not (code[m] == 1).any() for m in members]
+        return centres

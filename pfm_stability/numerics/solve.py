@@ -99,7 +99,7 @@ def expand_bracket(func, start: float, *, factor: float = 2.0, steps: int = 200,
     return None
 
 
-def newton_increasing(func, lo, hi, *, rtol: float = 4e-16, atol: float = 0.0, iterations: int = 200):
+def newton_increasing(func, lo, hi, *, rtol: float = 4e-16, atol: float = 0.0, iterations: int = 200, moving: bool = False):
     """Roots of strictly increasing functions, one per bracket, for arrays of brackets at once.
 
     Safeguarded Newton (Numerical Recipes' ``rtsafe``): a Newton step that
@@ -119,6 +119,10 @@ def newton_increasing(func, lo, hi, *, rtol: float = 4e-16, atol: float = 0.0, i
         at or near 0, where rtol·|x| is below f's round-off.
     iterations : int
         At most this many steps.
+    moving : bool
+        Call ``func(x, index)`` with the roots still moving alone (1-D brackets; `index` into them): a converged
+        root stays where it is (its step is 0 and its f the same), so it is not evaluated again — the same roots,
+        for an expensive `func`.
 
     Returns
     -------
@@ -129,19 +133,26 @@ def newton_increasing(func, lo, hi, *, rtol: float = 4e-16, atol: float = 0.0, i
     hi = np.array(hi, dtype=float)
     x = 0.5 * (lo + hi)
     previous = hi - lo
+    index = np.arange(x.size)
     for _ in range(iterations):
-        f, slope = func(x)
-        lo = np.where(f < 0, x, lo)
-        hi = np.where(f > 0, x, hi)
+        f, slope = func(x[index], index) if moving else func(x)
+        xi, lo_i, hi_i = (x[index], lo[index], hi[index]) if moving else (x, lo, hi)
+        lo_i = np.where(f < 0, xi, lo_i)
+        hi_i = np.where(f > 0, xi, hi_i)
         with np.errstate(divide="ignore", invalid="ignore"):
             correction = f / slope
-        newton = x - correction
-        converged = (f == 0) | (np.abs(correction) <= rtol * np.abs(x) + atol)
-        good = np.isfinite(newton) & (newton > lo) & (newton < hi) & (np.abs(correction) < 0.5 * previous)
-        step_to = np.where(converged, x, np.where(good, newton, 0.5 * (lo + hi)))
-        previous = np.abs(step_to - x)
-        x = step_to
-        if np.all(converged | (hi - lo <= rtol * np.abs(x) + atol)):
+        newton = xi - correction
+        converged = (f == 0) | (np.abs(correction) <= rtol * np.abs(xi) + atol)
+        good = np.isfinite(newton) & (newton > lo_i) & (newton < hi_i) & (np.abs(correction) < 0.5 * previous)
+        step_to = np.where(converged, xi, np.where(good, newton, 0.5 * (lo_i + hi_i)))
+        previous = np.abs(step_to - xi)
+        done = np.all(converged | (hi_i - lo_i <= rtol * np.abs(step_to) + atol))
+        if moving:
+            x[index], lo[index], hi[index] = step_to, lo_i, hi_i
+            index, previous = index[~converged], previous[~converged]
+        else:
+            x, lo, hi = step_to, lo_i, hi_i
+        if done:
             break
     return x
 
