@@ -66,8 +66,11 @@ def test_the_aliases_are_the_tables_fields():
 
 def test_every_field_is_documented_with_its_justification():
     """Every field is in the class docstring's Attributes, with its type, a unit (m, periods, e-folds, or
-    dimensionless) and where its value comes from (a definition, a measurement, a chosen or physical scale)."""
+    dimensionless) and where its value comes from (a definition, a measurement, a chosen or physical scale); and it
+    has a row of docs/judge.md's table."""
     from numpydoc.docscrape import NumpyDocString
+
+    table = (Path(__file__).resolve().parents[1] / "docs" / "judge.md").read_text()
 
     documented = {p.name: (p.type, " ".join(p.desc)) for p in NumpyDocString(inspect.getdoc(JudgeThresholds))["Attributes"]}
     units = ("m,", "m.", "m)", ", m", "periods", "dimensionless", "e-folds", "Turning points")
@@ -77,6 +80,7 @@ def test_every_field_is_documented_with_its_justification():
         text = documented[f.name][1]
         assert any(unit in text for unit in units), f"{f.name}: no unit"
         assert any(kind in text for kind in kinds), f"{f.name}: no justification"
+        assert f"\n| `{f.name}` |" in table, f"docs/judge.md's table has no row for {f.name}"
 
 
 def test_the_table_refuses_nonsense():

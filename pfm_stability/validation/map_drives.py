@@ -12,7 +12,9 @@ drive runs until its target is reached, it collides or stalls, or `DRIVE_TIME_FA
 
 **Episodes** (`maps.episodes.episodes`, the one definition the map's prediction uses too): the robot's
 lateral oscillation about its own path averaged over one period P = 2π/ω*; an episode is three periods of it
-that grow by an e-fold or stay above `AMPLITUDE_THRESHOLD`.
+that grow by an e-fold or stay above `AMPLITUDE_THRESHOLD`. Every threshold of the judge and of the scoring below
+is a field of `maps.judge_thresholds.JudgeThresholds` (docs/judge.md: justifications, measured sensitivity);
+`drive_map` is `judge_drives` (any table, ``thresholds=JUDGE``) of `simulate_drives` (the drives, simulated once).
 
 **Each drive is judged along the path it took** (its positions averaged over one period, `maps.analysis.judge_routes`
 with ``taken``: the prediction the map makes along any route — the loop driven through the force across the path,
