@@ -12,7 +12,9 @@ drive runs until its target is reached, it collides or stalls, or `DRIVE_TIME_FA
 
 **Episodes** (`maps.episodes.episodes`, the one definition the map's prediction uses too): the robot's
 lateral oscillation about its own path averaged over one period P = 2π/ω*; an episode is three periods of it
-that grow by an e-fold or stay above `AMPLITUDE_THRESHOLD`.
+that grow by an e-fold or stay above `AMPLITUDE_THRESHOLD`. Every threshold of the judge and of the scoring below
+is a field of `maps.judge_thresholds.JudgeThresholds` (docs/judge.md: justifications, measured sensitivity);
+`drive_map` is `judge_drives` (any table, ``thresholds=JUDGE``) of `simulate_drives` (the drives, simulated once).
 
 **Each drive is judged along the path it took** (its positions averaged over one period, `maps.analysis.judge_routes`
 with ``taken``: the prediction the map makes along any route — the loop driven through the force across the path,
@@ -45,26 +47,30 @@ unstable, driven, no episode). Route length never driven, and drives that stalle
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
 from ..checks import check_integer
-from ..io.serialize import json_number, json_ready
+from ..io.serialize import json_number
 from ..sim.engine import run_batch
 from ..sim.scenario import Pose, Scenario, Target
-from ..maps.episodes import AMPLITUDE_THRESHOLD, EPISODE_PERIODS, GROWTH_EFOLDS, NOISE_FLOOR, episodes, swing
+from ..maps.episodes import episodes, swing
+from ..maps.judge_thresholds import JUDGE, JudgeThresholds
 from ..maps.planner import SkeletonPlanner
 from ..maps.routes import polyline_arcs
+from .map_drive_results import Disagreement, Drive, DriveRuns, DriveValidation, SimulatedDrive, WobbleAgreement, wobble_agreement
 from .maps import START_OFFSET, _batches, _table_size, crop_grid, simulator_grid, stall_time
 
-__all__ = ["DRIVE_TIME_FACTOR", "MATCH_DISTANCE", "WOBBLE_FACTOR", "Disagreement", "Drive", "DriveValidation", "WobbleAgreement",
-           "drive_map", "goal_routes"]
+__all__ = ["DRIVE_TIME_FACTOR", "MATCH_DISTANCE", "WOBBLE_FACTOR", "Disagreement", "Drive", "DriveRuns", "DriveValidation",
+           "SimulatedDrive", "WobbleAgreement", "drive_map", "goal_routes", "judge_drives", "simulate_drives", "wobble_agreement"]
 
-MATCH_DISTANCE = 0.5
-"""Largest distance (m) from a trajectory point to the route sample it marks (at least the robot's width W)."""
+MATCH_DISTANCE = JUDGE.match_distance
+"""Largest distance (m) from a trajectory point to the route sample it marks (at least the robot's width W):
+`JudgeThresholds.match_distance` of `JUDGE` (docs/judge.md)."""
 DRIVE_TIME_FACTOR = 2.5
 """A drive lasts at most this many times its length's time (the plan's, or the straight line's), plus 5 s."""
 START_ROOM = 1e-3
@@ -79,234 +85,9 @@ FIGURES = {"recall": ("episode_recalled", "episode"), "precision": ("predicted_u
 """Each figure of the validation: the (part, whole) of `_score`'s lengths whose ratio it is (module docstring)."""
 CROP_SLACK = 3.0
 """How far (m) around a drive's straight line its cropped grid reaches beyond the window."""
-WOBBLE_FACTOR = 2.0
+WOBBLE_FACTOR = JUDGE.wobble_factor
 """A predicted weave agrees in size with the simulated one when their ratio lies within 1/this .. this
-(`WobbleAgreement`)."""
-
-
-@dataclass(frozen=True)
-class Drive:
-    """One simulated drive.
-
-    Attributes
-    ----------
-    index : int
-    kind : str
-        "route" (along a route piece, target at infinity) or "waypoints" (point to point).
-    x0, y0, x1, y1 : float
-        Start and goal (or the piece's end), m.
-    event : str or None
-        What ended it ("target_reached", "collision", "trapped"; None: its time ran out).
-    duration : float
-        s.
-    episodes : tuple of tuple
-        (t_start, t_end) of each oscillation episode, s.
-    max_amplitude : float
-        Largest lateral oscillation amplitude, m.
-    """
-
-    index: int
-    kind: str
-    x0: float
-    y0: float
-    x1: float
-    y1: float
-    event: str | None
-    duration: float
-    episodes: tuple = ()
-    max_amplitude: float = 0.0
-
-    def to_dict(self) -> dict:
-        """JSON form."""
-        return json_ready({**self.__dict__, "episodes": [list(e) for e in self.episodes]})
-
-
-@dataclass(frozen=True)
-class Disagreement:
-    """A stretch of route where the map's verdict and the drives disagree.
-
-    Attributes
-    ----------
-    kind : str
-        "missed" (an episode where stable was predicted) or "false alarm" (predicted unstable, driven, no episode).
-    route : int
-    start, stop, length : float
-        Arc positions along the route and length, m.
-    x0, y0, x1, y1 : float
-        Its ends, m.
-    drives : tuple of int
-        The drives that passed it.
-    predicted_amplitude : float
-        The largest lateral oscillation of the loop driven along it held for at least one period (`maps.paths`,
-        `maps.episodes.lateral_extent`), m.
-    simulated_amplitude : float
-        The same of the drives there (`maps.episodes.swing`: three alternating turning points about their paths
-        averaged over a period, as the episodes' judge finds them; a bend is none), m. Above `AMPLITUDE_THRESHOLD`
-        on a false alarm: the robot did weave past it, for one period or more but fewer than `EPISODE_PERIODS`; on a
-        missed episode, the predicted amplitude above it is the loop's weave that did not last.
-    """
-
-    kind: str
-    route: int
-    start: float
-    stop: float
-    length: float
-    x0: float
-    y0: float
-    x1: float
-    y1: float
-    drives: tuple = ()
-    predicted_amplitude: float = 0.0
-    simulated_amplitude: float = 0.0
-
-    def to_dict(self) -> dict:
-        """JSON form."""
-        return json_ready({**self.__dict__, "drives": list(self.drives)})
-
-
-@dataclass(frozen=True)
-class WobbleAgreement:
-    """How big the predicted weave is against the simulated one, along the measured part of the drives' own paths
-    (`wobble_agreement`): where either the prediction's loop or the drive wove past `AMPLITUDE_THRESHOLD` for at
-    least one period, the ratio of the two weaves held there (`DriveValidation`'s per-sample amplitudes:
-    `maps.episodes.lateral_extent`'s swing of the loop, `maps.episodes.swing` of the drive; 0 where one held none).
-    Recall and precision judge each side against the threshold; this says how far apart the two are in size, which
-    is what decides them near it.
-
-    Attributes
-    ----------
-    length : float
-        Measured length where either side wove past the threshold, m (the loop still in the corridor: where it left,
-        its size is only "at least `maps.driven.LEAVES`", and the length is counted as ``left`` instead).
-    within : float or None
-        Share of `length` where predicted / simulated lies within 1/`WOBBLE_FACTOR` .. `WOBBLE_FACTOR` (None: no
-        length).
-    ratio_quartiles : tuple of float or None
-        The 25th, 50th and 75th percentiles of predicted / simulated by length (a value of the samples, not
-        interpolated; 0 where the loop held no weave, inf where the drive held none).
-    left : float
-        Measured length where the prediction's loop left the corridor, m.
-    """
-
-    length: float
-    within: float | None
-    ratio_quartiles: tuple | None
-    left: float
-
-    def to_dict(self) -> dict:
-        """JSON form."""
-        return {"length": json_number(self.length), "within": json_number(self.within), "factor": WOBBLE_FACTOR,
-                "ratio_quartiles": None if self.ratio_quartiles is None else [json_number(v) for v in self.ratio_quartiles],
-                "left": json_number(self.left)}
-
-
-def wobble_agreement(predicted, simulated, spacing, leaves: float) -> WobbleAgreement:
-    """`WobbleAgreement` of measured samples.
-
-    Parameters
-    ----------
-    predicted, simulated : ndarray
-        The weave held at each sample by the prediction's loop and by the drive, m (>= 0).
-    spacing : ndarray
-        The samples' lengths, m.
-    leaves : float
-        A predicted weave this large or larger means the loop left the corridor, m.
-    """
-    predicted, simulated, spacing = (np.asarray(v, dtype=float) for v in (predicted, simulated, spacing))
-    left = predicted >= leaves
-    either = ~left & (np.maximum(predicted, simulated) >= AMPLITUDE_THRESHOLD)
-    length = float(spacing[either].sum())
-    if not length > 0:
-        return WobbleAgreement(0.0, None, None, float(spacing[left].sum()))
-    ratio = np.divide(predicted[either], simulated[either], out=np.full(int(either.sum()), np.inf), where=simulated[either] > 0)
-    weight = spacing[either]
-    within = float(weight[(ratio >= 1 / WOBBLE_FACTOR) & (ratio <= WOBBLE_FACTOR)].sum()) / length
-    order = np.argsort(ratio, kind="stable")
-    cumulative = np.cumsum(weight[order]) / length
-    quartiles = tuple(float(ratio[order][min(np.searchsorted(cumulative, q - 1e-12), ratio.size - 1)]) for q in (0.25, 0.5, 0.75))
-    return WobbleAgreement(length, within, quartiles, float(spacing[left].sum()))
-
-
-@dataclass(frozen=True)
-class DriveValidation:
-    """Recall and precision of the map's unstable stretches against the drives' episodes, by route length.
-
-    Attributes
-    ----------
-    recall, precision : float or None
-        By route length (None: nothing to measure).
-    drives : tuple of Drive
-    disagreements : tuple of Disagreement
-    lengths : dict
-        Length (m): of the map's routes ``route``, ``driven`` (covered by a drive), ``not_driven``; of the drives' own
-        paths ``drive_paths``, ``drive_paths_driven`` (measured), ``drive_paths_unmeasured`` (passed only in a drive's
-        last three periods); ``episode``, ``episode_recalled``, ``episode_off_route`` (the drives' path length in
-        episodes farther than the match distance from their own path: measured, not scored),
-        ``predicted_unstable_driven``, ``predicted_unstable_matched``, ``predicted_unstable_unmeasured``,
-        ``predicted_unstable_not_driven`` (on the map's routes, no drive near); of the disagreements,
-        ``false_alarm_swinging`` (false alarms where a drive wove past `AMPLITUDE_THRESHOLD` for at least one period,
-        not three) and ``missed_predicted_swinging`` (missed episodes where the loop wove past it, not for three).
-    counts : dict
-        Drives by how they ended, episodes found.
-    inputs : dict
-    seconds : float
-    episode_points : ndarray, shape (n, 2)
-        Robot positions during the episodes, m (for the picture).
-    by_kind : dict
-        ``route`` and ``waypoints``: the same recall, precision, specificity and lengths over that kind of drive only.
-    drive_paths : PathVerdicts or None
-        The verdicts along the paths the drives took (`maps.analysis.judge_routes`): the drives are scored
-        against them (a disagreement's ``route`` >= the map's route count is drive path ``route`` − that count).
-    recall_interval, precision_interval : tuple of float or None
-        95 % intervals of recall and precision over the choice of drives (`_interval`: the drives resampled with
-        replacement, `INTERVAL_RESAMPLES` times, seeded); None where the figure is None.
-    specificity : float or None
-        Of the length driven with a verdict and no episode within half a window (``lengths["quiet_driven"]``), the
-        share predicted stable (``quiet_predicted_stable``); None when every such metre was near an episode. Where no
-        drive oscillates, recall is undefined and precision rests on the few metres predicted unstable; this says how
-        much of the calm driving the map also called calm.
-    specificity_interval : tuple of float or None
-        Its 95 % interval over the drives.
-    wobble : WobbleAgreement or None
-        How big the predicted weave is against the simulated one where either passed the threshold.
-    """
-
-    recall: float | None
-    precision: float | None
-    drives: tuple
-    disagreements: tuple
-    lengths: dict
-    counts: dict
-    inputs: dict = field(default_factory=dict)
-    seconds: float = 0.0
-    episode_points: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))
-    by_kind: dict = field(default_factory=dict)
-    drive_paths: object = None
-    recall_interval: tuple | None = None
-    precision_interval: tuple | None = None
-    specificity: float | None = None
-    specificity_interval: tuple | None = None
-    wobble: WobbleAgreement | None = None
-
-    def to_dict(self) -> dict:
-        """JSON form."""
-        return {
-            "wobble": self.wobble.to_dict() if self.wobble is not None else None,
-            "drive_paths": self.drive_paths.to_dict() if self.drive_paths is not None else None,
-            "recall": json_number(self.recall) if self.recall is not None else None,
-            "precision": json_number(self.precision) if self.precision is not None else None,
-            "recall_interval": json_ready(self.recall_interval),
-            "precision_interval": json_ready(self.precision_interval),
-            "specificity": json_number(self.specificity) if self.specificity is not None else None,
-            "specificity_interval": json_ready(self.specificity_interval),
-            "by_kind": json_ready(self.by_kind),
-            "lengths": json_ready(self.lengths),
-            "counts": json_ready(self.counts),
-            "disagreements": [d.to_dict() for d in self.disagreements],
-            "drives": [d.to_dict() for d in self.drives],
-            "inputs": json_ready(self.inputs),
-            "timing": {"seconds": json_number(self.seconds)},
-        }
+(`WobbleAgreement`): `JudgeThresholds.wobble_factor` of `JUDGE`."""
 
 
 def _components(analysis):
@@ -363,8 +144,29 @@ def _planned(planner, p, q) -> tuple | None:
     return path, math.atan2(ahead[0] - path[0, 0], ahead[1] - path[0, 1]), float(arc[-1])
 
 
-def drive_map(analysis, count: int, *, seed: int = 0, progress=None) -> DriveValidation:
-    """Drive the VFF robot `count` times over a map and score the map's unstable stretches (module docstring).
+def drive_map(analysis, count: int, *, seed: int = 0, progress=None, thresholds: JudgeThresholds = JUDGE) -> DriveValidation:
+    """Drive the VFF robot `count` times over a map and score the map's unstable stretches (module docstring):
+    `judge_drives` of `simulate_drives`.
+
+    Parameters
+    ----------
+    analysis : MapAnalysis
+        A grid-law analysis with its routes' verdicts (`MapAnalysis.paths`).
+    count : int
+        Drives, >= 1.
+    seed : int
+        Seed of the drives' choice.
+    progress : callable, optional
+        ``progress(line)`` after each batch.
+    thresholds : JudgeThresholds
+        The judge's and the scoring's thresholds (`maps.judge_thresholds.JUDGE`: the package's; docs/judge.md).
+    """
+    return judge_drives(simulate_drives(analysis, count, seed=seed, progress=progress), thresholds)
+
+
+def simulate_drives(analysis, count: int, *, seed: int = 0, progress=None) -> DriveRuns:
+    """The drives of `drive_map`, simulated (module docstring, "Drives"), with the prediction along the paths they
+    took: nothing judged yet.
 
     Parameters
     ----------
@@ -377,23 +179,44 @@ def drive_map(analysis, count: int, *, seed: int = 0, progress=None) -> DriveVal
     progress : callable, optional
         ``progress(line)`` after each batch.
     """
-    from scipy.spatial import cKDTree
-
     from ..maps.analysis import judge_routes
-    from ..maps.driven import LEAVES
-    from ..maps.decide import PATH_VERDICTS, UNJUDGED
 
     started = time.perf_counter()
     count = check_integer("count", count, 1, 100_000)
     seed = check_integer("seed", seed, 0, 2**63 - 1)
-    pv = analysis.paths
-    if pv is None:
+    if analysis.paths is None:
         raise ValueError("validation by driving needs --law grid: the simulator senses the map through its histogram grid")
-    robot, controller, law = analysis.robot, analysis.controller, analysis.law
-    rng = np.random.default_rng(seed)
-    grid = simulator_grid(analysis.grid)
     omega = _omega(analysis)
     period = 2 * math.pi / omega if omega else math.inf
+    runs, skipped = _prepare(analysis, count, np.random.default_rng(seed))
+    drives, batches = [], _batches(runs)
+    for b, batch in enumerate(batches, 1):
+        outcome = run_batch([r.scenario for r in batch], record="trajectory", metrics=False)
+        for r, result in zip(batch, outcome.runs):
+            tr = result.trajectory
+            event = result.events[0].type if result.events else None
+            drives.append((r, SimulatedDrive(len(drives), r.kind, r.ends, event, tr.t, tr.x, tr.y)))
+        if progress:
+            progress(f"map drives: batch {b}/{len(batches)}: {len(batch)} drives")
+    # every drive's own path (period-averaged), judged like any route: prediction and episode on one path
+    taken, simulated = [], []
+    for r, d in drives:
+        try:
+            route = _taken_path(d.x, d.y, period, analysis.controller.T, analysis.grid.cell_size, len(taken), "drive",
+                                r.scenario.target, r.scenario.start)
+        except ValueError:  # fewer than two distinct points: the drive did not move
+            simulated.append(d)
+            continue
+        simulated.append(dataclasses.replace(d, path=len(taken)))
+        taken.append(route)
+    dp = judge_routes(analysis, taken, taken=True, speeds=False) if taken else None  # their samples' verdicts are scored
+    return DriveRuns(analysis, count, seed, period, tuple(simulated), skipped, dp, time.perf_counter() - started)
+
+
+def _prepare(analysis, count: int, rng) -> tuple:
+    """(the drives' `_Prepared` scenarios, how many could not start) of `count` drives (`_plan`, `rng`)."""
+    robot, controller, law = analysis.robot, analysis.controller, analysis.law
+    grid = simulator_grid(analysis.grid)
     h = law.window_cells // 2
     reach = (h + 1) * grid.cell_size + CROP_SLACK
     runs, skipped = [], 0
@@ -419,80 +242,44 @@ def drive_map(analysis, count: int, *, seed: int = 0, progress=None) -> DriveVal
             continue
         runs.append(_Prepared(kind, (float(p[0]), float(p[1]), float(q[0]), float(q[1])), scenario,
                               _table_size(local, h)))
-    drives, traces, scenarios = [], [], []
-    batches = _batches(runs)
-    for b, batch in enumerate(batches, 1):
-        outcome = run_batch([r.scenario for r in batch], record="trajectory", metrics=False)
-        for r, result in zip(batch, outcome.runs):
-            tr = result.trajectory
-            found, amplitude = episodes(tr.t, tr.x, tr.y, period)
-            event = result.events[0].type if result.events else None
-            drives.append(Drive(len(drives), r.kind, *r.ends, event=event, duration=float(tr.t[-1] - tr.t[0]) if tr.t.size else 0.0,
-                                episodes=found, max_amplitude=amplitude))
-            traces.append((tr.t, tr.x, tr.y))
-            scenarios.append(r.scenario)
-        if progress:
-            progress(f"map drives: batch {b}/{len(batches)}: {len(batch)} drives")
+    return runs, skipped
 
-    # every drive's own path (period-averaged), judged like any route: prediction and episode on one path
-    taken, own = [], {}
-    for d, (t, x, y), scenario in zip(drives, traces, scenarios):
-        try:
-            route = _taken_path(x, y, period, controller.T, analysis.grid.cell_size, len(taken), "drive", scenario.target,
-                                scenario.start)
-        except ValueError:  # fewer than two distinct points: the drive did not move
-            continue
-        own[d.index] = len(taken)
-        taken.append(route)
-    dp = judge_routes(analysis, taken, taken=True, speeds=False) if taken else None  # their samples' verdicts are scored
+
+def judge_drives(runs: DriveRuns, thresholds: JudgeThresholds = JUDGE) -> DriveValidation:
+    """Judge and score simulated drives (module docstring, "Episodes", "Route length"): each drive's episodes
+    (`maps.episodes.episodes`), the samples of its own path it measured, and recall, precision and specificity with
+    their intervals; with `JUDGE`, `drive_map`'s answer.
+
+    Parameters
+    ----------
+    runs : DriveRuns
+        The drives (`simulate_drives`).
+    thresholds : JudgeThresholds
+        The judge's and the scoring's thresholds (`maps.judge_thresholds.JUDGE`: the package's; docs/judge.md).
+    """
+    from ..maps.decide import PATH_VERDICTS, UNJUDGED
+    from ..maps.driven import LEAVES
+
+    started = time.perf_counter()
+    analysis, period, dp = runs.analysis, runs.period, runs.drive_paths
+    pv = analysis.paths
+    drives = []
+    for d in runs.drives:
+        found, amplitude = episodes(d.t, d.x, d.y, period, thresholds)
+        drives.append(Drive(d.index, d.kind, *d.ends, event=d.event, duration=d.duration, episodes=found,
+                            max_amplitude=amplitude))
     sc = _Scored.of(pv, dp)
-    base = pv.code.size
-
-    # per drive: its own path's samples passed (scored), those during its episodes, and the map's route samples it passed
-    tree = cKDTree(np.column_stack([pv.samples.x, pv.samples.y]))
-    limit = max(MATCH_DISTANCE, robot.W)
-    marks, points = [], []
-    unstable = sc.code == PATH_VERDICTS.index("unstable")
-    stable = sc.code == PATH_VERDICTS.index("stable")
-    unjudged = np.isin(sc.code, [PATH_VERDICTS.index(reason) for reason in UNJUDGED])
-    half = pv.window / 2 if math.isfinite(pv.window) else 0.0
-    reach_back = max(0.0, EPISODE_PERIODS * robot.V * period - half)  # m (`_cut_short`)
-    swung = np.zeros(sc.code.size)  # the drives' largest lateral oscillation at each sample of their own paths, m
-    for d, (t, x, y) in zip(drives, traces):
-        if t.size == 0 or d.index not in own:
-            marks.append(_Marks.none())
-            continue
-        dist, near = tree.query(np.column_stack([x, y]), distance_upper_bound=limit)
-        on_routes = np.unique(near[np.isfinite(dist)])
-        mine = base + np.flatnonzero(dp.samples.segment == own[d.index])
-        dist, nearest = cKDTree(np.column_stack([sc.x[mine], sc.y[mine]])).query(np.column_stack([x, y]), distance_upper_bound=limit)
-        nearest = mine[np.minimum(nearest, mine.size - 1)]
-        during = np.zeros(t.size, dtype=bool)
-        for lo, hi in d.episodes:
-            during |= (t >= lo) & (t <= hi)
-        near_path = np.isfinite(dist)
-        start = t - t[0] >= min(period, 0.25 * d.duration)  # the start's transient is not measured
-        # an episode needs three periods after a sample to be found, before the drive ended: a stall ended it when its
-        # progress stopped, `stall_time` before the stall was called
-        stop = t[-1] - (stall_time(robot.V) if d.event == "trapped" else 0.0)
-        end = stop - t >= EPISODE_PERIODS * period
-        hit = near_path & start & (end | during)
-        step = np.concatenate([[0.0], np.hypot(np.diff(x), np.diff(y))])
-        off = float(step[during & ~near_path].sum())  # an episode away from its own path (a spin): measured, not scored
-        unmeasured = np.setdiff1d(np.unique(nearest[near_path & start & ~end & ~during]), nearest[hit])
-        np.maximum.at(swung, nearest[hit], swing(t, x, y, period)[hit])
-        scored = np.unique(nearest[hit])
-        cut = _cut_short(mine, sc.arc, unstable, unjudged, unmeasured, reach_back)
-        marks.append(_Marks(np.setdiff1d(scored, cut), np.unique(nearest[hit & during]), off,
-                            np.union1d(unmeasured, np.intersect1d(scored, cut)), on_routes))
-        points.append(np.column_stack([x[during], y[during]]))
-    near_unstable = _within(unstable, sc.route, sc.arc, half)
-    lengths, driven, episode, near_episode = _score(sc, marks, range(len(drives)), unstable, stable, near_unstable, half, base)
-    figures = _figures(lengths)
+    verdict = _Verdicts(sc.code == PATH_VERDICTS.index("unstable"), sc.code == PATH_VERDICTS.index("stable"),
+                        np.isin(sc.code, [PATH_VERDICTS.index(reason) for reason in UNJUDGED]),
+                        pv.window * thresholds.match_window if math.isfinite(pv.window) else 0.0, pv.code.size)
+    marks, points, swung = _mark_drives(runs, drives, sc, verdict, thresholds)
+    near_unstable = _within(verdict.unstable, sc.route, sc.arc, verdict.half)
+    lengths, driven, episode, near_episode = _score(sc, marks, range(len(drives)), verdict.unstable, verdict.stable,
+                                                    near_unstable, verdict.half, verdict.base)
     by_kind = {}
     for kind in ("route", "waypoints"):
         chosen = [k for k, d in enumerate(drives) if d.kind == kind]
-        kind_lengths = _score(sc, marks, chosen, unstable, stable, near_unstable, half, base)[0]
+        kind_lengths = _score(sc, marks, chosen, verdict.unstable, verdict.stable, near_unstable, verdict.half, verdict.base)[0]
         by_kind[kind] = {**{name: json_number(v) if v is not None else None for name, v in _figures(kind_lengths).items()},
                          "lengths": kind_lengths}
     passed_by = [set() for _ in range(sc.code.size)]
@@ -500,31 +287,107 @@ def drive_map(analysis, count: int, *, seed: int = 0, progress=None) -> DriveVal
         for k in mark.scored:
             passed_by[k].add(d.index)
     disagreements = (_runs("missed", episode & ~near_unstable, sc, passed_by, swung)
-                     + _runs("false alarm", unstable & driven & ~near_episode, sc, passed_by, swung))
+                     + _runs("false alarm", verdict.unstable & driven & ~near_episode, sc, passed_by, swung))
     for key, kind, amplitude in (("false_alarm_swinging", "false alarm", "simulated_amplitude"),
                                  ("missed_predicted_swinging", "missed", "predicted_amplitude")):  # the side that wove
-        lengths[key] = float(sum(d.length for d in disagreements if d.kind == kind and getattr(d, amplitude) >= AMPLITUDE_THRESHOLD))
+        lengths[key] = float(sum(d.length for d in disagreements
+                                 if d.kind == kind and getattr(d, amplitude) >= thresholds.amplitude_threshold))
+    per_drive = [_score(sc, marks, [k], verdict.unstable, verdict.stable, near_unstable, verdict.half, verdict.base)[0]
+                 for k in range(len(drives))]
+    figures, intervals = _figures(lengths), _intervals(per_drive, _figures(lengths), runs.seed)
+    pts = np.vstack(points) if points else np.zeros((0, 2))
+    measured = np.flatnonzero(driven)
+    measured = measured[measured >= verdict.base]  # the drives' own paths' samples scored (`_score`)
+    wobble = wobble_agreement(np.nan_to_num(sc.amplitude[measured]), swung[measured], sc.spacing[measured], LEAVES,
+                              thresholds)
+    return DriveValidation(figures["recall"], figures["precision"], tuple(drives), disagreements, lengths,
+                           _counts(drives, runs.skipped), _inputs(runs, thresholds), runs.seconds + time.perf_counter() - started,
+                           pts, by_kind, dp, intervals["recall"], intervals["precision"], figures["specificity"],
+                           intervals["specificity"], wobble)
+
+
+def _counts(drives, skipped: int) -> dict:
+    """`DriveValidation.counts`: the drives by how they ended, the episodes found."""
     events = [d.event or "time" for d in drives]
-    counts = {"drives": len(drives), "not_started": skipped, "route_drives": sum(d.kind == "route" for d in drives),
-              "waypoint_drives": sum(d.kind == "waypoints" for d in drives), "episodes": sum(len(d.episodes) for d in drives),
-              **{f"ended_{e}": events.count(e) for e in sorted(set(events))}}
-    inputs = {"count": count, "seed": seed, "V": robot.V, "period": json_number(period), "window": json_number(pv.window),
-              "episode_periods": EPISODE_PERIODS, "growth_efolds": GROWTH_EFOLDS, "amplitude_threshold": AMPLITUDE_THRESHOLD,
-              "noise_floor": NOISE_FLOOR, "match_distance": limit, "start_offset": START_OFFSET,
-              "interval_resamples": INTERVAL_RESAMPLES}
-    per_drive = [_score(sc, marks, [k], unstable, stable, near_unstable, half, base)[0] for k in range(len(drives))]
+    return {"drives": len(drives), "not_started": skipped, "route_drives": sum(d.kind == "route" for d in drives),
+            "waypoint_drives": sum(d.kind == "waypoints" for d in drives), "episodes": sum(len(d.episodes) for d in drives),
+            **{f"ended_{e}": events.count(e) for e in sorted(set(events))}}
+
+
+def _inputs(runs: DriveRuns, thresholds: JudgeThresholds) -> dict:
+    """`DriveValidation.inputs`: what the drives and their judge were given."""
+    return {"count": runs.count, "seed": runs.seed, "V": runs.analysis.robot.V, "period": json_number(runs.period),
+            "window": json_number(runs.analysis.paths.window), "episode_periods": thresholds.episode_periods,
+            "growth_efolds": thresholds.growth_efolds, "amplitude_threshold": thresholds.amplitude_threshold,
+            "noise_floor": thresholds.noise_floor, "match_distance": max(thresholds.match_distance, runs.analysis.robot.W),
+            "start_offset": START_OFFSET, "interval_resamples": INTERVAL_RESAMPLES}
+
+
+def _intervals(per_drive: list, figures: dict, seed: int) -> dict:
+    """Each of `FIGURES`' 95 % interval over the drives (`_interval`; `per_drive`: each drive's `_score` lengths; None
+    where the figure is None), drawn in `FIGURES`' order from one generator seeded by the drives' `seed`."""
     resampled = np.random.default_rng([seed, 1])
     intervals = {}
     for name, (part, whole) in FIGURES.items():  # in this order: they draw on one generator
         shares = [np.array([L[key] for L in per_drive], dtype=float) for key in (part, whole)]
         intervals[name] = _interval(*shares, resampled) if figures[name] is not None else None
-    pts = np.vstack(points) if points else np.zeros((0, 2))
-    measured = np.flatnonzero(driven)
-    measured = measured[measured >= base]  # the drives' own paths' samples scored (`_score`)
-    wobble = wobble_agreement(np.nan_to_num(sc.amplitude[measured]), swung[measured], sc.spacing[measured], LEAVES)
-    return DriveValidation(figures["recall"], figures["precision"], tuple(drives), disagreements, lengths, counts, inputs,
-                           time.perf_counter() - started, pts, by_kind, dp, intervals["recall"], intervals["precision"],
-                           figures["specificity"], intervals["specificity"], wobble)
+    return intervals
+
+
+@dataclass(frozen=True)
+class _Verdicts:
+    """The scored samples' verdicts (`_Scored`): unstable, stable, unjudged (a wall ahead: no claim either way), the match's
+    half window (m: `JudgeThresholds.match_window` of Λ) and the map's routes' sample count (the drives' paths' follow)."""
+
+    unstable: np.ndarray
+    stable: np.ndarray
+    unjudged: np.ndarray
+    half: float
+    base: int
+
+
+def _mark_drives(runs: DriveRuns, drives, sc, verdict: _Verdicts, thresholds: JudgeThresholds) -> tuple:
+    """(marks, points, swung): each drive's `_Marks` (module docstring, "Route length"), its positions during its
+    episodes (m), and the drives' largest lateral oscillation at each sample of their own paths (m)."""
+    from scipy.spatial import cKDTree
+
+    robot, pv, period = runs.analysis.robot, runs.analysis.paths, runs.period
+    tree = cKDTree(np.column_stack([pv.samples.x, pv.samples.y]))
+    limit = max(thresholds.match_distance, robot.W)
+    reach_back = max(0.0, thresholds.end_exclusion * robot.V * period - verdict.half)  # m (`_cut_short`)
+    swung = np.zeros(sc.code.size)
+    marks, points = [], []
+    for d, s in zip(drives, runs.drives):
+        t, x, y = s.t, s.x, s.y
+        if t.size == 0 or s.path is None:
+            marks.append(_Marks.none())
+            continue
+        dist, near = tree.query(np.column_stack([x, y]), distance_upper_bound=limit)
+        on_routes = np.unique(near[np.isfinite(dist)])
+        mine = verdict.base + np.flatnonzero(runs.drive_paths.samples.segment == s.path)
+        dist, nearest = cKDTree(np.column_stack([sc.x[mine], sc.y[mine]])).query(np.column_stack([x, y]), distance_upper_bound=limit)
+        nearest = mine[np.minimum(nearest, mine.size - 1)]
+        during = np.zeros(t.size, dtype=bool)
+        for lo, hi in d.episodes:
+            during |= (t >= lo) & (t <= hi)
+        near_path = np.isfinite(dist)
+        # the start's transient is not measured
+        start = t - t[0] >= min(thresholds.start_periods * period, thresholds.start_share * d.duration)
+        # an episode needs its periods after a sample to be found, before the drive ended: a stall ended it when its
+        # progress stopped, `stall_time` before the stall was called
+        stop = t[-1] - (stall_time(robot.V) if d.event == "trapped" else 0.0)
+        end = stop - t >= thresholds.end_exclusion * period
+        hit = near_path & start & (end | during)
+        step = np.concatenate([[0.0], np.hypot(np.diff(x), np.diff(y))])
+        off = float(step[during & ~near_path].sum())  # an episode away from its own path (a spin): measured, not scored
+        unmeasured = np.setdiff1d(np.unique(nearest[near_path & start & ~end & ~during]), nearest[hit])
+        np.maximum.at(swung, nearest[hit], swing(t, x, y, period, thresholds)[hit])
+        scored = np.unique(nearest[hit])
+        cut = _cut_short(mine, sc.arc, verdict.unstable, verdict.unjudged, unmeasured, reach_back)
+        marks.append(_Marks(np.setdiff1d(scored, cut), np.unique(nearest[hit & during]), off,
+                            np.union1d(unmeasured, np.intersect1d(scored, cut)), on_routes))
+        points.append(np.column_stack([x[during], y[during]]))
+    return marks, points, swung
 
 
 @dataclass(frozen=True)
@@ -692,14 +555,15 @@ def _runs(kind: str, mask: np.ndarray, sc, passed_by, swung) -> tuple:
 
 
 def _taken_path(x, y, period: float, T: float, cell: float, index: int, source: str, target, start=None):
-    """The path a drive took: its positions (m) averaged over one period (s; the controller's step T, s), a point
+    """The path a drive took: its positions (m) averaged over one period (s; `JudgeThresholds.average_periods` of
+    `JUDGE`, the judge's; the controller's step T, s), a point
     every `cell` m of arc (`routes.path_of`, route `index`, `source`), with the point `target` (a `Target`) the robot
     steered at (`RoutePath.goal`, `RoutePath.lookahead`) and the `Pose` it started from, if given (`RoutePath.start`)."""
     from scipy.ndimage import uniform_filter1d
 
     from ..maps.routes import path_of
 
-    n = max(1, int(round(period / T)))
+    n = max(1, int(round(JUDGE.average_periods * period / T)))
     x, y = uniform_filter1d(x, n, mode="nearest"), uniform_filter1d(y, n, mode="nearest")
     arc = np.concatenate([[0.0], np.cumsum(np.hypot(np.diff(x), np.diff(y)))])
     step = np.flatnonzero(np.diff(np.concatenate([[-1.0], arc // cell])) > 0)  # a point every cell
