@@ -819,6 +819,11 @@ def _map_drive_lines(d: dict) -> list[str]:
                  + (f" (false alarms where a drive wove past {100 * d['inputs']['amplitude_threshold']:.1f} cm for a period, "
                     f"not {d['inputs']['episode_periods']}: {d['lengths']['false_alarm_swinging']:.1f} m)"
                     if d['lengths'].get('false_alarm_swinging') else ""))
+    c = d.get("collisions")
+    if c and c["count"]:  # where the drives met an obstacle, beside the map's prediction
+        lines.append(f"  collisions: {c['count']} drives met an obstacle; {c['foreseen']} within {c['match_distance']:g} m of a "
+                     f"predicted collision course, {c['near_weave']} more near a predicted weave, {c['off_routes']} off every route "
+                     f"(where: validation.collisions in the JSON; X on routes.png)")
     w = d.get("wobble")
     if w and w.get("within") is not None:  # how big the predicted weave is against the simulated one
         q = ", ".join(f"{v:.2f}" if isinstance(v, (int, float)) else str(v) for v in w["ratio_quartiles"])

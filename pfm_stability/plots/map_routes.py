@@ -105,6 +105,15 @@ def plot_route_verdicts(analysis, drives=None, ax=None, *, title: str | None = N
                            edgecolors="white", linewidths=0.8, zorder=7)
                 handles.append(Line2D([], [], marker=marker, ls="", color=colour, markeredgecolor="white", markersize=8, label=label))
 
+        collisions = getattr(drives, "collisions", None)
+        for foreseen, colour, label in ((True, "#000000", "drive collided: a collision course was predicted there"),
+                                        (False, "#d01c8b", "drive collided: no collision course predicted there")):
+            group = [c for c in (collisions.collisions if collisions is not None else ()) if c.foreseen == foreseen]
+            if group:
+                ax.scatter([c.x for c in group], [c.y for c in group], marker="X", s=55, color=colour, edgecolors="white",
+                           linewidths=0.7, zorder=7)
+                handles.append(Line2D([], [], marker="X", ls="", color=colour, markeredgecolor="white", markersize=8, label=label))
+
         def pct(v):
             return "n/a" if v is None else f"{100 * v:.0f}%"
 

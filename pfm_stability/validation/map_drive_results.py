@@ -30,6 +30,8 @@ class SimulatedDrive:
         What ended it (`Drive.event`).
     t, x, y : ndarray
         Its trajectory: times (s) and positions (m).
+    contact : tuple of float or None
+        (x, y) of the robot's centre where a collision ended it, m (None: no collision).
     path : int or None
         Its own path's index among `DriveRuns.drive_paths`' routes (None: it did not move).
     """
@@ -42,6 +44,7 @@ class SimulatedDrive:
     x: np.ndarray
     y: np.ndarray
     path: int | None = None
+    contact: tuple | None = None
 
     @property
     def duration(self) -> float:
@@ -104,6 +107,8 @@ class Drive:
         (t_start, t_end) of each oscillation episode, s.
     max_amplitude : float
         Largest lateral oscillation amplitude, m.
+    contact : tuple of float or None
+        (x, y) of the robot's centre where a collision ended it, m (None: no collision).
     """
 
     index: int
@@ -116,6 +121,7 @@ class Drive:
     duration: float
     episodes: tuple = ()
     max_amplitude: float = 0.0
+    contact: tuple | None = None
 
     def to_dict(self) -> dict:
         """JSON form."""
@@ -276,6 +282,8 @@ class DriveValidation:
         Its 95 % interval over the drives.
     wobble : WobbleAgreement or None
         How big the predicted weave is against the simulated one where either passed the threshold.
+    collisions : CollisionSummary or None
+        Where the drives collided and what the map predicted there (`validation.map_collisions`).
     """
 
     recall: float | None
@@ -294,11 +302,13 @@ class DriveValidation:
     specificity: float | None = None
     specificity_interval: tuple | None = None
     wobble: WobbleAgreement | None = None
+    collisions: object = None
 
     def to_dict(self) -> dict:
         """JSON form."""
         return {
             "wobble": self.wobble.to_dict() if self.wobble is not None else None,
+            "collisions": self.collisions.to_dict() if self.collisions is not None else None,
             "drive_paths": self.drive_paths.to_dict() if self.drive_paths is not None else None,
             "recall": json_number(self.recall) if self.recall is not None else None,
             "precision": json_number(self.precision) if self.precision is not None else None,

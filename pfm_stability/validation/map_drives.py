@@ -62,6 +62,7 @@ from ..maps.episodes import episodes, swing
 from ..maps.judge_thresholds import JUDGE, JudgeThresholds
 from ..maps.planner import SkeletonPlanner
 from ..maps.routes import polyline_arcs
+from .map_collisions import locate_collisions
 from .map_drive_results import Disagreement, Drive, DriveRuns, DriveValidation, SimulatedDrive, WobbleAgreement, wobble_agreement
 from .maps import START_OFFSET, _batches, _table_size, crop_grid, simulator_grid, stall_time
 
@@ -194,8 +195,10 @@ def simulate_drives(analysis, count: int, *, seed: int = 0, progress=None) -> Dr
         outcome = run_batch([r.scenario for r in batch], record="trajectory", metrics=False)
         for r, result in zip(batch, outcome.runs):
             tr = result.trajectory
-            event = result.events[0].type if result.events else None
-            drives.append((r, SimulatedDrive(len(drives), r.kind, r.ends, event, tr.t, tr.x, tr.y)))
+            first = result.events[0] if result.events else None
+            contact = (float(first.x), float(first.y)) if first is not None and first.type == "collision" else None
+            drives.append((r, SimulatedDrive(len(drives), r.kind, r.ends, first.type if first is not None else None, tr.t, tr.x, tr.y,
+                                             contact=contact)))
         if progress:
             progress(f"map drives: batch {b}/{len(batches)}: {len(batch)} drives")
     # every drive's own path (period-averaged), judged like any route: prediction and episode on one path
@@ -267,7 +270,7 @@ def judge_drives(runs: DriveRuns, thresholds: JudgeThresholds = JUDGE) -> DriveV
     for d in runs.drives:
         found, amplitude = episodes(d.t, d.x, d.y, period, thresholds)
         drives.append(Drive(d.index, d.kind, *d.ends, event=d.event, duration=d.duration, episodes=found,
-                            max_amplitude=amplitude))
+                            max_amplitude=amplitude, contact=d.contact))
     sc = _Scored.of(pv, dp)
     verdict = _Verdicts(sc.code == PATH_VERDICTS.index("unstable"), sc.code == PATH_VERDICTS.index("stable"),
                         np.isin(sc.code, [PATH_VERDICTS.index(reason) for reason in UNJUDGED]),
@@ -303,7 +306,9 @@ def judge_drives(runs: DriveRuns, thresholds: JudgeThresholds = JUDGE) -> DriveV
     return DriveValidation(figures["recall"], figures["precision"], tuple(drives), disagreements, lengths,
                            _counts(drives, runs.skipped), _inputs(runs, thresholds), runs.seconds + time.perf_counter() - started,
                            pts, by_kind, dp, intervals["recall"], intervals["precision"], figures["specificity"],
-                           intervals["specificity"], wobble)
+                           intervals["specificity"], wobble,
+                           locate_collisions(pv, [(d.index, *d.contact) for d in drives if d.contact is not None],
+                                             max(thresholds.match_distance, analysis.robot.W)))
 
 
 def _counts(drives, skipped: int) -> dict:
