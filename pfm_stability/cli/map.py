@@ -235,7 +235,7 @@ def _run_tracking(args, path, started: float) -> int:
     from ..extras import require
 
     given = [(f"--{key.replace('_', '-')}", getattr(args, key, None) is not None) for key in _VFF_ONLY] + [("--seed", args.seed != 0)]
-    refuse_vff_options(args, path, given, keep=("cell_size", "W"))
+    refuse_vff_options(args, path, given, keep=("cell_size",))
     if path.tracker.controller not in TRACKING_CONTROLLERS:
         raise ValueError(f"--controller auto found {path.tracker.controller} in the Nav2 file: map decides --controller vff or "
                          f"{', '.join(TRACKING_CONTROLLERS)} along a map's routes")

@@ -741,7 +741,7 @@ def render_map_tracking_text(data: dict) -> str:
         The analysis's JSON form (`maps.tracking.MapTracking.to_dict`, outputs and timing).
     """
     m, i, t = data["map"], data["inputs"], data["tracking"]
-    ref = t["models"][i["model"]]
+    ref = data["tracking_verdict"]
     pv = data["paths"]
     s = pv["summary"]
     lines = [f"map {m['name']}: {m['width']} x {m['height']} cells of {m['resolution']:g} m; routes on a grid of {i['cell_size']:g} m "
@@ -749,7 +749,7 @@ def render_map_tracking_text(data: dict) -> str:
              f"controller {data['controller']} at max_linear_vel V = {i['V']:g} m/s, lookahead {t['law']['L']:g} m; plant tau = {i['tau']:g} s, "
              f"D = {i['dead_time']:g} s, g = {i['plant_gain']:g}; T = {i['T']:g} s; model {i['model']}: (V/L)* = {number(ref['ratio_critical'])} 1/s",
              f"free space: {ref['verdict']}, margin {percent(ref['margin'])}, V* = {number(ref['V_critical'])} m/s, "
-             f"L* = {number(ref['lookahead_critical'])} m", ""]
+             f"L* = {number(ref['lookahead_critical'])} m, D* = {number(ref['dead_time_critical'])} s, T* = {number(ref['T_critical'])} s", ""]
     unstable = sorted((x for x in pv["stretches"] if x["verdict"] == "unstable"), key=lambda x: x["margin"])
     if unstable:
         lines.append(f"{'route':>5} {'from m':>7} {'to m':>7} {'margin':>8} {'V* m/s':>7} {'L* m':>6} {'V m/s':>6} {'L_c m':>6} {'kappa':>6}"

@@ -5,9 +5,9 @@ RPP tracks every route of the map (`routes.find_paths`, the skeleton's routes, a
 sampled every histogram cell as the VFF routes are (`decide.path_samples`). At each sample the analysis of
 ``report --controller rpp`` (`analysis.path_tracking`) is asked about the straight corridor the sample lies in:
 
-* **the half-width** L_c is the sample's clearance (`HistogramMap.clearance`: the distance from the point to the
-  nearest occupied cell's face, bilinear between cell centres), the distance Nav2's inflation layer turns into the
-  cost at the robot (`analysis.path_laws.corridor_pose_cost`), which the cost heuristic turns into a speed;
+* **the half-width** L_c is the sample's clearance on the map's own pixels (`HistogramMap.clearance` of the map at its
+  resolution: the distance from the point to the nearest occupied pixel's face, bilinear between pixel centres; the
+  routes come from the coarser histogram grid), the distance Nav2's inflation layer turns into the cost at the robot (`analysis.path_laws.corridor_pose_cost`), which the cost heuristic turns into a speed;
 * **the curvature** the regulation reads is the carrot's (`controllers.rpp.curvature` of the route point at the
   lookahead ahead along the route, in the frame of the route's tangent: what RPP computes on the route), at the
   lookahead of the straight corridor's speed; the curvature heuristic scales V by R/R_min below R_min =
@@ -82,23 +82,26 @@ class CorridorSamples:
     curvature: np.ndarray
 
 
-def route_corridors(grid, paths, clearance: np.ndarray, lookahead: float) -> CorridorSamples:
-    """The samples of `paths` every cell (`decide.path_samples`), their clearance and the carrot's curvature at `lookahead`.
+def route_corridors(grid, paths, clearance: np.ndarray, lookahead: float, spacing: float) -> CorridorSamples:
+    """The samples of `paths` every `spacing` m (`decide.path_samples`), their clearance and the carrot's curvature at
+    `lookahead`.
 
     Parameters
     ----------
     grid : HistogramMap
-        The map's histogram grid.
+        The grid of `clearance` (the map's own pixels: the costmap's distances).
     paths : sequence of RoutePath
         The routes.
     clearance : ndarray, shape (nx, ny)
         Distance from each cell centre to the nearest occupied cell, m (`HistogramMap.clearance`).
     lookahead : float
         The carrot's distance along the route, m.
+    spacing : float
+        Largest distance between samples, m (the routes' grid cell).
     """
     from scipy.ndimage import map_coordinates
 
-    x, y, tx, ty, route, arc, ds = path_samples(paths, grid.cell_size)
+    x, y, tx, ty, route, arc, ds = path_samples(paths, spacing)
     c = grid.cell_size
     at = np.vstack([(x - grid.x_min) / c - 0.5, (y - grid.y_min) / c - 0.5])
     half_width = map_coordinates(clearance, at, order=1, mode="nearest") if x.size else np.zeros(0)
@@ -258,7 +261,8 @@ class MapTracking:
     grid : HistogramMap
         The histogram grid the routes were found on.
     robot, controller : Robot, Controller
-        The plant and period; ``robot.V`` is the cruising speed (``max_linear_vel``), ``robot.W`` the zones' width.
+        The plant and period; ``robot.V`` is the cruising speed (``max_linear_vel``), ``robot.W`` twice the costmap's
+        inscribed radius (the routes where the robot fits; the zones reach W/2 from a route).
     tracker : io.nav2.Nav2Tracker
         The controller and its Nav2 parameters.
     model : str
@@ -289,7 +293,8 @@ class MapTracking:
     segments: tuple = ()
 
     def to_dict(self) -> dict:
-        """``map``, ``inputs``, ``controller``, ``tracking`` (the free-space reference), ``NV_critical``, ``segments`` (null),
+        """``map``, ``inputs``, ``controller``, ``tracking`` and ``tracking_verdict`` (the free-space reference: the law and the
+        model's verdict with D* and T*), ``NV_critical``, ``segments`` (null),
         ``summary``, ``warnings``, ``paths`` (the JSON of ``map --controller``, without outputs and timing)."""
         ref = self.reference.models[self.model]
         return {
@@ -301,7 +306,8 @@ class MapTracking:
                        "grid_cells": [int(self.grid.shape[0]), int(self.grid.shape[1])], "parameters": self.tracker.values(),
                        "costmap": self.tracker.costmap_values()},
             "controller": self.tracker.controller,
-            "tracking": self.reference.to_dict(),
+            "tracking": {key: value for key, value in self.reference.to_dict().items() if key != "models"},
+            "tracking_verdict": ref.to_dict(),
             "NV_critical": json_number(ref.NV_critical),
             "segments": None,
             "summary": self.paths.summary(),
@@ -404,8 +410,8 @@ def analyze_map_tracking(occupancy, robot, controller, tracker, *, model: str = 
     ----------
     occupancy : OccupancyMap
     robot : parameters.Robot
-        The plant (τ, D, g, τ_a); V is the cruising speed (``max_linear_vel``), W the robot's width (the routes where it
-        fits, the zones' width).
+        The plant (τ, D, g, τ_a); V is the cruising speed (``max_linear_vel``). Its width W is replaced by twice the
+        costmap's inscribed radius (the footprint Nav2 plans with): the routes where it fits, the zones' width.
     controller : parameters.Controller
         T, hold and compute delay.
     tracker : io.nav2.Nav2Tracker
@@ -434,6 +440,7 @@ def analyze_map_tracking(occupancy, robot, controller, tracker, *, model: str = 
     if tracker.controller not in MAP_CONTROLLERS:
         raise ValueError(f"controller must be one of {', '.join(MAP_CONTROLLERS)} along a map's routes; got {tracker.controller!r}")
     say = progress or (lambda line: None)
+    robot = robot.replace(W=2.0 * tracker.costmap_values()["inscribed_radius"])  # the costmap's footprint: where the robot fits
     warnings = scale_warnings(occupancy, robot.W)
     for line in warnings:
         (warn or (lambda text: None))(line)
@@ -451,7 +458,8 @@ def analyze_map_tracking(occupancy, robot, controller, tracker, *, model: str = 
     timing["routes"], clock = time.perf_counter() - clock, time.perf_counter()
     say(f"routes done ({timing['routes']:.2f} s)")
     base = _law(tracker, None, 0.0)
-    corridors = route_corridors(grid, paths, clearance, base.lookahead(base.speed(robot.V)))
+    pixels = histogram_of(occupancy, occupancy.resolution, unknown)  # the clearance at the map's own resolution, as the costmap sees it
+    corridors = route_corridors(pixels, paths, pixels.clearance(), base.lookahead(base.speed(robot.V)), grid.cell_size)
     code, keys, decided = _decide(tracker, robot, controller, loop_model, corridors, progress)
     stretches = _stretches(paths, corridors, code, keys, decided, base.values["max_lookahead_dist"])
     timing["verdicts"] = time.perf_counter() - clock
