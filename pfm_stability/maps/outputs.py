@@ -188,7 +188,27 @@ def speed_limits(analysis, a_max: float | None = None) -> np.ndarray:
 
 
 def stamp_stretch(values: np.ndarray, occupancy, points, stretch, reach: float, half: float, value: int, combine=np.minimum) -> None:
-    """`_stamp` `value` within `half` m of a route stretch extended by `reach` m along its route at both ends."""
+    """`_stamp` `value` within `half` m of a route stretch extended by `reach` m along its route at both ends.
+
+    Parameters
+    ----------
+    values : ndarray of int, shape (height, width)
+        Per map cell, changed in place.
+    occupancy : OccupancyMap
+        The map (its cells).
+    points : ndarray, shape (n, 2)
+        The stretch's route, m.
+    stretch : PathStretch or TrackingStretch
+        With ``start`` and ``stop`` (m along the route).
+    reach : float
+        m added at both ends.
+    half : float
+        m either side of the route.
+    value : int
+        What the cells receive.
+    combine : callable
+        Of a cell's value and `value` (`np.minimum`: the lower limit).
+    """
     piece = route_piece(points, stretch.start - reach, stretch.stop + reach)
     for (x0, y0), (x1, y1) in zip(piece[:-1], piece[1:]):
         _stamp(values, occupancy, x0, y0, x1, y1, half, value, combine)
