@@ -41,6 +41,7 @@ from ..io.serialize import json_number
 from ..models import models_for
 from .decide import path_samples
 from .field import histogram_of
+from .paths import routes_json
 from .routes import find_paths, find_routes, polyline_arcs
 
 __all__ = ["CURVATURE_STEP", "LOOKAHEAD_STEP", "MAP_CONTROLLERS", "TRACKING_VERDICTS", "MapTracking", "TrackingStretch", "TrackingVerdicts",
@@ -244,7 +245,7 @@ class TrackingVerdicts:
     def to_dict(self) -> dict:
         """``routes`` (source, length, points), ``stretches``, ``summary``, ``lookahead_parameter``."""
         return {
-            "routes": [{"source": p.source, "length": p.length, "points": [[float(a), float(b)] for a, b in p.points]} for p in self.paths],
+            "routes": routes_json(self.paths),
             "stretches": [s.to_dict() for s in self.stretches],
             "summary": self.summary(),
             "lookahead_parameter": self.lookahead_parameter,
