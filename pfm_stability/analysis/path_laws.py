@@ -39,6 +39,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from ..controllers.rpp import curvature_constraint
 from ..controllers.costmap import FREE_SPACE, INSCRIBED_INFLATED_OBSTACLE, LETHAL_OBSTACLE, Inflation
 from ..parameters import check_parameter
 
@@ -155,12 +156,17 @@ class PurePursuit:
         The costmap's inscribed radius, m.
     half_width : float or None
         The corridor's half-width L_c the cost is that of, m (None: free space).
+    curvature : float
+        The path's curvature the regulation reads, 1/m (0: a straight path). Along a bend of a map's route
+        (`maps.tracking`) the curvature heuristic scales V by R/R_min where R = 1/|κ| < ``regulated_linear_scaling_min_radius``;
+        the gains stay the straight path's (docs/path_tracking.md, "Regulated speed").
     """
 
     values: dict
     pose_cost: int = FREE
     inscribed_radius: float = 0.1
     half_width: float | None = None
+    curvature: float = 0.0
 
     name = "rpp"
     shape = (1.0, 2.0)
@@ -193,8 +199,11 @@ class PurePursuit:
         """
         scale = self.cost_scale()
         cost_v = V_set if scale is None else V_set * scale
-        v = max(min(cost_v, V_set), self.values["regulated_linear_scaling_min_speed"])
-        return min(abs(v), V_set)
+        v = self.values
+        curvature_v = (curvature_constraint(V_set, self.curvature, v["regulated_linear_scaling_min_radius"])
+                       if v["use_regulated_linear_velocity_scaling"] else V_set)
+        speed = max(min(cost_v, curvature_v, V_set), v["regulated_linear_scaling_min_speed"])
+        return min(abs(speed), V_set)
 
     def lookahead(self, V: float) -> float:
         """The lookahead that steers at the regulated (measured) speed V, m.
@@ -234,7 +243,13 @@ class PurePursuit:
         value : float
             Its value.
         """
-        return PurePursuit({**self.values, name: value}, self.pose_cost, self.inscribed_radius, self.half_width)
+        return PurePursuit({**self.values, name: value}, self.pose_cost, self.inscribed_radius, self.half_width, self.curvature)
+
+    @property
+    def lookahead_parameter(self) -> str:
+        """The Nav2 parameter that sets the steering lookahead from below: ``lookahead_dist``, ``curvature_lookahead_dist``
+        or, velocity-scaled, ``min_lookahead_dist`` (the clamp's lower end)."""
+        return {"fixed": "lookahead_dist", "curvature": "curvature_lookahead_dist"}.get(self.steering, "min_lookahead_dist")
 
 
 @dataclass(frozen=True)

@@ -33,7 +33,7 @@ from ..numerics.solve import bisect_root, first_crossing
 from ..parameters import RANGES
 from .path_laws import Graceful, MeasuredGains, PurePursuit, TrackingPoint
 
-__all__ = ["PathVerdict", "PathTracking", "ModelDelay", "analyze_path_tracking", "tracking_loop", "ratio_critical", "pure_delay_ratio", "GAIN_SPREAD",
+__all__ = ["PathVerdict", "PathTracking", "LawVerdict", "law_verdict", "check_tracking_point", "ModelDelay", "analyze_path_tracking", "tracking_loop", "ratio_critical", "pure_delay_ratio", "GAIN_SPREAD",
            "RATIO_RTOL", "RATIO_POINTS_PER_DECADE"]
 
 GAIN_SPREAD = 2.0
@@ -465,28 +465,100 @@ def _lookahead_time_critical(law, point: TrackingPoint, rho_star: float) -> floa
 
 
 # ------------------------------------------------------------------ every model
+@dataclass(frozen=True)
+class LawVerdict:
+    """One model's verdict and ρ-critical values of a closed-form law (RPP, Graceful) at one operating point: the part of
+    `PathVerdict` that does not need the delay searches (D*, T*), so that many operating points of one loop (the
+    stretches of a map, `maps.tracking`) share one ρ* search.
+
+    Attributes
+    ----------
+    verdict : str
+        "stable", "unstable" or "undecided" (`models.verdicts.judge`).
+    margin : float
+        ρ*/ρ − 1.
+    NV, NV_critical : float
+        The loop's NV and the model's NV* with k held, 1/s.
+    omega_critical : float or None
+        rad/s at NV*.
+    ratio_critical : float
+        ρ* = (V/L)*, 1/s.
+    V_critical : float
+        V*, m/s (`_speed_critical`).
+    lookahead_critical : float
+        L*, m (`_lookahead_critical`).
+    lookahead_time_critical : float or None
+        lookahead_time*, s (velocity-scaled RPP; None otherwise).
+    reason : str or None
+        Why the verdict is what it is beyond the model's answer.
+    """
+
+    verdict: str
+    margin: float
+    NV: float
+    NV_critical: float
+    omega_critical: float | None
+    ratio_critical: float
+    V_critical: float
+    lookahead_critical: float
+    lookahead_time_critical: float | None
+    reason: str | None = None
+
+
+def law_verdict(model, law, point: TrackingPoint, loop: Loop, rho_star: float | None = None) -> LawVerdict:
+    """One model's `LawVerdict` for a closed-form law at `point` (module docstring): the verdict by the one rule
+    (`models.verdicts.judge`), ρ* (`ratio_critical`), the margin ρ*/ρ − 1, V*, L* and lookahead_time*.
+
+    Parameters
+    ----------
+    model : LoopModel
+        One of the five models.
+    law : PurePursuit or Graceful
+        The linearised law.
+    point : TrackingPoint
+        The law at the cruising speed.
+    loop : Loop
+        The loop of `point` (`tracking_loop`).
+    rho_star : float, optional
+        ρ* of this model and loop, 1/s, when already known (it does not depend on k, so every operating point of one
+        plant and period shares it); default: searched (`ratio_critical`).
+    """
+    boundary = model.boundary(loop)
+    judgement = judge(point.NV, point.N, boundary, lambda nv: model.is_stable(nv, loop))
+    rho_star = ratio_critical(model, loop, law.shape) if rho_star is None else rho_star
+    margin = rho_star / point.ratio - 1.0
+    reason = judgement.reason
+    if judgement.verdict == "stable" and margin < 0:  # stable beyond the first loss along the ray: a later band of ρ
+        reason = "stable in a band of V/L beyond the first loss of stability (V*, L* bound the first band)"
+    return LawVerdict(judgement.verdict, margin, point.NV, boundary.NV_critical, boundary.omega_critical, rho_star,
+                      _speed_critical(law, rho_star), _lookahead_critical(law, point, rho_star),
+                      _lookahead_time_critical(law, point, rho_star), reason)
+
+
 def _verdict(model, law, point: TrackingPoint, loop: Loop) -> PathVerdict:
     """One model's `PathVerdict` (module docstring)."""
     NV, N = point.NV, point.N
-    boundary = model.boundary(loop)
-    judgement = judge(NV, N, boundary, lambda nv: model.is_stable(nv, loop))
     unstable_at_once = N < 0
-    T_star, D_star = (0.0, 0.0) if unstable_at_once else _delay_margins(model, NV, loop, judgement.stable)
+    if isinstance(law, MeasuredGains):
+        boundary = model.boundary(loop)
+        judgement = judge(NV, N, boundary, lambda nv: model.is_stable(nv, loop))
+        stable = judgement.stable
+    else:
+        own = law_verdict(model, law, point, loop)
+        stable = own.verdict == "stable"
+    T_star, D_star = (0.0, 0.0) if unstable_at_once else _delay_margins(model, NV, loop, stable)
     root = None if unstable_at_once else model.rightmost_root(NV, loop)
-    common = dict(model=model.name, verdict=judgement.verdict, NV=NV, NV_critical=boundary.NV_critical, omega_critical=boundary.omega_critical,
-                  dead_time_critical=D_star, T_critical=T_star, rightmost_root=root, reason=judgement.reason)
     if isinstance(law, MeasuredGains):
         low, high, verdicts = _gain_range(model, law, loop)
-        return PathVerdict(margin=judgement.margin, ratio_critical=None, V_critical=judgement.V_critical, lookahead_critical=None,
-                           lookahead_time_critical=None, margin_range=None if low is None else (low, high),
-                           verdict_range=verdicts, **common)
-    rho_star = ratio_critical(model, loop, law.shape)
-    margin = rho_star / point.ratio - 1.0
-    if judgement.verdict == "stable" and margin < 0:  # stable beyond the first loss along the ray: a later band of ρ
-        common["reason"] = "stable in a band of V/L beyond the first loss of stability (V*, L* bound the first band)"
-    return PathVerdict(margin=margin, ratio_critical=rho_star, V_critical=_speed_critical(law, rho_star),
-                       lookahead_critical=_lookahead_critical(law, point, rho_star),
-                       lookahead_time_critical=_lookahead_time_critical(law, point, rho_star), **common)
+        return PathVerdict(model=model.name, verdict=judgement.verdict, NV=NV, NV_critical=boundary.NV_critical,
+                           omega_critical=boundary.omega_critical, dead_time_critical=D_star, T_critical=T_star, rightmost_root=root,
+                           reason=judgement.reason, margin=judgement.margin, ratio_critical=None, V_critical=judgement.V_critical,
+                           lookahead_critical=None, lookahead_time_critical=None, margin_range=None if low is None else (low, high),
+                           verdict_range=verdicts)
+    return PathVerdict(model=model.name, verdict=own.verdict, margin=own.margin, NV=NV, NV_critical=own.NV_critical,
+                       omega_critical=own.omega_critical, ratio_critical=own.ratio_critical, V_critical=own.V_critical,
+                       lookahead_critical=own.lookahead_critical, lookahead_time_critical=own.lookahead_time_critical,
+                       dead_time_critical=D_star, T_critical=T_star, rightmost_root=root, reason=own.reason)
 
 
 def _delay_margins(model, NV: float, loop: Loop, stable: bool) -> tuple:
@@ -560,8 +632,11 @@ def _notes(law, point: TrackingPoint, half_width) -> tuple:
     notes = []
     if isinstance(law, PurePursuit):
         v = law.values
-        if v["use_regulated_linear_velocity_scaling"]:
+        if v["use_regulated_linear_velocity_scaling"] and law.curvature == 0:
             notes.append("curvature heuristic inactive on a straight path (kappa = 0: radius beyond regulated_linear_scaling_min_radius)")
+        elif v["use_regulated_linear_velocity_scaling"]:
+            notes.append(f"curvature heuristic at the path's curvature {law.curvature:.4g} 1/m (radius {1 / abs(law.curvature):.4g} m; "
+                         "the gains are the straight path's)")
         scale = law.cost_scale()
         if v["use_cost_regulated_linear_velocity_scaling"]:
             if scale is None:
@@ -594,6 +669,23 @@ def _model_delay(law, values: dict, robot, controller) -> ModelDelay | None:
     return ModelDelay(latency, dt, steps, steps * dt, values["model_delay_wz"])
 
 
+def check_tracking_point(point: TrackingPoint) -> None:
+    """ValueError unless the law at `point` drives forward (V > 0) with a steering gain k_θ in the loop's range.
+
+    Parameters
+    ----------
+    point : TrackingPoint
+        The law at the cruising speed.
+    """
+    if point.V <= 0:
+        raise ValueError(f"the controller drives at V = {point.V:g} m/s on the path: the lateral loop needs V > 0")
+    k = RANGES["k"]
+    if not k.low <= point.k_theta <= k.high:
+        what = f"V = {point.V:g} m/s over the lookahead L = {point.L:g} m" if point.L is not None else f"k_theta = {point.k_theta:g} 1/s"
+        raise ValueError(f"the controller's steering gain k_theta = {point.k_theta:g} 1/s ({what}) is outside the loop's "
+                         f"steering gains {k.describe()}")
+
+
 def analyze_path_tracking(robot, controller, law, models, *, V_set: float | None = None, half_width: float | None = None,
                           values: dict | None = None) -> PathTracking:
     """Every model's verdict and critical values for a controller's law about a straight path (module docstring).
@@ -621,13 +713,7 @@ def analyze_path_tracking(robot, controller, law, models, *, V_set: float | None
     """
     half_width = getattr(law, "half_width", None) if half_width is None else half_width
     point = law.point(robot.V if V_set is None else V_set)
-    if point.V <= 0:
-        raise ValueError(f"the controller drives at V = {point.V:g} m/s on the path: the lateral loop needs V > 0")
-    k = RANGES["k"]
-    if not k.low <= point.k_theta <= k.high:
-        what = f"V = {point.V:g} m/s over the lookahead L = {point.L:g} m" if point.L is not None else f"k_theta = {point.k_theta:g} 1/s"
-        raise ValueError(f"the controller's steering gain k_theta = {point.k_theta:g} 1/s ({what}) is outside the loop's "
-                         f"steering gains {k.describe()}")
+    check_tracking_point(point)
     loop = tracking_loop(robot, controller, point)
     verdicts = {m.name: _verdict(m, law, point, loop) for m in models}
     memory = None

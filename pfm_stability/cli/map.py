@@ -25,8 +25,8 @@ import argparse
 
 from ..laws.registry import DEFAULT_LAW, laws_for
 from ..parameters import MODEL_NAMES
-from .options import (add_law_options, add_parameter_options, describe, input_file, integer, number, resolve_law, resolve_parameters,
-                      shipped_or_given)
+from .options import (add_controller_options, add_law_options, add_parameter_options, describe, input_file, integer, number,
+                      refuse_vff_options, resolve_law, resolve_parameters, resolve_tracker, shipped_or_given)
 
 FORMATS = ("text", "json")
 SHIPPED_MAPS = ("depot", "warehouse", "tb3_sandbox")
@@ -57,6 +57,7 @@ def add_parser(sub) -> None:
     p.add_argument("map", metavar="MAP", help=f"map_server YAML file, or a shipped map: {', '.join(SHIPPED_MAPS)}")
     add_parameter_options(p)
     add_law_options(p, laws_for("map"), default=DEFAULT_LAW["map"])  # a Default: a --config FILE's law beats it (`options.typed`)
+    add_controller_options(p)  # --controller rpp: Nav2's Regulated Pure Pursuit along the routes (maps.tracking)
     p.add_argument("--model", choices=MODEL_NAMES, default="sampled",
                    help="loop model of the verdicts (default sampled, with the controller's hold and compute delay)")
     p.add_argument("--out-dir", type=_out_dir, metavar="DIR",
@@ -174,7 +175,13 @@ def run(args) -> int:
     from .render import render_map_text
 
     started = time.perf_counter()
-    params = resolve_parameters(args)
+    if str(args.controller) not in ("vff", "auto", *TRACKING_CONTROLLERS):
+        raise ValueError(f"--controller {args.controller}: map decides --controller vff or {', '.join(TRACKING_CONTROLLERS)} along a map's "
+                         "routes (docs/maps.md, \"Nav2's controllers along a map\")")
+    params = resolve_parameters(args, notes=str(args.controller) == "vff")
+    path = resolve_tracker(args, params)
+    if path is not None:
+        return _run_tracking(args, path, started)
     law, _ = resolve_law(args, params)
     check_map_law(law)  # the law resolved: typed, or named by --config FILE
     occupancy = load_map(map_path(args.map))
@@ -212,6 +219,65 @@ def run(args) -> int:
     else:
         print(render_map_text(data), end="")
     return 0
+
+
+TRACKING_CONTROLLERS = ("rpp",)
+"""The Nav2 controllers ``map --controller`` decides (`maps.tracking.MAP_CONTROLLERS`; numpy-free here for the refusal)."""
+_VFF_ONLY = ("validate", "wobble", "goals", "min_length")
+"""``map`` options of the VFF analysis alone (refused with a Nav2 controller, `_run_tracking`); ``--seed`` too when typed."""
+
+
+def _run_tracking(args, path, started: float) -> int:
+    """``map --controller rpp``: the controller along every route (`maps.tracking.analyze_map_tracking`), its outputs."""
+    import sys
+    import time
+
+    from ..extras import require
+
+    given = [(f"--{key.replace('_', '-')}", getattr(args, key, None) is not None) for key in _VFF_ONLY] + [("--seed", args.seed != 0)]
+    refuse_vff_options(args, path, given, keep=("cell_size",))
+    if path.tracker.controller not in TRACKING_CONTROLLERS:
+        raise ValueError(f"--controller auto found {path.tracker.controller} in the Nav2 file: map decides --controller vff or "
+                         f"{', '.join(TRACKING_CONTROLLERS)} along a map's routes")
+    require("maps", "pfm-stability map")
+    from ..io.serialize import dumps
+    from ..maps.occupancy import load_map
+    from ..maps.tracking import analyze_map_tracking
+    from .progress import line_progress
+    from .render import render_map_tracking_text
+
+    occupancy = load_map(map_path(args.map))
+    with line_progress("map", quiet=args.quiet) as progress:
+        analysis = analyze_map_tracking(occupancy, path.robot, path.controller, path.tracker, model=args.model, unknown=args.unknown,
+                                        cell_size=args.cell_size if args.cell_size is not None else 0.1, routes=_user_routes(args.route or ()),
+                                        progress=progress, warn=lambda line: print(f"pfm-stability: warning: {line}", file=sys.stderr, flush=True))
+        outputs = _write_tracking_outputs(analysis, args.out_dir, args.dilate_upstream) if args.out_dir else None
+    data = {**analysis.to_dict(), "validation": None, "outputs": outputs,
+            "timing": {"seconds": time.perf_counter() - started, **{f"{k}_seconds": v for k, v in analysis.timing.items()}}}
+    if args.format == "json":
+        print(dumps({"schema_version": _schema_version(), "command": "map", **data}))
+    else:
+        print(render_map_tracking_text(data), end="")
+    return 0
+
+
+def _write_tracking_outputs(analysis, out_dir: str, a_max=None) -> dict:
+    """The files of ``map --controller --out-dir``, all or none (`files.atomic_directory`): ``routes.csv``, the speed mask
+    (`maps.outputs`) and the ZoneParameterFilter's mask and parameters (`maps.zone_filter`)."""
+    import os
+
+    from ..io.files import atomic_directory, open_new
+    from ..maps.outputs import MASK_FILES, speed_mask_pgm, speed_mask_yaml, tracking_csv
+    from ..maps.zone_filter import ZONE_FILES, zone_mask_pgm, zone_mask_yaml, zone_params_yaml
+
+    contents = {"routes.csv": tracking_csv(analysis).encode("utf-8"), MASK_FILES[0]: speed_mask_pgm(analysis, a_max),
+                MASK_FILES[1]: speed_mask_yaml(analysis.occupancy).encode("utf-8"), ZONE_FILES[0]: zone_mask_pgm(analysis),
+                ZONE_FILES[1]: zone_mask_yaml(analysis.occupancy).encode("utf-8"), ZONE_FILES[2]: zone_params_yaml(analysis).encode("utf-8")}
+    with atomic_directory(out_dir, tuple(contents), what="map outputs") as paths:
+        for name, content in contents.items():
+            with open_new(paths[name], "wb") as fh:
+                fh.write(content)
+    return {name: os.path.join(out_dir, name) for name in contents}
 
 
 def _schema_version() -> str:

@@ -595,6 +595,31 @@ def add_controller_options(parser: argparse.ArgumentParser) -> None:
     group.add_argument("--k-y-se", type=number("k_y_se"), help=f"its standard error, {describe('k_y_se')} (default 0)")
 
 
+def refuse_vff_options(args, path, given=(), keep=()) -> None:
+    """ValueError naming the first option that applies only to ``--controller vff`` the user gave with a Nav2 controller:
+    ``--law``, ``--robot``, ``--mass``, the VFF gains ``--k``, ``--f``, ``--n``, ``--W`` (`path.sources` says who gave them),
+    every law parameter and choice, and the command's own `given` ((option, given) pairs).
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed options.
+    path : ResolvedTracker
+        The controller (`resolve_tracker`).
+    given : sequence of (str, bool)
+        More VFF-only options of the command, and whether each was given.
+    keep : sequence of str
+        Keys among the law parameters and the VFF values that the command reads with a Nav2 controller too.
+    """
+    options = [("--law", typed(args, "law")), ("--robot", typed(args, "robot")), ("--mass", getattr(args, "mass", None) is not None)]
+    options += [(f"--{key.replace('_', '-')}", path.sources.get(key) == "user") for key in ("k", "f", "n", "W") if key not in keep]
+    options += [(option_name(key), getattr(args, key, None) is not None) for key in (*parameter_keys(), *choice_keys()) if key not in keep]
+    for option, was_given in (*options, *given):
+        if was_given:
+            raise ValueError(f"{option} applies to --controller vff (the VFF loop), not to --controller {path.tracker.controller} "
+                             "(its gains are its own law's, docs/path_tracking.md)")
+
+
 def nav2_parameter(text: str) -> tuple:
     """An argparse ``type=`` for ``--param NAME=VALUE``: (name, value parsed by the YAML rule); the controller checks both
     (`resolve_tracker`, the registry's ranges).

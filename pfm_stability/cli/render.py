@@ -731,6 +731,44 @@ MAP_ROWS = 15
 """Segments listed by ``pfm-stability map`` (the worst first)."""
 
 
+def render_map_tracking_text(data: dict) -> str:
+    """``pfm-stability map --controller rpp``: the map, the robot and controller, the free-space reference, the unstable
+    stretches (smallest margin first) with the lookahead a zone sets, the summary, the outputs.
+
+    Parameters
+    ----------
+    data : dict
+        The analysis's JSON form (`maps.tracking.MapTracking.to_dict`, outputs and timing).
+    """
+    m, i, t = data["map"], data["inputs"], data["tracking"]
+    ref = data["tracking_verdict"]
+    pv = data["paths"]
+    s = pv["summary"]
+    lines = [f"map {m['name']}: {m['width']} x {m['height']} cells of {m['resolution']:g} m; routes on a grid of {i['cell_size']:g} m "
+             f"(unknown = {i['unknown']})",
+             f"controller {data['controller']} at max_linear_vel V = {i['V']:g} m/s, lookahead {t['law']['L']:g} m; plant tau = {i['tau']:g} s, "
+             f"D = {i['dead_time']:g} s, g = {i['plant_gain']:g}; T = {i['T']:g} s; model {i['model']}: (V/L)* = {number(ref['ratio_critical'])} 1/s",
+             f"free space: {ref['verdict']}, margin {percent(ref['margin'])}, V* = {number(ref['V_critical'])} m/s, "
+             f"L* = {number(ref['lookahead_critical'])} m, D* = {number(ref['dead_time_critical'])} s, T* = {number(ref['T_critical'])} s", ""]
+    unstable = sorted((x for x in pv["stretches"] if x["verdict"] == "unstable"), key=lambda x: x["margin"])
+    if unstable:
+        lines.append(f"{'route':>5} {'from m':>7} {'to m':>7} {'margin':>8} {'V* m/s':>7} {'L* m':>6} {'V m/s':>6} {'L_c m':>6} {'kappa':>6}"
+                     f"  zone {pv['lookahead_parameter']}")
+        for x in unstable[:MAP_ROWS]:
+            zone = "-" if x["zone_lookahead"] is None else f"{x['zone_lookahead']:g} m"
+            lines.append(f"{x['route']:>5} {x['start']:>7.2f} {x['stop']:>7.2f} {percent(x['margin']):>8} {number(x['V_critical']):>7} "
+                         f"{number(x['lookahead_critical']):>6} {x['V']:>6.3g} {x['half_width']:>6.3g} {x['curvature']:>6.3g}  {zone}")
+        if len(unstable) > MAP_ROWS:
+            lines.append(f"... {len(unstable) - MAP_ROWS} more unstable stretches (--format json, --out-dir: routes.csv)")
+    counts = ", ".join(f"{n} {v}" for v, n in s["stretches"].items() if n)
+    lines += [f"{s['routes']} routes, {s['route_length_m']:.1f} m: {s['unstable_length_m']:.1f} m unstable, {s['stable_length_m']:.1f} m stable, "
+              f"{s['unjudged_length_m']['no room']:.1f} m no room; stretches: {counts}; slowest V* {number(s['V_critical_min'])} m/s; "
+              f"{s['lookahead_zones']} unstable stretches a longer lookahead fixes; {s['decisions']} corridors decided"]
+    for name, path in (data.get("outputs") or {}).items():
+        lines.append(f"{name}: {path}")
+    return "\n".join(lines) + "\n"
+
+
 def render_map_text(data: dict) -> str:
     """``pfm-stability map``: the map, the robot, the one result set (the routes' unstable stretches, slowest V* first,
     and their summary; the segments with the power law), the validation, the outputs.

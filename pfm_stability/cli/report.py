@@ -3,9 +3,9 @@ and force law (``--law``, docs/fields.md, docs/velocity_and_fuzzy.md): `report.s
 
 from __future__ import annotations
 
-from ..laws.registry import FAMILY_LAWS, FORCE_LAWS, choice_keys, option_name, parameter_keys
+from ..laws.registry import FAMILY_LAWS, FORCE_LAWS
 from ..parameters import DOOR_OBSTACLES, MODEL_NAMES
-from .options import (PADE_ORDER, typed, add_controller_options, add_family_options, add_law_options, add_parameter_options, describe, number,
+from .options import (PADE_ORDER, add_controller_options, refuse_vff_options, add_family_options, add_law_options, add_parameter_options, describe, number,
                       resolve_family, resolve_parameters, resolve_tracker)
 
 FORMATS = ("text", "json", "markdown")
@@ -68,13 +68,7 @@ def _path_report(args, path):
     """A Nav2 controller's report (`report.stability.build_report` with its ``tracker``; docs/path_tracking.md)."""
     from ..report.stability import build_report
 
-    vff_only = [("--law", typed(args, "law")), ("--robot", typed(args, "robot")), ("--mass", args.mass is not None)]
-    vff_only += [(f"--{key.replace('_', '-')}", path.sources.get(key) == "user") for key in ("k", "f", "n", "W")]
-    vff_only += [(option_name(key), getattr(args, key, None) is not None) for key in (*parameter_keys(), *choice_keys())]
-    for option, given in vff_only:
-        if given:
-            raise ValueError(f"{option} applies to --controller vff (the VFF loop), not to --controller {path.tracker.controller} "
-                             "(its gains are its own law's, docs/path_tracking.md)")
+    refuse_vff_options(args, path)
     return build_report(
         path.robot, path.controller, alpha_deg=args.alpha, L=args.L, door=args.door, wobble=args.wobble,
         models=tuple(dict.fromkeys(args.model)) if args.model else MODEL_NAMES, pade_order=args.pade_order,

@@ -47,7 +47,7 @@ from ..checks import check_number
 from .base import Command, RobotState, normalize_angle
 from .plan import PRUNE_DISTANCE, lookahead_point, local_plan, path_length, to_robot_frame
 
-__all__ = ["RPPParams", "command", "lookahead_distance", "curvature", "regulated_speed", "closed_form_gains", "with_speed",
+__all__ = ["RPPParams", "command", "lookahead_distance", "curvature", "regulated_speed", "curvature_constraint", "closed_form_gains", "with_speed",
            "nominal_speed", "LINEARIZATION_STEPS",
            "GOAL_XY_TOLERANCE"]
 
@@ -203,6 +203,25 @@ def curvature(x: float, y: float) -> float:
     return 2.0 * y / d2 if d2 > 0.001 else 0.0
 
 
+def curvature_constraint(v: float, kappa: float, min_radius: float) -> float:
+    """``curvatureConstraint``: the speed v (m/s) scaled by 1 − |R − R_min|/R_min when the radius R = 1/|κ| is below
+    R_min = ``regulated_linear_scaling_min_radius`` (v itself at κ = 0 or R >= R_min), m/s.
+
+    Parameters
+    ----------
+    v : float
+        m/s.
+    kappa : float
+        The regulation curvature, 1/m.
+    min_radius : float
+        R_min, m.
+    """
+    if kappa == 0.0:
+        return v
+    radius = abs(1.0 / kappa)
+    return v * (1.0 - abs(radius - min_radius) / min_radius) if radius < min_radius else v
+
+
 def regulated_speed(params: RPPParams, kappa: float, pose_cost: float, inscribed_radius: float, remaining: float,
                     goal_distance: float) -> float:
     """``applyConstraints``: the regulated forward speed, m/s (module docstring, step 5).
@@ -223,10 +242,8 @@ def regulated_speed(params: RPPParams, kappa: float, pose_cost: float, inscribed
     """
     v = params.max_linear_vel
     curvature_v = cost_v = v
-    if params.use_regulated_linear_velocity_scaling and kappa != 0.0:
-        radius = abs(1.0 / kappa)
-        if radius < params.regulated_linear_scaling_min_radius:
-            curvature_v = v * (1.0 - abs(radius - params.regulated_linear_scaling_min_radius) / params.regulated_linear_scaling_min_radius)
+    if params.use_regulated_linear_velocity_scaling:
+        curvature_v = curvature_constraint(v, kappa, params.regulated_linear_scaling_min_radius)
     if params.use_cost_regulated_linear_velocity_scaling and pose_cost not in (0.0, 255.0):
         f = params.inflation_cost_scaling_factor
         distance = (f * inscribed_radius - math.log(pose_cost) + math.log(253.0)) / f

@@ -47,6 +47,9 @@ __all__ = [
     "speed_limits",
     "speed_mask_yaml",
     "speed_mask_pgm",
+    "stamp_stretch",
+    "tracking_csv",
+    "TRACKING_COLUMNS",
     "upstream_distance",
 ]
 
@@ -60,6 +63,9 @@ MASK_FILES = ("speed_mask.pgm", "speed_mask.yaml")
 ROUTE_COLUMNS = ("route", "start", "stop", "x0", "y0", "x1", "y1", "length", "verdict", "cause", "growth_rate", "efolds", "N", "margin",
                  "V_critical", "direction", "oscillates", "amplitude", "linearized_at_route")
 """What ``--out-dir`` receives."""
+TRACKING_COLUMNS = ("route", "start", "stop", "x0", "y0", "x1", "y1", "length", "verdict", "cause", "margin", "V_critical",
+                    "lookahead_critical", "V", "L", "half_width", "pose_cost", "curvature", "zone_lookahead")
+"""``routes.csv`` of ``map --controller rpp`` (`maps.tracking.TrackingStretch`)."""
 CSV_COLUMNS = ("x0", "y0", "x1", "y1", "length", "N", "c", "V_critical", "margin", "stable", "verdict", "offset", "samples", "analysed",
                "N_max", "V_critical_local", "wavelength")
 MIN_PERCENT = 1
@@ -86,9 +92,27 @@ def routes_csv(analysis) -> str:
     analysis : MapAnalysis
         With `MapAnalysis.paths`.
     """
-    lines = [",".join(ROUTE_COLUMNS)]
-    for stretch in analysis.paths.stretches:
-        lines.append(",".join(_csv_value(getattr(stretch, key)) for key in ROUTE_COLUMNS))
+    return _stretches_csv(analysis.paths.stretches, ROUTE_COLUMNS)
+
+
+def tracking_csv(analysis) -> str:
+    """One row per stretch of a Nav2 controller along the routes (`maps.tracking.TrackingStretch`): route, arc positions
+    and ends (m), length, verdict, cause, margin, V* (m/s), L* (m), the regulated speed (m/s) and lookahead (m), the
+    half-width (m), cost and curvature (1/m) of the worst sample, the zone's lookahead (m).
+
+    Parameters
+    ----------
+    analysis : MapTracking
+        With `maps.tracking.TrackingVerdicts` as ``paths``.
+    """
+    return _stretches_csv(analysis.paths.stretches, TRACKING_COLUMNS)
+
+
+def _stretches_csv(stretches, columns) -> str:
+    """A header of `columns` and one row per stretch."""
+    lines = [",".join(columns)]
+    for stretch in stretches:
+        lines.append(",".join(_csv_value(getattr(stretch, key)) for key in columns))
     return "\n".join(lines) + "\n"
 
 
@@ -159,10 +183,35 @@ def speed_limits(analysis, a_max: float | None = None) -> np.ndarray:
         if limit is None:
             continue
         reach = upstream_distance(V, limit, a_max) if a_max is not None else 0.0
-        points = route_piece(pv.paths[s.route].points, s.start - reach, s.stop + reach)
-        for (x0, y0), (x1, y1) in zip(points[:-1], points[1:]):
-            _stamp(limits, occupancy, x0, y0, x1, y1, half, _percent(limit, V))
+        stamp_stretch(limits, occupancy, pv.paths[s.route].points, s, reach, half, _percent(limit, V))
     return limits
+
+
+def stamp_stretch(values: np.ndarray, occupancy, points, stretch, reach: float, half: float, value: int, combine=np.minimum) -> None:
+    """`_stamp` `value` within `half` m of a route stretch extended by `reach` m along its route at both ends.
+
+    Parameters
+    ----------
+    values : ndarray of int, shape (height, width)
+        Per map cell, changed in place.
+    occupancy : OccupancyMap
+        The map (its cells).
+    points : ndarray, shape (n, 2)
+        The stretch's route, m.
+    stretch : PathStretch or TrackingStretch
+        With ``start`` and ``stop`` (m along the route).
+    reach : float
+        m added at both ends.
+    half : float
+        m either side of the route.
+    value : int
+        What the cells receive.
+    combine : callable
+        Of a cell's value and `value` (`np.minimum`: the lower limit).
+    """
+    piece = route_piece(points, stretch.start - reach, stretch.stop + reach)
+    for (x0, y0), (x1, y1) in zip(piece[:-1], piece[1:]):
+        _stamp(values, occupancy, x0, y0, x1, y1, half, value, combine)
 
 
 def has_zone(zone, V: float) -> bool:
@@ -236,8 +285,10 @@ def _percent(V_limit: float, V: float) -> int:
     return max(MIN_PERCENT, min(100, math.floor(100.0 * V_limit / V)))
 
 
-def _stamp(limits: np.ndarray, occupancy, x0: float, y0: float, x1: float, y1: float, half: float, percent: int) -> None:
-    """Lower `limits` to `percent` in the cells whose centres lie within `half` m of the segment (x0, y0)–(x1, y1)."""
+def _stamp(limits: np.ndarray, occupancy, x0: float, y0: float, x1: float, y1: float, half: float, percent: int,
+           combine=np.minimum) -> None:
+    """Lower `limits` to `percent` in the cells whose centres lie within `half` m of the segment (x0, y0)–(x1, y1)
+    (`combine` of the two: the lower limit; `np.maximum` for the zone mask's states, the longest lookahead)."""
     r = occupancy.resolution
     ox, oy = occupancy.origin[0], occupancy.origin[1]
     i0, j0 = occupancy.cell_of(min(x0, x1) - half, min(y0, y1) - half)
@@ -250,7 +301,7 @@ def _stamp(limits: np.ndarray, occupancy, x0: float, y0: float, x1: float, y1: f
     px, py = ox + (ii + 0.5) * r, oy + (jj + 0.5) * r
     near = _distance_to_segment(px, py, x0, y0, x1, y1) <= half
     block = limits[j0:j1 + 1, i0:i1 + 1]
-    block[near] = np.minimum(block[near], percent)
+    block[near] = combine(block[near], percent)
 
 
 def _distance_to_segment(px, py, x0, y0, x1, y1):

@@ -93,7 +93,7 @@ from .routes import polyline_arcs
 from .stretch_speed import stretch_speeds
 from .verdicts import END_FRACTION, GrowthRate, effective_gain
 
-__all__ = ["PathStretch", "PathVerdicts", "analyze_paths"]
+__all__ = ["PathStretch", "PathVerdicts", "analyze_paths", "routes_json"]
 
 @dataclass(frozen=True)
 class PathStretch:
@@ -276,10 +276,20 @@ class PathVerdicts:
     def to_dict(self) -> dict:
         """``routes`` (source, length, points), ``stretches``, ``summary``."""
         return {
-            "routes": [{"source": p.source, "length": p.length, "points": [[float(a), float(b)] for a, b in p.points]} for p in self.paths],
+            "routes": routes_json(self.paths),
             "stretches": [s.to_dict() for s in self.stretches],
             "summary": self.summary(),
         }
+
+
+def routes_json(paths) -> list:
+    """The routes, JSON-ready: each one's source, length (m) and points (m).
+
+    Parameters
+    ----------
+    paths : sequence of RoutePath
+    """
+    return [{"source": p.source, "length": p.length, "points": [[float(a), float(b)] for a, b in p.points]} for p in paths]
 
 
 def analyze_paths(grid, law, paths, clearance: np.ndarray, W: float, V: float, boundary, growth: GrowthRate,
