@@ -40,7 +40,7 @@ def test_each_collision_is_set_beside_the_nearest_prediction():
     assert by_drive[3].verdict == "stable" and not (by_drive[3].foreseen or by_drive[3].near_weave)
     assert by_drive[4].route == 1 and by_drive[4].distance == pytest.approx(0.2, abs=1e-9)
     assert by_drive[5].route is None and by_drive[5].verdict is None
-    assert (summary.foreseen, summary.near_weave, summary.off_routes) == (2, 1, 1)
+    assert (summary.foreseen, summary.near_weave, summary.elsewhere, summary.off_routes) == (2, 1, 2, 1)
     data = summary.to_dict()
     assert data["count"] == 6 and len(data["collisions"]) == 6 and data["match_distance"] == 0.5
 

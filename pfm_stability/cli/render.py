@@ -860,7 +860,8 @@ def _map_drive_lines(d: dict) -> list[str]:
     c = d.get("collisions")
     if c and c["count"]:  # where the drives met an obstacle, beside the map's prediction
         lines.append(f"  collisions: {c['count']} drives met an obstacle; {c['foreseen']} within {c['match_distance']:g} m of a "
-                     f"predicted collision course, {c['near_weave']} more near a predicted weave, {c['off_routes']} off every route "
+                     f"predicted collision course, {c['near_weave']} more near a predicted weave, {c['elsewhere']} elsewhere on a route, "
+                     f"{c['off_routes']} off every route "
                      f"(where: validation.collisions in the JSON; X on routes.png)")
     w = d.get("wobble")
     if w and w.get("within") is not None:  # how big the predicted weave is against the simulated one

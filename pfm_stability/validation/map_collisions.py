@@ -85,6 +85,12 @@ class CollisionSummary:
         return sum(c.near_weave and not c.foreseen for c in self.collisions)
 
     @property
+    def elsewhere(self) -> int:
+        """Collisions near a route but neither foreseen nor near a predicted weave (the route called stable there, or
+        unjudged)."""
+        return sum(c.route is not None and not (c.foreseen or c.near_weave) for c in self.collisions)
+
+    @property
     def off_routes(self) -> int:
         """Collisions farther than the match distance from every route."""
         return sum(c.route is None for c in self.collisions)
@@ -92,7 +98,7 @@ class CollisionSummary:
     def to_dict(self) -> dict:
         """JSON form: the counts and every collision."""
         return {"count": len(self.collisions), "foreseen": self.foreseen, "near_weave": self.near_weave,
-                "off_routes": self.off_routes, "match_distance": json_number(self.match_distance),
+                "elsewhere": self.elsewhere, "off_routes": self.off_routes, "match_distance": json_number(self.match_distance),
                 "collisions": [c.to_dict() for c in self.collisions]}
 
 

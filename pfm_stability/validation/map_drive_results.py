@@ -30,10 +30,10 @@ class SimulatedDrive:
         What ended it (`Drive.event`).
     t, x, y : ndarray
         Its trajectory: times (s) and positions (m).
-    contact : tuple of float or None
-        (x, y) of the robot's centre where a collision ended it, m (None: no collision).
     path : int or None
         Its own path's index among `DriveRuns.drive_paths`' routes (None: it did not move).
+    contact : tuple of float or None
+        (x, y) of the robot's centre where a collision ended it, m (None: no collision).
     """
 
     index: int
