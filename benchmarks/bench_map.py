@@ -27,7 +27,7 @@ def run_once(name: str, segments: bool = False) -> dict:
     from pfm_stability.cli.map import _write_outputs, map_path
     from pfm_stability.laws.fields import make_law
     from pfm_stability.maps.analysis import analyze_map
-    from pfm_stability.maps.occupancy import load_map
+    from pfm_stability.maps.reading.occupancy import load_map
     from pfm_stability.parameters import CARMEL
 
     robot, controller = CARMEL.robot, CARMEL.controller

@@ -7,7 +7,7 @@ report (`criteria.analyze_corridor` with the same grid law: what ``pfm-stability
 
 * middle N: the largest |N_i/N − 1| over the samples more than `MIDDLE` m from the segment's ends, where the
   window (±1.65 m) sees the whole wall on both sides, as the report's infinite corridor;
-* middle V*: V* of those samples' mean growth rate (`maps.verdicts.critical_speed`) against the report's V*;
+* middle V*: V* of those samples' mean growth rate (`maps.deciding.verdicts.critical_speed`) against the report's V*;
 * segment V*: the segment's own V* (every sample judged, ends included) against the report's V*.
 
 Prints one row per width and direction, and the largest of each column.
@@ -27,8 +27,8 @@ from PIL import Image
 from pfm_stability.analysis.criteria import analyze_corridor
 from pfm_stability.laws.fields import make_law
 from pfm_stability.maps.analysis import analyze_map
-from pfm_stability.maps.occupancy import load_map
-from pfm_stability.maps.verdicts import GrowthRate, critical_speed
+from pfm_stability.maps.reading.occupancy import load_map
+from pfm_stability.maps.deciding.verdicts import GrowthRate, critical_speed
 from pfm_stability.models import Loop, models_for
 from pfm_stability.parameters import CARMEL, Corridor
 

@@ -35,8 +35,8 @@ import numpy as np
 
 from pfm_stability.laws.fields import make_law
 from pfm_stability.maps.analysis import analyze_map
-from pfm_stability.maps.verdicts import END_FRACTION, TAPER_SLOPE
-from pfm_stability.maps.occupancy import load_map
+from pfm_stability.maps.deciding.verdicts import END_FRACTION, TAPER_SLOPE
+from pfm_stability.maps.reading.occupancy import load_map
 from pfm_stability.parameters import CARMEL
 from pfm_stability.io.serialize import dumps
 from pfm_stability.validation.maps import CLEAR_MARGIN, simulator_grid, validate_map_segments

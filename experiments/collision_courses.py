@@ -36,8 +36,8 @@ def measure(name: str, robot_changes: dict, drives: int, seed: int) -> dict:
     from pfm_stability.cli.map import map_path
     from pfm_stability.laws.fields import make_law
     from pfm_stability.maps.analysis import analyze_map
-    from pfm_stability.maps.decide import CAUSES
-    from pfm_stability.maps.occupancy import load_map
+    from pfm_stability.maps.deciding.decide import CAUSES
+    from pfm_stability.maps.reading.occupancy import load_map
     from pfm_stability.parameters import CARMEL
     from pfm_stability.validation.map_drives import judge_drives, simulate_drives
 

@@ -3,14 +3,14 @@
 For every shipped map (depot, warehouse, tb3_sandbox) at CARMEL (the default robot) and at the small robot
 (``--W 0.3 --V 0.5``), the map is analysed and driven once, as ``pfm-stability map MAP --validate N --seed S`` does
 (`validation.map_drives.simulate_drives`: the same drives, seeded), and the drives are judged again
-(`validation.map_drives.judge_drives`) with each threshold of `maps.judge_thresholds.JudgeThresholds` moved down and up
+(`validation.map_drives.judge_drives`) with each threshold of `maps.judging.judge_thresholds.JudgeThresholds` moved down and up
 (`VARIANTS`), the others at their defaults: recall, precision and specificity, each with its 95 % interval over the
 drives (`map_drives._interval`, through `judge_drives`), and the episodes found.
 
 **Only the judge side moves.** The prediction along the drives' own paths is made once, with the package's table
-(`JUDGE`): the map's prediction uses the same judge — the loop driven along a path is judged by `maps.episodes`
+(`JUDGE`): the map's prediction uses the same judge — the loop driven along a path is judged by `maps.judging.episodes`
 (episode periods, growth, amplitude, noise floor, smoothing, gaps, edges) and the window-edge relay is unstable when its
-cycle reaches `amplitude_threshold` (`maps.decide`) — so a change to one of those fields in the package would move the
+cycle reaches `amplitude_threshold` (`maps.deciding.decide`) — so a change to one of those fields in the package would move the
 prediction too. What this measures is how much the agreement rests on where the judge draws the line for the drives.
 
 ``swing_points`` and ``wobble_factor`` move only the reported weave sizes (``false_alarm_swinging``, ``wobble``),
@@ -34,7 +34,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from _common import jsonable, output_dir, save_figure, write_json  # noqa: E402
 
-from pfm_stability.maps.judge_thresholds import JUDGE, JudgeThresholds  # noqa: E402
+from pfm_stability.maps.judging.judge_thresholds import JUDGE, JudgeThresholds  # noqa: E402
 
 MAPS = ("depot", "warehouse", "tb3_sandbox")
 """The shipped maps (`cli.map.SHIPPED_MAPS`)."""
@@ -137,7 +137,7 @@ def analysis_of(map_name: str, robot: tuple, drives: int, seed: int):
     from pfm_stability.cli.map import map_path
     from pfm_stability.cli.options import resolve_law, resolve_parameters
     from pfm_stability.maps.analysis import analyze_map, check_map_law
-    from pfm_stability.maps.occupancy import load_map
+    from pfm_stability.maps.reading.occupancy import load_map
 
     args = build_parser().parse_args(["map", map_name, *robot, "--validate", str(drives), "--seed", str(seed)])
     params = resolve_parameters(args)

@@ -1,4 +1,4 @@
-"""The window-edge relay's limit cycle (`maps.relay`, docs/maps.md): predicted against simulated amplitude and frequency.
+"""The window-edge relay's limit cycle (`maps.deciding.relay`, docs/maps.md): predicted against simulated amplitude and frequency.
 
 Two levels:
 
@@ -10,10 +10,10 @@ Two levels:
    (half the peak-to-peak) too.
 2. **Map level.** CARMEL in an aisle between a one-cell wall and a solid rack (gap cells wide; the rack at the
    window's edge at the equilibrium): `maps.analysis.analyze_map`'s route verdicts (``PathVerdicts.amplitude``, the
-   relay's one-jump prediction as `maps.paths` calls it), the one-jump formula with the jump merged and the slope,
+   relay's one-jump prediction as `maps.deciding.paths` calls it), the one-jump formula with the jump merged and the slope,
    `window_cycle` (the describing function of the window's whole profile), and the VFF simulator (`sim.engine`, the
    grid law, target straight along the aisle, started 3 cm off the equilibrium): first harmonic, peak and the
-   episodes' amplitude (`maps.episodes.episodes`), and the frequency; and the settled first harmonic started 1, 3, 8
+   episodes' amplitude (`maps.judging.episodes.episodes`), and the frequency; and the settled first harmonic started 1, 3, 8
    and 15 cm off (the equilibrium beside a rack is stable only for small disturbances: the staircase's gain).
 
     python experiments/relay_amplitude.py --out experiments/results [--quick]
@@ -32,7 +32,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from _common import output_dir, row, save_figure, script_main, write_json  # noqa: E402
 
-from pfm_stability.maps.relay import relay_amplitude, window_cycle, window_relay  # noqa: E402
+from pfm_stability.maps.deciding.relay import relay_amplitude, window_cycle, window_relay  # noqa: E402
 from pfm_stability.parameters import CARMEL, HOLDS  # noqa: E402
 
 GAPS = (24, 28, 30, 32, 34)
@@ -141,9 +141,9 @@ def map_level(gaps, length: int = 500):
     """Per aisle: the map's predictions at its middle and the VFF simulator's cycle."""
     from pfm_stability.laws.fields import make_law
     from pfm_stability.maps.analysis import analyze_map
-    from pfm_stability.maps.episodes import episodes
-    from pfm_stability.maps.occupancy import load_map
-    from pfm_stability.maps.decide import path_samples
+    from pfm_stability.maps.judging.episodes import episodes
+    from pfm_stability.maps.reading.occupancy import load_map
+    from pfm_stability.maps.deciding.decide import path_samples
     from pfm_stability.models import make_model
     from pfm_stability.models.loop import Loop
     from pfm_stability.sim.engine import run_batch

@@ -24,7 +24,7 @@ parameter's critical value found by bisection on NV*, and a remedy's percentage
 from it, between OpenBLAS's Haswell and SkylakeX kernels). On the machine that
 recorded them the answers are checked at 1e-12 with ``ANSWERS_RTOL=1e-12``. A map is compared to
 its method's accuracy instead: an equilibrium where F_n jumps at a cell boundary
-is located to the bracket / 2^12, about 10 µm (`maps.equilibria.NEWTON_STEPS`),
+is located to the bracket / 2^12, about 10 µm (`maps.deciding.equilibria.NEWTON_STEPS`),
 and where round-off flips F_n's sign near the jump the offset moves by up to that
 (measured: 4e-7 m between numpy's AVX2 and AVX-512 kernels), so offsets compare
 to 1e-5 m and everything else of a map to 1e-9 relative (the gains evaluated at

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from pfm_stability.maps.field import HistogramMap
+from pfm_stability.maps.reading.field import HistogramMap
 from pfm_stability.numerics.cells import cell_center, cell_index
 from pfm_stability.sim.grid import HistogramGrid
 

@@ -1,4 +1,4 @@
-"""The oscillation judge's thresholds table (`maps.judge_thresholds`, docs/judge.md): its defaults are what the judge
+"""The oscillation judge's thresholds table (`maps.judging.judge_thresholds`, docs/judge.md): its defaults are what the judge
 uses, every field is documented, and a re-judging with another table equals a fresh judge with it.
 
 Each threshold of the episodes' judge is checked on a closed-form lateral signal that is an episode under the
@@ -19,9 +19,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from pfm_stability.maps import episodes as episodes_module
-from pfm_stability.maps.episodes import episodes, lateral_episodes, swing
-from pfm_stability.maps.judge_thresholds import JUDGE, JudgeThresholds
+from pfm_stability.maps.judging import episodes as episodes_module
+from pfm_stability.maps.judging.episodes import episodes, lateral_episodes, swing
+from pfm_stability.maps.judging.judge_thresholds import JUDGE, JudgeThresholds
 
 P = 1.0
 """The synthetic signals' period, s."""
@@ -52,7 +52,7 @@ def found(signal, **changes) -> tuple:
 
 def test_the_aliases_are_the_tables_fields():
     """The constants other code imports are the table's fields (one source of truth)."""
-    from pfm_stability.maps.decide import AMPLITUDE_THRESHOLD as decided
+    from pfm_stability.maps.deciding.decide import AMPLITUDE_THRESHOLD as decided
     from pfm_stability.validation import map_drives
 
     assert episodes_module.EPISODE_PERIODS == JUDGE.episode_periods == 3

@@ -3,7 +3,7 @@
 The shipped maps are analysed with robots that fit them (the TurtleBot3 sandbox with
 a 0.2 m robot); the outputs are checked by reading them back the way their users do:
 the PNG and the PGM with Pillow, the mask's YAML with PyYAML and its values with
-Nav2's scale-mode formula (`pfm_stability.maps.outputs.pixel_to_percent`). A bad map
+Nav2's scale-mode formula (`pfm_stability.maps.deciding.outputs.pixel_to_percent`). A bad map
 must give exit status 2, one line naming the problem, and nothing in the output
 directory.
 """
@@ -26,7 +26,7 @@ from jsonschema import Draft202012Validator
 from PIL import Image
 
 from pfm_stability.cli import main
-from pfm_stability.maps.outputs import pixel_to_percent
+from pfm_stability.maps.deciding.outputs import pixel_to_percent
 from pfm_stability.io.schema import load_schema
 from cli_helpers import file_error
 from map_helpers import shared_map_analyses
@@ -290,7 +290,7 @@ def test_a_resolution_typo_making_a_500_m_map_is_warned_before_the_work(tmp_path
     unknown cells was used (checked on a plausible map)."""
     from pfm_stability.laws.fields import make_law
     from pfm_stability.maps.analysis import analyze_map
-    from pfm_stability.maps.occupancy import load_map
+    from pfm_stability.maps.reading.occupancy import load_map
     from pfm_stability.parameters import CARMEL
 
     lines = []

@@ -8,7 +8,7 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from pfm_stability.maps.decide import CAUSES, PATH_VERDICTS
+from pfm_stability.maps.deciding.decide import CAUSES, PATH_VERDICTS
 from pfm_stability.validation.map_collisions import locate_collisions
 
 
@@ -61,8 +61,8 @@ def test_the_validation_locates_every_drive_that_collided(tmp_path):
     from pfm_stability.cli.map import map_path
     from pfm_stability.laws.fields import make_law
     from pfm_stability.maps.analysis import analyze_map
-    from pfm_stability.maps.contact import obstacle_distance
-    from pfm_stability.maps.occupancy import load_map
+    from pfm_stability.maps.reading.contact import obstacle_distance
+    from pfm_stability.maps.reading.occupancy import load_map
     from pfm_stability.parameters import CARMEL
     from pfm_stability.validation.map_drives import drive_map
 

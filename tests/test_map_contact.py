@@ -1,5 +1,5 @@
-"""Where the robot's disc meets an obstacle beside a route (`maps.contact`, docs/maps.md, "A collision course"), and
-the loop driven along the route stopping there (`maps.driven.driven_loops`: a collision course)."""
+"""Where the robot's disc meets an obstacle beside a route (`maps.reading.contact`, docs/maps.md, "A collision course"), and
+the loop driven along the route stopping there (`maps.judging.driven.driven_loops`: a collision course)."""
 
 from __future__ import annotations
 
@@ -8,8 +8,8 @@ import math
 import numpy as np
 import pytest
 
-from pfm_stability.maps.contact import BAND_BISECTIONS, free_band, obstacle_distance
-from pfm_stability.maps.field import HistogramMap
+from pfm_stability.maps.reading.contact import BAND_BISECTIONS, free_band, obstacle_distance
+from pfm_stability.maps.reading.field import HistogramMap
 
 
 def _random_grid(seed: int, shape=(30, 24), fill=0.08) -> HistogramMap:
@@ -90,7 +90,7 @@ def test_the_driven_loop_stops_where_its_disc_meets_an_obstacle():
     past 6 m, the samples of the period before are on a collision course, none earlier; past the contact the run is
     gone (its amplitude "at least" `LEAVES`). The same band within the run's first period is not judged (the start's
     transient): a band closed from the start marks nothing."""
-    from pfm_stability.maps.driven import LEAVES, DriveRequest, driven_loops
+    from pfm_stability.maps.judging.driven import LEAVES, DriveRequest, driven_loops
     from test_map_driven import _transition, _straight
     from pfm_stability.parameters import CARMEL
 
@@ -125,11 +125,11 @@ def test_a_collision_course_is_a_stretchs_one_answer(tmp_path, monkeypatch):
     and it gets a speed-mask zone; the rest of the hall stays stable."""
     from dataclasses import replace
 
-    import pfm_stability.maps.decide as decide
+    import pfm_stability.maps.deciding.decide as decide
     from pfm_stability.laws.fields import make_law
     from pfm_stability.maps.analysis import analyze_map
-    from pfm_stability.maps.occupancy import load_map
-    from pfm_stability.maps.outputs import has_zone
+    from pfm_stability.maps.reading.occupancy import load_map
+    from pfm_stability.maps.deciding.outputs import has_zone
     from test_map_paths import CONTROLLER, ROBOT, write_map
 
     img = np.full((240, 100), 254, dtype=np.uint8)

@@ -1,4 +1,4 @@
-"""``map --controller rpp``: Nav2's Regulated Pure Pursuit along a map's routes (`maps.tracking`, docs/maps.md, "Nav2's
+"""``map --controller rpp``: Nav2's Regulated Pure Pursuit along a map's routes (`maps.deciding.tracking`, docs/maps.md, "Nav2's
 controllers along a map").
 
 The independent route is ``report --controller rpp``: a stretch's verdict, margin, V* and L* at its half-width and speed
@@ -17,7 +17,7 @@ from PIL import Image
 
 from cli_helpers import VALIDATOR, disk_full, report_json, run
 from pfm_stability.io.yaml_files import read_yaml
-from pfm_stability.maps.outputs import pixel_to_percent
+from pfm_stability.maps.deciding.outputs import pixel_to_percent
 
 pytest.importorskip("skimage")
 

@@ -28,7 +28,7 @@ from cli_helpers import report_json, run
 from pfm_stability.laws.fields import make_law
 from pfm_stability.laws.force_law import corridor_gain
 from pfm_stability.maps.analysis import analyze_map
-from pfm_stability.maps.occupancy import load_map
+from pfm_stability.maps.reading.occupancy import load_map
 from pfm_stability.models import Loop, models_for
 from pfm_stability.parameters import CARMEL
 

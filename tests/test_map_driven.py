@@ -1,4 +1,4 @@
-"""The loop driven along a route through the force across it (`maps.driven._driven`, docs/maps.md, "The loop driven
+"""The loop driven along a route through the force across it (`maps.judging.driven._driven`, docs/maps.md, "The loop driven
 along the route"), its command form (`models.sampled.command_form`), and the drives' unmeasurable ends
 (`validation.map_drives`)."""
 
@@ -9,8 +9,8 @@ import math
 import numpy as np
 import pytest
 
-from pfm_stability.maps.driven import SampledTransition, _driven
-from pfm_stability.maps.verdicts import GrowthRate, effective_gain
+from pfm_stability.maps.judging.driven import SampledTransition, _driven
+from pfm_stability.maps.deciding.verdicts import GrowthRate, effective_gain
 from pfm_stability.models import Loop, models_for
 from pfm_stability.models.sampled import closed_loop_matrix, command_form
 from pfm_stability.parameters import CARMEL
@@ -68,7 +68,7 @@ def test_a_linear_force_drives_the_linear_loop(ratio, monkeypatch):
     started at the same offset, below, near and above NV*. The robot steers to the resultant's direction,
     atan(N·y) ≈ N·y − (N·y)³/3: started 1 µm off and compared while |y| <= 0.1 mm, the cubic term is below 1e-7 of
     the command (N·y <= 5e-4 here), so the two agree to 1e-12 m + 1e-6·|y| (round-off and that term, with margin)."""
-    import pfm_stability.maps.driven as driven
+    import pfm_stability.maps.judging.driven as driven
 
     monkeypatch.setattr(driven, "PREDICTION_OFFSET", 1e-6)
     robot, controller = CARMEL.robot, CARMEL.controller
@@ -81,7 +81,7 @@ def test_a_linear_force_drives_the_linear_loop(ratio, monkeypatch):
     route = np.zeros(steps, dtype=int)
     stopped = np.zeros((2, steps), dtype=bool)
     captured = {}
-    import pfm_stability.maps.episodes as episodes
+    import pfm_stability.maps.judging.episodes as episodes
 
     original = episodes.lateral_episodes
 
@@ -202,7 +202,7 @@ def test_goal_paths_are_judged_as_the_robot_drove_them(root):
     from test_map_paths import _report, corridor_analysis
 
     from pfm_stability.maps.analysis import add_routes
-    from pfm_stability.maps.routes import path_of
+    from pfm_stability.maps.reading.routes import path_of
     from pfm_stability.validation.map_drives import goal_routes
 
     V_star = _report(0.6).models["sampled"].critical["V_critical"]
@@ -237,9 +237,9 @@ def test_a_path_taken_beside_a_wall_steers_against_the_goals_pull_along_it(tmp_p
 
     from pfm_stability.laws.fields import make_law
     from pfm_stability.maps.analysis import analyze_map, judge_routes
-    from pfm_stability.maps.equilibria import lateral_force
-    from pfm_stability.maps.occupancy import load_map
-    from pfm_stability.maps.routes import path_of
+    from pfm_stability.maps.deciding.equilibria import lateral_force
+    from pfm_stability.maps.reading.occupancy import load_map
+    from pfm_stability.maps.reading.routes import path_of
 
     img = np.full((100, 30), 254, dtype=np.uint8)
     img[:, :3] = 0  # a wall 3 cells thick along y, x in [0, 0.3) m, 10 m long
@@ -288,7 +288,7 @@ def test_speeds_driven_together_are_each_speed_driven_alone():
     excursion to 1e-12 relative (a run's arithmetic is its own; only the batched matrix product's blocking may
     differ in the last bits). Two routes of different gains — one of them driven at one speed only — at three speeds
     (k = 20 1/s; 1.3·NV* at the fastest speed on the first route, which grows until it leaves; the others damped)."""
-    from pfm_stability.maps.driven import DriveRequest, driven_loops
+    from pfm_stability.maps.judging.driven import DriveRequest, driven_loops
 
     robot = CARMEL.robot.replace(W=0.4, tau=0.1, k=20.0, V=1.0)
     controller = CARMEL.controller.replace(T=0.025, f=2.0)

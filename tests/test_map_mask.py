@@ -1,4 +1,4 @@
-"""The speed mask from the routes' stretches, and its upstream dilation (`maps.outputs.speed_limits`, docs/maps.md,
+"""The speed mask from the routes' stretches, and its upstream dilation (`maps.deciding.outputs.speed_limits`, docs/maps.md,
 "The speed mask")."""
 
 from __future__ import annotations
@@ -10,10 +10,10 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from pfm_stability.maps.occupancy import OccupancyMap
-from pfm_stability.maps.outputs import route_piece, speed_limits, upstream_distance
-from pfm_stability.maps.paths import PathStretch
-from pfm_stability.maps.routes import path_of
+from pfm_stability.maps.reading.occupancy import OccupancyMap
+from pfm_stability.maps.deciding.outputs import route_piece, speed_limits, upstream_distance
+from pfm_stability.maps.deciding.paths import PathStretch
+from pfm_stability.maps.reading.routes import path_of
 
 R = 0.05  # m per map cell
 V, W = 1.0, 0.4  # m/s, m

@@ -1,4 +1,4 @@
-"""Verdicts along every route of a map (`maps.paths`) and validation by driving (`validation.map_drives`).
+"""Verdicts along every route of a map (`maps.deciding.paths`) and validation by driving (`validation.map_drives`).
 
 docs/maps.md, "Verdicts along every route" and "Validation by driving". The expected values come from other
 routes: the loop model's own rightmost root and `analyze_corridor` (what ``report --law grid`` prints) for a straight
@@ -20,11 +20,11 @@ from PIL import Image
 from pfm_stability.analysis.criteria import analyze_corridor
 from pfm_stability.laws.fields import make_law
 from pfm_stability.maps.analysis import analyze_map
-from pfm_stability.maps.episodes import AMPLITUDE_THRESHOLD, episodes, lateral_episodes
-from pfm_stability.maps.occupancy import load_map
-from pfm_stability.maps.driven import SampledTransition
-from pfm_stability.maps.decide import PATH_VERDICTS, WINDOW_PERIODS
-from pfm_stability.maps.verdicts import EFOLDS
+from pfm_stability.maps.judging.episodes import AMPLITUDE_THRESHOLD, episodes, lateral_episodes
+from pfm_stability.maps.reading.occupancy import load_map
+from pfm_stability.maps.judging.driven import SampledTransition
+from pfm_stability.maps.deciding.decide import PATH_VERDICTS, WINDOW_PERIODS
+from pfm_stability.maps.deciding.verdicts import EFOLDS
 from pfm_stability.models import Loop, models_for
 from pfm_stability.models.sampled import closed_loop_matrix
 from pfm_stability.parameters import CARMEL, Corridor
@@ -191,7 +191,7 @@ def test_a_carrot_too_near_makes_the_robot_weave_in_an_open_hall(tmp_path, facto
     towards a point target instead has N = 1/max(D, W), D the goal's distance. N to 1e-9: a closed form, evaluated
     along another route than the loop's."""
     from pfm_stability.maps.analysis import judge_routes
-    from pfm_stability.maps.routes import path_of
+    from pfm_stability.maps.reading.routes import path_of
     from pfm_stability.sim.engine import run_batch
     from pfm_stability.sim.scenario import Pose, Scenario, Target
     from pfm_stability.validation.maps import simulator_grid
@@ -272,7 +272,7 @@ def test_where_the_judged_part_is_cut_the_weave_is_not_turning(reverse):
     cut's value; with the third it holds the weave's 2 cm · sin(π/8)/(π/8) = 1.95 cm (to 1 %: the P/8 smoothing,
     `test_swing_is_the_weaves_amplitude_the_judge_sees`). Reversed in time, the cut lies just after an extreme at the
     start: the same."""
-    from pfm_stability.maps.episodes import lateral_extent
+    from pfm_stability.maps.judging.episodes import lateral_extent
 
     T, omega = 0.025, 2.0
     period = 2 * math.pi / omega
@@ -296,7 +296,7 @@ def test_swing_is_the_weaves_amplitude_the_judge_sees():
     of the path (a 90° arc of 2 m radius), whose distance from its own one-period average reaches centimetres, is
     no swing (0); zeros for a run shorter than two periods. `lateral_extent`'s swing of the same weave as a lateral signal
     agrees."""
-    from pfm_stability.maps.episodes import lateral_extent, swing
+    from pfm_stability.maps.judging.episodes import lateral_extent, swing
 
     T, omega = 0.025, 2.0
     period = 2 * math.pi / omega
@@ -311,7 +311,7 @@ def test_swing_is_the_weaves_amplitude_the_judge_sees():
     # a straight run, a quarter circle of radius 2 m, a straight run (1 m/s)
     heading = np.clip((t - 10.0) / (math.pi / 2 * 2.0), 0.0, 1.0) * math.pi / 2
     bx, by = np.cumsum(np.cos(heading)) * T, np.cumsum(np.sin(heading)) * T
-    from pfm_stability.maps.episodes import oscillation
+    from pfm_stability.maps.judging.episodes import oscillation
 
     assert np.abs(oscillation(t, bx, by, period)[0]).max() > 0.015  # the bend is off its average by more than the threshold
     assert not swing(t, bx, by, period).any()
@@ -325,7 +325,7 @@ def test_excursion_is_how_far_the_loop_strays_however_irregular():
     not follow: (1 − sin(π/2.4)/(π/2.4))·20 cm = 5.2 cm, past the threshold (down to 97 % of it between the residual's
     peaks, which a one-period window can miss by 0.1 P; 1 % for the discrete average). Zeros for a run shorter than two
     periods."""
-    from pfm_stability.maps.episodes import lateral_extent
+    from pfm_stability.maps.judging.episodes import lateral_extent
 
     T, omega = 0.025, 2.0
     period = 2 * math.pi / omega
@@ -421,7 +421,7 @@ def test_the_interval_over_the_drives_is_the_ratios_resampling_spread():
 def test_user_routes_read_nav2_paths_waypoints_and_csv(tmp_path):
     """A Nav2 nav_msgs/Path echoed as YAML, waypoints as pairs and as mappings, several routes, and a CSV with a header:
     the points as written (m); a bad point is one line naming the file and the point."""
-    from pfm_stability.maps.user_routes import read_points, read_routes
+    from pfm_stability.maps.reading.user_routes import read_points, read_routes
 
     (tmp_path / "plan.yaml").write_text("header: {frame_id: map}\nposes:\n  - header: {frame_id: map}\n    pose:\n"
                                         "      position: {x: 1.0, y: 2.0, z: 0.0}\n      orientation: {w: 1.0}\n"
@@ -442,7 +442,7 @@ def test_a_users_route_along_an_unstable_corridor_is_judged_unstable(root):
     """A waypoint route drawn by the user along the unstable corridor's axis (x = 0.65 m) is judged like the skeleton's
     route there: unstable at 1.4 V*, over most of its length (its ends within the window of the corridor's ends aside)."""
     from pfm_stability.maps.analysis import add_routes
-    from pfm_stability.maps.routes import path_of
+    from pfm_stability.maps.reading.routes import path_of
 
     V_star = _report(0.6).models["sampled"].critical["V_critical"]
     analysis = add_routes(corridor_analysis(0.6, 1.4 * V_star, root), [path_of([[0.65, 3.0], [0.65, 17.0]], 0, "waypoints")])
@@ -576,7 +576,7 @@ def test_thin_slam_walls_with_unknown_behind_the_simulation_sides_with_unknown_f
 def _rack_grid(law, rack_column: int, width: int = 60, length: int = 200):
     """A histogram grid `width` × `length` cells (c = law.cell_size) with one solid rack: every cell from column
     `rack_column` to the grid's right edge occupied (certainty law.cv)."""
-    from pfm_stability.maps.field import HistogramMap
+    from pfm_stability.maps.reading.field import HistogramMap
 
     cv = np.zeros((width, length), dtype=np.int16)
     cv[rack_column:, :] = law.cv
@@ -584,7 +584,7 @@ def _rack_grid(law, rack_column: int, width: int = 60, length: int = 200):
 
 
 def test_window_edge_relay_where_a_rack_enters_the_window():
-    """`maps.relay.window_relay` on a route along y with a solid rack on its +x side (CARMEL's grid law, window 33
+    """`maps.deciding.relay.window_relay` on a route along y with a solid rack on its +x side (CARMEL's grid law, window 33
     cells, c = 0.1 m). With the path 16 cells (h) from the rack's first column the window gains that column when the
     robot moves one cell towards it: F_n falls by the column's force (restoring: a relay). Expected size, by hand:
     the force of one column of 33 cells at 16.5 cells' lateral distance, Σ ρ·W^n·cv·dx/(dx² + dy²)^((n+1)/2) over the
@@ -593,7 +593,7 @@ def test_window_edge_relay_where_a_rack_enters_the_window():
     back on the rack's side: the net force changes sign across the jump. A path 5 cells from the rack (F_n pushes
     it away on both sides: no sign change) and a path with no rack within reach have no relay."""
     from pfm_stability.laws.fields import make_law
-    from pfm_stability.maps.relay import window_relay
+    from pfm_stability.maps.deciding.relay import window_relay
 
     law = make_law("grid", CARMEL.robot, CARMEL.controller)
     h, c = law.window_cells // 2, law.cell_size
@@ -607,7 +607,7 @@ def test_window_edge_relay_where_a_rack_enters_the_window():
     assert jump[1:].tolist() == [0.0, 0.0]
     # the mirror image (rack on the −x side, entering when the robot moves along −x): the same relay
     mirror = _rack_grid(law, 40)
-    from pfm_stability.maps.field import HistogramMap
+    from pfm_stability.maps.reading.field import HistogramMap
 
     mirror = HistogramMap(0.0, 0.0, c, np.ascontiguousarray(mirror.cv[::-1]))
     relay, jump_m = window_relay(mirror, law, 60 * c - x[:1], y[:1], *(v[:1] for v in t), np.zeros(1))
@@ -615,7 +615,7 @@ def test_window_edge_relay_where_a_rack_enters_the_window():
 
 
 def test_a_relay_stands_only_where_the_loop_driven_through_the_profile_strays_as_far(tmp_path, monkeypatch):
-    """The window-edge relay with the sampled model (`maps.paths`, docs/maps.md): the describing function of one jump
+    """The window-edge relay with the sampled model (`maps.deciding.paths`, docs/maps.md): the describing function of one jump
     is an estimate of the cycle; the loop driven through the whole profile (`decide.driven_loops`) is run there too, and the
     relay stands only where that loop strays as far from its one-period average (its excursion) as well. In a 3 m
     aisle between a one-cell wall and a solid rack (the test robot; the equilibrium at the window's edge, a restoring
@@ -623,7 +623,7 @@ def test_a_relay_stands_only_where_the_loop_driven_through_the_profile_strays_as
     threshold on every sample: with the driven loop's excursion replaced by 1 m those are the relay samples, with 0
     none remain. The real driven loop strays less than the threshold there, so the route is stable — and the VFF
     simulator agrees: four drives along the aisle find no episode (their largest weave held a period is under 2 cm)."""
-    import pfm_stability.maps.decide as decide
+    import pfm_stability.maps.deciding.decide as decide
     from pfm_stability.maps.analysis import judge_routes
     from pfm_stability.validation.map_drives import drive_map
 
@@ -654,7 +654,7 @@ def test_a_relay_stands_only_where_the_loop_driven_through_the_profile_strays_as
 
 def _column_force(law, h):
     """F_r/F_ct of one column of cells (certainty law.cv) at (h + 0.5) cells across, rows −h … h (the law's scale
-    ρ·W^n, `maps.field.window_kernels`' weights), by hand."""
+    ρ·W^n, `maps.reading.field.window_kernels`' weights), by hand."""
     c = law.cell_size
     dx, dy = (h + 0.5) * c, np.arange(-h, h + 1) * c
     return float(law.ratio * law.W**law.n * law.cv * np.sum(dx / (dx * dx + dy * dy) ** ((law.n + 1) / 2)))
@@ -666,7 +666,7 @@ def test_a_path_taken_is_linearized_at_itself_away_from_the_equilibrium(root):
     is linearized at its own points (the linearization point is the path point, to 1e-12 m), while the same path judged as a route keeps the axis' equilibrium (its linearization point within a cell of
     x = 0.65 m); a path 0.1 m off (within W/2) keeps it too."""
     from pfm_stability.maps.analysis import judge_routes
-    from pfm_stability.maps.routes import path_of
+    from pfm_stability.maps.reading.routes import path_of
 
     analysis = corridor_analysis(0.6, 0.5, root)
     assert ROBOT.W / 2 == pytest.approx(0.2)

@@ -1,4 +1,4 @@
-"""The global plans the drives of `--validate` follow (`maps.planner`): shortest paths along the free-space skeleton.
+"""The global plans the drives of `--validate` follow (`maps.reading.planner`): shortest paths along the free-space skeleton.
 
 docs/maps.md, "Validation by driving". The expected values are the test maps' geometry: an L-shaped corridor's
 centre lines, a wall that splits a room in two.
@@ -9,9 +9,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from pfm_stability.maps.field import HistogramMap
-from pfm_stability.maps.planner import SkeletonPlanner
-from pfm_stability.maps.routes import skeleton_of
+from pfm_stability.maps.reading.field import HistogramMap
+from pfm_stability.maps.reading.planner import SkeletonPlanner
+from pfm_stability.maps.reading.routes import skeleton_of
 
 W = 0.4
 """Robot width, m."""
@@ -38,7 +38,7 @@ def test_a_plan_round_a_corner_follows_the_corridors_centre_lines(monkeypatch):
     less than 0.4 m (a right angle rounded with radius r saves (2 − π/2)·r, 0.43·r) and strays at most 0.2 m from the
     centre lines at the corner ((√2 − 1)·r for r up to 0.5 m), within a cell of them farther than 0.5 m from it; every
     point where the robot fits (clearance > W/2), and the plan ends at the given points."""
-    from pfm_stability.maps import planner as planner_module
+    from pfm_stability.maps.reading import planner as planner_module
 
     grid = _l_corridor()
     skeleton, clearance = skeleton_of(grid, W)
@@ -106,7 +106,7 @@ def test_the_plan_is_smoothed_as_nav2s_simple_smoother_converges(seed):
     when they move the points by less than 1e-10 m in all; the contraction per sweep is about 0.6, so the remaining
     error is a few times that); the ends stay where they were; the jags shrink (the largest turn between consecutive
     resampled segments is smaller than the jagged plan's)."""
-    from pfm_stability.maps.planner import smooth_plan
+    from pfm_stability.maps.reading.planner import smooth_plan
 
     rng = np.random.default_rng(seed)
     n = int(rng.integers(6, 13))
@@ -130,8 +130,8 @@ def test_a_straight_plan_stays_straight_and_a_smoothed_plan_in_collision_is_not_
     neighbours' middle) — the L corridor's plan keeps its corner's cells free; and with the smoothing pushed into a
     wall (a plan whose smoothed points would enter an occupied cell) the planner returns the unsmoothed plan, as
     Nav2's smoother refuses a path in collision."""
-    from pfm_stability.maps import planner as planner_module
-    from pfm_stability.maps.planner import smooth_plan
+    from pfm_stability.maps.reading import planner as planner_module
+    from pfm_stability.maps.reading.planner import smooth_plan
 
     line = np.array([[0.0, 1.0], [3.0, 1.0]])
     straight = smooth_plan(line, 0.1)

@@ -1,4 +1,4 @@
-"""The window-edge relay's limit cycle (`maps.relay`) against the sampled loop simulated with the relay, and against
+"""The window-edge relay's limit cycle (`maps.deciding.relay`) against the sampled loop simulated with the relay, and against
 the VFF simulator beside a rack (docs/maps.md, "Verdicts along every route").
 
 Independent route: the loop is discretized here (expm of the augmented plant matrix, KB's τ, k, T, V, both holds,
@@ -32,7 +32,7 @@ import pytest
 from scipy.linalg import expm
 from scipy.optimize import brentq
 
-from pfm_stability.maps.relay import profile_cycle, relay_amplitude, window_cycle, window_relay
+from pfm_stability.maps.deciding.relay import profile_cycle, relay_amplitude, window_cycle, window_relay
 from pfm_stability.models import make_model
 from pfm_stability.models.loop import Loop
 from pfm_stability.parameters import CARMEL, HOLDS
@@ -253,7 +253,7 @@ def test_profile_cycle_no_cycle_and_leaving():
 def _aisle(law, gap: int, length: int = 400):
     """A histogram grid: a one-cell wall at column 0, free columns 1 … gap, a solid rack from column gap + 1 (the
     aisle of tests/test_map_paths.py's rack, with a wall on the other side)."""
-    from pfm_stability.maps.field import HistogramMap
+    from pfm_stability.maps.reading.field import HistogramMap
 
     cv = np.zeros((gap + 12, length), dtype=np.int16)
     cv[0, :] = law.cv
@@ -270,7 +270,7 @@ def test_a_split_jump_is_one_jump():
 
     law = make_law("grid", CARMEL.robot, CARMEL.controller)
     h, c = law.window_cells // 2, law.cell_size
-    from pfm_stability.maps.field import HistogramMap
+    from pfm_stability.maps.reading.field import HistogramMap
 
     cv = np.zeros((60, 200), dtype=np.int16)
     cv[40:, :] = law.cv

@@ -1,4 +1,4 @@
-"""The loop driven along a drive's own path as the robot drove it (`maps.driven.DrivenTrack`, `_driven`; docs/maps.md,
+"""The loop driven along a drive's own path as the robot drove it (`maps.judging.driven.DrivenTrack`, `_driven`; docs/maps.md,
 "A drive's own path is driven as the robot drove it"): the path's frame turning under the loop (`SampledTransition.turn`), the point the robot steered at
 (`validation.map_drives._aims`, `RoutePath.aims`) and the window sum at the loop's own point."""
 
@@ -11,9 +11,9 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from pfm_stability.maps.driven import PREDICTION_OFFSET, DrivenTrack, SampledTransition, _TrackWalk, _driven
-from pfm_stability.maps.decide import path_samples
-from pfm_stability.maps.routes import path_of
+from pfm_stability.maps.judging.driven import PREDICTION_OFFSET, DrivenTrack, SampledTransition, _TrackWalk, _driven
+from pfm_stability.maps.deciding.decide import path_samples
+from pfm_stability.maps.reading.routes import path_of
 from pfm_stability.models import Loop, models_for
 from pfm_stability.models.sampled import continuous_plant
 from pfm_stability.parameters import Controller, Robot
@@ -94,7 +94,7 @@ def test_round_a_bend_the_loop_holds_pure_pursuits_circle(radius, lookahead, mon
     offsets = np.arange(-1.0, 1.0 + 1e-9, 0.0125)
     profile = (offsets, np.zeros((n, offsets.size)), np.zeros((n, offsets.size)))
     captured = {}
-    import pfm_stability.maps.episodes as episodes
+    import pfm_stability.maps.judging.episodes as episodes
 
     original = episodes.lateral_extent
 
@@ -149,7 +149,7 @@ def test_the_loop_starts_where_the_robot_started(direction, monkeypatch):
     sx, sy = 3.0 - uy * y0, -1.0 + ux * y0  # y0 to the left of the path's start
     pose = math.pi / 2 - (direction + theta0)  # the simulator's heading: from +Y towards +X
     no_field = lambda px, py: (np.zeros(np.shape(px)), np.zeros(np.shape(px)))  # noqa: E731
-    import pfm_stability.maps.episodes as episodes
+    import pfm_stability.maps.judging.episodes as episodes
 
     original = episodes.lateral_extent
     for start, first in (((sx, sy, pose), y0), (None, PREDICTION_OFFSET)):

@@ -343,7 +343,7 @@ def _shipped(name: str, V: float):
     from pathlib import Path
 
     from pfm_stability.maps.analysis import analyze_map
-    from pfm_stability.maps.occupancy import load_map
+    from pfm_stability.maps.reading.occupancy import load_map
 
     maps = Path(__file__).resolve().parent.parent / "pfm_stability" / "data" / "maps"
     robot = CARMEL.robot.replace(W=0.4, tau=0.1, k=20.0, V=V)
@@ -389,7 +389,7 @@ def test_end_effect_and_judged_part_follow_the_along_track_force():
     segment whose run is shorter than a wavelength must say "end effect". Exact comparisons: the same
     arrays, thresholds applied by hand.
     """
-    from pfm_stability.maps.verdicts import END_FRACTION, judged_run
+    from pfm_stability.maps.deciding.verdicts import END_FRACTION, judged_run
 
     assert judged_run(np.array([0.9, 0.1, np.nan, -0.2, 0.7, 0.0]), 0.5) == (1, 4)
     assert judged_run(np.array([0.9, 0.8]), 0.5) == (0, 0)

@@ -24,11 +24,11 @@ from test_map_corridors import ROBOT as FAST_STEERING, CONTROLLER as FAST_CONTRO
 from pfm_stability.analysis.wobble import corridor_wobble
 from pfm_stability.laws.fields import make_law
 from pfm_stability.maps.analysis import analyze_map, judge_routes
-from pfm_stability.maps.occupancy import load_map
-from pfm_stability.maps.outputs import speed_limits, speed_mask_pgm
-from pfm_stability.maps.routes import path_of
-from pfm_stability.maps.stretch_speed import BISECT_STEPS, SPEED_STEP
-from pfm_stability.maps.wobble import V_CRITICAL_AGREEMENT, wobble_summary, with_wobble
+from pfm_stability.maps.reading.occupancy import load_map
+from pfm_stability.maps.deciding.outputs import speed_limits, speed_mask_pgm
+from pfm_stability.maps.reading.routes import path_of
+from pfm_stability.maps.deciding.stretch_speed import BISECT_STEPS, SPEED_STEP
+from pfm_stability.maps.deciding.wobble_zones import V_CRITICAL_AGREEMENT, wobble_summary, with_wobble
 from pfm_stability.parameters import CARMEL
 
 pytestmark = pytest.mark.xdist_group("map_wobble")  # the `corridor` and `routed` analyses once per suite (tests/conftest.py)

@@ -21,14 +21,14 @@ from PIL import Image
 from pfm_stability.analysis.criteria import analyze_corridor
 from pfm_stability.laws.fields import make_law
 from pfm_stability.maps.analysis import analyze_map, sample_verdict
-from pfm_stability.maps.field import (
+from pfm_stability.maps.reading.field import (
     HistogramMap,
     centre_field,
     histogram_of,
     window_force,
 )
-from pfm_stability.maps.occupancy import load_map, occupancy_values
-from pfm_stability.maps.outputs import percent_to_pixel, pixel_to_percent
+from pfm_stability.maps.reading.occupancy import load_map, occupancy_values
+from pfm_stability.maps.deciding.outputs import percent_to_pixel, pixel_to_percent
 from pfm_stability.models import Loop, models_for
 from pfm_stability.parameters import CARMEL, Corridor
 from pfm_stability.sim.grid import HistogramGrid
@@ -161,7 +161,7 @@ def test_the_field_does_not_depend_on_how_its_sum_is_chunked(monkeypatch):
     """`window_force` sums a chunk of points at a time (`field.CHUNK_ENTRIES` window cells): chunks of 37 cells —
     hundreds of chunks, and points with more cells than a chunk, alone in theirs — give the one-chunk answer to 4 ULP
     (each point's cells are summed in the same order either way, by one `np.bincount`), points off the grid included."""
-    from pfm_stability.maps import field
+    from pfm_stability.maps.reading import field
 
     rng = np.random.default_rng(11)
     law = make_law("grid", ROBOT, CONTROLLER, cell_size=0.1, window_cells=15)
@@ -321,7 +321,7 @@ def test_no_free_space_and_no_route(tmp_path):
         analyze_map(load_map(write_map(tmp_path, corridor_pixels(0.3), name="b")), ROBOT, CONTROLLER, law)
 
 
-# ------------------------------------------------------------ segment verdicts (maps.verdicts)
+# ------------------------------------------------------------ segment verdicts (maps.deciding.verdicts)
 def _random_loop(rng):
     """A random sampled loop far from CARMEL too: (model, loop, boundary, exact σ(NV))."""
     from pfm_stability.models import Sampled
@@ -340,7 +340,7 @@ def test_growth_table_equals_the_models_root(seed):
     decades about NV*, random loops. Tolerance 2 % of max(|σ|, 0.1·|σ at the most damped gain|): the table's
     40 points per decade miss only the corner where two real roots merge (measured ≤ 0.4 %); at NV* (a node) σ is 0
     to round-off."""
-    from pfm_stability.maps.verdicts import GrowthRate
+    from pfm_stability.maps.deciding.verdicts import GrowthRate
 
     rng = np.random.default_rng(seed)
     model, loop, boundary, sigma = _random_loop(rng)
@@ -357,7 +357,7 @@ def test_segment_critical_speed_is_where_the_exact_mean_growth_turns_positive(se
     """V* of a segment against the exact mean growth rate (the model's roots, no table): σ̄ < 0 just below V* and
     at 40 speeds below it, σ̄ > 0 just above, for random gain profiles with spikes, gaps and negative samples and
     random loops. Tolerance: ±1 % of V* (the table's σ error moves the crossing by less)."""
-    from pfm_stability.maps.verdicts import GrowthRate, critical_speed
+    from pfm_stability.maps.deciding.verdicts import GrowthRate, critical_speed
 
     rng = np.random.default_rng(seed)
     model, loop, boundary, sigma = _random_loop(rng)
@@ -380,7 +380,7 @@ def test_uniform_segment_is_decided_like_a_single_sample():
     """With the same N at every sample σ̄ = σ(N·V): N_eff = N and V* = NV*/N (`sample_verdict`, the report's route)
     on both branches of σ (a small gain's real root, an oscillating gain, an unstable one); tolerance 1e-7 (the
     bisections' widths; NV* is a node of the table)."""
-    from pfm_stability.maps.verdicts import GrowthRate, critical_speed, segment_gain
+    from pfm_stability.maps.deciding.verdicts import GrowthRate, critical_speed, segment_gain
 
     model = models_for(CONTROLLER, ["sampled"])[0]
     loop = Loop(ROBOT.tau, CONTROLLER.T, ROBOT.k)
@@ -398,7 +398,7 @@ def test_a_one_sample_spike_counts_by_its_growth_not_its_gain():
     """A single sample 20x the rest: the local worst would call the segment unstable; the mean growth rate is
     ((n−1)·σ(N·V) + σ(20N·V))/n, computed here from the model's roots, and N_eff has that σ (to 2 % of σ̄, the
     table's accuracy). A mean N below 0 makes the segment unstable at any speed (V* = 0)."""
-    from pfm_stability.maps.verdicts import GrowthRate, critical_speed, segment_gain
+    from pfm_stability.maps.deciding.verdicts import GrowthRate, critical_speed, segment_gain
 
     model = models_for(CONTROLLER, ["sampled"])[0]
     loop = Loop(ROBOT.tau, CONTROLLER.T, ROBOT.k)
@@ -423,7 +423,7 @@ def test_weak_segments_change_by_less_than_one_efold():
     """A segment is weak when its mean growth rate changes the deviation by less than one e-fold over it: a tiny N
     (slow real root σ ≈ −N·V) and a gain 0.1 % from the boundary (a slowly growing oscillation) both are over 2 m,
     a clearly stable or unstable gain is not. Checked against the model's own root: |σ|·length/V vs 1."""
-    from pfm_stability.maps.verdicts import is_weak
+    from pfm_stability.maps.deciding.verdicts import is_weak
 
     model = models_for(CONTROLLER, ["sampled"])[0]
     loop = Loop(ROBOT.tau, CONTROLLER.T, ROBOT.k)
@@ -439,7 +439,7 @@ def test_weak_segments_change_by_less_than_one_efold():
 
 def test_directional_gains_divide_by_each_directions_forward_force():
     """N one way is −dF_n/ds/(1 + F_r·t), the other −dF_n/ds/(1 − F_r·t); the per-sample N is the larger."""
-    from pfm_stability.maps.equilibria import Samples
+    from pfm_stability.maps.deciding.equilibria import Samples
 
     slope, ft = np.array([3.0, 2.0, 1.0]), np.array([0.4, -0.2, 0.0])
     forward = 1 - np.abs(ft)
@@ -450,13 +450,13 @@ def test_directional_gains_divide_by_each_directions_forward_force():
     assert np.maximum(fwd, rev) == pytest.approx(s.N)
 
 
-# ------------------------------------------------------------ tapering (maps.verdicts.drift_slope, TAPER_SLOPE)
+# ------------------------------------------------------------ tapering (maps.deciding.verdicts.drift_slope, TAPER_SLOPE)
 @pytest.mark.parametrize("seed", range(3))
 def test_drift_slope_is_the_exact_slope_of_a_linear_offset(seed):
     """`drift_slope` of s0 = a + b·s (noise-free, random a, b of both signs, random spacing, gaps as nan) is |b| to
     1e-9 (a least-squares line through points on a line: round-off only); a constant offset gives 0, and so do
     fewer than two finite samples."""
-    from pfm_stability.maps.verdicts import drift_slope
+    from pfm_stability.maps.deciding.verdicts import drift_slope
 
     rng = np.random.default_rng(seed)
     a, b = rng.uniform(-0.5, 0.5), rng.uniform(-2.0, 2.0)

@@ -26,7 +26,7 @@ from scipy.interpolate import pade as scipy_pade
 from scipy.linalg import expm
 
 from pfm_stability.maps.analysis import sample_verdict
-from pfm_stability.maps.verdicts import GrowthRate
+from pfm_stability.maps.deciding.verdicts import GrowthRate
 from pfm_stability.models import NEUTRAL_REASON, Loop, gain_margin, make_model, neutral_reason, verdict_label
 from pfm_stability.vectorized import loop_verdicts
 

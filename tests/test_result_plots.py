@@ -145,7 +145,7 @@ def test_plot_method_draws_into_a_given_axes():
     from pfm_stability.laws.fields import make_law
     import pfm_stability.maps.analysis as map_analysis
     from map_helpers import shared_map_analyses
-    from pfm_stability.maps.occupancy import load_map
+    from pfm_stability.maps.reading.occupancy import load_map
     from pfm_stability.plots.map import plot_map_stability
 
     panel = corridor_V_panel(ROBOT, CONTROLLER, resolution=RES)

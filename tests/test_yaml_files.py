@@ -27,7 +27,7 @@ from pfm_stability.io.config import load_config
 from pfm_stability.io.yaml_files import InputError, parse_yaml, read_yaml
 from pfm_stability.laws.fuzzy import DFAPF_FILE, load_dfapf
 from pfm_stability.laws.scene import Scene
-from pfm_stability.maps.occupancy import load_map
+from pfm_stability.maps.reading.occupancy import load_map
 from pfm_stability.sweeps.spec import load_spec
 from cli_helpers import file_error
 

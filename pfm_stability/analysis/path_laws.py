@@ -158,7 +158,7 @@ class PurePursuit:
         The corridor's half-width L_c the cost is that of, m (None: free space).
     curvature : float
         The path's curvature the regulation reads, 1/m (0: a straight path). Along a bend of a map's route
-        (`maps.tracking`) the curvature heuristic scales V by R/R_min where R = 1/|κ| < ``regulated_linear_scaling_min_radius``;
+        (`maps.deciding.tracking`) the curvature heuristic scales V by R/R_min where R = 1/|κ| < ``regulated_linear_scaling_min_radius``;
         the gains stay the straight path's (docs/path_tracking.md, "Regulated speed").
     """
 

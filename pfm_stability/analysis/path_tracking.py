@@ -469,7 +469,7 @@ def _lookahead_time_critical(law, point: TrackingPoint, rho_star: float) -> floa
 class LawVerdict:
     """One model's verdict and ρ-critical values of a closed-form law (RPP, Graceful) at one operating point: the part of
     `PathVerdict` that does not need the delay searches (D*, T*), so that many operating points of one loop (the
-    stretches of a map, `maps.tracking`) share one ρ* search.
+    stretches of a map, `maps.deciding.tracking`) share one ρ* search.
 
     Attributes
     ----------

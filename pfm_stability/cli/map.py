@@ -57,7 +57,7 @@ def add_parser(sub) -> None:
     p.add_argument("map", metavar="MAP", help=f"map_server YAML file, or a shipped map: {', '.join(SHIPPED_MAPS)}")
     add_parameter_options(p)
     add_law_options(p, laws_for("map"), default=DEFAULT_LAW["map"])  # a Default: a --config FILE's law beats it (`options.typed`)
-    add_controller_options(p)  # --controller rpp: Nav2's Regulated Pure Pursuit along the routes (maps.tracking)
+    add_controller_options(p)  # --controller rpp: Nav2's Regulated Pure Pursuit along the routes (maps.deciding.tracking)
     p.add_argument("--model", choices=MODEL_NAMES, default="sampled",
                    help="loop model of the verdicts (default sampled, with the controller's hold and compute delay)")
     p.add_argument("--out-dir", type=_out_dir, metavar="DIR",
@@ -102,8 +102,8 @@ def _validate(analysis, count: int, seed: int, progress):
 
 
 def _user_routes(files) -> list:
-    """The routes of every ``--route FILE`` (`maps.user_routes.read_routes`)."""
-    from ..maps.user_routes import read_routes
+    """The routes of every ``--route FILE`` (`maps.reading.user_routes.read_routes`)."""
+    from ..maps.reading.user_routes import read_routes
 
     routes = []
     for name in files:
@@ -114,7 +114,7 @@ def _user_routes(files) -> list:
 def _with_goals(analysis, goals_file: str, progress):
     """The analysis with the paths the simulated robot takes between the goals of ``--goals FILE``."""
     from ..maps.analysis import add_routes
-    from ..maps.user_routes import read_points
+    from ..maps.reading.user_routes import read_points
     from ..validation.map_drives import goal_routes
 
     return add_routes(analysis, goal_routes(analysis, read_points(goals_file)[0], progress))
@@ -138,7 +138,7 @@ def _write_outputs(analysis, out_dir: str, drives=None, a_max=None) -> dict:
     import matplotlib.pyplot as plt
 
     from ..io.files import atomic_directory, open_new
-    from ..maps.outputs import MASK_FILES, ROUTE_FILES, SEGMENT_FILES, routes_csv, segments_csv, speed_mask_pgm, speed_mask_yaml
+    from ..maps.deciding.outputs import MASK_FILES, ROUTE_FILES, SEGMENT_FILES, routes_csv, segments_csv, speed_mask_pgm, speed_mask_yaml
     from ..plots.map import plot_map_stability
     from ..plots.map_routes import plot_route_verdicts
 
@@ -169,7 +169,7 @@ def run(args) -> int:
     require("maps", "pfm-stability map")
 
     from ..maps.analysis import analyze_map, check_map_law
-    from ..maps.occupancy import load_map
+    from ..maps.reading.occupancy import load_map
     from ..io.serialize import dumps
     from .progress import line_progress
     from .render import render_map_text
@@ -188,13 +188,13 @@ def run(args) -> int:
     with line_progress("map", quiet=args.quiet) as progress:
         routes = _user_routes(args.route or ())
         analysis = analyze_map(occupancy, params.robot, params.controller, law, model=args.model, unknown=args.unknown,
-                               corridors=args.wobble is not None,  # the wobble reads the segments too (maps.wobble)
+                               corridors=args.wobble is not None,  # the wobble reads the segments too (maps.deciding.wobble_zones)
                                cell_size=args.cell_size, min_length=args.min_length, progress=progress,
                                warn=lambda line: print(f"pfm-stability: warning: {line}", file=sys.stderr, flush=True), routes=routes)
         if args.goals:
             analysis = _with_goals(analysis, args.goals, progress)
         if args.wobble is not None:
-            from ..maps.wobble import with_wobble
+            from ..maps.deciding.wobble_zones import with_wobble
 
             analysis = with_wobble(analysis, args.wobble)
             if progress is not None:
@@ -211,7 +211,7 @@ def run(args) -> int:
         "timing": {"seconds": time.perf_counter() - started, **{f"{k}_seconds": v for k, v in analysis.timing.items()}},
     }
     if args.wobble is not None:
-        from ..maps.wobble import wobble_summary
+        from ..maps.deciding.wobble_zones import wobble_summary
 
         data["wobble"] = wobble_summary(analysis, args.wobble).to_dict()
     if args.format == "json":
@@ -222,13 +222,13 @@ def run(args) -> int:
 
 
 TRACKING_CONTROLLERS = ("rpp",)
-"""The Nav2 controllers ``map --controller`` decides (`maps.tracking.MAP_CONTROLLERS`; numpy-free here for the refusal)."""
+"""The Nav2 controllers ``map --controller`` decides (`maps.deciding.tracking.MAP_CONTROLLERS`; numpy-free here for the refusal)."""
 _VFF_ONLY = ("validate", "wobble", "goals", "min_length")
 """``map`` options of the VFF analysis alone (refused with a Nav2 controller, `_run_tracking`); ``--seed`` too when typed."""
 
 
 def _run_tracking(args, path, started: float) -> int:
-    """``map --controller rpp``: the controller along every route (`maps.tracking.analyze_map_tracking`), its outputs."""
+    """``map --controller rpp``: the controller along every route (`maps.deciding.tracking.analyze_map_tracking`), its outputs."""
     import sys
     import time
 
@@ -241,8 +241,8 @@ def _run_tracking(args, path, started: float) -> int:
                          f"{', '.join(TRACKING_CONTROLLERS)} along a map's routes")
     require("maps", "pfm-stability map")
     from ..io.serialize import dumps
-    from ..maps.occupancy import load_map
-    from ..maps.tracking import analyze_map_tracking
+    from ..maps.reading.occupancy import load_map
+    from ..maps.deciding.tracking import analyze_map_tracking
     from .progress import line_progress
     from .render import render_map_tracking_text
 
@@ -263,12 +263,12 @@ def _run_tracking(args, path, started: float) -> int:
 
 def _write_tracking_outputs(analysis, out_dir: str, a_max=None) -> dict:
     """The files of ``map --controller --out-dir``, all or none (`files.atomic_directory`): ``routes.csv``, the speed mask
-    (`maps.outputs`) and the ZoneParameterFilter's mask and parameters (`maps.zone_filter`)."""
+    (`maps.deciding.outputs`) and the ZoneParameterFilter's mask and parameters (`maps.deciding.zone_filter`)."""
     import os
 
     from ..io.files import atomic_directory, open_new
-    from ..maps.outputs import MASK_FILES, speed_mask_pgm, speed_mask_yaml, tracking_csv
-    from ..maps.zone_filter import ZONE_FILES, zone_mask_pgm, zone_mask_yaml, zone_params_yaml
+    from ..maps.deciding.outputs import MASK_FILES, speed_mask_pgm, speed_mask_yaml, tracking_csv
+    from ..maps.deciding.zone_filter import ZONE_FILES, zone_mask_pgm, zone_mask_yaml, zone_params_yaml
 
     contents = {"routes.csv": tracking_csv(analysis).encode("utf-8"), MASK_FILES[0]: speed_mask_pgm(analysis, a_max),
                 MASK_FILES[1]: speed_mask_yaml(analysis.occupancy).encode("utf-8"), ZONE_FILES[0]: zone_mask_pgm(analysis),

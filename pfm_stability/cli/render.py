@@ -738,7 +738,7 @@ def render_map_tracking_text(data: dict) -> str:
     Parameters
     ----------
     data : dict
-        The analysis's JSON form (`maps.tracking.MapTracking.to_dict`, outputs and timing).
+        The analysis's JSON form (`maps.deciding.tracking.MapTracking.to_dict`, outputs and timing).
     """
     m, i, t = data["map"], data["inputs"], data["tracking"]
     ref = data["tracking_verdict"]
@@ -879,7 +879,7 @@ def _interval_text(interval) -> str:
 
 def _map_wobble_lines(w: dict | None, V: float) -> list[str]:
     """``map --wobble TOL``: how many zones (segments, route stretches) the mask drives at V_tolerance instead of V*, why
-    the others keep V*, and the range of the mask's limits (`maps.wobble.WobbleSummary`; docs/maps.md)."""
+    the others keep V*, and the range of the mask's limits (`maps.deciding.wobble_zones.WobbleSummary`; docs/maps.md)."""
     if w is None:
         return []
     kept = lambda counts, unit="": ", ".join(f"{n:.1f} m {why}" if unit else f"{n} {why}" for why, n in counts["kept"].items())

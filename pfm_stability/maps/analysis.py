@@ -50,14 +50,14 @@ from ..models import Loop, gain_margin, models_for, verdict_label
 from ..models.verdicts import Judgement, inside, judge
 from ..parameters import Controller, Robot
 from ..io.serialize import json_number
-from .equilibria import Samples, grid_equilibria, power_equilibria
-from .field import UNKNOWN_AS, HistogramMap, histogram_of
-from .occupancy import OccupancyMap
-from .driven import SampledTransition
-from .paths import PathVerdicts, analyze_paths
-from .routes import Route, default_min_length, find_paths, find_routes
-from .wobble import SegmentWobble
-from .verdicts import END_FRACTION, TAPER_SLOPE, GrowthRate, drift_slope, critical_speed, is_weak, judged_run, segment_gain, wavelength
+from .deciding.equilibria import Samples, grid_equilibria, power_equilibria
+from .reading.field import UNKNOWN_AS, HistogramMap, histogram_of
+from .reading.occupancy import OccupancyMap
+from .judging.driven import SampledTransition
+from .deciding.paths import PathVerdicts, analyze_paths
+from .reading.routes import Route, default_min_length, find_paths, find_routes
+from .deciding.wobble_zones import SegmentWobble
+from .deciding.verdicts import END_FRACTION, TAPER_SLOPE, GrowthRate, drift_slope, critical_speed, is_weak, judged_run, segment_gain, wavelength
 
 __all__ = ["DIRECTIONS", "MAP_LAWS", "MAX_CORRIDOR_WIDTHS", "MAX_MAP_SIDE", "MAX_RESOLUTION", "NO_VERDICT", "TAKEN_SOURCES", "MapAnalysis", "MapSegment",
            "add_routes", "analyze_map", "corridor_warnings", "judge_routes", "sample_verdict", "scale_warnings"]
@@ -134,7 +134,7 @@ class MapSegment:
     growth_rate : float or None
         σ̄, the mean growth rate over the judged part at the robot's V, 1/s (`verdicts.mean_growth`).
     wobble : SegmentWobble or None
-        The speed limit by wobble tolerance (`maps.wobble.with_wobble`, ``map --wobble``); None: not asked.
+        The speed limit by wobble tolerance (`maps.deciding.wobble_zones.with_wobble`, ``map --wobble``); None: not asked.
     """
 
     x0: float

@@ -1,6 +1,6 @@
 """Square cells of a regular grid: which cell holds a point, and where a cell's centre is.
 
-The one rule for every grid of the package (`CellGrid`: `maps.field.HistogramMap`, `sim.grid.HistogramGrid`):
+The one rule for every grid of the package (`CellGrid`: `maps.reading.field.HistogramMap`, `sim.grid.HistogramGrid`):
 cell (i, j) covers [x_min + i·c, x_min + (i + 1)·c) × [y_min + j·c, y_min + (j + 1)·c), c the cell size.
 """
 

@@ -1,4 +1,4 @@
-"""A map with the verdict along every route, and what the drives found (`maps.paths.PathVerdicts`,
+"""A map with the verdict along every route, and what the drives found (`maps.deciding.paths.PathVerdicts`,
 `validation.map_drives.DriveValidation`)."""
 
 from __future__ import annotations

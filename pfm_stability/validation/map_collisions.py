@@ -108,7 +108,7 @@ def locate_collisions(pv, contacts, match_distance: float) -> CollisionSummary:
     Parameters
     ----------
     pv : PathVerdicts
-        The map's routes and their verdicts (`maps.paths`).
+        The map's routes and their verdicts (`maps.deciding.paths`).
     contacts : sequence of (int, float, float)
         (drive index, x, y) of each drive that ended in a collision, m.
     match_distance : float
@@ -116,7 +116,7 @@ def locate_collisions(pv, contacts, match_distance: float) -> CollisionSummary:
     """
     from scipy.spatial import cKDTree
 
-    from ..maps.decide import CAUSES, PATH_VERDICTS
+    from ..maps.deciding.decide import CAUSES, PATH_VERDICTS
 
     x, y = pv.samples.x, pv.samples.y
     if not contacts:

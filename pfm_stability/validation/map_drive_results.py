@@ -11,7 +11,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..io.serialize import json_number, json_ready
-from ..maps.judge_thresholds import JUDGE, JudgeThresholds
+from ..maps.judging.judge_thresholds import JUDGE, JudgeThresholds
 
 __all__ = ["Disagreement", "Drive", "DriveRuns", "DriveValidation", "SimulatedDrive", "WobbleAgreement", "wobble_agreement"]
 
@@ -56,7 +56,7 @@ class SimulatedDrive:
 class DriveRuns:
     """A map's drives simulated once, with the prediction along their own paths: what `judge_drives` scores, with
     any `JudgeThresholds` (`drive_map` is the two in one; experiments/judge_thresholds.py re-judges one `DriveRuns`).
-    The prediction is the package's (made with `JUDGE`: `maps.driven`'s loop is judged by the same rule); a re-judging
+    The prediction is the package's (made with `JUDGE`: `maps.judging.driven`'s loop is judged by the same rule); a re-judging
     moves the drives' side only.
 
     Attributes
@@ -144,10 +144,10 @@ class Disagreement:
     drives : tuple of int
         The drives that passed it.
     predicted_amplitude : float
-        The largest lateral oscillation of the loop driven along it held for at least one period (`maps.paths`,
-        `maps.episodes.lateral_extent`), m.
+        The largest lateral oscillation of the loop driven along it held for at least one period (`maps.deciding.paths`,
+        `maps.judging.episodes.lateral_extent`), m.
     simulated_amplitude : float
-        The same of the drives there (`maps.episodes.swing`: three alternating turning points about their paths
+        The same of the drives there (`maps.judging.episodes.swing`: three alternating turning points about their paths
         averaged over a period, as the episodes' judge finds them; a bend is none), m. Above `AMPLITUDE_THRESHOLD`
         on a false alarm: the robot did weave past it, for one period or more but fewer than `EPISODE_PERIODS`; on a
         missed episode, the predicted amplitude above it is the loop's weave that did not last.
@@ -176,7 +176,7 @@ class WobbleAgreement:
     """How big the predicted weave is against the simulated one, along the measured part of the drives' own paths
     (`wobble_agreement`): where either the prediction's loop or the drive wove past `AMPLITUDE_THRESHOLD` for at
     least one period, the ratio of the two weaves held there (`DriveValidation`'s per-sample amplitudes:
-    `maps.episodes.lateral_extent`'s swing of the loop, `maps.episodes.swing` of the drive; 0 where one held none).
+    `maps.judging.episodes.lateral_extent`'s swing of the loop, `maps.judging.episodes.swing` of the drive; 0 where one held none).
     Recall and precision judge each side against the threshold; this says how far apart the two are in size, which
     is what decides them near it.
 
@@ -184,7 +184,7 @@ class WobbleAgreement:
     ----------
     length : float
         Measured length where either side wove past the threshold, m (the loop still in the corridor: where it left,
-        its size is only "at least `maps.driven.LEAVES`", and the length is counted as ``left`` instead).
+        its size is only "at least `maps.judging.driven.LEAVES`", and the length is counted as ``left`` instead).
     within : float or None
         Share of `length` where predicted / simulated lies within 1/`factor` .. `factor` (None: no
         length).
@@ -222,7 +222,7 @@ def wobble_agreement(predicted, simulated, spacing, leaves: float, thresholds: J
     leaves : float
         A predicted weave this large or larger means the loop left the corridor, m.
     thresholds : JudgeThresholds
-        Its `amplitude_threshold` and `wobble_factor` (`maps.judge_thresholds.JUDGE`: the package's).
+        Its `amplitude_threshold` and `wobble_factor` (`maps.judging.judge_thresholds.JUDGE`: the package's).
     """
     predicted, simulated, spacing = (np.asarray(v, dtype=float) for v in (predicted, simulated, spacing))
     factor = thresholds.wobble_factor

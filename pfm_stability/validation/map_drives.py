@@ -5,23 +5,23 @@
 around each drive). Half of them follow the routes: a route (`routes.RoutePath`) drawn at random (seeded), driven
 in a random direction from its first point plus a lateral offset δ = `START_OFFSET` (the disturbance) towards its
 last (`Target.point`: the VFF robot finds its own path); the other half go between two random reachable points of
-the routes (the same free component), following the global plan between them (`maps.planner.SkeletonPlanner`: the
+the routes (the same free component), following the global plan between them (`maps.reading.planner.SkeletonPlanner`: the
 shortest path along the skeleton) as a navigation stack would hand it to the VFF controller: the robot is pulled
 towards the plan's point `LOOKAHEAD` ahead of it (`Target.follow`, a pure-pursuit carrot), starting towards it. Every
 drive runs until its target is reached, it collides or stalls, or `DRIVE_TIME_FACTOR` times its length's time.
 
-**Episodes** (`maps.episodes.episodes`, the one definition the map's prediction uses too): the robot's
+**Episodes** (`maps.judging.episodes.episodes`, the one definition the map's prediction uses too): the robot's
 lateral oscillation about its own path averaged over one period P = 2π/ω*; an episode is three periods of it
 that grow by an e-fold or stay above `AMPLITUDE_THRESHOLD`. Every threshold of the judge and of the scoring below
-is a field of `maps.judge_thresholds.JudgeThresholds` (docs/judge.md: justifications, measured sensitivity);
+is a field of `maps.judging.judge_thresholds.JudgeThresholds` (docs/judge.md: justifications, measured sensitivity);
 `drive_map` is `judge_drives` (any table, ``thresholds=JUDGE``) of `simulate_drives` (the drives, simulated once).
 
 **Each drive is judged along the path it took** (its positions averaged over one period, `maps.analysis.judge_routes`
 with ``taken``: the prediction the map makes along any route — the loop driven through the force across the path,
-`maps.paths` — made along that path, in the direction it was driven, as the robot drove it: the window sum at the
+`maps.deciding.paths` — made along that path, in the direction it was driven, as the robot drove it: the window sum at the
 loop's own point, the attraction towards the point the robot steered at as it passed each point of the path (its
 plan's carrot or its goal, `RoutePath.aims`), the path's frame turning under the loop at the loop's own pace along
-it, and the loop's track judged in the plane by the drives' own judge; `maps.driven.DrivenTrack`). The VFF robot aims at a
+it, and the loop's track judged in the plane by the drives' own judge; `maps.judging.driven.DrivenTrack`). The VFF robot aims at a
 point, not along a route: it leaves the skeleton wherever the field bends it away (beside a rack it rides the
 window's edge, metres from the route), so comparing the skeleton's verdicts with a robot that drove elsewhere would
 compare two different paths.
@@ -58,10 +58,10 @@ from ..checks import check_integer
 from ..io.serialize import json_number
 from ..sim.engine import run_batch
 from ..sim.scenario import Pose, Scenario, Target
-from ..maps.episodes import episodes, swing
-from ..maps.judge_thresholds import JUDGE, JudgeThresholds
-from ..maps.planner import SkeletonPlanner
-from ..maps.routes import polyline_arcs
+from ..maps.judging.episodes import episodes, swing
+from ..maps.judging.judge_thresholds import JUDGE, JudgeThresholds
+from ..maps.reading.planner import SkeletonPlanner
+from ..maps.reading.routes import polyline_arcs
 from .map_collisions import locate_collisions
 from .map_drive_results import Disagreement, Drive, DriveRuns, DriveValidation, SimulatedDrive, WobbleAgreement, wobble_agreement
 from .maps import START_OFFSET, _batches, _table_size, crop_grid, simulator_grid, stall_time
@@ -160,7 +160,7 @@ def drive_map(analysis, count: int, *, seed: int = 0, progress=None, thresholds:
     progress : callable, optional
         ``progress(line)`` after each batch.
     thresholds : JudgeThresholds
-        The judge's and the scoring's thresholds (`maps.judge_thresholds.JUDGE`: the package's; docs/judge.md).
+        The judge's and the scoring's thresholds (`maps.judging.judge_thresholds.JUDGE`: the package's; docs/judge.md).
     """
     return judge_drives(simulate_drives(analysis, count, seed=seed, progress=progress), thresholds)
 
@@ -250,7 +250,7 @@ def _prepare(analysis, count: int, rng) -> tuple:
 
 def judge_drives(runs: DriveRuns, thresholds: JudgeThresholds = JUDGE) -> DriveValidation:
     """Judge and score simulated drives (module docstring, "Episodes", "Route length"): each drive's episodes
-    (`maps.episodes.episodes`), the samples of its own path it measured, and recall, precision and specificity with
+    (`maps.judging.episodes.episodes`), the samples of its own path it measured, and recall, precision and specificity with
     their intervals; with `JUDGE`, `drive_map`'s answer.
 
     Parameters
@@ -258,10 +258,10 @@ def judge_drives(runs: DriveRuns, thresholds: JudgeThresholds = JUDGE) -> DriveV
     runs : DriveRuns
         The drives (`simulate_drives`).
     thresholds : JudgeThresholds
-        The judge's and the scoring's thresholds (`maps.judge_thresholds.JUDGE`: the package's; docs/judge.md).
+        The judge's and the scoring's thresholds (`maps.judging.judge_thresholds.JUDGE`: the package's; docs/judge.md).
     """
-    from ..maps.decide import PATH_VERDICTS, UNJUDGED
-    from ..maps.driven import LEAVES
+    from ..maps.deciding.decide import PATH_VERDICTS, UNJUDGED
+    from ..maps.judging.driven import LEAVES
 
     started = time.perf_counter()
     analysis, period, dp = runs.analysis, runs.period, runs.drive_paths
@@ -480,7 +480,7 @@ class _Prepared:
 
 def _omega(analysis) -> float | None:
     """ω* of the analysis' model (rad/s), from its routes' window (Λ = 3·2πV/ω*), or None."""
-    from ..maps.decide import WINDOW_PERIODS
+    from ..maps.deciding.decide import WINDOW_PERIODS
 
     w = analysis.paths.window
     if not math.isfinite(w) or w <= 0:
@@ -566,7 +566,7 @@ def _taken_path(x, y, period: float, T: float, cell: float, index: int, source: 
     steered at (`RoutePath.goal`, `RoutePath.lookahead`) and the `Pose` it started from, if given (`RoutePath.start`)."""
     from scipy.ndimage import uniform_filter1d
 
-    from ..maps.routes import path_of
+    from ..maps.reading.routes import path_of
 
     n = max(1, int(round(JUDGE.average_periods * period / T)))
     x, y = uniform_filter1d(x, n, mode="nearest"), uniform_filter1d(y, n, mode="nearest")
@@ -599,7 +599,7 @@ def goal_routes(analysis, goals, progress=None) -> list:
     each drive (the simulator's grid law on the map's grid) follows the plan between the two goals as the validation's
     do (`SkeletonPlanner`, `Target.follow` with `LOOKAHEAD`; a point target straight at the goal where the skeleton
     does not join them), averaged over one oscillation period P = 2π/ω* — the path it follows, about which
-    `maps.paths` linearizes — from its start to where it stopped (the goal, a collision or a stall).
+    `maps.deciding.paths` linearizes — from its start to where it stopped (the goal, a collision or a stall).
 
     Parameters
     ----------

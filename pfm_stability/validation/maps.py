@@ -27,7 +27,7 @@ stall (the "trapped" event) is not counted. A σ within the run's `resolution` h
 sign: it disagrees when the predicted σ̄ differs from it by more than that (`contradicts`),
 else it is "not measurable (σ within resolution)". Each case is "agree", "disagree" or
 "not measurable" (`MapCase.outcome`); the agreement is over the measured ones only.
-A segment is driven over its judged part only (`maps.verdicts.judged_run`). Undefined values are
+A segment is driven over its judged part only (`maps.deciding.verdicts.judged_run`). Undefined values are
 None with a reason, never NaN.
 
 Each run senses a copy of the map's grid cropped to the segment's box widened
@@ -331,7 +331,7 @@ def stall_time(V: float) -> float:
 
 
 def simulator_grid(hmap) -> HistogramGrid:
-    """The simulator's frozen `HistogramGrid` of a map's histogram grid (`maps.field.HistogramMap`: same cells, same origin).
+    """The simulator's frozen `HistogramGrid` of a map's histogram grid (`maps.reading.field.HistogramMap`: same cells, same origin).
 
     Parameters
     ----------
@@ -508,7 +508,7 @@ def _batches(runs: list) -> list:
 
 
 def _judged_ends(s) -> tuple:
-    """([x0, y0, x1, y1], length) of the segment's judged part (`maps.verdicts.judged_run`; the whole segment without one), m."""
+    """([x0, y0, x1, y1], length) of the segment's judged part (`maps.deciding.verdicts.judged_run`; the whole segment without one), m."""
     ends = [float(s.x0), float(s.y0), float(s.x1), float(s.y1)]
     length = float(s.length)
     a, b = number(getattr(s, "judged_from", None)), number(getattr(s, "judged_to", None))

@@ -15,7 +15,7 @@ ea95cc394, 2026-08-11), as read in ``nav2_costmap_2d/plugins/costmap_filters/zon
   ``base: 0.0``, ``multiplier: 1.0`` (others are ignored with a warning).
 
 The mask's cells hold 0 (the file's lookahead) except within W/2 of each stretch with a zone lookahead
-(`maps.tracking.TrackingStretch.zone_lookahead`), which hold the state of that lookahead; the states are numbered
+(`maps.deciding.tracking.TrackingStretch.zone_lookahead`), which hold the state of that lookahead; the states are numbered
 1 … n by increasing lookahead (a cell covered by two zones takes the longer). The OccupancyGrid's values are
 0 … 100 (map_server's scale mode), so at most `MAX_STATES` states: the lookaheads are rounded up to a coarser step
 until they fit. The PGM is written in the speed mask's scale mode (`outputs.percent_to_pixel`: the value read back is
@@ -86,7 +86,7 @@ def zone_states(analysis) -> tuple:
     Parameters
     ----------
     analysis : MapTracking
-        ``map --controller`` (`maps.tracking.analyze_map_tracking`).
+        ``map --controller`` (`maps.deciding.tracking.analyze_map_tracking`).
     """
     distinct = sorted({v for v in _zone_values(analysis) if v is not None})
     return tuple(ZoneState(k + 1, float(v)) for k, v in enumerate(distinct))

@@ -4,12 +4,12 @@ The speed mask (docs/maps.md, "The speed mask") has the input map's size, resolu
 and origin. Each cell holds a speed limit as a percentage of the robot's V, for the
 Nav2 speed filter with ``type: 1`` (percentage), ``base: 0``, ``multiplier: 1``:
 
-* cells within W/2 of every unstable route stretch (`maps.paths`; with the power law, of every unstable segment whose
+* cells within W/2 of every unstable route stretch (`maps.deciding.paths`; with the power law, of every unstable segment whose
   V* is below V): 100·V*/V rounded down (never above what is stable), at least 1 (the filter reads 0 as
   "no limit"); with a braking deceleration a_max (``--dilate-upstream``) each route
   stretch's zone reaches (V² − V*²)/(2·a_max) further along its route at both ends
   (`upstream_distance`: Nav2's filter slows the robot only once it is inside a zone);
-* with a wobble tolerance (``map --wobble TOL``, `maps.wobble`) a segment's or route stretch's zone holds
+* with a wobble tolerance (``map --wobble TOL``, `maps.deciding.wobble_zones`) a segment's or route stretch's zone holds
   100·V_limit/V instead: V_tolerance, the fastest speed whose wobble stays under TOL, where the describing function
   is trusted, else V* (`ZoneWobble.V_limit`); a zone only where the verdict is unstable, none where V_limit >= V; a stretch's upstream dilation brakes to
   V_limit;
@@ -31,7 +31,7 @@ import math
 
 import numpy as np
 
-from .routes import polyline_arcs
+from ..reading.routes import polyline_arcs
 
 __all__ = [
     "has_zone",
@@ -65,7 +65,7 @@ ROUTE_COLUMNS = ("route", "start", "stop", "x0", "y0", "x1", "y1", "length", "ve
 """What ``--out-dir`` receives."""
 TRACKING_COLUMNS = ("route", "start", "stop", "x0", "y0", "x1", "y1", "length", "verdict", "cause", "margin", "V_critical",
                     "lookahead_critical", "V", "L", "half_width", "pose_cost", "curvature", "zone_lookahead")
-"""``routes.csv`` of ``map --controller rpp`` (`maps.tracking.TrackingStretch`)."""
+"""``routes.csv`` of ``map --controller rpp`` (`maps.deciding.tracking.TrackingStretch`)."""
 CSV_COLUMNS = ("x0", "y0", "x1", "y1", "length", "N", "c", "V_critical", "margin", "stable", "verdict", "offset", "samples", "analysed",
                "N_max", "V_critical_local", "wavelength")
 MIN_PERCENT = 1
@@ -83,7 +83,7 @@ def _csv_value(v) -> str:
 
 
 def routes_csv(analysis) -> str:
-    """One row per stretch of a route (`maps.paths.PathStretch`): route, arc positions and ends (m), length, verdict or
+    """One row per stretch of a route (`maps.deciding.paths.PathStretch`): route, arc positions and ends (m), length, verdict or
     the reason without one, label, the worst window's growth rate (1/s), e-folds, N_eff (1/m), margin, V* (m/s),
     direction, whether the linear loop weaves there and its amplitude (m), the share linearized about the route.
 
@@ -96,14 +96,14 @@ def routes_csv(analysis) -> str:
 
 
 def tracking_csv(analysis) -> str:
-    """One row per stretch of a Nav2 controller along the routes (`maps.tracking.TrackingStretch`): route, arc positions
+    """One row per stretch of a Nav2 controller along the routes (`maps.deciding.tracking.TrackingStretch`): route, arc positions
     and ends (m), length, verdict, cause, margin, V* (m/s), L* (m), the regulated speed (m/s) and lookahead (m), the
     half-width (m), cost and curvature (1/m) of the worst sample, the zone's lookahead (m).
 
     Parameters
     ----------
     analysis : MapTracking
-        With `maps.tracking.TrackingVerdicts` as ``paths``.
+        With `maps.deciding.tracking.TrackingVerdicts` as ``paths``.
     """
     return _stretches_csv(analysis.paths.stretches, TRACKING_COLUMNS)
 
@@ -216,7 +216,7 @@ def stamp_stretch(values: np.ndarray, occupancy, points, stretch, reach: float, 
 
 def has_zone(zone, V: float) -> bool:
     """Whether the speed mask draws a zone for a route stretch (or, with the power law, a segment) at speed V (m/s):
-    wherever its verdict is unstable. A stretch's V* is below V exactly then (`maps.stretch_speed`); a V* of 0 (no
+    wherever its verdict is unstable. A stretch's V* is below V exactly then (`maps.deciding.stretch_speed`); a V* of 0 (no
     speed down to a tenth of V calms it) is drawn at the filter's slowest, `MIN_PERCENT`. A segment's V* can lie above V
     with an unstable verdict (its mean growth changes sign more than once): no zone, nothing to slow to.
 

@@ -1,12 +1,12 @@
-"""Every sample of every route decided at one speed: the rule behind `maps.paths`' stretches (docs/maps.md,
+"""Every sample of every route decided at one speed: the rule behind `maps.deciding.paths`' stretches (docs/maps.md,
 "Verdicts along every route" and "One answer per stretch").
 
 `route_geometry` computes what does not depend on the speed (samples, lateral equilibria, the field's gradient, the
 lateral profile the loop is driven through, the window-edge jumps); `decide` applies the rule at a speed V — the
 window's growth (`WINDOW_PERIODS` wavelengths, at least `verdicts.EFOLDS` e-folds: "growth"), the loop driven along the
 route (`driven._driven`: a "forced weave"), the window-edge relay (`relay`: "relay") — and gives each sample its verdict
-and cause (`SampleDecision`). `maps.paths` makes the stretches and `maps.stretch_speed` their V* with the same rule.
-The rule itself is described in `maps.paths`' module docstring.
+and cause (`SampleDecision`). `maps.deciding.paths` makes the stretches and `maps.deciding.stretch_speed` their V* with the same rule.
+The rule itself is described in `maps.deciding.paths`' module docstring.
 """
 
 from __future__ import annotations
@@ -16,9 +16,9 @@ from dataclasses import dataclass, fields, replace
 
 import numpy as np
 
-from .contact import free_band
-from .driven import LEAVES, DriveRequest, DrivenTrack, SampledTransition, driven_loops
-from .episodes import AMPLITUDE_THRESHOLD
+from ..reading.contact import free_band
+from ..judging.driven import LEAVES, DriveRequest, DrivenTrack, SampledTransition, driven_loops
+from ..judging.episodes import AMPLITUDE_THRESHOLD
 from .equilibria import equilibria_at, lateral_force
 from .relay import relay_amplitude, window_relay
 from .verdicts import EFOLDS, END_FRACTION, GrowthRate, wavelength
@@ -333,9 +333,9 @@ CAUSES = ("growth", "forced weave", "relay", "collision course")
 """Why a sample is unstable (`SampleDecision.cause` indexes it; −1: stable or unjudged), tried in the order: the
 linear loop grows at least `verdicts.EFOLDS` e-folds over the window or the run of growing windows ("growth"); the
 loop driven along the route through the field weaves though the linear loop is damped (the field's ripple forcing
-it, `maps.episodes`: "forced weave"); the driven loop's disc meets an obstacle within one period after the sample
+it, `maps.judging.episodes`: "forced weave"); the driven loop's disc meets an obstacle within one period after the sample
 without a weave first ("collision course", `contact.free_band`); the window-edge relay holds a cycle of at least the
-episodes' amplitude (`maps.relay`: "relay")."""
+episodes' amplitude (`maps.deciding.relay`: "relay")."""
 
 
 @dataclass(frozen=True)

@@ -44,9 +44,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..checks import check_number
-from ..extras import require
-from ..io.yaml_files import InputError, YamlFile, leading_key, read_yaml
+from ...checks import check_number
+from ...extras import require
+from ...io.yaml_files import InputError, YamlFile, leading_key, read_yaml
 
 __all__ = ["MAP_KEYS", "MAX_PIXELS", "MODES", "OccupancyMap", "load_map", "occupancy_values"]
 

@@ -31,7 +31,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..extras import require
+from ...extras import require
 from .field import HistogramMap
 
 __all__ = ["JUNCTION_CUT", "MIN_LENGTH", "TOLERANCE_CELLS", "Route", "RoutePath", "default_min_length", "find_paths", "find_routes", "path_of",

@@ -1,6 +1,6 @@
 """The user's own routes: a Nav2 path, a CSV of x, y, or waypoints in YAML (docs/maps.md, "Your own routes").
 
-`read_routes` reads one file into `routes.RoutePath`s, judged like the skeleton's routes (`maps.paths`):
+`read_routes` reads one file into `routes.RoutePath`s, judged like the skeleton's routes (`maps.deciding.paths`):
 
 * a Nav2 path — a ``nav_msgs/Path`` as YAML (``ros2 topic echo --once /plan > plan.yaml``): ``poses``, each
   ``pose: {position: {x, y}}`` (a ``PoseStamped``; a bare ``position`` is accepted too), optionally under a

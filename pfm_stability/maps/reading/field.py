@@ -30,9 +30,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..laws.effective_force import DEFAULT_CV, GridWallLaw
+from ...laws.effective_force import DEFAULT_CV, GridWallLaw
 from .occupancy import OccupancyMap
-from ..numerics.cells import CellGrid
+from ...numerics.cells import CellGrid
 
 __all__ = ["CHUNK_ENTRIES", "UNKNOWN_AS", "HistogramMap", "centre_field", "histogram_of", "window_force"]
 

@@ -48,7 +48,7 @@ about its one-period average within half a period of the sample must reach the t
 **The loop driven along the route** (`_driven`): the sampled loop is also run along each route through the force
 across it (`lateral_profile`, every quarter cell: the window sum's jumps, a rack's staircase, a one-sided field), with
 the steering-rate limit on its command (`SampledTransition`, `models.sampled.command_form`); its episodes (the
-drives' own definition, `maps.episodes`) mark the route unstable (cause "forced weave"): a forced weave, or a cycle the
+drives' own definition, `maps.judging.episodes`) mark the route unstable (cause "forced weave"): a forced weave, or a cycle the
 nonlinearity holds, that the window growth cannot see.
 
 **Paths taken** (``taken``: the paths the simulated robot drove, between goals or in the validation,
@@ -86,10 +86,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..io.serialize import json_number
-from ..models.verdicts import inside as in_set, judge_arrays
+from ...io.serialize import json_number
+from ...models.verdicts import inside as in_set, judge_arrays
 from .decide import CAUSES, PATH_VERDICTS, UNJUDGED, DecisionRule, RouteGeometry, SampleDecision, decide, route_geometry
-from .routes import polyline_arcs
+from ..reading.routes import polyline_arcs
 from .stretch_speed import stretch_speeds
 from .verdicts import END_FRACTION, GrowthRate, effective_gain
 
@@ -133,10 +133,10 @@ class PathStretch:
     linearized_at_route : float
         Fraction of the stretch's samples without a lateral equilibrium (linearized about the route).
     oscillates : bool
-        The loop driven along the route weaves over part of it (`maps.episodes`).
+        The loop driven along the route weaves over part of it (`maps.judging.episodes`).
     amplitude : float
         The weave's predicted size: the largest lateral oscillation the loop driven along the route holds on it, m
-        (`maps.episodes.lateral_extent`; `LEAVES` where it left the corridor: at least that; a relay's cycle where that
+        (`maps.judging.episodes.lateral_extent`; `LEAVES` where it left the corridor: at least that; a relay's cycle where that
         is larger).
     """
 
@@ -202,7 +202,7 @@ class PathVerdicts:
         Window length Λ, m.
     stretches : tuple of PathStretch
     oscillates : ndarray of bool
-        The linear loop driven along the route weaves here (`maps.episodes`: a forced or growing oscillation).
+        The linear loop driven along the route weaves here (`maps.judging.episodes`: a forced or growing oscillation).
     amplitude : ndarray
         The predicted lateral oscillation at each sample, m (the largest of the runs passing it; as on `PathStretch`).
     cause : ndarray of int
@@ -231,7 +231,7 @@ class PathVerdicts:
 
     @property
     def relay(self) -> np.ndarray:
-        """Per sample: the window-edge relay holds the robot in a sustained oscillation here (`maps.relay`; cause
+        """Per sample: the window-edge relay holds the robot in a sustained oscillation here (`maps.deciding.relay`; cause
         "relay")."""
         return self.cause == CAUSES.index("relay")
 

@@ -45,9 +45,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..laws.effective_force import GridWallLaw
-from ..numerics.solve import newton_increasing
-from .field import HistogramMap, window_force
+from ...laws.effective_force import GridWallLaw
+from ...numerics.solve import newton_increasing
+from ..reading.field import HistogramMap, window_force
 
 __all__ = ["NEWTON_STEPS", "RAY_LENGTH", "Samples", "equilibria_at", "grid_equilibria", "lateral_force", "power_equilibria"]
 
@@ -214,7 +214,7 @@ def lateral_force(grid, law, x, y, tx, ty, s, jacobian=False, phase_nodes: int =
     phase_nodes : int
         Gauss–Legendre nodes of the average along t (`PHASE_NODES`).
     """
-    from ..numerics.solve import gauss_legendre
+    from ...numerics.solve import gauss_legendre
 
     nodes, weights = gauss_legendre(phase_nodes)
     u = nodes * grid.cell_size / 2

@@ -1,6 +1,6 @@
 """Oscillation episodes of a lateral motion: where a robot weaves (docs/maps.md, "Validation by driving").
 
-One definition serves the map's prediction (`maps.paths`: the linear loop driven along a route) and its judge
+One definition serves the map's prediction (`maps.deciding.paths`: the linear loop driven along a route) and its judge
 (`validation.map_drives`: the simulator's drives). The lateral oscillation is the motion minus its own average
 over one period P = 2π/ω* (the loop's oscillation at the boundary; `scipy.ndimage.uniform_filter1d`), smoothed
 over P/8 (the cell ripple, at c/V, is faster). Its turning points give amplitudes; an **episode** is
@@ -12,7 +12,7 @@ Amplitudes below `NOISE_FLOOR` are no oscillation. The first and last half perio
 not centred there), and the samples where the judged part is cut are no turning points (the motion is cut there,
 not turning).
 
-Every number above is a field of one table, `maps.judge_thresholds.JudgeThresholds` (the package's: `JUDGE`; the
+Every number above is a field of one table, `maps.judging.judge_thresholds.JudgeThresholds` (the package's: `JUDGE`; the
 names here are its fields' aliases), with its unit, justification and measured sensitivity in docs/judge.md; every
 function takes ``thresholds=JUDGE``, so that an experiment re-judges with another table.
 """
@@ -53,7 +53,7 @@ def lateral_episodes(t, lateral, period: float, thresholds: JudgeThresholds = JU
     period : float
         The oscillation period P, s.
     thresholds : JudgeThresholds
-        The judge's thresholds (`maps.judge_thresholds.JUDGE`: the package's; docs/judge.md).
+        The judge's thresholds (`maps.judging.judge_thresholds.JUDGE`: the package's; docs/judge.md).
     """
     t = np.asarray(t, dtype=float)
     r, n = _about_average(t, lateral, period, thresholds)
@@ -75,7 +75,7 @@ def lateral_extent(t, lateral, period: float, thresholds: JudgeThresholds = JUDG
     period : float
         The oscillation period P, s.
     thresholds : JudgeThresholds
-        The judge's thresholds (`maps.judge_thresholds.JUDGE`: the package's; docs/judge.md).
+        The judge's thresholds (`maps.judging.judge_thresholds.JUDGE`: the package's; docs/judge.md).
     """
     from scipy.ndimage import maximum_filter1d
 
@@ -126,7 +126,7 @@ def episodes(t, x, y, period: float, thresholds: JudgeThresholds = JUDGE) -> tup
     period : float
         The oscillation period P, s.
     thresholds : JudgeThresholds
-        The judge's thresholds (`maps.judge_thresholds.JUDGE`: the package's; docs/judge.md).
+        The judge's thresholds (`maps.judging.judge_thresholds.JUDGE`: the package's; docs/judge.md).
     """
     t = np.asarray(t, dtype=float)
     r, n = oscillation(t, x, y, period, thresholds)
@@ -148,7 +148,7 @@ def oscillation(t, x, y, period: float, thresholds: JudgeThresholds = JUDGE) -> 
     period : float
         The oscillation period P, s.
     thresholds : JudgeThresholds
-        The judge's thresholds (`maps.judge_thresholds.JUDGE`: the package's; its `average_periods` the average's
+        The judge's thresholds (`maps.judging.judge_thresholds.JUDGE`: the package's; its `average_periods` the average's
         length).
     """
     from scipy.ndimage import uniform_filter1d
@@ -179,7 +179,7 @@ def swing(t, x, y, period: float, thresholds: JudgeThresholds = JUDGE) -> np.nda
     period : float
         The oscillation period P, s.
     thresholds : JudgeThresholds
-        The judge's thresholds (`maps.judge_thresholds.JUDGE`: the package's; its `swing_points` the turning points
+        The judge's thresholds (`maps.judging.judge_thresholds.JUDGE`: the package's; its `swing_points` the turning points
         held).
     """
     t = np.asarray(t, dtype=float)

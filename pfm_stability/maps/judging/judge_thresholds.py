@@ -1,9 +1,9 @@
 """The oscillation judge's thresholds: one named, documented table (docs/judge.md).
 
-Every number the oscillation judge (`maps.episodes`: what an episode is, how large a swing is) and the drives'
+Every number the oscillation judge (`maps.judging.episodes`: what an episode is, how large a swing is) and the drives'
 scoring (`validation.map_drives`: which samples are measured, what matches what) compare against lives in
 `JudgeThresholds`, with its unit, where its value comes from and what moving it does; `JUDGE` is the table the
-package uses. Both the map's prediction (`maps.driven`, `maps.decide`: the loop driven along a route is judged by the
+package uses. Both the map's prediction (`maps.judging.driven`, `maps.deciding.decide`: the loop driven along a route is judged by the
 same rule, and the window-edge relay is unstable when its cycle reaches `amplitude_threshold`) and the validation read
 it, so a change to it moves both sides. The judge functions take ``thresholds=JUDGE``: an experiment re-judges the
 same drives with another table (experiments/judge_thresholds.py, whose measured sensitivity is docs/judge.md's
@@ -41,7 +41,7 @@ class JudgeThresholds:
         cycle, ±2 cm on the straight test corridor at 1.4 V* (W 0.4 m, k 20 1/s, 120 deg/s; tests/test_map_paths.py),
         reached within two periods, too soon for the growth to count; a stable loop's forced ripple on the same grid,
         and its decaying start transient after the first period, stay below 1.3 cm. Also the relay's test on the
-        prediction side (`maps.decide`: a window-edge relay is unstable when its cycle reaches it) and the size above
+        prediction side (`maps.deciding.decide`: a window-edge relay is unstable when its cycle reaches it) and the size above
         which a false alarm or a missed episode counts as "swinging" and a weave is compared (`WobbleAgreement`).
         Lower calls ripple an episode; higher misses rate-limited cycles.
     noise_floor : float
@@ -72,7 +72,7 @@ class JudgeThresholds:
         An episode (and a swing) begins this many periods before its first turning point. *Definition*: a sinusoid's
         zero crossing lies a quarter period before its extreme.
     swing_points : int
-        Turning points, alternating and spaced as above, a swing is held for (`maps.episodes.swing`, the weave the
+        Turning points, alternating and spaced as above, a swing is held for (`maps.judging.episodes.swing`, the weave the
         disagreements and `WobbleAgreement` report). *Definition*: three turning points are one period.
     match_distance : float
         Largest distance, m, from a drive's trajectory point to the sample of its own path (or of the map's routes)

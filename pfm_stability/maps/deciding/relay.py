@@ -49,7 +49,7 @@ N_1(A) = −(2/A)·⟨F(s0 + B + A·sin θ)·sin θ⟩; the cycle is the first A
 at the window's edge (tests/test_map_relay.py) this is what the VFF simulator does (0.17 m), while the one-jump
 formula gives 0.06 m (0.13 m with the split jump merged).
 
-`maps.paths` calls the point unstable ("relay") when the amplitude reaches the episodes' `AMPLITUDE_THRESHOLD`: a
+`maps.deciding.paths` calls the point unstable ("relay") when the amplitude reaches the episodes' `AMPLITUDE_THRESHOLD`: a
 smaller cycle is one the driving validation would not call an oscillation either.
 """
 

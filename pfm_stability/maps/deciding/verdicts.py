@@ -76,7 +76,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.interpolate import PchipInterpolator
 
-from ..numerics.solve import bisect_root, first_crossing
+from ...numerics.solve import bisect_root, first_crossing
 
 __all__ = ["EFOLDS", "END_FRACTION", "TAPER_SLOPE", "drift_slope", "GrowthRate", "SegmentGain", "critical_speed", "effective_gain", "is_weak", "judged_run",
            "mean_growth", "segment_gain", "wavelength"]

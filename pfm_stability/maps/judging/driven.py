@@ -1,11 +1,11 @@
 """The sampled loop driven along a route through the force across it (docs/maps.md, "The loop driven along the
-route", "A drive's own path is driven as the robot drove it"; `maps.paths` judges with it).
+route", "A drive's own path is driven as the robot drove it"; `maps.deciding.paths` judges with it).
 
 `SampledTransition` is the sampled loop's one-period map with its command apart (the window growth's Φ(NV) and the
 driven loop's step); `_driven` runs the loop along every route through the lateral force tabulated across it
 (`paths.lateral_profile`), and along a drive's own path as the robot drove it (`DrivenTrack`: the window sum at the
 loop's own point, the attraction towards the point the robot steered at, the path's frame turning under the loop at
-the loop's own pace, `_TrackWalk`; its track judged in the plane by the drives' own judge, `maps.episodes`).
+the loop's own pace, `_TrackWalk`; its track judged in the plane by the drives' own judge, `maps.judging.episodes`).
 """
 
 from __future__ import annotations
@@ -15,8 +15,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .field import window_force
-from .routes import polyline_arcs
+from ..reading.field import window_force
+from ..reading.routes import polyline_arcs
 
 __all__ = ["LEAVES", "OWN_STEPS", "PREDICTION_OFFSET", "DriveRequest", "DrivenLoop", "DrivenTrack", "SampledTransition", "driven_loops"]
 
@@ -77,8 +77,8 @@ class SampledTransition:
         max_steering_rate : float
             The robot's limit on its steering command, rad/s (`Robot.max_steering_rate`; inf: none).
         """
-        from ..models.sampled import closed_loop_matrix, command_form, continuous_plant
-        from ..numerics.matrix_exponential import zoh_blocks
+        from ...models.sampled import closed_loop_matrix, command_form, continuous_plant
+        from ...numerics.matrix_exponential import zoh_blocks
 
         def at(NV):  # Φ_cl at the loop gain NV (1/s)
             return np.asarray(closed_loop_matrix(loop, loop.loop_gain(NV), model.hold, model.compute_delay), dtype=float)
@@ -210,7 +210,7 @@ class DrivenLoop:
     Attributes
     ----------
     oscillates : ndarray of bool
-        An episode (`maps.episodes`) of the loop's lateral motion passes the sample.
+        An episode (`maps.judging.episodes`) of the loop's lateral motion passes the sample.
     collides : ndarray of bool
         The loop meets an obstacle within one period P after passing the sample (its disc leaves the free band,
         `contact.free_band`): the robot is on a collision course there.
@@ -238,7 +238,7 @@ def driven_loops(route, arc, profile, requests, transition: SampledTransition, p
     """The sampled loop driven along the routes at each requested speed (`DrivenLoop` per `DriveRequest`), all speeds'
     runs stepped together (one step of every run per period T).
 
-    The loop is driven along each route at V through the real lateral force across it (`maps.paths` module docstring,
+    The loop is driven along each route at V through the real lateral force across it (`maps.deciding.paths` module docstring,
     "The loop driven along the route"), in both directions (a path taken: the way it was driven), started
     `PREDICTION_OFFSET` off it (a drive's own path: where the robot started, `DrivenTrack.start`); its lateral
     position's episodes (`episodes.lateral_episodes`, the drives' judge) mark the samples the robot passes meanwhile;
@@ -251,7 +251,7 @@ def driven_loops(route, arc, profile, requests, transition: SampledTransition, p
     cells), P and A what the goal balances across the path and its attraction along it, K the goal's pull back to
     the path, sat the steering-rate limit (`DriveRequest`). The run stops where it leaves the profile or `LEAVES`.
 
-    **A drive's own path** (a path taken whose aims are known, `track`) is driven as the robot drove it (`maps.paths`
+    **A drive's own path** (a path taken whose aims are known, `track`) is driven as the robot drove it (`maps.deciding.paths`
     module docstring, "A drive's own path"): at the loop's own point q = p(s) + y·nrm(s) the force is the window sum there
     (`DrivenTrack.force`, not the profile's value at the sample's cell middle), the attraction is the unit vector from q
     to the point the robot steered at (`RoutePath.aims`: its carrot, whose pull back to the path is the K·y above

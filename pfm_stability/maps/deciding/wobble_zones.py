@@ -23,7 +23,7 @@ models: walls thicker than a cell, one-sided, bent; a route stretch's own speed 
 window, is compared, since its V* lies above it where the stretch is too short for a slow growth to reach an e-fold),
 and which is faster than the zone's V* (the tolerance only relaxes the mask). Everywhere else the mask keeps V*, and
 `ZoneWobble.reason` says why (`ZoneWobble.kept` its short name). One rule for both kinds of zone, except that an
-unstable route stretch whose cause is "relay" (the window-edge relay, `maps.relay`) or "forced weave" (a forced weave along the
+unstable route stretch whose cause is "relay" (the window-edge relay, `maps.deciding.relay`) or "forced weave" (a forced weave along the
 route) is not a Hopf cycle of the straight corridor: it keeps V*.
 """
 
@@ -34,10 +34,10 @@ from dataclasses import dataclass, fields, replace
 
 import numpy as np
 
-from ..analysis.wobble import WOBBLE_MODELS, corridor_branch, trusted_cycle
-from ..io.serialize import json_number
-from ..laws.effective_force import GridWallLaw
-from ..checks import check_number
+from ...analysis.wobble import WOBBLE_MODELS, corridor_branch, trusted_cycle
+from ...io.serialize import json_number
+from ...laws.effective_force import GridWallLaw
+from ...checks import check_number
 from .equilibria import RAY_LENGTH
 from .outputs import has_zone
 from .decide import path_samples

@@ -23,7 +23,7 @@ most the costmap's inscribed radius) is not judged ("no room").
 **Stretches** are runs of one verdict along a route (`TrackingStretch`); each gives the worst sample's numbers (the
 smallest margin: the fastest regulated speed), the smallest V* and the largest L* of its samples, and, where it is
 unstable and a lookahead L* <= ``max_lookahead_dist`` is stable, the lookahead a ZoneParameterFilter zone sets there
-(`TrackingStretch.zone_lookahead`: L* rounded up to `LOOKAHEAD_STEP`). The masks are `maps.outputs`'.
+(`TrackingStretch.zone_lookahead`: L* rounded up to `LOOKAHEAD_STEP`). The masks are `maps.deciding.outputs`'.
 """
 
 from __future__ import annotations
@@ -34,15 +34,15 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from ..analysis.path_laws import PurePursuit, corridor_pose_cost, path_law
-from ..analysis.path_tracking import LawVerdict, PathTracking, analyze_path_tracking, check_tracking_point, law_verdict, ratio_critical, tracking_loop
-from ..controllers.rpp import curvature as carrot_curvature
-from ..io.serialize import json_number
-from ..models import models_for
+from ...analysis.path_laws import PurePursuit, corridor_pose_cost, path_law
+from ...analysis.path_tracking import LawVerdict, PathTracking, analyze_path_tracking, check_tracking_point, law_verdict, ratio_critical, tracking_loop
+from ...controllers.rpp import curvature as carrot_curvature
+from ...io.serialize import json_number
+from ...models import models_for
 from .decide import path_samples
-from .field import histogram_of
+from ..reading.field import histogram_of
 from .paths import routes_json
-from .routes import find_paths, find_routes, polyline_arcs
+from ..reading.routes import find_paths, find_routes, polyline_arcs
 
 __all__ = ["CURVATURE_STEP", "LOOKAHEAD_STEP", "MAP_CONTROLLERS", "TRACKING_VERDICTS", "MapTracking", "TrackingStretch", "TrackingVerdicts",
            "analyze_map_tracking", "route_corridors"]
@@ -277,7 +277,7 @@ class MapTracking:
     unknown : str
         How unknown map cells counted.
     segments : tuple
-        Empty: the routes' stretches are the result set (`maps.outputs.speed_limits` reads them).
+        Empty: the routes' stretches are the result set (`maps.deciding.outputs.speed_limits` reads them).
     """
 
     occupancy: object
@@ -436,7 +436,7 @@ def analyze_map_tracking(occupancy, robot, controller, tracker, *, model: str = 
         A controller other than `MAP_CONTROLLERS`, a map with no free space or no route, an operating point outside the
         loop's range (`analysis.path_tracking.check_tracking_point`).
     """
-    from .analysis import scale_warnings
+    from ..analysis import scale_warnings
 
     if tracker.controller not in MAP_CONTROLLERS:
         raise ValueError(f"controller must be one of {', '.join(MAP_CONTROLLERS)} along a map's routes; got {tracker.controller!r}")
