@@ -68,7 +68,7 @@ def test_the_validation_locates_every_drive_that_collided(tmp_path):
 
     robot, controller = CARMEL.robot.replace(W=0.3, V=0.5), CARMEL.controller
     analysis = analyze_map(load_map(map_path("tb3_sandbox")), robot, controller, make_law("grid", robot, controller), corridors=False)
-    validation = drive_map(analysis, 12, seed=0)
+    validation = drive_map(analysis, 6, seed=0)
     collided = [d for d in validation.drives if d.event == "collision"]
     assert collided and all(d.contact is not None for d in collided)
     assert all(d.contact is None for d in validation.drives if d.event != "collision")

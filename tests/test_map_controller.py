@@ -97,8 +97,9 @@ def test_the_straight_corridor_gets_one_verdict(corridor):
 def test_the_zone_mask_sets_a_lookahead_the_report_finds_stable(corridor, tmp_path):
     out = tmp_path / "out"
     data = map_json([str(corridor), "--controller", "rpp", *FAST, "--out-dir", str(out)])
-    assert sorted(p.name for p in out.iterdir()) == ["routes.csv", "speed_mask.pgm", "speed_mask.yaml", "zone_mask.pgm", "zone_mask.yaml",
+    assert sorted(p.name for p in out.iterdir()) == ["routes.csv", "routes.png", "speed_mask.pgm", "speed_mask.yaml", "zone_mask.pgm", "zone_mask.yaml",
                                                      "zone_params.yaml"]
+    assert (out / "routes.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"  # the stretches drawn by verdict and remedy
     s = _middle(data)
     zone = s["zone_lookahead"]
     assert zone is not None and s["lookahead_critical"] <= zone <= 0.9 and zone - s["lookahead_critical"] < 0.01 + 1e-9

@@ -261,8 +261,28 @@ def _run_tracking(args, path, started: float) -> int:
     return 0
 
 
+def _tracking_picture(analysis) -> bytes:
+    """``routes.png`` of ``map --controller`` (`plots.map_routes.plot_tracking_verdicts`), PNG bytes."""
+    import io
+
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from ..plots.map_routes import plot_tracking_verdicts
+
+    fig = plot_tracking_verdicts(analysis)
+    try:
+        buffer = io.BytesIO()
+        fig.savefig(buffer, format="png", dpi=110)
+        return buffer.getvalue()
+    finally:
+        plt.close(fig)
+
+
 def _write_tracking_outputs(analysis, out_dir: str, a_max=None) -> dict:
-    """The files of ``map --controller --out-dir``, all or none (`files.atomic_directory`): ``routes.csv``, the speed mask
+    """The files of ``map --controller --out-dir``, all or none (`files.atomic_directory`): ``routes.png``, ``routes.csv``, the speed mask
     (`maps.deciding.outputs`) and the ZoneParameterFilter's mask and parameters (`maps.deciding.zone_filter`)."""
     import os
 
@@ -270,7 +290,8 @@ def _write_tracking_outputs(analysis, out_dir: str, a_max=None) -> dict:
     from ..maps.deciding.outputs import MASK_FILES, speed_mask_pgm, speed_mask_yaml, tracking_csv
     from ..maps.deciding.zone_filter import ZONE_FILES, zone_mask_pgm, zone_mask_yaml, zone_params_yaml
 
-    contents = {"routes.csv": tracking_csv(analysis).encode("utf-8"), MASK_FILES[0]: speed_mask_pgm(analysis, a_max),
+    contents = {"routes.png": _tracking_picture(analysis), "routes.csv": tracking_csv(analysis).encode("utf-8"),
+                MASK_FILES[0]: speed_mask_pgm(analysis, a_max),
                 MASK_FILES[1]: speed_mask_yaml(analysis.occupancy).encode("utf-8"), ZONE_FILES[0]: zone_mask_pgm(analysis),
                 ZONE_FILES[1]: zone_mask_yaml(analysis.occupancy).encode("utf-8"), ZONE_FILES[2]: zone_params_yaml(analysis).encode("utf-8")}
     with atomic_directory(out_dir, tuple(contents), what="map outputs") as paths:

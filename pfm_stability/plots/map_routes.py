@@ -9,7 +9,7 @@ import numpy as np
 
 from .map import OCCUPIED_GREY, UNKNOWN_GREY, map_frame
 
-__all__ = ["ROUTE_STYLES", "plot_route_verdicts"]
+__all__ = ["ROUTE_STYLES", "TRACKING_STYLES", "plot_route_verdicts", "plot_tracking_verdicts"]
 
 ROUTE_STYLES = {
     "nothing grows": dict(color="#a6d96a", lw=1.6, label="stable: no field (calm at any speed)"),
@@ -143,4 +143,63 @@ def plot_route_verdicts(analysis, drives=None, ax=None, *, title: str | None = N
                  f"unknown cells {analysis.unknown}\n{100 * (s['decided_fraction'] or 0):.0f}% of {s['route_length_m']:.0f} m of route "
                  f"decided; unstable {s['unstable_length_m']:.1f} m" + validation)
     ax.set_title(title, fontsize=9.5)
+    return fig
+
+
+TRACKING_STYLES = {
+    "stable": dict(color="#1a9641", lw=2.6, label="stable at the file's lookahead"),
+    "longer lookahead": dict(color="#fdae61", lw=3.4, label="unstable; a longer lookahead calms it (ZoneParameterFilter zone)"),
+    "slower": dict(color="#d7191c", lw=3.6, label="unstable; only a lower speed calms it (speed mask zone)"),
+    "undecided": dict(color="0.45", lw=1.4, label="undecided", ls=(0, (1.5, 2.0))),
+    "no room": dict(color="0.3", lw=1.4, label="no room (the costmap's footprint does not fit)", ls=(0, (4.0, 2.0))),
+}
+"""Style of a Nav2 controller's stretch (`maps.deciding.tracking.TrackingStretch`) by its verdict and its remedy."""
+
+
+def _tracking_kind(stretch) -> str:
+    if stretch.verdict == "unstable":
+        return "longer lookahead" if stretch.zone_lookahead is not None else "slower"
+    return stretch.verdict if stretch.verdict in TRACKING_STYLES else "undecided"
+
+
+def plot_tracking_verdicts(analysis, ax=None, *, size=None):
+    """The map with every route stretch of a Nav2 controller (``map --controller rpp``) drawn by its verdict and the
+    remedy its masks apply: a longer lookahead (the ZoneParameterFilter's zone), or a lower speed (the speed mask's).
+
+    Parameters
+    ----------
+    analysis : MapTracking
+        `maps.deciding.tracking.analyze_map_tracking`'s result.
+    ax : matplotlib Axes, optional
+    size : (float, float), optional
+        Figure size, inches.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    from matplotlib.collections import LineCollection
+    from matplotlib.lines import Line2D
+
+    occupancy, tv = analysis.occupancy, analysis.paths
+    fig, ax, (x0, x1, y0, y1), _ = map_frame(occupancy, ax, size, (0.6, 2.2))
+    handles = []
+    for kind, style in TRACKING_STYLES.items():
+        lines = [_stretch_lines(tv.paths, s) for s in tv.stretches if _tracking_kind(s) == kind]
+        if lines:
+            ax.add_collection(LineCollection(lines, colors=style["color"], linewidths=style["lw"], linestyles=[style.get("ls", "-")],
+                                             zorder=3, capstyle="butt"))
+            handles.append(Line2D([], [], color=style["color"], lw=style["lw"], ls=style.get("ls", "-"), label=style["label"]))
+    handles.append(Line2D([], [], marker="s", ls="", color=str(OCCUPIED_GREY), markersize=8, label="occupied"))
+    fig.legend(handles=handles, loc="outside lower center", ncol=2, fontsize=7.5, frameon=False)
+    ax.set_xlim(x0, x1)
+    ax.set_ylim(y0, y1)
+    ax.set_xlabel("x (m)")
+    ax.set_ylabel("y (m)")
+    ax.set_aspect("equal")
+    unstable = sum(s.length for s in tv.stretches if s.verdict == "unstable")
+    zoned = sum(s.length for s in tv.stretches if _tracking_kind(s) == "longer lookahead")
+    ax.set_title(f"{occupancy.name}: {tv.controller} along every route at V = {analysis.robot.V:g} m/s ({analysis.model} model)\n"
+                 f"unstable {unstable:.1f} m of {sum(s.length for s in tv.stretches):.0f} m; a longer lookahead calms {zoned:.1f} m of it",
+                 fontsize=9.5)
     return fig

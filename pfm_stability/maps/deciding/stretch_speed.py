@@ -49,7 +49,8 @@ worst window; the growth between them interpolated, `decide.decide`'s ``centres`
 its length shares 7/8 of its steps, so the growth between two centres changes little."""
 BISECT_STEPS = 2
 """Halvings of the ladder's step between the rung found calm and the one above it (unstable): V* lies within
-0.1·V/2² = 2.5 % of V below the rule's edge (each halving costs a run of the driven loop per bracket: four halvings, 0.625 %, took the warehouse from 10 s to 15 s)."""
+0.1·V/2² = 2.5 % of V below the rule's edge (each halving is one batched run of the driven loop for every bracket, about 0.4 s on the warehouse: with four, 0.625 %,
+the warehouse took 8.2–8.8 s against 7.2–7.8 s, too near its 10 s bar)."""
 HEADROOM_GROWTH = 1.25
 """Ratio of the speeds tried above V before the bisection of a stable stretch's V* (its bracket)."""
 HEADROOM_MAX = 1e3
