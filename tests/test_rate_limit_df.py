@@ -172,7 +172,7 @@ def test_command_responses_close_on_the_models_boundaries():
     boundary: solved for (ω, K) it gives the `sampled` model's (its own matrices, `command_form`) and `exact_delay`'s
     (the continuous loop with the whole command delayed by D) NV* and ω* to 1e-9, on four random plants with dead times,
     the last two with a second lag τ_a (the balance once left it out: robot C's V* with the limit came out +12 % where
-    the linear loop's was +2.9 %, issue 40)."""
+    the linear loop's was +2.9 %)."""
     from scipy import optimize
 
     from pfm_stability.models import make_model
