@@ -170,7 +170,9 @@ def test_unstable_cycle_of_a_sampled_loop_through_the_limiter():
 def test_command_responses_close_on_the_models_boundaries():
     """Without the limiter the balance on the loop seen from its command, 1 + H₀(ω) + K·H₁(ω) = 0, is each model's own
     boundary: solved for (ω, K) it gives the `sampled` model's (its own matrices, `command_form`) and `exact_delay`'s
-    (the continuous loop with the whole command delayed by D) NV* and ω* to 1e-9, on four random plants with dead times."""
+    (the continuous loop with the whole command delayed by D) NV* and ω* to 1e-9, on four random plants with dead times,
+    the last two with a second lag τ_a (the balance once left it out: robot C's V* with the limit came out +12 % where
+    the linear loop's was +2.9 %)."""
     from scipy import optimize
 
     from pfm_stability.models import make_model
@@ -179,7 +181,7 @@ def test_command_responses_close_on_the_models_boundaries():
     rng = np.random.default_rng(3)
     for i in range(4):
         robot = Robot(V=1.0, tau=rng.uniform(0.05, 0.5), k=rng.uniform(1, 4), W=0.5, plant_gain=rng.uniform(0.7, 1.3),
-                      dead_time=rng.uniform(0.01, 0.1) * (i % 2))
+                      dead_time=rng.uniform(0.01, 0.1) * (i % 2), actuator_lag=(0.0, 0.0, 0.04, 0.08)[i])
         controller = Controller(f=1.0, n=2.0, T=rng.uniform(0.02, 0.12), hold="command", compute_delay=int(rng.integers(0, 2)))
         gk = robot.plant_gain * robot.k
         for model in ("sampled", "exact_delay"):

@@ -27,14 +27,14 @@ heading taken linear); the cycles are the describing function's. Measured agains
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from ..checks import check_number
 from ..io.serialize import json_number
 from ..laws.force_law import ForceLaw
-from ..models.loop import Loop
+from .limiter import motor_loop
 from .wobble import THIRD_HARMONIC_LIMIT, WobbleBranch, corridor_branch, corridor_steering, reported_cycle, wall_branch, wall_steering
 
 __all__ = ["Disturbance", "start_amplitude", "disturbance_speed", "corridor_disturbance", "wall_disturbance"]
@@ -56,7 +56,7 @@ def start_amplitude(robot, controller, N: float, V: float, disturbance: float, m
     Parameters
     ----------
     robot : parameters.Robot
-        τ, k, g, D, `max_steering_rate`, `yaw_accel_limit`.
+        τ, k, g, D, τ_a, `max_steering_rate`, `yaw_accel_limit`.
     controller : parameters.Controller
         T, hold, compute delay.
     N : float
@@ -79,7 +79,9 @@ def start_amplitude(robot, controller, N: float, V: float, disturbance: float, m
 
     g, gk = robot.plant_gain, robot.plant_gain * robot.k
     T = controller.T
-    loop = Loop(robot.tau, T, gk, dead_time=robot.dead_time if T > 0 else 0.0)
+    loop = motor_loop(robot, controller)
+    if T == 0:
+        loop = replace(loop, dead_time=0.0)
     K = gk * N * V
     plant = continuous_plant(loop, controller.hold)[0].shape[0]
     if T == 0:

@@ -6,7 +6,8 @@ amplitude A is no longer the loop model's own boundary at a reduced gain (`wobbl
 is solved on the loop's transfer seen from the command. `command_responses` gives it (the `sampled` loop's own
 matrices, `models.sampled.command_form`, or the continuous loop with the whole command delayed), `limited_balance`
 solves it amplitude by amplitude, and `wobble.limited_branch` makes the branch of it. `loop_filtering` and
-`limiter_harmonic` are the trust measures' pieces both routes share.
+`limiter_harmonic` are the trust measures' pieces both routes share; `motor_loop`, `drive_lags` and `lag_gain` the
+robot's loop as both routes close it, with both of the drive's lags (τ and a second lag τ_a).
 """
 
 from __future__ import annotations
@@ -22,7 +23,8 @@ from ..models import make_model
 from ..models.loop import Loop
 from .describing import J1_PEAK, harmonic_content, rate_limit_df, rate_limit_waveform, saturation_df_for_output
 
-__all__ = ["LimitedBalance", "command_responses", "limited_balance", "limiter_harmonic", "loop_filtering"]
+__all__ = ["LimitedBalance", "command_responses", "drive_lags", "lag_gain", "limited_balance", "limiter_harmonic", "loop_filtering",
+           "motor_loop"]
 
 
 @dataclass(frozen=True)
@@ -66,13 +68,13 @@ def command_responses(robot, controller, model: str):
     1 + N_c·(H₀ + K·H₁) = 0. `sampled` (T > 0): the sampled loop's own matrices (`models.sampled.command_form`,
     x_(k+1) = M·x_k + n·w_k, v_k = −(F0 + K·F1)·x_k), H_i = F_i·(zI − M)⁻¹·n at z = e^(jωT); otherwise the
     continuous loop with the whole command delayed by D and the field's term by T more,
-    H₀ = g·k·e^(−jωD)/(jω(jωτ + 1)), H₁ = e^(−jω(T + D))/((jω)²(jωτ + 1)): τs³ + s² + gk(s + NV·e^(−sT))·e^(−sD) = 0
-    with N_c = 1.
+    H₀ = g·k·e^(−jωD)/(jω·P(jω)), H₁ = e^(−jω(T + D))/((jω)²·P(jω)) with the drive's lags P(s) = (τs + 1)(τ_a·s + 1):
+    s²·P(s) + gk(s + NV·e^(−sT))·e^(−sD) = 0 with N_c = 1.
 
     Parameters
     ----------
     robot : parameters.Robot
-        τ, k, g, D.
+        τ, k, g, D, τ_a.
     controller : parameters.Controller
         T, compute delay (``hold="command"``).
     model : {"exact_delay", "sampled"}
@@ -84,9 +86,9 @@ def command_responses(robot, controller, model: str):
     """
     from ..models.sampled import command_form
 
-    gk, D, T = robot.plant_gain * robot.k, robot.dead_time, controller.T
-    loop = Loop(robot.tau, T, gk, dead_time=D)
-    tau = loop.tau
+    D, T = robot.dead_time, controller.T
+    loop = motor_loop(robot, controller)
+    gk, lags = loop.k, drive_lags(loop)
     if model == "sampled" and T > 0:
         M, n, F0, F1 = command_form(loop, "command", controller.compute_delay)
         eye = np.eye(M.shape[0])
@@ -100,7 +102,7 @@ def command_responses(robot, controller, model: str):
 
     def continuous(w):
         s = 1j * np.asarray(w, dtype=float)
-        plant = np.exp(-s * D) / (s * (tau * s + 1.0))
+        plant = np.exp(-s * D) / (s * (lags[0] * s + 1.0) * (lags[1] * s + 1.0))
         return gk * plant, np.exp(-s * T) * plant / s
 
     return continuous
@@ -132,7 +134,7 @@ def limited_balance(robot, controller, delta, A, Nf, model: str, *, heading_limi
     Parameters
     ----------
     robot : parameters.Robot
-        τ, k, g, D, `max_steering_rate`, `yaw_accel_limit` (finite unless ``heading_limit``).
+        τ, k, g, D, τ_a, `max_steering_rate`, `yaw_accel_limit` (finite unless ``heading_limit``).
     controller : parameters.Controller
         T, compute delay; ``hold="command"``.
     delta : callable
@@ -154,9 +156,10 @@ def limited_balance(robot, controller, delta, A, Nf, model: str, *, heading_limi
     g, D = robot.plant_gain, robot.dead_time
     gk, M, R = g * robot.k, g * robot.max_steering_rate, g * robot.yaw_accel_limit
     T = controller.T
-    tau = Loop(robot.tau, T, gk, dead_time=D).tau
+    loop = motor_loop(robot, controller)
+    lags = drive_lags(loop)
     limiter_T = T if model == "sampled" else 0.0
-    b = loop_model.boundary(Loop(tau, T, gk, dead_time=D))
+    b = loop_model.boundary(loop)
     NV0, w0 = b.NV_critical, b.omega_critical
     if not (math.isfinite(NV0) and NV0 > 0 and w0):
         raise ValueError(f"the {model} loop has no oscillatory stability boundary here (NV* = {NV0:g} 1/s): no wobble to predict")
@@ -168,7 +171,7 @@ def limited_balance(robot, controller, delta, A, Nf, model: str, *, heading_limi
         n_s = 1.0 if U <= M or heading_limit else float(saturation_df_for_output(U, M))
         step = 2.0 * U * math.sin(0.5 * w * limiter_T) / (R * limiter_T) if limiter_T > 0 else U * w / R  # <= 1: not limiting
         N_r = complex(rate_limit_df(U, w, R, limiter_T)) if step > 1.0 else 1.0 + 0j
-        theta = abs(N_r) * U / (w * math.hypot(1.0, w * tau))
+        theta = abs(N_r) * U / (w * lag_gain(w, lags))
         N_h = complex(rate_limit_df(theta, w, M)) if heading_limit and theta * w > M else 1.0 + 0j
         theta *= abs(N_h)
         return w, U, n_s, N_r, N_h, theta, gk * nf * a * w / theta
@@ -184,7 +187,7 @@ def limited_balance(robot, controller, delta, A, Nf, model: str, *, heading_limi
     speeds, omegas, headings, gains, thirds, rates, lim_gains, lim_lags = (np.full(A.size, np.nan) for _ in range(8))
     cascades = np.zeros(A.size, dtype=bool)
     theta0 = A[0] * w0 * Nf[0] / NV0
-    linear = np.array([math.log(w0), math.log(theta0 * w0 * math.hypot(1.0, w0 * tau))])  # U ∝ A on the linear part
+    linear = np.array([math.log(w0), math.log(theta0 * w0 * lag_gain(w0, lags))])  # U ∝ A on the linear part
     guess = linear
     for i, (a, nf) in enumerate(zip(A, Nf)):
         if not math.isfinite(nf):
@@ -210,27 +213,70 @@ def limited_balance(robot, controller, delta, A, Nf, model: str, *, heading_limi
         cascades[i] = n_s < 1.0 and flank > 1.0
         h3_sat = harmonic_content(lambda x: np.clip(x, -M, M), U / n_s) if n_s < 1.0 else 0.0
         h3_lim = limiter_harmonic(U * w / R) if math.isfinite(R) else 0.0
-        to_heading = math.hypot(1.0, w * tau) / (3.0 * math.hypot(1.0, 3.0 * w * tau))
+        to_heading = lag_gain(w, lags) / (3.0 * lag_gain(3.0 * w, lags))
         h3_head = limiter_harmonic(theta / abs(N_h) * w / M) if heading_limit else 0.0  # the heading's own triangle
         rates[i] = h3_sat * to_heading + h3_head
-        thirds[i] = (h3_field[i] + h3_sat + h3_lim) * loop_filtering(w, tau, gk * n_s * abs(N_r)) + h3_head / 3.0 \
+        thirds[i] = (h3_field[i] + h3_sat + h3_lim) * loop_filtering(w, lags, gk * n_s * abs(N_r)) + h3_head / 3.0 \
             + special.jv(3, theta) / (3.0 * special.j1(theta))
     limited = math.isfinite(R)
     return LimitedBalance(speeds, omegas, headings, gains, thirds, rates, lim_gains if limited else None, lim_lags if limited else None,
                           cascades if limited and not heading_limit else None, NV0, w0)
 
 
-def loop_filtering(omega: float, tau: float, k: float) -> float:
-    """|L(3jω)|/|L(jω)| with L(s) = 1/(s(τs² + s + k)): how the steering loop filters a third harmonic on its way to y.
+def loop_filtering(omega: float, lags: tuple, k: float) -> float:
+    """|L(3jω)|/|L(jω)| with L(s) = 1/(s(s·P(s) + k)), P(s) = (τs + 1)(τ_a·s + 1) the drive's lags: how the steering loop
+    filters a third harmonic on its way to y (τ_a = 0: 1/(s(τs² + s + k))).
 
     Parameters
     ----------
     omega : float
         rad/s.
-    tau : float
-        Steering lag, s.
+    lags : tuple of float
+        (τ, τ_a), s (`drive_lags`).
     k : float
         The loop's (equivalent) steering gain, 1/s.
     """
-    L = lambda s: 1.0 / (s * (tau * s * s + s + k))
+    tau, second = lags
+    L = lambda s: 1.0 / (s * (s * (tau * s + 1.0) * (second * s + 1.0) + k))
     return abs(L(3j * omega)) / abs(L(1j * omega))
+
+
+def motor_loop(robot, controller, gain_factor: float = 1.0) -> Loop:
+    """The robot's loop in the motor's units, the one the harmonic balance closes: steering gain g·k·`gain_factor`, plant
+    gain 1, the robot's dead time D and both of its lags τ, τ_a (`Loop.of` with g folded into k: the saturation and the
+    limiter act on g·u, docs/simulator.md).
+
+    Parameters
+    ----------
+    robot : parameters.Robot
+        τ, k, g, D, τ_a.
+    controller : parameters.Controller
+        T.
+    gain_factor : float
+        The saturation's describing function on the steering gain (1: not saturating).
+    """
+    return Loop(robot.tau, controller.T, robot.plant_gain * robot.k * gain_factor, dead_time=robot.dead_time,
+                actuator_lag=robot.actuator_lag)
+
+
+def drive_lags(loop: Loop) -> tuple:
+    """(τ, τ_a), s: the drive's lags as a `Loop` stores them (τ_a = 0 for a first-order drive).
+
+    Parameters
+    ----------
+    loop : Loop
+    """
+    return float(loop.tau), float(loop.actuator_lag)
+
+
+def lag_gain(omega, lags: tuple):
+    """|P(jω)| = √(1 + ω²τ²)·√(1 + ω²τ_a²): the applied command's amplitude over the turning rate's at ω.
+
+    Parameters
+    ----------
+    omega : float or ndarray
+        rad/s.
+    lags : tuple of float
+        (τ, τ_a), s (`drive_lags`).
+    """
+    return np.hypot(1.0, omega * lags[0]) * np.hypot(1.0, omega * lags[1])

@@ -66,7 +66,7 @@ from ..laws.force_law import ForceLaw, corridor_gain, wall_equilibrium, wall_gai
 from ..models import make_model
 from ..models.loop import Loop
 from .describing import J1_PEAK, describing_function, harmonic_content, saturation_df_for_output
-from .limiter import limited_balance, loop_filtering
+from .limiter import drive_lags, lag_gain, limited_balance, loop_filtering, motor_loop
 
 __all__ = [
     "WOBBLE_MODELS",
@@ -601,13 +601,13 @@ class _GainTable:
         x = math.log(factor)
         return float(self.NV(x)), float(self.omega(x))
 
-    def factor(self, gain: float, tau: float, M: float) -> float | None:
-        """The largest f with n_s(E) = f, where the applied rate's fundamental U = Θω√(1 + ω²τ²), Θ = gain·ω/NV*
-        (`gain` = A·N_f(A)); None when none exists (the limit cannot carry the cycle)."""
+    def factor(self, gain: float, lags: tuple, M: float) -> float | None:
+        """The largest f with n_s(E) = f, where the applied rate's fundamental U = Θω·|P(jω)| (the drive's lags
+        `limiter.lag_gain`), Θ = gain·ω/NV* (`gain` = A·N_f(A)); None when none exists (the limit cannot carry the cycle)."""
         f = np.geomspace(self.FACTORS[0], 1.0, 400)
         x = np.log(f)
         w = self.omega(x)
-        U = gain * w * w / self.NV(x) * np.hypot(1.0, w * tau)
+        U = gain * w * w / self.NV(x) * lag_gain(w, lags)
         g = saturation_df_for_output(U, M) - f
         change = np.flatnonzero((g[:-1] > 0) != (g[1:] > 0))
         if change.size == 0:
@@ -616,19 +616,19 @@ class _GainTable:
 
         def residual(factor):
             NV, w = self(factor)
-            u = gain * w * w / NV * math.hypot(1.0, w * tau)
+            u = gain * w * w / NV * lag_gain(w, lags)
             return saturation_df_for_output(u, M) - factor
 
         return optimize.brentq(residual, f[j], f[j + 1], xtol=1e-13)
 
 
 @functools.lru_cache(maxsize=32)
-def _gain_table(model: str, hold: str, compute_delay: int, tau: float, T: float, k: float, dead_time: float = 0.0) -> _GainTable:
-    """The `_GainTable` of one loop, shared by its wall and corridor branches (64 model boundaries)."""
+def _gain_table(model: str, hold: str, compute_delay: int, loop: Loop) -> _GainTable:
+    """The `_GainTable` of one loop (`limiter.motor_loop`), shared by its wall and corridor branches (64 model boundaries)."""
     loop_model = make_model(model, hold=hold, compute_delay=compute_delay)
 
     def boundary(gain_factor: float):
-        b = loop_model.boundary(Loop(tau, T, k * gain_factor, dead_time=dead_time))
+        b = loop_model.boundary(replace(loop, k=loop.k * gain_factor))
         return b.NV_critical, b.omega_critical
 
     return _GainTable(boundary)
@@ -689,12 +689,12 @@ def _branch_of(robot, controller, delta, N: float, A, Nf, clearance: float, mode
         return limited_branch(robot, controller, delta, N, A, Nf, clearance, model, beta_f)
     loop_model = make_model(model, hold=controller.hold, compute_delay=controller.compute_delay)
     # in the motor's units: the plant gain g scales the command after the rate limit (docs/simulator.md), so
-    # g·sat_M(u) = sat_gM(g·u): a robot (k, M, g) is the robot (g·k, g·M, 1); the dead time D stays in the loop
-    g, D = robot.plant_gain, robot.dead_time
-    tau, k, T, M = robot.tau, g * robot.k, controller.T, g * robot.max_steering_rate
+    # g·sat_M(u) = sat_gM(g·u): a robot (k, M, g) is the robot (g·k, g·M, 1); the dead time D and the lags τ, τ_a stay in the loop
+    loop = motor_loop(robot, controller)
+    lags, k, M = drive_lags(loop), loop.k, robot.plant_gain * robot.max_steering_rate
 
     def boundary(gain_factor: float):
-        b = loop_model.boundary(Loop(tau, T, k * gain_factor, dead_time=D))
+        b = loop_model.boundary(motor_loop(robot, controller, gain_factor))
         return b.NV_critical, b.omega_critical
 
     NV0, w0 = boundary(1.0)
@@ -709,21 +709,21 @@ def _branch_of(robot, controller, delta, N: float, A, Nf, clearance: float, mode
         if not math.isfinite(nf):
             continue
         theta, w, factor = a * w0 * nf / NV0, w0, 1.0
-        if theta * w0 * math.hypot(1.0, w0 * tau) > M:  # the rate limit bites: solve for the steering gain's factor
-            table = table or _gain_table(model, controller.hold, controller.compute_delay, tau, T, k, D)
-            factor = table.factor(a * nf, tau, M)
+        if theta * w0 * lag_gain(w0, lags) > M:  # the rate limit bites: solve for the steering gain's factor
+            table = table or _gain_table(model, controller.hold, controller.compute_delay, loop)
+            factor = table.factor(a * nf, lags, M)
             if factor is None:
                 continue
             NV, w = table(factor)
             theta = a * w * nf / NV
         if not theta < J1_PEAK:
             continue
-        U = theta * w * math.hypot(1.0, w * tau)
+        U = theta * w * lag_gain(w, lags)
         speeds[i] = a * w / (2.0 * special.j1(theta))
         omegas[i], headings[i], gains[i] = w, theta, factor
         h3_rate = harmonic_content(sat, _fundamental_input(U, M)) if factor < 1.0 else 0.0
-        rates[i] = h3_rate * math.hypot(1.0, w * tau) / (3.0 * math.hypot(1.0, 3.0 * w * tau))
-        thirds[i] = (h3[i] + h3_rate) * loop_filtering(w, tau, k * factor) \
+        rates[i] = h3_rate * lag_gain(w, lags) / (3.0 * lag_gain(3.0 * w, lags))
+        thirds[i] = (h3[i] + h3_rate) * loop_filtering(w, lags, k * factor) \
             + special.jv(3, theta) / (3.0 * special.j1(theta))
     beta = beta_f - w0**2 / (8.0 * V_star**2)
     return WobbleBranch(model, A, speeds, omegas, headings, gains, thirds, rates, V_star, w0, beta, clearance, gain=N, hold=controller.hold)
