@@ -129,3 +129,24 @@ def test_the_limited_cycle_of_a_two_lag_loop_against_the_loop_iterated():
     y = np.abs(run(lo, 1200))
     peaks = y[1:-1][(y[1:-1] >= y[:-2]) & (y[1:-1] >= y[2:])]
     assert np.median(peaks[5:25]) == pytest.approx(A[0], rel=0.03)
+
+
+@pytest.mark.parametrize("alpha", [20.0, 45.0])
+def test_a_second_lag_enters_the_wall_branch_too(alpha):
+    """The wall's branch and a small start's V*(D) at a wall discontinuity (α = 20° and 45°) take the second lag τ_a as
+    the corridor's do (`test_a_second_lag_enters_the_limited_boundary`): both equal the `sampled` model's linear V* of
+    robot C's identified plant (to 1e-6: the limiter is linear below its threshold), and leaving τ_a out moves that V*
+    by more than 5 % (so the check can fail)."""
+    from pfm_stability.analysis.disturbance import wall_disturbance
+    from pfm_stability.analysis.wobble import wall_branch
+    from pfm_stability.validation.common import predicted_boundaries, scenario_law, validation_models
+
+    robot, controller, _ = ROBOT_C
+    alpha = math.radians(alpha)  # the analyses take α in rad
+    law = scenario_law("grid", robot, controller)
+    linear = predicted_boundaries("wall", "V", robot, controller, law, alpha, validation_models(controller))["sampled"]
+    small = wall_disturbance(robot, controller, law, alpha, 0.01)
+    assert small.V_critical == pytest.approx(linear, rel=1e-6) and small.V_disturbance == pytest.approx(linear, rel=1e-6)
+    assert wall_branch(robot, controller, law, alpha).V_critical == pytest.approx(linear, rel=1e-6)
+    without = predicted_boundaries("wall", "V", robot.replace(actuator_lag=0.0), controller, law, alpha, validation_models(controller))
+    assert without["sampled"] > 1.05 * linear
