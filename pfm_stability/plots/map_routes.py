@@ -67,7 +67,7 @@ def plot_route_verdicts(analysis, drives=None, ax=None, *, title: str | None = N
 
     occupancy = analysis.occupancy
     pv = analysis.paths
-    fig, ax, (x0, x1, y0, y1), _ = map_frame(occupancy, ax, size, (0.6, 3.0))
+    fig, ax, (x0, x1, y0, y1), _ = map_frame(occupancy, ax, size, (0.6, 3.0 if drives is None else 3.6))  # the validation's title lines
     kinds = []
     for kind, style in ROUTE_STYLES.items():
         lines = [_stretch_lines(pv.paths, s) for s in pv.stretches if _kind(s) == kind]
