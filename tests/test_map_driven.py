@@ -1,4 +1,4 @@
-"""The loop driven along a route through the force across it (`maps.judging.driven._driven`, docs/maps.md, "The loop driven
+"""The loop driven along a route through the force across it (`maps.judging.driven.driven_loops`, docs/maps.md, "The loop driven
 along the route"), its command form (`models.sampled.command_form`), and the drives' unmeasurable ends
 (`validation.map_drives`)."""
 
@@ -9,7 +9,7 @@ import math
 import numpy as np
 import pytest
 
-from pfm_stability.maps.judging.driven import SampledTransition, _driven
+from pfm_stability.maps.judging.driven import DriveRequest, SampledTransition, driven_loops
 from pfm_stability.maps.deciding.verdicts import GrowthRate, effective_gain
 from pfm_stability.models import Loop, models_for
 from pfm_stability.models.sampled import closed_loop_matrix, command_form
@@ -21,6 +21,12 @@ from test_map_paths import SHARED_CORRIDORS, corridors_root
 def root(tmp_path_factory):
     """`test_map_paths.corridor_analysis`' folder: its analyses of the 1.2 m corridor are shared with that module's tests."""
     return corridors_root(tmp_path_factory)
+
+
+def _driven(route, arc, stopped, profile, pull, attraction, aim, V: float, transition, period: float, taken, track=None):
+    """(oscillates, amplitude, excursion) of the loop driven at one speed V: `driven_loops` with one `DriveRequest`."""
+    loop = driven_loops(route, arc, profile, [DriveRequest(V, stopped, pull, attraction, aim)], transition, period, taken, track)[0]
+    return loop.oscillates, loop.amplitude, loop.excursion
 
 
 def _loops(seed: int, count: int):
@@ -288,7 +294,6 @@ def test_speeds_driven_together_are_each_speed_driven_alone():
     excursion to 1e-12 relative (a run's arithmetic is its own; only the batched matrix product's blocking may
     differ in the last bits). Two routes of different gains — one of them driven at one speed only — at three speeds
     (k = 20 1/s; 1.3·NV* at the fastest speed on the first route, which grows until it leaves; the others damped)."""
-    from pfm_stability.maps.judging.driven import DriveRequest, driven_loops
 
     robot = CARMEL.robot.replace(W=0.4, tau=0.1, k=20.0, V=1.0)
     controller = CARMEL.controller.replace(T=0.025, f=2.0)

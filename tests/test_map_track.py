@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from pfm_stability.maps.judging.driven import PREDICTION_OFFSET, DrivenTrack, SampledTransition, _TrackWalk, _driven
+from pfm_stability.maps.judging.driven import PREDICTION_OFFSET, DrivenTrack, SampledTransition, _TrackWalk
 from pfm_stability.maps.deciding.decide import path_samples
 from pfm_stability.maps.reading.routes import path_of
 from pfm_stability.models import Loop, models_for
@@ -19,7 +19,7 @@ from pfm_stability.models.sampled import continuous_plant
 from pfm_stability.parameters import Controller, Robot
 from pfm_stability.sim.scenario import Target
 from pfm_stability.validation.map_drives import _taken_path
-from test_map_driven import _loops
+from test_map_driven import _driven, _loops
 
 
 def test_the_frames_turn_enters_the_state_as_the_plant_integrates_a_heading_rate():

@@ -4,7 +4,7 @@
 `route_geometry` computes what does not depend on the speed (samples, lateral equilibria, the field's gradient, the
 lateral profile the loop is driven through, the window-edge jumps); `decide` applies the rule at a speed V — the
 window's growth (`WINDOW_PERIODS` wavelengths, at least `verdicts.EFOLDS` e-folds: "growth"), the loop driven along the
-route (`driven._driven`: a "forced weave"), the window-edge relay (`relay`: "relay") — and gives each sample its verdict
+route (`driven.driven_loops`: a "forced weave"), the window-edge relay (`relay`: "relay") — and gives each sample its verdict
 and cause (`SampleDecision`). `maps.deciding.paths` makes the stretches and `maps.deciding.stretch_speed` their V* with the same rule.
 The rule itself is described in `maps.deciding.paths`' module docstring.
 """
@@ -189,7 +189,7 @@ class DecisionRule:
 
     @property
     def drives(self) -> bool:
-        """The loop is driven along the routes (`driven._driven`): the sampled model with an oscillation frequency."""
+        """The loop is driven along the routes (`driven.driven_loops`): the sampled model with an oscillation frequency."""
         omega = self.boundary.omega_critical
         return self.transition is not None and bool(omega) and omega > 0
 

@@ -45,7 +45,7 @@ with the sampled model, by the loop driven along the route there too (below: it 
 sampling and the rate limit; the one jump's first harmonic runs high near the threshold): its lateral excursion
 about its one-period average within half a period of the sample must reach the threshold as well.
 
-**The loop driven along the route** (`_driven`): the sampled loop is also run along each route through the force
+**The loop driven along the route** (`driven_loops`): the sampled loop is also run along each route through the force
 across it (`lateral_profile`, every quarter cell: the window sum's jumps, a rack's staircase, a one-sided field), with
 the steering-rate limit on its command (`SampledTransition`, `models.sampled.command_form`); its episodes (the
 drives' own definition, `maps.judging.episodes`) mark the route unstable (cause "forced weave"): a forced weave, or a cycle the
@@ -64,7 +64,7 @@ which oscillates once V/D passes NV*. Such a path is judged the way it was drive
 ahead that way it is unjudged ("wall ahead").
 
 **A drive's own path** (a path taken whose aims are known, `RoutePath.aims`: the point the robot steered at as it
-passed each of its points) is driven as the robot drove it (`DrivenTrack`, `_driven`): the force at the loop's own
+passed each of its points) is driven as the robot drove it (`DrivenTrack`, `driven_loops`): the force at the loop's own
 point p(s) + y·nrm is the window sum there, the attraction is the unit vector from there to the point steered at,
 the loop moves along the path at its own pace, ds/dt = V·cos θ/(1 − κ·y) (`_TrackWalk`: a robot weaving about its path
 covers less of it than V·t, and keeps its phase only at that pace), and the path's frame turns under it — its heading

@@ -2,7 +2,7 @@
 route", "A drive's own path is driven as the robot drove it"; `maps.deciding.paths` judges with it).
 
 `SampledTransition` is the sampled loop's one-period map with its command apart (the window growth's Φ(NV) and the
-driven loop's step); `_driven` runs the loop along every route through the lateral force tabulated across it
+driven loop's step); `driven_loops` runs the loop along every route through the lateral force tabulated across it
 (`paths.lateral_profile`), and along a drive's own path as the robot drove it (`DrivenTrack`: the window sum at the
 loop's own point, the attraction towards the point the robot steered at, the path's frame turning under the loop at
 the loop's own pace, `_TrackWalk`; its track judged in the plane by the drives' own judge, `maps.judging.episodes`).
@@ -94,7 +94,7 @@ class SampledTransition:
 
 
 PREDICTION_OFFSET = 0.03
-"""Lateral offset (m) of the loop's start from the route or path in `_driven` (the drives' start offset,
+"""Lateral offset (m) of the loop's start from the route or path in `driven_loops` (the drives' start offset,
 `validation.maps.START_OFFSET`): the disturbance whose growth shows where the loop is unstable. On a path taken too,
 unless the pose the robot started from is known (a drive's own path: the loop starts there, `DrivenTrack.start`):
 the loop's cycle is reached from above as from below (a rate-limited cycle at 1.7 cm, approached from 5 mm,
@@ -116,7 +116,7 @@ def _path_heading(tx, ty, route) -> np.ndarray:
 
 @dataclass(frozen=True)
 class DrivenTrack:
-    """What the loop driven along a drive's own path knows besides the force across it (`_driven`): the path's
+    """What the loop driven along a drive's own path knows besides the force across it (`driven_loops`): the path's
     samples and direction, the point the robot steered at, and the field itself.
 
     Attributes
@@ -226,13 +226,6 @@ class DrivenLoop:
     excursion: np.ndarray
 
 
-def _driven(route, arc, stopped, profile, pull, attraction, aim, V: float, transition: SampledTransition, period: float, taken,
-            track: DrivenTrack | None = None):
-    """(oscillates, amplitude, excursion) of the loop driven at one speed V (`driven_loops` with one `DriveRequest`)."""
-    loop = driven_loops(route, arc, profile, [DriveRequest(V, stopped, pull, attraction, aim)], transition, period, taken, track)[0]
-    return loop.oscillates, loop.amplitude, loop.excursion
-
-
 def driven_loops(route, arc, profile, requests, transition: SampledTransition, period: float, taken,
                  track: DrivenTrack | None = None) -> list:
     """The sampled loop driven along the routes at each requested speed (`DrivenLoop` per `DriveRequest`), all speeds'
@@ -321,10 +314,10 @@ class _RunPlan:
     def of(cls, route, arc, requests, T: float, taken, track) -> "_RunPlan | None":
         """The runs (None: none long enough, 8 steps, to judge)."""
         runs = []  # (samples passed at each step, sign of travel, a drive's own path, request)
+        samples_of = {int(r): np.flatnonzero(route == r) for r in np.unique(route)}  # the same at every speed
         for q, request in enumerate(requests):
             step = request.V * T
-            for r in np.unique(route):
-                idx = np.flatnonzero(route == r)
+            for r, idx in samples_of.items():
                 if (request.routes is not None and not request.routes[r]) or idx.size < 2:
                     continue
                 a = arc[idx]
@@ -453,7 +446,7 @@ progresses along the path at V·cos θ/(1 − κ·y) (`_TrackWalk`), slower only
 
 
 class _TrackWalk:
-    """The loops along drives' own paths (`_driven`), each at its own progress s along its path: ds/dt = V·cos θ/(1 − κ·y)
+    """The loops along drives' own paths (`driven_loops`), each at its own progress s along its path: ds/dt = V·cos θ/(1 − κ·y)
     (θ its heading from the path's, y its offset to the left, κ the path's curvature): a robot weaving about its path
     covers less of it than V·t, and the loop must keep the robot's pace to keep its phase.
 
@@ -525,7 +518,7 @@ class _TrackWalk:
 
 
 def _steered(track: DrivenTrack, at: np.ndarray, y: np.ndarray) -> np.ndarray:
-    """g (rad, `_driven`'s sign) of loops at lateral offsets `y` (m) from their path's points: the direction of the
+    """g (rad, `driven_loops`'s sign) of loops at lateral offsets `y` (m) from their path's points: the direction of the
     resultant of the window sum at q = p + y·nrm and the unit attraction from q to the point steered at, from the
     path's tangent (KB eq 4). `at`: `_TrackWalk.here` at the loops' step, shape (5, loops)."""
     px, py, phi, ax, ay = at
