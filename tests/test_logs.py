@@ -2,8 +2,9 @@
 stream, and every bad log is one line.
 
 The logs are written here by `log_helpers` (rosbags' own writers, no ROS). Values are compared exactly: the reader
-takes the yaw rate from the message bytes, which must be the float64 that was serialized; times to 1 µs (they pass
-through nanosecond integers and one subtraction in float64 seconds).
+takes the yaw rate from the message bytes, which must be the float64 that was serialized (no arithmetic: a copy of
+8 bytes; the CSV writes ``repr`` and reads ``float``, a round trip exact on every IEEE machine), so exact equality is
+legitimate; times to 1 µs (they pass through nanosecond integers and one subtraction in float64 seconds).
 """
 
 from __future__ import annotations

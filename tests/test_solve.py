@@ -37,7 +37,7 @@ def test_expand_bracket_finds_far_roots_both_ways():
 
 def test_newton_with_the_moving_roots_alone_finds_the_same_roots():
     """`newton_increasing(..., moving=True)` evaluates only the roots not yet converged (a converged root stays put:
-    its step is 0 and f the same) and returns the very same roots as evaluating every bracket each step — smooth
+    its step is 0 and f the same) and returns the same roots, to a few ULP, as evaluating every bracket each step — smooth
     roots (quadratic convergence) and jumps (bisection to the bracket's width) together, 200 random brackets;
     and it evaluates fewer points."""
     import numpy as np
@@ -67,5 +67,8 @@ def test_newton_with_the_moving_roots_alone_finds_the_same_roots():
     lo, hi = root - rng.uniform(0.01, 1.0, 200), root + rng.uniform(0.01, 1.0, 200)
     expected = newton_increasing(everyone, lo, hi, atol=1e-9, iterations=30)
     got = newton_increasing(moving, lo, hi, atol=1e-9, iterations=30, moving=True)
-    assert np.array_equal(got, expected)
+    # a few ULP of roots in (-2, 2), not bit for bit: f is evaluated on arrays of other lengths in the two runs (numpy's
+    # SIMD kernels may round an element differently), which moves a converged Newton root by about an ULP; a root
+    # given another root's f, or left at a bisection midpoint, is off by orders of magnitude more
+    np.testing.assert_allclose(got, expected, rtol=0, atol=1e-15)
     assert np.abs(got - root).max() < 1e-6 and calls["moving"] < calls["all"]
