@@ -76,8 +76,9 @@ sub-interval of 1e-9·T moves the robot by 1e-9 of a step while it adds a mode a
 simulator's linear-prediction fit and the sampled model would have to carry."""
 
 
-KB_PLANT = {"plant_gain": 1.0, "dead_time": 0.0, "actuator_lag": 0.0}
-"""KB's steering plant τω̇ + ω = u: plant gain 1, no dead time, no second lag (`Robot`'s and `models.Loop`'s defaults)."""
+KB_PLANT = {"plant_gain": 1.0, "dead_time": 0.0, "actuator_lag": 0.0, "slip_lag": 0.0}
+"""KB's steering plant τω̇ + ω = u: plant gain 1, no dead time, no second lag, no slip (`Robot`'s and `models.Loop`'s
+defaults)."""
 
 
 def plant_not_kb(source) -> dict:
@@ -86,7 +87,7 @@ def plant_not_kb(source) -> dict:
     Parameters
     ----------
     source : Robot or models.Loop
-        Anything with ``plant_gain``, ``dead_time`` (s) and ``actuator_lag`` (s).
+        Anything with ``plant_gain``, ``dead_time`` (s), ``actuator_lag`` (s) and ``slip_lag`` (s).
     """
     return {name: getattr(source, name) for name, kb in KB_PLANT.items() if getattr(source, name) != kb}
 
@@ -244,6 +245,7 @@ RANGES = {
     "dead_time": Range(0.0, 10.0, low_open=False, unit="s"),
     "plant_gain": Range(1e-3, 100.0, low_open=False),
     "actuator_lag": Range(0.0, 10.0, low_open=False, unit="s"),
+    "slip_lag": Range(0.0, 10.0, low_open=False, unit="s"),
     "yaw_accel_limit": Range(0.0, math.inf, high_open=True, unit="rad/s^2"),
     # where a computation needs a narrower range than the parameter's own
     "T_sampled": Range(0.0, 100.0, unit="s"),
@@ -435,6 +437,10 @@ class Robot:
     actuator_lag : float
         A second lag τ_a of the drive (an actuator filter), s, in [0, 10]: the plant is
         g·e^(−sD)/((τs + 1)(τ_a·s + 1)) (0 = KB's first-order plant; docs/models.md).
+    slip_lag : float
+        The lag τ_s of the robot's course (its direction of travel) behind its heading, s, in [0, 10]: a base that
+        slides sideways in a turn (a skid-steer, soft tyres) moves along χ with τ_s·χ̇ + χ = θ, ẋ = V·χ (0 = it goes
+        where it points, KB's robot; docs/models.md, "A base that slides").
     yaw_accel_limit : float
         The largest rate of change of the commanded yaw rate, rad/s², > 0 (a velocity smoother's angular
         acceleration limit); ``inf`` (the default) = none. Nonlinear: the linear models do not see it.
@@ -449,9 +455,10 @@ class Robot:
     plant_gain: float = 1.0
     actuator_lag: float = 0.0
     yaw_accel_limit: float = math.inf
+    slip_lag: float = 0.0
 
     def __post_init__(self):
-        for name in ("V", "tau", "k", "W", "max_steering_rate", "dead_time", "plant_gain", "actuator_lag"):
+        for name in ("V", "tau", "k", "W", "max_steering_rate", "dead_time", "plant_gain", "actuator_lag", "slip_lag"):
             object.__setattr__(self, name, check_parameter(name, getattr(self, name)))
         if self.yaw_accel_limit != math.inf:  # inf: no limit (the default, never typed)
             object.__setattr__(self, "yaw_accel_limit", check_parameter("yaw_accel_limit", self.yaw_accel_limit))

@@ -218,7 +218,7 @@ class ExactDelay(LoopModel):
         if NV < 0:
             return 0.0
         if not loop.kb_form:  # the general loop: the signed measure's first sign change over k (`_signed_gain_k`)
-            if NV * (loop.tau + loop.actuator_lag + loop.delay) >= 1.0 + loop.c:  # the k → 0 limit: kb_first_order's
+            if NV * (loop.tau + loop.actuator_lag + loop.slip_lag + loop.delay) >= 1.0 + loop.c:  # the k → 0 limit: kb_first_order's
                 return 0.0
             return self._signed_gain_k(NV, loop, lambda loops: np.array([x.delay_stable(x.loop_gain(NV)) for x in loops]))
         if NV == 0 and loop.c == 0.0:

@@ -112,7 +112,7 @@ class KBFirstOrder(AffineGainModel):
         loop : Characteristic
             The loop judged; its own T, s, is replaced by T*.
         """
-        if loop.family.name != "steering" or getattr(loop, "actuator_lag", 0.0) > 0:
+        if loop.family.name != "steering" or _beyond_first_order(loop):
             return LoopModel.critical_delay(self, NV, loop)
         NV = _check_NV(NV)
         if NV < 0:
@@ -148,7 +148,7 @@ class KBFirstOrder(AffineGainModel):
             τ (s), T (s), k (1/s) and the heading gain c.
         """
         loop = _steering(loop, "critical_gain_k")
-        if loop.actuator_lag > 0:
+        if _beyond_first_order(loop):
             return LoopModel.critical_gain_k(self, NV, loop)
         NV = _check_NV(NV)
         if NV < 0:
@@ -180,9 +180,15 @@ class KBFirstOrder(AffineGainModel):
             τ, T, k, c and g (its own D is replaced).
         """
         loop = _steering(loop, "critical_dead_time")
-        if loop.actuator_lag > 0:
+        if _beyond_first_order(loop):
             return LoopModel.critical_dead_time(self, NV, loop)
         return 0.0 if NV < 0 else _routh_margin(loop, _check_NV(NV), "D")
+
+
+def _beyond_first_order(loop) -> bool:
+    """True for a steering loop whose first-order form is not τs³ + αs² + gk·b·s + gkNV (a second lag, or a course that
+    lags the heading): its critical values are `LoopModel`'s searches, not the closed forms below."""
+    return getattr(loop, "actuator_lag", 0.0) > 0 or getattr(loop, "slip_lag", 0.0) > 0
 
 
 def _routh_coefficients(loop, NV: float, which: str) -> tuple:

@@ -68,6 +68,11 @@ class Loop(Characteristic):
         τ_a, s, in [0, 10] (default 0): a second lag of the drive, the plant
         g·e^(−sD)/((τs + 1)(τ_a·s + 1)); τ_a with τ_a·g·k < 10⁻⁹ is 0. The two lags are
         interchangeable: τ = 0 with τ_a > 0 is stored as τ = τ_a, τ_a = 0.
+    slip_lag : float, keyword only
+        τ_s, s, in [0, 10] (default 0): the course χ (the direction the robot moves in) follows the heading through
+        τ_s·χ̇ + χ = θ and ẋ = V·χ (a base that slides sideways in a turn). Only the field's path sees it: every term
+        but the field's is multiplied by (τ_s·s + 1) — (τ_s s + 1)(p0(s) + gk·s·e^(−s·h₁)) + gkNV·e^(−s(T + D)) = 0
+        (docs/models.md, "A base that slides"); τ_s with τ_s·g·k < 10⁻⁹ is 0.
     heading_sampled : bool, keyword only
         Whether the sampled controller computes the heading feedback too (a path tracker
         computing ω from the pose: the heading term is delayed by T + D, as the field's),
@@ -83,16 +88,17 @@ class Loop(Characteristic):
     dead_time: float = field(default=0.0, kw_only=True)
     actuator_lag: float = field(default=0.0, kw_only=True)
     heading_sampled: bool = field(default=False, kw_only=True)
+    slip_lag: float = field(default=0.0, kw_only=True)
 
     def __post_init__(self):
         for name in ("tau", "T", "k"):
             object.__setattr__(self, name, check_parameter(name, getattr(self, name)))
-        defaults = (("plant_gain", 1.0), ("dead_time", 0.0), ("actuator_lag", 0.0))
+        defaults = (("plant_gain", 1.0), ("dead_time", 0.0), ("actuator_lag", 0.0), ("slip_lag", 0.0))
         for name in [n for n, d in defaults if getattr(self, n).__class__ is not float or getattr(self, n) != d]:
             object.__setattr__(self, name, check_parameter(name, getattr(self, name)))
         if self.heading_sampled.__class__ is not bool:
             raise ValueError(f"heading_sampled must be True or False; got {self.heading_sampled!r}")
-        for name in ("tau", "actuator_lag"):  # a lag 10⁹ times faster than the steering loop: an ideal motor
+        for name in ("tau", "actuator_lag", "slip_lag"):  # a lag 10⁹ times faster than the steering loop: none
             if getattr(self, name) * self.steering_gain < TAU_RESOLUTION:
                 object.__setattr__(self, name, 0.0)
         if self.tau == 0.0 and self.actuator_lag > 0.0:  # one lag: it is the motor's (the plant is the same)
@@ -105,7 +111,7 @@ class Loop(Characteristic):
 
     @classmethod
     def of(cls, robot, controller, *, c: float = 0.0, heading_sampled: bool = False) -> "Loop":
-        """The loop of a robot and its controller (τ, k, g, D, τ_a; T), with heading gain `c`: the one constructor from them.
+        """The loop of a robot and its controller (τ, k, g, D, τ_a, τ_s; T), with heading gain `c`: the one constructor from them.
 
         Parameters
         ----------
@@ -117,19 +123,20 @@ class Loop(Characteristic):
             Whether the controller computes the heading feedback too (`Loop.heading_sampled`).
         """
         return cls(robot.tau, controller.T, robot.k, c=c, plant_gain=robot.plant_gain, dead_time=robot.dead_time,
-                   actuator_lag=robot.actuator_lag, heading_sampled=heading_sampled)
+                   actuator_lag=robot.actuator_lag, heading_sampled=heading_sampled, slip_lag=robot.slip_lag)
 
     @property
     def kb_form(self) -> bool:
-        """True for KB's loop τs³ + s² + gks + gk(cs + NV)·e^(−sT) (one delay: no dead time, no second lag, the heading
-        closed by the drive): the models run the code they always ran. False: the general loop (`quasi_terms`)."""
-        return self.dead_time == 0.0 and self.actuator_lag == 0.0 and not self.heading_sampled
+        """True for KB's loop τs³ + s² + gks + gk(cs + NV)·e^(−sT) (one delay: no dead time, no second lag, no slip, the
+        heading closed by the drive): the models run the code they always ran. False: the general loop (`quasi_terms`)."""
+        return self.dead_time == 0.0 and self.actuator_lag == 0.0 and self.slip_lag == 0.0 and not self.heading_sampled
 
     @property
     def lags(self) -> np.ndarray:
-        """p0(s) = s²·(τs + 1)·(τ_a·s + 1), descending: the drive's lags and the two integrations (θ, x)."""
+        """p0(s) = s²·(τs + 1)·(τ_a·s + 1)·(τ_s·s + 1), descending: the drive's lags, the course's and the two
+        integrations (θ, x)."""
         p = np.array([1.0, 0.0, 0.0])
-        for lag in (self.tau, self.actuator_lag):
+        for lag in (self.tau, self.actuator_lag, self.slip_lag):
             if lag > 0:
                 p = np.polymul([lag, 1.0], p)
         return p
@@ -139,12 +146,20 @@ class Loop(Characteristic):
         """h₁, s: the heading term's delay, D (+ T when `heading_sampled`)."""
         return self.dead_time + self.T if self.heading_sampled else self.dead_time
 
+    @property
+    def slip(self) -> np.ndarray:
+        """(τ_s·s + 1), descending ([1] without slip): the factor of every term but the field's (`slip_lag`)."""
+        return np.array([self.slip_lag, 1.0]) if self.slip_lag > 0 else np.array([1.0])
+
     def quasi_terms(self):
-        """The loop as p0(s) + gk·s·e^(−s·h₁) + gkc·s·e^(−s(T + D)) + K·e^(−s(T + D)) (`numerics.quasi.QuasiPolynomial`)."""
+        """The loop as p0(s) + gk·s·(τ_s s + 1)·e^(−s·h₁) + gkc·s·(τ_s s + 1)·e^(−s(T + D)) + K·e^(−s(T + D))
+        (`numerics.quasi.QuasiPolynomial`; p0 carries the course's lag too: `lags`)."""
         from ..numerics.quasi import DelayedTerm, QuasiPolynomial
 
-        k = self.steering_gain
-        terms = [DelayedTerm((k, 0.0), self.heading_delay)] + ([DelayedTerm((self.heading, 0.0), self.delay)] if self.c != 0.0 else [])
+        k, slip = self.steering_gain, self.slip
+        terms = [DelayedTerm(tuple(np.polymul([k, 0.0], slip)), self.heading_delay)]
+        if self.c != 0.0:
+            terms.append(DelayedTerm(tuple(np.polymul([self.heading, 0.0], slip)), self.delay))
         return QuasiPolynomial(self.lags, terms, self.delay)
 
     @property
@@ -161,7 +176,7 @@ class Loop(Characteristic):
         """`STEERING` for KB's loop; with a plant (g, D, τ_a) or a sampled heading the equations it solves (`steering_family`)."""
         if self.kb_form and self.plant_gain == 1.0:
             return STEERING
-        return steering_family(self.dead_time > 0, self.actuator_lag > 0, self.heading_sampled)
+        return steering_family(self.dead_time > 0, self.actuator_lag > 0, self.heading_sampled, self.slip_lag > 0)
 
     @property
     def plant(self) -> np.ndarray:
@@ -169,7 +184,7 @@ class Loop(Characteristic):
         delays left out: what `continuous` sees)."""
         k = self.steering_gain
         if not self.kb_form:
-            return np.polyadd(self.lags, [k, 0.0])
+            return np.polyadd(self.lags, np.polymul([k, 0.0], self.slip))
         return np.array([self.tau, 1.0, k, 0.0]) if self.tau > 0 else np.array([1.0, k, 0.0])
 
     @property
@@ -192,7 +207,7 @@ class Loop(Characteristic):
             return self.plant
         k = self.steering_gain
         if not self.kb_form:
-            return np.polyadd(self.lags, [k * (1.0 + self.c), 0.0])
+            return np.polyadd(self.lags, np.polymul([k * (1.0 + self.c), 0.0], self.slip))
         return np.array([self.tau, 1.0, k * (1.0 + self.c), 0.0]) if self.tau > 0 else np.array([1.0, k * (1.0 + self.c), 0.0])
 
     def loop_gain(self, NV: float) -> float:
@@ -256,10 +271,10 @@ class Loop(Characteristic):
         """Every field but k kept, with steering gain k, 1/s, unchecked (a probe of k in `gain_range`); τ and τ_a with
         their product with g·k below 10⁻⁹ are 0, and a lone τ_a is τ, as the constructor stores them."""
         k = float(k)
-        tau, lag = (x if x * self.plant_gain * k >= TAU_RESOLUTION else 0.0 for x in (self.tau, self.actuator_lag))
+        tau, lag, slip = (x if x * self.plant_gain * k >= TAU_RESOLUTION else 0.0 for x in (self.tau, self.actuator_lag, self.slip_lag))
         if tau == 0.0 and lag > 0.0:
             tau, lag = lag, 0.0
-        return _unchecked(Loop, **{**vars(self), "tau": tau, "actuator_lag": lag, "k": k})
+        return _unchecked(Loop, **{**vars(self), "tau": tau, "actuator_lag": lag, "slip_lag": slip, "k": k})
 
     def delay_search(self, NV: float) -> tuple:
         """T* searched from 1 % of the loop's fastest time scale to 1e-7 relative (a report shows 4 digits).
@@ -285,7 +300,12 @@ class Loop(Characteristic):
         return self._state_space(check_choice("hold", hold, HOLDS))
 
     def _state_space(self, hold: str) -> tuple:
-        """`state_space` for a `hold` already checked (`Characteristic._state_space`)."""
+        """`state_space` for a `hold` already checked (`Characteristic._state_space`); with a slip the course χ before y."""
+        A, B, F0, F1 = self._drive_state_space(hold)
+        return _with_course(A, B, F0, F1, self.slip_lag) if self.slip_lag > 0 else (A, B, F0, F1)
+
+    def _drive_state_space(self, hold: str) -> tuple:
+        """(A, B, F0, F1) without the course's lag: states (z,) (ω,) θ, y."""
         tau, k = self.tau, self.steering_gain
         if self.actuator_lag > 0:
             return _two_lag_state_space(self.actuator_lag, tau, k, self.heading, hold)
@@ -397,6 +417,19 @@ def _one(x) -> np.ndarray:
     return np.array([float(x)])
 
 
+def _with_course(A, B, F0, F1, slip: float) -> tuple:
+    """(A, B, F0, F1) with the course χ as a first state: τ_s·χ̇ + χ = θ, ẏ = χ instead of θ (y = x/V; `Loop.slip_lag`).
+    The heading and the lateral offset stay the last two states (θ, y) and the yaw rate the one before them; the feedback
+    reads θ and y as before (the controller senses its heading and its position); χ feeds nothing back."""
+    n = A.shape[0]
+    out = np.zeros((n + 1, n + 1))
+    out[1:, 1:] = A
+    out[n, n - 1], out[n, 0] = 0.0, 1.0  # ẏ = χ (the drive's own ẏ = θ dropped)
+    out[0, n - 1], out[0, 0] = 1.0 / slip, -1.0 / slip
+    first = lambda v: np.concatenate([[0.0], v])  # noqa: E731
+    return out, np.vstack([[[0.0]], B]), first(F0), first(F1)
+
+
 def _two_lag_state_space(lag: float, tau: float, k: float, heading: float, hold: str) -> tuple:
     """(A, B, F0, F1) of the drive with two lags: states (z, ω, θ, y), τ_a·ż + z = v (− g·k·θ with a held reference),
     τω̇ + ω = z, θ̇ = ω, ẏ = θ; the command held is v = −(F0 + K·F1)·state (`Loop.state_space`)."""
@@ -409,29 +442,32 @@ def _two_lag_state_space(lag: float, tau: float, k: float, heading: float, hold:
 
 
 @functools.lru_cache(maxsize=16)
-def steering_family(delayed: bool, second_lag: bool, heading_sampled: bool) -> LoopFamily:
+def steering_family(delayed: bool, second_lag: bool, heading_sampled: bool, slip: bool = False) -> LoopFamily:
     """The steering loop's family with the equations each model solves for a plant with a dead time D
-    (`delayed`), a second lag τ_a (`second_lag`) and the heading sampled by the controller (docs/models.md).
+    (`delayed`), a second lag τ_a (`second_lag`), the heading sampled by the controller and a course that lags the
+    heading (`slip`, `Loop.slip_lag`; docs/models.md).
 
     Parameters
     ----------
-    delayed, second_lag, heading_sampled : bool
+    delayed, second_lag, heading_sampled, slip : bool
         Which of the general loop's features the equations show.
     """
     lags = "(tau s + 1)(tau_a s + 1) s^2" if second_lag else "tau s^3 + s^2"
     h1 = ("(T + D)" if delayed else "T") if heading_sampled else ("D" if delayed else None)
     hK = "(T + D)" if delayed else "T"
-    if not (delayed or second_lag or heading_sampled):  # only a plant gain: KB's equations with g k
+    if not (delayed or second_lag or heading_sampled or slip):  # only a plant gain: KB's equations with g k
         return LoopFamily("steering", "NV", _kb_equations("g k"), ("order", "hold", "compute_delay"))
     field_term = "N V"  # with a heading gain c read (c s + N V), as KB's equations read k N V
     delayed_heading = f"g k s exp(-s {h1})" if h1 else "g k s"
     first = f"g k s (1 - {h1} s)" if h1 else "g k s"
+    slipping = (lambda rest: f"(tau_s s + 1)({rest})") if slip else (lambda rest: rest)
     equations = {
-        "continuous": f"{lags} + g k s + g k N V = 0  (no delay)",
-        "kb_first_order": f"{lags} + {first} + g k {field_term} (1 - {hK} s) = 0  (each delay to first order, KB eq 19)",
-        "pade": f"{lags} + {delayed_heading} + g k {field_term} exp(-s {hK}) = 0, each exp(-s h) by Pade(m,m)",
-        "exact_delay": f"{lags} + {delayed_heading} + g k {field_term} exp(-s {hK}) = 0",
-        "sampled": "det(zI - Phi_cl(gkNV)) = 0, ZOH, period T" + (", the commands on their way for D (modified z-transform)" if delayed else ""),
+        "continuous": f"{slipping(f'{lags} + g k s')} + g k N V = 0  (no delay)",
+        "kb_first_order": f"{slipping(f'{lags} + {first}')} + g k {field_term} (1 - {hK} s) = 0  (each delay to first order, KB eq 19)",
+        "pade": f"{slipping(f'{lags} + {delayed_heading}')} + g k {field_term} exp(-s {hK}) = 0, each exp(-s h) by Pade(m,m)",
+        "exact_delay": f"{slipping(f'{lags} + {delayed_heading}')} + g k {field_term} exp(-s {hK}) = 0",
+        "sampled": "det(zI - Phi_cl(gkNV)) = 0, ZOH, period T" + (", the commands on their way for D (modified z-transform)" if delayed else "")
+                   + (", the course's lag tau_s a state" if slip else ""),
     }
     return LoopFamily("steering", "NV", equations, ("order", "hold", "compute_delay"))
 

@@ -5,7 +5,7 @@ numbers:
 
 * `latin_hypercube` is ``scipy.stats.qmc.LatinHypercube(d, seed=seed).random(n)``
   (its default form: each of the n strata of every axis holds one point, placed
-  uniformly at random inside it), bit for bit — a test compares them. It is
+  uniformly at random inside it), to a few ULP — a test compares them. It is
   written out here, in numpy alone, because importing ``scipy.stats`` loads
   every distribution of SciPy and takes about a second: a fixed cost paid by
   every sampled sweep and every ``validate --sweep`` before any work, for five

@@ -267,7 +267,8 @@ class MeasureAxis:
 
 
 def check_first_order(robot) -> None:
-    """ValueError unless the robot's drive is first order (`Robot.actuator_lag` = 0): the simulator's solution between
+    """ValueError unless the robot's drive is first order (`Robot.actuator_lag` = 0) and it moves where it points
+    (`Robot.slip_lag` = 0: its kinematics are ẋ = V·sin θ, KB's): the simulator's solution between
     samples is the exact one of τω̇ + ω = g·u (`sim.robot`); a second lag is the loop models' (docs/models.md), and the
     MuJoCo robots carry one of their own (docs/mujoco.md). Asked where the simulator steps a robot (`sim.engine.run_batch`,
     `sim.reference.simulate_reference`, `sim.tracking.simulate_tracking`), not of a scenario MuJoCo runs.
@@ -279,6 +280,9 @@ def check_first_order(robot) -> None:
     if robot.actuator_lag > 0:
         raise ValueError(f"actuator_lag must be 0 for the simulator (its drive is the first-order lag tau, solved exactly between "
                          f"samples; the loop models take a second lag: docs/simulator.md); got {robot.actuator_lag}")
+    if robot.slip_lag > 0:
+        raise ValueError(f"slip_lag must be 0 for the simulator (its robot moves where it points; the loop models take a course "
+                         f"that lags the heading, and MuJoCo's skid-steer slides: docs/simulator.md); got {robot.slip_lag}")
 
 
 @dataclass(frozen=True)

@@ -256,7 +256,7 @@ def _verdict_columns(spec: SweepSpec, inputs: dict, NV: np.ndarray, reasons: np.
         stable, verdict, critical, margin = model_answers(
             model, tau, T, inputs["k"], safe, groups=groups, hold=spec.controller.hold,
             compute_delay=spec.controller.compute_delay, pade_order=spec.pade_order, plant_gain=spec.robot.plant_gain,
-            dead_time=spec.robot.dead_time, actuator_lag=spec.robot.actuator_lag)
+            dead_time=spec.robot.dead_time, actuator_lag=spec.robot.actuator_lag, slip_lag=spec.robot.slip_lag)
         stable[undefined], verdict[undefined], margin[undefined] = False, None, math.nan
         names += list(model_columns(model))
         arrays += [stable, verdict, critical, margin]

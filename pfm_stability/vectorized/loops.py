@@ -101,19 +101,19 @@ def _NV_array(NV) -> np.ndarray:
     return NV + 0.0
 
 
-def _options(model, hold, compute_delay, pade_order, plant_gain=1.0, dead_time=0.0, actuator_lag=0.0):
+def _options(model, hold, compute_delay, pade_order, plant_gain=1.0, dead_time=0.0, actuator_lag=0.0, slip_lag=0.0):
     """The checked model name and its options (the scalar models' messages)."""
     check_choice("model", model, MODEL_NAMES)
     hold = check_choice("hold", hold, HOLDS)
     compute_delay = check_integer("compute_delay", compute_delay, 0, 1)
     pade_order = check_integer("pade_order", pade_order, 1, 12)
     plant = {name: check_parameter(name, value) for name, value in
-             (("plant_gain", plant_gain), ("dead_time", dead_time), ("actuator_lag", actuator_lag))}
+             (("plant_gain", plant_gain), ("dead_time", dead_time), ("actuator_lag", actuator_lag), ("slip_lag", slip_lag))}
     return model, {"hold": hold, "compute_delay": compute_delay, "pade_order": pade_order, "plant": plant}
 
 
 def _kb_plant(options) -> bool:
-    """KB's plant 1/(τs + 1) (plant gain 1, no dead time, no second lag): the loops the array routes solve."""
+    """KB's plant 1/(τs + 1) (plant gain 1, no dead time, no second lag, no slip): the loops the array routes solve."""
     return options["plant"] == KB_PLANT
 
 
@@ -140,7 +140,7 @@ def loop_arrays(tau, T, k, NV, c=None):
 
 def _scalar_route(model, points, index, answers: _Answers, verdicts: bool, plant: dict) -> list:
     """The scalar model's boundary at the points `index` (and its `is_stable` if `verdicts`), for the steering plant
-    `plant` (``plant_gain``, ``dead_time``, ``actuator_lag``): fills `answers` there and returns the (point, Boundary) pairs."""
+    `plant` (``plant_gain``, ``dead_time``, ``actuator_lag``, ``slip_lag``): fills `answers` there and returns the (point, Boundary) pairs."""
     tau, T, k, c, NV = points
     out = []
     for i in index:
@@ -168,7 +168,7 @@ def _fallback(points, options):
 
 
 def loop_verdicts(model, tau, T, k, NV, *, c=None, hold="command", compute_delay=0, pade_order=3, plant_gain=1.0, dead_time=0.0,
-                  actuator_lag=0.0, columns="all") -> LoopVerdicts:
+                  actuator_lag=0.0, slip_lag=0.0, columns="all") -> LoopVerdicts:
     """One loop model's verdicts, NV* and margins for arrays of points.
 
     All arrays broadcast together (scalars allowed).
@@ -193,9 +193,9 @@ def loop_verdicts(model, tau, T, k, NV, *, c=None, hold="command", compute_delay
         ``sampled`` only: samples from measurement to actuation.
     pade_order : int
         ``pade`` only: Padé order m, 1 … 12.
-    plant_gain, dead_time, actuator_lag : float
-        The steering plant's gain g ([0.001, 100]), dead time D (s, [0, 10]) and second lag τ_a (s, [0, 10]), the
-        same at every point (`models.Loop`; default 1, 0 and 0, KB's plant). Another plant than KB's has no array route: every point is
+    plant_gain, dead_time, actuator_lag, slip_lag : float
+        The steering plant's gain g ([0.001, 100]), dead time D (s, [0, 10]), second lag τ_a (s, [0, 10]) and the
+        course's lag τ_s (s, [0, 10]), the same at every point (`models.Loop`; default 1, 0, 0 and 0, KB's plant). Another plant than KB's has no array route: every point is
         the scalar model's (`models.make_model`), some thirty times slower (6.5 against 0.25 ms a point for the five
         models, 200 random loops).
     columns : {"all", "verdict"}
@@ -216,7 +216,7 @@ def loop_verdicts(model, tau, T, k, NV, *, c=None, hold="command", compute_delay
         An unknown model or option, or the first out-of-range value
         (parameter, range, point index) — the scalar models' messages.
     """
-    name, options = _options(model, hold, compute_delay, pade_order, plant_gain, dead_time, actuator_lag)
+    name, options = _options(model, hold, compute_delay, pade_order, plant_gain, dead_time, actuator_lag, slip_lag)
     check_choice("columns", columns, COLUMNS)
     points, shape = loop_arrays(tau, T, k, NV, c)
     if columns == "verdict" and name in _STABILITY and _kb_plant(options):
