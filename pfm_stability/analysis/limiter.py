@@ -35,7 +35,8 @@ class LimitedBalance:
     Attributes
     ----------
     speeds, omegas, headings, rate_gains, third_harmonics, rate_harmonics : ndarray
-        V (m/s), ω (rad/s), Θ (rad), the saturation's (or the heading's rate limit's) gain, the trust measures.
+        V (m/s), ω (rad/s), Θ (rad: the course's amplitude, the heading's without a slide, `Robot.slip_lag`), the
+        saturation's (or the heading's rate limit's) gain, the trust measures.
     limiter_gains, limiter_lags : ndarray or None
         |N_r| and its lag (rad); None without a yaw acceleration limit.
     cascades : ndarray of bool or None
@@ -103,7 +104,7 @@ def command_responses(robot, controller, model: str):
     def continuous(w):
         s = 1j * np.asarray(w, dtype=float)
         plant = np.exp(-s * D) / (s * (lags[0] * s + 1.0) * (lags[1] * s + 1.0))
-        return gk * plant, np.exp(-s * T) * plant / s
+        return gk * plant, np.exp(-s * T) * plant / (s * (lags[2] * s + 1.0))  # y follows the course: τ_s
 
     return continuous
 
@@ -171,8 +172,9 @@ def limited_balance(robot, controller, delta, A, Nf, model: str, *, heading_limi
         n_s = 1.0 if U <= M or heading_limit else float(saturation_df_for_output(U, M))
         step = 2.0 * U * math.sin(0.5 * w * limiter_T) / (R * limiter_T) if limiter_T > 0 else U * w / R  # <= 1: not limiting
         N_r = complex(rate_limit_df(U, w, R, limiter_T)) if step > 1.0 else 1.0 + 0j
-        theta = abs(N_r) * U / (w * lag_gain(w, lags))
-        N_h = complex(rate_limit_df(theta, w, M)) if heading_limit and theta * w > M else 1.0 + 0j
+        theta = abs(N_r) * U / (w * lag_gain(w, lags))  # the course's amplitude (the heading's without a slide)
+        heading = theta * math.hypot(1.0, w * lags[2])
+        N_h = complex(rate_limit_df(heading, w, M)) if heading_limit and heading * w > M else 1.0 + 0j
         theta *= abs(N_h)
         return w, U, n_s, N_r, N_h, theta, gk * nf * a * w / theta
 
@@ -214,7 +216,7 @@ def limited_balance(robot, controller, delta, A, Nf, model: str, *, heading_limi
         h3_sat = harmonic_content(lambda x: np.clip(x, -M, M), U / n_s) if n_s < 1.0 else 0.0
         h3_lim = limiter_harmonic(U * w / R) if math.isfinite(R) else 0.0
         to_heading = lag_gain(w, lags) / (3.0 * lag_gain(3.0 * w, lags))
-        h3_head = limiter_harmonic(theta / abs(N_h) * w / M) if heading_limit else 0.0  # the heading's own triangle
+        h3_head = limiter_harmonic(theta / abs(N_h) * math.hypot(1.0, w * lags[2]) * w / M) if heading_limit else 0.0  # the heading's own triangle
         rates[i] = h3_sat * to_heading + h3_head
         thirds[i] = (h3_field[i] + h3_sat + h3_lim) * loop_filtering(w, lags, gk * n_s * abs(N_r)) + h3_head / 3.0 \
             + special.jv(3, theta) / (3.0 * special.j1(theta))
@@ -224,27 +226,27 @@ def limited_balance(robot, controller, delta, A, Nf, model: str, *, heading_limi
 
 
 def loop_filtering(omega: float, lags: tuple, k: float) -> float:
-    """|L(3jω)|/|L(jω)| with L(s) = 1/(s(s·P(s) + k)), P(s) = (τs + 1)(τ_a·s + 1) the drive's lags: how the steering loop
-    filters a third harmonic on its way to y (τ_a = 0: 1/(s(τs² + s + k))).
+    """|L(3jω)|/|L(jω)| with L(s) = 1/(s(s·P(s) + k)(τ_s·s + 1)), P(s) = (τs + 1)(τ_a·s + 1) the drive's lags and τ_s the
+    course's: how the steering loop filters a third harmonic on its way to y (τ_a = τ_s = 0: 1/(s(τs² + s + k))).
 
     Parameters
     ----------
     omega : float
         rad/s.
     lags : tuple of float
-        (τ, τ_a), s (`drive_lags`).
+        (τ, τ_a, τ_s), s (`drive_lags`).
     k : float
         The loop's (equivalent) steering gain, 1/s.
     """
-    tau, second = lags
-    L = lambda s: 1.0 / (s * (s * (tau * s + 1.0) * (second * s + 1.0) + k))
+    tau, second, slip = lags
+    L = lambda s: 1.0 / (s * (s * (tau * s + 1.0) * (second * s + 1.0) + k) * (slip * s + 1.0))
     return abs(L(3j * omega)) / abs(L(1j * omega))
 
 
 def motor_loop(robot, controller, gain_factor: float = 1.0) -> Loop:
     """The robot's loop in the motor's units, the one the harmonic balance closes: steering gain g·k·`gain_factor`, plant
-    gain 1, the robot's dead time D and both of its lags τ, τ_a (`Loop.of` with g folded into k: the saturation and the
-    limiter act on g·u, docs/simulator.md).
+    gain 1, the robot's dead time D, both of its lags τ, τ_a and its course's τ_s (`Loop.of` with g folded into k: the
+    saturation and the limiter act on g·u, docs/simulator.md).
 
     Parameters
     ----------
@@ -256,27 +258,29 @@ def motor_loop(robot, controller, gain_factor: float = 1.0) -> Loop:
         The saturation's describing function on the steering gain (1: not saturating).
     """
     return Loop(robot.tau, controller.T, robot.plant_gain * robot.k * gain_factor, dead_time=robot.dead_time,
-                actuator_lag=robot.actuator_lag)
+                actuator_lag=robot.actuator_lag, slip_lag=robot.slip_lag)
 
 
 def drive_lags(loop: Loop) -> tuple:
-    """(τ, τ_a), s: the drive's lags as a `Loop` stores them (τ_a = 0 for a first-order drive).
+    """(τ, τ_a, τ_s), s: the drive's lags and the course's as a `Loop` stores them (0 where there is none).
 
     Parameters
     ----------
     loop : Loop
     """
-    return float(loop.tau), float(loop.actuator_lag)
+    return float(loop.tau), float(loop.actuator_lag), float(loop.slip_lag)
 
 
 def lag_gain(omega, lags: tuple):
-    """|P(jω)| = √(1 + ω²τ²)·√(1 + ω²τ_a²): the applied command's amplitude over the turning rate's at ω.
+    """|P(jω)|·|1 + jωτ_s| = √(1 + ω²τ²)·√(1 + ω²τ_a²)·√(1 + ω²τ_s²): the applied command's amplitude over the course's
+    rate at ω (the turning rate's without a slide: the harmonic balance's Θ is the course's amplitude, which the lateral
+    motion ẋ = V·sin χ sees; docs/wobble.md).
 
     Parameters
     ----------
     omega : float or ndarray
         rad/s.
     lags : tuple of float
-        (τ, τ_a), s (`drive_lags`).
+        (τ, τ_a, τ_s), s (`drive_lags`).
     """
-    return np.hypot(1.0, omega * lags[0]) * np.hypot(1.0, omega * lags[1])
+    return np.hypot(1.0, omega * lags[0]) * np.hypot(1.0, omega * lags[1]) * np.hypot(1.0, omega * lags[2])

@@ -303,14 +303,14 @@ def tracking_loop(robot, controller, point: TrackingPoint) -> Loop:
     Parameters
     ----------
     robot : parameters.Robot
-        τ, g, D, τ_a (its k is not used: the controller's gains replace it).
+        τ, g, D, τ_a, τ_s (its k is not used: the controller's gains replace it).
     controller : parameters.Controller
         T.
     point : TrackingPoint
         The law's gains.
     """
     return Loop(robot.tau, controller.T, point.k_theta, plant_gain=robot.plant_gain, dead_time=robot.dead_time,
-                actuator_lag=robot.actuator_lag, heading_sampled=True)
+                actuator_lag=robot.actuator_lag, heading_sampled=True, slip_lag=robot.slip_lag)
 
 
 def _ratio_bracket(loop: Loop, shape: tuple) -> tuple | None:

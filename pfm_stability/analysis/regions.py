@@ -152,8 +152,8 @@ def _delay_loop(robot: Robot, controller: Controller) -> tuple:
 
 def _array_delay_route(model: LoopModel, robot: Robot) -> bool:
     """Whether `exact_delay`'s verdicts come from the vectorized crossing count: its one-delay loop, KB's plant or only a
-    plant gain (g·k); a dead time or a second lag makes the general loop, decided by the model's stable set."""
-    return isinstance(model, ExactDelay) and robot.dead_time == 0.0 and robot.actuator_lag == 0.0
+    plant gain (g·k); a dead time, a second lag or a slide makes the general loop, decided by the model's stable set."""
+    return isinstance(model, ExactDelay) and robot.dead_time == 0.0 and robot.actuator_lag == 0.0 and robot.slip_lag == 0.0
 
 
 def _general_verdicts(robot: Robot, controller: Controller, NV):

@@ -235,7 +235,7 @@ class WobbleBranch:
     omegas : ndarray
         ω(A), rad/s.
     headings : ndarray
-        Θ(A), rad.
+        Θ(A), rad: the course's amplitude (the heading's without a slide, `Robot.slip_lag`).
     rate_gains : ndarray
         n_s(A), the rate limit's describing function.
     third_harmonics : ndarray

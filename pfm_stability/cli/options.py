@@ -267,6 +267,8 @@ def add_parameter_options(parser: argparse.ArgumentParser, *, sampled: bool = Fa
         "actuator_lag": "second lag tau_a of the drive (an actuator filter): plant g e^(-sD)/((tau s + 1)(tau_a s + 1))",
         "yaw_accel_limit": "largest rate of change of the commanded yaw rate (a velocity smoother's angular acceleration limit; "
                            "default: none)",
+        "slip_lag": "lag tau_s of the course behind the heading (a base that slides sideways in a turn): "
+                    "tau_s dchi/dt + chi = theta, dx/dt = V chi",
     }
     for name, text in helps.items():
         key = "T_sampled" if sampled and name == "T" else name
@@ -277,7 +279,7 @@ def add_parameter_options(parser: argparse.ArgumentParser, *, sampled: bool = Fa
     )
 
 
-_ROBOT_FIELDS = ("V", "tau", "k", "W", "dead_time", "plant_gain", "actuator_lag", "yaw_accel_limit")
+_ROBOT_FIELDS = ("V", "tau", "k", "W", "dead_time", "plant_gain", "actuator_lag", "yaw_accel_limit", "slip_lag")
 _CONTROLLER_FIELDS = ("f", "n", "T", "hold", "compute_delay")
 
 
@@ -673,6 +675,7 @@ _PLANT_ASSUMED = {
                  "pfm-stability identify, docs/diagnose.md)",
     "plant_gain": "the turning the drive delivers per commanded yaw rate is not in a Nav2 file; this is the preset's (pfm-stability identify)",
     "actuator_lag": "a second lag of the drive is not in a Nav2 file; this is the preset's (pfm-stability identify)",
+    "slip_lag": "whether the base slides sideways in a turn is not in a Nav2 file; this is the preset's (pfm-stability identify)",
     "hold": "the base holds the last cmd_vel between controller cycles",
     "compute_delay": "the controller server publishes a command as soon as it is computed: 0 samples (the computation time is part of "
                      "the dead time D)",

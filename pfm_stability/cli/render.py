@@ -52,6 +52,7 @@ _LABELS = {
     "dead_time": "D (steering plant dead time)",
     "plant_gain": "g (steering plant gain)",
     "actuator_lag": "tau_a (drive's second lag)",
+    "slip_lag": "tau_s (course's lag)",
     "yaw_accel_limit": "R (drive's yaw accel limit)",
     "max_steering_rate": "omega_max (steering-rate limit)",
     "f": "f (force ratio)",
@@ -328,8 +329,9 @@ def _footnote(report) -> list[str]:
         from .render_families import HOLONOMIC_FOOTNOTE
 
         return ["", HOLONOMIC_FOOTNOTE]
-    plant = {name: report.inputs[name]["value"] for name in ("dead_time", "plant_gain", "actuator_lag") if name in report.inputs}
-    if plant.get("dead_time", 0.0) > 0 or plant.get("plant_gain", 1.0) != 1.0 or plant.get("actuator_lag", 0.0) > 0:  # the verdicts carry D* (`criteria._plant_given`)
+    plant = {name: report.inputs[name]["value"] for name in ("dead_time", "plant_gain", "actuator_lag", "slip_lag") if name in report.inputs}
+    if (plant.get("dead_time", 0.0) > 0 or plant.get("plant_gain", 1.0) != 1.0 or plant.get("actuator_lag", 0.0) > 0
+            or plant.get("slip_lag", 0.0) > 0):  # the verdicts carry D* (`criteria._plant_given`)
         return ["", _FOOTNOTE + " " + _PLANT_FOOTNOTE]
     return ["", _FOOTNOTE]
 

@@ -58,8 +58,8 @@ __all__ = [
 DEFAULT_PRESET = "carmel"
 """The base of a file without a ``preset`` key."""
 
-ROBOT_KEYS = ("V", "tau", "k", "W", "max_steering_rate", "dead_time", "plant_gain", "actuator_lag", "yaw_accel_limit")
-"""Keys of ``robot:`` (`parameters.Robot`; ``max_steering_rate`` in deg/s, ``dead_time`` and ``actuator_lag`` in s,
+ROBOT_KEYS = ("V", "tau", "k", "W", "max_steering_rate", "dead_time", "plant_gain", "actuator_lag", "yaw_accel_limit", "slip_lag")
+"""Keys of ``robot:`` (`parameters.Robot`; ``max_steering_rate`` in deg/s, ``dead_time``, ``actuator_lag`` and ``slip_lag`` in s,
 ``plant_gain`` dimensionless, ``yaw_accel_limit`` in rad/s²: what ``pfm-stability identify --out`` writes)."""
 
 FAMILY_ROBOT_KEYS = ("family", "mass")
@@ -79,7 +79,8 @@ SCENARIO_KEYS = {"wall": ("alpha",), "corridor": ("L",)}
 TOP_KEYS = ("preset", "name", "source", "robot", "controller", "law", "scenario", "assumed")
 """Top-level keys of a configuration file (docs/config.md)."""
 
-PARAMETER_KEYS = ("V", "tau", "k", "W", "dead_time", "plant_gain", "actuator_lag", "yaw_accel_limit", "f", "n", "T", "hold", "compute_delay")
+PARAMETER_KEYS = ("V", "tau", "k", "W", "dead_time", "plant_gain", "actuator_lag", "yaw_accel_limit", "slip_lag", "f", "n", "T", "hold",
+                  "compute_delay")
 """The parameters whose provenance `Config.sources` records (as the command line's `resolve_parameters`)."""
 
 _STEERING_RATE_DEG = (0.0, math.inf)  # deg/s, open at both ends: RANGES["max_steering_rate"] in degrees
@@ -382,6 +383,8 @@ NAV2_ASSUMED = {
     "plant_gain": "a Nav2 file does not give the steering plant's gain; this is the preset's (measure yours: pfm-stability identify, docs/diagnose.md)",
     "actuator_lag": "a Nav2 file does not give the drive's second lag; this is the preset's (measure yours: pfm-stability identify, docs/diagnose.md)",
     "yaw_accel_limit": "no velocity_smoother node in the Nav2 file; this is the preset's (none unless it gives one)",
+    "slip_lag": "a Nav2 file does not say whether the base slides sideways in a turn; this is the preset's (measure yours: "
+                "pfm-stability identify with a pose that sees the base move, docs/diagnose.md)",
 }
 """Why a loop parameter a Nav2 file cannot give is an assumption (marked ASSUMED in the report)."""
 

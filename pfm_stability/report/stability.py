@@ -51,7 +51,7 @@ LAW_INPUTS = parameter_keys(FORCE_LAWS)
 """The static laws' own parameters, listed after W when the law takes them (`laws.registry.parameter_keys`: in
 `laws.registry.PARAMETERS` order)."""
 
-PLANT_INPUTS = ("dead_time", "plant_gain", "actuator_lag")
+PLANT_INPUTS = ("dead_time", "plant_gain", "actuator_lag", "slip_lag")
 """The steering plant's dead time D and gain g (`parameters.Robot`), listed after k only when given: a value other than
 the default (D = 0, g = 1) or one the user typed (`plant_inputs`), so reports without them are as before."""
 
@@ -670,7 +670,7 @@ def plant_inputs(robot: Robot, sources: dict | None) -> dict:
         Parameter name → provenance (`build_report`'s ``sources``).
     """
     sources = sources or {}
-    defaults = {"dead_time": 0.0, "plant_gain": 1.0, "actuator_lag": 0.0}
+    defaults = {"dead_time": 0.0, "plant_gain": 1.0, "actuator_lag": 0.0, "slip_lag": 0.0}
     shown = {}
     for name in PLANT_INPUTS:
         value, source = getattr(robot, name), sources.get(name)
