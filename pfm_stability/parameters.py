@@ -437,13 +437,13 @@ class Robot:
     actuator_lag : float
         A second lag τ_a of the drive (an actuator filter), s, in [0, 10]: the plant is
         g·e^(−sD)/((τs + 1)(τ_a·s + 1)) (0 = KB's first-order plant; docs/models.md).
+    yaw_accel_limit : float
+        The largest rate of change of the commanded yaw rate, rad/s², > 0 (a velocity smoother's angular
+        acceleration limit); ``inf`` (the default) = none. Nonlinear: the linear models do not see it.
     slip_lag : float
         The lag τ_s of the robot's course (its direction of travel) behind its heading, s, in [0, 10]: a base that
         slides sideways in a turn (a skid-steer, soft tyres) moves along χ with τ_s·χ̇ + χ = θ, ẋ = V·χ (0 = it goes
         where it points, KB's robot; docs/models.md, "A base that slides").
-    yaw_accel_limit : float
-        The largest rate of change of the commanded yaw rate, rad/s², > 0 (a velocity smoother's angular
-        acceleration limit); ``inf`` (the default) = none. Nonlinear: the linear models do not see it.
     """
 
     V: float

@@ -193,7 +193,7 @@ BAD = [
     ({"robot": {"mass": 2}}, "robot.mass applies to robot family holonomic (robot.family: holonomic), not to family steering"),
     ({"robot": {"family": "kinematic", "mass": 2}}, "robot.mass applies to robot family holonomic"),
     ({"robot": {"family": "wheeled"}}, "robot.family must be one of steering, kinematic, holonomic; got 'wheeled'"),
-    ({"robot": {"a_max": 2}}, "robot.a_max is not a key (did you mean law.a_max?); robot takes V, tau, k, W, max_steering_rate, dead_time, plant_gain, actuator_lag, yaw_accel_limit, family, mass"),
+    ({"robot": {"a_max": 2}}, "robot.a_max is not a key (did you mean law.a_max?); robot takes V, tau, k, W, max_steering_rate, dead_time, plant_gain, actuator_lag, yaw_accel_limit, slip_lag, family, mass"),
     ({"robot": {"famly": "holonomic"}}, "robot.famly is not a key (did you mean family?)"),
     ({"robot": {"family": "holonomic"}, "law": {"name": "grid"}}, "robot.family holonomic takes law velocity or velocity-gated"),
     ({"law": {"name": "power", "alpha_p": 1}}, "law.alpha_p applies to velocity, velocity-gated or fuzzy, not to law power"),

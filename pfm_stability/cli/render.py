@@ -25,7 +25,7 @@ import functools
 import math
 import textwrap
 
-from ..parameters import RANGES, SHOWN_AS
+from ..parameters import KB_PLANT, RANGES, SHOWN_AS
 from .formatting import number, percent, table
 
 __all__ = [
@@ -329,9 +329,7 @@ def _footnote(report) -> list[str]:
         from .render_families import HOLONOMIC_FOOTNOTE
 
         return ["", HOLONOMIC_FOOTNOTE]
-    plant = {name: report.inputs[name]["value"] for name in ("dead_time", "plant_gain", "actuator_lag", "slip_lag") if name in report.inputs}
-    if (plant.get("dead_time", 0.0) > 0 or plant.get("plant_gain", 1.0) != 1.0 or plant.get("actuator_lag", 0.0) > 0
-            or plant.get("slip_lag", 0.0) > 0):  # the verdicts carry D* (`criteria._plant_given`)
+    if any(report.inputs[name]["value"] != kb for name, kb in KB_PLANT.items() if name in report.inputs):  # D* (`criteria._plant_given`)
         return ["", _FOOTNOTE + " " + _PLANT_FOOTNOTE]
     return ["", _FOOTNOTE]
 

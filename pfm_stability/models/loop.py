@@ -68,16 +68,16 @@ class Loop(Characteristic):
         τ_a, s, in [0, 10] (default 0): a second lag of the drive, the plant
         g·e^(−sD)/((τs + 1)(τ_a·s + 1)); τ_a with τ_a·g·k < 10⁻⁹ is 0. The two lags are
         interchangeable: τ = 0 with τ_a > 0 is stored as τ = τ_a, τ_a = 0.
-    slip_lag : float, keyword only
-        τ_s, s, in [0, 10] (default 0): the course χ (the direction the robot moves in) follows the heading through
-        τ_s·χ̇ + χ = θ and ẋ = V·χ (a base that slides sideways in a turn). Only the field's path sees it: every term
-        but the field's is multiplied by (τ_s·s + 1) — (τ_s s + 1)(p0(s) + gk·s·e^(−s·h₁)) + gkNV·e^(−s(T + D)) = 0
-        (docs/models.md, "A base that slides"); τ_s with τ_s·g·k < 10⁻⁹ is 0.
     heading_sampled : bool, keyword only
         Whether the sampled controller computes the heading feedback too (a path tracker
         computing ω from the pose: the heading term is delayed by T + D, as the field's),
         or the drive closes it (KB eq 18: delayed by D only). Default False. The `sampled`
         model does not read it (its ``hold`` says what is sampled).
+    slip_lag : float, keyword only
+        τ_s, s, in [0, 10] (default 0): the course χ (the direction the robot moves in) follows the heading through
+        τ_s·χ̇ + χ = θ and ẋ = V·χ (a base that slides sideways in a turn). Only the field's path sees it: every term
+        but the field's is multiplied by (τ_s·s + 1) — (τ_s s + 1)(p0(s) + gk·s·e^(−s·h₁)) + gkNV·e^(−s(T + D)) = 0
+        (docs/models.md, "A base that slides"); τ_s with τ_s·g·k < 10⁻⁹ is 0.
     """
 
     tau: float
