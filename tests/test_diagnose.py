@@ -67,11 +67,12 @@ def test_the_pose_is_read_from_the_message_bytes(driven, tmp_path):
         np.testing.assert_allclose(pose.vx, log.log.odom_vx, atol=1e-12)
 
 
-def test_a_csv_has_no_pose(tmp_path):
+def test_a_csv_without_the_pose_columns_has_no_pose(tmp_path):
     path = tmp_path / "log.csv"
     path.write_text("t,cmd_wz,odom_wz\n0,0,\n0.1,,0\n")
-    with pytest.raises(LogError, match="a CSV log has no poses"):
+    with pytest.raises(LogError, match="has no column 'x'"):
         read_log(path, need=("pose",))
+    assert read_log(path, need=("command",), optional=("pose",)).pose is None
 
 
 # ------------------------------------------------------------------------------ walls from one scan

@@ -54,6 +54,13 @@ measured |dω/dt| saturates where the model asks for more) and a deadband or bac
 small commands deliver nothing fits better by at least `BETTER` of the residual sum of squares on the same samples).
 A narrowband log is fitted with the first order alone: it cannot tell the candidates apart.
 
+The slide
+---------
+With a pose (``log.pose``: a localisation's, a motion-capture system's, a simulator's ground truth — not wheel
+odometry's, which cannot show it), `analysis.slip_fit.fit_slip_lag` measures the lag τ_s of the base's course behind
+its heading from the lateral velocity in the base's frame (docs/diagnose.md, "The slide"); it needs no command and is
+reported whether or not the plant is identified (`Identification.slip`, or `slip_reason` why not).
+
 Nothing identified
 ------------------
 A log whose command never changes, a robot that does not follow its commands (g's interval holds 0 or
@@ -71,13 +78,14 @@ import numpy as np
 from ..io.logs import LogData, TimeSeries
 from ..io.serialize import json_number
 from .excitation import BAND, NARROWBAND, Excitation, command_spectrum, excitation_of, ridge_point
-from .plant_fit import (DEAD_TIME_BOUNDS, PLANT_MODELS, SELECT_SAMPLES, SMOOTHING_FREQUENCY, TAU_BOUNDS, Z95, CandidateFit,
+from .plant_fit import (DEAD_TIME_BOUNDS, PLANT_MODELS, SELECT_SAMPLES, SMOOTHING_FREQUENCY, TAU_BOUNDS, Z95, CandidateFit, Estimate,
                         PlantParameters, Samples, autocorrelation, candidates, covariance, fit_first_order, fit_model, grid_start,
                         jacobian, residuals)
 from .plant_response import lag_response, mean_wait
+from .slip_fit import SlipFit, fit_slip_lag
 
 __all__ = ["Estimate", "ControllerTiming", "FitWarning", "FitQuality", "Excitation", "PlantFit", "LogSummary",
-           "Identification", "CandidateFit", "SmootherFit", "SMOOTHING_FREQUENCY", "controller_timing", "excitation_windows", "command_spectrum", "lag_response",
+           "Identification", "SlipFit", "CandidateFit", "SmootherFit", "SMOOTHING_FREQUENCY", "controller_timing", "excitation_windows", "command_spectrum", "lag_response",
            "fit_plant", "identify", "ridge_point", "NARROWBAND", "BAND", "PLANT_MODELS",
            "MISSED_FACTOR", "SETTLE", "LEAD", "STALE", "DEAD_TIME_BOUNDS", "TAU_BOUNDS", "BETTER", "RATE_SOURCES"]
 
@@ -97,28 +105,6 @@ samples (speed: the final fit uses every sample; the candidates are compared on 
 
 
 # ------------------------------------------------------------------------------------------ results
-@dataclass(frozen=True)
-class Estimate:
-    """A parameter and its 95 % interval [low, high] (the parameter's unit); low and high are NaN (null in JSON) when
-    the log cannot determine the parameter (`Excitation.narrowband`).
-
-    Attributes
-    ----------
-    value : float
-        The estimate, in the parameter's unit.
-    low, high : float
-        The 95 % interval's ends, same unit; NaN when not identifiable.
-    """
-
-    value: float
-    low: float
-    high: float
-
-    def to_dict(self) -> dict:
-        """``{value, low, high}``."""
-        return {"value": json_number(self.value), "low": json_number(self.low), "high": json_number(self.high)}
-
-
 @dataclass(frozen=True)
 class ControllerTiming:
     """The controller's real period from its command stamps.
@@ -332,6 +318,8 @@ class LogSummary:
         Where the rate comes from (`RATE_SOURCES`).
     command_stamps : str
         Where the command's times come from: ``header``, ``receive`` or ``csv``.
+    pose_topic : str or None
+        The pose's topic (a CSV's: ``x,y,yaw``) when the slide was measured from it, else None.
     """
 
     path: str
@@ -341,11 +329,14 @@ class LogSummary:
     rate_topic: str
     rate_source: str
     command_stamps: str
+    pose_topic: str | None = None
 
     def to_dict(self) -> dict:
-        """The ``log`` of the JSON output."""
-        return {"path": self.path, "format": self.format, "duration": json_number(self.duration),
-                "topics": {"command": self.command_topic, "rate": self.rate_topic},
+        """The ``log`` of the JSON output (``topics.pose`` only with a pose)."""
+        topics = {"command": self.command_topic, "rate": self.rate_topic}
+        if self.pose_topic is not None:
+            topics["pose"] = self.pose_topic
+        return {"path": self.path, "format": self.format, "duration": json_number(self.duration), "topics": topics,
                 "rate_source": self.rate_source, "command_stamps": self.command_stamps}
 
 
@@ -365,6 +356,10 @@ class Identification:
         The fitted plant when `identified`.
     log : LogSummary
         What was read.
+    slip : SlipFit or None
+        The slide measured from the log's pose (`analysis.slip_fit`), when it has one and it shows the slide.
+    slip_reason : str or None
+        Why the slide was not measured from the log's pose; None when it was, or when the log has no pose.
     """
 
     identified: bool
@@ -372,6 +367,22 @@ class Identification:
     controller: ControllerTiming
     plant: PlantFit | None
     log: LogSummary
+    slip: SlipFit | None = None
+    slip_reason: str | None = None
+
+    @property
+    def has_pose(self) -> bool:
+        """Whether the slide was looked for (the log has a pose): measured, or not with `slip_reason`."""
+        return self.slip is not None or self.slip_reason is not None
+
+    def slip_dict(self) -> dict | None:
+        """The ``slip`` of the JSON output: null without a pose; else ``slip_lag`` (null with ``reason`` when not
+        measured) and the fit's details."""
+        if not self.has_pose:
+            return None
+        if self.slip is None:
+            return {"slip_lag": None, "reason": self.slip_reason}
+        return {**self.slip.to_dict(), "reason": None}
 
     def to_dict(self) -> dict:
         """The JSON output of ``pfm-stability identify`` without ``schema_version``, ``command`` and ``timing``."""
@@ -385,6 +396,7 @@ class Identification:
                     "warnings": [] if plant is None else [w.to_dict() for w in plant.warnings],
                     "excitation": None if plant is None or plant.excitation is None else plant.excitation.to_dict(),
                     "models": [] if plant is None else [m.to_dict() for m in plant.models]},
+            "slip": self.slip_dict(),
             "log": self.log.to_dict(),
         }
 
@@ -682,8 +694,18 @@ def _rate_limit(s: Samples, p: PlantParameters) -> float | None:
 
 
 # ------------------------------------------------------------------------------------------ the whole
-def identify(log: LogData, rate_source: str = "odometry", smoothing_frequency: float = SMOOTHING_FREQUENCY) -> Identification:
-    """The controller's timing and the yaw-rate plant identified from `log`.
+def _slide(pose) -> tuple[SlipFit | None, str | None]:
+    """`fit_slip_lag` of the pose; a pose that is no numbers (a localisation that lost itself) is a reason, not an error:
+    the plant does not need it."""
+    try:
+        return fit_slip_lag(pose.t, pose.x, pose.y, pose.yaw)
+    except ValueError as exc:
+        return None, f"{exc} ({pose.topic})"
+
+
+def identify(log: LogData, rate_source: str = "odometry", smoothing_frequency: float = SMOOTHING_FREQUENCY, *,
+             slip: bool = True) -> Identification:
+    """The controller's timing and the yaw-rate plant identified from `log`, and the base's slide from its pose.
 
     Parameters
     ----------
@@ -693,6 +715,9 @@ def identify(log: LogData, rate_source: str = "odometry", smoothing_frequency: f
         ``"odometry"`` or ``"imu"`` (`RATE_SOURCES`): where the achieved yaw rate comes from.
     smoothing_frequency : float
         The rate (Hz) of the velocity smoother a slew limit is fitted as (Nav2's default 20); 0: a continuous ramp.
+    slip : bool
+        Measure the slide's lag τ_s from ``log.pose`` when there is one (`analysis.slip_fit.fit_slip_lag`; the pose must
+        see the base move: not wheel odometry's). False: not looked for, as without a pose.
 
     Returns
     -------
@@ -710,8 +735,11 @@ def identify(log: LogData, rate_source: str = "odometry", smoothing_frequency: f
         raise ValueError(f"the log was read without its {'command' if log.command is None else rate_source}")
     command = log.command
     timing = controller_timing(command.t)
-    summary = LogSummary(log.path, log.format, float(log.duration), command.topic, rate.topic, rate_source, command.stamps)
+    pose = log.pose if slip else None
+    summary = LogSummary(log.path, log.format, float(log.duration), command.topic, rate.topic, rate_source, command.stamps,
+                         None if pose is None else pose.topic)
     if not (math.isfinite(smoothing_frequency) and 0.0 <= smoothing_frequency <= 1000.0):
         raise ValueError(f"smoothing frequency must be in [0, 1000] Hz (0: a continuous ramp); got {smoothing_frequency!r}")
     plant, reason = fit_plant(command.t, command.value, rate, timing.T, smoothing_frequency)
-    return Identification(plant is not None, reason, timing, plant, summary)
+    slide, slip_reason = (None, None) if pose is None else _slide(pose)
+    return Identification(plant is not None, reason, timing, plant, summary, slide, slip_reason)

@@ -35,7 +35,7 @@ import numpy as np
 from ..io.serialize import json_number
 from .plant_response import lag_at, lag_response, lag_states, plant_response, slew_limited, smoothed
 
-__all__ = ["Samples", "CandidateFit", "PlantParameters", "PLANT_MODELS", "MODEL_PARAMETERS", "DEAD_TIME_BOUNDS", "TAU_BOUNDS",
+__all__ = ["Estimate", "Samples", "CandidateFit", "PlantParameters", "PLANT_MODELS", "MODEL_PARAMETERS", "DEAD_TIME_BOUNDS", "TAU_BOUNDS",
            "RATIO_HIGH", "SLEW_BOUNDS", "SMOOTHING_FREQUENCY", "PHASES", "SELECT_SAMPLES", "LJUNG_BOX_LAGS", "Z95", "grid_start", "fit_first_order",
            "fit_model", "residuals", "jacobian", "covariance", "autocorrelation", "ljung_box", "candidates"]
 
@@ -71,6 +71,28 @@ MODEL_PARAMETERS = {"first_order": ("g", "tau", "D", "b"), "two_lags": ("g", "ta
 _ORDER = ("g", "tau", "rho", "D", "log_slew", "b")
 _STEP = {"tau": 1e-6, "rho": 1e-6, "D": 1e-7, "log_slew": 1e-6}
 """Forward-difference steps (s, −, s, −): the responses are smooth in each at this scale, and ε/h ~ 1e-10."""
+
+
+@dataclass(frozen=True)
+class Estimate:
+    """A parameter and its 95 % interval [low, high] (the parameter's unit); low and high are NaN (null in JSON) when
+    the log cannot determine the parameter (`analysis.excitation.Excitation.narrowband`).
+
+    Attributes
+    ----------
+    value : float
+        The estimate, in the parameter's unit.
+    low, high : float
+        The 95 % interval's ends, same unit; NaN when not identifiable.
+    """
+
+    value: float
+    low: float
+    high: float
+
+    def to_dict(self) -> dict:
+        """``{value, low, high}``."""
+        return {"value": json_number(self.value), "low": json_number(self.low), "high": json_number(self.high)}
 
 
 @dataclass(frozen=True)

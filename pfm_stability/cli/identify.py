@@ -2,6 +2,7 @@
 
     pfm-stability identify LOG [--out ROBOT.yaml] [--format text|json|markdown]
                                [--cmd-topic /cmd_vel] [--odom-topic /odom] [--imu-topic /imu] [--rate-source odometry|imu]
+                               [--pose-topic TOPIC]
 
 LOG is a ROS 2 bag (its directory, or a ``.db3``/``.mcap`` file), a ROS 1 ``.bag`` or a CSV
 (docs/diagnose.md, "Logs"). The commanded yaw rate (``/cmd_vel``) against the achieved one (the
@@ -11,8 +12,14 @@ one's Ljung–Box whiteness) — with 95 % intervals; the command's stamps give 
 (`pfm_stability.analysis.identification`). JSON keys (`pfm_stability/io/schema/output.schema.json`):
 ``schema_version``, ``command`` ("identify"), ``identified``, ``reason``, ``plant`` (``model``, ``g``, ``tau``,
 ``dead_time``, ``actuator_lag``, ``yaw_accel_limit``, each ``{value, low, high}`` or null, and ``identifiable``),
-``controller`` (``T``, ``jitter``, ``missed``, …), ``fit`` (``quality``, ``warnings``, ``excitation``, ``models``), ``log``
-(path, format, duration, topics), ``timing``.
+``controller`` (``T``, ``jitter``, ``missed``, …), ``fit`` (``quality``, ``warnings``, ``excitation``, ``models``), ``slip``
+(null without a pose; else ``slip_lag`` ``{value, low, high}`` or null with its ``reason``), ``log`` (path, format,
+duration, topics), ``timing``.
+
+The slide's lag τ_s (`pfm_stability.analysis.slip_fit`) is measured from a pose that sees the base move: a bag's
+``--pose-topic`` (an Odometry from a localisation, motion capture or a simulator's ground truth; wheel odometry cannot
+show a slide, so the odometry's own pose is not used unless named here), a CSV's ``x, y, yaw`` columns when it has them.
+``--out`` writes it as ``slip_lag`` when measured.
 
 A log that shows nothing to identify (the command never changes, the robot does not move) is an
 answer, not an error: exit 0 with ``identified`` false and the reason (the controller's period is
@@ -61,7 +68,10 @@ def topic(name: str):
 TOPICS = {"cmd": ("/cmd_vel", "the command (Twist or TwistStamped; default /cmd_vel)"),
           "odom": ("/odom", "the odometry (Odometry; default /odom)"),
           "imu": ("/imu", "the IMU (Imu; default /imu), read with --rate-source imu"),
-          "scan": ("/scan", "the laser scans (LaserScan; default /scan)")}
+          "scan": ("/scan", "the laser scans (LaserScan; default /scan)"),
+          "pose": (None, "the pose the slide's lag slip_lag is measured from (Odometry of a localisation, motion capture or a "
+                         "simulator's ground truth: wheel odometry cannot show a slide; default none; a CSV's x, y, yaw columns "
+                         "are read when it has them)")}
 """The log's topics a command reads: option ``--KEY-topic``, its default and help."""
 
 
@@ -100,10 +110,10 @@ def add_parser(sub) -> None:
     )
     p.add_argument("log", metavar="LOG", help="a ROS 2 bag directory, a .db3 or .mcap file, a ROS 1 .bag, or a .csv")
     p.add_argument("--out", type=output_path("out", ".yaml"), metavar="ROBOT.yaml",
-                   help="write the identified tau, dead_time, plant_gain (actuator_lag, yaw_accel_limit when the data show them) "
-                   "and T as a configuration file (docs/config.md)")
+                   help="write the identified tau, dead_time, plant_gain (actuator_lag, yaw_accel_limit when the data show them, "
+                   "slip_lag when measured from a pose) and T as a configuration file (docs/config.md)")
     p.add_argument("--format", choices=FORMATS, default="text")
-    add_topic_options(p, ("cmd", "odom", "imu"))
+    add_topic_options(p, ("cmd", "odom", "imu", "pose"))
     p.add_argument("--rate-source", choices=("odometry", "imu"), default="odometry",
                    help="where the achieved yaw rate comes from (default: odometry)")
     p.set_defaults(run=run)
@@ -123,10 +133,12 @@ def run(args) -> int:
     from ..io.serialize import SCHEMA_VERSION, dumps
 
     started = time.perf_counter()
-    if log_format(args.log) != "csv":
+    csv = log_format(args.log) == "csv"
+    if not csv:
         require("logs", "pfm-stability identify")
-    topics = LogTopics(command=args.cmd_topic, odometry=args.odom_topic, imu=args.imu_topic)
-    log = read_log(args.log, topics, need=("command", args.rate_source))
+    topics = LogTopics(command=args.cmd_topic, odometry=args.odom_topic, imu=args.imu_topic, pose=args.pose_topic)
+    pose = {"optional": ("pose",)} if csv else {"need": ("command", args.rate_source, "pose")} if args.pose_topic else {}
+    log = read_log(args.log, topics, **{"need": ("command", args.rate_source), **pose})
     result = identify(log, args.rate_source)
     if args.out:
         if not result.identified:
@@ -214,6 +226,41 @@ def _quality(q) -> str:
             f"bias {q.bias:+.2g} rad/s")
 
 
+def _slide_rows(slip) -> list[tuple[str, str, str]]:
+    """(name, value, 95 % interval) of the slide's lag and the pose's heading offset."""
+    lag, offset = slip.slip_lag, slip.misalignment
+    ms = lambda v: f"{1000 * v:.2f} ms"  # noqa: E731 - a slide is a few ms: 10 µs shows its interval
+    return [("τ_s (slip lag)", ms(lag.value), f"{ms(lag.low)} to {ms(lag.high)}"),
+            ("heading offset", f"{1000 * offset.value:.3g} mrad", f"{1000 * offset.low:.3g} to {1000 * offset.high:.3g} mrad")]
+
+
+def _slide_fit(slip) -> str:
+    return (f"{slip.samples} samples moving at {slip.speed:.3g} m/s (median), yaw rate varying by {slip.turn:.3g} rad/s; "
+            f"R² {slip.r2:.3f}; the lag's own lag mattered by at most {100 * slip.lag_bias:.2g} % (corrected)")
+
+
+def _slide_text(result) -> list[str]:
+    """The slide's lines of the text output: none without a pose."""
+    if not result.has_pose:
+        return []
+    source = f"slide (the course's lag behind the heading, from the pose {result.log.pose_topic})"
+    if result.slip is None:
+        return ["", f"{source}: not measured — {result.slip_reason}"]
+    return (["", f"{source}, 95 % intervals"] + [f"  {name:17s} {value:>14s}   [{interval}]" for name, value, interval in
+                                                _slide_rows(result.slip)] + [f"  {_slide_fit(result.slip)}"])
+
+
+def _slide_markdown(result) -> list[str]:
+    """The slide's lines of the Markdown output: none without a pose."""
+    if not result.has_pose:
+        return []
+    if result.slip is None:
+        return [f"**Slide not measured** (pose {result.log.pose_topic}): {result.slip_reason}.", ""]
+    out = [f"| slide, from the pose {result.log.pose_topic} | value | 95 % interval |", "| --- | --- | --- |"]
+    return out + [f"| {name} | {value} | {interval} |" for name, value, interval in _slide_rows(result.slip)] + \
+        ["", f"Slide fit: {_slide_fit(result.slip)}.", ""]
+
+
 def render_text(result) -> str:
     """The text output of ``identify`` (an `Identification`).
 
@@ -226,7 +273,7 @@ def render_text(result) -> str:
     out = [f"log: {parts['source']}", "", f"controller (from {result.log.command_topic})",
            f"  T       {parts['T']}", f"  jitter  {parts['jitter']}", f"  missed  {parts['missed']}", ""]
     if not result.identified:
-        return "\n".join(out + [f"plant: not identified — {result.reason}", ""])
+        return "\n".join(out + [f"plant: not identified — {result.reason}"] + _slide_text(result) + [""])
     plant = result.plant
     out.append(f"plant {_MODEL_NAMES[plant.model]}, 95 % intervals")
     out += [f"  {name:17s} {value:>14s}   [{interval}]" for name, value, interval in _plant_rows(plant)]
@@ -236,7 +283,7 @@ def render_text(result) -> str:
         out += [f"  {line}" for line in _models(plant)]
     out += ["", f"fit: {_quality(plant.quality)}"]
     out += [f"warning ({w.kind}): {w.message}" for w in plant.warnings] or ["warnings: none"]
-    return "\n".join(out + [""])
+    return "\n".join(out + _slide_text(result) + [""])
 
 
 def render_markdown(result) -> str:
@@ -251,7 +298,7 @@ def render_markdown(result) -> str:
     out = ["## Identified from the log", "", f"Log: {parts['source']}.", "", "| controller | |", "| --- | --- |",
            f"| T | {parts['T']} |", f"| jitter | {parts['jitter']} |", f"| missed | {parts['missed']} |", ""]
     if not result.identified:
-        return "\n".join(out + [f"**Plant not identified:** {result.reason}.", ""])
+        return "\n".join(out + [f"**Plant not identified:** {result.reason}.", ""] + _slide_markdown(result))
     plant = result.plant
     out += [f"| plant {_MODEL_NAMES[plant.model]} | value | 95 % interval |", "| --- | --- | --- |"]
     out += [f"| {name} | {value} | {interval} |" for name, value, interval in _plant_rows(plant)]
@@ -262,12 +309,13 @@ def render_markdown(result) -> str:
         out += [f"| {m.model} | {m.bic - best:+.1f} | {m.ljung_box_p:.3g} | {'selected' if m.selected else ''} |" for m in plant.models]
     out += ["", f"Fit: {_quality(plant.quality)}.", ""]
     out += [f"- **{w.kind}**: {w.message}" for w in plant.warnings] or ["No warnings: the model explains the data."]
-    return "\n".join(out + [""])
+    return "\n".join(out + [""] + _slide_markdown(result))
 
 
 def robot_yaml(result) -> str:
     """The configuration file ``--out`` writes: ``robot: {tau, dead_time, plant_gain}`` (and ``actuator_lag``,
-    ``yaw_accel_limit`` when the selected plant has them), ``controller: {T}``, commented.
+    ``yaw_accel_limit`` when the selected plant has them, ``slip_lag`` when measured from a pose), ``controller: {T}``,
+    commented.
 
     Parameters
     ----------
@@ -296,6 +344,10 @@ def robot_yaml(result) -> str:
         e = plant.yaw_accel_limit
         lines.append(f"  yaw_accel_limit: {e.value:.6g}   # rad/s^2, slew limit on the commanded yaw rate, identified from {name} "
                      f"({e.low:.4g} to {e.high:.4g})")
+    if result.slip is not None:
+        e = result.slip.slip_lag
+        lines.append(f"  slip_lag: {max(e.value, 0.0):.6g}   # s, lag of the course behind the heading (the base's slide), "
+                     f"identified from the pose {log.pose_topic} of {name} ({e.low:.4g} to {e.high:.4g})")
     lines += [
         "controller:",
         f"  T: {c.T:.6g}            # s, median period of {log.command_topic} in {name} "

@@ -27,7 +27,8 @@ so the validation's bisection (`pfm_stability.validation`) treats MuJoCo's runs 
 (`MujocoRuns`).
 
 `drive_log` drives the robot open loop with a step or chirp yaw-rate command and records what a robot's
-log holds (the command, the wheel odometry's yaw rate, the gyro's), for ``pfm-stability identify``;
+log holds (the command, the wheel odometry's yaw rate, the gyro's, and the base's true pose, as a motion-capture system
+would see it), for ``pfm-stability identify``;
 `write_csv_log` writes it as a CSV log (docs/diagnose.md, "Logs").
 """
 
@@ -604,6 +605,12 @@ class DriveLog:
         The wheel odometry's yaw rate, (ω_right − ω_left)·r/b (rad/s), at its rate.
     imu_t, imu_wz : ndarray
         The gyro's yaw rate (the base's angular velocity about its z axis, rad/s), at the same instants.
+    x, y, yaw : ndarray
+        The base's true pose at the odometry's instants (MuJoCo's state, as a motion-capture system would see it): its
+        origin's position (m) and its heading (rad from +x towards +y, the odometry convention of `CorridorLog`).
+    v_forward, v_lateral : ndarray
+        The base origin's true velocity at the same instants in the base's frame (m/s; lateral positive to the left),
+        from MuJoCo's velocities, not from the pose: the ground truth of a slide (docs/diagnose.md, "The slide").
     """
 
     cmd_t: np.ndarray
@@ -613,6 +620,11 @@ class DriveLog:
     odom_wz: np.ndarray
     imu_t: np.ndarray
     imu_wz: np.ndarray
+    x: np.ndarray
+    y: np.ndarray
+    yaw: np.ndarray
+    v_forward: np.ndarray
+    v_lateral: np.ndarray
 
 
 def _profile(name: str, t: np.ndarray, amplitude: float, duration: float, seed: int) -> np.ndarray:
@@ -685,7 +697,9 @@ def drive_log(profile: str = "both", *, options: EngineOptions = EngineOptions()
     dof = model.jnt_dofadr[model.body_jntadr[base]]
     left, right = (mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_ACTUATOR, s) for s in ("left", "right"))
     wl, wr = (model.jnt_dofadr[model.actuator_trnid[a, 0]] for a in (left, right))
-    odom_t, odom_wz, imu_wz = [], [], []
+    q = model.jnt_qposadr[model.body_jntadr[base]]
+    lag = 0.0 if model.opt.integrator == mujoco.mjtIntegrator.mjINT_RK4 else dt / 2  # _true_motion
+    odom_t, odom_wz, imu_wz, truth = [], [], [], []
     j, now = 0, 0
     while now <= total:
         while j < cmd_step.size and cmd_step[j] <= now:
@@ -698,6 +712,7 @@ def drive_log(profile: str = "both", *, options: EngineOptions = EngineOptions()
             odom_t.append(now * dt)
             odom_wz.append((data.qvel[wr] - data.qvel[wl]) * robot.wheel_radius / robot.track)
             imu_wz.append(float(data.qvel[dof + 5]))
+            truth.append(_true_motion(data, q, dof, lag))
         while next_odom <= now:
             next_odom = next(odometry)
         nxt = min(int(cmd_step[j]) if j < cmd_step.size else total + 1, next_odom, path.next_event(now), total + 1)
@@ -706,12 +721,31 @@ def drive_log(profile: str = "both", *, options: EngineOptions = EngineOptions()
         mujoco.mj_step(model, data, nstep=nxt - now)
         now = nxt
     odom_t = np.asarray(odom_t)
-    return DriveLog(cmd_t, cmd_wz, np.full_like(cmd_t, V), odom_t, np.asarray(odom_wz), odom_t.copy(), np.asarray(imu_wz))
+    return DriveLog(cmd_t, cmd_wz, np.full_like(cmd_t, V), odom_t, np.asarray(odom_wz), odom_t.copy(), np.asarray(imu_wz),
+                    *np.asarray(truth, dtype=float).reshape(-1, 5).T)
 
 
-def write_csv_log(log: DriveLog, path) -> None:
-    """Write `log` as a CSV log (``t, cmd_wz, odom_wz, imu_wz``: one row per time, blank where a series has no value;
-    docs/diagnose.md), atomically.
+def _true_motion(data, q: int, dof: int, lag: float) -> tuple[float, float, float, float, float]:
+    """(x, y, yaw, v_forward, v_lateral) of the base from MuJoCo's current state.
+
+    The pose is the free joint's position and quaternion (qpos, not xpos/xmat, which `mj_step` leaves one step behind),
+    yaw from +x towards +y (the body's x axis is its forward direction, `robots.place`). The velocity is its origin's
+    (qvel's linear part, world frame) in the base's frame at the velocity's own time: MuJoCo's Euler and implicit
+    integrators move the position by the step's new velocity, so qvel is the velocity over the last step, `lag` = half
+    a step before the pose; it is rotated by the heading then, yaw − r·lag (r the body's yaw rate). Rotated by the
+    heading of the step's end it would read a slide half a step longer than the pose shows (0.5 ms at 1-ms steps); a
+    heading one step stale (xmat) with this velocity, half a step shorter."""
+    w, qx, qy, qz = (float(v) for v in data.qpos[q + 3:q + 7])
+    yaw = math.atan2(2.0 * (w * qz + qx * qy), 1.0 - 2.0 * (qy * qy + qz * qz))
+    vx, vy = float(data.qvel[dof]), float(data.qvel[dof + 1])
+    then = yaw - float(data.qvel[dof + 5]) * lag
+    c, s = math.cos(then), math.sin(then)
+    return float(data.qpos[q]), float(data.qpos[q + 1]), yaw, vx * c + vy * s, -vx * s + vy * c
+
+
+def write_csv_log(log: DriveLog, path, *, pose: bool = True) -> None:
+    """Write `log` as a CSV log (``t, cmd_wz, odom_wz, imu_wz`` and, with `pose`, the base's true pose ``x, y, yaw`` at
+    the odometry's instants: one row per time, blank where a series has no value; docs/diagnose.md), atomically.
 
     Parameters
     ----------
@@ -719,14 +753,23 @@ def write_csv_log(log: DriveLog, path) -> None:
         The recorded drive.
     path : str or os.PathLike
         The CSV file.
+    pose : bool
+        Write the pose's columns (what ``identify`` measures the slide from; docs/diagnose.md, "The slide").
     """
     from ..io.files import atomic_file
 
-    rows = {}
-    for column, (ts, vs) in enumerate(((log.cmd_t, log.cmd_wz), (log.odom_t, log.odom_wz), (log.imu_t, log.imu_wz))):
-        for t_, v in zip(ts.tolist(), vs.tolist()):
-            rows.setdefault(round(t_, 9), ["", "", ""])[column] = repr(v)
+    series = [(log.cmd_t, (log.cmd_wz,)), (log.odom_t, (log.odom_wz,)), (log.imu_t, (log.imu_wz,))]
+    if pose:
+        series.append((log.odom_t, (log.x, log.y, log.yaw)))
+    width = sum(len(values) for _, values in series)
+    rows, column = {}, 0
+    for ts, values in series:
+        for i, t_ in enumerate(ts.tolist()):
+            row = rows.setdefault(round(t_, 9), [""] * width)
+            for k, v in enumerate(values):
+                row[column + k] = repr(float(v[i]))
+        column += len(values)
     with atomic_file(path, "w", what="log") as fh:
-        fh.write("t,cmd_wz,odom_wz,imu_wz\n")
+        fh.write("t,cmd_wz,odom_wz,imu_wz" + (",x,y,yaw" if pose else "") + "\n")
         for t_ in sorted(rows):
             fh.write(f"{t_!r}," + ",".join(rows[t_]) + "\n")

@@ -10,12 +10,13 @@ command       ``geometry_msgs/msg/Twist``                   ``angular.z`` (rad/s
 odometry      ``nav_msgs/msg/Odometry``                     ``twist.twist.angular.z`` the header stamp
 imu           ``sensor_msgs/msg/Imu``                       ``angular_velocity.z``  the header stamp
 scan          ``sensor_msgs/msg/LaserScan``                 a caller's reduction    the header stamp
-pose          ``nav_msgs/msg/Odometry`` (the odometry topic) x, y, yaw, linear.x    the header stamp
+pose          ``nav_msgs/msg/Odometry`` (`LogTopics.pose`)   x, y, yaw, linear.x    the header stamp
 ============= ============================================= ======================= ===================
 
 The pose (`PoseSeries`: position x, y in m, the yaw in rad from the orientation's quaternion, the forward speed
-``twist.twist.linear.x`` in m/s) is in the odometry's frame; `pose_at` interpolates it at other times (a scan's),
-which is how a scan's sensor-frame reduction is placed in the odometry frame (the laser is taken to sit at the base's
+``twist.twist.linear.x`` in m/s) is in the odometry's frame (the odometry's own topic unless `LogTopics.pose` names
+another: a localisation's or a motion-capture system's, which see the base slide where wheel odometry cannot;
+a CSV's columns ``x, y, yaw``); `pose_at` interpolates it at other times (a scan's), which is how a scan's sensor-frame reduction is placed in the odometry frame (the laser is taken to sit at the base's
 origin, looking forward: a bag without ``/tf_static`` says nothing else).
 
 Times are seconds since the log's first message (`LogData.start`, epoch seconds, says when that was).
@@ -67,8 +68,10 @@ MESSAGE_TYPES = {
 }
 """Series → the message types accepted on its topic."""
 
-CSV_COLUMNS = {"command": "cmd_wz", "odometry": "odom_wz", "imu": "imu_wz"}
-"""Series → its column in a CSV log; the first column is ``t`` (s). One row per time; a blank cell: no value then."""
+CSV_COLUMNS = {"command": ("cmd_wz",), "odometry": ("odom_wz",), "imu": ("imu_wz",), "pose": ("x", "y", "yaw")}
+"""Series → its columns in a CSV log; the first column is ``t`` (s). One row per time; a blank cell: no value then. The
+pose is three columns (m, m, rad from +x towards +y), all filled or all blank in a row; its forward speed is not a
+column (`PoseSeries.vx` is then the pose's own central difference along its heading)."""
 
 
 class LogError(ValueError):
@@ -82,23 +85,28 @@ class LogTopics:
     Attributes
     ----------
     command, odometry, imu, scan : str
-        The topics (defaults: ``/cmd_vel``, ``/odom``, ``/imu``, ``/scan``); the pose is the odometry's.
+        The topics (defaults: ``/cmd_vel``, ``/odom``, ``/imu``, ``/scan``).
+    pose : str or None
+        The pose's topic (a ``nav_msgs/msg/Odometry``); None (the default): the odometry's.
     """
 
     command: str = "/cmd_vel"
     odometry: str = "/odom"
     imu: str = "/imu"
     scan: str = "/scan"
+    pose: str | None = None
 
     def of(self, series: str) -> str:
-        """The topic of `series` (the pose is the odometry topic's).
+        """The topic of `series` (the pose's: `pose`, else the odometry's).
 
         Parameters
         ----------
         series : str
             One of `SERIES`.
         """
-        return self.odometry if series == "pose" else getattr(self, series)
+        if series == "pose":
+            return self.odometry if self.pose is None else self.pose
+        return getattr(self, series)
 
 
 @dataclass(frozen=True)
@@ -364,7 +372,7 @@ def log_format(path: str) -> str:
 
 
 def read_log(path, topics: LogTopics = LogTopics(), *, need: Sequence[str] = ("command", "odometry"),
-             scan_reducer: Callable[[Scan], Any] | None = None, scan_batch: int = 1) -> LogData:
+             scan_reducer: Callable[[Scan], Any] | None = None, scan_batch: int = 1, optional: Sequence[str] = ()) -> LogData:
     """Read the series `need` of the log at `path` in one pass, keeping only their numbers.
 
     Parameters
@@ -380,6 +388,8 @@ def read_log(path, topics: LogTopics = LogTopics(), *, need: Sequence[str] = ("c
     scan_batch : int
         With more than 1, the reducer takes a list of up to this many `Scan` (in order) and returns one result per
         scan: a vectorized reducer, with at most `scan_batch` scans held at once.
+    optional : sequence of str
+        Series read when the log has them (a bag: their topic; a CSV: their columns), else None; not in `need`.
 
     Returns
     -------
@@ -392,21 +402,22 @@ def read_log(path, topics: LogTopics = LogTopics(), *, need: Sequence[str] = ("c
         One line naming the problem (module docstring, "Bad logs").
     """
     path = os.fspath(path)
-    unknown = [s for s in need if s not in SERIES]
+    unknown = [s for s in (*need, *optional) if s not in SERIES]
     if unknown:
         raise LogError(f"unknown series {unknown[0]!r}; the series are {', '.join(SERIES)}")
-    if "scan" in need and scan_reducer is None:
+    if "scan" in (*need, *optional) and scan_reducer is None:
         raise LogError("reading scans needs a scan_reducer (scans are reduced as they are read, never held)")
     kind = log_format(path)
+    optional = tuple(s for s in optional if s not in need)
     if kind == "csv":
-        for series in ("scan", "pose"):
-            if series in need:
-                raise LogError(f"{path}: a CSV log has no {series}s (its columns: t, {', '.join(CSV_COLUMNS.values())})")
-        return _read_csv(path, need)
+        if "scan" in need:
+            columns = ", ".join(c for cs in CSV_COLUMNS.values() for c in cs)
+            raise LogError(f"{path}: a CSV log has no scans (its columns: t, {columns})")
+        return _read_csv(path, need, tuple(s for s in optional if s != "scan"))
     from ..extras import require
 
     require("logs", "reading a ROS bag")
-    return _read_bag(path, kind, topics, tuple(need), scan_reducer, max(int(scan_batch), 1))
+    return _read_bag(path, kind, topics, tuple(need), scan_reducer, max(int(scan_batch), 1), optional)
 
 
 class _ReducerFailed(Exception):
@@ -418,7 +429,8 @@ def _one_line(exc: BaseException) -> str:
     return text if len(text) <= 200 else text[:197] + "..."
 
 
-def _read_bag(path: str, kind: str, topics: LogTopics, need: tuple[str, ...], scan_reducer, scan_batch: int) -> LogData:
+def _read_bag(path: str, kind: str, topics: LogTopics, need: tuple[str, ...], scan_reducer, scan_batch: int,
+              optional: tuple[str, ...] = ()) -> LogData:
     from pathlib import Path
 
     from rosbags.highlevel import AnyReader
@@ -432,6 +444,8 @@ def _read_bag(path: str, kind: str, topics: LogTopics, need: tuple[str, ...], sc
     except Exception as exc:  # noqa: BLE001 - rosbags and sqlite3/zstd raise many kinds on a corrupt file: one line each
         raise LogError(f"could not read {path} (corrupt or truncated?): {_one_line(exc)}") from None
     try:
+        present = {c.topic for c in reader.connections}
+        need = need + tuple(s for s in optional if topics.of(s) in present)
         return _stream(reader, path, kind, topics, need, scan_reducer, scan_batch)
     except LogError:
         raise
@@ -561,8 +575,9 @@ def _check_order(t: np.ndarray, topic: str, path: str) -> None:
                        f"({t[k]:.6f} s after {t[k - 1]:.6f} s from the start; {back.size} such place{'s' if back.size > 1 else ''})")
 
 
-def _read_csv(path: str, need: Sequence[str]) -> LogData:
-    """A wide CSV: ``t`` then one column per series (`CSV_COLUMNS`), a blank cell where a row has no value of it."""
+def _read_csv(path: str, need: Sequence[str], optional: Sequence[str] = ()) -> LogData:
+    """A wide CSV: ``t`` then the columns of each series (`CSV_COLUMNS`), a blank cell where a row has no value of it;
+    the series of `optional` are read when all their columns are there."""
     try:
         with open(path, newline="", encoding="utf-8") as fh:
             rows = csv.reader(fh)
@@ -570,13 +585,14 @@ def _read_csv(path: str, need: Sequence[str]) -> LogData:
             if header is None:
                 raise LogError(f"{path} is empty: no header line")
             header = [h.strip() for h in header]
-            expected = ["t"] + [CSV_COLUMNS[s] for s in need]
+            expected = ["t"] + [c for s in need for c in CSV_COLUMNS[s]]
             for column in expected:
                 if column not in header:
                     raise LogError(f"CSV {path} has no column {column!r} (its columns: {', '.join(header)}); "
                                    f"expected {', '.join(expected)}")
-            where = {name: header.index(name) for name in expected}
-            t_all, series = [], {s: ([], []) for s in need}
+            wanted = tuple(need) + tuple(s for s in optional if all(c in header for c in CSV_COLUMNS[s]))
+            where = {name: header.index(name) for name in ["t"] + [c for s in wanted for c in CSV_COLUMNS[s]]}
+            t_all, series = [], {s: ([], []) for s in wanted}
             for line, row in enumerate(rows, start=2):
                 if not any(cell.strip() for cell in row):
                     continue
@@ -584,25 +600,47 @@ def _read_csv(path: str, need: Sequence[str]) -> LogData:
                 if t is None:
                     raise LogError(f"CSV {path} line {line}: no time t")
                 t_all.append(t)
-                for s in need:
-                    v = _cell(row, where[CSV_COLUMNS[s]], path, line, CSV_COLUMNS[s])
-                    if v is not None:
-                        series[s][0].append(t)
-                        series[s][1].append(v)
+                for s in wanted:
+                    values = [_cell(row, where[c], path, line, c) for c in CSV_COLUMNS[s]]
+                    if all(v is None for v in values):
+                        continue
+                    if any(v is None for v in values):
+                        blank = ", ".join(c for c, v in zip(CSV_COLUMNS[s], values) if v is None)
+                        raise LogError(f"CSV {path} line {line}: the {s} is {', '.join(CSV_COLUMNS[s])} together; "
+                                       f"{blank} blank")
+                    series[s][0].append(t)
+                    series[s][1].append(values)
     except UnicodeDecodeError as exc:
         raise LogError(f"CSV {path} is not text: {_one_line(exc)}") from None
     if not t_all:
         raise LogError(f"{path} is empty: no rows")
     t0 = min(t_all)
     result = {}
-    for s in need:
+    for s in wanted:
+        name = ",".join(CSV_COLUMNS[s])
         if not series[s][0]:
-            raise LogError(f"CSV {path}: column {CSV_COLUMNS[s]} has no values")
+            raise LogError(f"CSV {path}: column {name} has no values" if len(CSV_COLUMNS[s]) == 1 else
+                           f"CSV {path}: columns {name} have no values")
         t = np.asarray(series[s][0]) - t0
-        _check_order(t, CSV_COLUMNS[s], path)
-        result[s] = TimeSeries(CSV_COLUMNS[s], "csv", t, np.asarray(series[s][1]), "csv")
+        _check_order(t, name, path)
+        values = np.asarray(series[s][1], dtype=float)
+        if s == "pose":
+            x, y, yaw = values.T.copy()
+            result[s] = PoseSeries(name, t, x, y, yaw, _forward_speed(t, x, y, yaw))
+        else:
+            result[s] = TimeSeries(name, "csv", t, values[:, 0].copy(), "csv")
     columns = tuple((c, "csv") for c in header[1:])
     return LogData(path, "csv", t0, max(t_all) - t0, tuple(sorted(columns)), **result)
+
+
+def _forward_speed(t: np.ndarray, x: np.ndarray, y: np.ndarray, yaw: np.ndarray) -> np.ndarray:
+    """The pose's speed along its heading (m/s): central differences of the position (one-sided at the ends), 0 where
+    the times do not advance."""
+    if t.size < 2:
+        return np.zeros_like(t)
+    dx, dy, dt = (np.gradient(a) for a in (x, y, t))
+    safe = np.where(dt > 0, dt, 1.0)
+    return np.where(dt > 0, (dx * np.cos(yaw) + dy * np.sin(yaw)) / safe, 0.0)
 
 
 def _cell(row: list[str], index: int, path: str, line: int, column: str) -> float | None:
