@@ -13,7 +13,7 @@ For each robot and corridor: (1) the plant is identified as a user would — an 
 logged as a CSV, ``identify`` on the gyro's rate — at 0.8 m/s, then again at the speed of the boundary it predicts,
 twice (the plant depends on the speed); (2) MuJoCo's V* is bisected (30-s runs, a 1 % bracket) from a start 1 cm and
 5 cm off the centre line; (3) corridor runs at 0.85 and 1.15 times the 1-cm V* (from 5 cm off, 30 s) are logged as
-bags and diagnosed with k, W, f, n, the identified plant (g, τ, D, τ_a, the slew limit) and the grid's law: the
+bags and diagnosed with k, W, f, n, the identified plant (g, τ, D, τ_a, the slew limit, the slide τ_s) and the grid's law: the
 verdicts, the measured ω (crossings, with its interval) against the ``sampled`` model's, and diagnose's ``sampled``
 V* against MuJoCo's. Writes ``DIR/diagnose_mujoco.json``, ``.md`` and ``.png``.
 
@@ -81,12 +81,13 @@ def identify_mujoco(name: str, options: dict, drive: dict, V: float, out_dir) ->
     log = drive_log("both", options=EngineOptions(robot_model=name, **options), V=V, duration=60.0, **drive)
     path = Path(out_dir) / f"{name}_V{V:.2f}_identify.csv"
     write_csv_log(log, path)
-    result = identify(read_log(path, need=("command", "imu")), "imu")
+    result = identify(read_log(path, need=("command", "imu"), optional=("pose",)), "imu")
     p = result.plant
     none = lambda e: None if e is None else e.to_dict()  # noqa: E731
     return {"V": V, "model": p.model, "g": p.g.to_dict(), "tau": p.tau.to_dict(), "dead_time": p.dead_time.to_dict(),
             "actuator_lag": none(p.actuator_lag), "yaw_accel_limit": none(p.yaw_accel_limit), "r2": p.quality.r2,
             "smoother": none(p.smoother), "loop_dead_time": p.loop_dead_time,
+            "slip_lag": None if result.slip is None else result.slip.slip_lag.to_dict(),
             "T": result.controller.T, "csv": path.name,
             "candidates": {m.model: {"g": m.parameters.g, "tau": m.parameters.tau, "dead_time": m.parameters.dead_time,
                                      "actuator_lag": m.parameters.actuator_lag, "bic": m.bic} for m in p.models}}
@@ -101,6 +102,8 @@ def mujoco_pair(plant: dict, T: float, V: float = 1.0):
         extra["actuator_lag"] = plant["actuator_lag"]["value"]
     if plant["yaw_accel_limit"] is not None:
         extra["yaw_accel_limit"] = plant["yaw_accel_limit"]["value"]
+    if plant.get("slip_lag") is not None:
+        extra["slip_lag"] = max(plant["slip_lag"]["value"], 0.0)
     wait = plant["smoother"]["mean_wait"] if plant.get("smoother") else 0.0  # a small command's wait for the smoother's tick
     robot = Robot(V=V, tau=plant["tau"]["value"], k=K, W=W, plant_gain=plant["g"]["value"],
                   dead_time=max(plant["dead_time"]["value"] + wait, 0.0), **extra)
@@ -189,18 +192,21 @@ def mujoco_case(key: str, L: float, quick: bool, out_dir) -> dict:
             "first_order_V": predicted_V({**plant, **{k: {"value": v} for k, v in plant["candidates"]["first_order"].items()
                                                        if k != "bic" and k != "actuator_lag"}, "actuator_lag": None,
                                           "yaw_accel_limit": None}, T, L) if plant["candidates"] else None,
+            "without_slide_V": predicted_V({**plant, "slip_lag": None}, T, L),
             "bisections": bisections, "diagnosed": runs, "seconds": time.perf_counter() - started}
 
 
 def mujoco_table(cases) -> str:
     """The Markdown table of docs/diagnose.md and docs/mujoco.md."""
-    head = ("| robot | L (m) | plant identified | V* MuJoCo 1 cm | V* MuJoCo 5 cm | sampled V* (gap to 1 cm) | with the limit V*(1 cm), "
+    head = ("| robot | L (m) | plant identified | V* MuJoCo 1 cm | V* MuJoCo 5 cm | sampled V* (gap to 1 cm) | without the slide (gap) | "
+            "with the limit V*(1 cm), "
             "V*(5 cm) (gaps) | diagnose V* at 0.85·V* (gap) | verdicts 0.85 / 1.15 | ω measured / predicted at 1.15 |")
     out = [head, "|" + " --- |" * (head.count("|") - 1)]
     for c in cases:
         p = c["plant"]
         extra = (f", τ_a {p['actuator_lag']['value']:.3f} s" if p["actuator_lag"] else "") + \
-                (f", A {p['yaw_accel_limit']['value']:.2f} rad/s²" if p["yaw_accel_limit"] else "")
+                (f", A {p['yaw_accel_limit']['value']:.2f} rad/s²" if p["yaw_accel_limit"] else "") + \
+                (f"; slide τ_s {1000 * p['slip_lag']['value']:.2f} ms" if p.get("slip_lag") else "")
         plant = f"{p['model']}: g {p['g']['value']:.3f}, τ {p['tau']['value']:.3f} s, D {1000 * p['dead_time']['value']:.0f} ms{extra}"
         b1, b5 = c["bisections"][str(OFFSETS[0])], c["bisections"][str(OFFSETS[1])]
         low, high = c["diagnosed"]
@@ -212,7 +218,8 @@ def mujoco_table(cases) -> str:
         limited = (f"{b1['limited']:.3f} ({100 * b1['limited_error']:+.1f} %), {b5['limited']:.3f} ({100 * b5['limited_error']:+.1f} %)"
                    if b1.get("limited") is not None and b5.get("limited") is not None else "—")
         out.append(f"| {c['robot']} ({c['model']}) | {c['L']:g} | {plant} | {b1['V_mujoco']:.3f} | {b5['V_mujoco']:.3f} | "
-                   f"{b1['sampled']:.3f} ({100 * b1['error']:+.1f} %) | {limited} | {diag} | {verdict(low)}, {verdict(high)} | {omega} |")
+                   f"{b1['sampled']:.3f} ({100 * b1['error']:+.1f} %) | {c['without_slide_V']:.3f} "
+                   f"({100 * (c['without_slide_V'] / b1['V_mujoco'] - 1):+.1f} %) | {limited} | {diag} | {verdict(low)}, {verdict(high)} | {omega} |")
     return "\n".join(out) + "\n"
 
 

@@ -50,7 +50,8 @@ MODELS = ("continuous", "kb_first_order", "pade", "exact_delay", "sampled")
 
 
 def identify_robot(name: str, out_dir: str, options: dict | None = None, V: float = 0.8) -> dict:
-    """Drive at V (m/s), log as CSV, identify: {g, tau, dead_time (value, low, high), r2, warnings, csv, V}."""
+    """Drive at V (m/s), log as CSV with the base's pose, identify: {g, tau, dead_time, slip_lag (value, low, high; the
+    slide's, None when not measured), r2, warnings, csv, V}."""
     from pfm_stability.analysis.identification import identify
     from pfm_stability.engines.mujoco import EngineOptions, drive_log, write_csv_log
     from pfm_stability.io.logs import read_log
@@ -60,11 +61,12 @@ def identify_robot(name: str, out_dir: str, options: dict | None = None, V: floa
     suffix = "" if not options else "_" + "_".join(f"{k}{v}" for k, v in sorted(options.items()))
     path = os.path.join(out_dir, f"{name}{suffix}_V{V:.2f}_identify.csv")
     write_csv_log(log, path)
-    result = identify(read_log(path, need=("command", "imu")), "imu")
+    result = identify(read_log(path, need=("command", "imu"), optional=("pose",)), "imu")
     if not result.identified:
         raise RuntimeError(f"{name}: nothing identified: {result.reason}")
     p = result.plant
     return {"g": p.g.to_dict(), "tau": p.tau.to_dict(), "dead_time": p.dead_time.to_dict(), "r2": p.quality.r2,
+            "slip_lag": None if result.slip is None else result.slip.slip_lag.to_dict(),
             "warnings": [w.kind for w in p.warnings], "csv": os.path.basename(path), "T": result.controller.T, "V": V}
 
 
@@ -82,12 +84,14 @@ def identify_at_boundary(name: str, L: float, T: float, out_dir: str, options: d
     return plant
 
 
-def predicted_pair(name: str, plant: dict, T: float):
-    """The predictions' robot (the identified τ, plant gain g and dead time D; the controller's k) and controller."""
+def predicted_pair(name: str, plant: dict, T: float, slide: bool = True):
+    """The predictions' robot (the identified τ, plant gain g, dead time D and, with `slide`, the slide's τ_s; the
+    controller's k) and controller. The package's simulator takes no slide (its robot goes where it points)."""
     from pfm_stability.parameters import Controller, Robot
 
+    slip = plant.get("slip_lag")
     robot = Robot(V=1.0, tau=plant["tau"]["value"], k=K, W=ROBOTS[name], plant_gain=plant["g"]["value"],
-                  dead_time=max(plant["dead_time"]["value"], 0.0))
+                  dead_time=max(plant["dead_time"]["value"], 0.0), slip_lag=max(slip["value"], 0.0) if slip and slide else 0.0)
     return robot, Controller(f=F, n=N, T=T, hold="command", compute_delay=1)
 
 
@@ -100,7 +104,7 @@ def bisect_case(name: str, plant: dict | None, L: float, T: float, duration: flo
 
     if plant is None:
         plant = identify_at_boundary(name, L, T, out_dir, {k: v for k, v in (engine or {}).items() if k == "caster_friction"})
-    robot, controller = predicted_pair(name, plant, T)
+    robot, controller = predicted_pair(name, plant, T, slide=not simulator)
     runner = None if simulator else MujocoRuns.factory(EngineOptions(robot_model=name, **(engine or {})))
     started = time.perf_counter()
     v = validate_boundary("corridor", "V", robot=robot, controller=controller, env="grid", L=L, duration=duration, runner=runner, **BISECTION)

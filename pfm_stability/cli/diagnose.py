@@ -167,7 +167,7 @@ def parameters_table(result, sources: dict) -> dict:
 
     r, c = result.robot, result.controller
     values = {"V": r.V, "tau": r.tau, "dead_time": r.dead_time, "plant_gain": r.plant_gain, "actuator_lag": r.actuator_lag,
-              "yaw_accel_limit": r.yaw_accel_limit, "k": r.k, "W": r.W, "T": c.T, "f": c.f, "n": c.n, "hold": c.hold,
+              "yaw_accel_limit": r.yaw_accel_limit, "slip_lag": r.slip_lag, "k": r.k, "W": r.W, "T": c.T, "f": c.f, "n": c.n, "hold": c.hold,
               "compute_delay": c.compute_delay}
     from ..io.serialize import json_number
 
