@@ -213,6 +213,9 @@ def test_the_command_prints_and_writes_the_slide(drives, tmp_path):
     config = yaml.safe_load(out.read_text())
     assert config["robot"]["slip_lag"] == pytest.approx(slip["slip_lag"]["value"], rel=1e-5)  # written to 6 digits
     assert "slip_lag:" in out.read_text() and "the base's slide" in out.read_text()
+    from pfm_stability.io.config import load_config
+
+    assert load_config(out).robot.slip_lag == pytest.approx(slip["slip_lag"]["value"], rel=1e-5)  # report --config reads it
     code, text, _ = run(["identify", str(with_pose)])
     assert code == 0 and "τ_s (slip lag)" in text and "from the pose x,y,yaw" in text
     code, md, _ = run(["identify", str(with_pose), "--format", "markdown"])

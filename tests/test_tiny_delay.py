@@ -85,6 +85,27 @@ def test_report_at_a_tiny_delay_is_the_continuous_report(capsys):
         assert tiny == zero
 
 
+@pytest.mark.parametrize("D", TINY)
+@pytest.mark.parametrize("name", MODEL_NAMES)
+def test_a_tiny_dead_time_is_none_in_every_model(name, D):
+    """A dead time below 1e-12 s is stored as 0 (its Padé coefficients D^m would underflow: `report --door-obstacle posts
+    --dead-time 2.2e-309` overflowed in the companion matrix, which the fuzzer found): NV* equals the loop's without a
+    dead time (same floats), with warnings as errors."""
+    model = make_model(name, hold="command", compute_delay=1)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        tiny = model.boundary(Loop(0.3, 0.065, 2.0, plant_gain=0.8, dead_time=D))
+        zero = model.boundary(Loop(0.3, 0.065, 2.0, plant_gain=0.8))
+    assert Loop(0.3, 0.065, 2.0, dead_time=D).dead_time == 0.0 and tiny.NV_critical == zero.NV_critical
+
+
+def test_the_report_the_fuzzer_found_with_a_tiny_dead_time(capsys):
+    """`report --door-obstacle posts --dead-time 2.2e-309 --L 1.0` answers (exit 0), with warnings as errors."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert main(["report", "--door-obstacle", "posts", "--dead-time", "2.225073858507203e-309", "--L", "1.0"]) == 0, capsys.readouterr().err
+
+
 @pytest.mark.parametrize("T", TINY)
 def test_holonomic_loop_stores_a_tiny_delay_as_zero(T):
     """HolonomicLoop(T, c_h) follows `Loop`: T < 1e-12 s is a continuous controller (T = 0), the resolution itself is kept."""

@@ -64,6 +64,7 @@ class Loop(Characteristic):
         τω̇ + ω = g·u(t − D) (docs/models.md, "Plant gain and dead time"): the loop's
         steering gain is g·k (`steering_gain`; `k` stays the controller's, k* is in it).
         D delays the whole command k(δ − θ): the heading term by D, the field's by T + D.
+        D < 10⁻¹² s is stored as 0 (`T_RESOLUTION`, as T).
     actuator_lag : float, keyword only
         τ_a, s, in [0, 10] (default 0): a second lag of the drive, the plant
         g·e^(−sD)/((τs + 1)(τ_a·s + 1)); τ_a with τ_a·g·k < 10⁻⁹ is 0. The two lags are
@@ -106,6 +107,8 @@ class Loop(Characteristic):
             object.__setattr__(self, "actuator_lag", 0.0)
         if self.T < T_RESOLUTION:  # faster than a picosecond: a continuous controller
             object.__setattr__(self, "T", 0.0)
+        if self.dead_time < T_RESOLUTION:  # a picosecond of dead time is none (its Padé coefficients D^m would underflow)
+            object.__setattr__(self, "dead_time", 0.0)
         if self.c.__class__ is not float or self.c != 0.0:
             object.__setattr__(self, "c", check_heading_gain(self.c))
 
