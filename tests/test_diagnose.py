@@ -272,6 +272,8 @@ def test_dead_time_and_plant_gain_are_measured_through_and_identified(tmp_path):
     p = data["parameters"]
     assert p["dead_time"]["value"] == pytest.approx(0.07, abs=0.02) and p["dead_time"]["source"].startswith("identified from")
     assert p["plant_gain"]["value"] == pytest.approx(0.85, rel=0.05) and p["plant_gain"]["source"].startswith("identified from")
+    # the simulator's robot goes where it points: its pose shows no slide, and the prediction takes none
+    assert p["slip_lag"]["value"] == 0.0 and p["slip_lag"]["source"].startswith("none: ")
 
 
 @pytest.mark.slow

@@ -290,3 +290,25 @@ def test_robot_bs_second_lag_predicts_its_boundary():
     V = predicted_boundaries("corridor", "V", robot, controller, scenario_law("grid", robot, controller), 0.9,
                              validation_models(controller))["sampled"]
     assert V == pytest.approx(0.796, rel=0.03)
+
+
+def test_diagnose_measures_robot_cs_slide_from_its_pose(corridor_c, tmp_path):
+    """`diagnose` without τ and T identifies the plant from the bag and the base's slide from its /odom pose (MuJoCo's
+    state, which sees the base move): τ_s within 1 ms of the 9.53 ms robot C's drive gives (docs/diagnose.md, "The
+    slide"; a 10-s run at 0.6 m/s turns less than the drive, hence the looser tolerance), and the prediction uses it."""
+    import json
+
+    from cli_helpers import run as run_cli
+    from log_helpers import Plant, Recording, SyntheticLog, write_ros2
+
+    log = corridor_c
+    synthetic = SyntheticLog(Plant(), Recording(T=1 / 11, scan_rate=10.0), log.cmd_t, log.cmd_wz, log.cmd_vx, log.odom_t,
+                             log.odom_wz, scan_t=log.scan_t, odom_x=log.odom_x, odom_y=log.odom_y, odom_yaw=log.odom_yaw,
+                             odom_vx=log.odom_vx, scan_ranges=log.scan_ranges)
+    bag = write_ros2(synthetic, tmp_path / "c", storage="mcap")
+    config = tmp_path / "robot.yaml"
+    config.write_text("robot: {k: 2.0, W: 0.5}\ncontroller: {f: 3.0, n: 2, hold: command, compute_delay: 1}\nlaw: grid\n")
+    code, out, err = run_cli(["diagnose", str(bag), "--config", str(config), "--format", "json"])
+    assert code == 0, err
+    slip = json.loads(out)["parameters"]["slip_lag"]
+    assert slip["value"] == pytest.approx(0.00953, abs=0.001) and slip["source"].startswith("identified from the pose of")

@@ -116,8 +116,9 @@ def run(args) -> int:
     topics = LogTopics(command=args.cmd_topic, odometry=args.odom_topic, scan=args.scan_topic)
     need = ("command", "odometry", "pose", "scan") if to_identify else ("pose", "scan")
     log = _read(args.log, topics, need, want_commands=not to_identify and math.isfinite(params.robot.yaw_accel_limit))
-    # the pose read here is the wheel odometry's, which cannot show a slide (docs/diagnose.md, "The slide"): not looked for
-    identification = identify(log, "odometry", slip=False) if to_identify else None
+    # the odometry's pose shows a slide when it sees the base move (a simulator's, a localised one); a wheel odometry's
+    # shows none, and its interval holds 0 (docs/diagnose.md, "The slide")
+    identification = identify(log, "odometry") if to_identify else None
     robot, controller, sources = complete_from_log(params.robot, params.controller, params.sources, identification)
     result = diagnose(log, robot, controller, law=_law(law, robot, controller))
     if result.judged is not None:

@@ -51,11 +51,12 @@ __all__ = ["Measured", "Predicted", "StretchDiagnosis", "Diagnosis", "diagnose",
 
 USER_PARAMETERS = ("k", "W", "f", "n")
 """What no log shows: the steering gain, the robot's width and KB's law (f, n): the user's (``--config`` or options)."""
-LOG_PARAMETERS = ("tau", "T", "dead_time", "plant_gain", "actuator_lag", "yaw_accel_limit")
+LOG_PARAMETERS = ("tau", "T", "dead_time", "plant_gain", "actuator_lag", "yaw_accel_limit", "slip_lag")
 """What the log shows (`analysis.identification`): the steering lag, the controller's period, the plant's dead time and
-gain, its second lag and the slew limit on its command (when the data support them), unless the user gives them. The
-log is identified when τ or T is missing (`needs_identification`); D, g, τ_a and the limit alone keep their defaults
-(0 s, 1, 0 s, none) rather than ask a log without commands for them."""
+gain, its second lag and the slew limit on its command (when the data support them), and its base's slide from the
+odometry's pose (when its interval excludes 0), unless the user gives them. The log is identified when τ or T is
+missing (`needs_identification`); D, g, τ_a, the limit and the slide alone keep their defaults (0 s, 1, 0 s, none,
+0 s) rather than ask a log without commands for them."""
 MATCH = 0.15
 """A model matches when its root is within this relative distance of the measured σ + jω (and its verdict agrees)."""
 MIN_AMPLITUDE = 0.005
@@ -395,7 +396,7 @@ def _drive_limits(robot: Robot, sources: dict, from_preset: set, identification)
 
 
 def complete_from_log(robot: Robot, controller: Controller, sources: dict, identification) -> tuple[Robot, Controller, dict]:
-    """τ, T, D, g, τ_a and the slew limit from the identification where the user did not give them (their source is a
+    """τ, T, D, g, τ_a, the slew limit and the slide from the identification where the user did not give them (their source is
     preset); the new sources.
 
     Parameters
@@ -416,6 +417,7 @@ def complete_from_log(robot: Robot, controller: Controller, sources: dict, ident
     from_preset = {name for name in LOG_PARAMETERS if _from_preset(sources, name)}
     if not from_preset or identification is None:
         return robot, controller, sources
+    robot, sources = _slide(robot, sources, from_preset, identification)  # from the pose: whatever the plant's fit
     if "T" in from_preset:
         controller = controller.replace(T=identification.controller.T)
         sources["T"] = f"identified from {identification.log.path} (median period of {identification.log.command_topic})"
@@ -449,6 +451,25 @@ def complete_from_log(robot: Robot, controller: Controller, sources: dict, ident
                              f"{math.degrees(x.phase):.0f}° there, which the log determines")
     robot, sources = _drive_limits(robot, sources, from_preset, identification)
     return robot, controller, sources
+
+
+def _slide(robot: Robot, sources: dict, from_preset: set, identification) -> tuple[Robot, dict]:
+    """τ_s from the log's pose where the user gave none (docs/diagnose.md, "The slide"): taken when its 95 % interval
+    excludes 0 (a slide the pose shows); else none. A wheel odometry's pose shows none — or half its period, if it
+    integrates its heading by Euler's rule — which robot.slip_lag in --config overrides."""
+    if "slip_lag" not in from_preset or not identification.has_pose:
+        return robot, sources
+    where, fit = identification.log.path, identification.slip
+    if fit is None:
+        sources["slip_lag"] = f"none: not measured from the pose of {where} ({identification.slip_reason})"
+    elif fit.slip_lag.low <= 0.0:
+        sources["slip_lag"] = (f"none: the pose of {where} shows no slide ({fit.slip_lag.low:.3g} to {fit.slip_lag.high:.3g} s "
+                               "holds 0)")
+    else:
+        robot = robot.replace(slip_lag=fit.slip_lag.value)
+        sources["slip_lag"] = (f"identified from the pose of {where} ({fit.slip_lag.low:.4g} to {fit.slip_lag.high:.4g} s; "
+                               "a wheel odometry integrated by Euler's rule shows half its period: give robot.slip_lag if so)")
+    return robot, sources
 
 
 # ------------------------------------------------------------------------------------------ judging
