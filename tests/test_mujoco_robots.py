@@ -201,6 +201,16 @@ def test_the_skid_steer_turns_linearly_by_skidding():
     assert side[1] > 10 * side[0] > 0
 
 
+def _bag(log, path):
+    """Robot C's corridor log written as an MCAP bag (its commands, odometry with MuJoCo's pose, scans)."""
+    from log_helpers import Plant, Recording, SyntheticLog, write_ros2
+
+    synthetic = SyntheticLog(Plant(), Recording(T=1 / 11, scan_rate=10.0), log.cmd_t, log.cmd_wz, log.cmd_vx, log.odom_t,
+                             log.odom_wz, scan_t=log.scan_t, odom_x=log.odom_x, odom_y=log.odom_y, odom_yaw=log.odom_yaw,
+                             odom_vx=log.odom_vx, scan_ranges=log.scan_ranges)
+    return write_ros2(synthetic, path, storage="mcap")
+
+
 @pytest.fixture(scope="module")
 def corridor_c():
     robot = Robot(V=0.6, tau=0.1, k=2.0, W=0.5)
@@ -237,13 +247,8 @@ def test_diagnose_sets_the_slew_limit_against_the_commands(corridor_c, tmp_path)
     import json
 
     from cli_helpers import VALIDATOR, run as run_cli
-    from log_helpers import Plant, Recording, SyntheticLog, write_ros2
-
     log = corridor_c
-    synthetic = SyntheticLog(Plant(), Recording(T=1 / 11, scan_rate=10.0), log.cmd_t, log.cmd_wz, log.cmd_vx, log.odom_t,
-                             log.odom_wz, scan_t=log.scan_t, odom_x=log.odom_x, odom_y=log.odom_y, odom_yaw=log.odom_yaw,
-                             odom_vx=log.odom_vx, scan_ranges=log.scan_ranges)
-    bag = write_ros2(synthetic, tmp_path / "c", storage="mcap")
+    bag = _bag(log, tmp_path / "c")
     config = tmp_path / "robot.yaml"
     config.write_text("robot: {k: 2.0, W: 0.5, tau: 0.13, plant_gain: 0.3, yaw_accel_limit: 2.0}\n"
                       "controller: {T: 0.0909, f: 3.0, n: 2, hold: command, compute_delay: 1}\nlaw: grid\n")
@@ -299,13 +304,8 @@ def test_diagnose_measures_robot_cs_slide_from_its_pose(corridor_c, tmp_path):
     import json
 
     from cli_helpers import run as run_cli
-    from log_helpers import Plant, Recording, SyntheticLog, write_ros2
-
     log = corridor_c
-    synthetic = SyntheticLog(Plant(), Recording(T=1 / 11, scan_rate=10.0), log.cmd_t, log.cmd_wz, log.cmd_vx, log.odom_t,
-                             log.odom_wz, scan_t=log.scan_t, odom_x=log.odom_x, odom_y=log.odom_y, odom_yaw=log.odom_yaw,
-                             odom_vx=log.odom_vx, scan_ranges=log.scan_ranges)
-    bag = write_ros2(synthetic, tmp_path / "c", storage="mcap")
+    bag = _bag(log, tmp_path / "c")
     config = tmp_path / "robot.yaml"
     config.write_text("robot: {k: 2.0, W: 0.5}\ncontroller: {f: 3.0, n: 2, hold: command, compute_delay: 1}\nlaw: grid\n")
     code, out, err = run_cli(["diagnose", str(bag), "--config", str(config), "--format", "json"])
