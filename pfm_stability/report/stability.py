@@ -41,7 +41,7 @@ from ..laws.force_law import ForceLaw, PowerLaw, law_in_force
 from ..models import HEADING_GAIN_RANGE, STEERING, KBFirstOrder, Loop, LoopFamily, Sampled, make_models, models_for
 from ..models.family import root_json
 from ..laws.registry import FAMILY_CHOICE_DEFAULTS, FAMILY_DEFAULTS, FORCE_LAWS, HOLONOMIC_LAWS, LAW_PARAMETERS, parameter_keys
-from ..parameters import MODEL_NAMES, RANGES, ROBOT_FAMILIES, Controller, Corridor, Robot, Wall, check_parameter
+from ..parameters import KB_PLANT, MODEL_NAMES, RANGES, ROBOT_FAMILIES, Controller, Corridor, Robot, Wall, check_parameter
 from .remedy import change as _change
 
 __all__ = ["StabilityReport", "KBError", "LawDescription", "build_report", "remedies", "kb_error", "kb_errors", "KINEMATIC_TAU_SOURCE",
@@ -655,9 +655,9 @@ def _family_law_report(robot, controller, family, law, alpha, alpha_deg, L, mode
 
 
 def plant_inputs(robot: Robot, sources: dict | None) -> dict:
-    """{name: value} of the steering plant's D and g that the report lists (`PLANT_INPUTS`).
+    """{name: value} of the steering plant's D, g, τ_a and τ_s that the report lists (`PLANT_INPUTS`).
 
-    Each is listed when it differs from KB's robot (D = 0, g = 1) or when it was
+    Each is listed when it differs from KB's robot (`parameters.KB_PLANT`: D = 0, g = 1, τ_a = τ_s = 0) or when it was
     typed (source ``user``: `cli.options.resolve_parameters`), so every report
     that does not give them — a file that states KB's values included — keeps
     its inputs (and its JSON keys) as before.
@@ -670,11 +670,10 @@ def plant_inputs(robot: Robot, sources: dict | None) -> dict:
         Parameter name → provenance (`build_report`'s ``sources``).
     """
     sources = sources or {}
-    defaults = {"dead_time": 0.0, "plant_gain": 1.0, "actuator_lag": 0.0, "slip_lag": 0.0}
     shown = {}
     for name in PLANT_INPUTS:
         value, source = getattr(robot, name), sources.get(name)
-        if value != defaults[name] or source == "user":
+        if value != KB_PLANT[name] or source == "user":
             shown[name] = value
     return shown
 
