@@ -31,7 +31,7 @@ from .criteria import loop_of
 from ..laws.force_law import ForceLaw, PowerLaw, corridor_gain, wall_gain_arrays
 from ..models import ExactDelay, LoopModel, models_for
 from ..models.verdicts import in_stable_set
-from ..parameters import Controller, Robot, check_parameter
+from ..parameters import Controller, Robot, check_parameter, plant_not_kb
 from ..io.serialize import json_array, json_number
 from ..vectorized import delay_verdicts_from_gain, exact_delay_verdicts, loop_gain_arrays
 
@@ -153,7 +153,7 @@ def _delay_loop(robot: Robot, controller: Controller) -> tuple:
 def _array_delay_route(model: LoopModel, robot: Robot) -> bool:
     """Whether `exact_delay`'s verdicts come from the vectorized crossing count: its one-delay loop, KB's plant or only a
     plant gain (g·k); a dead time, a second lag or a slide makes the general loop, decided by the model's stable set."""
-    return isinstance(model, ExactDelay) and robot.dead_time == 0.0 and robot.actuator_lag == 0.0 and robot.slip_lag == 0.0
+    return isinstance(model, ExactDelay) and set(plant_not_kb(robot)) <= {"plant_gain"}
 
 
 def _general_verdicts(robot: Robot, controller: Controller, NV):
