@@ -660,6 +660,33 @@ def _column_force(law, h):
     return float(law.ratio * law.W**law.n * law.cv * np.sum(dx / (dx * dx + dy * dy) ** ((law.n + 1) / 2)))
 
 
+@SHARED_CORRIDORS
+def test_a_direction_never_driven_is_never_the_worse_one(root):
+    """A path taken is driven one way: its reverse direction is stopped at every sample (N_reverse nan), so each
+    sample's window growth is the forward direction's and every stretch's direction is forward. Along the middle of
+    the 1.2 m corridor's axis (uniform N, no end in the window) the window's growth equals the sampled loop's own
+    growth rate log ρ(Φ(k·N·V))/T (`models.sampled.closed_loop_matrix`'s eigenvalues, an independent route from the
+    window's renormalized product): to 1e-9 1/s (measured 5e-14: round-off over the window's 128 steps), at a speed
+    far inside the boundary and one near it. (A window with no step once counted as 0 e-folds, "no growth", and
+    won over the decaying forward direction: growth 0, N 0, V* = V, and the relay judged with the force of a
+    direction never driven — a bookstore drive's weave missed.)"""
+    from pfm_stability.maps.analysis import judge_routes
+    from pfm_stability.maps.reading.routes import path_of
+
+    for V in (0.5, 0.9):
+        analysis = corridor_analysis(0.6, V, root)
+        pv = judge_routes(analysis, [path_of([[0.65, 6.0], [0.65, 14.0]], 0, "drive")], taken=True)
+        assert np.isnan(pv.N_reverse).all()
+        assert pv.stretches and all(s.direction == "forward" for s in pv.stretches if s.verdict in ("stable", "unstable"))
+        middle = (pv.samples.y > 8.0) & (pv.samples.y < 12.0)
+        loop = Loop.of(ROBOT.replace(V=V), CONTROLLER)
+        own = [np.log(np.abs(np.linalg.eigvals(closed_loop_matrix(loop, ROBOT.k * N * V, CONTROLLER.hold,
+                                                                     CONTROLLER.compute_delay))).max()) / CONTROLLER.T
+               for N in pv.N_forward[middle]]
+        assert middle.sum() > 20 and np.allclose(pv.window_growth[middle], own, rtol=0, atol=1e-9)
+        assert (pv.window_growth[middle] < 0).all()
+
+
 def test_a_path_taken_is_linearized_at_itself_away_from_the_equilibrium(root):
     """`judge_routes(..., taken=True)` (a path the robot drove, held there by its goal): along the 1.2 m corridor
     (axis x = 0.65 m, equilibrium on it by symmetry), a path 0.3 m off the axis — farther than W/2 = 0.2 m (ROBOT) —

@@ -627,7 +627,7 @@ def _window_products(Ns: tuple, route: np.ndarray, arc: np.ndarray, half: float,
     duration = valid.sum(axis=1) * transition.T
     with np.errstate(invalid="ignore", divide="ignore"):
         rate = np.where(duration > 0, log_rho / np.where(duration > 0, duration, 1.0), np.nan)
-    rate = np.where(np.abs(log_rho) < ROUND_OFF_EFOLDS, 0.0, rate)
+    rate = np.where((duration > 0) & (np.abs(log_rho) < ROUND_OFF_EFOLDS), 0.0, rate)  # a window with no step stays nan
     first = 0
     for k, idx in where:
         rates[k][idx], seconds[k][idx] = rate[first:first + idx.size], duration[first:first + idx.size]
