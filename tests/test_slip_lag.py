@@ -201,3 +201,23 @@ def test_report_prints_the_equation_with_the_slide_and_refuses_a_bad_one():
     assert data["inputs"]["slip_lag"]["value"] == 0.02
     code, out, err = run_cli(["report", "--preset", "carmel", "--L", "0.9", "--slip-lag", "-1"])
     assert code == 2 and len(err.strip().splitlines()) == 1 and "-1" in err and "slip" in err
+
+
+def test_a_path_tracking_report_lists_the_slide_its_loop_closes_through():
+    """`report --controller rpp --slip-lag` lists τ_s among the plant's inputs (`report.path.PLANT`), its JSON validates,
+    and the slide reaches RPP's loop: each model's NV* with a 0.1-s slide is below NV* without it (a lag in the loop
+    lowers its boundary; `analysis.path_tracking` builds the loop with the robot's slip_lag)."""
+    import json
+
+    from cli_helpers import VALIDATOR, run as run_cli
+
+    answers = {}
+    for slide in ("0", "0.1"):
+        code, out, err = run_cli(["report", "--controller", "rpp", "--L", "1.0", "--slip-lag", slide, "--format", "json"])
+        assert code == 0, err
+        data = json.loads(out)
+        assert [e.message for e in VALIDATOR.iter_errors(data)] == []
+        assert data["inputs"]["slip_lag"]["value"] == float(slide)
+        answers[slide] = data["path"]
+    for model in ("sampled", "exact_delay", "continuous"):
+        assert answers["0.1"][model]["NV_critical"] < answers["0"][model]["NV_critical"], model

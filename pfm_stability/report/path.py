@@ -21,7 +21,7 @@ from .remedy import change
 
 __all__ = ["path_report", "path_remedies", "path_inputs", "path_json"]
 
-PLANT = ("tau", "dead_time", "plant_gain", "actuator_lag")
+PLANT = ("tau", "dead_time", "plant_gain", "actuator_lag", "slip_lag")
 """The robot's plant the loop closes through (`parameters.Robot`), listed for every path-tracking report."""
 
 
