@@ -93,16 +93,17 @@ from ..reading.routes import polyline_arcs
 from .stretch_speed import stretch_speeds
 from .verdicts import END_FRACTION, GrowthRate, effective_gain
 
-__all__ = ["PathStretch", "PathVerdicts", "analyze_paths", "routes_json"]
+__all__ = ["PathStretch", "PathVerdicts", "RouteStretch", "analyze_paths", "routes_json", "verdict_lengths"]
 
 @dataclass(frozen=True)
-class PathStretch:
-    """A run of one verdict along one route.
+class RouteStretch:
+    """A run of one verdict along one route: what a VFF stretch (`PathStretch`) and a Nav2 controller's
+    (`tracking.TrackingStretch`) share.
 
     Attributes
     ----------
     route : int
-        Index of the route in `PathVerdicts.paths`.
+        Index of the route in its result's ``paths``.
     start, stop : float
         Arc positions along the route, m.
     x0, y0, x1, y1 : float
@@ -110,7 +111,45 @@ class PathStretch:
     length : float
         m.
     verdict : str
-        "stable", "unstable", or a reason of `UNJUDGED`.
+        "stable", "unstable", or why it is not decided.
+    cause : str or None
+        Why it is unstable; None when stable.
+    """
+
+    NUMBERS = ()
+    """The fields that may be infinite, written "inf" in JSON (`to_dict`)."""
+
+    route: int
+    start: float
+    stop: float
+    x0: float
+    y0: float
+    x1: float
+    y1: float
+    length: float
+    verdict: str
+    cause: str | None = None
+
+    @property
+    def decided(self) -> bool:
+        """True for "stable" and "unstable"."""
+        return self.verdict in ("stable", "unstable")
+
+    def to_dict(self) -> dict:
+        """JSON-ready ("inf" for infinite values)."""
+        out = dict(self.__dict__)
+        for key in self.NUMBERS:
+            out[key] = json_number(out[key]) if out[key] is not None else None
+        return out
+
+
+@dataclass(frozen=True)
+class PathStretch(RouteStretch):
+    """A run of one verdict along one route (`RouteStretch`; ``verdict`` "stable", "unstable", or a reason of
+    `UNJUDGED`).
+
+    Attributes
+    ----------
     cause : str or None
         Why it is unstable (`CAUSES`): "growth" (the linear loop), "forced weave" (the field's ripple drives a weave),
         "relay" (the window's edge), "collision course" (the driven loop meets an obstacle without a weave first);
@@ -140,16 +179,8 @@ class PathStretch:
         is larger).
     """
 
-    route: int
-    start: float
-    stop: float
-    x0: float
-    y0: float
-    x1: float
-    y1: float
-    length: float
-    verdict: str
-    cause: str | None = None
+    NUMBERS = ("growth_rate", "efolds", "N", "margin", "V_critical")
+
     growth_rate: float | None = None
     efolds: float | None = None
     N: float | None = None
@@ -159,18 +190,6 @@ class PathStretch:
     linearized_at_route: float = 0.0
     oscillates: bool = False
     amplitude: float = 0.0
-
-    @property
-    def decided(self) -> bool:
-        """True for "stable" and "unstable"."""
-        return self.verdict in ("stable", "unstable")
-
-    def to_dict(self) -> dict:
-        """JSON-ready ("inf" for infinite values)."""
-        out = dict(self.__dict__)
-        for key in ("growth_rate", "efolds", "N", "margin", "V_critical"):
-            out[key] = json_number(out[key]) if out[key] is not None else None
-        return out
 
 
 @dataclass(frozen=True)
@@ -254,17 +273,10 @@ class PathVerdicts:
         """``route_length_m``, ``decided_length_m``, ``decided_fraction``, ``unstable_length_m``, ``stable_length_m``,
         ``linearized_at_route_length_m``, ``unstable_length_by_cause_m`` (`CAUSES`), ``unjudged_length_m`` per reason,
         ``window_m``, ``V_critical_min`` (the smallest V* of a decided stretch, m/s)."""
-        total = float(self.spacing.sum())
-        decided = self.length_of("stable") + self.length_of("unstable")
         values = [s.V_critical for s in self.stretches if s.verdict == "unstable" and s.V_critical is not None]
         values += [s.V_critical for s in self.stretches if s.verdict == "stable" and s.V_critical is not None]
         return {
-            "routes": len(self.paths),
-            "route_length_m": total,
-            "decided_length_m": decided,
-            "decided_fraction": decided / total if total > 0 else None,
-            "unstable_length_m": self.length_of("unstable"),
-            "stable_length_m": self.length_of("stable"),
+            **verdict_lengths(len(self.paths), float(self.spacing.sum()), self.length_of),
             "linearized_at_route_length_m": float(self.spacing[~np.isfinite(self.samples.offset)].sum()),
             "unstable_length_by_cause_m": {c: float(self.spacing[self.cause == k].sum()) if self.cause is not None else 0.0
                                            for k, c in enumerate(CAUSES)},
@@ -280,6 +292,26 @@ class PathVerdicts:
             "stretches": [s.to_dict() for s in self.stretches],
             "summary": self.summary(),
         }
+
+
+def verdict_lengths(routes: int, total: float, length_of) -> dict:
+    """The lengths a map's result set summarises (`PathVerdicts.summary`, `tracking.TrackingVerdicts.summary`):
+    ``routes``, ``route_length_m``, ``decided_length_m``, ``decided_fraction`` (None without route),
+    ``unstable_length_m``, ``stable_length_m``.
+
+    Parameters
+    ----------
+    routes : int
+        How many routes.
+    total : float
+        Their length, m.
+    length_of : callable
+        ``length_of(verdict)``: the route length with that verdict, m.
+    """
+    stable, unstable = length_of("stable"), length_of("unstable")
+    return {"routes": routes, "route_length_m": total, "decided_length_m": stable + unstable,
+            "decided_fraction": (stable + unstable) / total if total > 0 else None,
+            "unstable_length_m": unstable, "stable_length_m": stable}
 
 
 def routes_json(paths) -> list:

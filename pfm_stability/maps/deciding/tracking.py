@@ -41,7 +41,7 @@ from ...io.serialize import json_number
 from ...models import models_for
 from .decide import path_samples
 from ..reading.field import histogram_of
-from .paths import routes_json
+from .paths import RouteStretch, routes_json, verdict_lengths
 from ..reading.routes import find_paths, find_routes, polyline_arcs
 
 __all__ = ["CURVATURE_STEP", "LOOKAHEAD_STEP", "MAP_CONTROLLERS", "TRACKING_VERDICTS", "MapTracking", "TrackingStretch", "TrackingVerdicts",
@@ -119,23 +119,12 @@ def route_corridors(grid, paths, clearance: np.ndarray, lookahead: float, spacin
 
 
 @dataclass(frozen=True)
-class TrackingStretch:
-    """A run of one verdict of the controller along one route.
+class TrackingStretch(RouteStretch):
+    """A run of one verdict of the controller along one route (`paths.RouteStretch`; ``verdict`` one of
+    `TRACKING_VERDICTS`, ``cause`` "growth" (the linear loop) where unstable, else None).
 
     Attributes
     ----------
-    route : int
-        Index of the route in `TrackingVerdicts.paths`.
-    start, stop : float
-        Arc positions along the route, m.
-    x0, y0, x1, y1 : float
-        The end points on the route, m.
-    length : float
-        m.
-    verdict : str
-        One of `TRACKING_VERDICTS`.
-    cause : str or None
-        "growth" (the linear loop) where unstable, else None.
     margin : float or None
         ρ*/ρ − 1 of the worst sample (the smallest), as ``report --controller rpp`` computes it.
     V_critical : float or None
@@ -157,16 +146,8 @@ class TrackingStretch:
         value the ZoneParameterFilter sets here; None otherwise.
     """
 
-    route: int
-    start: float
-    stop: float
-    x0: float
-    y0: float
-    x1: float
-    y1: float
-    length: float
-    verdict: str
-    cause: str | None = None
+    NUMBERS = ("margin", "V_critical", "lookahead_critical")
+
     margin: float | None = None
     V_critical: float | None = None
     lookahead_critical: float | None = None
@@ -176,13 +157,6 @@ class TrackingStretch:
     pose_cost: int | None = None
     curvature: float | None = None
     zone_lookahead: float | None = None
-
-    def to_dict(self) -> dict:
-        """JSON-ready ("inf" for infinite values)."""
-        out = dict(self.__dict__)
-        for key in ("margin", "V_critical", "lookahead_critical"):
-            out[key] = json_number(out[key]) if out[key] is not None else None
-        return out
 
 
 @dataclass(frozen=True)
@@ -225,16 +199,9 @@ class TrackingVerdicts:
     def summary(self) -> dict:
         """``routes``, ``route_length_m``, ``decided_fraction``, lengths by verdict (m), ``stretches`` by verdict,
         ``V_critical_min``, ``lookahead_zones`` (unstable stretches a lookahead zone fixes), ``decisions``."""
-        total = float(self.corridors.ds.sum())
-        decided = self.length_of("stable") + self.length_of("unstable")
         values = [s.V_critical for s in self.stretches if s.V_critical is not None]
         return {
-            "routes": len(self.paths),
-            "route_length_m": total,
-            "decided_length_m": decided,
-            "decided_fraction": decided / total if total > 0 else None,
-            "unstable_length_m": self.length_of("unstable"),
-            "stable_length_m": self.length_of("stable"),
+            **verdict_lengths(len(self.paths), float(self.corridors.ds.sum()), self.length_of),
             "unjudged_length_m": {"no room": self.length_of("no room")},
             "stretches": {v: sum(s.verdict == v for s in self.stretches) for v in TRACKING_VERDICTS},
             "V_critical_min": json_number(min(values)) if values else None,
