@@ -101,14 +101,14 @@ def _NV_array(NV) -> np.ndarray:
     return NV + 0.0
 
 
-def _options(model, hold, compute_delay, pade_order, plant_gain=1.0, dead_time=0.0, actuator_lag=0.0, slip_lag=0.0):
-    """The checked model name and its options (the scalar models' messages)."""
+def _options(model, hold, compute_delay, pade_order, plant: dict):
+    """The checked model name and its options (the scalar models' messages); `plant` holds each of
+    `parameters.KB_PLANT`'s fields."""
     check_choice("model", model, MODEL_NAMES)
     hold = check_choice("hold", hold, HOLDS)
     compute_delay = check_integer("compute_delay", compute_delay, 0, 1)
     pade_order = check_integer("pade_order", pade_order, 1, 12)
-    plant = {name: check_parameter(name, value) for name, value in
-             (("plant_gain", plant_gain), ("dead_time", dead_time), ("actuator_lag", actuator_lag), ("slip_lag", slip_lag))}
+    plant = {name: check_parameter(name, plant[name]) for name in KB_PLANT}
     return model, {"hold": hold, "compute_delay": compute_delay, "pade_order": pade_order, "plant": plant}
 
 
@@ -216,7 +216,8 @@ def loop_verdicts(model, tau, T, k, NV, *, c=None, hold="command", compute_delay
         An unknown model or option, or the first out-of-range value
         (parameter, range, point index) — the scalar models' messages.
     """
-    name, options = _options(model, hold, compute_delay, pade_order, plant_gain, dead_time, actuator_lag, slip_lag)
+    name, options = _options(model, hold, compute_delay, pade_order,
+                             {"plant_gain": plant_gain, "dead_time": dead_time, "actuator_lag": actuator_lag, "slip_lag": slip_lag})
     check_choice("columns", columns, COLUMNS)
     points, shape = loop_arrays(tau, T, k, NV, c)
     if columns == "verdict" and name in _STABILITY and _kb_plant(options):
