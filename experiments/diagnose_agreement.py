@@ -19,6 +19,10 @@ V* against MuJoCo's. Writes ``DIR/diagnose_mujoco.json``, ``.md`` and ``.png``.
 
     python experiments/diagnose_agreement.py [--runs 40] [--seed 0] [--kind both|corridor|wall]
     python experiments/diagnose_agreement.py --mujoco --out-dir DIR [--robots A B C] [--quick]
+    python experiments/diagnose_agreement.py --command-path --out-dir DIR [--quick]
+
+``--command-path``: robot C's MuJoCo V* behind a smoother whose limit never binds, a 25-ms command delay, or neither
+(`run_command_path`; docs/mujoco.md, "The command path"). Writes ``DIR/command_path.json``.
 """
 
 from __future__ import annotations
@@ -284,6 +288,41 @@ def run_mujoco(out_dir, robots, quick: bool) -> int:
     return 0
 
 
+COMMAND_PATH_VARIANTS = ("smoother that never binds", "25-ms command delay", "neither")
+"""Robot C's command path three ways (``--command-path``): Nav2's 20-Hz smoother with a limit of 1e5 rad/s², which never
+binds (only its tick's wait acts), no smoother but a 25-ms command dead time (half the tick, the wait's mean), and
+neither (docs/mujoco.md, "The command path")."""
+
+
+def run_command_path(out_dir, quick: bool) -> int:
+    """Robot C's MuJoCo V* (L = 0.7 m, a 1-cm start, 30-s runs, a 1 % bracket; its controller's timing, its
+    identified τ 0.132 s and g 0.296 for the predictions beside it) with each of `COMMAND_PATH_VARIANTS`: a smoother
+    whose limit never binds is a wait. Writes ``DIR/command_path.json``."""
+    from pfm_stability.engines.command_path import VelocitySmoother
+    from pfm_stability.engines.mujoco import EngineOptions, MujocoRuns
+    from pfm_stability.io.files import write_text
+    from pfm_stability.parameters import Controller, Robot
+    from pfm_stability.validation import validate_boundary
+
+    name, T, _, options, _ = mujoco_robots()["C"]
+    engines = dict(zip(COMMAND_PATH_VARIANTS, (dict(smoother=VelocitySmoother(max_accel=1e5, max_decel=1e5)),
+                                               dict(command_delay=0.025), {})))
+    robot = Robot(V=1.0, tau=0.132, k=K, W=W, plant_gain=0.296)
+    controller = Controller(f=F, n=N, T=T, hold="command", compute_delay=1)
+    results = {}
+    for key, engine in engines.items():
+        v = validate_boundary("corridor", "V", robot=robot, controller=controller, env="grid", L=0.7, offset=0.01,
+                              duration=15.0 if quick else 30.0, rtol=0.03 if quick else 0.01, members=7,
+                              runner=MujocoRuns.factory(EngineOptions(robot_model=name, timing=options["timing"], **engine)))
+        results[key] = {"V_mujoco": v.simulated_boundary, "bracket": list(v.bracket), "runs": v.runs}
+        print(f"robot C, {key}: V* MuJoCo {v.simulated_boundary:.3f} m/s [{v.bracket[0]:.3f}, {v.bracket[1]:.3f}]", flush=True)
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    write_text(out / "command_path.json", json.dumps({"robot": "C", "model": name, "L": 0.7, "offset": 0.01, "T": T,
+                                                      "results": results}, indent=2), what="results")
+    return 0
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--runs", type=int, default=40)
@@ -293,7 +332,11 @@ def main(argv=None) -> int:
     parser.add_argument("--out-dir", default="out/diagnose_mujoco")
     parser.add_argument("--robots", nargs="+", choices=("A", "B", "C"), default=["A", "B", "C"])
     parser.add_argument("--quick", action="store_true", help="MuJoCo: one corridor per robot, 15-s runs, a 3 % bracket")
+    parser.add_argument("--command-path", action="store_true",
+                        help="MuJoCo: robot C behind a smoother that never binds, a 25-ms delay, or neither")
     args = parser.parse_args(argv)
+    if args.command_path:
+        return run_command_path(args.out_dir, args.quick)
     if args.mujoco:
         return run_mujoco(args.out_dir, args.robots, args.quick)
     rows = []
