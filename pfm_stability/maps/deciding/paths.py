@@ -145,11 +145,20 @@ class RouteStretch:
 
 @dataclass(frozen=True)
 class PathStretch(RouteStretch):
-    """A run of one verdict along one route (`RouteStretch`; ``verdict`` "stable", "unstable", or a reason of
-    `UNJUDGED`).
+    """A run of one verdict along one route (`RouteStretch`).
 
     Attributes
     ----------
+    route : int
+        Index of the route in `PathVerdicts.paths`.
+    start, stop : float
+        Arc positions along the route, m.
+    x0, y0, x1, y1 : float
+        The end points on the route, m.
+    length : float
+        m.
+    verdict : str
+        "stable", "unstable", or a reason of `UNJUDGED`.
     cause : str or None
         Why it is unstable (`CAUSES`): "growth" (the linear loop), "forced weave" (the field's ripple drives a weave),
         "relay" (the window's edge), "collision course" (the driven loop meets an obstacle without a weave first);

@@ -120,11 +120,22 @@ def route_corridors(grid, paths, clearance: np.ndarray, lookahead: float, spacin
 
 @dataclass(frozen=True)
 class TrackingStretch(RouteStretch):
-    """A run of one verdict of the controller along one route (`paths.RouteStretch`; ``verdict`` one of
-    `TRACKING_VERDICTS`, ``cause`` "growth" (the linear loop) where unstable, else None).
+    """A run of one verdict of the controller along one route (`paths.RouteStretch`).
 
     Attributes
     ----------
+    route : int
+        Index of the route in `TrackingVerdicts.paths`.
+    start, stop : float
+        Arc positions along the route, m.
+    x0, y0, x1, y1 : float
+        The end points on the route, m.
+    length : float
+        m.
+    verdict : str
+        One of `TRACKING_VERDICTS`.
+    cause : str or None
+        "growth" (the linear loop) where unstable, else None.
     margin : float or None
         ρ*/ρ − 1 of the worst sample (the smallest), as ``report --controller rpp`` computes it.
     V_critical : float or None
