@@ -43,7 +43,8 @@ Scheduling under ``pytest -n N`` (``--dist loadgroup`` in pyproject.toml):
 * tests that share an expensive module fixture carry ``pytest.mark.xdist_group(name)``: a group runs
   on one worker, so its fixture is computed once per suite rather than once per worker that happens
   to get one of its tests (the experiments in quick mode, the verdict sweep, the grid validations,
-  the random trap scenes). xdist hands out the groups first, largest first;
+  the random trap scenes, the symbolic derivation's sympy steps). xdist hands out the groups first,
+  largest (most tests) first;
 * then the tests marked ``slow`` (each a few seconds or more; the notebooks of ``analyses/`` are
   marked here), so that no long test starts last while the other worker idles;
 * then the rest in collection order.

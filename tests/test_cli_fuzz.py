@@ -337,6 +337,8 @@ def _fuzz_test(command):
 
     test.__name__ = f"test_fuzz_{command}"
     test.__doc__ = f"Random `pfm-stability {command}` command lines: exit 0 or 2, one error line, strict JSON, files written ({examples} examples)."
+    if command == "derive":  # on the worker of tests/test_derivation.py: the derivation's sympy steps once (tests/conftest.py)
+        test = pytest.mark.xdist_group("derivation")(test)
     return pytest.mark.slow(test)  # seconds each: scheduled first (tests/conftest.py)
 
 
