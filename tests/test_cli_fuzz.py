@@ -61,7 +61,7 @@ PNG = b"\x89PNG\r\n\x1a\n"
 
 POSITIONAL_VALUES = {"traps": SHIPPED_SCENES}
 """Valid values of positionals that are not choices (a scene file or a shipped scene's name)."""
-SHARE = {"report": 2.0, "simulate": 1.0, "validate": 0.6, "plot": 0.2, "derive": 0.06, "traps": 0.15}
+SHARE = {"report": 2.0, "simulate": 1.0, "validate": 0.6, "plot": 0.14, "derive": 0.06, "traps": 0.15}
 """Examples per subcommand, as a fraction of the profile's ``max_examples`` (at least 4)."""
 
 CHEAP = {
