@@ -38,6 +38,13 @@ cell says which), so the suite checks that every cell still runs in a fraction o
 variable unset) a notebook draws its published figures as before; ``PFM_STABILITY_QUICK= pytest analyses`` runs
 them in full here.
 
+Bytecode: where ``PYTHONDONTWRITEBYTECODE`` is set (this development machine's environment sets it), every process
+compiles each module it imports from source and pytest rewrites the asserts of every test module again in each xdist
+worker, before the first test: 14 s of CPU per worker, 5-6 s with the bytecode kept (``pytest --collect-only``).
+The suite's processes write their bytecode (``sys.dont_write_bytecode = False``, set here before the package is
+imported; ``__pycache__/`` is ignored by git); the fresh processes they start keep the variable and read it.
+``PFM_STABILITY_TEST_BYTECODE=0`` leaves Python's setting alone. Numbers do not depend on it.
+
 Scheduling under ``pytest -n N`` (``--dist loadgroup`` in pyproject.toml):
 
 * tests that share an expensive module fixture carry ``pytest.mark.xdist_group(name)``: a group runs
@@ -51,7 +58,10 @@ Scheduling under ``pytest -n N`` (``--dist loadgroup`` in pyproject.toml):
 """
 
 import os
+import sys
 
+if os.environ.get("PFM_STABILITY_TEST_BYTECODE", "1") != "0":
+    sys.dont_write_bytecode = False  # the rewritten test modules and the package compiled once, not per process (docstring)
 for _variable in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_variable, "1")
 for _variable, _value in (("MALLOC_MMAP_THRESHOLD_", "33554432"), ("MALLOC_TRIM_THRESHOLD_", "1073741824")):
