@@ -38,19 +38,30 @@ cell says which), so the suite checks that every cell still runs in a fraction o
 variable unset) a notebook draws its published figures as before; ``PFM_STABILITY_QUICK= pytest analyses`` runs
 them in full here.
 
+Bytecode: where ``PYTHONDONTWRITEBYTECODE`` is set (this development machine's environment sets it), every process
+compiles each module it imports from source and pytest rewrites the asserts of every test module again in each xdist
+worker, before the first test: 14 s of CPU per worker, 5-6 s with the bytecode kept (``pytest --collect-only``).
+The suite's processes write their bytecode (``sys.dont_write_bytecode = False``, set here before the package is
+imported; ``__pycache__/`` is ignored by git); the fresh processes they start keep the variable and read it.
+``PFM_STABILITY_TEST_BYTECODE=0`` leaves Python's setting alone. Numbers do not depend on it.
+
 Scheduling under ``pytest -n N`` (``--dist loadgroup`` in pyproject.toml):
 
 * tests that share an expensive module fixture carry ``pytest.mark.xdist_group(name)``: a group runs
   on one worker, so its fixture is computed once per suite rather than once per worker that happens
   to get one of its tests (the experiments in quick mode, the verdict sweep, the grid validations,
-  the random trap scenes). xdist hands out the groups first, largest first;
+  the random trap scenes, the symbolic derivation's sympy steps). xdist hands out the groups first,
+  largest (most tests) first;
 * then the tests marked ``slow`` (each a few seconds or more; the notebooks of ``analyses/`` are
   marked here), so that no long test starts last while the other worker idles;
 * then the rest in collection order.
 """
 
 import os
+import sys
 
+if os.environ.get("PFM_STABILITY_TEST_BYTECODE", "1") != "0":
+    sys.dont_write_bytecode = False  # the rewritten test modules and the package compiled once, not per process (docstring)
 for _variable in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_variable, "1")
 for _variable, _value in (("MALLOC_MMAP_THRESHOLD_", "33554432"), ("MALLOC_TRIM_THRESHOLD_", "1073741824")):

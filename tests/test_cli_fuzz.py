@@ -61,7 +61,7 @@ PNG = b"\x89PNG\r\n\x1a\n"
 
 POSITIONAL_VALUES = {"traps": SHIPPED_SCENES}
 """Valid values of positionals that are not choices (a scene file or a shipped scene's name)."""
-SHARE = {"report": 2.0, "simulate": 1.0, "validate": 0.6, "plot": 0.2, "derive": 0.06, "traps": 0.15}
+SHARE = {"report": 2.0, "simulate": 1.0, "validate": 0.6, "plot": 0.14, "derive": 0.06, "traps": 0.15}
 """Examples per subcommand, as a fraction of the profile's ``max_examples`` (at least 4)."""
 
 CHEAP = {
@@ -337,6 +337,8 @@ def _fuzz_test(command):
 
     test.__name__ = f"test_fuzz_{command}"
     test.__doc__ = f"Random `pfm-stability {command}` command lines: exit 0 or 2, one error line, strict JSON, files written ({examples} examples)."
+    if command == "derive":  # on the worker of tests/test_derivation.py: the derivation's sympy steps once (tests/conftest.py)
+        test = pytest.mark.xdist_group("derivation")(test)
     return pytest.mark.slow(test)  # seconds each: scheduled first (tests/conftest.py)
 
 

@@ -35,6 +35,8 @@ from pfm_stability.laws.force_law import ForceLaw, PowerLaw, corridor_gain, wall
 from pfm_stability.models import Continuous, KBFirstOrder, Loop
 from pfm_stability.parameters import CARMEL
 
+pytestmark = pytest.mark.xdist_group("derivation")  # the derivation's sympy steps once per suite (tests/conftest.py)
+
 POINTS = 50
 RTOL = 1e-10
 SEED = 19910409  # KB was presented at ICRA, April 1991

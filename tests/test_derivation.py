@@ -44,6 +44,8 @@ from pfm_stability.analysis.derivation import (
     theta,
 )
 
+pytestmark = pytest.mark.xdist_group("derivation")  # the derivation's sympy steps once per suite (tests/conftest.py)
+
 
 def same(a, b) -> bool:
     """Exact symbolic identity a ≡ b."""

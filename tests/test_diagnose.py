@@ -145,11 +145,16 @@ def test_verdicts_agree_on_random_corridors_and_walls(tmp_path):
     """4 random corridors and 4 walls away from the boundary (|margin| > 5 %; the full set of 40 is
     experiments/diagnose_agreement.py): the ``sampled`` verdict is the sign of the measured growth, ω is the
     simulator's within 5 %, L and d0 within 2 cm (the median of an oscillation about a wall's nonlinear force is not
-    quite its equilibrium: α inferred from d0 moved 2° for a 1 cm error at α = 36°)."""
+    quite its equilibrium: α inferred from d0 moved 2° for a 1 cm error at α = 36°). Only ``sampled`` is predicted
+    with (``models=("sampled",)``): the verdict checked is its own, which the other models do not change, and their
+    critical values (the report of the judged stretch) cost most of a diagnosis; every model is predicted on the
+    driven log (`test_measured_oscillation_is_the_simulators`,
+    `test_json_validates_and_answers_for_the_whole_log_and_each_stretch`)."""
     for seed in range(100, 108):
         kind = ("corridor", "wall")[seed % 2]
         path, robot, controller, geometry, margin, truth = corridor_run(seed, tmp_path, duration=20.0, kind=kind)
-        result = diagnose(read_log(path, need=("pose", "scan"), scan_reducer=wall_lines), robot, controller)
+        result = diagnose(read_log(path, need=("pose", "scan"), scan_reducer=wall_lines), robot, controller,
+                          models=("sampled",))
         s = result.judged
         assert s is not None and s.stretch.kind == kind, result.reason
         assert s.predicted["sampled"].stable == s.measured.stable == (margin > 0), (seed, margin, s.measured)
